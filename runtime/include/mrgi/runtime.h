@@ -1,0 +1,96 @@
+// The public API: create a Runtime for a capture's cameras and scene, feed it frames, get
+// composited RGBA8 frames and per-pass statistics back.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mrgi/expected.h"
+#include "mrgi/frame.h"
+#include "mrgi/scene.h"
+
+namespace mrgi {
+
+struct DeviceInfo {
+  uint32_t index = 0;
+  std::string name;
+  std::string type;         // "cpu", "integrated-gpu", "discrete-gpu", ...
+  std::string driver;       // driver name and version
+  uint32_t api_version = 0;
+  uint64_t device_local_mib = 0;
+  bool selected = false;    // what mrgi would use with the given selector
+};
+
+struct DeviceSettings {
+  // Device selector: empty = $MRGI_DEVICE, else lavapipe (llvmpipe) if present, else device 0.
+  // A number picks by index; other text picks the first device whose name contains it.
+  std::string device;
+  bool validate = false;    // Vulkan validation layers; a message becomes an error in tests
+};
+
+// Lists the Vulkan devices and marks the one `settings` would pick.
+Expected<std::vector<DeviceInfo>> list_devices(const DeviceSettings& settings);
+
+// Level "last" in the CLI resolves to technique_level_count(name) - 1.
+struct RuntimeSettings {
+  DeviceSettings device;
+  std::string technique = "baseline";  // baseline | (later) dir, dlpv, dvct, ssrt
+  int level = 0;                       // 0 = the technique's best quality
+  int output_width = 0;                // 0 = the colour camera's width
+  int output_height = 0;
+  double exposure = 1.0;               // camera exposure (capture.json), for the tone mapper
+  int frames_in_flight = 2;            // readback latency, frames (1..3)
+};
+
+struct PassTiming {
+  std::string name;
+  double gpu_ms = 0.0;
+};
+
+struct FrameStats {
+  int64_t frame_index = 0;
+  std::vector<PassTiming> passes;      // GPU time per pass that ran
+  double gpu_total_ms = 0.0;           // sum of the passes (first to last timestamp)
+  double cpu_ms = 0.0;                 // wall time of process() on the host
+  int level = 0;
+  std::vector<std::string> skipped;    // passes culled or skipped this frame, with reason
+};
+
+struct FrameOutput {
+  ImageRGBA8 image;    // composited frame, output size
+  FrameStats stats;
+  // Linear RGB buffers for error measurement, output size (only when requested in settings):
+  // not part of the shipped path.
+};
+
+class Runtime {
+ public:
+  virtual ~Runtime() = default;
+  // Processes one frame. Frames are pipelined: the output returned belongs to the frame given
+  // frames_in_flight-1 calls earlier; flush() drains the rest at the end of a stream.
+  virtual Expected<std::vector<FrameOutput>> process(const InputFrame& frame) = 0;
+  virtual Expected<std::vector<FrameOutput>> flush() = 0;
+  virtual const DeviceInfo& device() const = 0;
+  virtual double memory_mib() const = 0;      // everything allocated at start-up, MiB
+  virtual int level_count() const = 0;
+  virtual std::vector<std::string> level_names() const = 0;
+  virtual Status set_level(int level) = 0;   // the scheduler's knob; never allocates
+};
+
+struct CameraSetup {
+  Intrinsics color;
+  Intrinsics depth;
+  double depth_scale = 5000.0;
+  double exposure = 1.0;
+};
+
+Expected<std::unique_ptr<Runtime>> create_runtime(const RuntimeSettings& settings,
+                                                  const CameraSetup& cameras,
+                                                  const SceneDesc& scene);
+
+// Names of the registered techniques and their level names (best first).
+std::vector<std::string> technique_names();
+Expected<std::vector<std::string>> technique_levels(const std::string& technique);
+
+}  // namespace mrgi

@@ -1,0 +1,113 @@
+// scene.json v1 (DESIGN.md) and the glTF 2.0 content it places.
+// Units: metres, radians only where named *_rad, degrees where named *_deg; colours linear RGB.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "mrgi/expected.h"
+#include "mrgi/image.h"
+
+namespace mrgi {
+
+struct Placement {
+  glm::vec3 position{0.0f};
+  glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};  // JSON gives x y z w; stored in glm's w,x,y,z
+  glm::vec3 scale{1.0f};                      // JSON accepts a number (uniform) or [x, y, z]
+  glm::mat4 matrix() const;                   // object-to-world
+};
+
+struct VirtualObjectDesc {
+  std::string gltf;  // absolute path (resolved against the scene file's folder when loaded)
+  Placement placement;
+};
+
+enum class LightType { Point, Spot, Directional };
+struct LightDesc {
+  LightType type = LightType::Point;
+  bool real = true;                   // a real lamp (in the camera image) or a virtual one
+  glm::vec3 position{0.0f};           // world, metres (point, spot)
+  glm::vec3 direction{0.0f, -1.0f, 0.0f};  // world, unit (spot, directional: where light goes)
+  glm::vec3 color{1.0f};              // linear RGB tint, multiplied by intensity
+  float intensity = 1.0f;             // W/sr (point/spot) or W/m^2 (directional), per channel
+  float inner_angle_deg = 30.0f;      // spot: full intensity inside this half-angle
+  float outer_angle_deg = 45.0f;      // spot: zero outside this half-angle
+};
+
+struct EnvironmentDesc {
+  bool present = false;
+  bool real = true;
+  std::string image;                  // absolute path, or empty with from_env_camera
+  bool from_env_camera = false;       // use the capture's env/* stream
+  float intensity = 1.0f;
+  glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};  // environment-to-world
+};
+
+// Hints for real surfaces (the runtime estimates albedo from the camera otherwise).
+struct MaterialHint {
+  glm::vec3 base_color{0.8f};
+  float roughness = 1.0f;
+  float metallic = 0.0f;
+};
+
+struct RealGeometryDesc {
+  std::string gltf;  // absolute path
+  Placement placement;
+  bool has_material_hint = false;
+  MaterialHint material;
+};
+
+struct SceneDesc {
+  std::string path;  // the scene.json it was read from (for messages)
+  std::vector<VirtualObjectDesc> virtual_objects;
+  std::vector<LightDesc> lights;
+  EnvironmentDesc environment;
+  std::vector<RealGeometryDesc> real_geometry;
+};
+
+// Parses and validates scene.json. Unknown keys, wrong types, non-unit quaternions, NaNs,
+// negative intensities or spot angles with inner > outer are refused, naming file, key and rule.
+Expected<SceneDesc> load_scene_json(const std::string& path);
+Status write_scene_json(const std::string& path, const SceneDesc& scene);
+
+// ---- Loaded glTF content -------------------------------------------------------------------
+
+struct Material {
+  glm::vec4 base_color_factor{1.0f};
+  int base_color_texture = -1;   // index into Model::textures, -1 = none
+  float metallic = 1.0f;         // glTF defaults
+  float roughness = 1.0f;
+  float transmission = 0.0f;     // KHR_materials_transmission
+  float ior = 1.5f;              // KHR_materials_ior
+  glm::vec3 emissive{0.0f};
+  bool double_sided = false;
+};
+
+// One triangle list in world space after node transforms and the placement are applied.
+struct MeshPrimitive {
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;      // generated from faces when the file has none
+  std::vector<glm::vec2> uvs;          // empty when the file has none
+  std::vector<uint32_t> indices;       // triangle list
+  int material = -1;                   // index into Model::materials; -1 = glTF default material
+};
+
+struct Texture {
+  ImageRGBA8 image;  // sRGB-encoded base colour
+};
+
+struct Model {
+  std::vector<MeshPrimitive> primitives;
+  std::vector<Material> materials;
+  std::vector<Texture> textures;
+  glm::vec3 bounds_min{0.0f}, bounds_max{0.0f};  // world-space AABB
+};
+
+// Loads a .gltf/.glb (tinygltf), flattens the node hierarchy of the default scene and applies
+// `placement` on top. Triangles only; other primitive modes are refused with the mesh's name.
+Expected<Model> load_gltf(const std::string& path, const Placement& placement);
+
+}  // namespace mrgi
