@@ -1,0 +1,44 @@
+// Sub-commands of the `mrgi` tool register themselves, one file each (cmd_*.cpp), so adding a
+// command touches no other file. Contract for scripts and CI: exit 0 on success, 2 on bad usage,
+// 1 on bad input or failure, with a message on stderr.
+#pragma once
+#include <stdexcept>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "mrgi/expected.h"
+
+namespace mrgi::tool {
+
+// Adds one sub-command (with its options and callback) to the top-level app.
+using CommandSetup = void (*)(CLI::App& app);
+
+struct CommandRegistrar {
+  CommandRegistrar(const char* name, CommandSetup setup);
+};
+
+#define MRGI_COMMAND(name, setup) \
+  static ::mrgi::tool::CommandRegistrar mrgi_command_registrar_##name(#name, setup)
+
+// Thrown from a callback to end the command with an exit code and a message on stderr.
+struct CommandFailure : std::runtime_error {
+  int exit_code;
+  CommandFailure(int code, const std::string& message) : std::runtime_error(message), exit_code(code) {}
+};
+
+// Exit code for an error kind: BadUsage -> 2, everything else -> 1.
+int exit_code_for(ErrorKind kind);
+[[noreturn]] void fail_with(const Error& error);
+
+// Unwraps an Expected or ends the command with its error.
+template <class T>
+T take(Expected<T>&& e) {
+  if (!e.ok()) fail_with(e.error());
+  return std::move(e).value();
+}
+
+// Progress on stderr for long work (one line, rewritten in place when stderr is a terminal).
+void progress(const std::string& what, size_t done, size_t total, double elapsed_s);
+
+}  // namespace mrgi::tool

@@ -1,0 +1,58 @@
+// mrgi: the command-line tool. Sub-commands live in cmd_*.cpp and register themselves.
+#include <unistd.h>
+
+#include <cstdio>
+#include <functional>
+#include <iostream>
+#include <map>
+
+#include "commands.h"
+
+namespace mrgi::tool {
+namespace {
+std::map<std::string, CommandSetup>& registry() {
+  static std::map<std::string, CommandSetup> r;
+  return r;
+}
+}  // namespace
+
+CommandRegistrar::CommandRegistrar(const char* name, CommandSetup setup) { registry()[name] = setup; }
+
+int exit_code_for(ErrorKind kind) { return kind == ErrorKind::BadUsage ? 2 : 1; }
+
+void fail_with(const Error& error) {
+  throw CommandFailure(exit_code_for(error.kind), std::string(to_string(error.kind)) + ": " + error.message);
+}
+
+void progress(const std::string& what, size_t done, size_t total, double elapsed_s) {
+  const double eta = done > 0 ? elapsed_s / double(done) * double(total - done) : 0.0;
+  const bool tty = isatty(STDERR_FILENO);
+  std::fprintf(stderr, "%s%s: %zu/%zu (%.0f%%), %.1f s elapsed, ETA %.1f s%s", tty ? "\r" : "",
+               what.c_str(), done, total, total ? 100.0 * double(done) / double(total) : 100.0,
+               elapsed_s, eta, tty ? (done == total ? "\n" : "") : "\n");
+  std::fflush(stderr);
+}
+
+}  // namespace mrgi::tool
+
+int main(int argc, char** argv) {
+  using namespace mrgi::tool;
+  CLI::App app{"mrgi: mixed-reality global illumination runtime (Vulkan, differential rendering)"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "mrgi 0.1.0");
+  for (auto& [name, setup] : registry()) setup(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help and --version exit 0; usage errors exit 2 (the tool's contract).
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  } catch (const CommandFailure& f) {
+    std::cerr << "mrgi: " << f.what() << "\n";
+    return f.exit_code;
+  } catch (const std::exception& e) {
+    std::cerr << "mrgi: internal error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
