@@ -1,29 +1,38 @@
 // Error metrics shared by the runtime, the tests and the bench (DESIGN.md "Ground truth and
-// error"). All differences are taken in linear RGB after decoding sRGB.
+// error"). O = mrgi's output, C = the camera frame, G = the ground-truth augmented frame.
 #pragma once
+#include <cstddef>
+
 #include "mrgi/expected.h"
 #include "mrgi/image.h"
 
 namespace mrgi {
 
-// Which pixels a figure covers. Virtual pixels are those where the reference differs from the
-// camera frame because a virtual object is seen there; the mask comes from the caller (the
-// synthetic capture knows it; the runtime knows its own virtual mask).
 struct ErrorFigures {
-  double rde = 0.0;        // ||(O-C)-(G-C)|| / ||G-C||; 0 perfect, 1 = camera frame untouched
-  double rmse8 = 0.0;      // RMSE of O vs G in 8-bit sRGB units
-  double ssim = 1.0;       // mean SSIM of luma (8x8 windows... see metrics.cpp)
+  // RDE = ||(O-C)-(G-C)|| / ||G-C|| over the set's pixels, in linear RGB (sRGB decoded):
+  // 0 is perfect, 1 is no better than leaving the camera frame untouched.
+  double rde = 0.0;
+  // False when ||G-C|| is 0 over the set (nothing should change there, e.g. no virtual pixel):
+  // rde is then meaningless and reported as 0; delta_rms tells how much O changed anyway.
+  bool rde_defined = false;
+  double delta_rms = 0.0;  // RMS of (O-C)-(G-C) per channel, linear units (0..1)
+  double rmse8 = 0.0;      // RMSE of O against G in 8-bit sRGB units
+  double ssim = 1.0;       // mean SSIM of sRGB luma (Wang et al. 2004: 11x11 Gaussian, sigma 1.5)
   size_t pixels = 0;
 };
 
 struct RdeReport {
-  ErrorFigures all, real, virtual_;
+  ErrorFigures all, real, virtual_;  // virtual_: pixels where the mask is non-zero
 };
 
-// mask: nullptr = every pixel real; else 1 byte per pixel, non-zero = virtual.
-// Returns BadInput when sizes differ. When ||G-C|| is 0 over a set, rde is 0 if O==C there too
-// and +inf otherwise is avoided: reported as ||O-C|| / (1 linear unit * pixels) instead, flagged.
+// virtual_mask: nullptr = every pixel is real; else one byte per pixel, non-zero = virtual.
+// Different sizes are a BadInput error naming the sizes.
 Expected<RdeReport> measure_error(const ImageRGB8& output, const ImageRGB8& camera,
-                                  const ImageRGB8& reference, const Image<uint8_t, 1>* virtual_mask);
+                                  const ImageRGB8& reference, const ImageU8* virtual_mask);
+Expected<RdeReport> measure_error(const ImageRGBA8& output, const ImageRGB8& camera,
+                                  const ImageRGB8& reference, const ImageU8* virtual_mask);
+
+// sRGB transfer (IEC 61966-2-1), 8-bit code to linear [0,1]; a 256-entry table.
+float srgb8_to_linear(uint8_t v);
 
 }  // namespace mrgi

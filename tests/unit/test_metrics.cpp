@@ -1,0 +1,86 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "mrgi/metrics.h"
+
+using namespace mrgi;
+
+namespace {
+ImageRGB8 filled(int w, int h, uint8_t v) { return ImageRGB8(w, h, v); }
+}  // namespace
+
+TEST(Metrics, IdenticalOutputHasZeroError) {
+  ImageRGB8 c = filled(32, 16, 100), g = filled(32, 16, 100);
+  for (int x = 0; x < 8; ++x) g.at(x, 3)[1] = 30;  // a shadow in the reference
+  auto r = measure_error(g, c, g, nullptr);
+  ASSERT_TRUE(r.ok());
+  EXPECT_TRUE(r->all.rde_defined);
+  EXPECT_DOUBLE_EQ(r->all.rde, 0.0);
+  EXPECT_DOUBLE_EQ(r->all.rmse8, 0.0);
+  EXPECT_NEAR(r->all.ssim, 1.0, 1e-9);
+}
+
+TEST(Metrics, CameraOnlyOutputHasRdeOne) {
+  ImageRGB8 c = filled(32, 16, 120), g = c;
+  for (int y = 4; y < 12; ++y)
+    for (int x = 4; x < 20; ++x) g.at(x, y)[0] = g.at(x, y)[1] = g.at(x, y)[2] = 40;
+  auto r = measure_error(c, c, g, nullptr);
+  ASSERT_TRUE(r.ok());
+  EXPECT_NEAR(r->all.rde, 1.0, 1e-12);
+  EXPECT_GT(r->all.rmse8, 0.0);
+  EXPECT_LT(r->all.ssim, 1.0);
+}
+
+TEST(Metrics, KnownOffsetGivesKnownRde) {
+  // G-C = d everywhere (linear), O-C = d/2: RDE = ||d/2|| / ||d|| = 0.5 exactly in linear space.
+  ImageRGB8 c = filled(8, 8, 0), g = filled(8, 8, 255), o = filled(8, 8, 188);
+  const double half = srgb8_to_linear(188);
+  auto r = measure_error(o, c, g, nullptr);
+  ASSERT_TRUE(r.ok());
+  EXPECT_NEAR(r->all.rde, 1.0 - half, 1e-9);
+  EXPECT_NEAR(r->all.rde, 0.5, 0.01);
+  EXPECT_NEAR(r->all.rmse8, 255.0 - 188.0, 1e-9);
+}
+
+TEST(Metrics, MaskSplitsRealAndVirtualPixels) {
+  ImageRGB8 c = filled(4, 4, 50), g = c, o = c;
+  ImageU8 mask(4, 4, 0);
+  mask.at(0, 0)[0] = 255;
+  g.at(0, 0)[0] = 200;  // virtual pixel differs in the reference, output got it right
+  o.at(0, 0)[0] = 200;
+  g.at(3, 3)[2] = 10;   // a real shadow pixel the output missed
+  auto r = measure_error(o, c, g, &mask);
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r->virtual_.pixels, 1u);
+  EXPECT_EQ(r->real.pixels, 15u);
+  EXPECT_DOUBLE_EQ(r->virtual_.rde, 0.0);
+  EXPECT_NEAR(r->real.rde, 1.0, 1e-12);
+  EXPECT_GT(r->all.rde, 0.0);
+  EXPECT_LT(r->all.rde, 1.0);
+}
+
+TEST(Metrics, NothingToChangeIsReportedUndefined) {
+  ImageRGB8 c = filled(4, 4, 50), o = filled(4, 4, 60);
+  auto r = measure_error(o, c, c, nullptr);
+  ASSERT_TRUE(r.ok());
+  EXPECT_FALSE(r->all.rde_defined);
+  EXPECT_GT(r->all.delta_rms, 0.0);
+  EXPECT_FALSE(std::isnan(r->all.rde));
+}
+
+TEST(Metrics, SizeMismatchIsRefusedWithSizes) {
+  auto r = measure_error(filled(4, 4, 0), filled(4, 4, 0), filled(5, 4, 0), nullptr);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().kind, ErrorKind::BadInput);
+  EXPECT_NE(r.error().message.find("5x4"), std::string::npos);
+}
+
+TEST(Metrics, RgbaOutputMatchesRgb) {
+  ImageRGB8 c = filled(6, 6, 90), g = c;
+  g.at(2, 2)[0] = 10;
+  ImageRGBA8 o(6, 6, 90);
+  auto r = measure_error(o, c, g, nullptr);
+  ASSERT_TRUE(r.ok());
+  EXPECT_NEAR(r->all.rde, 1.0, 1e-12);
+}
