@@ -1,0 +1,160 @@
+// The Vulkan context: instance, one physical device, one graphics+compute queue, memory
+// accounting, start-up uploads and the optional validation layer whose messages are recorded.
+// Headless (no surface). Requires Vulkan 1.2 with synchronization2, dynamic rendering and
+// VK_KHR_push_descriptor (Mesa lavapipe 22.3+, current desktop and mobile drivers); a device
+// without them is refused at creation with a message naming what is missing.
+#pragma once
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "mrgi/expected.h"
+#include "mrgi/runtime.h"
+
+namespace mrgi::gpu {
+
+// Where a resource's memory lives.
+enum class MemoryUsage {
+  DeviceLocal,  // GPU only
+  Upload,       // host-visible + coherent, persistently mapped: host writes, GPU reads
+  Readback,     // host-visible (cached if available), persistently mapped: GPU writes, host reads
+};
+
+// A buffer with its own VkDeviceMemory. `mapped` is non-null for Upload/Readback.
+struct GpuBuffer {
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkDeviceSize size = 0;          // requested size in bytes
+  VkDeviceSize allocated = 0;     // bytes of device memory behind it (>= size)
+  VkBufferUsageFlags usage = 0;
+  MemoryUsage memory_usage = MemoryUsage::DeviceLocal;
+  bool coherent = true;           // false: call Context::invalidate before host reads
+  void* mapped = nullptr;
+};
+
+// A 2D image (optionally layered / mipmapped) with one view over all levels and layers.
+struct ImageCreateDesc {
+  VkFormat format = VK_FORMAT_R8G8B8A8_UNORM;
+  uint32_t width = 1, height = 1;
+  uint32_t mip_levels = 1;
+  uint32_t layers = 1;            // > 1: a 2D array view
+  VkImageUsageFlags usage = 0;
+  std::string name;               // debug name (shown by validation messages)
+};
+struct GpuImage {
+  VkImage image = VK_NULL_HANDLE;
+  VkImageView view = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkFormat format = VK_FORMAT_UNDEFINED;
+  VkExtent2D extent{0, 0};
+  uint32_t mip_levels = 1, layers = 1;
+  VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT;
+  VkImageUsageFlags usage = 0;
+  VkDeviceSize allocated = 0;
+};
+
+// Samplers every pass may use, created once.
+struct StandardSamplers {
+  VkSampler linear_clamp = VK_NULL_HANDLE;
+  VkSampler nearest_clamp = VK_NULL_HANDLE;
+  VkSampler linear_repeat = VK_NULL_HANDLE;
+  VkSampler shadow_compare = VK_NULL_HANDLE;  // linear, compare LESS_OR_EQUAL, clamp to border 1
+};
+
+class Context {
+ public:
+  // Selects the device per DeviceSettings (see runtime.h) and creates everything.
+  static Expected<std::unique_ptr<Context>> create(const DeviceSettings& settings);
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  VkInstance instance() const { return instance_; }
+  VkPhysicalDevice physical_device() const { return physical_; }
+  VkDevice device() const { return device_; }
+  VkQueue queue() const { return queue_; }
+  uint32_t queue_family() const { return queue_family_; }
+  const DeviceInfo& info() const { return info_; }
+  const VkPhysicalDeviceProperties& properties() const { return properties_; }
+  // Nanoseconds per timestamp tick (VkPhysicalDeviceLimits::timestampPeriod).
+  double timestamp_period_ns() const { return properties_.limits.timestampPeriod; }
+  // Valid bits of the queue's timestamps (0: the queue has none; timings are then refused).
+  uint32_t timestamp_valid_bits() const { return timestamp_valid_bits_; }
+  const StandardSamplers& samplers() const { return samplers_; }
+  // vkCmdPushDescriptorSetKHR, fetched at creation.
+  PFN_vkCmdPushDescriptorSetKHR cmd_push_descriptor_set() const { return push_descriptor_set_; }
+
+  // Validation (DeviceSettings::validate): every warning and error message, in order.
+  bool validation_enabled() const { return validate_; }
+  size_t validation_message_count() const;
+  std::vector<std::string> validation_messages() const;
+  void clear_validation_messages();
+
+  // Resources. Each has its own allocation; all are meant to be made at start-up. The counters
+  // below are exact (sum of VkMemoryRequirements sizes of live allocations).
+  Expected<GpuBuffer> create_buffer(VkDeviceSize size, VkBufferUsageFlags usage,
+                                    MemoryUsage memory, const std::string& name);
+  Expected<GpuImage> create_image(const ImageCreateDesc& desc);
+  void destroy(GpuBuffer& buffer);
+  void destroy(GpuImage& image);
+  uint64_t allocated_bytes() const { return allocated_bytes_; }
+  double memory_mib() const { return double(allocated_bytes_) / (1024.0 * 1024.0); }
+  uint64_t allocation_count() const { return allocation_count_; }
+  // Makes GPU writes visible to the host for non-coherent Readback memory (no-op if coherent).
+  Status invalidate(const GpuBuffer& buffer);
+
+  // Start-up helpers: record into a one-shot command buffer, submit and wait. Not for frames.
+  Status submit_and_wait(const std::function<void(VkCommandBuffer)>& record);
+  // Copies bytes into a device-local buffer through a temporary staging buffer.
+  Status upload_buffer(const GpuBuffer& dst, const void* data, VkDeviceSize size,
+                       VkDeviceSize dst_offset = 0);
+  // Uploads tightly packed texels into mip 0 / layer 0 and leaves the image in `final_layout`.
+  Status upload_image(const GpuImage& dst, const void* texels, VkDeviceSize size,
+                      VkImageLayout final_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+
+  // Debug names through VK_EXT_debug_utils when validation is on (no-op otherwise).
+  void set_name(VkObjectType type, uint64_t handle, const std::string& name) const;
+
+  // Internal: called by the debug messenger.
+  void record_validation_message(std::string message);
+
+ private:
+  Context() = default;
+  Status init(const DeviceSettings& settings);
+  Expected<VkDeviceMemory> allocate(const VkMemoryRequirements& req, MemoryUsage usage,
+                                    bool* coherent);
+
+  VkInstance instance_ = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_ = VK_NULL_HANDLE;
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  uint32_t queue_family_ = 0;
+  uint32_t timestamp_valid_bits_ = 0;
+  VkCommandPool upload_pool_ = VK_NULL_HANDLE;
+  VkPhysicalDeviceProperties properties_{};
+  VkPhysicalDeviceMemoryProperties memory_properties_{};
+  DeviceInfo info_;
+  StandardSamplers samplers_;
+  PFN_vkCmdPushDescriptorSetKHR push_descriptor_set_ = nullptr;
+  PFN_vkSetDebugUtilsObjectNameEXT set_object_name_ = nullptr;
+  bool validate_ = false;
+  uint64_t allocated_bytes_ = 0;
+  uint64_t allocation_count_ = 0;
+  mutable std::mutex messages_mutex_;
+  std::vector<std::string> messages_;
+};
+
+// Image aspect for a format (depth formats -> DEPTH, else COLOR).
+VkImageAspectFlags aspect_of(VkFormat format);
+bool is_depth_format(VkFormat format);
+// Bytes per texel of the uncompressed formats mrgi uses (0 for others).
+uint32_t bytes_per_texel(VkFormat format);
+
+}  // namespace mrgi::gpu

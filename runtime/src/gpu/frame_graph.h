@@ -1,0 +1,321 @@
+// The frame graph: every GPU resource is declared and allocated once at start-up (sized for the
+// largest quality level); each frame, passes are added with their declared reads and writes,
+// compile() culls passes whose results nobody uses and derives every barrier and layout change
+// from the declarations, and execute() records the passes with a timestamp pair each.
+// Modelled on Filament's FrameGraph (reference-counted culling) and Granite's render graph.
+//
+// Frame loop (N = frames_in_flight slots, each with its own command buffer, fence, queries):
+//   auto done = graph.begin_frame();   // waits only for the frame that used this slot N frames ago
+//   graph.add_pass("shade", PassKind::Compute, [&](PassBuilder& b) { b.read(a, Access::Sampled);
+//                  b.write(c, Access::StorageWrite); }, [&](VkCommandBuffer cmd, PassContext& p) {...});
+//   graph.mark_output(readback);
+//   graph.compile(); graph.submit();   // (or execute(cmd) into a command buffer of your own)
+// `done` holds the per-pass GPU times of the frame that last used the slot; its Readback buffers
+// (ring copies of that slot) may be read until submit().
+#pragma once
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "gpu/context.h"
+#include "mrgi/expected.h"
+#include "mrgi/runtime.h"
+
+namespace mrgi::gpu {
+
+struct ImageHandle {
+  uint32_t id = UINT32_MAX;
+  bool valid() const { return id != UINT32_MAX; }
+  bool operator==(const ImageHandle&) const = default;
+};
+struct BufferHandle {
+  uint32_t id = UINT32_MAX;
+  bool valid() const { return id != UINT32_MAX; }
+  bool operator==(const BufferHandle&) const = default;
+};
+
+enum class SizeMode {
+  Absolute,        // width x height texels
+  OutputRelative,  // scale x the output size; the used extent follows set_output_size/render_scale
+};
+
+struct ImageDesc {
+  std::string name;
+  VkFormat format = VK_FORMAT_R8G8B8A8_UNORM;
+  SizeMode size_mode = SizeMode::OutputRelative;
+  uint32_t width = 0, height = 0;  // Absolute only
+  float scale = 1.0f;              // OutputRelative only: fraction of the output size (0, 4]
+  // OutputRelative only: also scaled by the per-frame render scale (internal resolution knob).
+  bool follows_render_scale = true;
+  uint32_t mip_levels = 1;
+  uint32_t layers = 1;
+  // Persistent: contents survive across frames (temporal history). The last write of a frame is
+  // always kept (never culled) and its first read in a frame sees the previous frame's contents.
+  bool history = false;
+  VkImageUsageFlags extra_usage = 0;  // usage beyond what the declared accesses imply
+};
+
+struct BufferDesc {
+  std::string name;
+  VkDeviceSize size = 0;  // bytes
+  MemoryUsage memory = MemoryUsage::DeviceLocal;
+  // One copy per frame slot (the handle resolves to the current slot's copy). Needed for Upload
+  // buffers the host fills every frame and Readback buffers read frames later.
+  bool per_frame_copies = false;
+  bool history = false;   // as ImageDesc::history
+  VkBufferUsageFlags extra_usage = 0;
+};
+
+// How a pass touches a resource. Stages come from this and the pass kind.
+enum class Access : uint8_t {
+  Sampled,                  // texture fetch through a sampler (image)
+  StorageRead,              // imageLoad / SSBO read
+  StorageWrite,             // imageStore / SSBO write, previous contents not needed
+  StorageReadWrite,         // read-modify-write (atomics, in-place filters)
+  ColorAttachmentWrite,     // render target, cleared or overwritten
+  ColorAttachmentReadWrite, // render target with blending or load
+  DepthAttachmentWrite,     // depth test and write
+  DepthAttachmentRead,      // depth test without write
+  TransferSrc,
+  TransferDst,
+  VertexBuffer,
+  IndexBuffer,
+  UniformRead,
+  IndirectRead,
+};
+bool is_write(Access access);
+bool is_read(Access access);
+const char* to_string(Access access);
+
+enum class PassKind : uint8_t { Compute, Graphics, Transfer };
+const char* to_string(PassKind kind);
+
+// --- The pure compile step (no Vulkan calls: tests inspect it without a GPU) ------------------
+
+struct ResourceRef {
+  bool is_image = true;
+  uint32_t id = 0;
+  bool operator==(const ResourceRef&) const = default;
+};
+
+struct ResourceUse {
+  ResourceRef resource;
+  Access access = Access::Sampled;
+};
+
+struct PassDecl {
+  std::string name;
+  PassKind kind = PassKind::Compute;
+  std::vector<ResourceUse> uses;
+  bool side_effect = false;  // never culled (e.g. writes something outside the graph)
+};
+
+// What the GPU last did to a resource, carried from frame to frame.
+struct ResourceState {
+  VkPipelineStageFlags2 write_stages = 0;  // stages of the last write not yet waited on
+  VkAccessFlags2 write_access = 0;
+  VkPipelineStageFlags2 read_stages = 0;   // reads since that write (a write must wait on them)
+  VkAccessFlags2 visible_access = 0;       // accesses the last write was already made visible to
+  VkPipelineStageFlags2 visible_stages = 0;
+  VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
+};
+
+struct ResourceInfo {
+  std::string name;
+  bool is_image = true;
+  bool is_output = false;     // marked output or history: its final writer is kept
+  bool history = false;       // contents must be preserved across frames (no discard on write)
+  bool host_read = false;     // a Readback buffer: the frame ends with a barrier to HOST_READ
+  ResourceState initial;      // state at the start of the frame
+};
+
+struct Barrier {
+  ResourceRef resource;
+  std::string resource_name;
+  VkPipelineStageFlags2 src_stages = 0;
+  VkAccessFlags2 src_access = 0;
+  VkImageLayout old_layout = VK_IMAGE_LAYOUT_UNDEFINED;  // images only
+  VkPipelineStageFlags2 dst_stages = 0;
+  VkAccessFlags2 dst_access = 0;
+  VkImageLayout new_layout = VK_IMAGE_LAYOUT_UNDEFINED;
+};
+
+struct CompiledPass {
+  uint32_t pass_index = 0;          // index into the declared pass list
+  std::string name;
+  std::vector<Barrier> barriers;    // recorded before the pass
+};
+
+struct CompiledGraph {
+  std::vector<CompiledPass> passes;       // the passes that run, in declaration order
+  std::vector<std::string> culled;        // names of the passes culled
+  std::vector<Barrier> final_barriers;    // after the last pass (host reads of readback buffers)
+  std::vector<ResourceState> final_states;  // per resource, the state at the end of the frame
+  // Barriers naming this resource (by name), in order; for tests.
+  std::vector<Barrier> barriers_for(const std::string& resource_name) const;
+  bool runs(const std::string& pass_name) const;
+};
+
+// Culls and derives barriers. Errors (BadUsage) name the pass and resource: a resource used twice
+// by one pass, an image access on a buffer or the reverse, an unknown resource id.
+Expected<CompiledGraph> compile_graph(const std::vector<PassDecl>& passes,
+                                      const std::vector<ResourceInfo>& resources);
+
+// Stage/access/layout one use implies (what the barrier derivation uses).
+struct AccessInfo {
+  VkPipelineStageFlags2 stages = 0;
+  VkAccessFlags2 access = 0;
+  VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
+};
+AccessInfo access_info(PassKind kind, Access access, bool is_image, bool depth_format);
+
+// --- The runtime graph --------------------------------------------------------------------------
+
+class FrameGraph;
+
+class PassBuilder {
+ public:
+  void read(ImageHandle image, Access access = Access::Sampled);
+  void write(ImageHandle image, Access access = Access::StorageWrite);
+  void read(BufferHandle buffer, Access access = Access::StorageRead);
+  void write(BufferHandle buffer, Access access = Access::StorageWrite);
+  void side_effect();  // keep this pass even if nothing reads what it writes
+
+ private:
+  friend class FrameGraph;
+  explicit PassBuilder(PassDecl& decl) : decl_(decl) {}
+  PassDecl& decl_;
+};
+
+// Given to a pass's execute callback.
+class PassContext {
+ public:
+  VkImage image(ImageHandle h) const;
+  VkImageView view(ImageHandle h) const;
+  VkFormat format(ImageHandle h) const;
+  VkExtent2D extent(ImageHandle h) const;   // the used extent this frame (<= allocated)
+  VkBuffer buffer(BufferHandle h) const;    // the current slot's copy
+  VkDeviceSize buffer_size(BufferHandle h) const;
+  void* mapped(BufferHandle h) const;       // current slot's mapping (Upload/Readback)
+  VkExtent2D output_size() const;
+  float render_scale() const;
+  int64_t frame_index() const;
+  uint32_t slot() const;
+  const Context& context() const;
+
+ private:
+  friend class FrameGraph;
+  explicit PassContext(const FrameGraph& g) : graph_(g) {}
+  const FrameGraph& graph_;
+};
+
+struct FrameGraphSettings {
+  uint32_t max_output_width = 640;   // pixels: OutputRelative images are allocated for this
+  uint32_t max_output_height = 480;
+  float max_render_scale = 1.0f;     // (0, 1]; OutputRelative images also x this at most
+  uint32_t frames_in_flight = 2;     // 1..3
+  uint32_t max_passes = 64;          // timestamp queries per slot = 2 x this
+};
+
+// Per-pass GPU times of one completed frame.
+struct FrameTimings {
+  int64_t frame_index = -1;
+  uint32_t slot = 0;
+  std::vector<PassTiming> passes;    // passes that ran, in order, milliseconds
+  double total_ms = 0.0;             // first pass start to last pass end
+  std::vector<std::string> culled;
+};
+
+class FrameGraph {
+ public:
+  static Expected<std::unique_ptr<FrameGraph>> create(Context& context,
+                                                      const FrameGraphSettings& settings);
+  ~FrameGraph();
+  FrameGraph(const FrameGraph&) = delete;
+  FrameGraph& operator=(const FrameGraph&) = delete;
+
+  // Start-up: resources are allocated here, at once. Usage flags are given by `usage` (what the
+  // passes will declare); errors name the resource and the rule.
+  Expected<ImageHandle> create_image(const ImageDesc& desc, VkImageUsageFlags usage);
+  Expected<BufferHandle> create_buffer(const BufferDesc& desc, VkBufferUsageFlags usage);
+  // External resources (owned by the caller, which keeps them alive). `layout` is their current
+  // layout; the graph tracks it from then on.
+  ImageHandle import_image(const std::string& name, const GpuImage& image,
+                           VkImageLayout layout, bool history = true);
+  BufferHandle import_buffer(const std::string& name, const GpuBuffer& buffer,
+                             bool history = true);
+  // Fills an image with texels at start-up (staging copy, waits), leaving it SHADER_READ_ONLY.
+  Status upload_image(ImageHandle image, const void* texels, VkDeviceSize size);
+
+  // Per-frame size knobs: the used extent of OutputRelative images. Never reallocates; values
+  // beyond what was allocated for are BadUsage.
+  Status set_output_size(uint32_t width, uint32_t height);
+  Status set_render_scale(float scale);
+  VkExtent2D output_size() const { return output_size_; }
+  float render_scale() const { return render_scale_; }
+  VkExtent2D extent(ImageHandle image) const;  // used extent now
+  VkExtent2D allocated_extent(ImageHandle image) const;
+  const GpuImage& gpu_image(ImageHandle image) const;
+  const GpuBuffer& gpu_buffer(BufferHandle buffer, uint32_t slot) const;
+  const std::string& name(ImageHandle image) const;
+  const std::string& name(BufferHandle buffer) const;
+
+  // Frame loop.
+  // Waits for the slot's previous frame (if any), reads its timestamps, resets the slot, clears
+  // the pass list. Returns that previous frame's timings, or nullopt when the slot was unused.
+  Expected<std::optional<FrameTimings>> begin_frame();
+  using SetupFn = std::function<void(PassBuilder&)>;
+  using ExecuteFn = std::function<void(VkCommandBuffer, PassContext&)>;
+  void add_pass(const std::string& name, PassKind kind, const SetupFn& setup, ExecuteFn execute);
+  void mark_output(ImageHandle image);
+  void mark_output(BufferHandle buffer);
+  Status compile();
+  const CompiledGraph& compiled() const { return compiled_; }
+  // Records barriers, passes and timestamps into `cmd` (begun by the caller).
+  Status execute(VkCommandBuffer cmd);
+  // Begins the slot's command buffer, execute()s, ends and submits it with the slot's fence.
+  Status submit();
+  // Waits for every frame in flight; returns their timings oldest first.
+  Expected<std::vector<FrameTimings>> flush();
+
+  int64_t frame_index() const { return frame_index_; }   // of the frame being built
+  uint32_t slot() const { return slot_; }
+  uint32_t frames_in_flight() const { return settings_.frames_in_flight; }
+  // Host pointer of a Readback/Upload buffer's copy in `slot` (e.g. FrameTimings::slot).
+  void* mapped(BufferHandle buffer, uint32_t slot) const;
+  Context& context() const { return context_; }
+
+ private:
+  friend class PassContext;
+  struct ImageEntry;
+  struct BufferEntry;
+  struct Slot;
+  struct PassEntry;
+  FrameGraph(Context& context, const FrameGraphSettings& settings);
+  Status init();
+  Expected<std::optional<FrameTimings>> collect(uint32_t slot_index);
+  std::vector<ResourceInfo> resource_infos() const;
+
+  Context& context_;
+  FrameGraphSettings settings_;
+  std::vector<ImageEntry> images_;
+  std::vector<BufferEntry> buffers_;
+  std::vector<Slot> slots_;
+  std::vector<PassDecl> decls_;
+  std::vector<ExecuteFn> executes_;
+  std::vector<ResourceRef> outputs_;
+  CompiledGraph compiled_;
+  bool compiled_valid_ = false;
+  VkCommandPool pool_ = VK_NULL_HANDLE;
+  VkExtent2D output_size_{0, 0};
+  float render_scale_ = 1.0f;
+  int64_t frame_index_ = -1;
+  uint32_t slot_ = 0;
+  bool in_frame_ = false;
+};
+
+}  // namespace mrgi::gpu

@@ -1,0 +1,123 @@
+// Pipelines from embedded SPIR-V. Descriptors are push descriptors (VK_KHR_push_descriptor):
+// set 0 of every pipeline is a push-descriptor set, so nothing is allocated per frame and no
+// pool is needed. Push constants are visible to all the pipeline's stages.
+#pragma once
+#include <vulkan/vulkan.h>
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "gpu/context.h"
+#include "mrgi/expected.h"
+
+namespace mrgi::gpu {
+
+// Binding i of set 0 (index in the vector = binding number).
+struct DescriptorBinding {
+  VkDescriptorType type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+  uint32_t count = 1;
+};
+
+struct ComputePipelineDesc {
+  std::string name;                    // for errors and debug names
+  std::span<const uint32_t> spirv;     // entry point "main"
+  std::vector<DescriptorBinding> bindings;
+  uint32_t push_constant_bytes = 0;    // <= 128 (the guaranteed minimum)
+};
+
+struct VertexAttribute {
+  uint32_t location = 0;
+  uint32_t binding = 0;
+  VkFormat format = VK_FORMAT_R32G32B32_SFLOAT;
+  uint32_t offset = 0;                 // bytes
+};
+
+struct GraphicsPipelineDesc {
+  std::string name;
+  std::span<const uint32_t> vertex_spirv;
+  std::span<const uint32_t> fragment_spirv;  // empty: depth-only (shadow maps)
+  std::vector<DescriptorBinding> bindings;
+  uint32_t push_constant_bytes = 0;
+  std::vector<uint32_t> vertex_strides;      // bytes, one per vertex binding (per-vertex rate)
+  std::vector<VertexAttribute> attributes;
+  VkPrimitiveTopology topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+  std::vector<VkFormat> color_formats;       // dynamic rendering attachments
+  VkFormat depth_format = VK_FORMAT_UNDEFINED;
+  bool depth_test = true;
+  bool depth_write = true;
+  VkCompareOp depth_compare = VK_COMPARE_OP_LESS_OR_EQUAL;
+  VkCullModeFlags cull_mode = VK_CULL_MODE_BACK_BIT;
+  VkFrontFace front_face = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+  // Depth bias for shadow maps (0 = off): constant in depth units, slope in units per slope.
+  float depth_bias_constant = 0.0f;
+  float depth_bias_slope = 0.0f;
+  bool additive_blend = false;               // colour = src + dst on every attachment
+};
+
+// Viewport and scissor are dynamic state (set per pass from the used extent).
+struct Pipeline {
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+  VkPipelineBindPoint bind_point = VK_PIPELINE_BIND_POINT_COMPUTE;
+  VkShaderStageFlags stages = 0;
+  uint32_t push_constant_bytes = 0;
+  std::vector<DescriptorBinding> bindings;
+};
+
+Expected<Pipeline> create_compute_pipeline(const Context& ctx, const ComputePipelineDesc& desc);
+Expected<Pipeline> create_graphics_pipeline(const Context& ctx, const GraphicsPipelineDesc& desc);
+void destroy_pipeline(const Context& ctx, Pipeline& pipeline);
+
+// Owns a pipeline and destroys it with the context's device.
+class PipelineHandle {
+ public:
+  PipelineHandle() = default;
+  PipelineHandle(const Context& ctx, Pipeline p) : ctx_(&ctx), p_(std::move(p)) {}
+  ~PipelineHandle() { reset(); }
+  PipelineHandle(PipelineHandle&& o) noexcept : ctx_(o.ctx_), p_(std::move(o.p_)) { o.p_ = {}; }
+  PipelineHandle& operator=(PipelineHandle&& o) noexcept;
+  PipelineHandle(const PipelineHandle&) = delete;
+  PipelineHandle& operator=(const PipelineHandle&) = delete;
+  const Pipeline& operator*() const { return p_; }
+  const Pipeline* operator->() const { return &p_; }
+  void reset();
+
+ private:
+  const Context* ctx_ = nullptr;
+  Pipeline p_;
+};
+
+// Collects up to 16 descriptor writes on the stack and pushes them (no heap, no pool).
+// Images: storage images are in GENERAL, sampled ones in SHADER_READ_ONLY_OPTIMAL (what the frame
+// graph transitions them to).
+class DescriptorPush {
+ public:
+  static constexpr uint32_t kMaxWrites = 16;
+  DescriptorPush& storage_image(uint32_t binding, VkImageView view);
+  DescriptorPush& sampled_image(uint32_t binding, VkImageView view, VkSampler sampler);
+  DescriptorPush& storage_buffer(uint32_t binding, VkBuffer buffer, VkDeviceSize offset = 0,
+                                 VkDeviceSize range = VK_WHOLE_SIZE);
+  DescriptorPush& uniform_buffer(uint32_t binding, VkBuffer buffer, VkDeviceSize offset = 0,
+                                 VkDeviceSize range = VK_WHOLE_SIZE);
+  // Binds nothing else: call after vkCmdBindPipeline.
+  void push(const Context& ctx, VkCommandBuffer cmd, const Pipeline& pipeline);
+
+ private:
+  std::array<VkWriteDescriptorSet, kMaxWrites> writes_{};
+  std::array<VkDescriptorImageInfo, kMaxWrites> images_{};
+  std::array<VkDescriptorBufferInfo, kMaxWrites> buffers_{};
+  uint32_t count_ = 0;
+  bool overflow_ = false;
+};
+
+// Binds `pipeline`, pushes constants (`bytes` must equal the pipeline's push_constant_bytes)
+// and dispatches ceil(width/local_x) x ceil(height/local_y) groups.
+void dispatch_2d(VkCommandBuffer cmd, const Pipeline& pipeline, const void* push_constants,
+                 uint32_t bytes, uint32_t width, uint32_t height, uint32_t local_x = 8,
+                 uint32_t local_y = 8);
+
+}  // namespace mrgi::gpu
