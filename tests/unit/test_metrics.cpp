@@ -84,3 +84,15 @@ TEST(Metrics, RgbaOutputMatchesRgb) {
   ASSERT_TRUE(r.ok());
   EXPECT_NEAR(r->all.rde, 1.0, 1e-12);
 }
+
+TEST(Metrics, PoolingTwoFramesEqualsOneBigFrame) {
+  ImageRGB8 c = filled(4, 2, 50), g1 = c, g2 = c, o = c;
+  g1.at(0, 0)[0] = 200;
+  g2.at(1, 1)[1] = 0;
+  auto r1 = measure_error(o, c, g1, nullptr), r2 = measure_error(o, c, g2, nullptr);
+  ASSERT_TRUE(r1.ok() && r2.ok());
+  const ErrorFigures p = pool(r1->all, r2->all);
+  EXPECT_EQ(p.pixels, 16u);
+  EXPECT_NEAR(p.rde, 1.0, 1e-12);  // camera-only output on both frames
+  EXPECT_NEAR(p.rmse8 * p.rmse8 * 16 * 3, r1->all.rmse8 * r1->all.rmse8 * 8 * 3 + r2->all.rmse8 * r2->all.rmse8 * 8 * 3, 1e-6);
+}

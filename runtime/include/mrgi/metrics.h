@@ -19,6 +19,9 @@ struct ErrorFigures {
   double rmse8 = 0.0;      // RMSE of O against G in 8-bit sRGB units
   double ssim = 1.0;       // mean SSIM of sRGB luma (Wang et al. 2004: 11x11 Gaussian, sigma 1.5)
   size_t pixels = 0;
+  // Sums behind rde, so figures over many frames pool as sqrt(sum err2 / sum ref2).
+  double err2 = 0.0;       // sum over the set of |O-G|^2 (linear RGB)
+  double ref2 = 0.0;       // sum over the set of |G-C|^2
 };
 
 struct RdeReport {
@@ -31,6 +34,9 @@ Expected<RdeReport> measure_error(const ImageRGB8& output, const ImageRGB8& came
                                   const ImageRGB8& reference, const ImageU8* virtual_mask);
 Expected<RdeReport> measure_error(const ImageRGBA8& output, const ImageRGB8& camera,
                                   const ImageRGB8& reference, const ImageU8* virtual_mask);
+
+// Pools figures of several frames (pixel-weighted means for rmse8/ssim, sums for rde).
+ErrorFigures pool(const ErrorFigures& a, const ErrorFigures& b);
 
 // sRGB transfer (IEC 61966-2-1), 8-bit code to linear [0,1]; a 256-entry table.
 float srgb8_to_linear(uint8_t v);

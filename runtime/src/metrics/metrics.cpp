@@ -79,6 +79,8 @@ struct Accumulator {
   ErrorFigures finish() const {
     ErrorFigures f;
     f.pixels = pixels;
+    f.err2 = err2;
+    f.ref2 = ref2;
     if (pixels == 0) return f;
     // ||G-C|| below one 8-bit step's worth over the set counts as "nothing to change".
     const double floor = 1e-12;
@@ -128,6 +130,16 @@ Expected<RdeReport> measure(const Image<uint8_t, CO>& o, const ImageRGB8& c, con
 }  // namespace
 
 float srgb8_to_linear(uint8_t v) { return srgb_table()[v]; }
+
+ErrorFigures pool(const ErrorFigures& a, const ErrorFigures& b) {
+  Accumulator acc;
+  acc.pixels = a.pixels + b.pixels;
+  acc.err2 = a.err2 + b.err2;
+  acc.ref2 = a.ref2 + b.ref2;
+  acc.rmse2 = (a.rmse8 * a.rmse8 * double(a.pixels) + b.rmse8 * b.rmse8 * double(b.pixels)) * 3.0;
+  acc.ssim = a.ssim * double(a.pixels) + b.ssim * double(b.pixels);
+  return acc.finish();
+}
 
 Expected<RdeReport> measure_error(const ImageRGB8& output, const ImageRGB8& camera,
                                   const ImageRGB8& reference, const ImageU8* virtual_mask) {

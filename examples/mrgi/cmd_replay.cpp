@@ -1,0 +1,119 @@
+// mrgi replay CAPTURE --technique NAME --out DIR [--level N|last] [--frames N] [--width W --height H]
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+
+#include "commands.h"
+#include "mrgi/platform/capture.h"
+#include "mrgi/runtime.h"
+#include "replay_output.h"
+
+namespace mrgi::tool {
+namespace {
+
+struct ReplayOptions {
+  std::string capture, technique = "baseline", out, level = "0", device;
+  int frames = 0, width = 0, height = 0;
+  bool validate = false, quiet = false;
+};
+
+// "last" = the technique's cheapest level; a number must name an existing level.
+int resolve_level(const std::string& technique, const std::string& level) {
+  auto levels = take(technique_levels(technique));
+  if (level == "last") return int(levels.size()) - 1;
+  char* end = nullptr;
+  const long n = std::strtol(level.c_str(), &end, 10);
+  if (level.empty() || *end != '\0' || n < 0 || n >= long(levels.size())) {
+    std::string names;
+    for (size_t i = 0; i < levels.size(); ++i) names += (i ? ", " : "") + std::to_string(i) + "=" + levels[i];
+    throw CommandFailure(2, "--level '" + level + "': technique '" + technique + "' has levels " + names + " (or 'last')");
+  }
+  return int(n);
+}
+
+void run_replay(const ReplayOptions& o) {
+  if ((o.width == 0) != (o.height == 0)) throw CommandFailure(2, "--width and --height go together");
+  const int level = resolve_level(o.technique, o.level);
+  CaptureReader capture = take(CaptureReader::open(o.capture));
+  const CaptureInfo& info = capture.info();
+  const size_t frames = o.frames > 0 ? std::min<size_t>(size_t(o.frames), capture.frame_count()) : capture.frame_count();
+  if (frames == 0) throw CommandFailure(1, o.capture + ": capture has no frames");
+
+  RuntimeSettings settings;
+  settings.device.device = o.device;
+  settings.device.validate = o.validate;
+  settings.technique = o.technique;
+  settings.level = level;
+  settings.output_width = o.width;
+  settings.output_height = o.height;
+  settings.exposure = info.exposure;
+  CameraSetup cameras{info.color, info.depth, info.depth_scale, info.exposure};
+  const SceneDesc scene = capture.scene() ? *capture.scene() : SceneDesc{};
+  auto runtime = take(create_runtime(settings, cameras, scene));
+
+  const int out_w = o.width ? o.width : info.color.width, out_h = o.height ? o.height : info.color.height;
+  ReplayMeta meta{o.capture, o.technique, level, runtime->level_names()[level], runtime->device().name,
+                  runtime->memory_mib(), out_w, out_h};
+  ReplayOutput output = take(ReplayOutput::create(o.out, meta));
+
+  // Outputs come back frames_in_flight-1 calls late; keep each input's camera frame until then.
+  std::vector<ImageRGB8> cameras_by_frame(frames);
+  size_t written = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  auto consume = [&](std::vector<FrameOutput>&& outs) {
+    for (FrameOutput& f : outs) {
+      const size_t i = size_t(f.stats.frame_index);
+      std::optional<ImageRGB8> ref;
+      std::optional<ImageU8> mask;
+      if (!capture.entry(i).reference.empty()) {
+        ref = resize_rgb8(take(capture.read_reference(i)), out_w, out_h);
+        if (!capture.entry(i).reference_mask.empty())
+          mask = resize_mask_nearest(take(capture.read_reference_mask(i)), out_w, out_h);
+      }
+      auto st = output.add(f, cameras_by_frame[i], ref ? &*ref : nullptr, mask ? &*mask : nullptr);
+      if (!st.ok()) fail_with(st.error());
+      cameras_by_frame[i] = ImageRGB8{};
+      ++written;
+      if (!o.quiet)
+        progress("replay " + o.technique, written, frames,
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    }
+  };
+  for (size_t i = 0; i < frames; ++i) {
+    InputFrame frame = take(capture.read_frame(i));
+    frame.index = int64_t(i);
+    cameras_by_frame[i] = resize_rgb8(frame.color, out_w, out_h);
+    consume(take(runtime->process(frame)));
+  }
+  consume(take(runtime->flush()));
+  if (written != frames)
+    throw CommandFailure(1, "internal: " + std::to_string(written) + " of " + std::to_string(frames) + " frames came back");
+  nlohmann::json summary = take(output.finish());
+  std::cout << summary.dump(2) << "\n";
+}
+
+void setup(CLI::App& app) {
+  auto opts = std::make_shared<ReplayOptions>();
+  CLI::App* cmd = app.add_subcommand("replay", "Replay a capture (format v1) through a technique and write frames, stats and a summary");
+  cmd->add_option("capture", opts->capture, "capture folder (capture format v1, TUM RGB-D compatible)")->required();
+  cmd->add_option("--technique,-t", opts->technique, "technique: " + [] {
+    std::string s;
+    for (auto& n : technique_names()) s += (s.empty() ? "" : ", ") + n;
+    return s;
+  }())->capture_default_str();
+  cmd->add_option("--out,-o", opts->out, "output folder (frames/, stats.json, summary.json, side_by_side.png)")->required();
+  cmd->add_option("--level,-l", opts->level, "quality level: 0 = best, N, or 'last' = cheapest")->capture_default_str();
+  cmd->add_option("--frames,-n", opts->frames, "replay at most N frames (0 = all)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--width", opts->width, "output width in pixels (default: the colour camera's)")->check(CLI::Range(16, 8192));
+  cmd->add_option("--height", opts->height, "output height in pixels")->check(CLI::Range(16, 8192));
+  cmd->add_option("--device", opts->device, "Vulkan device: index or name part (default $MRGI_DEVICE, else lavapipe)");
+  cmd->add_flag("--validate", opts->validate, "enable Vulkan validation layers");
+  cmd->add_flag("--quiet,-q", opts->quiet, "no progress on stderr");
+  cmd->callback([opts] { run_replay(*opts); });
+}
+
+}  // namespace
+
+MRGI_COMMAND(replay, setup);
+
+}  // namespace mrgi::tool

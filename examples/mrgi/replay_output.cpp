@@ -1,0 +1,185 @@
+#include "replay_output.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+namespace fs = std::filesystem;
+
+namespace mrgi::tool {
+namespace {
+
+Status write_json(const std::string& path, const nlohmann::json& j) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp);
+    if (!f) return fail(ErrorKind::Device, tmp + ": cannot open for writing");
+    f << j.dump(2) << "\n";
+    if (!f) return fail(ErrorKind::Device, tmp + ": write failed");
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) return fail(ErrorKind::Device, path + ": rename failed: " + ec.message());
+  return ok_status();
+}
+
+std::string frame_name(size_t i) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%06zu.png", i);
+  return buf;
+}
+
+int lp_num_threads() {
+  const char* v = std::getenv("LP_NUM_THREADS");
+  return v ? std::atoi(v) : 0;  // 0 = not set (lavapipe then uses one thread per core)
+}
+
+}  // namespace
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const size_t rank = size_t(std::ceil(p / 100.0 * double(v.size())));
+  return v[std::clamp<size_t>(rank, 1, v.size()) - 1];
+}
+
+nlohmann::json figures_json(const ErrorFigures& f) {
+  nlohmann::json j;
+  j["rde"] = f.rde_defined ? nlohmann::json(f.rde) : nlohmann::json(nullptr);
+  j["delta_rms"] = f.delta_rms;
+  j["rmse8"] = f.rmse8;
+  j["ssim"] = f.ssim;
+  j["pixels"] = f.pixels;
+  return j;
+}
+
+ImageRGB8 resize_rgb8(const ImageRGB8& src, int w, int h) {
+  if (src.width == w && src.height == h) return src;
+  ImageRGB8 out(w, h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const double sx = std::clamp((x + 0.5) * src.width / w - 0.5, 0.0, src.width - 1.0);
+      const double sy = std::clamp((y + 0.5) * src.height / h - 0.5, 0.0, src.height - 1.0);
+      const int x0 = int(sx), y0 = int(sy);
+      const int x1 = std::min(x0 + 1, src.width - 1), y1 = std::min(y0 + 1, src.height - 1);
+      const double fx = sx - x0, fy = sy - y0;
+      for (int c = 0; c < 3; ++c) {
+        const double v = (1 - fy) * ((1 - fx) * src.at(x0, y0)[c] + fx * src.at(x1, y0)[c]) +
+                         fy * ((1 - fx) * src.at(x0, y1)[c] + fx * src.at(x1, y1)[c]);
+        out.at(x, y)[c] = uint8_t(std::lround(v));
+      }
+    }
+  return out;
+}
+
+ImageU8 resize_mask_nearest(const ImageU8& src, int w, int h) {
+  if (src.width == w && src.height == h) return src;
+  ImageU8 out(w, h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      out.at(x, y)[0] = *src.at(std::min(src.width - 1, x * src.width / w), std::min(src.height - 1, y * src.height / h));
+  return out;
+}
+
+Expected<ReplayOutput> ReplayOutput::create(const std::string& dir, const ReplayMeta& meta) {
+  ReplayOutput out;
+  out.dir_ = fs::absolute(dir).lexically_normal().string();
+  if (!out.dir_.empty() && out.dir_.back() == '/') out.dir_.pop_back();
+  out.partial_ = out.dir_ + ".partial";
+  out.meta_ = meta;
+  std::error_code ec;
+  // Only an earlier mrgi output (or an empty folder) is replaced: --out must never wipe user data.
+  if (fs::exists(out.dir_, ec) &&
+      !(fs::is_directory(out.dir_, ec) &&
+        (fs::is_empty(out.dir_, ec) || fs::exists(out.dir_ + "/summary.json", ec))))
+    return fail(ErrorKind::BadUsage, out.dir_ + ": --out exists and is not an earlier mrgi output "
+                                                "(no summary.json); refusing to overwrite it");
+  fs::remove_all(out.partial_, ec);
+  fs::create_directories(out.partial_ + "/frames", ec);
+  if (ec) return fail(ErrorKind::BadInput, out.partial_ + ": cannot create output folder: " + ec.message());
+  return out;
+}
+
+Status ReplayOutput::add(const FrameOutput& out, const ImageRGB8& camera, const ImageRGB8* reference,
+                         const ImageU8* mask) {
+  const size_t i = frame_ms_.size();
+  MRGI_TRY(write_png(partial_ + "/frames/" + frame_name(i), out.image));
+  nlohmann::json s;
+  s["frame"] = out.stats.frame_index;
+  s["level"] = out.stats.level;
+  s["gpu_total_ms"] = out.stats.gpu_total_ms;
+  s["wall_ms"] = out.stats.cpu_ms;
+  nlohmann::json passes = nlohmann::json::object();
+  for (const auto& p : out.stats.passes) passes[p.name] = p.gpu_ms;
+  s["passes_ms"] = passes;
+  s["skipped"] = out.stats.skipped;
+  if (reference) {
+    auto r = measure_error(out.image, camera, *reference, mask);
+    if (!r.ok()) return r.error();
+    s["error"] = {{"all", figures_json(r->all)}, {"real", figures_json(r->real)},
+                  {"virtual", figures_json(r->virtual_)}};
+    if (!pooled_) {
+      pooled_ = *r;
+    } else {
+      pooled_->all = pool(pooled_->all, r->all);
+      pooled_->real = pool(pooled_->real, r->real);
+      pooled_->virtual_ = pool(pooled_->virtual_, r->virtual_);
+    }
+    last_reference_ = *reference;
+  }
+  stats_.push_back(std::move(s));
+  frame_ms_.push_back(out.stats.gpu_total_ms);
+  wall_ms_.push_back(out.stats.cpu_ms);
+  last_camera_ = camera;
+  last_output_ = out.image;
+  return ok_status();
+}
+
+Expected<nlohmann::json> ReplayOutput::finish() {
+  nlohmann::json summary;
+  summary["frames"] = frame_ms_.size();
+  summary["median_frame_ms"] = percentile(frame_ms_, 50);
+  summary["p95_frame_ms"] = percentile(frame_ms_, 95);
+  summary["median_wall_ms"] = percentile(wall_ms_, 50);
+  summary["frame_ms_is"] = "GPU time of the frame graph (first to last timestamp), per frame";
+  summary["technique"] = meta_.technique;
+  summary["level"] = meta_.level;
+  summary["level_name"] = meta_.level_name;
+  summary["device"] = meta_.device;
+  summary["lp_num_threads"] = lp_num_threads();
+  summary["memory_mib"] = meta_.memory_mib;
+  summary["width"] = meta_.width;
+  summary["height"] = meta_.height;
+  summary["source"] = meta_.source;
+  if (pooled_) {
+    auto rde = [](const ErrorFigures& f) { return f.rde_defined ? nlohmann::json(f.rde) : nlohmann::json(nullptr); };
+    summary["rde"] = {{"all", rde(pooled_->all)}, {"real", rde(pooled_->real)}, {"virtual", rde(pooled_->virtual_)}};
+    summary["error"] = {{"all", figures_json(pooled_->all)}, {"real", figures_json(pooled_->real)},
+                        {"virtual", figures_json(pooled_->virtual_)}};
+  }
+  MRGI_TRY(write_json(partial_ + "/stats.json", stats_));
+  MRGI_TRY(write_json(partial_ + "/summary.json", summary));
+  if (!last_output_.empty()) {
+    const int w = last_output_.width, h = last_output_.height;
+    const int panels = last_reference_.empty() ? 2 : 3;
+    ImageRGB8 sbs(w * panels, h);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        for (int c = 0; c < 3; ++c) {
+          sbs.at(x, y)[c] = last_camera_.at(x, y)[c];
+          sbs.at(x + w, y)[c] = last_output_.at(x, y)[c];
+          if (panels == 3) sbs.at(x + 2 * w, y)[c] = last_reference_.at(x, y)[c];
+        }
+    MRGI_TRY(write_png(partial_ + "/side_by_side.png", sbs));
+  }
+  std::error_code ec;
+  fs::remove_all(dir_, ec);
+  fs::rename(partial_, dir_, ec);
+  if (ec) return fail(ErrorKind::Device, dir_ + ": cannot move finished output into place: " + ec.message());
+  return summary;
+}
+
+}  // namespace mrgi::tool

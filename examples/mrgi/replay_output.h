@@ -1,0 +1,59 @@
+// What `mrgi replay` and `mrgi live` write to --out DIR:
+//   DIR/frames/NNNNNN.png   composited RGBA8 frames
+//   DIR/stats.json          per frame: each pass's GPU ms, total ms, wall ms, level, skipped passes,
+//                           and the frame's error figures when a reference exists
+//   DIR/summary.json        frames, median_frame_ms, p95_frame_ms, technique, level, device,
+//                           lp_num_threads, memory_mib, and rde {all, real, virtual} with references
+//   DIR/side_by_side.png    camera | mrgi | reference (or camera | mrgi) of the last frame
+// Everything is written under DIR.partial and renamed over DIR by finish(), so a failed run leaves
+// no half-written output behind.
+#pragma once
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "mrgi/metrics.h"
+#include "mrgi/runtime.h"
+
+namespace mrgi::tool {
+
+struct ReplayMeta {
+  std::string source;     // capture folder or live source
+  std::string technique;
+  int level = 0;
+  std::string level_name;
+  std::string device;
+  double memory_mib = 0.0;
+  int width = 0, height = 0;
+};
+
+class ReplayOutput {
+ public:
+  static Expected<ReplayOutput> create(const std::string& dir, const ReplayMeta& meta);
+  // camera: the input colour frame at output size; reference/mask optional (capture references).
+  Status add(const FrameOutput& out, const ImageRGB8& camera, const ImageRGB8* reference,
+             const ImageU8* mask);
+  // Writes stats.json, summary.json and the side-by-side image, then renames DIR.partial to DIR.
+  Expected<nlohmann::json> finish();
+  size_t frames() const { return frame_ms_.size(); }
+
+ private:
+  std::string dir_, partial_;
+  ReplayMeta meta_;
+  nlohmann::json stats_ = nlohmann::json::array();
+  std::vector<double> frame_ms_, wall_ms_;
+  std::optional<RdeReport> pooled_;
+  ImageRGB8 last_camera_, last_reference_;
+  ImageRGBA8 last_output_;
+};
+
+// Median and 95th percentile (nearest rank) of a sample; 0 for an empty one.
+double percentile(std::vector<double> v, double p);
+nlohmann::json figures_json(const ErrorFigures& f);
+// Resamples an 8-bit RGB image to w x h (bilinear), for cameras larger than the output.
+ImageRGB8 resize_rgb8(const ImageRGB8& src, int w, int h);
+ImageU8 resize_mask_nearest(const ImageU8& src, int w, int h);
+
+}  // namespace mrgi::tool
