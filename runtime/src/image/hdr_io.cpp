@@ -1,0 +1,122 @@
+// HDR environment images: OpenEXR through tinyexr, Radiance .hdr through stb_image, and 8-bit
+// sRGB PNG decoded to linear. All of them come back as linear RGB float.
+#define STB_IMAGE_IMPLEMENTATION
+#define STBI_NO_STDIO_WARNINGS
+#define STBI_ONLY_HDR
+#include <stb/stb_image.h>
+#include <tinyexr.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include "image/file_io.h"
+#include "image/srgb.h"
+#include "mrgi/image.h"
+
+namespace mrgi {
+namespace {
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
+}
+
+// Radiance is finite; one NaN or Inf would poison every sum (importance sampling, SH) built on it.
+Status check_finite(const std::string& path, const ImageRGBF& img) {
+  for (size_t i = 0; i < img.data.size(); ++i) {
+    if (!std::isfinite(img.data[i])) {
+      const size_t pixel = i / 3;
+      return fail(ErrorKind::BadInput,
+                  path + ": pixel (" + std::to_string(pixel % size_t(img.width)) + ", " +
+                      std::to_string(pixel / size_t(img.width)) + ") channel " +
+                      std::to_string(i % 3) + " is " + (std::isnan(img.data[i]) ? "NaN" : "infinite") +
+                      "; HDR images must hold finite radiance");
+    }
+  }
+  return ok_status();
+}
+
+Expected<ImageRGBF> load_exr(const std::string& path) {
+  float* rgba = nullptr;
+  int w = 0, h = 0;
+  const char* err = nullptr;
+  const int rc = LoadEXR(&rgba, &w, &h, path.c_str(), &err);
+  if (rc != TINYEXR_SUCCESS) {
+    std::string why = err ? err : ("tinyexr error " + std::to_string(rc));
+    if (err) FreeEXRErrorMessage(err);
+    std::free(rgba);
+    return fail(ErrorKind::BadInput, path + ": cannot decode OpenEXR: " + why);
+  }
+  std::unique_ptr<float, decltype(&std::free)> owner(rgba, &std::free);
+  if (w <= 0 || h <= 0) return fail(ErrorKind::BadInput, path + ": OpenEXR image has no pixels");
+  ImageRGBF img(w, h);
+  for (size_t i = 0; i < img.pixel_count(); ++i)
+    for (int c = 0; c < 3; ++c) img.data[i * 3 + size_t(c)] = rgba[i * 4 + size_t(c)];
+  return img;
+}
+
+Expected<ImageRGBF> load_radiance_hdr(const std::string& path) {
+  auto bytes = read_file_bytes(path);
+  if (!bytes) return bytes.error();
+  int w = 0, h = 0, channels = 0;
+  float* pixels = stbi_loadf_from_memory(bytes->data(), int(bytes->size()), &w, &h, &channels, 3);
+  if (!pixels)
+    return fail(ErrorKind::BadInput, path + ": cannot decode Radiance HDR: " + stbi_failure_reason());
+  std::unique_ptr<float, decltype(&stbi_image_free)> owner(pixels, &stbi_image_free);
+  ImageRGBF img(w, h);
+  std::copy(pixels, pixels + img.data.size(), img.data.begin());
+  return img;
+}
+
+Expected<ImageRGBF> load_srgb_png(const std::string& path) {
+  auto png = load_png_rgb8(path);
+  if (!png) return png.error();
+  const auto& table = srgb8_to_linear_table();
+  ImageRGBF img(png->width, png->height);
+  for (size_t i = 0; i < img.data.size(); ++i) img.data[i] = table[png->data[i]];
+  return img;
+}
+
+}  // namespace
+
+Expected<ImageRGBF> load_hdr_image(const std::string& path) {
+  const std::string ext = lower_extension(path);
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    return fail(ErrorKind::NotFound, path + ": file does not exist (or is not a regular file)");
+  Expected<ImageRGBF> img = ImageRGBF{};
+  if (ext == ".exr") img = load_exr(path);
+  else if (ext == ".hdr") img = load_radiance_hdr(path);
+  else if (ext == ".png") img = load_srgb_png(path);
+  else
+    return fail(ErrorKind::BadInput, path + ": unsupported HDR image extension '" + ext +
+                                         "'; expected .exr, .hdr or .png");
+  if (!img) return img.error();
+  MRGI_TRY(check_finite(path, *img));
+  return img;
+}
+
+// 32-bit float channels (not half) so a written image reads back bit-identical.
+Status write_exr(const std::string& path, const ImageRGBF& img) {
+  if (img.empty() || img.data.size() != img.pixel_count() * 3)
+    return fail(ErrorKind::BadUsage, path + ": cannot write OpenEXR: image is empty or its data "
+                                            "size is not width*height*3");
+  MRGI_TRY(check_finite(path, img));
+  const std::string tmp = path + ".tmp";
+  const char* err = nullptr;
+  const int rc = SaveEXR(img.data.data(), img.width, img.height, 3, /*save_as_fp16=*/0, tmp.c_str(), &err);
+  if (rc != TINYEXR_SUCCESS) {
+    std::string why = err ? err : ("tinyexr error " + std::to_string(rc));
+    if (err) FreeEXRErrorMessage(err);
+    std::remove(tmp.c_str());
+    return fail(ErrorKind::Device, path + ": cannot write OpenEXR: " + why);
+  }
+  return rename_into_place(tmp, path);
+}
+
+}  // namespace mrgi

@@ -1,0 +1,157 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include "capture/temp_dir.h"
+#include "image/srgb.h"
+#include "mrgi/image.h"
+
+namespace mrgi {
+namespace {
+
+using testing::TempDir;
+
+template <class T, int C>
+Image<T, C> gradient(int w, int h, int mul) {
+  Image<T, C> img(w, h);
+  for (size_t i = 0; i < img.data.size(); ++i) img.data[i] = T((i * size_t(mul) + 7) % 65536);
+  return img;
+}
+
+TEST(PngIo, RoundTripsEveryFormatBitExactly) {
+  TempDir dir;
+  const auto rgb = gradient<uint8_t, 3>(13, 7, 5);
+  const auto rgba = gradient<uint8_t, 4>(5, 9, 3);
+  const auto u16 = gradient<uint16_t, 1>(11, 4, 4099);
+  const auto u8 = gradient<uint8_t, 1>(3, 17, 11);
+  ASSERT_TRUE(write_png(dir.file("rgb.png"), rgb).ok());
+  ASSERT_TRUE(write_png(dir.file("rgba.png"), rgba).ok());
+  ASSERT_TRUE(write_png(dir.file("u16.png"), u16).ok());
+  ASSERT_TRUE(write_png(dir.file("u8.png"), u8).ok());
+  auto rgb2 = load_png_rgb8(dir.file("rgb.png"));
+  auto rgba2 = load_png_rgba8(dir.file("rgba.png"));
+  auto u162 = load_png_u16(dir.file("u16.png"));
+  auto u82 = load_png_u8(dir.file("u8.png"));
+  ASSERT_TRUE(rgb2.ok() && rgba2.ok() && u162.ok() && u82.ok());
+  EXPECT_EQ(rgb2->width, 13);
+  EXPECT_EQ(rgb2->height, 7);
+  EXPECT_EQ(rgb2->data, rgb.data);
+  EXPECT_EQ(rgba2->data, rgba.data);
+  EXPECT_EQ(u162->width, 11);
+  EXPECT_EQ(u162->data, u16.data);  // also proves the 16-bit byte order is right
+  EXPECT_GT(*std::max_element(u162->data.begin(), u162->data.end()), 255);
+  EXPECT_EQ(u82->data, u8.data);
+  // No temporary file is left behind by the write-then-rename.
+  EXPECT_FALSE(std::filesystem::exists(dir.file("rgb.png.tmp")));
+}
+
+TEST(PngIo, RgbaLoaderGivesRgbAnOpaqueAlpha) {
+  TempDir dir;
+  ImageRGB8 rgb(2, 1);
+  rgb.data = {1, 2, 3, 4, 5, 6};
+  ASSERT_TRUE(write_png(dir.file("c.png"), rgb).ok());
+  auto rgba = load_png_rgba8(dir.file("c.png"));
+  ASSERT_TRUE(rgba.ok());
+  EXPECT_EQ(rgba->data, (std::vector<uint8_t>{1, 2, 3, 255, 4, 5, 6, 255}));
+}
+
+TEST(PngIo, ColourLoaderRefuses16BitAndGrey) {
+  TempDir dir;
+  ASSERT_TRUE(write_png(dir.file("d.png"), ImageU16(4, 4, 1000)).ok());
+  ASSERT_TRUE(write_png(dir.file("m.png"), ImageU8(4, 4, 9)).ok());
+  EXPECT_ERROR(load_png_rgb8(dir.file("d.png")), BadInput, "d.png", "16-bit grey", "expected 8-bit RGB");
+  EXPECT_ERROR(load_png_rgb8(dir.file("m.png")), BadInput, "m.png", "8-bit grey", "expected 8-bit RGB");
+}
+
+TEST(PngIo, DepthLoaderRefuses8Bit) {
+  TempDir dir;
+  ASSERT_TRUE(write_png(dir.file("m.png"), ImageU8(4, 3, 9)).ok());
+  ASSERT_TRUE(write_png(dir.file("c.png"), ImageRGB8(4, 3, 9)).ok());
+  EXPECT_ERROR(load_png_u16(dir.file("m.png")), BadInput, "m.png", "8-bit grey (4x3)", "expected 16-bit grey");
+  EXPECT_ERROR(load_png_u16(dir.file("c.png")), BadInput, "c.png", "8-bit RGB", "16-bit");
+  EXPECT_ERROR(load_png_u8(dir.file("c.png")), BadInput, "c.png", "8-bit RGB", "expected 8-bit grey");
+}
+
+TEST(PngIo, MissingAndCorruptFilesAreNamed) {
+  TempDir dir;
+  EXPECT_ERROR(load_png_rgb8(dir.file("none.png")), NotFound, "none.png", "does not exist");
+  testing::write_text(dir.file("junk.png"), "this is not a png");
+  EXPECT_ERROR(load_png_rgb8(dir.file("junk.png")), BadInput, "junk.png", "not a PNG");
+  // A real PNG cut in half: libpng's error is reported, nothing crashes.
+  ASSERT_TRUE(write_png(dir.file("full.png"), gradient<uint8_t, 3>(64, 64, 13)).ok());
+  const auto size = std::filesystem::file_size(dir.file("full.png"));
+  std::filesystem::resize_file(dir.file("full.png"), size / 2);
+  EXPECT_ERROR(load_png_rgb8(dir.file("full.png")), BadInput, "full.png", "cannot decode PNG");
+}
+
+TEST(PngIo, WriterRefusesEmptyImage) {
+  TempDir dir;
+  EXPECT_ERROR(write_png(dir.file("e.png"), ImageRGB8{}), BadUsage, "e.png", "empty");
+  EXPECT_FALSE(std::filesystem::exists(dir.file("e.png")));
+}
+
+TEST(HdrIo, ExrRoundTripsFloatsExactly) {
+  TempDir dir;
+  ImageRGBF img(6, 3);
+  for (size_t i = 0; i < img.data.size(); ++i) img.data[i] = float(i) * 0.37f + 1e-3f * float(i * i);
+  img.data[4] = 12345.678f;
+  ASSERT_TRUE(write_exr(dir.file("e.exr"), img).ok());
+  auto back = load_hdr_image(dir.file("e.exr"));
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->width, 6);
+  EXPECT_EQ(back->height, 3);
+  EXPECT_EQ(back->data, img.data);
+}
+
+TEST(HdrIo, NonFiniteRadianceIsRefusedNamingFileAndPixel) {
+  TempDir dir;
+  ImageRGBF img(4, 2, 0.5f);
+  img.at(1, 1)[2] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_ERROR(write_exr(dir.file("n.exr"), img), BadInput, "n.exr", "pixel (1, 1)", "NaN", "finite");
+}
+
+TEST(HdrIo, PngIsDecodedFromSrgbToLinear) {
+  TempDir dir;
+  ImageRGB8 png(3, 1);
+  png.data = {0, 128, 255, 255, 255, 255, 10, 20, 30};
+  ASSERT_TRUE(write_png(dir.file("env.png"), png).ok());
+  auto lin = load_hdr_image(dir.file("env.png"));
+  ASSERT_TRUE(lin.ok());
+  EXPECT_FLOAT_EQ(lin->data[0], 0.0f);
+  EXPECT_NEAR(lin->data[1], 0.2158605f, 1e-6f);  // sRGB 128 -> 0.2158605 linear
+  EXPECT_FLOAT_EQ(lin->data[2], 1.0f);
+  EXPECT_NEAR(lin->data[6], 10.0f / 255.0f / 12.92f, 1e-7f);  // linear segment of the curve
+}
+
+TEST(HdrIo, RadianceHdrFromStb) {
+  TempDir dir;
+  // A 2x1 uncompressed RGBE file: (128,64,32,129) = (1, 0.5, 0.25) and (128,128,128,128) = 0.5.
+  std::string hdr = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 2\n";
+  hdr += std::string("\x80\x40\x20\x81\x80\x80\x80\x80", 8);
+  testing::write_text(dir.file("e.hdr"), hdr);
+  auto img = load_hdr_image(dir.file("e.hdr"));
+  ASSERT_TRUE(img.ok()) << img.error().message;
+  ASSERT_EQ(img->width, 2);
+  EXPECT_NEAR(img->data[0], 1.0f, 1e-2f);
+  EXPECT_NEAR(img->data[1], 0.5f, 1e-2f);
+  EXPECT_NEAR(img->data[2], 0.25f, 1e-2f);
+  EXPECT_NEAR(img->data[3], 0.5f, 1e-2f);
+}
+
+TEST(HdrIo, UnknownExtensionAndMissingFile) {
+  TempDir dir;
+  testing::write_text(dir.file("e.jpg"), "x");
+  EXPECT_ERROR(load_hdr_image(dir.file("e.jpg")), BadInput, "e.jpg", ".exr, .hdr or .png");
+  EXPECT_ERROR(load_hdr_image(dir.file("none.exr")), NotFound, "none.exr");
+}
+
+TEST(Srgb, CurveRoundTripsEveryCode) {
+  for (int i = 0; i < 256; ++i)
+    EXPECT_EQ(linear_to_srgb8(srgb8_to_linear_table()[size_t(i)]), i);
+  EXPECT_EQ(linear_to_srgb8(std::numeric_limits<float>::quiet_NaN()), 0);
+}
+
+}  // namespace
+}  // namespace mrgi
