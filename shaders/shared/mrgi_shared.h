@@ -1,0 +1,206 @@
+// Math shared by the shaders and the C++ side (reference renderer, tests), written once in the
+// subset of GLSL that also compiles as C++ with GLM, so CPU unit tests check what shaders run.
+//
+// GLSL:  #extension GL_GOOGLE_include_directive : require
+//        #include "shared/mrgi_shared.h"
+// C++:   #include "shared/mrgi_shared.h"   (everything is in namespace mrgi::shader)
+//
+// Rules for this file: float literals carry an `f` suffix (GLM does not mix float and double),
+// no swizzles (GLM needs GLM_FORCE_SWIZZLE for them), no out-parameters or arrays (structs
+// instead), every function MRGI_FN.
+#ifndef MRGI_SHARED_H
+#define MRGI_SHARED_H
+
+#ifdef __cplusplus
+#include <cstdint>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/packing.hpp>
+namespace mrgi::shader {
+using glm::abs;
+using glm::clamp;
+using glm::dot;
+using glm::max;
+using glm::min;
+using glm::mix;
+using glm::normalize;
+using glm::packSnorm2x16;
+using glm::pow;
+using glm::smoothstep;
+using glm::unpackSnorm2x16;
+using glm::vec2;
+using glm::vec3;
+using glm::vec4;
+using glm::ivec2;
+using uint = uint32_t;
+#define MRGI_FN inline
+#else
+#define MRGI_FN
+#endif
+
+const float MRGI_PI = 3.14159265358979f;
+
+// ---- colour -------------------------------------------------------------------------------
+
+// sRGB transfer function (IEC 61966-2-1), per channel, input clamped to [0, 1].
+MRGI_FN float srgb_encode1(float linear) {
+  float c = clamp(linear, 0.0f, 1.0f);
+  return c <= 0.0031308f ? 12.92f * c : 1.055f * pow(c, 1.0f / 2.4f) - 0.055f;
+}
+MRGI_FN float srgb_decode1(float encoded) {
+  float c = clamp(encoded, 0.0f, 1.0f);
+  return c <= 0.04045f ? c / 12.92f : pow((c + 0.055f) / 1.055f, 2.4f);
+}
+MRGI_FN vec3 srgb_encode(vec3 linear) {
+  return vec3(srgb_encode1(linear.x), srgb_encode1(linear.y), srgb_encode1(linear.z));
+}
+MRGI_FN vec3 srgb_decode(vec3 encoded) {
+  return vec3(srgb_decode1(encoded.x), srgb_decode1(encoded.y), srgb_decode1(encoded.z));
+}
+
+// Rec. 709 / sRGB primaries luminance of linear RGB.
+MRGI_FN float luminance(vec3 linear_rgb) {
+  return dot(linear_rgb, vec3(0.2126f, 0.7152f, 0.0722f));
+}
+
+// The camera model (DESIGN.md, capture.json `exposure`): linear radiance times exposure is the
+// linear sensor value, clipped at 1 (sensor saturation), then the sRGB curve. Compose and the
+// reference renderer both use it, so both "see" with the same camera. Negative or NaN-free
+// input is assumed; values below 0 clip to 0.
+MRGI_FN vec3 camera_response(vec3 radiance, float exposure) {
+  return srgb_encode(radiance * exposure);
+}
+// Inverse of camera_response for unsaturated values: sRGB camera value -> linear radiance.
+// exposure <= 0 is treated as 1 (never divides by zero).
+MRGI_FN vec3 camera_to_radiance(vec3 encoded, float exposure) {
+  float e = exposure > 0.0f ? exposure : 1.0f;
+  return srgb_decode(encoded) / e;
+}
+
+// ---- normals --------------------------------------------------------------------------------
+
+// Octahedral mapping of a unit vector to [-1, 1]^2 (Cigolle et al. 2014, "A Survey of Efficient
+// Representations for Independent Unit Vectors").
+MRGI_FN vec2 sign_not_zero(vec2 v) {
+  return vec2(v.x >= 0.0f ? 1.0f : -1.0f, v.y >= 0.0f ? 1.0f : -1.0f);
+}
+MRGI_FN vec2 oct_encode(vec3 n) {
+  vec3 a = vec3(abs(n.x), abs(n.y), abs(n.z));
+  float l1 = a.x + a.y + a.z;
+  vec2 p = vec2(n.x, n.y) * (1.0f / max(l1, 1e-20f));
+  if (n.z < 0.0f) {
+    p = (vec2(1.0f) - vec2(abs(p.y), abs(p.x))) * sign_not_zero(p);
+  }
+  return p;
+}
+MRGI_FN vec3 oct_decode(vec2 e) {
+  vec3 v = vec3(e.x, e.y, 1.0f - abs(e.x) - abs(e.y));
+  if (v.z < 0.0f) {
+    vec2 xy = (vec2(1.0f) - vec2(abs(v.y), abs(v.x))) * sign_not_zero(vec2(v.x, v.y));
+    v.x = xy.x;
+    v.y = xy.y;
+  }
+  return normalize(v);
+}
+// Two snorm16 in one uint (for R32_UINT normal buffers).
+MRGI_FN uint oct_pack(vec3 n) { return packSnorm2x16(oct_encode(n)); }
+MRGI_FN vec3 oct_unpack(uint p) { return oct_decode(unpackSnorm2x16(p)); }
+
+// ---- spherical harmonics --------------------------------------------------------------------
+
+// Real SH basis, bands 0..3 (16 coefficients), orthonormal over the sphere, with the sign
+// convention and index order of Sloan, "Stupid Spherical Harmonics (SH) Tricks" (2008),
+// appendix: index l*(l+1)+m, m = -l..l. `d` must be unit length.
+struct SH16 {
+  vec4 c0;  // Y00, Y1-1, Y10, Y11
+  vec4 c1;  // Y2-2, Y2-1, Y20, Y21
+  vec4 c2;  // Y22, Y3-3, Y3-2, Y3-1
+  vec4 c3;  // Y30, Y31, Y32, Y33
+};
+MRGI_FN SH16 sh_basis16(vec3 d) {
+  float x = d.x, y = d.y, z = d.z;
+  float x2 = x * x, y2 = y * y, z2 = z * z;
+  SH16 r;
+  r.c0 = vec4(0.282094791773878f, -0.488602511902920f * y, 0.488602511902920f * z,
+              -0.488602511902920f * x);
+  r.c1 = vec4(1.092548430592079f * x * y, -1.092548430592079f * y * z,
+              0.315391565252520f * (3.0f * z2 - 1.0f), -1.092548430592079f * x * z);
+  r.c2 = vec4(0.546274215296040f * (x2 - y2), -0.590043589926644f * y * (3.0f * x2 - y2),
+              2.890611442640554f * x * y * z, -0.457045799464466f * y * (5.0f * z2 - 1.0f));
+  r.c3 = vec4(0.373176332590115f * z * (5.0f * z2 - 3.0f),
+              -0.457045799464466f * x * (5.0f * z2 - 1.0f),
+              1.445305721320277f * z * (x2 - y2), -0.590043589926644f * x * (x2 - 3.0f * y2));
+  return r;
+}
+// Coefficient i (0..15) of an SH16; out-of-range i returns 0.
+MRGI_FN float sh_get(SH16 s, int i) {
+  vec4 v = i < 4 ? s.c0 : (i < 8 ? s.c1 : (i < 12 ? s.c2 : s.c3));
+  int k = i - 4 * (i / 4);
+  if (i < 0 || i > 15) return 0.0f;
+  return k == 0 ? v.x : (k == 1 ? v.y : (k == 2 ? v.z : v.w));
+}
+MRGI_FN float sh_dot(SH16 a, SH16 b) {
+  return dot(a.c0, b.c0) + dot(a.c1, b.c1) + dot(a.c2, b.c2) + dot(a.c3, b.c3);
+}
+// Zonal factors of the clamped-cosine kernel per band (Ramamoorthi & Hanrahan 2001):
+// irradiance E(n) = sum_l A_l sum_m L_lm Y_lm(n); A = pi, 2pi/3, pi/4, 0 for l = 0..3.
+MRGI_FN SH16 sh_scale_cosine_lobe(SH16 radiance) {
+  SH16 r;
+  const float a0 = MRGI_PI, a1 = 2.0f * MRGI_PI / 3.0f, a2 = MRGI_PI / 4.0f;
+  r.c0 = radiance.c0 * vec4(a0, a1, a1, a1);
+  r.c1 = radiance.c1 * vec4(a2, a2, a2, a2);
+  r.c2 = radiance.c2 * vec4(a2, 0.0f, 0.0f, 0.0f);
+  r.c3 = vec4(0.0f);
+  return r;
+}
+
+// ---- lights ---------------------------------------------------------------------------------
+
+// Spot cone: 1 inside the inner half-angle, 0 outside the outer one, smoothstep between, on
+// the cosines. `cos_angle` = dot(spot direction, direction to the lit point).
+MRGI_FN float spot_falloff(float cos_angle, float cos_outer, float cos_inner) {
+  if (cos_inner <= cos_outer) return cos_angle >= cos_outer ? 1.0f : 0.0f;
+  return smoothstep(cos_outer, cos_inner, cos_angle);
+}
+
+// ---- cameras --------------------------------------------------------------------------------
+
+// Pinhole, OpenCV convention: x right, y down, looking along +z; `k` = (fx, fy, cx, cy) in
+// pixels; integer pixel coordinates are pixel centres (pixel (0,0) covers [-0.5, 0.5]^2).
+MRGI_FN vec2 project_pinhole(vec3 p_camera, vec4 k) {
+  float iz = 1.0f / max(p_camera.z, 1e-9f);
+  return vec2(k.x * p_camera.x * iz + k.z, k.y * p_camera.y * iz + k.w);
+}
+// The point at depth `z` (along +z, metres) seen at `pixel`.
+MRGI_FN vec3 unproject_pinhole(vec2 pixel, float z, vec4 k) {
+  return vec3((pixel.x - k.z) / k.x * z, (pixel.y - k.w) / k.y * z, z);
+}
+
+// ---- differential compose -------------------------------------------------------------------
+
+// Knecht et al. (differential instant radiosity; "Reflective and Refractive Objects for Mixed
+// Reality", eq. 1-2): L_final = CI + alpha * (L_rv - L_r), alpha = CI / L_r per channel, which
+// makes the change relative to what the camera saw instead of to the model. Guards: where L_r
+// is below `eps` the ratio is meaningless (dark or unmodelled real surface), so alpha blends to 1
+// (absolute delta) over [eps, 2 eps]; alpha is clamped to [0, alpha_max]; the result is >= 0.
+// Virtual pixels (virtual_mask = 1) show L_rv itself (the camera colour there is occluded).
+// All inputs in the same (linear or camera) space.
+MRGI_FN float compose_alpha1(float camera, float l_r, float eps, float alpha_max) {
+  float ratio = clamp(camera / max(l_r, eps), 0.0f, alpha_max);
+  return mix(1.0f, ratio, smoothstep(eps, 2.0f * eps, l_r));
+}
+MRGI_FN vec3 differential_compose(vec3 camera, vec3 l_r, vec3 l_rv, float virtual_mask,
+                                  float eps, float alpha_max) {
+  vec3 alpha = vec3(compose_alpha1(camera.x, l_r.x, eps, alpha_max),
+                    compose_alpha1(camera.y, l_r.y, eps, alpha_max),
+                    compose_alpha1(camera.z, l_r.z, eps, alpha_max));
+  vec3 real = max(camera + alpha * (l_rv - l_r), vec3(0.0f));
+  return mix(real, max(l_rv, vec3(0.0f)), clamp(virtual_mask, 0.0f, 1.0f));
+}
+
+#ifdef __cplusplus
+}  // namespace mrgi::shader
+#undef MRGI_FN
+#endif
+
+#endif  // MRGI_SHARED_H

@@ -1,0 +1,202 @@
+// CPU checks of shaders/shared/mrgi_shared.h, the math the shaders run: known values, round
+// trips, and SH orthonormality by numeric integration over the sphere.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "../../shaders/shared/mrgi_shared.h"
+
+namespace {
+using namespace mrgi::shader;
+
+TEST(SharedMath, SrgbKnownValues) {
+  EXPECT_FLOAT_EQ(srgb_encode1(0.0f), 0.0f);
+  EXPECT_FLOAT_EQ(srgb_encode1(1.0f), 1.0f);
+  EXPECT_NEAR(srgb_encode1(0.5f), 0.735357f, 1e-5f);       // 188/255 in 8 bit
+  EXPECT_NEAR(srgb_encode1(0.002f), 0.002f * 12.92f, 1e-7f);  // linear toe
+  EXPECT_NEAR(srgb_decode1(0.5f), 0.214041f, 1e-5f);
+  EXPECT_FLOAT_EQ(srgb_encode1(7.0f), 1.0f);                // clipped, not extrapolated
+  EXPECT_FLOAT_EQ(srgb_encode1(-1.0f), 0.0f);
+  // Continuity at the toe/curve boundary.
+  EXPECT_NEAR(srgb_encode1(0.0031308f), srgb_encode1(0.0031309f), 1e-5f);
+  EXPECT_NEAR(srgb_decode1(0.04045f), srgb_decode1(0.040451f), 1e-5f);
+}
+
+TEST(SharedMath, SrgbRoundTripEvery8BitValue) {
+  for (int i = 0; i <= 255; ++i) {
+    const float e = float(i) / 255.0f;
+    EXPECT_NEAR(srgb_encode1(srgb_decode1(e)), e, 2e-6f) << i;
+  }
+  const vec3 v = srgb_decode(srgb_encode(vec3(0.1f, 0.5f, 0.9f)));
+  EXPECT_NEAR(v.x, 0.1f, 1e-5f);
+  EXPECT_NEAR(v.y, 0.5f, 1e-5f);
+  EXPECT_NEAR(v.z, 0.9f, 1e-5f);
+}
+
+TEST(SharedMath, LuminanceWeights) {
+  EXPECT_NEAR(luminance(vec3(1.0f)), 1.0f, 1e-6f);
+  EXPECT_NEAR(luminance(vec3(0.0f, 1.0f, 0.0f)), 0.7152f, 1e-6f);
+  EXPECT_GT(luminance(vec3(0.0f, 1.0f, 0.0f)), luminance(vec3(1.0f, 0.0f, 0.0f)));
+}
+
+TEST(SharedMath, CameraResponseAndInverse) {
+  // exposure 0.5: radiance 1 -> linear 0.5 -> sRGB 0.7354.
+  EXPECT_NEAR(camera_response(vec3(1.0f), 0.5f).x, 0.735357f, 1e-5f);
+  // saturates at 1
+  EXPECT_FLOAT_EQ(camera_response(vec3(10.0f), 1.0f).y, 1.0f);
+  const vec3 r = camera_to_radiance(camera_response(vec3(0.3f, 0.6f, 1.2f), 0.7f), 0.7f);
+  EXPECT_NEAR(r.x, 0.3f, 1e-5f);
+  EXPECT_NEAR(r.y, 0.6f, 1e-5f);
+  EXPECT_NEAR(r.z, 1.2f, 1e-5f);
+  // A zero exposure must not divide by zero.
+  EXPECT_TRUE(std::isfinite(camera_to_radiance(vec3(0.5f), 0.0f).x));
+}
+
+TEST(SharedMath, OctahedralRoundTrip) {
+  std::mt19937 rng(7);
+  std::normal_distribution<float> g;
+  float worst = 0.0f;
+  for (int i = 0; i < 20000; ++i) {
+    const vec3 n = glm::normalize(vec3(g(rng), g(rng), g(rng)));
+    const vec2 e = oct_encode(n);
+    ASSERT_LE(std::abs(e.x), 1.0f + 1e-6f);
+    ASSERT_LE(std::abs(e.y), 1.0f + 1e-6f);
+    const vec3 d = oct_decode(e);
+    worst = std::max(worst, glm::length(d - n));
+    // Packed to 2 x snorm16: error below 1e-4 rad-ish.
+    EXPECT_LT(glm::length(oct_unpack(oct_pack(n)) - n), 1e-4f);
+  }
+  EXPECT_LT(worst, 1e-5f);
+  // Axis and seam cases, including -z where the fold happens.
+  for (vec3 n : {vec3(0, 0, 1), vec3(0, 0, -1), vec3(1, 0, 0), vec3(-1, 0, 0), vec3(0, -1, 0),
+                 glm::normalize(vec3(1, 1, -1)), glm::normalize(vec3(-1, 0, -1))}) {
+    EXPECT_LT(glm::length(oct_decode(oct_encode(n)) - n), 1e-5f);
+  }
+}
+
+TEST(SharedMath, ShKnownValues) {
+  const SH16 z = sh_basis16(vec3(0, 0, 1));
+  EXPECT_NEAR(z.c0.x, 0.5f / std::sqrt(float(M_PI)), 1e-6f);
+  EXPECT_NEAR(z.c0.z, std::sqrt(3.0f / (4.0f * float(M_PI))), 1e-6f);
+  EXPECT_NEAR(z.c1.z, std::sqrt(5.0f / (16.0f * float(M_PI))) * 2.0f, 1e-6f);  // 3z^2-1 = 2
+  EXPECT_NEAR(z.c3.x, std::sqrt(7.0f / (16.0f * float(M_PI))) * 2.0f, 1e-5f);  // z(5z^2-3) = 2
+  // Sloan's sign convention: Y1,1 = -c x.
+  const SH16 x = sh_basis16(vec3(1, 0, 0));
+  EXPECT_LT(x.c0.w, 0.0f);
+  EXPECT_NEAR(x.c0.w, -0.488603f, 1e-5f);
+  EXPECT_FLOAT_EQ(sh_get(x, 3), x.c0.w);
+  EXPECT_FLOAT_EQ(sh_get(x, 15), x.c3.w);
+  EXPECT_FLOAT_EQ(sh_get(x, 16), 0.0f);
+  EXPECT_FLOAT_EQ(sh_get(x, -1), 0.0f);
+}
+
+// Integral over the sphere of Y_i Y_j = delta_ij, by a midpoint rule in (cos theta, phi), which is
+// uniform in solid angle.
+TEST(SharedMath, ShOrthonormalByIntegration) {
+  const int nu = 256, nphi = 512;
+  double gram[16][16] = {};
+  const double dw = (2.0 / nu) * (2.0 * M_PI / nphi);
+  for (int i = 0; i < nu; ++i) {
+    const double u = -1.0 + (i + 0.5) * 2.0 / nu;
+    const double s = std::sqrt(1.0 - u * u);
+    for (int j = 0; j < nphi; ++j) {
+      const double phi = (j + 0.5) * 2.0 * M_PI / nphi;
+      const SH16 y = sh_basis16(vec3(float(s * std::cos(phi)), float(s * std::sin(phi)), float(u)));
+      for (int a = 0; a < 16; ++a)
+        for (int b = a; b < 16; ++b) gram[a][b] += double(sh_get(y, a)) * sh_get(y, b) * dw;
+    }
+  }
+  for (int a = 0; a < 16; ++a)
+    for (int b = a; b < 16; ++b) EXPECT_NEAR(gram[a][b], a == b ? 1.0 : 0.0, 2e-3) << a << "," << b;
+}
+
+// Irradiance of a constant radiance L over the hemisphere is pi L; of a single-direction lobe it
+// follows the clamped cosine.
+TEST(SharedMath, ShCosineLobeGivesIrradiance) {
+  SH16 radiance{};
+  radiance.c0 = vec4(1.0f / 0.282094791773878f, 0, 0, 0);  // constant radiance 1
+  const SH16 e = sh_scale_cosine_lobe(radiance);
+  EXPECT_NEAR(sh_dot(e, sh_basis16(vec3(0, 1, 0))), float(M_PI), 1e-4f);
+  // Project a narrow lobe from +z and check E(n) ~ max(cos, 0) shape at a few normals.
+  const vec3 light = vec3(0, 0, 1);
+  SH16 proj = sh_basis16(light);  // delta function of unit intensity in direction `light`
+  const SH16 irr = sh_scale_cosine_lobe(proj);
+  const float e_up = sh_dot(irr, sh_basis16(light));
+  const float e_side = sh_dot(irr, sh_basis16(vec3(1, 0, 0)));
+  const float e_down = sh_dot(irr, sh_basis16(vec3(0, 0, -1)));
+  EXPECT_NEAR(e_up, 1.0f, 0.1f);  // band-limited approximation of cos(0) = 1
+  EXPECT_LT(std::abs(e_side), 0.2f);
+  EXPECT_LT(std::abs(e_down), 0.1f);
+}
+
+TEST(SharedMath, SpotFalloff) {
+  const float co = std::cos(glm::radians(30.0f)), ci = std::cos(glm::radians(20.0f));
+  EXPECT_FLOAT_EQ(spot_falloff(1.0f, co, ci), 1.0f);
+  EXPECT_FLOAT_EQ(spot_falloff(ci, co, ci), 1.0f);
+  EXPECT_FLOAT_EQ(spot_falloff(co, co, ci), 0.0f);
+  EXPECT_FLOAT_EQ(spot_falloff(std::cos(glm::radians(45.0f)), co, ci), 0.0f);
+  const float mid = spot_falloff(0.5f * (co + ci), co, ci);
+  EXPECT_NEAR(mid, 0.5f, 1e-5f);
+  // Monotonic inside the transition.
+  float prev = -1.0f;
+  for (int i = 0; i <= 10; ++i) {
+    const float v = spot_falloff(co + (ci - co) * float(i) / 10.0f, co, ci);
+    EXPECT_GE(v, prev);
+    prev = v;
+  }
+  // Degenerate cone (inner == outer) is a hard edge, not NaN.
+  EXPECT_FLOAT_EQ(spot_falloff(0.95f, 0.9f, 0.9f), 1.0f);
+  EXPECT_FLOAT_EQ(spot_falloff(0.85f, 0.9f, 0.9f), 0.0f);
+}
+
+TEST(SharedMath, PinholeProjectUnproject) {
+  const vec4 k(517.3f, 516.5f, 318.6f, 255.3f);
+  // The principal point sees the optical axis.
+  const vec2 c = project_pinhole(vec3(0, 0, 2), k);
+  EXPECT_FLOAT_EQ(c.x, 318.6f);
+  EXPECT_FLOAT_EQ(c.y, 255.3f);
+  // +x right, +y down in the image (OpenCV).
+  const vec2 p = project_pinhole(vec3(0.1f, 0.2f, 1.0f), k);
+  EXPECT_NEAR(p.x, 318.6f + 51.73f, 1e-3f);
+  EXPECT_NEAR(p.y, 255.3f + 103.3f, 1e-3f);
+  for (vec3 q : {vec3(0.3f, -0.2f, 1.5f), vec3(-1.0f, 0.7f, 4.0f)}) {
+    const vec3 r = unproject_pinhole(project_pinhole(q, k), q.z, k);
+    EXPECT_NEAR(r.x, q.x, 1e-5f);
+    EXPECT_NEAR(r.y, q.y, 1e-5f);
+    EXPECT_NEAR(r.z, q.z, 1e-6f);
+  }
+  // Behind the camera or at z = 0: finite, never NaN.
+  const vec2 z0 = project_pinhole(vec3(1, 1, 0), k);
+  EXPECT_TRUE(std::isfinite(z0.x) && std::isfinite(z0.y));
+}
+
+TEST(SharedMath, DifferentialCompose) {
+  const float eps = 1e-3f, amax = 4.0f;
+  // No change between L_r and L_rv -> the camera image untouched.
+  vec3 o = differential_compose(vec3(0.4f, 0.5f, 0.6f), vec3(0.2f), vec3(0.2f), 0.0f, eps, amax);
+  EXPECT_NEAR(o.x, 0.4f, 1e-6f);
+  EXPECT_NEAR(o.z, 0.6f, 1e-6f);
+  // A virtual shadow halving the modelled light halves the camera colour (alpha = CI / L_r).
+  o = differential_compose(vec3(0.4f), vec3(0.8f), vec3(0.4f), 0.0f, eps, amax);
+  EXPECT_NEAR(o.x, 0.2f, 1e-6f);
+  // Where L_r -> 0 (unlit in the model) the delta is added as is (alpha -> 1), finite.
+  o = differential_compose(vec3(0.3f), vec3(0.0f), vec3(0.25f), 0.0f, eps, amax);
+  EXPECT_NEAR(o.x, 0.55f, 1e-6f);
+  // Alpha is clamped: a bright camera over a dim model cannot explode.
+  o = differential_compose(vec3(1.0f), vec3(0.01f), vec3(0.5f), 0.0f, eps, amax);
+  EXPECT_NEAR(o.x, 1.0f + amax * 0.49f, 1e-5f);
+  // Never negative.
+  o = differential_compose(vec3(0.1f), vec3(0.05f), vec3(0.0f), 0.0f, eps, amax);
+  EXPECT_GE(o.x, 0.0f);
+  // Virtual pixels show L_rv.
+  o = differential_compose(vec3(0.9f), vec3(0.1f), vec3(0.3f, 0.2f, 0.1f), 1.0f, eps, amax);
+  EXPECT_NEAR(o.y, 0.2f, 1e-6f);
+  // Alpha is continuous across the guard band [eps, 2 eps].
+  const float a1 = compose_alpha1(0.5f, eps * 0.999f, eps, amax);
+  const float a2 = compose_alpha1(0.5f, eps * 1.001f, eps, amax);
+  EXPECT_NEAR(a1, a2, 1e-2f);
+  EXPECT_FLOAT_EQ(compose_alpha1(0.5f, 0.0f, eps, amax), 1.0f);
+}
+
+}  // namespace
