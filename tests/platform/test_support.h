@@ -1,0 +1,54 @@
+// Helpers shared by the platform tests: temp folders and a watchdog so that a hang fails the test
+// binary loudly instead of blocking CI.
+#pragma once
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <functional>
+#include <future>
+#include <string>
+#include <thread>
+
+namespace mrgi::test {
+
+inline std::string shared_data(const std::string& rel) { return std::string(MRGI_SHARED_DIR) + "/data/" + rel; }
+
+// A fresh folder under the system temp dir, removed when the object dies.
+struct TempDir {
+  std::filesystem::path path;
+  explicit TempDir(const std::string& tag) {
+    path = std::filesystem::temp_directory_path() /
+           ("mrgi-" + tag + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter()++));
+    std::filesystem::remove_all(path);
+    std::filesystem::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path, ec);
+  }
+  std::string file(const std::string& name) const { return (path / name).string(); }
+  static std::atomic<int>& counter() {
+    static std::atomic<int> c{0};
+    return c;
+  }
+};
+
+// Runs fn on another thread; if it has not returned after `limit`, the process aborts with a
+// message (a hang is a failure, and a hung thread cannot be cancelled).
+inline void run_with_deadline(std::chrono::seconds limit, const std::string& what, std::function<void()> fn) {
+  auto done = std::make_shared<std::promise<void>>();
+  auto fut = done->get_future();
+  std::thread([fn = std::move(fn), done] {
+    fn();
+    done->set_value();
+  }).detach();
+  if (fut.wait_for(limit) != std::future_status::ready) {
+    std::fprintf(stderr, "FATAL: %s did not finish within %lld s (hang)\n", what.c_str(), (long long)limit.count());
+    std::fflush(stderr);
+    std::abort();
+  }
+}
+
+}  // namespace mrgi::test
