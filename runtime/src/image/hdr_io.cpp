@@ -1,8 +1,8 @@
 // HDR environment images: OpenEXR through tinyexr, Radiance .hdr through stb_image, and 8-bit
 // sRGB PNG decoded to linear. All of them come back as linear RGB float.
+// The one stb_image implementation in the program. It must be the full decoder: its symbols
+// also satisfy libtinygltf.so's references (ELF interposition), which decodes PNG/JPEG textures.
 #define STB_IMAGE_IMPLEMENTATION
-#define STBI_NO_STDIO_WARNINGS
-#define STBI_ONLY_HDR
 #include <stb/stb_image.h>
 #include <tinyexr.h>
 

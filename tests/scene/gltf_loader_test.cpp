@@ -1,0 +1,203 @@
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <fstream>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "capture/temp_dir.h"
+#include "mrgi/scene.h"
+
+namespace mrgi {
+namespace {
+
+using testing::TempDir;
+using testing::write_text;
+
+const std::string kModels = std::string(MRGI_SHARED_DIR) + "/data/models/";
+
+void expect_vec3_near(const glm::vec3& a, const glm::vec3& b, float tol) {
+  EXPECT_NEAR(a.x, b.x, tol);
+  EXPECT_NEAR(a.y, b.y, tol);
+  EXPECT_NEAR(a.z, b.z, tol);
+}
+
+size_t vertex_count(const Model& m) {
+  size_t n = 0;
+  for (const auto& p : m.primitives) n += p.positions.size();
+  return n;
+}
+
+TEST(GltfLoader, BunnyVerticesBoundsAndMaterial) {
+  auto model = load_gltf(kModels + "bunny.glb", Placement{});
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  ASSERT_EQ(model->primitives.size(), 1u);
+  const auto& prim = model->primitives[0];
+  EXPECT_EQ(prim.positions.size(), 8146u);
+  EXPECT_EQ(prim.normals.size(), 8146u);
+  EXPECT_EQ(prim.indices.size(), 48642u);
+  EXPECT_TRUE(prim.uvs.empty());
+  expect_vec3_near(model->bounds_min, {-0.0945716f, -0.0618736f, -0.186643f}, 1e-6f);
+  expect_vec3_near(model->bounds_max, {0.0609346f, 0.0586895f, -0.0333891f}, 1e-6f);
+  ASSERT_EQ(model->materials.size(), 1u);
+  const Material& mat = model->materials[size_t(prim.material)];
+  EXPECT_NEAR(mat.base_color_factor.g, 0.6f, 1e-6f);
+  EXPECT_FLOAT_EQ(mat.metallic, 0.0f);
+  EXPECT_NEAR(mat.roughness, 0.8f, 1e-6f);
+  EXPECT_TRUE(mat.double_sided);
+  EXPECT_EQ(mat.base_color_texture, -1);
+  for (const auto& n : prim.normals) ASSERT_NEAR(glm::length(n), 1.0f, 1e-4f);
+}
+
+TEST(GltfLoader, DuckNodeTransformAndTexture) {
+  auto model = load_gltf(kModels + "duck.glb", Placement{});
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  ASSERT_EQ(model->primitives.size(), 1u);  // the camera node carries no mesh
+  const auto& prim = model->primitives[0];
+  EXPECT_EQ(prim.positions.size(), 2399u);
+  EXPECT_EQ(prim.uvs.size(), 2399u);
+  EXPECT_EQ(prim.indices.size(), 12636u);
+  // The root node scales centimetres to metres (matrix 0.01).
+  expect_vec3_near(model->bounds_min, {-0.692985f, 0.0992937f, -0.613282f}, 1e-5f);
+  expect_vec3_near(model->bounds_max, {0.961799f, 1.6397f, 0.539252f}, 1e-5f);
+  ASSERT_EQ(model->textures.size(), 1u);
+  const Material& mat = model->materials[size_t(prim.material)];
+  ASSERT_EQ(mat.base_color_texture, 0);
+  const ImageRGBA8& tex = model->textures[0].image;
+  EXPECT_EQ(tex.width, 512);
+  EXPECT_EQ(tex.height, 512);
+  // A yellow duck: the texture's mean is red/green heavy, and alpha is opaque.
+  double r = 0, g = 0, b = 0;
+  for (size_t i = 0; i < tex.pixel_count(); ++i) {
+    r += tex.data[i * 4];
+    g += tex.data[i * 4 + 1];
+    b += tex.data[i * 4 + 2];
+    ASSERT_EQ(tex.data[i * 4 + 3], 255);
+  }
+  EXPECT_GT(r, 2 * b);
+  EXPECT_GT(g, b);
+}
+
+TEST(GltfLoader, PlacementIsAppliedOnTop) {
+  Placement p;
+  p.position = {10, 0, 0};
+  p.scale = glm::vec3(2.0f);
+  auto base = load_gltf(kModels + "bunny.glb", Placement{});
+  auto moved = load_gltf(kModels + "bunny.glb", p);
+  ASSERT_TRUE(base.ok() && moved.ok());
+  expect_vec3_near(moved->bounds_min, base->bounds_min * 2.0f + glm::vec3(10, 0, 0), 1e-5f);
+  expect_vec3_near(moved->bounds_max, base->bounds_max * 2.0f + glm::vec3(10, 0, 0), 1e-5f);
+}
+
+TEST(GltfLoader, CornellBoxMeshesAndIor) {
+  auto model = load_gltf(kModels + "cornell_box.glb", Placement{});
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  EXPECT_EQ(model->primitives.size(), 8u);
+  EXPECT_EQ(vertex_count(*model), 72u);
+  expect_vec3_near(model->bounds_min, {0.0f, 0.0f, 0.0f}, 1e-6f);
+  expect_vec3_near(model->bounds_max, {0.556f, 0.5488f, 0.5592f}, 1e-6f);
+  ASSERT_GE(model->materials.size(), 4u);
+  EXPECT_NEAR(model->materials[0].ior, 1.45f, 1e-6f);
+  EXPECT_EQ(model->materials[2].base_color_factor, glm::vec4(0, 1, 0, 1));  // green
+}
+
+// A hand-written .gltf: one triangle, no normals (flat normals must be generated), a TRS node
+// under a parent, byte-strided positions and a transmissive glass material.
+struct TinyGltf {
+  TempDir dir;
+  std::string path;
+  explicit TinyGltf(const std::string& mode = "4") {
+    // Positions with a 16-byte stride (4 bytes of padding after each vec3).
+    const float data[] = {0, 0, 0, -1, 1, 0, 0, -1, 0, 1, 0, -1};
+    std::ofstream(dir.file("tri.bin"), std::ios::binary)
+        .write(reinterpret_cast<const char*>(data), sizeof(data));
+    path = dir.file("tri.gltf");
+    write_text(path, R"({
+  "asset": {"version": "2.0"},
+  "extensionsUsed": ["KHR_materials_transmission", "KHR_materials_ior"],
+  "scene": 0,
+  "scenes": [{"nodes": [0]}],
+  "nodes": [{"children": [1], "translation": [0, 1, 0]},
+            {"mesh": 0, "rotation": [0, 0.7071068, 0, 0.7071068], "scale": [2, 2, 2]}],
+  "meshes": [{"name": "glass_tri", "primitives": [{"attributes": {"POSITION": 0}, "material": 0, "mode": )" +
+                         mode + R"(}]}],
+  "materials": [{"name": "glass", "pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.95, 1, 1],
+                 "metallicFactor": 0, "roughnessFactor": 0.05},
+                 "emissiveFactor": [0.1, 0.2, 0.3],
+                 "extensions": {"KHR_materials_transmission": {"transmissionFactor": 0.95},
+                                "KHR_materials_ior": {"ior": 1.33}}}],
+  "buffers": [{"uri": "tri.bin", "byteLength": 48}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48, "byteStride": 16}],
+  "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                 "min": [0, 0, 0], "max": [1, 1, 0]}]
+})");
+  }
+};
+
+TEST(GltfLoader, TinyFileWithTransmissionTrsAndFlatNormals) {
+  TinyGltf f;
+  auto model = load_gltf(f.path, Placement{});
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  ASSERT_EQ(model->primitives.size(), 1u);
+  const auto& prim = model->primitives[0];
+  ASSERT_EQ(prim.positions.size(), 3u);
+  // Node: rotate 90 deg about +y, scale 2, then the parent lifts by 1: (1,0,0) -> (0,1,-2).
+  expect_vec3_near(prim.positions[0], {0, 1, 0}, 1e-5f);
+  expect_vec3_near(prim.positions[1], {0, 1, -2}, 1e-5f);
+  expect_vec3_near(prim.positions[2], {0, 3, 0}, 1e-5f);
+  // The triangle faces +z before the rotation, so +x after it.
+  for (const auto& n : prim.normals) expect_vec3_near(n, {1, 0, 0}, 1e-5f);
+  EXPECT_EQ(prim.indices, (std::vector<uint32_t>{0, 1, 2}));
+  const Material& mat = model->materials[0];
+  EXPECT_NEAR(mat.transmission, 0.95f, 1e-6f);
+  EXPECT_NEAR(mat.ior, 1.33f, 1e-6f);
+  EXPECT_NEAR(mat.roughness, 0.05f, 1e-6f);
+  EXPECT_NEAR(mat.emissive.z, 0.3f, 1e-6f);
+  EXPECT_FALSE(mat.double_sided);
+  expect_vec3_near(model->bounds_min, {0, 1, -2}, 1e-5f);
+  expect_vec3_near(model->bounds_max, {0, 3, 0}, 1e-5f);
+}
+
+TEST(GltfLoader, MirroringPlacementKeepsFrontFaces) {
+  TinyGltf f;
+  Placement mirror;
+  mirror.scale = {-1, 1, 1};
+  auto model = load_gltf(f.path, mirror);
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  const auto& prim = model->primitives[0];
+  const glm::vec3 a = prim.positions[prim.indices[0]], b = prim.positions[prim.indices[1]],
+                  c = prim.positions[prim.indices[2]];
+  // Winding and stored normal agree after the mirror.
+  EXPECT_GT(glm::dot(glm::cross(b - a, c - a), prim.normals[0]), 0.0f);
+}
+
+TEST(GltfLoader, NonTriangleModeIsRefusedNamingTheMesh) {
+  TinyGltf f("0");
+  EXPECT_ERROR(load_gltf(f.path, Placement{}), BadInput, "tri.gltf", "'glass_tri'", "points",
+               "triangle lists only");
+}
+
+TEST(GltfLoader, MissingAndBrokenFiles) {
+  TempDir dir;
+  EXPECT_ERROR(load_gltf(dir.file("none.glb"), Placement{}), NotFound, "none.glb");
+  write_text(dir.file("bad.gltf"), "{ not json");
+  EXPECT_ERROR(load_gltf(dir.file("bad.gltf"), Placement{}), BadInput, "bad.gltf", "cannot load glTF");
+  write_text(dir.file("x.obj"), "v 0 0 0");
+  EXPECT_ERROR(load_gltf(dir.file("x.obj"), Placement{}), BadInput, "x.obj", ".gltf or .glb");
+}
+
+TEST(GltfLoader, AccessorPastBufferEndIsRefused) {
+  TinyGltf f;
+  // Claim 4 vertices in a 48-byte view with a 16-byte stride: the 4th reads past the end.
+  std::ifstream in(f.path);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text.replace(text.find("\"count\": 3"), 10, "\"count\": 4");
+  write_text(f.path, text);
+  auto model = load_gltf(f.path, Placement{});
+  ASSERT_FALSE(model.ok());
+  EXPECT_EQ(model.error().kind, ErrorKind::BadInput);
+  EXPECT_TRUE(testing::contains(model.error().message, "tri.gltf")) << model.error().message;
+}
+
+}  // namespace
+}  // namespace mrgi
