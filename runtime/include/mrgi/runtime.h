@@ -55,11 +55,16 @@ struct FrameStats {
   double cpu_ms = 0.0;                 // wall time of process() on the host
   int level = 0;
   std::vector<std::string> skipped;    // passes culled or skipped this frame, with reason
+  // Conditions worth knowing about this frame, e.g. "pose: none given, previous pose used".
+  std::vector<std::string> notes;
 };
 
 struct FrameOutput {
   ImageRGBA8 image;    // composited frame, output size
   FrameStats stats;
+  // Output size; 255 where a virtual object is seen (composited as TM(L_rv)), 0 on real pixels.
+  // For RDE over real / virtual pixels (metrics.h).
+  Image<uint8_t, 1> virtual_mask;
   // Linear RGB buffers for error measurement, output size (only when requested in settings):
   // not part of the shipped path.
 };
