@@ -67,6 +67,24 @@ struct StandardSamplers {
   VkSampler shadow_compare = VK_NULL_HANDLE;  // linear, compare LESS_OR_EQUAL, clamp to border 1
 };
 
+// Entry points that are core in 1.3 but extensions in 1.2 (sync2, dynamic rendering), fetched
+// with the right name for the device's API version.
+struct DeviceFunctions {
+  PFN_vkCmdPipelineBarrier2 cmd_pipeline_barrier2 = nullptr;
+  PFN_vkCmdWriteTimestamp2 cmd_write_timestamp2 = nullptr;
+  PFN_vkQueueSubmit2 queue_submit2 = nullptr;
+  PFN_vkCmdBeginRendering cmd_begin_rendering = nullptr;
+  PFN_vkCmdEndRendering cmd_end_rendering = nullptr;
+  PFN_vkCmdPushDescriptorSetKHR cmd_push_descriptor_set = nullptr;
+};
+
+// The device index `selector` picks among `devices` (rules of DeviceSettings::device, with the
+// $MRGI_DEVICE step already applied by the caller). BadUsage listing the devices if none matches.
+Expected<uint32_t> select_device_index(const std::vector<DeviceInfo>& devices,
+                                       const std::string& selector);
+// DeviceSettings::device, or $MRGI_DEVICE when that is empty.
+std::string effective_device_selector(const DeviceSettings& settings);
+
 class Context {
  public:
   // Selects the device per DeviceSettings (see runtime.h) and creates everything.
@@ -88,7 +106,8 @@ class Context {
   uint32_t timestamp_valid_bits() const { return timestamp_valid_bits_; }
   const StandardSamplers& samplers() const { return samplers_; }
   // vkCmdPushDescriptorSetKHR, fetched at creation.
-  PFN_vkCmdPushDescriptorSetKHR cmd_push_descriptor_set() const { return push_descriptor_set_; }
+  PFN_vkCmdPushDescriptorSetKHR cmd_push_descriptor_set() const { return fn_.cmd_push_descriptor_set; }
+  const DeviceFunctions& fn() const { return fn_; }
 
   // Validation (DeviceSettings::validate): every warning and error message, in order.
   bool validation_enabled() const { return validate_; }
@@ -142,7 +161,7 @@ class Context {
   VkPhysicalDeviceMemoryProperties memory_properties_{};
   DeviceInfo info_;
   StandardSamplers samplers_;
-  PFN_vkCmdPushDescriptorSetKHR push_descriptor_set_ = nullptr;
+  DeviceFunctions fn_;
   PFN_vkSetDebugUtilsObjectNameEXT set_object_name_ = nullptr;
   bool validate_ = false;
   uint64_t allocated_bytes_ = 0;

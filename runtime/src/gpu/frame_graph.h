@@ -86,6 +86,7 @@ enum class Access : uint8_t {
   IndexBuffer,
   UniformRead,
   IndirectRead,
+  DepthAttachmentReadWrite, // depth test and write over loaded contents (e.g. real depth)
 };
 bool is_write(Access access);
 bool is_read(Access access);
@@ -96,6 +97,7 @@ const char* to_string(PassKind kind);
 
 // --- The pure compile step (no Vulkan calls: tests inspect it without a GPU) ------------------
 
+// `id` indexes the `resources` list given to compile_graph; `is_image` must match it.
 struct ResourceRef {
   bool is_image = true;
   uint32_t id = 0;
@@ -187,7 +189,8 @@ class PassBuilder {
 
  private:
   friend class FrameGraph;
-  explicit PassBuilder(PassDecl& decl) : decl_(decl) {}
+  PassBuilder(FrameGraph& graph, PassDecl& decl) : graph_(graph), decl_(decl) {}
+  FrameGraph& graph_;
   PassDecl& decl_;
 };
 
@@ -291,6 +294,7 @@ class FrameGraph {
 
  private:
   friend class PassContext;
+  friend class PassBuilder;
   struct ImageEntry;
   struct BufferEntry;
   struct Slot;

@@ -1,0 +1,486 @@
+// The runtime half of the frame graph: resources, frame slots, recording and timestamps. The
+// culling and barrier rules are in frame_graph_compile.cpp.
+#include <algorithm>
+#include <cmath>
+
+#include "gpu/frame_graph.h"
+#include "gpu/vk_check.h"
+
+namespace mrgi::gpu {
+namespace {
+constexpr uint64_t kFrameTimeoutNs = 10ull * 1000 * 1000 * 1000;
+}
+
+struct FrameGraph::ImageEntry {
+  ImageDesc desc;
+  GpuImage gpu;
+  bool owned = true;
+  ResourceState state;
+};
+
+struct FrameGraph::BufferEntry {
+  BufferDesc desc;
+  std::vector<GpuBuffer> copies;       // one, or one per frame slot
+  std::vector<ResourceState> states;   // per copy
+  bool owned = true;
+};
+
+struct FrameGraph::Slot {
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  VkFence fence = VK_NULL_HANDLE;
+  VkQueryPool queries = VK_NULL_HANDLE;
+  bool submitted = false;
+  int64_t frame_index = -1;
+  std::vector<std::string> pass_names;
+  std::vector<std::string> culled;
+};
+
+// --- PassBuilder / PassContext -------------------------------------------------------------------
+
+void PassBuilder::read(ImageHandle image, Access access) {
+  decl_.uses.push_back({ResourceRef{true, image.id}, access});
+}
+void PassBuilder::write(ImageHandle image, Access access) {
+  decl_.uses.push_back({ResourceRef{true, image.id}, access});
+}
+void PassBuilder::read(BufferHandle buffer, Access access) {
+  decl_.uses.push_back({ResourceRef{false, uint32_t(graph_.images_.size()) + buffer.id}, access});
+}
+void PassBuilder::write(BufferHandle buffer, Access access) {
+  decl_.uses.push_back({ResourceRef{false, uint32_t(graph_.images_.size()) + buffer.id}, access});
+}
+void PassBuilder::side_effect() { decl_.side_effect = true; }
+
+VkImage PassContext::image(ImageHandle h) const { return graph_.gpu_image(h).image; }
+VkImageView PassContext::view(ImageHandle h) const { return graph_.gpu_image(h).view; }
+VkFormat PassContext::format(ImageHandle h) const { return graph_.gpu_image(h).format; }
+VkExtent2D PassContext::extent(ImageHandle h) const { return graph_.extent(h); }
+VkBuffer PassContext::buffer(BufferHandle h) const { return graph_.gpu_buffer(h, graph_.slot_).buffer; }
+VkDeviceSize PassContext::buffer_size(BufferHandle h) const { return graph_.gpu_buffer(h, graph_.slot_).size; }
+void* PassContext::mapped(BufferHandle h) const { return graph_.mapped(h, graph_.slot_); }
+VkExtent2D PassContext::output_size() const { return graph_.output_size_; }
+float PassContext::render_scale() const { return graph_.render_scale_; }
+int64_t PassContext::frame_index() const { return graph_.frame_index_; }
+uint32_t PassContext::slot() const { return graph_.slot_; }
+const Context& PassContext::context() const { return graph_.context_; }
+
+// --- creation ------------------------------------------------------------------------------------
+
+FrameGraph::FrameGraph(Context& context, const FrameGraphSettings& settings)
+    : context_(context), settings_(settings) {}
+
+Expected<std::unique_ptr<FrameGraph>> FrameGraph::create(Context& context, const FrameGraphSettings& settings) {
+  if (settings.frames_in_flight < 1 || settings.frames_in_flight > 3)
+    return fail(ErrorKind::BadUsage, "FrameGraphSettings.frames_in_flight = " +
+                                         std::to_string(settings.frames_in_flight) + ": must be 1..3");
+  if (settings.max_output_width == 0 || settings.max_output_height == 0)
+    return fail(ErrorKind::BadUsage, "FrameGraphSettings.max_output_width/height must be > 0");
+  if (!(settings.max_render_scale > 0.0f && settings.max_render_scale <= 1.0f))
+    return fail(ErrorKind::BadUsage, "FrameGraphSettings.max_render_scale must be in (0, 1]");
+  if (settings.max_passes == 0 || settings.max_passes > 1024)
+    return fail(ErrorKind::BadUsage, "FrameGraphSettings.max_passes must be 1..1024");
+  if (context.timestamp_valid_bits() == 0)
+    return fail(ErrorKind::Device, "device '" + context.info().name + "': its queue has no timestamps, "
+                                   "which per-pass timing needs");
+  std::unique_ptr<FrameGraph> g(new FrameGraph(context, settings));
+  MRGI_TRY(g->init());
+  return g;
+}
+
+Status FrameGraph::init() {
+  output_size_ = {settings_.max_output_width, settings_.max_output_height};
+  render_scale_ = settings_.max_render_scale;
+  VkDevice dev = context_.device();
+  VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pci.queueFamilyIndex = context_.queue_family();
+  VK_CHECK(vkCreateCommandPool(dev, &pci, nullptr, &pool_));
+  slots_.resize(settings_.frames_in_flight);
+  for (Slot& s : slots_) {
+    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    ai.commandPool = pool_;
+    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    ai.commandBufferCount = 1;
+    VK_CHECK(vkAllocateCommandBuffers(dev, &ai, &s.cmd));
+    VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    VK_CHECK(vkCreateFence(dev, &fci, nullptr, &s.fence));
+    VkQueryPoolCreateInfo qci{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    qci.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    qci.queryCount = 2 * settings_.max_passes;
+    VK_CHECK(vkCreateQueryPool(dev, &qci, nullptr, &s.queries));
+    s.pass_names.reserve(settings_.max_passes);
+  }
+  decls_.reserve(settings_.max_passes);
+  executes_.reserve(settings_.max_passes);
+  return ok_status();
+}
+
+FrameGraph::~FrameGraph() {
+  VkDevice dev = context_.device();
+  vkDeviceWaitIdle(dev);
+  for (Slot& s : slots_) {
+    if (s.fence) vkDestroyFence(dev, s.fence, nullptr);
+    if (s.queries) vkDestroyQueryPool(dev, s.queries, nullptr);
+  }
+  if (pool_) vkDestroyCommandPool(dev, pool_, nullptr);
+  for (ImageEntry& e : images_)
+    if (e.owned) context_.destroy(e.gpu);
+  for (BufferEntry& e : buffers_)
+    if (e.owned)
+      for (GpuBuffer& b : e.copies) context_.destroy(b);
+}
+
+static VkExtent2D relative_extent(uint32_t w, uint32_t h, float scale) {
+  return {std::max(1u, uint32_t(std::ceil(double(w) * scale))), std::max(1u, uint32_t(std::ceil(double(h) * scale)))};
+}
+
+Expected<ImageHandle> FrameGraph::create_image(const ImageDesc& desc, VkImageUsageFlags usage) {
+  const std::string what = "frame graph image '" + desc.name + "'";
+  if (in_frame_) return fail(ErrorKind::BadUsage, what + ": resources are created at start-up, not inside a frame");
+  if (desc.name.empty()) return fail(ErrorKind::BadUsage, "frame graph image: name must not be empty");
+  for (const ImageEntry& e : images_)
+    if (e.desc.name == desc.name) return fail(ErrorKind::BadUsage, what + ": name already used");
+  VkExtent2D ext;
+  if (desc.size_mode == SizeMode::Absolute) {
+    if (desc.width == 0 || desc.height == 0)
+      return fail(ErrorKind::BadUsage, what + ": absolute size needs width and height > 0");
+    ext = {desc.width, desc.height};
+  } else {
+    if (!(desc.scale > 0.0f && desc.scale <= 4.0f))
+      return fail(ErrorKind::BadUsage, what + ": scale " + std::to_string(desc.scale) + " must be in (0, 4]");
+    const float s = desc.scale * (desc.follows_render_scale ? settings_.max_render_scale : 1.0f);
+    ext = relative_extent(settings_.max_output_width, settings_.max_output_height, s);
+  }
+  ImageCreateDesc cd;
+  cd.format = desc.format;
+  cd.width = ext.width;
+  cd.height = ext.height;
+  cd.mip_levels = desc.mip_levels;
+  cd.layers = desc.layers;
+  cd.usage = usage | desc.extra_usage;
+  cd.name = desc.name;
+  auto img = context_.create_image(cd);
+  if (!img) return img.error();
+  ImageEntry e;
+  e.desc = desc;
+  e.gpu = *img;
+  images_.push_back(std::move(e));
+  return ImageHandle{uint32_t(images_.size() - 1)};
+}
+
+Expected<BufferHandle> FrameGraph::create_buffer(const BufferDesc& desc, VkBufferUsageFlags usage) {
+  const std::string what = "frame graph buffer '" + desc.name + "'";
+  if (in_frame_) return fail(ErrorKind::BadUsage, what + ": resources are created at start-up, not inside a frame");
+  if (desc.name.empty()) return fail(ErrorKind::BadUsage, "frame graph buffer: name must not be empty");
+  for (const BufferEntry& e : buffers_)
+    if (e.desc.name == desc.name) return fail(ErrorKind::BadUsage, what + ": name already used");
+  BufferEntry e;
+  e.desc = desc;
+  const uint32_t copies = desc.per_frame_copies ? settings_.frames_in_flight : 1;
+  for (uint32_t i = 0; i < copies; ++i) {
+    auto b = context_.create_buffer(desc.size, usage | desc.extra_usage, desc.memory,
+                                    copies > 1 ? desc.name + "#" + std::to_string(i) : desc.name);
+    if (!b) {
+      for (GpuBuffer& made : e.copies) context_.destroy(made);
+      return b.error();
+    }
+    e.copies.push_back(*b);
+  }
+  e.states.resize(copies);
+  buffers_.push_back(std::move(e));
+  return BufferHandle{uint32_t(buffers_.size() - 1)};
+}
+
+ImageHandle FrameGraph::import_image(const std::string& name, const GpuImage& image, VkImageLayout layout,
+                                     bool history) {
+  ImageEntry e;
+  e.desc.name = name;
+  e.desc.format = image.format;
+  e.desc.size_mode = SizeMode::Absolute;
+  e.desc.width = image.extent.width;
+  e.desc.height = image.extent.height;
+  e.desc.mip_levels = image.mip_levels;
+  e.desc.layers = image.layers;
+  e.desc.history = history;
+  e.gpu = image;
+  e.owned = false;
+  e.state.layout = layout;
+  images_.push_back(std::move(e));
+  return ImageHandle{uint32_t(images_.size() - 1)};
+}
+
+BufferHandle FrameGraph::import_buffer(const std::string& name, const GpuBuffer& buffer, bool history) {
+  BufferEntry e;
+  e.desc.name = name;
+  e.desc.size = buffer.size;
+  e.desc.memory = buffer.memory_usage;
+  e.desc.history = history;
+  e.copies.push_back(buffer);
+  e.states.resize(1);
+  e.owned = false;
+  buffers_.push_back(std::move(e));
+  return BufferHandle{uint32_t(buffers_.size() - 1)};
+}
+
+Status FrameGraph::upload_image(ImageHandle image, const void* texels, VkDeviceSize size) {
+  if (image.id >= images_.size()) return fail(ErrorKind::BadUsage, "upload_image: invalid image handle");
+  if (in_frame_) return fail(ErrorKind::BadUsage, "upload_image('" + images_[image.id].desc.name +
+                                                      "'): start-up only, not inside a frame");
+  // Previous frames may still use it.
+  VK_CHECK(vkQueueWaitIdle(context_.queue()));
+  ImageEntry& e = images_[image.id];
+  MRGI_TRY(context_.upload_image(e.gpu, texels, size, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL));
+  e.state = ResourceState{};
+  e.state.layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+  return ok_status();
+}
+
+// --- sizes ---------------------------------------------------------------------------------------
+
+Status FrameGraph::set_output_size(uint32_t width, uint32_t height) {
+  if (width == 0 || height == 0 || width > settings_.max_output_width || height > settings_.max_output_height)
+    return fail(ErrorKind::BadUsage, "output size " + std::to_string(width) + "x" + std::to_string(height) +
+                                         " must be non-zero and within the allocated " +
+                                         std::to_string(settings_.max_output_width) + "x" +
+                                         std::to_string(settings_.max_output_height));
+  output_size_ = {width, height};
+  return ok_status();
+}
+
+Status FrameGraph::set_render_scale(float scale) {
+  if (!(scale > 0.0f && scale <= settings_.max_render_scale))
+    return fail(ErrorKind::BadUsage, "render scale " + std::to_string(scale) + " must be in (0, " +
+                                         std::to_string(settings_.max_render_scale) + "] (allocated maximum)");
+  render_scale_ = scale;
+  return ok_status();
+}
+
+VkExtent2D FrameGraph::extent(ImageHandle image) const {
+  const ImageEntry& e = images_.at(image.id);
+  if (e.desc.size_mode == SizeMode::Absolute) return e.gpu.extent;
+  const float s = e.desc.scale * (e.desc.follows_render_scale ? render_scale_ : 1.0f);
+  const VkExtent2D r = relative_extent(output_size_.width, output_size_.height, s);
+  return {std::min(r.width, e.gpu.extent.width), std::min(r.height, e.gpu.extent.height)};
+}
+
+VkExtent2D FrameGraph::allocated_extent(ImageHandle image) const { return images_.at(image.id).gpu.extent; }
+const GpuImage& FrameGraph::gpu_image(ImageHandle image) const { return images_.at(image.id).gpu; }
+const GpuBuffer& FrameGraph::gpu_buffer(BufferHandle buffer, uint32_t slot) const {
+  const BufferEntry& e = buffers_.at(buffer.id);
+  return e.copies.size() > 1 ? e.copies.at(slot) : e.copies[0];
+}
+const std::string& FrameGraph::name(ImageHandle image) const { return images_.at(image.id).desc.name; }
+const std::string& FrameGraph::name(BufferHandle buffer) const { return buffers_.at(buffer.id).desc.name; }
+void* FrameGraph::mapped(BufferHandle buffer, uint32_t slot) const { return gpu_buffer(buffer, slot).mapped; }
+
+// --- frames --------------------------------------------------------------------------------------
+
+Expected<std::optional<FrameTimings>> FrameGraph::collect(uint32_t index) {
+  Slot& s = slots_[index];
+  if (!s.submitted) return std::optional<FrameTimings>{};
+  VkDevice dev = context_.device();
+  const VkResult w = vkWaitForFences(dev, 1, &s.fence, VK_TRUE, kFrameTimeoutNs);
+  if (w == VK_TIMEOUT)
+    return fail(ErrorKind::Timeout, "frame " + std::to_string(s.frame_index) + " did not finish on the GPU within 10 s");
+  VK_CHECK(w);
+  VK_CHECK(vkResetFences(dev, 1, &s.fence));
+  s.submitted = false;
+  FrameTimings t;
+  t.frame_index = s.frame_index;
+  t.slot = index;
+  t.culled = s.culled;
+  const uint32_t n = uint32_t(s.pass_names.size());
+  if (n > 0) {
+    uint64_t ticks[2 * 1024];
+    VK_CHECK(vkGetQueryPoolResults(dev, s.queries, 0, 2 * n, sizeof(uint64_t) * 2 * n, ticks, sizeof(uint64_t),
+                                   VK_QUERY_RESULT_64_BIT));
+    const uint32_t bits = context_.timestamp_valid_bits();
+    const uint64_t mask = bits >= 64 ? ~0ull : ((1ull << bits) - 1);
+    const double ms_per_tick = context_.timestamp_period_ns() * 1e-6;
+    for (uint32_t i = 0; i < n; ++i) {
+      const uint64_t a = ticks[2 * i] & mask, b = ticks[2 * i + 1] & mask;
+      t.passes.push_back(PassTiming{s.pass_names[i], double((b - a) & mask) * ms_per_tick});
+    }
+    t.total_ms = double(((ticks[2 * n - 1] & mask) - (ticks[0] & mask)) & mask) * ms_per_tick;
+  }
+  return std::optional<FrameTimings>(std::move(t));
+}
+
+Expected<std::optional<FrameTimings>> FrameGraph::begin_frame() {
+  if (in_frame_) return fail(ErrorKind::BadUsage, "begin_frame: the previous frame was not submitted");
+  const int64_t next = frame_index_ + 1;
+  const uint32_t slot = uint32_t(next % int64_t(slots_.size()));
+  auto done = collect(slot);
+  if (!done) return done.error();
+  VK_CHECK(vkResetCommandBuffer(slots_[slot].cmd, 0));
+  frame_index_ = next;
+  slot_ = slot;
+  decls_.clear();
+  executes_.clear();
+  outputs_.clear();
+  compiled_valid_ = false;
+  in_frame_ = true;
+  return done;
+}
+
+void FrameGraph::add_pass(const std::string& name, PassKind kind, const SetupFn& setup, ExecuteFn execute) {
+  decls_.push_back(PassDecl{name, kind, {}, false});
+  PassBuilder builder(*this, decls_.back());
+  setup(builder);
+  executes_.push_back(std::move(execute));
+  compiled_valid_ = false;
+}
+
+void FrameGraph::mark_output(ImageHandle image) { outputs_.push_back(ResourceRef{true, image.id}); }
+void FrameGraph::mark_output(BufferHandle buffer) {
+  outputs_.push_back(ResourceRef{false, uint32_t(images_.size()) + buffer.id});
+}
+
+std::vector<ResourceInfo> FrameGraph::resource_infos() const {
+  std::vector<ResourceInfo> infos;
+  infos.reserve(images_.size() + buffers_.size());
+  for (const ImageEntry& e : images_) {
+    ResourceInfo r;
+    r.name = e.desc.name;
+    r.is_image = true;
+    r.history = e.desc.history;
+    r.initial = e.state;
+    infos.push_back(std::move(r));
+  }
+  for (const BufferEntry& e : buffers_) {
+    ResourceInfo r;
+    r.name = e.desc.name;
+    r.is_image = false;
+    r.history = e.desc.history;
+    r.host_read = e.desc.memory == MemoryUsage::Readback;
+    r.initial = e.states.size() > 1 ? e.states[slot_] : e.states[0];
+    infos.push_back(std::move(r));
+  }
+  for (const ResourceRef& o : outputs_)
+    if (o.id < infos.size()) infos[o.id].is_output = true;
+  return infos;
+}
+
+Status FrameGraph::compile() {
+  if (!in_frame_) return fail(ErrorKind::BadUsage, "compile: call begin_frame first");
+  for (const ResourceRef& o : outputs_)
+    if (o.id >= images_.size() + buffers_.size())
+      return fail(ErrorKind::BadUsage, "mark_output: invalid resource handle");
+  auto g = compile_graph(decls_, resource_infos());
+  if (!g) return g.error();
+  if (g->passes.size() > settings_.max_passes)
+    return fail(ErrorKind::BadUsage, std::to_string(g->passes.size()) + " passes run this frame, more than "
+                                     "FrameGraphSettings.max_passes = " + std::to_string(settings_.max_passes));
+  compiled_ = std::move(*g);
+  compiled_valid_ = true;
+  return ok_status();
+}
+
+Status FrameGraph::execute(VkCommandBuffer cmd) {
+  if (!compiled_valid_) return fail(ErrorKind::BadUsage, "execute: compile() the frame first");
+  const DeviceFunctions& fn = context_.fn();
+  Slot& slot = slots_[slot_];
+  const uint32_t n = uint32_t(compiled_.passes.size());
+  if (n > 0) vkCmdResetQueryPool(cmd, slot.queries, 0, 2 * n);
+  std::vector<VkImageMemoryBarrier2> image_barriers;
+  std::vector<VkBufferMemoryBarrier2> buffer_barriers;
+  auto record_barriers = [&](const std::vector<Barrier>& barriers) {
+    if (barriers.empty()) return;
+    image_barriers.clear();
+    buffer_barriers.clear();
+    for (const Barrier& b : barriers) {
+      if (b.resource.is_image) {
+        const GpuImage& img = images_[b.resource.id].gpu;
+        VkImageMemoryBarrier2 ib{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+        ib.srcStageMask = b.src_stages;
+        ib.srcAccessMask = b.src_access;
+        ib.dstStageMask = b.dst_stages;
+        ib.dstAccessMask = b.dst_access;
+        ib.oldLayout = b.old_layout;
+        ib.newLayout = b.new_layout;
+        ib.srcQueueFamilyIndex = ib.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        ib.image = img.image;
+        ib.subresourceRange = {img.aspect, 0, img.mip_levels, 0, img.layers};
+        image_barriers.push_back(ib);
+      } else {
+        const uint32_t id = b.resource.id - uint32_t(images_.size());
+        const GpuBuffer& buf = gpu_buffer(BufferHandle{id}, slot_);
+        VkBufferMemoryBarrier2 bb{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
+        bb.srcStageMask = b.src_stages;
+        bb.srcAccessMask = b.src_access;
+        bb.dstStageMask = b.dst_stages;
+        bb.dstAccessMask = b.dst_access;
+        bb.srcQueueFamilyIndex = bb.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        bb.buffer = buf.buffer;
+        bb.offset = 0;
+        bb.size = VK_WHOLE_SIZE;
+        buffer_barriers.push_back(bb);
+      }
+    }
+    VkDependencyInfo di{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    di.imageMemoryBarrierCount = uint32_t(image_barriers.size());
+    di.pImageMemoryBarriers = image_barriers.data();
+    di.bufferMemoryBarrierCount = uint32_t(buffer_barriers.size());
+    di.pBufferMemoryBarriers = buffer_barriers.data();
+    fn.cmd_pipeline_barrier2(cmd, &di);
+  };
+  PassContext ctx(*this);
+  for (uint32_t i = 0; i < n; ++i) {
+    const CompiledPass& p = compiled_.passes[i];
+    record_barriers(p.barriers);
+    fn.cmd_write_timestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, slot.queries, 2 * i);
+    if (executes_[p.pass_index]) executes_[p.pass_index](cmd, ctx);
+    fn.cmd_write_timestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, slot.queries, 2 * i + 1);
+  }
+  record_barriers(compiled_.final_barriers);
+  // The GPU state at the end of this frame is where the next frame starts.
+  for (size_t r = 0; r < compiled_.final_states.size(); ++r) {
+    if (r < images_.size()) {
+      images_[r].state = compiled_.final_states[r];
+    } else {
+      BufferEntry& e = buffers_[r - images_.size()];
+      (e.states.size() > 1 ? e.states[slot_] : e.states[0]) = compiled_.final_states[r];
+    }
+  }
+  slot.pass_names.clear();
+  for (const CompiledPass& p : compiled_.passes) slot.pass_names.push_back(p.name);
+  slot.culled = compiled_.culled;
+  slot.frame_index = frame_index_;
+  return ok_status();
+}
+
+Status FrameGraph::submit() {
+  if (!in_frame_) return fail(ErrorKind::BadUsage, "submit: call begin_frame first");
+  if (!compiled_valid_) MRGI_TRY(compile());
+  Slot& slot = slots_[slot_];
+  VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  VK_CHECK(vkBeginCommandBuffer(slot.cmd, &bi));
+  MRGI_TRY(execute(slot.cmd));
+  VK_CHECK(vkEndCommandBuffer(slot.cmd));
+  VkCommandBufferSubmitInfo cbi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+  cbi.commandBuffer = slot.cmd;
+  VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+  si.commandBufferInfoCount = 1;
+  si.pCommandBufferInfos = &cbi;
+  VK_CHECK(context_.fn().queue_submit2(context_.queue(), 1, &si, slot.fence));
+  slot.submitted = true;
+  in_frame_ = false;
+  return ok_status();
+}
+
+Expected<std::vector<FrameTimings>> FrameGraph::flush() {
+  if (in_frame_) return fail(ErrorKind::BadUsage, "flush: the current frame was not submitted");
+  std::vector<FrameTimings> out;
+  const uint32_t n = uint32_t(slots_.size());
+  // Oldest first: the slot after the current one is the oldest in flight.
+  for (uint32_t k = 1; k <= n; ++k) {
+    const uint32_t index = (slot_ + k) % n;
+    auto t = collect(index);
+    if (!t) return t.error();
+    if (*t) out.push_back(std::move(**t));
+  }
+  return out;
+}
+
+}  // namespace mrgi::gpu

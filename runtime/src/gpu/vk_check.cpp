@@ -1,0 +1,53 @@
+#include "gpu/vk_check.h"
+
+#include <cstdio>
+
+namespace mrgi::gpu {
+
+const char* vk_result_name(VkResult r) {
+  switch (r) {
+#define MRGI_VK_RESULT(x) case x: return #x;
+    MRGI_VK_RESULT(VK_SUCCESS)
+    MRGI_VK_RESULT(VK_NOT_READY)
+    MRGI_VK_RESULT(VK_TIMEOUT)
+    MRGI_VK_RESULT(VK_EVENT_SET)
+    MRGI_VK_RESULT(VK_EVENT_RESET)
+    MRGI_VK_RESULT(VK_INCOMPLETE)
+    MRGI_VK_RESULT(VK_ERROR_OUT_OF_HOST_MEMORY)
+    MRGI_VK_RESULT(VK_ERROR_OUT_OF_DEVICE_MEMORY)
+    MRGI_VK_RESULT(VK_ERROR_INITIALIZATION_FAILED)
+    MRGI_VK_RESULT(VK_ERROR_DEVICE_LOST)
+    MRGI_VK_RESULT(VK_ERROR_MEMORY_MAP_FAILED)
+    MRGI_VK_RESULT(VK_ERROR_LAYER_NOT_PRESENT)
+    MRGI_VK_RESULT(VK_ERROR_EXTENSION_NOT_PRESENT)
+    MRGI_VK_RESULT(VK_ERROR_FEATURE_NOT_PRESENT)
+    MRGI_VK_RESULT(VK_ERROR_INCOMPATIBLE_DRIVER)
+    MRGI_VK_RESULT(VK_ERROR_TOO_MANY_OBJECTS)
+    MRGI_VK_RESULT(VK_ERROR_FORMAT_NOT_SUPPORTED)
+    MRGI_VK_RESULT(VK_ERROR_FRAGMENTED_POOL)
+    MRGI_VK_RESULT(VK_ERROR_UNKNOWN)
+    MRGI_VK_RESULT(VK_ERROR_OUT_OF_POOL_MEMORY)
+    MRGI_VK_RESULT(VK_ERROR_INVALID_EXTERNAL_HANDLE)
+    MRGI_VK_RESULT(VK_ERROR_FRAGMENTATION)
+    MRGI_VK_RESULT(VK_ERROR_INVALID_OPAQUE_CAPTURE_ADDRESS)
+    MRGI_VK_RESULT(VK_PIPELINE_COMPILE_REQUIRED)
+    MRGI_VK_RESULT(VK_ERROR_SURFACE_LOST_KHR)
+    MRGI_VK_RESULT(VK_ERROR_NATIVE_WINDOW_IN_USE_KHR)
+    MRGI_VK_RESULT(VK_SUBOPTIMAL_KHR)
+    MRGI_VK_RESULT(VK_ERROR_OUT_OF_DATE_KHR)
+    MRGI_VK_RESULT(VK_ERROR_VALIDATION_FAILED_EXT)
+    MRGI_VK_RESULT(VK_ERROR_INVALID_SHADER_NV)
+#undef MRGI_VK_RESULT
+    default: break;
+  }
+  static thread_local char buf[32];
+  std::snprintf(buf, sizeof buf, "VkResult(%d)", int(r));
+  return buf;
+}
+
+Error vk_error(VkResult result, const char* expr, const char* file, int line) {
+  return fail(ErrorKind::Device, std::string(file) + ":" + std::to_string(line) + ": " + expr +
+                                     " failed with " + vk_result_name(result));
+}
+
+}  // namespace mrgi::gpu
