@@ -1,0 +1,102 @@
+#include "compose/compose.h"
+
+#include <cstring>
+
+#include <glm/glm.hpp>
+
+#include "gpu/shaders.h"
+
+namespace mrgi::compose {
+namespace {
+
+struct ComposePush {
+  glm::vec4 internal_uv;
+  glm::vec4 compose;
+};
+
+}  // namespace
+
+Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph, uint32_t width,
+                                  uint32_t height, const ComposeSettings& settings) {
+  Compose c;
+  c.settings_ = settings;
+  c.width_ = width;
+  c.height_ = height;
+  const VkDeviceSize bytes = VkDeviceSize(width) * height * 4;
+  auto out = graph.create_buffer({"output_rgba8", bytes, gpu::MemoryUsage::Readback, true},
+                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  if (!out) return out.error();
+  c.output_ = *out;
+  auto mask = graph.create_buffer({"virtual_mask", bytes, gpu::MemoryUsage::Readback, true},
+                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  if (!mask) return mask.error();
+  c.mask_ = *mask;
+  auto spv = gpu::shader_spirv("compose/compose.comp");
+  if (!spv) return spv.error();
+  const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+  const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  const auto tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+  auto p = gpu::create_compute_pipeline(
+      context, {"compose", *spv, {{ubo}, {ssbo}, {tex}, {tex}, {tex}, {ssbo}, {ssbo}},
+                sizeof(ComposePush)});
+  if (!p) return p.error();
+  c.pipeline_ = gpu::PipelineHandle(context, std::move(*p));
+  return c;
+}
+
+void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
+  in_ = inputs;
+  allocated_ = graph.allocated_extent(inputs.lit_rv);
+  graph.add_pass(
+      "compose", gpu::PassKind::Compute,
+      [this](gpu::PassBuilder& b) {
+        b.read(in_.frame_constants, gpu::Access::UniformRead);
+        b.read(in_.color_upload, gpu::Access::StorageRead);
+        b.read(in_.lit_rv, gpu::Access::Sampled);
+        b.read(in_.lit_r, gpu::Access::Sampled);
+        b.read(in_.virtual_position, gpu::Access::Sampled);
+        b.write(output_, gpu::Access::StorageWrite);
+        b.write(mask_, gpu::Access::StorageWrite);
+      },
+      [this](VkCommandBuffer cmd, gpu::PassContext& pass) { dispatch(cmd, pass); });
+  graph.mark_output(output_);
+  graph.mark_output(mask_);
+}
+
+void Compose::dispatch(VkCommandBuffer cmd, gpu::PassContext& pass) {
+  const gpu::Context& ctx = pass.context();
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_->pipeline);
+  gpu::DescriptorPush()
+      .uniform_buffer(0, pass.buffer(in_.frame_constants))
+      .storage_buffer(1, pass.buffer(in_.color_upload))
+      .sampled_image(2, pass.view(in_.lit_rv), ctx.samplers().linear_clamp)
+      .sampled_image(3, pass.view(in_.lit_r), ctx.samplers().linear_clamp)
+      .sampled_image(4, pass.view(in_.virtual_position), ctx.samplers().nearest_clamp)
+      .storage_buffer(5, pass.buffer(output_))
+      .storage_buffer(6, pass.buffer(mask_))
+      .push(ctx, cmd, *pipeline_);
+  const VkExtent2D used = pass.extent(in_.lit_rv);
+  ComposePush pc;
+  const VkExtent2D full = allocated_;
+  pc.internal_uv = glm::vec4(float(used.width) / float(full.width), float(used.height) / float(full.height),
+                             1.0f / float(full.width), 1.0f / float(full.height));
+  pc.compose = glm::vec4(settings_.eps, settings_.alpha_max, 0.0f, 0.0f);
+  gpu::dispatch_2d(cmd, *pipeline_, &pc, sizeof(pc), width_, height_);
+}
+
+Status Compose::read(const gpu::FrameGraph& graph, uint32_t slot, ImageRGBA8& image,
+                     Image<uint8_t, 1>& mask) const {
+  const gpu::GpuBuffer& ob = graph.gpu_buffer(output_, slot);
+  const gpu::GpuBuffer& mb = graph.gpu_buffer(mask_, slot);
+  MRGI_TRY(graph.context().invalidate(ob));
+  MRGI_TRY(graph.context().invalidate(mb));
+  image = ImageRGBA8(int(width_), int(height_));
+  mask = Image<uint8_t, 1>(int(width_), int(height_));
+  // Packed with packUnorm4x8 (r in the low byte): on a little-endian host the bytes are RGBA.
+  std::memcpy(image.data.data(), graph.mapped(output_, slot), image.data.size());
+  const uint32_t* m = static_cast<const uint32_t*>(graph.mapped(mask_, slot));
+  for (size_t i = 0; i < mask.data.size(); ++i) mask.data[i] = m[i] != 0 ? 255 : 0;
+  return ok_status();
+}
+
+}  // namespace mrgi::compose

@@ -1,0 +1,48 @@
+// Compose (DESIGN.md "One frame, as data"): tone-maps L_rv and L_r with the camera's response and
+// adds their difference onto the camera frame per caustics-DIR eq. 1-2 (shaders/compose/
+// compose.comp says how and why in linear space), at the output resolution (the solutions are
+// upsampled bilinearly when the internal resolution is lower). Writes the RGBA8 sRGB frame and
+// the virtual-pixel mask straight into this slot's readback buffers.
+#pragma once
+#include "gpu/frame_graph.h"
+#include "gpu/pipelines.h"
+#include "mrgi/image.h"
+
+namespace mrgi::compose {
+
+// Guards of the differential composite (mrgi_shared.h differential_compose), in linear camera
+// units (exposure-scaled radiance, 1 = sensor saturation).
+struct ComposeSettings {
+  float eps = 1e-3f;       // below this modelled real light, alpha blends to 1 (absolute delta)
+  float alpha_max = 10.0f; // alpha = CI / TM(L_r) clamped to [0, alpha_max]
+};
+
+struct ComposeInputs {
+  gpu::BufferHandle frame_constants;
+  gpu::BufferHandle color_upload;
+  gpu::ImageHandle lit_rv, lit_r, virtual_position;
+};
+
+class Compose {
+ public:
+  static Expected<Compose> create(gpu::Context& context, gpu::FrameGraph& graph, uint32_t width,
+                                  uint32_t height, const ComposeSettings& settings = {});
+  // Adds the pass "compose" and marks both readback buffers as outputs.
+  void record(gpu::FrameGraph& graph, const ComposeInputs& inputs);
+  // Copies slot `slot`'s results (after its frame completed) into `image` and `mask`
+  // (resized to the output size; non-zero mask = virtual pixel).
+  Status read(const gpu::FrameGraph& graph, uint32_t slot, ImageRGBA8& image,
+              Image<uint8_t, 1>& mask) const;
+
+ private:
+  void dispatch(VkCommandBuffer cmd, gpu::PassContext& pass);
+
+  ComposeSettings settings_;
+  uint32_t width_ = 0, height_ = 0;
+  ComposeInputs in_;
+  VkExtent2D allocated_{1, 1};  // of the internal-resolution images (their used part varies)
+  gpu::BufferHandle output_, mask_;
+  gpu::PipelineHandle pipeline_;
+};
+
+}  // namespace mrgi::compose

@@ -1,0 +1,138 @@
+#include "recon/virtual_gbuffer.h"
+
+#include "gpu/shaders.h"
+
+namespace mrgi::recon {
+namespace {
+
+constexpr VkFormat kPositionFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+constexpr VkFormat kNormalFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+constexpr VkFormat kAlbedoFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
+
+Expected<gpu::ImageHandle> internal_image(gpu::FrameGraph& graph, const char* name, VkFormat format,
+                                          VkImageUsageFlags usage) {
+  gpu::ImageDesc d;
+  d.name = name;
+  d.format = format;
+  d.size_mode = gpu::SizeMode::OutputRelative;
+  return graph.create_image(d, usage);
+}
+
+}  // namespace
+
+Expected<VirtualGBuffer> VirtualGBuffer::create(gpu::Context& context, gpu::FrameGraph& graph,
+                                                const technique::SceneGpu& scene) {
+  VirtualGBuffer v;
+  v.scene_ = &scene;
+  const VkImageUsageFlags color = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+  auto p = internal_image(graph, "virtual_position", kPositionFormat, color);
+  if (!p) return p.error();
+  v.position_ = *p;
+  auto n = internal_image(graph, "virtual_normal", kNormalFormat, color);
+  if (!n) return n.error();
+  v.normal_ = *n;
+  auto a = internal_image(graph, "virtual_albedo", kAlbedoFormat, color);
+  if (!a) return a.error();
+  v.albedo_ = *a;
+  auto d = internal_image(graph, "virtual_depth", kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
+  if (!d) return d.error();
+  v.depth_ = *d;
+  v.color_layout_ =
+      gpu::access_info(gpu::PassKind::Graphics, gpu::Access::ColorAttachmentWrite, true, false).layout;
+  v.depth_layout_ =
+      gpu::access_info(gpu::PassKind::Graphics, gpu::Access::DepthAttachmentWrite, true, true).layout;
+
+  auto vs = gpu::shader_spirv("gbuffer/virtual.vert");
+  if (!vs) return vs.error();
+  auto fs = gpu::shader_spirv("gbuffer/virtual.frag");
+  if (!fs) return fs.error();
+  gpu::GraphicsPipelineDesc desc;
+  desc.name = "virtual_gbuffer";
+  desc.vertex_spirv = *vs;
+  desc.fragment_spirv = *fs;
+  desc.bindings = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
+                   {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+                   {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
+                   {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER}};
+  desc.push_constant_bytes = sizeof(int32_t);
+  desc.vertex_strides = {sizeof(technique::GpuVertex)};
+  desc.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(technique::GpuVertex, position)},
+                     {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(technique::GpuVertex, normal)},
+                     {2, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(technique::GpuVertex, uv)}};
+  desc.color_formats = {kPositionFormat, kNormalFormat, kAlbedoFormat};
+  desc.depth_format = kDepthFormat;
+  desc.depth_compare = VK_COMPARE_OP_LESS;
+  // Both sides: glTF objects may be single-sided, and the y-down projection flips winding.
+  desc.cull_mode = VK_CULL_MODE_NONE;
+  auto pipe = gpu::create_graphics_pipeline(context, desc);
+  if (!pipe) return pipe.error();
+  v.pipeline_ = gpu::PipelineHandle(context, std::move(*pipe));
+  return v;
+}
+
+void VirtualGBuffer::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_constants,
+                            gpu::ImageHandle real_position) {
+  frame_constants_ = frame_constants;
+  real_position_ = real_position;
+  graph.add_pass(
+      "virtual_gbuffer", gpu::PassKind::Graphics,
+      [this](gpu::PassBuilder& b) {
+        b.read(frame_constants_, gpu::Access::UniformRead);
+        b.read(scene_->materials, gpu::Access::StorageRead);
+        b.read(scene_->base_color_maps, gpu::Access::Sampled);
+        b.read(scene_->virtual_objects.vertices, gpu::Access::VertexBuffer);
+        b.read(scene_->virtual_objects.indices, gpu::Access::IndexBuffer);
+        b.read(real_position_, gpu::Access::Sampled);
+        b.write(position_, gpu::Access::ColorAttachmentWrite);
+        b.write(normal_, gpu::Access::ColorAttachmentWrite);
+        b.write(albedo_, gpu::Access::ColorAttachmentWrite);
+        b.write(depth_, gpu::Access::DepthAttachmentWrite);
+      },
+      [this](VkCommandBuffer cmd, gpu::PassContext& pass) { draw(cmd, pass); });
+}
+
+void VirtualGBuffer::draw(VkCommandBuffer cmd, gpu::PassContext& pass) {
+  const VkExtent2D e = pass.extent(position_);
+  VkRenderingAttachmentInfo colors[3];
+  const gpu::ImageHandle targets[3] = {position_, normal_, albedo_};
+  for (int i = 0; i < 3; ++i) {
+    colors[i] = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    colors[i].imageView = pass.view(targets[i]);
+    colors[i].imageLayout = color_layout_;
+    colors[i].loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    colors[i].storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    colors[i].clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
+  }
+  VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+  depth.imageView = pass.view(depth_);
+  depth.imageLayout = depth_layout_;
+  depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+  depth.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+  depth.clearValue.depthStencil = {1.0f, 0};
+  VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+  ri.renderArea = {{0, 0}, e};
+  ri.layerCount = 1;
+  ri.colorAttachmentCount = 3;
+  ri.pColorAttachments = colors;
+  ri.pDepthAttachment = &depth;
+  vkCmdBeginRendering(cmd, &ri);
+  if (!scene_->virtual_objects.empty()) {
+    const VkViewport vp{0.0f, 0.0f, float(e.width), float(e.height), 0.0f, 1.0f};
+    const VkRect2D sc{{0, 0}, e};
+    vkCmdSetViewport(cmd, 0, 1, &vp);
+    vkCmdSetScissor(cmd, 0, 1, &sc);
+    const gpu::Context& ctx = pass.context();
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_->pipeline);
+    gpu::DescriptorPush()
+        .uniform_buffer(0, pass.buffer(frame_constants_))
+        .storage_buffer(1, pass.buffer(scene_->materials))
+        .sampled_image(2, pass.view(real_position_), ctx.samplers().nearest_clamp)
+        .sampled_image(3, scene_->base_color_array_view(), ctx.samplers().linear_repeat)
+        .push(ctx, cmd, *pipeline_);
+    scene_->virtual_objects.draw(cmd, pass, &*pipeline_);
+  }
+  vkCmdEndRendering(cmd);
+}
+
+}  // namespace mrgi::recon

@@ -1,0 +1,38 @@
+// The virtual G-buffer: the scene's glTF objects rasterised from the colour camera (OpenCV
+// intrinsics -> Vulkan projection with y down and depth 0..1, FrameConstants::world_to_clip) at
+// the internal resolution, hidden where the reconstructed real surface is in front.
+// Images: virtual_position (RGBA32F: xyz world, w 1 where a virtual object is seen = the
+// real/virtual mask), virtual_normal (RGBA16F: xyz, w roughness), virtual_albedo (RGBA16F:
+// linear base colour, w metallic), virtual_depth (D32, for the virtual objects among themselves).
+#pragma once
+#include "gpu/frame_graph.h"
+#include "gpu/pipelines.h"
+#include "technique/scene_gpu.h"
+
+namespace mrgi::recon {
+
+class VirtualGBuffer {
+ public:
+  static Expected<VirtualGBuffer> create(gpu::Context& context, gpu::FrameGraph& graph,
+                                         const technique::SceneGpu& scene);
+  // Adds the pass "virtual_gbuffer" (always: with no object it clears the mask).
+  void record(gpu::FrameGraph& graph, gpu::BufferHandle frame_constants,
+              gpu::ImageHandle real_position);
+
+  gpu::ImageHandle position() const { return position_; }
+  gpu::ImageHandle normal() const { return normal_; }
+  gpu::ImageHandle albedo() const { return albedo_; }
+
+ private:
+  void draw(VkCommandBuffer cmd, gpu::PassContext& pass);
+
+  const technique::SceneGpu* scene_ = nullptr;
+  gpu::BufferHandle frame_constants_;
+  gpu::ImageHandle real_position_;
+  gpu::ImageHandle position_, normal_, albedo_, depth_;
+  gpu::PipelineHandle pipeline_;
+  VkImageLayout color_layout_ = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+  VkImageLayout depth_layout_ = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+};
+
+}  // namespace mrgi::recon

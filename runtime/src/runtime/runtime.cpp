@@ -1,0 +1,398 @@
+// create_runtime: the Vulkan context, the frame graph, the uploaded scene, reconstruction, the
+// virtual G-buffer, the technique and compose, all allocated once here for the technique's top
+// level. process() uploads a frame, records this frame's passes, submits, and returns the frames
+// that completed (pipelined over frames_in_flight slots).
+#include <algorithm>
+#include <chrono>
+#include <optional>
+#include <string>
+
+#include <glm/gtc/matrix_inverse.hpp>
+
+#include "common/frame_constants.glsl"
+#include "compose/compose.h"
+#include "gpu/context.h"
+#include "gpu/frame_graph.h"
+#include "mrgi/runtime.h"
+#include "recon/reconstruction.h"
+#include "recon/virtual_gbuffer.h"
+#include "runtime/camera_math.h"
+#include "technique/scene_gpu.h"
+#include "technique/technique.h"
+
+namespace mrgi {
+namespace {
+
+using runtime_detail::environment_mean;
+using runtime_detail::opencv_projection;
+
+// A virtual surface is hidden behind a real one closer by more than this fraction of its depth.
+constexpr float kVirtualDepthTolerance = 0.02f;
+
+bool same_intrinsics(const Intrinsics& a, const Intrinsics& b) {
+  return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy &&
+         a.cx == b.cx && a.cy == b.cy;
+}
+
+std::string size_text(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
+
+// What a submitted frame needs to become a FrameOutput once its slot completes.
+struct SlotRecord {
+  bool used = false;
+  int64_t frame_index = 0;
+  int level = 0;
+  double cpu_ms = 0.0;
+  std::vector<std::string> skipped;
+  std::vector<std::string> notes;
+};
+
+class RuntimeImpl final : public Runtime {
+ public:
+  RuntimeImpl() = default;
+  ~RuntimeImpl() override;
+  Status init(const RuntimeSettings& settings, const CameraSetup& cameras, const SceneDesc& scene);
+
+  Expected<std::vector<FrameOutput>> process(const InputFrame& frame) override;
+  Expected<std::vector<FrameOutput>> flush() override;
+  const DeviceInfo& device() const override { return context_->info(); }
+  double memory_mib() const override { return context_->memory_mib(); }
+  int level_count() const override { return int(technique_->levels().size()); }
+  std::vector<std::string> level_names() const override;
+  Status set_level(int level) override;
+
+ private:
+  Status check_validation() const;
+  Status check_frame(const InputFrame& frame) const;
+  void write_constants(const InputFrame& frame, const glm::dmat4& camera_to_world,
+                       const glm::vec3& ambient_both, const glm::vec3& ambient_virtual);
+  Expected<FrameOutput> collect(const gpu::FrameTimings& timings);
+
+  RuntimeSettings settings_;
+  CameraSetup cameras_;
+  SceneDesc scene_;
+  int output_w_ = 0, output_h_ = 0;
+  int level_ = 0;
+  // Declared in creation order; destroyed in reverse (the device outlives everything on it).
+  std::unique_ptr<gpu::Context> context_;
+  std::unique_ptr<gpu::FrameGraph> graph_;
+  std::unique_ptr<technique::SceneGpu> scene_gpu_;
+  std::optional<recon::Reconstruction> recon_;
+  std::optional<recon::VirtualGBuffer> virtual_gbuffer_;
+  gpu::BufferHandle frame_constants_;
+  gpu::ImageHandle lit_rv_, lit_r_;
+  std::unique_ptr<technique::Technique> technique_;
+  std::optional<compose::Compose> compose_;
+  std::vector<SlotRecord> slots_;
+  glm::dmat4 last_pose_{1.0};
+  bool have_pose_ = false;
+  glm::vec3 env_mean_{0.0f};  // environment from a file: mean radiance x intensity
+};
+
+RuntimeImpl::~RuntimeImpl() {
+  if (context_ && context_->device() != VK_NULL_HANDLE) vkDeviceWaitIdle(context_->device());
+  compose_.reset();
+  technique_.reset();
+  virtual_gbuffer_.reset();
+  recon_.reset();
+  scene_gpu_.reset();
+  graph_.reset();
+  context_.reset();
+}
+
+Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cameras,
+                         const SceneDesc& scene) {
+  settings_ = settings;
+  cameras_ = cameras;
+  scene_ = scene;
+  auto entry = technique::find_technique(settings.technique);
+  if (!entry) return entry.error();
+  const std::vector<technique::QualityLevel> ladder = (*entry)->ladder();
+  if (settings.level < 0 || settings.level >= int(ladder.size()))
+    return fail(ErrorKind::BadUsage, "RuntimeSettings.level " + std::to_string(settings.level) +
+                                         ": technique '" + settings.technique + "' has levels 0.." +
+                                         std::to_string(ladder.size() - 1));
+  if (settings.frames_in_flight < 1 || settings.frames_in_flight > 3)
+    return fail(ErrorKind::BadUsage, "RuntimeSettings.frames_in_flight " +
+                                         std::to_string(settings.frames_in_flight) + ": must be 1..3");
+  if ((settings.output_width == 0) != (settings.output_height == 0) || settings.output_width < 0 ||
+      settings.output_height < 0)
+    return fail(ErrorKind::BadUsage, "RuntimeSettings.output_width/output_height: both 0 (the "
+                                     "colour camera's size) or both positive");
+  const Intrinsics& c = cameras.color;
+  const Intrinsics& d = cameras.depth;
+  if (c.width < 2 || c.height < 2 || d.width < 1 || d.height < 1 || !(c.fx > 0) || !(c.fy > 0) ||
+      !(d.fx > 0) || !(d.fy > 0))
+    return fail(ErrorKind::BadInput, "CameraSetup: colour and depth intrinsics need sizes >= 2 "
+                                     "and fx, fy > 0");
+  if (!(cameras.depth_scale > 0.0))
+    return fail(ErrorKind::BadInput, "CameraSetup.depth_scale must be > 0 (depth units per metre)");
+  if (!(cameras.exposure > 0.0))
+    return fail(ErrorKind::BadInput, "CameraSetup.exposure must be > 0");
+  output_w_ = settings.output_width ? settings.output_width : c.width;
+  output_h_ = settings.output_height ? settings.output_height : c.height;
+  level_ = settings.level;
+
+  auto ctx = gpu::Context::create(settings.device);
+  if (!ctx) return ctx.error();
+  context_ = std::move(*ctx);
+  gpu::FrameGraphSettings gs;
+  gs.max_output_width = uint32_t(output_w_);
+  gs.max_output_height = uint32_t(output_h_);
+  gs.max_render_scale = 0.0f;
+  for (const auto& l : ladder) gs.max_render_scale = std::max(gs.max_render_scale, l.internal_scale);
+  gs.frames_in_flight = uint32_t(settings.frames_in_flight);
+  auto graph = gpu::FrameGraph::create(*context_, gs);
+  if (!graph) return graph.error();
+  graph_ = std::move(*graph);
+  MRGI_TRY(graph_->set_output_size(uint32_t(output_w_), uint32_t(output_h_)));
+
+  auto sg = technique::SceneGpu::create(*context_, *graph_, scene_);
+  if (!sg) return sg.error();
+  scene_gpu_ = std::move(*sg);
+  auto rc = recon::Reconstruction::create(*context_, *graph_, c, d);
+  if (!rc) return rc.error();
+  recon_.emplace(std::move(*rc));
+  auto vg = recon::VirtualGBuffer::create(*context_, *graph_, *scene_gpu_);
+  if (!vg) return vg.error();
+  virtual_gbuffer_.emplace(std::move(*vg));
+
+  auto fc = graph_->create_buffer({"frame_constants", sizeof(shader::FrameConstants),
+                                   gpu::MemoryUsage::Upload, true},
+                                  VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  if (!fc) return fc.error();
+  frame_constants_ = *fc;
+  for (gpu::ImageHandle* h : {&lit_rv_, &lit_r_}) {
+    gpu::ImageDesc desc;
+    desc.name = h == &lit_rv_ ? "lit_rv" : "lit_r";
+    desc.format = VK_FORMAT_R16G16B16A16_SFLOAT;
+    auto img = graph_->create_image(desc, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT);
+    if (!img) return img.error();
+    *h = *img;
+  }
+
+  technique::SharedResources shared;
+  shared.context = context_.get();
+  shared.graph = graph_.get();
+  shared.scene = &scene_;
+  shared.scene_gpu = scene_gpu_.get();
+  shared.frame_constants = frame_constants_;
+  shared.real_position = recon_->position();
+  shared.real_normal = recon_->normal();
+  shared.real_albedo = recon_->albedo();
+  shared.virtual_position = virtual_gbuffer_->position();
+  shared.virtual_normal = virtual_gbuffer_->normal();
+  shared.virtual_albedo = virtual_gbuffer_->albedo();
+  shared.lit_rv = lit_rv_;
+  shared.lit_r = lit_r_;
+  auto tech = (*entry)->create(shared);
+  if (!tech) return tech.error();
+  technique_ = std::move(*tech);
+
+  auto comp = compose::Compose::create(*context_, *graph_, uint32_t(output_w_), uint32_t(output_h_));
+  if (!comp) return comp.error();
+  compose_.emplace(std::move(*comp));
+
+  // Baseline's environment: a constant ambient from the mean radiance (no occlusion). An image
+  // file is averaged once here; the env camera's frames are averaged per frame in process().
+  const EnvironmentDesc& env = scene_.environment;
+  if (env.present && !env.from_env_camera) {
+    auto img = load_hdr_image(env.image);
+    if (!img) return img.error();
+    env_mean_ = environment_mean(*img, true) * env.intensity;
+  }
+  slots_.resize(size_t(settings.frames_in_flight));
+  for (SlotRecord& s : slots_) {
+    s.skipped.reserve(16);
+    s.notes.reserve(4);
+  }
+  return check_validation();
+}
+
+Status RuntimeImpl::check_validation() const {
+  if (!context_->validation_enabled() || context_->validation_message_count() == 0) return ok_status();
+  std::string all;
+  for (const std::string& m : context_->validation_messages()) all += "\n  " + m;
+  return fail(ErrorKind::Device, "Vulkan validation reported " +
+                                     std::to_string(context_->validation_message_count()) +
+                                     " message(s):" + all);
+}
+
+Status RuntimeImpl::check_frame(const InputFrame& frame) const {
+  const Intrinsics& c = cameras_.color;
+  const Intrinsics& d = cameras_.depth;
+  const std::string where = "frame " + std::to_string(frame.index) + ": ";
+  if (frame.color.width != c.width || frame.color.height != c.height ||
+      frame.color.data.size() != size_t(c.width) * c.height * 3)
+    return fail(ErrorKind::BadInput, where + "colour image is " +
+                                         size_text(frame.color.width, frame.color.height) +
+                                         "; every frame must have the colour intrinsics' size " +
+                                         size_text(c.width, c.height) + " given at set-up");
+  if (frame.depth.width != d.width || frame.depth.height != d.height ||
+      frame.depth.data.size() != size_t(d.width) * d.height)
+    return fail(ErrorKind::BadInput, where + "depth image is " +
+                                         size_text(frame.depth.width, frame.depth.height) +
+                                         "; every frame must have the depth intrinsics' size " +
+                                         size_text(d.width, d.height) + " given at set-up");
+  return ok_status();
+}
+
+void RuntimeImpl::write_constants(const InputFrame& frame, const glm::dmat4& camera_to_world,
+                                  const glm::vec3& ambient_both, const glm::vec3& ambient_virtual) {
+  (void)frame;
+  auto* fc = static_cast<shader::FrameConstants*>(graph_->mapped(frame_constants_, graph_->slot()));
+  const VkExtent2D internal = graph_->extent(lit_rv_);
+  const Intrinsics ik = cameras_.color.scaled_to(int(internal.width), int(internal.height));
+  const Intrinsics ok = cameras_.color.scaled_to(output_w_, output_h_);
+  const glm::mat4 c2w = glm::mat4(camera_to_world);
+  const glm::mat4 w2c = glm::mat4(glm::inverse(camera_to_world));
+  auto k4 = [](const Intrinsics& k) { return glm::vec4(float(k.fx), float(k.fy), float(k.cx), float(k.cy)); };
+  shader::FrameConstants f{};
+  f.world_to_clip = opencv_projection(ik) * w2c;
+  f.camera_to_world = c2w;
+  f.world_to_camera = w2c;
+  f.camera_world = glm::vec4(glm::vec3(camera_to_world[3]), 1.0f);
+  f.internal_k = k4(ik);
+  f.output_k = k4(ok);
+  f.color_k = k4(cameras_.color);
+  f.depth_k = k4(cameras_.depth);
+  f.internal_output_size = glm::ivec4(int(internal.width), int(internal.height), output_w_, output_h_);
+  f.color_depth_size = glm::ivec4(cameras_.color.width, cameras_.color.height,
+                                  cameras_.depth.width, cameras_.depth.height);
+  f.camera = glm::vec4(float(cameras_.depth_scale), float(cameras_.exposure),
+                       kVirtualDepthTolerance, 0.0f);
+  f.ambient_both = glm::vec4(ambient_both, 0.0f);
+  f.ambient_virtual = glm::vec4(ambient_virtual, 0.0f);
+  f.flags = glm::ivec4(same_intrinsics(cameras_.color, cameras_.depth) ? 1 : 0, 0, 0, 0);
+  *fc = f;
+}
+
+Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame) {
+  const auto t0 = std::chrono::steady_clock::now();
+  MRGI_TRY(check_frame(frame));
+  std::vector<FrameOutput> outputs;
+  auto done = graph_->begin_frame();
+  if (!done) return done.error();
+  if (done->has_value()) {
+    auto out = collect(**done);
+    if (!out) return out.error();
+    outputs.push_back(std::move(*out));
+  }
+  SlotRecord& rec = slots_[graph_->slot()];
+  rec.used = true;
+  rec.frame_index = frame.index;
+  rec.level = level_;
+  rec.skipped.clear();
+  rec.notes.clear();
+
+  // A frame without a pose keeps the last known one (identity before any): the output is then
+  // only right for a camera that did not move; the stats say so.
+  if (frame.pose) {
+    last_pose_ = frame.pose->matrix();
+    have_pose_ = true;
+  } else {
+    rec.notes.push_back(have_pose_ ? "pose: none given, previous frame's pose used"
+                                   : "pose: none given and none before, identity used");
+  }
+  glm::vec3 env = env_mean_;
+  const EnvironmentDesc& e = scene_.environment;
+  if (e.present && e.from_env_camera) {
+    if (frame.env) {
+      env = environment_mean(*frame.env, false) * e.intensity;
+      env_mean_ = env;  // kept for frames without an env image
+    } else {
+      rec.notes.push_back("environment: no env image in this frame, the last mean used");
+    }
+  }
+  const glm::vec3 ambient_both = e.present && e.real ? env : glm::vec3(0.0f);
+  const glm::vec3 ambient_virtual = e.present && !e.real ? env : glm::vec3(0.0f);
+
+  const technique::QualityLevel& level = technique_->levels()[size_t(level_)];
+  MRGI_TRY(graph_->set_render_scale(level.internal_scale));
+  write_constants(frame, last_pose_, ambient_both, ambient_virtual);
+  recon_->upload(*graph_, frame);
+
+  recon_->record(*graph_, frame_constants_);
+  virtual_gbuffer_->record(*graph_, frame_constants_, recon_->position());
+  technique::FrameInfo info;
+  info.frame_index = frame.index;
+  info.level = level_;
+  info.virtual_objects_present = !scene_gpu_->virtual_objects.empty();
+  MRGI_TRY(technique_->record(info, rec.skipped));
+  compose_->record(*graph_, {frame_constants_, recon_->color_upload(), lit_rv_, lit_r_,
+                             virtual_gbuffer_->position()});
+  MRGI_TRY(graph_->compile());
+  MRGI_TRY(graph_->submit());
+  rec.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  MRGI_TRY(check_validation());
+  return outputs;
+}
+
+Expected<FrameOutput> RuntimeImpl::collect(const gpu::FrameTimings& timings) {
+  SlotRecord& rec = slots_[timings.slot];
+  FrameOutput out;
+  MRGI_TRY(compose_->read(*graph_, timings.slot, out.image, out.virtual_mask));
+  out.stats.frame_index = rec.frame_index;
+  out.stats.passes = timings.passes;
+  out.stats.gpu_total_ms = timings.total_ms;
+  out.stats.cpu_ms = rec.cpu_ms;
+  out.stats.level = rec.level;
+  out.stats.skipped = rec.skipped;
+  for (const std::string& c : timings.culled) out.stats.skipped.push_back(c + ": culled (nothing reads it)");
+  out.stats.notes = rec.notes;
+  rec.used = false;
+  return out;
+}
+
+Expected<std::vector<FrameOutput>> RuntimeImpl::flush() {
+  auto all = graph_->flush();
+  if (!all) return all.error();
+  std::vector<FrameOutput> outputs;
+  for (const gpu::FrameTimings& t : *all) {
+    auto out = collect(t);
+    if (!out) return out.error();
+    outputs.push_back(std::move(*out));
+  }
+  MRGI_TRY(check_validation());
+  return outputs;
+}
+
+std::vector<std::string> RuntimeImpl::level_names() const {
+  std::vector<std::string> names;
+  for (const auto& l : technique_->levels()) names.push_back(l.name);
+  return names;
+}
+
+Status RuntimeImpl::set_level(int level) {
+  if (level < 0 || level >= level_count())
+    return fail(ErrorKind::BadUsage, "set_level(" + std::to_string(level) + "): technique '" +
+                                         technique_->name() + "' has levels 0.." +
+                                         std::to_string(level_count() - 1));
+  level_ = level;
+  return ok_status();
+}
+
+}  // namespace
+
+Expected<std::unique_ptr<Runtime>> create_runtime(const RuntimeSettings& settings,
+                                                  const CameraSetup& cameras,
+                                                  const SceneDesc& scene) {
+  auto rt = std::make_unique<RuntimeImpl>();
+  MRGI_TRY(rt->init(settings, cameras, scene));
+  return std::unique_ptr<Runtime>(std::move(rt));
+}
+
+std::vector<std::string> technique_names() {
+  std::vector<std::string> names;
+  for (const auto& e : technique::registered_techniques()) names.push_back(e.name);
+  return names;
+}
+
+Expected<std::vector<std::string>> technique_levels(const std::string& technique) {
+  auto entry = technique::find_technique(technique);
+  if (!entry) return entry.error();
+  std::vector<std::string> names;
+  for (const auto& l : (*entry)->ladder()) names.push_back(l.name);
+  return names;
+}
+
+}  // namespace mrgi

@@ -1,0 +1,333 @@
+#include "technique/baseline/baseline.h"
+
+#include <algorithm>
+#include <string>
+
+#include "gpu/pipelines.h"
+#include "gpu/shaders.h"
+#include "gpu/vk_check.h"
+#include "technique/baseline/shadow_plan.h"
+#include "technique/image_views.h"
+#include "technique/scene_gpu.h"
+
+namespace mrgi::technique {
+namespace {
+
+constexpr uint32_t kTopShadowSize = 2048;
+// Depth bias of the shadow rasterisation: constant in units of the depth format's resolution
+// at the primitive's depth, slope in units per unit of depth slope (hardware slope scaling).
+constexpr float kDepthBiasConstant = 16.0f;
+constexpr float kDepthBiasSlope = 2.5f;
+
+struct GridPush {
+  glm::mat4 view_proj;
+  glm::ivec4 grid;
+};
+struct ShadePush {
+  glm::vec4 shadow;
+};
+
+double knob(const QualityLevel& level, const std::string& name) {
+  for (const Knob& k : level.knobs)
+    if (k.name == name) return k.value;
+  return 0.0;
+}
+
+class Baseline final : public Technique {
+ public:
+  explicit Baseline(const SharedResources& shared) : shared_(shared), ladder_(baseline_ladder()) {}
+  const std::string& name() const override { return name_; }
+  const std::vector<QualityLevel>& levels() const override { return ladder_; }
+  Status init();
+  Status record(const FrameInfo& info, std::vector<std::string>& skipped) override;
+
+ private:
+  void render_faces(VkCommandBuffer cmd, gpu::PassContext& pass, const std::vector<ShadowFace>& faces,
+                    const std::vector<VkImageView>& layer_views);
+  void shade(VkCommandBuffer cmd, gpu::PassContext& pass);
+
+  std::string name_ = "baseline";
+  SharedResources shared_;
+  std::vector<QualityLevel> ladder_;
+  ShadowPlan plan_;
+  gpu::BufferHandle lights_;
+  gpu::ImageHandle shadow_primary_, shadow_virtual_;
+  ImageViews views_;
+  std::vector<VkImageView> primary_layer_views_, virtual_layer_views_;
+  VkImageView primary_array_view_ = VK_NULL_HANDLE, virtual_array_view_ = VK_NULL_HANDLE;
+  gpu::PipelineHandle grid_pipeline_, mesh_pipeline_, shade_pipeline_;
+  VkImageLayout depth_write_layout_ = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+  // This frame's knobs (set by record before the passes are added).
+  uint32_t shadow_size_ = kTopShadowSize;
+  int pcf_radius_ = 1;
+};
+
+Status Baseline::init() {
+  gpu::Context& ctx = *shared_.context;
+  gpu::FrameGraph& graph = *shared_.graph;
+  const SceneGpu& sg = *shared_.scene_gpu;
+
+  Bounds bounds;
+  if (!sg.virtual_objects.empty()) bounds.add(sg.virtual_objects.bounds_min, sg.virtual_objects.bounds_max);
+  if (!sg.real_proxies.empty()) bounds.add(sg.real_proxies.bounds_min, sg.real_proxies.bounds_max);
+  auto plan = plan_shadow_maps(*shared_.scene, bounds);
+  if (!plan) return plan.error();
+  plan_ = std::move(*plan);
+  if (sg.virtual_objects.empty()) {
+    // Nothing virtual casts: the virtual-caster maps would stay empty (all lit), so none is
+    // made and the shader treats st_v as 1.
+    plan_.virtual_only.clear();
+    for (int i = 0; i < plan_.light_set.count.x; ++i) plan_.light_set.lights[i].layers.y = -1;
+  }
+
+  auto lights = graph.create_buffer({"baseline_lights", sizeof(shader::LightSet)},
+                                    VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  if (!lights) return lights.error();
+  lights_ = *lights;
+  MRGI_TRY(ctx.upload_buffer(graph.gpu_buffer(lights_, 0), &plan_.light_set, sizeof(shader::LightSet)));
+
+  auto make_map = [&](const char* name, size_t layers) -> Expected<gpu::ImageHandle> {
+    gpu::ImageDesc d;
+    d.name = name;
+    d.format = VK_FORMAT_D32_SFLOAT;
+    d.size_mode = gpu::SizeMode::Absolute;
+    d.width = d.height = kTopShadowSize;
+    d.layers = uint32_t(std::max<size_t>(1, layers));
+    return graph.create_image(d, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT);
+  };
+  auto primary = make_map("shadow_primary", plan_.primary.size());
+  if (!primary) return primary.error();
+  shadow_primary_ = *primary;
+  auto virt = make_map("shadow_virtual", plan_.virtual_only.size());
+  if (!virt) return virt.error();
+  shadow_virtual_ = *virt;
+
+  views_ = ImageViews(ctx.device());
+  auto make_views = [&](gpu::ImageHandle h, size_t layers, std::vector<VkImageView>& per_layer,
+                        VkImageView& array) -> Status {
+    const gpu::GpuImage& img = graph.gpu_image(h);
+    for (size_t i = 0; i < layers; ++i) {
+      auto v = views_.create(img, VK_IMAGE_VIEW_TYPE_2D, uint32_t(i), 1);
+      if (!v) return v.error();
+      per_layer.push_back(*v);
+    }
+    auto a = views_.create(img, VK_IMAGE_VIEW_TYPE_2D_ARRAY, 0, img.layers);
+    if (!a) return a.error();
+    array = *a;
+    return ok_status();
+  };
+  MRGI_TRY(make_views(shadow_primary_, plan_.primary.size(), primary_layer_views_, primary_array_view_));
+  MRGI_TRY(make_views(shadow_virtual_, plan_.virtual_only.size(), virtual_layer_views_, virtual_array_view_));
+  depth_write_layout_ =
+      gpu::access_info(gpu::PassKind::Graphics, gpu::Access::DepthAttachmentWrite, true, true).layout;
+
+  auto grid_vs = gpu::shader_spirv("baseline/shadow_depth_grid.vert");
+  if (!grid_vs) return grid_vs.error();
+  gpu::GraphicsPipelineDesc grid;
+  grid.name = "baseline_shadow_depth_grid";
+  grid.vertex_spirv = *grid_vs;
+  grid.bindings = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1}};
+  grid.push_constant_bytes = sizeof(GridPush);
+  grid.depth_format = VK_FORMAT_D32_SFLOAT;
+  grid.cull_mode = VK_CULL_MODE_NONE;
+  grid.depth_bias_constant = kDepthBiasConstant;
+  grid.depth_bias_slope = kDepthBiasSlope;
+  auto gp = gpu::create_graphics_pipeline(ctx, grid);
+  if (!gp) return gp.error();
+  grid_pipeline_ = gpu::PipelineHandle(ctx, std::move(*gp));
+
+  auto mesh_vs = gpu::shader_spirv("baseline/shadow_mesh.vert");
+  if (!mesh_vs) return mesh_vs.error();
+  gpu::GraphicsPipelineDesc mesh;
+  mesh.name = "baseline_shadow_mesh";
+  mesh.vertex_spirv = *mesh_vs;
+  mesh.push_constant_bytes = sizeof(glm::mat4);
+  mesh.vertex_strides = {sizeof(GpuVertex)};
+  mesh.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}};
+  mesh.depth_format = VK_FORMAT_D32_SFLOAT;
+  mesh.cull_mode = VK_CULL_MODE_NONE;
+  mesh.depth_bias_constant = kDepthBiasConstant;
+  mesh.depth_bias_slope = kDepthBiasSlope;
+  auto mp = gpu::create_graphics_pipeline(ctx, mesh);
+  if (!mp) return mp.error();
+  mesh_pipeline_ = gpu::PipelineHandle(ctx, std::move(*mp));
+
+  auto shade_cs = gpu::shader_spirv("baseline/shade_direct.comp");
+  if (!shade_cs) return shade_cs.error();
+  gpu::ComputePipelineDesc shade;
+  shade.name = "baseline_shade_direct";
+  shade.spirv = *shade_cs;
+  const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+  const auto tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+  const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+  shade.bindings = {{ubo}, {ubo}, {tex}, {tex}, {tex}, {tex}, {tex}, {tex}, {tex}, {tex}, {img}, {img}};
+  shade.push_constant_bytes = sizeof(ShadePush);
+  auto sp = gpu::create_compute_pipeline(ctx, shade);
+  if (!sp) return sp.error();
+  shade_pipeline_ = gpu::PipelineHandle(ctx, std::move(*sp));
+  return ok_status();
+}
+
+Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped) {
+  if (info.level < 0 || info.level >= int(ladder_.size()))
+    return fail(ErrorKind::BadUsage, "baseline: level " + std::to_string(info.level) +
+                                         " outside 0.." + std::to_string(ladder_.size() - 1));
+  const QualityLevel& level = ladder_[size_t(info.level)];
+  shadow_size_ = uint32_t(knob(level, "shadow_map_size"));
+  pcf_radius_ = int(knob(level, "pcf_radius"));
+  gpu::FrameGraph& graph = *shared_.graph;
+  const SceneGpu& sg = *shared_.scene_gpu;
+  const SharedResources& s = shared_;
+
+  if (plan_.primary.empty()) {
+    skipped.push_back("shadow_primary: no lamp in the scene");
+  } else {
+    graph.add_pass(
+        "shadow_primary", gpu::PassKind::Graphics,
+        [this](gpu::PassBuilder& b) {
+          b.read(shared_.real_position, gpu::Access::Sampled);
+          b.read(shared_.scene_gpu->real_proxies.vertices, gpu::Access::VertexBuffer);
+          b.read(shared_.scene_gpu->real_proxies.indices, gpu::Access::IndexBuffer);
+          b.read(shared_.scene_gpu->virtual_objects.vertices, gpu::Access::VertexBuffer);
+          b.read(shared_.scene_gpu->virtual_objects.indices, gpu::Access::IndexBuffer);
+          b.write(shadow_primary_, gpu::Access::DepthAttachmentWrite);
+        },
+        [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
+          render_faces(cmd, pass, plan_.primary, primary_layer_views_);
+        });
+  }
+  if (plan_.real_lamps == 0) {
+    skipped.push_back("shadow_virtual_casters: no real lamp (virtual lamps use one map)");
+  } else if (sg.virtual_objects.empty()) {
+    skipped.push_back("shadow_virtual_casters: no virtual object in the scene");
+  } else {
+    graph.add_pass(
+        "shadow_virtual_casters", gpu::PassKind::Graphics,
+        [this](gpu::PassBuilder& b) {
+          b.read(shared_.scene_gpu->virtual_objects.vertices, gpu::Access::VertexBuffer);
+          b.read(shared_.scene_gpu->virtual_objects.indices, gpu::Access::IndexBuffer);
+          b.write(shadow_virtual_, gpu::Access::DepthAttachmentWrite);
+        },
+        [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
+          render_faces(cmd, pass, plan_.virtual_only, virtual_layer_views_);
+        });
+  }
+  (void)s;
+  graph.add_pass(
+      "shade_direct", gpu::PassKind::Compute,
+      [this](gpu::PassBuilder& b) {
+        const SharedResources& r = shared_;
+        b.read(r.frame_constants, gpu::Access::UniformRead);
+        b.read(lights_, gpu::Access::UniformRead);
+        b.read(r.real_position, gpu::Access::Sampled);
+        b.read(r.real_normal, gpu::Access::Sampled);
+        b.read(r.real_albedo, gpu::Access::Sampled);
+        b.read(r.virtual_position, gpu::Access::Sampled);
+        b.read(r.virtual_normal, gpu::Access::Sampled);
+        b.read(r.virtual_albedo, gpu::Access::Sampled);
+        b.read(shadow_primary_, gpu::Access::Sampled);
+        b.read(shadow_virtual_, gpu::Access::Sampled);
+        b.write(r.lit_rv, gpu::Access::StorageWrite);
+        b.write(r.lit_r, gpu::Access::StorageWrite);
+      },
+      [this](VkCommandBuffer cmd, gpu::PassContext& pass) { shade(cmd, pass); });
+  return ok_status();
+}
+
+void Baseline::render_faces(VkCommandBuffer cmd, gpu::PassContext& pass,
+                            const std::vector<ShadowFace>& faces,
+                            const std::vector<VkImageView>& layer_views) {
+  const gpu::Context& ctx = pass.context();
+  const SceneGpu& sg = *shared_.scene_gpu;
+  const VkExtent2D grid = pass.extent(shared_.real_position);
+  const uint32_t grid_vertices =
+      grid.width > 1 && grid.height > 1 ? (grid.width - 1) * (grid.height - 1) * 6 : 0;
+  const uint32_t s = shadow_size_;
+  for (const ShadowFace& face : faces) {
+    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    depth.imageView = layer_views[size_t(face.layer)];
+    depth.imageLayout = depth_write_layout_;
+    depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    depth.clearValue.depthStencil = {1.0f, 0};
+    VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+    ri.renderArea = {{0, 0}, {s, s}};
+    ri.layerCount = 1;
+    ri.pDepthAttachment = &depth;
+    vkCmdBeginRendering(cmd, &ri);
+    const VkViewport vp{0.0f, 0.0f, float(s), float(s), 0.0f, 1.0f};
+    const VkRect2D sc{{0, 0}, {s, s}};
+    vkCmdSetViewport(cmd, 0, 1, &vp);
+    vkCmdSetScissor(cmd, 0, 1, &sc);
+    if (face.real_casters && grid_vertices > 0) {
+      vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, grid_pipeline_->pipeline);
+      gpu::DescriptorPush()
+          .sampled_image(0, pass.view(shared_.real_position), ctx.samplers().nearest_clamp)
+          .push(ctx, cmd, *grid_pipeline_);
+      GridPush pc{face.view_proj, glm::ivec4(int(grid.width), int(grid.height), 0, 0)};
+      vkCmdPushConstants(cmd, grid_pipeline_->layout, grid_pipeline_->stages, 0, sizeof(pc), &pc);
+      vkCmdDraw(cmd, grid_vertices, 1, 0, 0);
+    }
+    const bool proxies = face.real_casters && !sg.real_proxies.empty();
+    const bool virtuals = face.virtual_casters && !sg.virtual_objects.empty();
+    if (proxies || virtuals) {
+      vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mesh_pipeline_->pipeline);
+      vkCmdPushConstants(cmd, mesh_pipeline_->layout, mesh_pipeline_->stages, 0, sizeof(glm::mat4),
+                         &face.view_proj);
+      if (proxies) sg.real_proxies.draw(cmd, pass, nullptr);
+      if (virtuals) sg.virtual_objects.draw(cmd, pass, nullptr);
+    }
+    vkCmdEndRendering(cmd);
+  }
+}
+
+void Baseline::shade(VkCommandBuffer cmd, gpu::PassContext& pass) {
+  const gpu::Context& ctx = pass.context();
+  const SharedResources& r = shared_;
+  const VkSampler nearest = ctx.samplers().nearest_clamp;
+  const VkSampler compare = ctx.samplers().shadow_compare;
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, shade_pipeline_->pipeline);
+  gpu::DescriptorPush()
+      .uniform_buffer(0, pass.buffer(r.frame_constants))
+      .uniform_buffer(1, pass.buffer(lights_))
+      .sampled_image(2, pass.view(r.real_position), nearest)
+      .sampled_image(3, pass.view(r.real_normal), nearest)
+      .sampled_image(4, pass.view(r.real_albedo), nearest)
+      .sampled_image(5, pass.view(r.virtual_position), nearest)
+      .sampled_image(6, pass.view(r.virtual_normal), nearest)
+      .sampled_image(7, pass.view(r.virtual_albedo), nearest)
+      .sampled_image(8, primary_array_view_, compare)
+      .sampled_image(9, virtual_array_view_, compare)
+      .storage_image(10, pass.view(r.lit_rv))
+      .storage_image(11, pass.view(r.lit_r))
+      .push(ctx, cmd, *shade_pipeline_);
+  ShadePush pc;
+  pc.shadow = glm::vec4(float(shadow_size_) / float(kTopShadowSize), float(shadow_size_),
+                        float(kTopShadowSize), float(pcf_radius_));
+  const VkExtent2D e = pass.extent(r.lit_rv);
+  gpu::dispatch_2d(cmd, *shade_pipeline_, &pc, sizeof(pc), e.width, e.height);
+}
+
+}  // namespace
+
+std::vector<QualityLevel> baseline_ladder() {
+  auto level = [](const char* name, double size, double scale, double pcf) {
+    QualityLevel l;
+    l.name = name;
+    l.internal_scale = float(scale);
+    l.knobs = {{"shadow_map_size", size, "texels per side of each map face"},
+               {"internal_scale", scale, "fraction of the output width and height"},
+               {"pcf_radius", pcf, "compare taps on each side of the centre tap"}};
+    return l;
+  };
+  return {level("high", 2048, 1.0, 1), level("medium", 1024, 1.0, 1), level("low", 512, 0.75, 1),
+          level("lowest", 256, 0.5, 0)};
+}
+
+Expected<std::unique_ptr<Technique>> create_baseline(const SharedResources& shared) {
+  auto t = std::make_unique<Baseline>(shared);
+  MRGI_TRY(t->init());
+  return std::unique_ptr<Technique>(std::move(t));
+}
+
+}  // namespace mrgi::technique

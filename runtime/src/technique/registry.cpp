@@ -1,0 +1,26 @@
+#include <string>
+
+#include "technique/baseline/baseline.h"
+#include "technique/technique.h"
+
+namespace mrgi::technique {
+
+// One line per technique; a new technique is a new folder plus one line here (an explicit list:
+// self-registering objects in a static library are dropped by the linker when unreferenced).
+const std::vector<TechniqueEntry>& registered_techniques() {
+  static const std::vector<TechniqueEntry> entries = {
+      {"baseline", &baseline_ladder, &create_baseline},
+  };
+  return entries;
+}
+
+Expected<const TechniqueEntry*> find_technique(const std::string& name) {
+  std::string known;
+  for (const TechniqueEntry& e : registered_techniques()) {
+    if (e.name == name) return &e;
+    known += (known.empty() ? "" : ", ") + std::string(e.name);
+  }
+  return fail(ErrorKind::BadUsage, "technique '" + name + "' is not known; known techniques: " + known);
+}
+
+}  // namespace mrgi::technique

@@ -1,0 +1,218 @@
+#include "technique/scene_gpu.h"
+
+#include <algorithm>
+#include <cstring>
+
+#define STB_IMAGE_RESIZE_STATIC
+#define STB_IMAGE_RESIZE_IMPLEMENTATION
+#include <stb/stb_image_resize.h>
+
+#include "common/scene_materials.glsl"
+#include "gpu/vk_check.h"
+
+namespace mrgi::technique {
+namespace {
+
+struct MeshData {
+  std::vector<GpuVertex> vertices;
+  std::vector<uint32_t> indices;
+  std::vector<DrawRange> draws;
+  glm::vec3 lo{1e30f}, hi{-1e30f};
+};
+
+// Appends a model's primitives; material indices are offset by `material_base`.
+void append_model(const Model& model, int material_base, MeshData& out) {
+  for (const MeshPrimitive& prim : model.primitives) {
+    if (prim.indices.empty() || prim.positions.empty()) continue;
+    DrawRange range;
+    range.first_index = uint32_t(out.indices.size());
+    range.index_count = uint32_t(prim.indices.size());
+    range.vertex_offset = int32_t(out.vertices.size());
+    range.material = prim.material < 0 ? 0 : material_base + prim.material;
+    for (size_t i = 0; i < prim.positions.size(); ++i) {
+      GpuVertex v;
+      v.position = prim.positions[i];
+      v.normal = i < prim.normals.size() ? prim.normals[i] : glm::vec3(0.0f, 1.0f, 0.0f);
+      v.uv = i < prim.uvs.size() ? prim.uvs[i] : glm::vec2(0.0f);
+      out.lo = glm::min(out.lo, v.position);
+      out.hi = glm::max(out.hi, v.position);
+      out.vertices.push_back(v);
+    }
+    out.indices.insert(out.indices.end(), prim.indices.begin(), prim.indices.end());
+    out.draws.push_back(range);
+  }
+}
+
+Expected<MeshSet> upload_meshes(gpu::Context& ctx, gpu::FrameGraph& graph, const MeshData& data,
+                                const std::string& name) {
+  MeshSet set;
+  // Never zero-sized (Vulkan forbids it); an empty set simply has no draws.
+  const VkDeviceSize vbytes = std::max<VkDeviceSize>(64, data.vertices.size() * sizeof(GpuVertex));
+  const VkDeviceSize ibytes = std::max<VkDeviceSize>(64, data.indices.size() * sizeof(uint32_t));
+  auto vb = graph.create_buffer({name + "_vertices", vbytes}, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT |
+                                                              VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  if (!vb) return vb.error();
+  auto ib = graph.create_buffer({name + "_indices", ibytes}, VK_BUFFER_USAGE_INDEX_BUFFER_BIT |
+                                                             VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  if (!ib) return ib.error();
+  if (!data.vertices.empty()) {
+    MRGI_TRY(ctx.upload_buffer(graph.gpu_buffer(*vb, 0), data.vertices.data(),
+                               data.vertices.size() * sizeof(GpuVertex)));
+    MRGI_TRY(ctx.upload_buffer(graph.gpu_buffer(*ib, 0), data.indices.data(),
+                               data.indices.size() * sizeof(uint32_t)));
+  }
+  set.vertices = *vb;
+  set.indices = *ib;
+  set.draws = data.draws;
+  if (!data.draws.empty()) {
+    set.bounds_min = data.lo;
+    set.bounds_max = data.hi;
+  }
+  return set;
+}
+
+// Uploads every layer of a layered image and leaves it SHADER_READ_ONLY_OPTIMAL.
+Status upload_layers(gpu::Context& ctx, const gpu::GpuImage& image,
+                     const std::vector<uint8_t>& texels, uint32_t side, uint32_t layers) {
+  auto staging = ctx.create_buffer(texels.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                   gpu::MemoryUsage::Upload, "base_color_maps_staging");
+  if (!staging) return staging.error();
+  std::memcpy(staging->mapped, texels.data(), texels.size());
+  Status st = ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+    b.srcStageMask = VK_PIPELINE_STAGE_2_NONE;
+    b.dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+    b.dstAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = image.image;
+    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, layers};
+    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    dep.imageMemoryBarrierCount = 1;
+    dep.pImageMemoryBarriers = &b;
+    vkCmdPipelineBarrier2(cmd, &dep);
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, layers};
+    region.imageExtent = {side, side, 1};
+    vkCmdCopyBufferToImage(cmd, staging->buffer, image.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                           1, &region);
+    b.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+    b.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+    b.dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+    b.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
+    b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    vkCmdPipelineBarrier2(cmd, &dep);
+  });
+  ctx.destroy(*staging);
+  return st;
+}
+
+}  // namespace
+
+void MeshSet::draw(VkCommandBuffer cmd, const gpu::PassContext& pass,
+                   const gpu::Pipeline* material_pipeline) const {
+  if (draws.empty()) return;
+  VkBuffer vb = pass.buffer(vertices);
+  VkDeviceSize offset = 0;
+  vkCmdBindVertexBuffers(cmd, 0, 1, &vb, &offset);
+  vkCmdBindIndexBuffer(cmd, pass.buffer(indices), 0, VK_INDEX_TYPE_UINT32);
+  for (const DrawRange& d : draws) {
+    if (material_pipeline)
+      vkCmdPushConstants(cmd, material_pipeline->layout, material_pipeline->stages, 0,
+                         sizeof(int32_t), &d.material);
+    vkCmdDrawIndexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0);
+  }
+}
+
+Expected<std::unique_ptr<SceneGpu>> SceneGpu::create(gpu::Context& context, gpu::FrameGraph& graph,
+                                                     const SceneDesc& scene) {
+  std::unique_ptr<SceneGpu> out(new SceneGpu(context));
+  MeshData virtual_data, proxy_data;
+  std::vector<shader::GpuMaterial> materials;
+  std::vector<const ImageRGBA8*> textures;
+  std::vector<Model> models;  // kept until the textures are resampled
+  models.reserve(scene.virtual_objects.size());
+  for (const VirtualObjectDesc& obj : scene.virtual_objects) {
+    auto model = load_gltf(obj.gltf, obj.placement);
+    if (!model) return model.error();
+    models.push_back(std::move(*model));
+  }
+  // Material 0 is the glTF default material (white, metallic 1, roughness 1 per the spec).
+  materials.push_back({glm::vec4(1.0f), glm::vec4(1.0f, 1.0f, -1.0f, 0.0f)});
+  for (const Model& m : models) {
+    const int material_base = int(materials.size());
+    const int texture_base = int(textures.size());
+    for (const Material& mat : m.materials) {
+      const float layer = mat.base_color_texture >= 0 &&
+                                  mat.base_color_texture < int(m.textures.size())
+                              ? float(texture_base + mat.base_color_texture)
+                              : -1.0f;
+      materials.push_back({mat.base_color_factor,
+                           glm::vec4(mat.metallic, mat.roughness, layer, 0.0f)});
+    }
+    for (const Texture& t : m.textures) textures.push_back(&t.image);
+    append_model(m, material_base, virtual_data);
+  }
+  for (const RealGeometryDesc& proxy : scene.real_geometry) {
+    auto model = load_gltf(proxy.gltf, proxy.placement);
+    if (!model) return model.error();
+    append_model(*model, 0, proxy_data);
+  }
+
+  auto vset = upload_meshes(context, graph, virtual_data, "virtual_objects");
+  if (!vset) return vset.error();
+  out->virtual_objects = std::move(*vset);
+  auto pset = upload_meshes(context, graph, proxy_data, "real_proxies");
+  if (!pset) return pset.error();
+  out->real_proxies = std::move(*pset);
+
+  auto mb = graph.create_buffer({"virtual_materials", materials.size() * sizeof(shader::GpuMaterial)},
+                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  if (!mb) return mb.error();
+  MRGI_TRY(context.upload_buffer(graph.gpu_buffer(*mb, 0), materials.data(),
+                                 materials.size() * sizeof(shader::GpuMaterial)));
+  out->materials = *mb;
+
+  // Texture array: one square side for all layers.
+  uint32_t side = 1;
+  for (const ImageRGBA8* t : textures)
+    side = std::max<uint32_t>(side, uint32_t(std::max(t->width, t->height)));
+  side = std::min<uint32_t>(side, kMaxTextureSide);
+  const uint32_t layers = std::max<uint32_t>(1, uint32_t(textures.size()));
+  std::vector<uint8_t> texels(size_t(side) * side * 4 * layers, 255);
+  for (size_t i = 0; i < textures.size(); ++i) {
+    const ImageRGBA8& t = *textures[i];
+    if (t.empty()) continue;
+    uint8_t* dst = texels.data() + size_t(side) * side * 4 * i;
+    if (!stbir_resize_uint8_srgb(t.data.data(), t.width, t.height, 0, dst, int(side), int(side), 0,
+                                 4, 3, 0))
+      return fail(ErrorKind::Internal, "scene_gpu: resampling base-colour texture " +
+                                           std::to_string(i) + " failed");
+  }
+  gpu::ImageCreateDesc desc;
+  desc.format = VK_FORMAT_R8G8B8A8_SRGB;
+  desc.width = desc.height = side;
+  desc.layers = layers;
+  desc.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+  desc.name = "base_color_maps";
+  auto image = context.create_image(desc);
+  if (!image) return image.error();
+  out->texture_array_ = *image;
+  MRGI_TRY(upload_layers(context, out->texture_array_, texels, side, layers));
+  out->views_ = ImageViews(context.device());
+  auto view = out->views_.create(out->texture_array_, VK_IMAGE_VIEW_TYPE_2D_ARRAY, 0, layers);
+  if (!view) return view.error();
+  out->array_view_ = *view;
+  out->base_color_maps = graph.import_image("base_color_maps", out->texture_array_,
+                                            VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, true);
+  return out;
+}
+
+SceneGpu::~SceneGpu() {
+  views_.reset();
+  context_.destroy(texture_array_);
+}
+
+}  // namespace mrgi::technique

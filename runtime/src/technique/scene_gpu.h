@@ -1,0 +1,75 @@
+// The scene's triangle meshes on the GPU, uploaded once at start-up: the glTF virtual objects
+// (for the virtual G-buffer and shadow maps) and the real proxy geometry of scene.json (shadow
+// casters in the real-caster maps). One interleaved vertex buffer and one index buffer per set,
+// a material array and one base-colour texture array for the virtual objects.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "gpu/context.h"
+#include "gpu/frame_graph.h"
+#include "gpu/pipelines.h"
+#include "technique/image_views.h"
+#include "mrgi/expected.h"
+#include "mrgi/scene.h"
+
+namespace mrgi::technique {
+
+// Vertex layout of both sets (32 bytes): world-space position, normal, texture coordinate.
+struct GpuVertex {
+  glm::vec3 position;
+  glm::vec3 normal;
+  glm::vec2 uv;
+};
+static_assert(sizeof(GpuVertex) == 32);
+
+struct DrawRange {
+  uint32_t first_index = 0;
+  uint32_t index_count = 0;
+  int32_t vertex_offset = 0;
+  int32_t material = 0;  // index into the material array (virtual set only)
+};
+
+struct MeshSet {
+  gpu::BufferHandle vertices;  // GpuVertex[]
+  gpu::BufferHandle indices;   // uint32 triangle list
+  std::vector<DrawRange> draws;
+  glm::vec3 bounds_min{0.0f}, bounds_max{0.0f};  // world AABB; meaningless when empty()
+  bool empty() const { return draws.empty(); }
+  // Binds the buffers and draws every range; with `material_pipeline` the range's material
+  // index is pushed as a 4-byte push constant at offset 0 before each draw.
+  void draw(VkCommandBuffer cmd, const gpu::PassContext& pass,
+            const gpu::Pipeline* material_pipeline) const;
+};
+
+// Base-colour textures are resampled to one square size (the largest texture side, at most
+// kMaxTextureSide texels) so they fit one 2D array image; glTF texture i is layer i.
+inline constexpr int kMaxTextureSide = 1024;
+
+class SceneGpu {
+ public:
+  // Loads every glTF of `scene` (load_gltf) and uploads it. Errors name the glTF file.
+  static Expected<std::unique_ptr<SceneGpu>> create(gpu::Context& context, gpu::FrameGraph& graph,
+                                                    const SceneDesc& scene);
+  ~SceneGpu();
+  SceneGpu(const SceneGpu&) = delete;
+  SceneGpu& operator=(const SceneGpu&) = delete;
+
+  MeshSet virtual_objects;
+  MeshSet real_proxies;
+  gpu::BufferHandle materials;        // shader::GpuMaterial[] (at least one entry)
+  gpu::ImageHandle base_color_maps;   // R8G8B8A8_SRGB array (at least one white layer)
+  VkImageView base_color_array_view() const { return array_view_; }  // 2D_ARRAY over all layers
+
+ private:
+  explicit SceneGpu(gpu::Context& context) : context_(context) {}
+  gpu::Context& context_;
+  gpu::GpuImage texture_array_;       // owned here, imported into the graph
+  ImageViews views_;
+  VkImageView array_view_ = VK_NULL_HANDLE;
+};
+
+}  // namespace mrgi::technique

@@ -1,0 +1,91 @@
+// The technique interface (DESIGN.md "Techniques"): one GI method from the papers per module,
+// each in its own folder under technique/, registered by name in registry.cpp.
+//
+// A technique
+//   - declares its quality ladder: ordered levels, best first, each a name and knobs with units;
+//   - allocates everything it needs for its TOP level at start-up (create); lower levels use a
+//     part of those resources (a smaller corner of a shadow map, a smaller internal resolution),
+//     so changing level never allocates;
+//   - records its passes into the frame graph for a given level (record), writing the two
+//     solutions L_rv and L_r (linear radiance) that compose turns into the output;
+//   - says which of its passes this frame needs: passes it leaves out are reported in
+//     FrameStats::skipped as "pass: reason".
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gpu/frame_graph.h"
+#include "mrgi/expected.h"
+#include "mrgi/runtime.h"
+#include "mrgi/scene.h"
+
+namespace mrgi::gpu {
+class Context;
+}
+
+namespace mrgi::technique {
+
+struct Knob {
+  std::string name;   // e.g. "shadow_map_size"
+  double value = 0.0;
+  std::string unit;   // e.g. "texels per side", "fraction of output width and height"
+};
+
+struct QualityLevel {
+  std::string name;
+  std::vector<Knob> knobs;
+  // Fraction of the output resolution the G-buffers and solutions use at this level, (0, 1].
+  // Every technique has it: the runtime applies it as the frame graph's render scale.
+  float internal_scale = 1.0f;
+};
+
+// The shared start-up inputs of a technique (owned by the runtime, alive as long as it).
+class SceneGpu;
+struct SharedResources {
+  gpu::Context* context = nullptr;
+  gpu::FrameGraph* graph = nullptr;
+  const SceneDesc* scene = nullptr;
+  const SceneGpu* scene_gpu = nullptr;     // uploaded virtual meshes and real proxies
+  // Per frame, written by the runtime: FrameConstants (shaders/common/frame_constants.glsl).
+  gpu::BufferHandle frame_constants;
+  // Real G-buffer (recon/): positions (xyz world, w depth; 0 invalid), normals, albedo.
+  gpu::ImageHandle real_position, real_normal, real_albedo;
+  // Virtual G-buffer (recon/virtual_gbuffer): xyz world + coverage, normal + roughness,
+  // base colour + metallic.
+  gpu::ImageHandle virtual_position, virtual_normal, virtual_albedo;
+  // The solutions the technique writes (RGBA16F, internal resolution, linear radiance).
+  gpu::ImageHandle lit_rv, lit_r;
+};
+
+// What record() needs to know about the current frame.
+struct FrameInfo {
+  int64_t frame_index = 0;
+  int level = 0;
+  bool virtual_objects_present = false;
+};
+
+class Technique {
+ public:
+  virtual ~Technique() = default;
+  virtual const std::string& name() const = 0;
+  virtual const std::vector<QualityLevel>& levels() const = 0;
+  // Records this frame's passes for `info.level`; appends "pass: reason" for each pass left out.
+  virtual Status record(const FrameInfo& info, std::vector<std::string>& skipped) = 0;
+};
+
+using TechniqueFactory = Expected<std::unique_ptr<Technique>> (*)(const SharedResources&);
+using LadderFn = std::vector<QualityLevel> (*)();
+
+struct TechniqueEntry {
+  const char* name;
+  LadderFn ladder;           // the quality ladder without creating anything
+  TechniqueFactory create;   // allocates for the top level
+};
+
+// Every technique built into this library, in a fixed order.
+const std::vector<TechniqueEntry>& registered_techniques();
+// BadUsage naming the known techniques when `name` is not one of them.
+Expected<const TechniqueEntry*> find_technique(const std::string& name);
+
+}  // namespace mrgi::technique

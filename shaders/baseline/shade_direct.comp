@@ -1,0 +1,155 @@
+#version 460
+// Baseline: direct light only, with real/virtual shadow maps, per DIR eq. 1-5:
+//   L_rv += L_o * min(st_r, st_v)          (every lamp, every surface)
+//   L_r  += L_o * r(lamp) * r(p) * st_r    (only real lamps on real points, real casters)
+// L_o: Lambert for real surfaces (albedo from the camera, recon/depth_to_positions.comp);
+// Lambert + GGX (metallic/roughness) for virtual ones; inverse-square distance, spot cone.
+// A constant ambient from the environment's mean radiance (no occlusion) is added: a real
+// environment to both solutions, a virtual one to L_rv only.
+#extension GL_GOOGLE_include_directive : require
+#include "shared/mrgi_shared.h"
+#include "common/frame_constants.glsl"
+#include "common/light_set.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
+layout(std140, set = 0, binding = 1) uniform LightUbo { LightSet light_set; };
+layout(set = 0, binding = 2) uniform sampler2D real_position;
+layout(set = 0, binding = 3) uniform sampler2D real_normal;
+layout(set = 0, binding = 4) uniform sampler2D real_albedo;
+layout(set = 0, binding = 5) uniform sampler2D virtual_position;
+layout(set = 0, binding = 6) uniform sampler2D virtual_normal;
+layout(set = 0, binding = 7) uniform sampler2D virtual_albedo;
+layout(set = 0, binding = 8) uniform sampler2DArrayShadow shadow_primary;
+layout(set = 0, binding = 9) uniform sampler2DArrayShadow shadow_virtual;
+layout(set = 0, binding = 10, rgba16f) writeonly uniform image2D lit_rv;
+layout(set = 0, binding = 11, rgba16f) writeonly uniform image2D lit_r;
+layout(push_constant) uniform Level {
+  vec4 shadow;  // x used map size / allocated size, y used size (texels), z allocated size,
+                // w PCF radius (taps each side of the centre)
+} level;
+
+const float kNormalOffsetTexels = 1.5f;  // shadow lookup moved along the normal, in texels
+
+int cube_face(vec3 d) {
+  vec3 a = abs(d);
+  if (a.x >= a.y && a.x >= a.z) return d.x >= 0.0f ? 0 : 1;
+  if (a.y >= a.z) return d.y >= 0.0f ? 2 : 3;
+  return d.z >= 0.0f ? 4 : 5;
+}
+
+// Fraction of the lamp seen from p through one map (1 lit, 0 shadowed), PCF over
+// (2r+1)^2 bilinear compare taps. Points outside the map's frustum are lit.
+float shadow_test(sampler2DArrayShadow map, int first_layer, int light, vec3 p, vec3 n) {
+  ShadowLight L = light_set.lights[light];
+  int type = int(L.position_type.w);
+  int face = 0;
+  float texel_world;
+  if (type == MRGI_LIGHT_DIRECTIONAL) {
+    texel_world = L.cone.w / level.shadow.y;
+  } else {
+    vec3 d = p - L.position_type.xyz;
+    if (L.layers.z == 6) face = cube_face(d);
+    texel_world = L.cone.z * length(d) / level.shadow.y;
+  }
+  vec3 q = p + n * (kNormalOffsetTexels * texel_world);
+  vec4 clip = light_set.face_view_proj[light * 6 + face] * vec4(q, 1.0f);
+  if (!(clip.w > 0.0f)) return 1.0f;
+  vec3 ndc = clip.xyz / clip.w;
+  if (any(greaterThan(abs(ndc.xy), vec2(1.0f))) || ndc.z > 1.0f || ndc.z < 0.0f) return 1.0f;
+  vec2 uv = (ndc.xy * 0.5f + 0.5f) * level.shadow.x;  // into the used corner of the map
+  float texel = 1.0f / level.shadow.z;
+  vec2 lo = vec2(0.5f * texel), hi = vec2(level.shadow.x - 0.5f * texel);
+  int r = int(level.shadow.w);
+  float sum = 0.0f;
+  for (int j = -r; j <= r; ++j) {
+    for (int i = -r; i <= r; ++i) {
+      vec2 t = clamp(uv + vec2(i, j) * texel, lo, hi);
+      sum += texture(map, vec4(t, float(first_layer + face), ndc.z));
+    }
+  }
+  return sum / float((2 * r + 1) * (2 * r + 1));
+}
+
+// GGX (Trowbridge-Reitz) with Smith height-correlated visibility and Schlick Fresnel, the glTF
+// metallic-roughness model; returns the BRDF times pi-free cosine is applied by the caller.
+vec3 brdf(vec3 n, vec3 v, vec3 l, vec3 base, float metallic, float roughness, bool specular) {
+  vec3 diffuse = base * (1.0f - metallic) / MRGI_PI;
+  if (!specular) return base / MRGI_PI;
+  vec3 h = normalize(v + l);
+  float nl = max(dot(n, l), 0.0f), nv = max(dot(n, v), 1e-4f), nh = max(dot(n, h), 0.0f);
+  float a = roughness * roughness, a2 = a * a;
+  float d = a2 / (MRGI_PI * pow(nh * nh * (a2 - 1.0f) + 1.0f, 2.0f));
+  float vis = 0.5f / max(nl * sqrt(nv * nv * (1.0f - a2) + a2) + nv * sqrt(nl * nl * (1.0f - a2) + a2), 1e-6f);
+  vec3 f0 = mix(vec3(0.04f), base, metallic);
+  vec3 f = f0 + (1.0f - f0) * pow(1.0f - max(dot(v, h), 0.0f), 5.0f);
+  return (1.0f - f) * diffuse + d * vis * f;
+}
+
+vec3 sanitize(vec3 c) {
+  return vec3(isnan(c.x) ? 0.0f : c.x, isnan(c.y) ? 0.0f : c.y, isnan(c.z) ? 0.0f : c.z);
+}
+
+void main() {
+  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+  if (any(greaterThanEqual(pixel, frame.internal_output_size.xy))) return;
+  vec4 vpos = texelFetch(virtual_position, pixel, 0);
+  bool is_virtual = vpos.w > 0.5f;
+  vec4 pos, nrm, alb;
+  if (is_virtual) {
+    pos = vpos;
+    nrm = texelFetch(virtual_normal, pixel, 0);
+    alb = texelFetch(virtual_albedo, pixel, 0);
+  } else {
+    pos = texelFetch(real_position, pixel, 0);
+    nrm = texelFetch(real_normal, pixel, 0);
+    alb = vec4(texelFetch(real_albedo, pixel, 0).rgb, 0.0f);
+    if (!(pos.w > 0.0f)) {  // no measurement: nothing is known there, both solutions are 0
+      imageStore(lit_rv, pixel, vec4(0.0f));
+      imageStore(lit_r, pixel, vec4(0.0f));
+      return;
+    }
+  }
+  vec3 p = pos.xyz;
+  vec3 n = normalize(nrm.xyz);
+  vec3 v = normalize(frame.camera_world.xyz - p);
+  float roughness = is_virtual ? nrm.w : 1.0f;
+  float r_p = is_virtual ? 0.0f : 1.0f;
+
+  vec3 l_rv = alb.rgb * (frame.ambient_both.rgb + frame.ambient_virtual.rgb);
+  vec3 l_r = r_p * alb.rgb * frame.ambient_both.rgb;
+  int count = min(light_set.count.x, MRGI_MAX_LIGHTS);
+  for (int i = 0; i < count; ++i) {
+    ShadowLight L = light_set.lights[i];
+    int type = int(L.position_type.w);
+    vec3 wi;
+    vec3 irradiance_rgb;
+    if (type == MRGI_LIGHT_DIRECTIONAL) {
+      wi = -L.direction_real.xyz;
+      irradiance_rgb = L.intensity.rgb;
+    } else {
+      vec3 to_light = L.position_type.xyz - p;
+      float d2 = max(dot(to_light, to_light), 1e-6f);
+      wi = to_light * inversesqrt(d2);
+      float cone = 1.0f;
+      if (type == MRGI_LIGHT_SPOT)
+        cone = spot_falloff(dot(L.direction_real.xyz, -wi), L.cone.y, L.cone.x);
+      irradiance_rgb = L.intensity.rgb * cone / d2;
+    }
+    float nl = dot(n, wi);
+    if (nl <= 0.0f || all(equal(irradiance_rgb, vec3(0.0f)))) continue;
+    vec3 lo = brdf(n, v, wi, alb.rgb, alb.a, roughness, is_virtual) * irradiance_rgb * nl;
+    float st_primary = shadow_test(shadow_primary, L.layers.x, i, p, n);
+    bool real_lamp = L.direction_real.w > 0.5f;
+    if (real_lamp) {
+      float st_v = L.layers.y >= 0 ? shadow_test(shadow_virtual, L.layers.y, i, p, n) : 1.0f;
+      l_rv += lo * min(st_primary, st_v);   // eq. 1, 3
+      l_r += lo * r_p * st_primary;          // eq. 2
+    } else {
+      l_rv += lo * st_primary;               // the virtual lamp's map holds every caster
+    }
+  }
+  // Half floats end at 65504: clamp so no Inf reaches compose.
+  imageStore(lit_rv, pixel, vec4(clamp(sanitize(l_rv), vec3(0.0f), vec3(60000.0f)), 1.0f));
+  imageStore(lit_r, pixel, vec4(clamp(sanitize(l_r), vec3(0.0f), vec3(60000.0f)), 1.0f));
+}

@@ -1,0 +1,45 @@
+// Per-frame constants shared by every mrgi pass (one uniform buffer, written by the runtime each
+// frame). Compiled both as GLSL (std140) and as C++ (GLM), so the layout is written once: only
+// vec4 / ivec4 / mat4 members, which have the same size and 16-byte alignment in std140 and GLM.
+// (The file is .glsl so the shader build tracks it as a dependency.)
+#ifndef MRGI_FRAME_CONSTANTS_GLSL
+#define MRGI_FRAME_CONSTANTS_GLSL
+
+#ifdef __cplusplus
+#include <glm/glm.hpp>
+namespace mrgi::shader {
+using glm::ivec4;
+using glm::mat4;
+using glm::vec4;
+#endif
+
+// Depth discontinuity rule used by normals and the real caster mesh: two neighbouring depths
+// belong to one surface when |z_a - z_b| <= MRGI_DEPTH_EDGE_RELATIVE * min(z_a, z_b).
+#define MRGI_DEPTH_EDGE_RELATIVE 0.05
+
+// Sizes are pixels; k vectors are pinhole intrinsics (fx, fy, cx, cy) in pixels, OpenCV
+// convention (mrgi_shared.h project_pinhole / unproject_pinhole).
+struct FrameConstants {
+  mat4 world_to_clip;     // virtual raster at the internal resolution: Vulkan clip, y down, z 0..1
+  mat4 camera_to_world;   // this frame's pose
+  mat4 world_to_camera;
+  vec4 camera_world;      // xyz camera centre in world, w unused
+  vec4 internal_k;        // colour camera scaled to the internal (G-buffer) resolution
+  vec4 output_k;          // colour camera scaled to the output resolution
+  vec4 color_k;           // colour camera as captured
+  vec4 depth_k;           // depth camera as captured
+  ivec4 internal_output_size;  // internal w, h; output w, h
+  ivec4 color_depth_size;      // colour w, h; depth w, h
+  vec4 camera;            // x depth units per metre, y exposure (radiance -> linear camera value),
+                          // z virtual-behind-real tolerance (fraction of the real depth), w unused
+  vec4 ambient_both;      // rgb radiance of a real environment's mean: added to L_r and L_rv
+  vec4 ambient_virtual;   // rgb radiance of a virtual environment's mean: added to L_rv only
+  ivec4 flags;            // x: 1 depth registered to colour (same intrinsics), 0 resampled
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(FrameConstants) == 3 * 64 + 11 * 16, "std140 mirror");
+}  // namespace mrgi::shader
+#endif
+
+#endif  // MRGI_FRAME_CONSTANTS_GLSL

@@ -1,0 +1,43 @@
+// Scene lamps with their shadow-map layers, as the shading passes see them (one uniform buffer
+// written at start-up: lamps are static in scene.json v1). Shared by C++ and GLSL like
+// frame_constants.glsl.
+#ifndef MRGI_LIGHT_SET_GLSL
+#define MRGI_LIGHT_SET_GLSL
+#ifdef __cplusplus
+#include <glm/glm.hpp>
+namespace mrgi::shader {
+using glm::ivec4;
+using glm::mat4;
+using glm::vec4;
+#endif
+
+#define MRGI_MAX_LIGHTS 8
+#define MRGI_LIGHT_POINT 0
+#define MRGI_LIGHT_SPOT 1
+#define MRGI_LIGHT_DIRECTIONAL 2
+
+struct ShadowLight {
+  vec4 position_type;   // xyz world position, metres (point, spot); w type (MRGI_LIGHT_*)
+  vec4 direction_real;  // xyz unit direction the light travels (spot, directional); w 1 real lamp
+  vec4 intensity;       // rgb W/sr (point, spot) or W/m^2 (directional), linear; w unused
+  vec4 cone;            // x cos(inner half-angle), y cos(outer) (spot); z 2 tan(half fov) of the
+                        // perspective maps (texel footprint per metre per texel count);
+                        // w ortho map width in metres (directional)
+  ivec4 layers;         // x first layer in shadow_primary (real casters of a real lamp, all
+                        // casters of a virtual one); y first layer in shadow_virtual (virtual
+                        // casters of a real lamp) or -1; z faces (1, or 6 for a point lamp cube)
+};
+
+// Point lamps use a cube of 6 perspective faces: +X, -X, +Y, -Y, +Z, -Z (major axis of the
+// light-to-point vector picks the face), each a 90 degree frustum.
+struct LightSet {
+  ivec4 count;                                   // x number of lamps
+  ShadowLight lights[MRGI_MAX_LIGHTS];
+  mat4 face_view_proj[MRGI_MAX_LIGHTS * 6];      // lamp i face f at i * 6 + f; Vulkan clip
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(ShadowLight) == 80, "std140 mirror");
+}  // namespace mrgi::shader
+#endif
+#endif  // MRGI_LIGHT_SET_GLSL

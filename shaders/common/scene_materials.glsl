@@ -1,0 +1,20 @@
+// Virtual object materials as the GPU sees them (one std430 array, uploaded at start-up), shared
+// by C++ and GLSL like frame_constants.glsl.
+#ifndef MRGI_SCENE_MATERIALS_GLSL
+#define MRGI_SCENE_MATERIALS_GLSL
+#ifdef __cplusplus
+#include <glm/glm.hpp>
+namespace mrgi::shader {
+using glm::vec4;
+#endif
+
+struct GpuMaterial {
+  vec4 base_color_factor;  // linear RGBA (glTF baseColorFactor)
+  vec4 params;             // x metallic, y roughness, z base-colour texture layer (-1 none), w unused
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(GpuMaterial) == 32, "std430 mirror");
+}  // namespace mrgi::shader
+#endif
+#endif  // MRGI_SCENE_MATERIALS_GLSL

@@ -1,0 +1,76 @@
+#version 460
+// Compose (caustics-DIR eq. 1-2) at the output resolution:
+//   real pixels:    out = CI + alpha * (TM(L_rv) - TM(L_r)),  alpha = CI / TM(L_r)
+//   virtual pixels: out = TM(L_rv)
+// TM is the camera model of mrgi_shared.h (radiance * exposure, clipped at 1, then sRGB) and the
+// whole composite is done on the linear side of that sRGB curve: the identity
+// CI * TM(L_rv) / TM(L_r) scales the light the camera measured, which is only true for values
+// proportional to radiance; differences of sRGB-encoded values would darken shadows by the
+// curve's slope instead. alpha is guarded by differential_compose (mrgi_shared.h): it blends to
+// 1 where TM(L_r) < eps (no modelled light: the delta is added as is) and is clamped to
+// [0, alpha_max] (a barely lit model point would otherwise multiply a virtual lamp's light by
+// an unbounded factor). NaN or Inf never reach the output: inputs are sanitised first.
+#extension GL_GOOGLE_include_directive : require
+#include "shared/mrgi_shared.h"
+#include "common/frame_constants.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
+layout(std430, set = 0, binding = 1) readonly buffer ColorWords { uint color_words[]; };  // RGB8
+layout(set = 0, binding = 2) uniform sampler2D lit_rv;            // linear sampler
+layout(set = 0, binding = 3) uniform sampler2D lit_r;
+layout(set = 0, binding = 4) uniform sampler2D virtual_position;  // w: virtual coverage
+layout(std430, set = 0, binding = 5) writeonly buffer Output { uint out_rgba8[]; };
+layout(std430, set = 0, binding = 6) writeonly buffer Mask { uint out_mask[]; };
+layout(push_constant) uniform Params {
+  vec4 internal_uv;  // xy used internal extent / allocated extent, zw 1 / allocated extent
+  vec4 compose;      // x eps (linear camera units), y alpha_max
+} params;
+
+uint color_byte(uint index) { return (color_words[index >> 2] >> ((index & 3u) * 8u)) & 0xffu; }
+
+vec3 camera_linear(ivec2 p) {
+  ivec2 size = frame.color_depth_size.xy;
+  p = clamp(p, ivec2(0), size - 1);
+  uint base = uint(p.y * size.x + p.x) * 3u;
+  vec3 encoded = vec3(color_byte(base), color_byte(base + 1u), color_byte(base + 2u)) / 255.0f;
+  return srgb_decode(encoded);
+}
+
+vec3 finite(vec3 c) {
+  return vec3(isnan(c.x) || isinf(c.x) ? 0.0f : c.x, isnan(c.y) || isinf(c.y) ? 0.0f : c.y,
+              isnan(c.z) || isinf(c.z) ? 0.0f : c.z);
+}
+
+void main() {
+  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 out_size = frame.internal_output_size.zw;
+  if (any(greaterThanEqual(pixel, out_size))) return;
+  vec2 rel = (vec2(pixel) + 0.5f) / vec2(out_size);
+
+  // Camera colour at this output pixel (bilinear on linear values; exact when sizes match).
+  vec2 cp = rel * vec2(frame.color_depth_size.xy) - 0.5f;
+  ivec2 c0 = ivec2(floor(cp));
+  vec2 f = cp - vec2(c0);
+  vec3 ci = mix(mix(camera_linear(c0), camera_linear(c0 + ivec2(1, 0)), f.x),
+                mix(camera_linear(c0 + ivec2(0, 1)), camera_linear(c0 + ivec2(1, 1)), f.x), f.y);
+
+  // The solutions at the internal resolution, upsampled bilinearly inside the used extent.
+  vec2 uv = clamp(rel * params.internal_uv.xy, 0.5f * params.internal_uv.zw,
+                  params.internal_uv.xy - 0.5f * params.internal_uv.zw);
+  vec3 rv = finite(textureLod(lit_rv, uv, 0.0f).rgb);
+  vec3 r = finite(textureLod(lit_r, uv, 0.0f).rgb);
+  ivec2 ip = min(ivec2(rel * params.internal_uv.xy / params.internal_uv.zw),
+                 frame.internal_output_size.xy - 1);
+  float is_virtual = texelFetch(virtual_position, ip, 0).w > 0.5f ? 1.0f : 0.0f;
+
+  float exposure = frame.camera.y;
+  vec3 tm_rv = clamp(rv * exposure, vec3(0.0f), vec3(1.0f));
+  vec3 tm_r = clamp(r * exposure, vec3(0.0f), vec3(1.0f));
+  vec3 out_linear = differential_compose(ci, tm_r, tm_rv, is_virtual, params.compose.x,
+                                         params.compose.y);
+  vec3 encoded = srgb_encode(clamp(finite(out_linear), vec3(0.0f), vec3(1.0f)));
+  uint index = uint(pixel.y * out_size.x + pixel.x);
+  out_rgba8[index] = packUnorm4x8(vec4(encoded, 1.0f));
+  out_mask[index] = is_virtual > 0.5f ? 1u : 0u;
+}

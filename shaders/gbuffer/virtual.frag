@@ -1,0 +1,39 @@
+#version 460
+// Virtual G-buffer: world position + coverage, normal + roughness, linear base colour +
+// metallic. A virtual fragment behind the real surface seen at its pixel (reconstructed depth)
+// is hidden, so real objects occlude virtual ones.
+#extension GL_GOOGLE_include_directive : require
+#include "common/frame_constants.glsl"
+#include "common/scene_materials.glsl"
+
+layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
+layout(std430, set = 0, binding = 1) readonly buffer Materials { GpuMaterial materials[]; };
+layout(set = 0, binding = 2) uniform sampler2D real_position;         // xyz world, w depth
+layout(set = 0, binding = 3) uniform sampler2DArray base_color_maps;  // sRGB, decoded on fetch
+layout(push_constant) uniform Draw { int material; } draw;
+
+layout(location = 0) in vec3 in_world;
+layout(location = 1) in vec3 in_normal;
+layout(location = 2) in vec2 in_uv;
+layout(location = 3) in float in_view_z;
+layout(location = 0) out vec4 out_position;  // xyz world, w = 1 (virtual coverage mask)
+layout(location = 1) out vec4 out_normal;    // xyz unit, w roughness
+layout(location = 2) out vec4 out_albedo;    // rgb linear base colour, w metallic
+
+void main() {
+  vec4 real = texelFetch(real_position, ivec2(gl_FragCoord.xy), 0);
+  // Hidden when a valid real surface is in front by more than the tolerance (a fraction of
+  // the depth: sensor noise grows with distance; objects resting on a real surface stay seen).
+  if (real.w > 0.0f && real.w < in_view_z * (1.0f - frame.camera.z)) discard;
+
+  GpuMaterial m = materials[max(draw.material, 0)];
+  vec4 base = m.base_color_factor;
+  if (m.params.z >= 0.0f) base *= texture(base_color_maps, vec3(in_uv, m.params.z));
+  vec3 n = normalize(in_normal);
+  if (any(isnan(n))) n = vec3(0.0f, 1.0f, 0.0f);
+  // Single-sided glTF seen from behind, or a flipped normal: shade the side the camera sees.
+  if (dot(n, frame.camera_world.xyz - in_world) < 0.0f) n = -n;
+  out_position = vec4(in_world, 1.0f);
+  out_normal = vec4(n, clamp(m.params.y, 0.02f, 1.0f));
+  out_albedo = vec4(clamp(base.rgb, vec3(0.0f), vec3(1.0f)), clamp(m.params.x, 0.0f, 1.0f));
+}
