@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <random>
 #include <string>
 
@@ -51,7 +52,7 @@ inline bool contains(const std::string& haystack, const std::string& needle) {
     ASSERT_FALSE(mrgi_result_.ok()) << "expected an error of kind " #KIND;          \
     EXPECT_EQ(mrgi_result_.error().kind, ::mrgi::ErrorKind::KIND)                     \
         << mrgi_result_.error().message;                                              \
-    for (const char* mrgi_fragment_ : {__VA_ARGS__})                                  \
+    for (const char* mrgi_fragment_ : std::initializer_list<const char*>{__VA_ARGS__})                             \
       EXPECT_TRUE(::mrgi::testing::contains(mrgi_result_.error().message, mrgi_fragment_)) \
           << "message '" << mrgi_result_.error().message << "' lacks '" << mrgi_fragment_ << "'"; \
   } while (0)

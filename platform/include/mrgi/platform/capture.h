@@ -66,6 +66,8 @@ class CaptureReader {
   size_t frame_count() const { return entries_.size(); }
   const CaptureFrameEntry& entry(size_t i) const { return entries_[i]; }
   bool has_references() const;
+  // Colour frames of rgb.txt left out because no depth frame lay within 0.02 s of them.
+  size_t dropped_color_frames() const { return dropped_color_frames_; }
 
   // Loads frame i, checking image sizes against the intrinsics and bit depths (8-bit RGB colour,
   // 16-bit single-channel depth).
@@ -78,6 +80,7 @@ class CaptureReader {
   CaptureInfo info_;
   std::optional<SceneDesc> scene_;
   std::vector<CaptureFrameEntry> entries_;
+  size_t dropped_color_frames_ = 0;
 };
 
 // Writes a capture folder. The folder is built under FOLDER.partial and renamed on finish(),
@@ -95,6 +98,7 @@ class CaptureWriter {
   CaptureInfo info_;
   std::string rgb_list_, depth_list_, gt_list_, env_list_, ref_list_;
   size_t count_ = 0;
+  double last_timestamp_ = 0.0;
 };
 
 Expected<CaptureInfo> load_capture_json(const std::string& path);

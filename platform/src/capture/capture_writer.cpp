@@ -1,0 +1,172 @@
+// Capture format v1 writer. Frames go to FOLDER.partial/{rgb,depth,env,reference}/NNNNNN.*, the
+// lists and JSON files are written by finish(), and only then is FOLDER.partial renamed to
+// FOLDER. Timestamps and poses are written in shortest round-trip decimal, so a reader gets back
+// bit-identical values. Env images are stored as 32-bit float OpenEXR.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "capture/capture_text.h"
+#include "mrgi/platform/capture.h"
+
+namespace mrgi {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string frame_name(size_t index, const char* suffix) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%06zu%s", index, suffix);
+  return buf;
+}
+
+std::string list_header(const char* what, const char* format) {
+  return std::string("# ") + what + " (mrgi capture format v1)\n# " + format + "\n";
+}
+
+Status check_image_size(const std::string& folder, const char* what, int w, int h, const Intrinsics& k) {
+  if (w != k.width || h != k.height)
+    return fail(ErrorKind::BadUsage, folder + ": " + what + " image is " + std::to_string(w) + "x" +
+                                         std::to_string(h) + ", but the capture's intrinsics say " +
+                                         std::to_string(k.width) + "x" + std::to_string(k.height));
+  return ok_status();
+}
+
+}  // namespace
+
+Expected<CaptureWriter> CaptureWriter::create(const std::string& folder, const CaptureInfo& info,
+                                              const std::optional<SceneDesc>& scene) {
+  std::error_code ec;
+  if (fs::exists(folder, ec) && !(fs::is_directory(folder, ec) && fs::is_empty(folder, ec)))
+    return fail(ErrorKind::BadUsage, folder + ": already exists and is not an empty folder; remove it "
+                                              "first (a capture is never written over another)");
+  CaptureWriter w;
+  w.folder_ = fs::path(folder).lexically_normal().string();
+  while (!w.folder_.empty() && w.folder_.back() == '/' && w.folder_.size() > 1) w.folder_.pop_back();
+  w.partial_ = w.folder_ + ".partial";
+  w.info_ = info;
+  // A left-over .partial is an earlier interrupted write of this same capture.
+  fs::remove_all(w.partial_, ec);
+  for (const char* sub : {"rgb", "depth"}) {
+    fs::create_directories(fs::path(w.partial_) / sub, ec);
+    if (ec)
+      return fail(ErrorKind::Device, w.partial_ + ": cannot create folder '" + sub + "': " + ec.message());
+  }
+  if (scene) {
+    // Written now so its paths are made relative to the folder's final parent (FOLDER.partial is
+    // FOLDER's sibling, so relative paths stay valid after the rename).
+    MRGI_TRY(write_scene_json((fs::path(w.partial_) / "scene.json").string(), *scene));
+  }
+  w.rgb_list_ = list_header("colour images", "timestamp filename");
+  w.depth_list_ = list_header("depth images", "timestamp filename");
+  w.gt_list_.clear();
+  w.env_list_.clear();
+  w.ref_list_.clear();
+  return w;
+}
+
+Status CaptureWriter::add_frame(const InputFrame& frame, const ImageRGB8* reference,
+                                const Image<uint8_t, 1>* reference_mask) {
+  if (partial_.empty()) return fail(ErrorKind::BadUsage, folder_ + ": writer already finished");
+  MRGI_TRY(check_image_size(folder_, "colour", frame.color.width, frame.color.height, info_.color));
+  MRGI_TRY(check_image_size(folder_, "depth", frame.depth.width, frame.depth.height, info_.depth));
+  if (!std::isfinite(frame.timestamp) || !std::isfinite(frame.depth_timestamp))
+    return fail(ErrorKind::BadUsage, folder_ + ": frame " + std::to_string(count_) + ": timestamps must be finite");
+  if (count_ > 0 && !(frame.timestamp > last_timestamp_))
+    return fail(ErrorKind::BadUsage, folder_ + ": frame " + std::to_string(count_) + ": timestamp " +
+                                         capture::format_double(frame.timestamp) +
+                                         " does not increase (previous " +
+                                         capture::format_double(last_timestamp_) + ")");
+  if (std::abs(frame.depth_timestamp - frame.timestamp) >= 0.02)
+    return fail(ErrorKind::BadUsage, folder_ + ": frame " + std::to_string(count_) +
+                                         ": depth timestamp is 0.02 s or more from the colour "
+                                         "timestamp; a reader would not associate them");
+  const bool has_pose = frame.pose.has_value();
+  if (count_ > 0 && has_pose != !gt_list_.empty())
+    return fail(ErrorKind::BadUsage, folder_ + ": frame " + std::to_string(count_) +
+                                         ": either every frame has a pose or none has");
+  if (has_pose) {
+    const Pose& p = *frame.pose;
+    const double len = std::sqrt(glm::dot(p.rotation, p.rotation));
+    if (!std::isfinite(len) || !std::isfinite(glm::dot(p.translation, p.translation)) ||
+        std::abs(len - 1.0) > 1e-3)
+      return fail(ErrorKind::BadUsage, folder_ + ": frame " + std::to_string(count_) +
+                                           ": pose must be finite with a unit quaternion (within 0.001)");
+  }
+  if (reference_mask && !reference)
+    return fail(ErrorKind::BadUsage, folder_ + ": a reference mask needs a reference image");
+  if (reference) {
+    MRGI_TRY(check_image_size(folder_, "reference", reference->width, reference->height, info_.color));
+  }
+  if (reference_mask)
+    MRGI_TRY(check_image_size(folder_, "reference mask", reference_mask->width, reference_mask->height,
+                              info_.color));
+
+  const fs::path dir(partial_);
+  const std::string ts = capture::format_double(frame.timestamp);
+  const std::string rgb = "rgb/" + frame_name(count_, ".png");
+  const std::string depth = "depth/" + frame_name(count_, ".png");
+  MRGI_TRY(write_png((dir / rgb).string(), frame.color));
+  MRGI_TRY(write_png((dir / depth).string(), frame.depth));
+  rgb_list_ += ts + " " + rgb + "\n";
+  depth_list_ += capture::format_double(frame.depth_timestamp) + " " + depth + "\n";
+  if (has_pose) {
+    if (gt_list_.empty()) gt_list_ = list_header("ground-truth camera-to-world poses", "timestamp tx ty tz qx qy qz qw");
+    const Pose& p = *frame.pose;
+    gt_list_ += ts;
+    for (double v : {p.translation.x, p.translation.y, p.translation.z, p.rotation.x, p.rotation.y,
+                     p.rotation.z, p.rotation.w})
+      gt_list_ += " " + capture::format_double(v);
+    gt_list_ += "\n";
+  }
+  if (frame.env) {
+    std::error_code ec;
+    fs::create_directories(dir / "env", ec);
+    const std::string env = "env/" + frame_name(count_, ".exr");
+    MRGI_TRY(write_exr((dir / env).string(), *frame.env));
+    if (env_list_.empty()) env_list_ = list_header("environment images (linear radiance)", "timestamp filename");
+    env_list_ += ts + " " + env + "\n";
+  }
+  if (reference) {
+    std::error_code ec;
+    fs::create_directories(dir / "reference", ec);
+    const std::string ref = "reference/" + frame_name(count_, ".png");
+    MRGI_TRY(write_png((dir / ref).string(), *reference));
+    if (ref_list_.empty()) ref_list_ = list_header("ground-truth augmented frames", "timestamp filename [mask_filename]");
+    ref_list_ += ts + " " + ref;
+    if (reference_mask) {
+      const std::string mask = "reference/" + frame_name(count_, "_mask.png");
+      MRGI_TRY(write_png((dir / mask).string(), *reference_mask));
+      ref_list_ += " " + mask;
+    }
+    ref_list_ += "\n";
+  }
+  last_timestamp_ = frame.timestamp;
+  ++count_;
+  return ok_status();
+}
+
+Status CaptureWriter::finish() {
+  if (partial_.empty()) return fail(ErrorKind::BadUsage, folder_ + ": writer already finished");
+  if (count_ == 0) return fail(ErrorKind::BadUsage, folder_ + ": no frames were added");
+  const fs::path dir(partial_);
+  MRGI_TRY(capture::write_text((dir / "rgb.txt").string(), rgb_list_));
+  MRGI_TRY(capture::write_text((dir / "depth.txt").string(), depth_list_));
+  if (!gt_list_.empty()) MRGI_TRY(capture::write_text((dir / "groundtruth.txt").string(), gt_list_));
+  if (!env_list_.empty()) MRGI_TRY(capture::write_text((dir / "env.txt").string(), env_list_));
+  if (!ref_list_.empty()) MRGI_TRY(capture::write_text((dir / "reference.txt").string(), ref_list_));
+  MRGI_TRY(write_capture_json((dir / "capture.json").string(), info_));
+  std::error_code ec;
+  if (fs::exists(folder_, ec)) {
+    if (!fs::is_empty(folder_, ec))
+      return fail(ErrorKind::BadUsage, folder_ + ": appeared and is not empty while the capture was "
+                                                 "written; the capture stays in " + partial_);
+    fs::remove(folder_, ec);
+  }
+  fs::rename(partial_, folder_, ec);
+  if (ec) return fail(ErrorKind::Device, folder_ + ": cannot rename " + partial_ + ": " + ec.message());
+  partial_.clear();
+  return ok_status();
+}
+
+}  // namespace mrgi
