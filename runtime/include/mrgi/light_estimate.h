@@ -1,0 +1,44 @@
+// The real-world light estimated from the camera image (probeless: image-space radiance transfer,
+// technique `ssrt`), in the two forms AR apps consume: spherical-harmonics environment radiance
+// (like ARCore's ambient SH / Filament's IndirectLight::irradiance) and one dominant directional
+// light (like ARCore's main light direction + intensity / a Filament sun).
+//
+// Conventions (DESIGN.md): world space, right-handed, metres, +y up; linear RGB.
+// SH: real orthonormal basis of shaders/shared/mrgi_shared.h (Sloan 2008 sign convention and
+// index order l*(l+1)+m, m = -l..l). Radiance is L(w) = sum_i sh_radiance[i] * Y_i(w).
+#pragma once
+#include <array>
+#include <cstdint>
+
+namespace mrgi {
+
+using Rgb = std::array<float, 3>;
+
+struct LightEstimate {
+  // false until the first frame whose system was solvable; the fields below then hold the prior.
+  bool valid = false;
+  int64_t frame_index = -1;   // the frame whose image the estimate was solved from
+  double timestamp = 0.0;     // that frame's timestamp, seconds
+  int bands = 4;              // 1..4: coefficients beyond bands*bands are 0
+  // Environment radiance SH, linear RGB radiance (camera exposure divided out), up to 4 bands.
+  std::array<Rgb, 16> sh_radiance{};
+  // The same light as irradiance SH (cosine-lobe convolved, Ramamoorthi & Hanrahan 2001: bands
+  // 0..2 times pi, 2pi/3, pi/4): E(n) = sum_i irradiance_sh9[i] * Y_i(n). Lambertian outgoing
+  // radiance of albedo a is a * E(n) / pi.
+  std::array<Rgb, 9> irradiance_sh9{};
+  // Unit vector from the scene TOWARDS the dominant light (world space), from SH band 1 (paper
+  // Sec. 5.4). Filament's LightManager direction is the opposite (the direction light travels).
+  std::array<float, 3> direction_to_light{0.0f, 1.0f, 0.0f};
+  // Irradiance at normal incidence of the directional light that best reproduces the directional
+  // (band >= 1) part of the estimated irradiance, linear RGB (>= 0).
+  Rgb dominant_intensity{};
+  // How well the frame constrained the estimate, 0..1: the fraction of the 16 SH directions
+  // (eigenvalues of the normal matrix) the data constrained without help from the prior. A frame
+  // that sees one flat wall gives a low value; a room corner with floor and walls a higher one.
+  float confidence = 0.0f;
+};
+
+// Irradiance E(n) of an estimate for a unit normal n (world space), linear RGB.
+Rgb irradiance_at(const LightEstimate& estimate, const std::array<float, 3>& normal);
+
+}  // namespace mrgi

@@ -1,0 +1,154 @@
+#include "technique/ssrt/light_estimator.h"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace mrgi::ssrt {
+namespace {
+
+using Mat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor, 16, 16>;
+using Rhs = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor, 16, 3>;
+
+Status check_range(bool ok, const char* field, const std::string& rule) {
+  if (ok) return ok_status();
+  return fail(ErrorKind::BadUsage,
+              std::string("ssrt LightEstimatorSettings.") + field + ": " + rule);
+}
+
+double luminance(const glm::dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
+
+}  // namespace
+
+void LightSystem::add(const ShVector& transfer, const glm::dvec3& intensity) {
+  for (int i = 0; i < kMaxShCoeffs; ++i) {
+    const double ti = transfer[i];
+    for (int j = 0; j < kMaxShCoeffs; ++j) ata[i * kMaxShCoeffs + j] += ti * double(transfer[j]);
+    atb[i * 3 + 0] += ti * intensity.x;
+    atb[i * 3 + 1] += ti * intensity.y;
+    atb[i * 3 + 2] += ti * intensity.z;
+  }
+  samples += 1.0;
+}
+
+Expected<LightEstimator> LightEstimator::create(const LightEstimatorSettings& s) {
+  MRGI_TRY(check_range(s.bands >= 1 && s.bands <= kMaxShBands, "bands", "must be 1..4"));
+  MRGI_TRY(check_range(s.gray_albedo > 0.0 && s.gray_albedo <= 1.0, "gray_albedo",
+                       "must be in (0, 1]"));
+  MRGI_TRY(check_range(s.relative_regularisation >= 0.0 && std::isfinite(s.relative_regularisation),
+                       "relative_regularisation", "must be finite and >= 0"));
+  MRGI_TRY(check_range(s.min_regularisation > 0.0 && std::isfinite(s.min_regularisation),
+                       "min_regularisation", "must be finite and > 0"));
+  MRGI_TRY(check_range(s.band_penalty >= 0.0 && std::isfinite(s.band_penalty), "band_penalty",
+                       "must be finite and >= 0"));
+  MRGI_TRY(check_range(s.time_constant_s >= 0.0 && std::isfinite(s.time_constant_s),
+                       "time_constant_s", "must be finite and >= 0 seconds"));
+  MRGI_TRY(check_range(s.nominal_frame_s > 0.0 && s.nominal_frame_s <= 1.0, "nominal_frame_s",
+                       "must be in (0, 1] seconds"));
+  MRGI_TRY(check_range(s.prior_radiance >= 0.0 && std::isfinite(s.prior_radiance),
+                       "prior_radiance", "must be finite and >= 0"));
+  MRGI_TRY(check_range(s.confidence_eigen_fraction > 0.0 && s.confidence_eigen_fraction < 1.0,
+                       "confidence_eigen_fraction", "must be in (0, 1)"));
+  LightEstimator e(s);
+  e.reset();
+  return e;
+}
+
+void LightEstimator::reset() {
+  filtered_ = ShRgb{};
+  // Band 0 of a uniform radiance L is L * sqrt(4 pi) (Y00 = 1 / sqrt(4 pi)).
+  filtered_[0] = glm::dvec3(settings_.prior_radiance * std::sqrt(4.0 * 3.14159265358979323846));
+  frame_solution_ = filtered_;
+  estimate_ = LightEstimate{};
+  estimate_.bands = settings_.bands;
+  fill_light_estimate(filtered_, settings_.bands, estimate_);
+  have_previous_ = false;
+  last_timestamp_ = 0.0;
+}
+
+Expected<LightEstimate> LightEstimator::update(const LightSystem& system, int64_t frame_index,
+                                               double timestamp_s) {
+  for (double v : system.ata)
+    if (!std::isfinite(v))
+      return fail(ErrorKind::BadInput, "ssrt light estimation: frame " +
+                                           std::to_string(frame_index) +
+                                           ": T^T T holds NaN or Inf; frame not used");
+  for (double v : system.atb)
+    if (!std::isfinite(v))
+      return fail(ErrorKind::BadInput, "ssrt light estimation: frame " +
+                                           std::to_string(frame_index) +
+                                           ": T^T I_c holds NaN or Inf; frame not used");
+  const int n = settings_.bands * settings_.bands;
+  Mat ata(n, n);
+  Rhs atb(n, 3);
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) ata(i, j) = system.ata[i * kMaxShCoeffs + j];
+    const double inv_a = 1.0 / settings_.gray_albedo;  // T l = I_c / a
+    for (int c = 0; c < 3; ++c) atb(i, c) = system.atb[i * 3 + c] * inv_a;
+  }
+  if (settings_.white_light) {
+    for (int i = 0; i < n; ++i) {
+      const double y = luminance(glm::dvec3(atb(i, 0), atb(i, 1), atb(i, 2)));
+      atb.row(i).setConstant(y);
+    }
+  }
+  // Symmetrise (float sums from the GPU are not exactly symmetric).
+  ata = (0.5 * (ata + ata.transpose())).eval();
+
+  // Confidence: how many directions of the SH space the data pins down on its own.
+  Eigen::SelfAdjointEigenSolver<Mat> eig(ata, Eigen::EigenvaluesOnly);
+  const auto& ev = eig.eigenvalues();
+  const double max_ev = std::max(ev.maxCoeff(), 0.0);
+  int constrained = 0;
+  for (int i = 0; i < n; ++i)
+    if (max_ev > 0.0 && ev(i) > settings_.confidence_eigen_fraction * max_ev) ++constrained;
+
+  // Tikhonov towards the previous estimate (or the prior).
+  const double mean_diag = ata.trace() / n;
+  const double lambda = settings_.relative_regularisation * std::max(mean_diag, 0.0) +
+                        settings_.min_regularisation;
+  Mat lhs = ata;
+  Rhs rhs = atb;
+  for (int i = 0; i < n; ++i) {
+    const int l = sh_band(i);
+    const double w = lambda * (1.0 + settings_.band_penalty * l * (l + 1));
+    lhs(i, i) += w;
+    for (int c = 0; c < 3; ++c) rhs(i, c) += w * filtered_[i][c];
+  }
+  // lhs is symmetric positive definite (T^T T is PSD, the added diagonal > 0): LDLT is exact
+  // and stable; a robust fallback is not needed, but a non-finite result is still refused.
+  const Rhs x = lhs.ldlt().solve(rhs);
+  if (!x.allFinite()) {
+    return fail(ErrorKind::Internal, "ssrt light estimation: frame " +
+                                         std::to_string(frame_index) +
+                                         ": the regularised solve gave NaN/Inf; frame not used");
+  }
+  for (int i = 0; i < kMaxShCoeffs; ++i)
+    frame_solution_[i] = i < n ? glm::dvec3(x(i, 0), x(i, 1), x(i, 2)) : glm::dvec3(0.0);
+
+  // Temporal filter. The first real frame replaces the prior outright.
+  double alpha = 1.0;
+  if (have_previous_ && settings_.time_constant_s > 0.0) {
+    double dt = timestamp_s - last_timestamp_;
+    if (!std::isfinite(dt) || dt <= 0.0) dt = settings_.nominal_frame_s;
+    dt = std::min(dt, 10.0 * settings_.time_constant_s);
+    alpha = 1.0 - std::exp(-dt / settings_.time_constant_s);
+  }
+  const bool informative = constrained > 0;
+  if (informative) {
+    for (int i = 0; i < kMaxShCoeffs; ++i)
+      filtered_[i] += alpha * (frame_solution_[i] - filtered_[i]);
+    have_previous_ = true;
+    last_timestamp_ = timestamp_s;
+  }
+  estimate_.valid = estimate_.valid || informative;
+  estimate_.frame_index = frame_index;
+  estimate_.timestamp = timestamp_s;
+  estimate_.confidence = float(constrained) / float(n);
+  fill_light_estimate(filtered_, settings_.bands, estimate_);
+  return estimate_;
+}
+
+}  // namespace mrgi::ssrt

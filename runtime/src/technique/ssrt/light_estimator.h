@@ -1,0 +1,96 @@
+// Probeless light estimation of the ssrt technique (paper Sec. 5.2, after Gruber et al. 2012):
+// per pixel, the radiance transfer vector T(x) (SH, visibility included) and the camera's linear
+// intensity I_c(x) give one row of T l = I_c; the estimated environment light l (SH) is the
+// least-squares solution. The GPU sums the normal equations (T^T T, T^T I_c) over the frame; this
+// class solves them with Eigen, regularised and filtered over time, and exports the result.
+//
+// Why regularised: the system is ill-posed whenever the frame does not show enough different
+// normals (one flat wall: rank 1 without occlusion) or shows no light at all (a black couch:
+// T^T T ~ 0 after the albedo), and band 3 is never constrained by unshadowed diffuse surfaces
+// (its clamped-cosine factor is 0). Plain least squares then returns arbitrary or infinite
+// coefficients. We solve
+//     min_l ||T l - I_c / a||^2 + lambda * sum_i gamma_i (l_i - p_i)^2
+// (Tikhonov towards p = the previous estimate, or the prior before the first one), so
+// unconstrained directions keep what was known and constrained ones follow the data.
+#pragma once
+#include <array>
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "mrgi/expected.h"
+#include "mrgi/light_estimate.h"
+#include "technique/ssrt/sh_tools.h"
+
+namespace mrgi::ssrt {
+
+// The frame's normal equations. `ata` is the full symmetric 16x16 matrix (row-major), `atb` is
+// 16 x 3 (row-major: coefficient, then R G B). `samples` counts the rows (pixels) summed.
+struct LightSystem {
+  std::array<double, kMaxShCoeffs * kMaxShCoeffs> ata{};
+  std::array<double, kMaxShCoeffs * 3> atb{};
+  double samples = 0.0;
+
+  void clear() { *this = LightSystem{}; }
+  // Adds one pixel: transfer vector (the first `bands`^2 entries are used) and linear RGB.
+  void add(const ShVector& transfer, const glm::dvec3& intensity);
+};
+
+struct LightEstimatorSettings {
+  int bands = 4;                     // 1..4 SH bands solved (16 coefficients at 4)
+  // Gray-world albedo assumed for every real surface (paper Sec. 6.4: the material colour is
+  // not modelled, light is assumed white). The estimate scales with 1/this.
+  double gray_albedo = 0.5;
+  // Tikhonov weight relative to the mean diagonal of T^T T (dimensionless), so the balance of
+  // data and prior does not depend on the number of pixels or on exposure.
+  double relative_regularisation = 1e-3;
+  // Absolute floor of the weight (in units of T^T T), so a frame without any data (all black,
+  // no valid pixel) returns the previous estimate instead of dividing by zero.
+  double min_regularisation = 1e-9;
+  // Per-band growth of the penalty: gamma_l = 1 + band_penalty * l (l + 1). Higher bands are
+  // the ones least constrained by diffuse reflection (Ramamoorthi & Hanrahan 2001).
+  double band_penalty = 1.0;
+  // Exponential temporal filter: after a step of dt seconds the estimate moves a fraction
+  // 1 - exp(-dt / time_constant_s) towards the frame's solution. 0 disables filtering.
+  double time_constant_s = 0.5;
+  // Step used when timestamps do not advance (replays of stills, broken clocks), seconds.
+  double nominal_frame_s = 1.0 / 30.0;
+  // The paper assumes white light (Sec. 5): the three channels are solved as one (luminance)
+  // and exported grey. false: each channel is solved on its own (same T^T T).
+  bool white_light = true;
+  // The prior before the first frame: a uniform (band 0 only) environment of this radiance.
+  double prior_radiance = 0.5;
+  // Eigenvalues of T^T T above this fraction of the largest count as constrained (confidence).
+  double confidence_eigen_fraction = 1e-3;
+};
+
+class LightEstimator {
+ public:
+  // BadUsage naming the field when a setting is out of range.
+  static Expected<LightEstimator> create(const LightEstimatorSettings& settings);
+
+  // Solves the frame's system, filters it into the running estimate and returns that. A system
+  // holding NaN or Inf is refused (BadInput) and the estimate is kept as it was, so a broken
+  // frame cannot poison the filter.
+  Expected<LightEstimate> update(const LightSystem& system, int64_t frame_index,
+                                 double timestamp_s);
+
+  // The last frame's unfiltered least-squares solution and the filtered estimate.
+  const ShRgb& frame_solution() const { return frame_solution_; }
+  const ShRgb& filtered() const { return filtered_; }
+  const LightEstimate& estimate() const { return estimate_; }
+  const LightEstimatorSettings& settings() const { return settings_; }
+  void reset();
+
+ private:
+  explicit LightEstimator(const LightEstimatorSettings& settings) : settings_(settings) {}
+
+  LightEstimatorSettings settings_;
+  ShRgb frame_solution_{};
+  ShRgb filtered_{};
+  LightEstimate estimate_;
+  bool have_previous_ = false;
+  double last_timestamp_ = 0.0;
+};
+
+}  // namespace mrgi::ssrt

@@ -1,0 +1,115 @@
+#include "technique/ssrt/sh_tools.h"
+
+#include <cmath>
+
+#include "shared/mrgi_shared.h"
+
+namespace mrgi::ssrt {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// Clamped-cosine zonal factors A_l (Ramamoorthi & Hanrahan 2001) for l = 0..3.
+constexpr double kCosineLobe[kMaxShBands] = {kPi, 2.0 * kPi / 3.0, kPi / 4.0, 0.0};
+
+double luminance(const glm::dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
+
+}  // namespace
+
+ShVector sh_basis(const glm::vec3& direction) {
+  ShVector out{};
+  const float len = glm::length(direction);
+  if (!(len > 0.0f) || !std::isfinite(len)) return out;
+  const shader::SH16 b = shader::sh_basis16(direction / len);
+  for (int i = 0; i < kMaxShCoeffs; ++i) out[i] = shader::sh_get(b, i);
+  return out;
+}
+
+int sh_band(int coefficient) {
+  int l = 0;
+  while ((l + 1) * (l + 1) <= coefficient) ++l;
+  return l;
+}
+
+ShRgb sh_directional_light(const glm::dvec3& direction_to_light, const glm::dvec3& irradiance,
+                           int bands) {
+  ShRgb out{};
+  const ShVector y = sh_basis(glm::vec3(direction_to_light));
+  for (int i = 0; i < bands * bands && i < kMaxShCoeffs; ++i) out[i] = irradiance * double(y[i]);
+  return out;
+}
+
+glm::dvec3 sh_evaluate(const ShRgb& l, const glm::vec3& direction) {
+  const ShVector y = sh_basis(direction);
+  glm::dvec3 sum(0.0);
+  for (int i = 0; i < kMaxShCoeffs; ++i) sum += l[i] * double(y[i]);
+  return sum;
+}
+
+glm::dvec3 sh_irradiance(const ShRgb& l, const glm::vec3& normal) {
+  const ShVector y = sh_basis(normal);
+  glm::dvec3 sum(0.0);
+  for (int i = 0; i < kMaxShCoeffs; ++i) sum += kCosineLobe[sh_band(i)] * l[i] * double(y[i]);
+  return sum;
+}
+
+bool sh_dominant_direction(const ShRgb& l, glm::dvec3& out) {
+  // Band 1 in Sloan order is (Y1-1, Y10, Y11) = c * (-y, z, -x): the vector of coefficients maps
+  // back to a direction as (-L11, -L1-1, L10).
+  const glm::dvec3 d(-luminance(l[3]), -luminance(l[1]), luminance(l[2]));
+  const double len = glm::length(d);
+  if (!(len > 1e-30) || !std::isfinite(len)) return false;
+  out = d / len;
+  return true;
+}
+
+glm::dvec3 sh_dominant_intensity(const ShRgb& l, const glm::dvec3& direction) {
+  const ShVector y = sh_basis(glm::vec3(direction));
+  glm::dvec3 num(0.0);
+  double den = 0.0;
+  for (int i = 1; i < 9; ++i) {
+    const double a = kCosineLobe[sh_band(i)];
+    num += a * a * l[i] * double(y[i]);
+    den += a * a * double(y[i]) * double(y[i]);
+  }
+  if (!(den > 0.0)) return glm::dvec3(0.0);
+  return glm::max(num / den, glm::dvec3(0.0));
+}
+
+void fill_light_estimate(const ShRgb& l, int bands, LightEstimate& out) {
+  out.bands = bands;
+  for (int i = 0; i < kMaxShCoeffs; ++i) {
+    const glm::dvec3 c = i < bands * bands ? l[i] : glm::dvec3(0.0);
+    out.sh_radiance[i] = {float(c.x), float(c.y), float(c.z)};
+    if (i < 9) {
+      const glm::dvec3 e = c * kCosineLobe[sh_band(i)];
+      out.irradiance_sh9[i] = {float(e.x), float(e.y), float(e.z)};
+    }
+  }
+  glm::dvec3 dir(out.direction_to_light[0], out.direction_to_light[1], out.direction_to_light[2]);
+  if (sh_dominant_direction(l, dir)) {
+    out.direction_to_light = {float(dir.x), float(dir.y), float(dir.z)};
+  }
+  const glm::dvec3 c = sh_dominant_intensity(l, dir);
+  out.dominant_intensity = {float(c.x), float(c.y), float(c.z)};
+}
+
+bool is_finite(const ShRgb& l) {
+  for (const auto& c : l)
+    if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z)) return false;
+  return true;
+}
+
+}  // namespace mrgi::ssrt
+
+namespace mrgi {
+
+Rgb irradiance_at(const LightEstimate& estimate, const std::array<float, 3>& normal) {
+  const glm::vec3 n(normal[0], normal[1], normal[2]);
+  const ssrt::ShVector y = ssrt::sh_basis(n);
+  Rgb out{0.0f, 0.0f, 0.0f};
+  for (int i = 0; i < 9; ++i)
+    for (int c = 0; c < 3; ++c) out[c] += estimate.irradiance_sh9[i][c] * y[i];
+  return out;
+}
+
+}  // namespace mrgi

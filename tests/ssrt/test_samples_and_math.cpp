@@ -1,0 +1,192 @@
+// The ssrt sample sets (spherical Delaunay, chi of eq. 9, pre-computed SH weights) and the
+// per-sample shader math of shaders/ssrt/ssrt_math.h (eq. 6-8, 10-15), checked on the CPU.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <set>
+
+#include "../../shaders/ssrt/ssrt_math.h"
+#include "technique/ssrt/sample_directions.h"
+#include "technique/ssrt/sh_tools.h"
+
+namespace {
+using namespace mrgi;
+using namespace mrgi::ssrt;
+using mrgi::shader::vec3;
+
+constexpr double kPi = 3.14159265358979323846;
+
+TEST(SsrtSamples, OctahedronTriangulation) {
+  const std::vector<glm::dvec3> p = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0},
+                                     {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  auto tris = spherical_delaunay(p);
+  ASSERT_TRUE(tris.ok()) << tris.error().message;
+  EXPECT_EQ(tris->size(), 8u);
+  EXPECT_NEAR(median_edge_angle(p, *tris), kPi / 2.0, 1e-12);
+}
+
+TEST(SsrtSamples, DelaunayOfRandomPointsIsAClosedEmptyCircleTriangulation) {
+  std::mt19937 rng(4);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::vector<glm::dvec3> p(200);
+  for (auto& v : p) v = glm::normalize(glm::dvec3(g(rng), g(rng), g(rng)));
+  auto tris = spherical_delaunay(p);
+  ASSERT_TRUE(tris.ok());
+  // Euler for a triangulated sphere: F = 2V - 4, E = 3V - 6.
+  EXPECT_EQ(tris->size(), 2 * p.size() - 4);
+  std::set<std::pair<uint32_t, uint32_t>> edges;
+  for (const auto& t : *tris) {
+    for (int e = 0; e < 3; ++e)
+      edges.insert({std::min(t[e], t[(e + 1) % 3]), std::max(t[e], t[(e + 1) % 3])});
+    // Empty circumcircle on the sphere = no point above the triangle's plane.
+    const glm::dvec3 n = glm::cross(p[t[1]] - p[t[0]], p[t[2]] - p[t[0]]);
+    for (const auto& q : p) EXPECT_LE(glm::dot(n, q - p[t[0]]), 1e-9);
+  }
+  EXPECT_EQ(edges.size(), 3 * p.size() - 6);
+}
+
+TEST(SsrtSamples, CoplanarOrTooFewPointsAreRefused) {
+  EXPECT_FALSE(spherical_delaunay({{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}}).ok());
+  auto flat = spherical_delaunay({{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}});
+  ASSERT_FALSE(flat.ok());
+  EXPECT_EQ(flat.error().kind, ErrorKind::BadInput);
+}
+
+TEST(SsrtSamples, SetsCoverTheSphereAndChiFollowsTheDensity) {
+  for (uint32_t n : {16u, 64u, 256u}) {
+    auto s = make_sample_sets({n, 1});
+    ASSERT_TRUE(s.ok());
+    ASSERT_EQ(s->samples.size(), size_t(kJitterSets) * n);
+    // A triangular lattice of n points: spacing sqrt(8 pi / (sqrt(3) n)).
+    const double lattice = std::sqrt(8.0 * kPi / (std::sqrt(3.0) * n));
+    EXPECT_NEAR(s->median_neighbour_angle, lattice, 0.3 * lattice) << n;
+    EXPECT_NEAR(s->chi, 1.0 - std::cos(0.5 * s->median_neighbour_angle), 1e-6);
+    for (int set = 0; set < kJitterSets; ++set) {
+      // The SH weights integrate the basis: sum_j Y_i(w_j) dw ~ integral Y_i = sqrt(4 pi) d_i0.
+      double sums[16] = {};
+      for (uint32_t j = 0; j < n; ++j) {
+        const GpuSample& g = s->samples[size_t(set) * n + j];
+        EXPECT_NEAR(glm::length(glm::vec3(g.direction_and_radius)), 1.0f, 1e-5f);
+        EXPECT_GT(g.direction_and_radius.w, 0.0f);
+        EXPECT_LE(g.direction_and_radius.w, 1.0f);
+        for (int i = 0; i < 16; ++i) sums[i] += g.sh_weights[i / 4][i % 4];
+      }
+      EXPECT_NEAR(sums[0], std::sqrt(4.0 * kPi), 1e-4);
+      // Odd bands integrate to 0 exactly (antipodal pairs); even ones up to the jitter.
+      for (int i = 1; i < 4; ++i) EXPECT_NEAR(sums[i], 0.0, 1e-5) << "band 1, N " << n;
+      for (int i = 9; i < 16; ++i) EXPECT_NEAR(sums[i], 0.0, 1e-5) << "band 3, N " << n;
+      // (16 directions are too coarse for band 2 to integrate well; the ladder uses >= 32.)
+      // Jittered random sampling: the error shrinks like 1/sqrt(N).
+      if (n >= 64) {
+        for (int i = 4; i < 9; ++i)
+          EXPECT_NEAR(sums[i], 0.0, 3.0 / std::sqrt(double(n))) << "band 2, N " << n;
+      }
+    }
+  }
+  auto a = make_sample_sets({32, 5});
+  auto b = make_sample_sets({32, 5});
+  auto c = make_sample_sets({32, 6});
+  EXPECT_EQ(a->samples[17].direction_and_radius, b->samples[17].direction_and_radius);
+  EXPECT_NE(a->samples[17].direction_and_radius, c->samples[17].direction_and_radius);
+  EXPECT_FALSE(make_sample_sets({4, 1}).ok());
+  EXPECT_FALSE(make_sample_sets({2000, 1}).ok());
+  EXPECT_FALSE(make_sample_sets({33, 1}).ok());
+}
+
+TEST(SsrtMath, ContinuousVisibilityRisesOverHalfASampleSpacing) {
+  const float median = 0.4f;
+  const float chi = shader::ssrt_chi_from_median_angle(median);
+  const vec3 x(0.0f), w(0.0f, 0.0f, 1.0f);
+  // Occluder straight along w: blocked.
+  EXPECT_FLOAT_EQ(shader::ssrt_visibility_k(x, vec3(0, 0, 2), w, chi), 0.0f);
+  // At half the median angle K reaches 1; beyond it stays 1; in between it rises monotonically.
+  auto at = [&](float angle) {
+    return shader::ssrt_visibility_k(x, vec3(std::sin(angle), 0, std::cos(angle)), w, chi);
+  };
+  EXPECT_NEAR(at(0.5f * median), 1.0f, 1e-4f);
+  EXPECT_FLOAT_EQ(at(1.5f), 1.0f);
+  float last = 0.0f;
+  for (float a = 0.0f; a <= 0.5f * median; a += 0.01f) {
+    EXPECT_GE(at(a), last);
+    last = at(a);
+  }
+  EXPECT_NEAR(at(0.25f * median), (1.0f - std::cos(0.25f * median)) / chi, 1e-4f);
+  // Degenerate s == x: visible, never NaN.
+  EXPECT_EQ(shader::ssrt_visibility_k(x, x, w, chi), 1.0f);
+}
+
+TEST(SsrtMath, TransferOfAnUnoccludedPixelGivesTheLambertianRadiance) {
+  auto s = make_sample_sets({256, 3});
+  ASSERT_TRUE(s.ok());
+  // Uniform radiance L: a white Lambertian surface reflects L. dot(T, l) with l_0 = L sqrt(4pi).
+  const float L = 2.0f;
+  const vec3 n = glm::normalize(vec3(0.3f, -0.5f, 0.8f));
+  for (int set = 0; set < kJitterSets; ++set) {
+    double t0 = 0.0;
+    for (uint32_t j = 0; j < s->directions; ++j) {
+      const GpuSample& g = s->samples[size_t(set) * s->directions + j];
+      t0 += shader::ssrt_transfer_weight(n, vec3(g.direction_and_radius), 1.0f, 1.0f) *
+            g.sh_weights[0].x;
+    }
+    EXPECT_NEAR(t0 * L * std::sqrt(4.0 * kPi), L, 0.05 * L) << "set " << set;
+  }
+}
+
+TEST(SsrtMath, FormFactorAndFacingGate) {
+  const vec3 x(0.0f), nx(0, 0, 1), s(0, 0, 1), ns(0, 0, -1);
+  const float area = 0.01f;
+  EXPECT_NEAR(shader::ssrt_form_factor(x, nx, s, ns, area, 0.01f), area / float(kPi), 1e-7f);
+  // Twice the distance: a quarter.
+  EXPECT_NEAR(shader::ssrt_form_factor(x, nx, vec3(0, 0, 2), ns, area, 0.01f),
+              area / float(kPi) / 4.0f, 1e-7f);
+  // Sender facing away or receiver behind: nothing.
+  EXPECT_EQ(shader::ssrt_form_factor(x, nx, s, vec3(0, 0, 1), area, 0.01f), 0.0f);
+  EXPECT_EQ(shader::ssrt_form_factor(x, nx, vec3(0, 0, -1), vec3(0, 0, 1), area, 0.01f), 0.0f);
+  EXPECT_EQ(shader::ssrt_facing_gate(ns, vec3(0, 0, 1)), 1.0f);
+  EXPECT_EQ(shader::ssrt_facing_gate(vec3(0, 0, 1), vec3(0, 0, 1)), 0.0f);
+  // The distance clamp bounds the 1/d^2 singularity.
+  const float near = shader::ssrt_form_factor(x, nx, vec3(0, 0, 1e-6f), ns, 1.0f, 0.05f);
+  EXPECT_TRUE(std::isfinite(near));
+  EXPECT_LE(near, 1.0f);
+}
+
+TEST(SsrtMath, IndirectTermOnlyFromOccludingLitSenders) {
+  const vec3 x(0.0f), nx(0, 0, 1), s(0, 0, 0.5f), ns(0, 0, -1), albedo(0.8f, 0.2f, 0.1f);
+  const vec3 light_dir(0, 0, -1), e(3.0f);
+  const vec3 full = shader::ssrt_indirect_term(x, nx, s, ns, albedo, 0.0f, light_dir, e, 0.01f, 0.01f);
+  // Expected: albedo * E * cos / pi (sender radiance) * pi * F.
+  const float f = shader::ssrt_form_factor(x, nx, s, ns, 0.01f, 0.01f);
+  EXPECT_NEAR(full.x, 0.8f * 3.0f / float(kPi) * float(kPi) * f, 1e-6f);
+  EXPECT_GT(full.x, full.y);  // coloured by the sender's albedo
+  // Visible sample (K = 1): no bounce. Sender not lit: no bounce.
+  EXPECT_EQ(shader::ssrt_indirect_term(x, nx, s, ns, albedo, 1.0f, light_dir, e, 0.01f, 0.01f).x, 0.0f);
+  EXPECT_EQ(shader::ssrt_indirect_term(x, nx, s, ns, albedo, 0.0f, -light_dir, e, 0.01f, 0.01f).x, 0.0f);
+}
+
+TEST(SsrtMath, ToneMapAndDifferentialComposite) {
+  // Reinhard: L = avg maps to key / (1 + key) when white is large; monotonic; bounded.
+  EXPECT_NEAR(shader::ssrt_reinhard(2.0f, 0.18f, 2.0f, 1e6f), 0.18f / 1.18f, 1e-6f);
+  EXPECT_EQ(shader::ssrt_reinhard(1.0f, 0.18f, 0.0f, 1.0f), 0.0f);
+  EXPECT_NEAR(shader::ssrt_reinhard(1e30f, 0.18f, 1e-30f, 1e6f), 1.0f, 1e-6f);  // HDR: white
+  EXPECT_NEAR(shader::ssrt_reinhard(4.0f, 1.0f, 1.0f, 4.0f), 1.0f, 1e-6f);  // L_white -> 1
+  EXPECT_LT(shader::ssrt_reinhard(1.0f, 0.18f, 1.0f, 1e6f),
+            shader::ssrt_reinhard(2.0f, 0.18f, 1.0f, 1e6f));
+  const vec3 cam(0.5f, 0.4f, 0.3f);
+  // No change where the virtual object has no effect: exactly the camera.
+  const vec3 same = shader::ssrt_direct_differential(cam, 1.3f, 1.3f, 0.18f, 1.0f, 1e6f);
+  EXPECT_EQ(same.x, cam.x);
+  EXPECT_EQ(same.z, cam.z);
+  // A shadow darkens, more light brightens, never negative.
+  EXPECT_LT(shader::ssrt_direct_differential(cam, 1.0f, 0.2f, 0.18f, 1.0f, 1e6f).x, cam.x);
+  EXPECT_GT(shader::ssrt_direct_differential(cam, 1.0f, 2.0f, 0.18f, 1.0f, 1e6f).x, cam.x);
+  EXPECT_GE(shader::ssrt_direct_differential(cam, 1e6f, 0.0f, 50.0f, 1e-6f, 1e6f).x, 0.0f);
+  // Eq. 14: equal bounce buffers select nothing, different ones select R'_i.
+  EXPECT_EQ(shader::ssrt_indirect_select(vec3(0.3f), vec3(0.3f), 1e-3f).x, 0.0f);
+  EXPECT_EQ(shader::ssrt_indirect_select(vec3(0.3f), vec3(0.5f), 1e-3f).x, 0.5f);
+  const vec3 out = shader::ssrt_compose_real(cam, 1.0f, 1.0f, vec3(0.1f), vec3(0.4f),
+                                             vec3(0.5f), 0.18f, 1.0f, 1e6f, 1e-3f);
+  EXPECT_NEAR(out.x, cam.x + 0.4f * 0.5f / float(kPi), 1e-6f);
+}
+
+}  // namespace
