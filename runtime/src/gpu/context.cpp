@@ -152,6 +152,10 @@ T load_device_fn(VkDevice device, const char* core, const char* khr) {
 
 }  // namespace
 
+Expected<VkInstance> create_instance_for_listing() { return create_instance(false, nullptr); }
+Expected<std::vector<VkPhysicalDevice>> physical_devices_for_listing(VkInstance i) { return physical_devices(i); }
+std::vector<DeviceInfo> describe_all_devices(const std::vector<VkPhysicalDevice>& pds) { return describe_all(pds); }
+
 std::string effective_device_selector(const DeviceSettings& settings) {
   if (!settings.device.empty()) return settings.device;
   const char* env = std::getenv("MRGI_DEVICE");
@@ -182,20 +186,6 @@ Expected<uint32_t> select_device_index(const std::vector<DeviceInfo>& devices,
   return fail(ErrorKind::BadUsage, "device selector '" + selector +
                                        "' matches no device name (use an index or a name substring):" +
                                        device_list_text(devices));
-}
-
-Expected<std::vector<DeviceInfo>> list_devices(const DeviceSettings& settings) {
-  auto instance = create_instance(false, nullptr);
-  if (!instance) return instance.error();
-  auto pds = physical_devices(*instance);
-  std::vector<DeviceInfo> devices;
-  if (pds) devices = describe_all(*pds);
-  vkDestroyInstance(*instance, nullptr);
-  if (!pds) return pds.error();
-  auto chosen = select_device_index(devices, effective_device_selector(settings));
-  if (!chosen) return chosen.error();
-  devices[*chosen].selected = true;
-  return devices;
 }
 
 Expected<std::unique_ptr<Context>> Context::create(const DeviceSettings& settings) {
@@ -713,3 +703,21 @@ uint32_t bytes_per_texel(VkFormat f) {
 }
 
 }  // namespace mrgi::gpu
+
+namespace mrgi {
+
+Expected<std::vector<DeviceInfo>> list_devices(const DeviceSettings& settings) {
+  auto instance = gpu::create_instance_for_listing();
+  if (!instance) return instance.error();
+  auto pds = gpu::physical_devices_for_listing(*instance);
+  std::vector<DeviceInfo> devices;
+  if (pds) devices = gpu::describe_all_devices(*pds);
+  vkDestroyInstance(*instance, nullptr);
+  if (!pds) return pds.error();
+  auto chosen = gpu::select_device_index(devices, gpu::effective_device_selector(settings));
+  if (!chosen) return chosen.error();
+  devices[*chosen].selected = true;
+  return devices;
+}
+
+}  // namespace mrgi

@@ -229,9 +229,13 @@ Status FrameGraph::upload_image(ImageHandle image, const void* texels, VkDeviceS
   // Previous frames may still use it.
   VK_CHECK(vkQueueWaitIdle(context_.queue()));
   ImageEntry& e = images_[image.id];
-  MRGI_TRY(context_.upload_image(e.gpu, texels, size, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL));
+  // Leave it in the layout its usage allows, so the first pass's barrier is a valid transition.
+  const VkImageLayout layout = (e.gpu.usage & VK_IMAGE_USAGE_SAMPLED_BIT) ? VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL
+                               : (e.gpu.usage & VK_IMAGE_USAGE_STORAGE_BIT) ? VK_IMAGE_LAYOUT_GENERAL
+                                                                            : VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+  MRGI_TRY(context_.upload_image(e.gpu, texels, size, layout));
   e.state = ResourceState{};
-  e.state.layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+  e.state.layout = layout;
   return ok_status();
 }
 

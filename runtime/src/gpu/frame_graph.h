@@ -251,7 +251,8 @@ class FrameGraph {
                            VkImageLayout layout, bool history = true);
   BufferHandle import_buffer(const std::string& name, const GpuBuffer& buffer,
                              bool history = true);
-  // Fills an image with texels at start-up (staging copy, waits), leaving it SHADER_READ_ONLY.
+  // Fills an image with texels at start-up (staging copy, waits), leaving it SHADER_READ_ONLY
+  // (sampled usage), GENERAL (storage) or TRANSFER_DST; the graph tracks the layout.
   Status upload_image(ImageHandle image, const void* texels, VkDeviceSize size);
 
   // Per-frame size knobs: the used extent of OutputRelative images. Never reallocates; values
