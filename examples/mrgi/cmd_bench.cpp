@@ -1,0 +1,91 @@
+// mrgi bench [--suite FILE] [--techniques LIST] [--levels all|LIST] [--scenes LIST] [--frames N]
+//            [--warmup N] --out DIR [--check BASELINE] [--write-baseline FILE]
+// Exit 0: done (and the check passed); 1: bad input, failure, or the regression check failed;
+// 2: bad usage.
+#include <cstdio>
+#include <iostream>
+#include <optional>
+
+#include "commands.h"
+#include "mrgi/perf/bench.h"
+#include "mrgi/perf/regression.h"
+#include "mrgi/perf/report.h"
+
+namespace mrgi::tool {
+namespace {
+
+struct BenchOptions {
+  perf::BenchSettings settings;
+  std::string out, check, write_baseline;
+  bool quiet = false;
+};
+
+void run_bench_command(BenchOptions& o) {
+  // Before any Vulkan instance exists: lavapipe reads it when the device is created.
+  perf::ensure_lp_num_threads();
+  std::optional<perf::Baseline> baseline;
+  if (!o.check.empty()) baseline = take(perf::load_baseline(o.check));  // fail before hours of work
+  if (!o.quiet) o.settings.progress = [](const std::string& what, size_t done, size_t total, double elapsed) {
+    progress("bench " + what, done, total, elapsed);
+  };
+  const perf::BenchResult result = take(perf::run_bench(o.settings));
+  std::optional<perf::CheckReport> check;
+  if (baseline) check = perf::check_against(result, *baseline);
+  auto st = perf::write_bench_outputs(o.out, result, check ? &*check : nullptr);
+  if (!st.ok()) fail_with(st.error());
+  if (!o.write_baseline.empty()) {
+    auto wb = perf::write_baseline(o.write_baseline, perf::make_baseline(result));
+    if (!wb.ok()) fail_with(wb.error());
+  }
+  std::printf("bench: %zu runs on %s (LP_NUM_THREADS=%s), floor %.3f ms, %.1f s; wrote %s/{bench.json,bench.csv,report.md,pareto.png}\n",
+              result.entries.size(), result.device.c_str(),
+              result.lp_num_threads.empty() ? "unset" : result.lp_num_threads.c_str(), result.floor_median_ms,
+              result.duration_s, o.out.c_str());
+  if (!o.write_baseline.empty()) std::printf("bench: wrote baseline %s\n", o.write_baseline.c_str());
+  if (check) {
+    std::cout << check->summary();
+    if (!check->passed)
+      throw CommandFailure(1, "regression check against " + o.check + " failed (" +
+                                  std::to_string(check->violations.size()) + " violations; see above and " + o.out +
+                                  "/report.md)");
+  }
+}
+
+void setup(CLI::App& app) {
+  auto opts = std::make_shared<BenchOptions>();
+  opts->settings.suite = "perf/suite.json";
+  CLI::App* cmd = app.add_subcommand(
+      "bench", "Run every technique and quality level over the scene suite; write bench.json, bench.csv, "
+               "report.md and pareto.png; optionally check against a baseline");
+  cmd->add_option("--suite", opts->settings.suite, "suite manifest (JSON)")->capture_default_str();
+  cmd->add_option("--techniques,-t", opts->settings.techniques, "techniques to run, comma-separated (default: all)")
+      ->delimiter(',');
+  cmd->add_option("--levels,-l", opts->settings.levels,
+                  "'all' (default) or comma-separated level indices, names, or 'last' (the cheapest)")
+      ->delimiter(',');
+  cmd->add_option("--scenes,-s", opts->settings.scenes, "suite scenes to run, comma-separated (default: all)")
+      ->delimiter(',');
+  cmd->add_option("--frames,-n", opts->settings.frames, "measured frames per run")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  cmd->add_option("--warmup", opts->settings.warmup, "frames run before measuring, per run")
+      ->check(CLI::Range(0, 100000))
+      ->capture_default_str();
+  cmd->add_option("--floor-frames", opts->settings.floor_frames, "floor-pass samples taken before each run")
+      ->check(CLI::Range(3, 100000))
+      ->capture_default_str();
+  cmd->add_option("--out,-o", opts->out, "output folder (built as DIR.partial, renamed at the end)")->required();
+  cmd->add_option("--check", opts->check, "baseline to compare with (perf/baseline.json); exit 1 on a regression");
+  cmd->add_option("--write-baseline", opts->write_baseline, "write a baseline from this run to FILE");
+  cmd->add_option("--device", opts->settings.device.device,
+                  "Vulkan device: index or name part (default $MRGI_DEVICE, else lavapipe)");
+  cmd->add_flag("--validate", opts->settings.device.validate, "enable Vulkan validation layers (slower)");
+  cmd->add_flag("--quiet,-q", opts->quiet, "no progress on stderr");
+  cmd->callback([opts] { run_bench_command(*opts); });
+}
+
+}  // namespace
+
+MRGI_COMMAND(bench, setup);
+
+}  // namespace mrgi::tool

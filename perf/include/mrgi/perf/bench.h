@@ -1,0 +1,106 @@
+// The bench: replays the scene suite through every technique and quality level on one Vulkan
+// device, times a floor pass in the same process, and measures error against the captures'
+// references. Timings are GPU times from the frame graph's timestamps (FrameStats).
+//
+// One run (scene, technique, level) = a fresh Runtime at that level fed `warmup` frames (not
+// measured) and then `frames` measured ones. A capture shorter than warmup + frames is replayed
+// forth and back (0,1,..,n-1,n-2,..,1,0,1,..) with timestamps continued, so the motion stays
+// continuous for temporal filters. Before every run the floor pass is timed at the scene's output
+// size; a scene's floor is the median of all its floor samples, so ratios compare times taken
+// in the same process, close together in time.
+#pragma once
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "mrgi/expected.h"
+#include "mrgi/metrics.h"
+#include "mrgi/runtime.h"
+
+namespace mrgi::perf {
+
+// what, done, total, elapsed seconds (units: frames, warm-up included).
+using ProgressFn = std::function<void(const std::string&, size_t, size_t, double)>;
+
+struct BenchSettings {
+  std::string suite;                     // path of suite.json
+  std::vector<std::string> scenes;       // empty = every scene of the suite
+  std::vector<std::string> techniques;   // empty = technique_names()
+  // Empty or {"all"} = every level; else level indices ("0"), names, or "last" (the cheapest).
+  std::vector<std::string> levels;
+  int frames = 16;                       // measured frames per run (>= 1)
+  int warmup = 4;                        // frames per run before measuring (>= 0)
+  int floor_frames = 20;                 // floor pass samples per run (>= 3)
+  int floor_warmup = 3;
+  DeviceSettings device;
+  ProgressFn progress;                   // optional
+};
+
+// Times of one series (frame total or one pass), in ms and as ratios to the scene's floor.
+struct TimeSummary {
+  size_t samples = 0;
+  double median_ms = 0.0, p95_ms = 0.0;
+  double median_ratio = 0.0, p95_ratio = 0.0;  // ms / the scene's floor median ms
+};
+
+struct PassSummary {
+  std::string name;
+  TimeSummary time;  // over the measured frames in which the pass ran (samples says how many)
+};
+
+struct BenchEntry {
+  std::string scene, technique, level_name;
+  int level = 0;
+  int width = 0, height = 0;             // output size
+  TimeSummary frame;                     // FrameStats::gpu_total_ms
+  double median_wall_ms = 0.0;           // FrameStats::cpu_ms (host wall time of process())
+  std::vector<PassSummary> passes;       // in first-seen order
+  double memory_mib = 0.0;               // Runtime::memory_mib()
+  bool has_reference = false;            // error below is meaningful only when true
+  RdeReport error;                       // pooled over the measured frames
+  std::vector<std::string> skipped;      // distinct skip notes seen over the measured frames
+};
+
+struct SceneFloor {
+  std::string scene;
+  int width = 0, height = 0;
+  size_t samples = 0;
+  double median_ms = 0.0, p95_ms = 0.0, min_ms = 0.0;
+};
+
+struct BenchResult {
+  std::vector<BenchEntry> entries;       // scene-major, then technique, then level
+  std::vector<SceneFloor> floors;        // one per scene
+  double floor_median_ms = 0.0;          // over every floor sample of the run
+  std::string device, driver;
+  std::string lp_num_threads;            // the value in effect ("" = unset: not a valid timing)
+  std::string commit;                    // git HEAD of the source tree ("" if unknown)
+  bool dirty = false;                    // uncommitted changes in the source tree
+  bool subset = false;                   // scenes, techniques or levels were restricted
+  std::string suite;
+  int frames = 0, warmup = 0;
+  std::string started_utc;               // ISO 8601
+  double duration_s = 0.0;
+};
+
+// Sets LP_NUM_THREADS=2 when it is unset (lavapipe reads it when a device is created, so call this
+// before any Vulkan instance exists) and returns the value now in effect.
+std::string ensure_lp_num_threads();
+
+Expected<BenchResult> run_bench(const BenchSettings& settings);
+
+// Suite-wide figures of one technique level: mean over scenes of the median frame ms and ratio,
+// error pooled over every measured frame of every scene. Used by the report and the plot.
+struct LevelAggregate {
+  std::string technique, level_name;
+  int level = 0;
+  size_t scenes = 0;
+  double mean_median_ms = 0.0, mean_median_ratio = 0.0;
+  double max_memory_mib = 0.0;
+  bool has_reference = false;
+  RdeReport error;
+};
+std::vector<LevelAggregate> aggregate_levels(const BenchResult& result);
+
+}  // namespace mrgi::perf

@@ -1,0 +1,30 @@
+// What `mrgi bench --out DIR` writes, all under DIR.partial and renamed to DIR at the end:
+//   bench.json  everything: settings, device, lp_num_threads, commit, floors, every entry with
+//               frame and per-pass median/p95 (ms and ratio), memory, error (all/real/virtual:
+//               RDE, delta RMS, RMSE, SSIM), suite aggregates per level, the Pareto front and
+//               the regression check when one was asked for
+//   bench.csv   one row per scene/technique/level
+//   report.md   per technique a table per level and scene, per-pass medians, the floors, the plot
+//   pareto.png  median frame ms against RDE per technique level (suite aggregate), front marked
+#pragma once
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "mrgi/expected.h"
+#include "mrgi/image.h"
+#include "mrgi/perf/bench.h"
+#include "mrgi/perf/regression.h"
+
+namespace mrgi::perf {
+
+nlohmann::json bench_json(const BenchResult& result, const CheckReport* check);
+std::string bench_csv(const BenchResult& result);
+std::string report_markdown(const BenchResult& result, const CheckReport* check);
+// 960 x 640 plot of the suite aggregates (aggregate_levels), one colour and marker per technique.
+ImageRGB8 render_pareto_plot(const BenchResult& result);
+
+// Writes the four files. DIR must be absent, empty or an earlier bench output (has bench.json).
+Status write_bench_outputs(const std::string& dir, const BenchResult& result, const CheckReport* check);
+
+}  // namespace mrgi::perf

@@ -1,0 +1,392 @@
+// The bench loop: scenes x techniques x levels, each run preceded by a floor-pass measurement.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+
+#include "gpu/context.h"
+#include "gpu/floor_pass.h"
+#include "mrgi/perf/bench.h"
+#include "mrgi/perf/stats.h"
+#include "mrgi/perf/suite.h"
+#include "mrgi/platform/capture.h"
+
+#ifndef MRGI_PERF_SOURCE_DIR
+#define MRGI_PERF_SOURCE_DIR ""
+#endif
+
+namespace mrgi::perf {
+namespace {
+
+// A capture held in memory, so replaying it costs no file I/O between timed frames.
+struct LoadedScene {
+  SuiteScene suite;
+  CaptureInfo info;
+  SceneDesc scene;
+  std::vector<InputFrame> frames;
+  std::vector<std::optional<ImageRGB8>> references;
+  std::vector<std::optional<ImageU8>> masks;
+  double frame_interval_s = 1.0 / 30.0;
+};
+
+Expected<LoadedScene> load_scene(const SuiteScene& s) {
+  auto reader = CaptureReader::open(s.capture);
+  if (!reader.ok()) return fail(reader.error().kind, "scene '" + s.name + "': " + reader.error().message);
+  LoadedScene l;
+  l.suite = s;
+  l.info = reader->info();
+  if (reader->scene()) l.scene = *reader->scene();
+  const size_t n = reader->frame_count();
+  if (n == 0) return fail(ErrorKind::BadInput, s.capture + ": capture has no frames (scene '" + s.name + "')");
+  for (size_t i = 0; i < n; ++i) {
+    auto f = reader->read_frame(i);
+    if (!f.ok()) return f.error();
+    l.frames.push_back(std::move(f).value());
+    std::optional<ImageRGB8> ref;
+    std::optional<ImageU8> mask;
+    if (!reader->entry(i).reference.empty()) {
+      auto r = reader->read_reference(i);
+      if (!r.ok()) return r.error();
+      ref = std::move(r).value();
+      if (!reader->entry(i).reference_mask.empty()) {
+        auto m = reader->read_reference_mask(i);
+        if (!m.ok()) return m.error();
+        mask = std::move(m).value();
+      }
+    }
+    l.references.push_back(std::move(ref));
+    l.masks.push_back(std::move(mask));
+  }
+  if (n > 1) {
+    const double span = l.frames.back().timestamp - l.frames.front().timestamp;
+    if (span > 0.0) l.frame_interval_s = span / double(n - 1);
+  }
+  return l;
+}
+
+// Replay order forth and back: 0..n-1, n-2..1, 0..; keeps motion continuous for temporal filters.
+size_t ping_pong(size_t k, size_t n) {
+  if (n <= 1) return 0;
+  const size_t period = 2 * (n - 1);
+  const size_t r = k % period;
+  return r < n ? r : period - r;
+}
+
+std::string shell_first_line(const std::string& command) {
+  std::string out;
+  if (FILE* p = popen(command.c_str(), "r")) {
+    char buf[256];
+    if (std::fgets(buf, sizeof buf, p)) out = buf;
+    pclose(p);
+  }
+  while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
+  return out;
+}
+
+std::string utc_now() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+// Resolves the --levels items for one technique into level indices, best first.
+Expected<std::vector<int>> resolve_levels(const std::string& technique, const std::vector<std::string>& items) {
+  auto names = technique_levels(technique);
+  if (!names.ok()) return names.error();
+  const int n = int(names->size());
+  if (n == 0) return fail(ErrorKind::Internal, "technique '" + technique + "' declares no quality levels");
+  std::set<int> picked;
+  const bool all = items.empty() || (items.size() == 1 && items[0] == "all");
+  for (int i = 0; all && i < n; ++i) picked.insert(i);
+  for (size_t k = 0; !all && k < items.size(); ++k) {
+    const std::string& it = items[k];
+    int index = -1;
+    if (it == "last") index = n - 1;
+    for (int i = 0; i < n && index < 0; ++i)
+      if ((*names)[i] == it) index = i;
+    if (index < 0 && !it.empty() && it.find_first_not_of("0123456789") == std::string::npos) {
+      const long v = std::strtol(it.c_str(), nullptr, 10);
+      if (v < n) index = int(v);
+    }
+    if (index < 0) {
+      std::string known;
+      for (int i = 0; i < n; ++i) known += (i ? ", " : "") + std::to_string(i) + "=" + (*names)[i];
+      return fail(ErrorKind::BadUsage, "--levels '" + it + "': technique '" + technique + "' has levels " + known +
+                                           " (or 'last', 'all')");
+    }
+    picked.insert(index);
+  }
+  return std::vector<int>(picked.begin(), picked.end());
+}
+
+TimeSummary summarize(const std::vector<double>& ms, double floor_ms) {
+  TimeSummary t;
+  t.samples = ms.size();
+  t.median_ms = percentile(ms, 50);
+  t.p95_ms = percentile(ms, 95);
+  if (floor_ms > 0.0) {
+    t.median_ratio = t.median_ms / floor_ms;
+    t.p95_ratio = t.p95_ms / floor_ms;
+  }
+  return t;
+}
+
+// Raw samples of one run, summarized once the scene's floor is known.
+struct RunSamples {
+  BenchEntry entry;
+  std::vector<double> frame_ms, wall_ms;
+  std::vector<std::string> pass_order;
+  std::map<std::string, std::vector<double>> pass_ms;
+};
+
+struct Progress {
+  const ProgressFn* fn = nullptr;
+  size_t done = 0, total = 0;
+  std::chrono::steady_clock::time_point t0 = std::chrono::steady_clock::now();
+  void step(const std::string& what, size_t frames) {
+    done += frames;
+    if (fn && *fn)
+      (*fn)(what, done, total, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+};
+
+Expected<RunSamples> run_one(const LoadedScene& l, const std::string& technique, int level,
+                             const BenchSettings& s, const std::string& floor_device) {
+  RuntimeSettings rs;
+  rs.device = s.device;
+  rs.technique = technique;
+  rs.level = level;
+  rs.exposure = l.info.exposure;
+  const CameraSetup cameras{l.info.color, l.info.depth, l.info.depth_scale, l.info.exposure};
+  auto created = create_runtime(rs, cameras, l.scene);
+  const std::string what = "scene '" + l.suite.name + "', technique '" + technique + "', level " + std::to_string(level);
+  if (!created.ok()) return fail(created.error().kind, what + ": " + created.error().message);
+  std::unique_ptr<Runtime> rt = std::move(created).value();
+  if (rt->device().name != floor_device)
+    return fail(ErrorKind::Device, what + ": the runtime chose device '" + rt->device().name +
+                                       "' but the floor pass ran on '" + floor_device + "'; ratios would compare devices");
+
+  RunSamples r;
+  BenchEntry& e = r.entry;
+  e.scene = l.suite.name;
+  e.technique = technique;
+  e.level = level;
+  const auto level_names = rt->level_names();
+  e.level_name = level < int(level_names.size()) ? level_names[size_t(level)] : std::to_string(level);
+  e.width = l.info.color.width;
+  e.height = l.info.color.height;
+  e.memory_mib = rt->memory_mib();
+  std::set<std::string> skipped;
+  const size_t warmup = size_t(s.warmup), total = warmup + size_t(s.frames), n = l.frames.size();
+  std::optional<Status> failure;
+  bool pooled_any = false;
+
+  auto consume = [&](std::vector<FrameOutput>& outs) -> Status {
+    for (const FrameOutput& out : outs) {
+      const int64_t k = out.stats.frame_index;
+      if (k < 0 || size_t(k) >= total)
+        return fail(ErrorKind::Internal, what + ": runtime returned frame index " + std::to_string(k) +
+                                             " outside 0.." + std::to_string(total - 1));
+      if (size_t(k) < warmup) continue;
+      const size_t src = ping_pong(size_t(k), n);
+      r.frame_ms.push_back(out.stats.gpu_total_ms);
+      r.wall_ms.push_back(out.stats.cpu_ms);
+      for (const PassTiming& p : out.stats.passes) {
+        auto [it, inserted] = r.pass_ms.try_emplace(p.name);
+        if (inserted) r.pass_order.push_back(p.name);
+        it->second.push_back(p.gpu_ms);
+      }
+      for (const std::string& sk : out.stats.skipped) skipped.insert(sk);
+      if (l.references[src]) {
+        const ImageU8* mask = l.masks[src] ? &*l.masks[src] : nullptr;
+        auto err = measure_error(out.image, l.frames[src].color, *l.references[src], mask);
+        if (!err.ok()) return fail(err.error().kind, what + ", frame " + std::to_string(src) + ": " + err.error().message);
+        if (!pooled_any) {
+          e.error = *err;
+        } else {
+          e.error.all = pool(e.error.all, err->all);
+          e.error.real = pool(e.error.real, err->real);
+          e.error.virtual_ = pool(e.error.virtual_, err->virtual_);
+        }
+        pooled_any = true;
+      }
+    }
+    return ok_status();
+  };
+
+  // One InputFrame reused for every call: copy-assignment keeps the image buffers' capacity.
+  InputFrame work;
+  const double t_first = l.frames.front().timestamp;
+  for (size_t k = 0; k < total; ++k) {
+    const InputFrame& src = l.frames[ping_pong(k, n)];
+    work.color = src.color;
+    work.depth = src.depth;
+    work.pose = src.pose;
+    work.env = src.env;
+    work.index = int64_t(k);
+    work.timestamp = t_first + double(k) * l.frame_interval_s;
+    work.depth_timestamp = work.timestamp + (src.depth_timestamp - src.timestamp);
+    auto outs = rt->process(work);
+    if (!outs.ok()) return fail(outs.error().kind, what + ", frame " + std::to_string(k) + ": " + outs.error().message);
+    MRGI_TRY(consume(*outs));
+  }
+  auto rest = rt->flush();
+  if (!rest.ok()) return fail(rest.error().kind, what + ", flush: " + rest.error().message);
+  MRGI_TRY(consume(*rest));
+  if (r.frame_ms.size() != size_t(s.frames))
+    return fail(ErrorKind::Internal, what + ": " + std::to_string(r.frame_ms.size()) + " of " +
+                                         std::to_string(s.frames) + " measured frames came back");
+  e.has_reference = pooled_any;
+  e.skipped.assign(skipped.begin(), skipped.end());
+  return r;
+}
+
+}  // namespace
+
+std::string ensure_lp_num_threads() {
+  setenv("LP_NUM_THREADS", "2", /*overwrite=*/0);
+  const char* v = std::getenv("LP_NUM_THREADS");
+  return v ? v : "";
+}
+
+Expected<BenchResult> run_bench(const BenchSettings& s) {
+  if (s.frames < 1) return fail(ErrorKind::BadUsage, "--frames must be at least 1 (got " + std::to_string(s.frames) + ")");
+  if (s.warmup < 0) return fail(ErrorKind::BadUsage, "--warmup must not be negative");
+  if (s.floor_frames < 3) return fail(ErrorKind::BadUsage, "floor_frames must be at least 3");
+  if (s.floor_warmup < 0) return fail(ErrorKind::BadUsage, "floor_warmup must not be negative");
+
+  BenchResult result;
+  result.lp_num_threads = ensure_lp_num_threads();
+  result.started_utc = utc_now();
+  result.suite = s.suite;
+  result.frames = s.frames;
+  result.warmup = s.warmup;
+  result.subset = !s.scenes.empty() || !s.techniques.empty() ||
+                  !(s.levels.empty() || (s.levels.size() == 1 && s.levels[0] == "all"));
+  const std::string src_dir = MRGI_PERF_SOURCE_DIR;
+  if (!src_dir.empty()) {
+    result.commit = shell_first_line("git -C '" + src_dir + "' rev-parse HEAD 2>/dev/null");
+    result.dirty = !result.commit.empty() &&
+                   !shell_first_line("git -C '" + src_dir + "' status --porcelain --untracked-files=no 2>/dev/null").empty();
+  }
+
+  auto suite = load_suite(s.suite);
+  if (!suite.ok()) return suite.error();
+  auto scenes = select_scenes(*suite, s.scenes);
+  if (!scenes.ok()) return scenes.error();
+
+  std::vector<std::string> techniques = s.techniques.empty() ? technique_names() : s.techniques;
+  const std::vector<std::string> known = technique_names();
+  std::vector<std::pair<std::string, std::vector<int>>> plan;
+  for (const std::string& t : techniques) {
+    if (std::find(known.begin(), known.end(), t) == known.end()) {
+      std::string list;
+      for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+      return fail(ErrorKind::BadUsage, "--techniques: unknown technique '" + t + "' (registered: " + list + ")");
+    }
+    auto levels = resolve_levels(t, s.levels);
+    if (!levels.ok()) return levels.error();
+    plan.emplace_back(t, std::move(levels).value());
+  }
+  if (plan.empty()) return fail(ErrorKind::BadUsage, "no technique to run (the registry is empty)");
+
+  auto floor_ctx = gpu::Context::create(s.device);
+  if (!floor_ctx.ok()) return fail(floor_ctx.error().kind, "floor pass: " + floor_ctx.error().message);
+  gpu::Context& ctx = **floor_ctx;
+  result.device = ctx.info().name;
+  result.driver = ctx.info().driver;
+
+  Progress progress;
+  progress.fn = &s.progress;
+  size_t runs_per_scene = 0;
+  for (const auto& [t, levels] : plan) runs_per_scene += levels.size();
+  progress.total = scenes->size() * runs_per_scene * size_t(s.warmup + s.frames);
+  const auto t0 = std::chrono::steady_clock::now();
+
+  std::vector<double> all_floor;
+  for (const SuiteScene& sc : *scenes) {
+    auto loaded = load_scene(sc);
+    if (!loaded.ok()) return loaded.error();
+    const int w = loaded->info.color.width, h = loaded->info.color.height;
+    std::vector<double> floor_ms;
+    std::vector<RunSamples> runs;
+    for (const auto& [t, levels] : plan)
+      for (int level : levels) {
+        // The floor right before each run: machine load drifts, and a scene's ratios should
+        // divide by floor times taken alongside its own.
+        auto floor = gpu::measure_floor_pass(ctx, uint32_t(w), uint32_t(h), uint32_t(s.floor_frames),
+                                             uint32_t(s.floor_warmup));
+        if (!floor.ok()) return fail(floor.error().kind, "floor pass (scene '" + sc.name + "'): " + floor.error().message);
+        floor_ms.insert(floor_ms.end(), floor->samples_ms.begin(), floor->samples_ms.end());
+        auto run = run_one(*loaded, t, level, s, result.device);
+        if (!run.ok()) return run.error();
+        runs.push_back(std::move(run).value());
+        progress.step(sc.name + " " + t + " " + runs.back().entry.level_name, size_t(s.warmup + s.frames));
+      }
+    SceneFloor f;
+    f.scene = sc.name;
+    f.width = w;
+    f.height = h;
+    f.samples = floor_ms.size();
+    f.median_ms = percentile(floor_ms, 50);
+    f.p95_ms = percentile(floor_ms, 95);
+    f.min_ms = floor_ms.empty() ? 0.0 : *std::min_element(floor_ms.begin(), floor_ms.end());
+    if (!(f.median_ms > 0.0))
+      return fail(ErrorKind::Device, "floor pass (scene '" + sc.name + "'): median GPU time is " +
+                                         std::to_string(f.median_ms) + " ms; the device's timestamps are unusable for ratios");
+    all_floor.insert(all_floor.end(), floor_ms.begin(), floor_ms.end());
+    result.floors.push_back(f);
+    for (RunSamples& r : runs) {
+      r.entry.frame = summarize(r.frame_ms, f.median_ms);
+      r.entry.median_wall_ms = percentile(r.wall_ms, 50);
+      for (const std::string& name : r.pass_order)
+        r.entry.passes.push_back(PassSummary{name, summarize(r.pass_ms[name], f.median_ms)});
+      result.entries.push_back(std::move(r.entry));
+    }
+  }
+  result.floor_median_ms = percentile(all_floor, 50);
+  result.duration_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return result;
+}
+
+std::vector<LevelAggregate> aggregate_levels(const BenchResult& result) {
+  std::vector<LevelAggregate> out;
+  for (const BenchEntry& e : result.entries) {
+    auto it = std::find_if(out.begin(), out.end(), [&](const LevelAggregate& a) {
+      return a.technique == e.technique && a.level == e.level;
+    });
+    if (it == out.end()) {
+      out.push_back(LevelAggregate{e.technique, e.level_name, e.level});
+      it = out.end() - 1;
+    }
+    it->scenes += 1;
+    it->mean_median_ms += e.frame.median_ms;
+    it->mean_median_ratio += e.frame.median_ratio;
+    it->max_memory_mib = std::max(it->max_memory_mib, e.memory_mib);
+    if (e.has_reference) {
+      if (!it->has_reference) {
+        it->error = e.error;
+      } else {
+        it->error.all = pool(it->error.all, e.error.all);
+        it->error.real = pool(it->error.real, e.error.real);
+        it->error.virtual_ = pool(it->error.virtual_, e.error.virtual_);
+      }
+      it->has_reference = true;
+    }
+  }
+  for (LevelAggregate& a : out) {
+    a.mean_median_ms /= double(a.scenes);
+    a.mean_median_ratio /= double(a.scenes);
+  }
+  return out;
+}
+
+}  // namespace mrgi::perf

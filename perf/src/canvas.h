@@ -1,0 +1,42 @@
+// A small RGB rasteriser for the bench's plots: coverage-antialiased lines and markers (coverage
+// from the distance of each pixel centre to the shape), axis-aligned rectangles with fractional
+// edges, and text from stb_easy_font's quads (scaled, optionally turned 90 degrees).
+#pragma once
+#include <cstdint>
+#include <string>
+
+#include "mrgi/image.h"
+
+namespace mrgi::perf {
+
+struct Rgb {
+  uint8_t r = 0, g = 0, b = 0;
+};
+
+enum class Marker { Circle, Square, TriangleUp, Diamond, Plus, Cross, TriangleDown };
+
+class Canvas {
+ public:
+  Canvas(int width, int height, Rgb background);
+  const ImageRGB8& image() const { return image_; }
+
+  // Mixes `c` into pixel (x, y) with weight alpha in [0, 1]; outside pixels are ignored.
+  void blend(int x, int y, Rgb c, float alpha);
+  void fill_rect(float x0, float y0, float x1, float y1, Rgb c, float alpha = 1.0f);
+  // A segment `width` pixels wide with round caps; dash > 0 draws dashes of that length (and
+  // gaps of dash/2) along it.
+  void line(float x0, float y0, float x1, float y1, float width, Rgb c, float dash = 0.0f);
+  // A filled marker of radius r (pixels) with a 1-pixel outline in `outline`.
+  void marker(float cx, float cy, Marker m, float r, Rgb fill, Rgb outline);
+
+  // Text with its top-left corner at (x, y); scale 1 is stb_easy_font's ~7 px cap height.
+  // vertical: turned 90 degrees anticlockwise (reads bottom to top), (x, y) is then bottom-left.
+  void text(float x, float y, const std::string& s, float scale, Rgb c, bool vertical = false);
+  static float text_width(const std::string& s, float scale);
+  static float text_height(float scale) { return 7.0f * scale; }
+
+ private:
+  ImageRGB8 image_;
+};
+
+}  // namespace mrgi::perf

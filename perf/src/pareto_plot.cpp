@@ -1,0 +1,151 @@
+// pareto.png: suite-aggregate median frame ms (x) against pooled RDE (y), one colour and marker
+// per technique, the Pareto front as a dashed line through its points, a legend at the right.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include "canvas.h"
+#include "mrgi/perf/pareto.h"
+#include "mrgi/perf/report.h"
+
+namespace mrgi::perf {
+namespace {
+
+constexpr int kWidth = 960, kHeight = 640;
+constexpr float kLeft = 90, kRight = 230, kTop = 60, kBottom = 80;  // plot-area margins, px
+
+const Rgb kPalette[] = {{31, 119, 180}, {255, 127, 14}, {44, 160, 44},  {214, 39, 40},
+                        {148, 103, 189}, {140, 86, 75},  {227, 119, 194}, {127, 127, 127}};
+const Marker kMarkers[] = {Marker::Circle, Marker::Square, Marker::TriangleUp, Marker::Diamond,
+                           Marker::Plus,   Marker::Cross,  Marker::TriangleDown};
+
+// Axis from 0 to a "nice" maximum with 4..8 ticks of step 1, 2 or 5 x 10^k.
+struct Axis {
+  double max = 1.0, step = 0.2;
+};
+Axis nice_axis(double data_max) {
+  if (!(data_max > 0.0) || !std::isfinite(data_max)) data_max = 1.0;
+  const double target = data_max * 1.08;
+  const double raw = target / 5.0;
+  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
+  double step = mag;
+  for (double m : {1.0, 2.0, 5.0, 10.0})
+    if (m * mag >= raw) {
+      step = m * mag;
+      break;
+    }
+  return Axis{std::ceil(target / step - 1e-9) * step, step};
+}
+
+std::string tick_label(double v, double step) {
+  char buf[32];
+  const int decimals = step >= 1.0 ? 0 : int(std::ceil(-std::log10(step) - 1e-9));
+  std::snprintf(buf, sizeof buf, "%.*f", std::clamp(decimals, 0, 6), v);
+  return buf;
+}
+
+}  // namespace
+
+ImageRGB8 render_pareto_plot(const BenchResult& result) {
+  const Rgb white{255, 255, 255}, black{0, 0, 0}, grid{225, 225, 225}, dark{70, 70, 70};
+  Canvas cv(kWidth, kHeight, white);
+  const float px0 = kLeft, px1 = kWidth - kRight, py0 = kTop, py1 = kHeight - kBottom;
+
+  const std::vector<LevelAggregate> levels = aggregate_levels(result);
+  std::vector<ParetoPoint> points;
+  std::vector<size_t> plotted;  // indices into levels with a defined RDE
+  for (size_t i = 0; i < levels.size(); ++i)
+    if (levels[i].has_reference && levels[i].error.all.rde_defined) {
+      points.push_back({levels[i].mean_median_ms, levels[i].error.all.rde});
+      plotted.push_back(i);
+    }
+  double max_x = 0.0, max_y = 0.0;
+  for (const ParetoPoint& p : points) {
+    max_x = std::max(max_x, p.cost);
+    max_y = std::max(max_y, p.error);
+  }
+  const Axis ax = nice_axis(max_x), ay = nice_axis(max_y);
+  auto sx = [&](double x) { return float(px0 + (px1 - px0) * x / ax.max); };
+  auto sy = [&](double y) { return float(py1 - (py1 - py0) * y / ay.max); };
+
+  // Grid, ticks and tick labels.
+  for (int i = 0; i * ax.step <= ax.max + 1e-9; ++i) {
+    const double v = i * ax.step;
+    const float x = sx(v);
+    cv.line(x, py0, x, py1, 1.0f, grid);
+    cv.line(x, py1, x, py1 + 6, 1.5f, black);
+    const std::string t = tick_label(v, ax.step);
+    cv.text(x - Canvas::text_width(t, 2) / 2, py1 + 12, t, 2, black);
+  }
+  for (int i = 0; i * ay.step <= ay.max + 1e-9; ++i) {
+    const double v = i * ay.step;
+    const float y = sy(v);
+    cv.line(px0, y, px1, y, 1.0f, grid);
+    cv.line(px0 - 6, y, px0, y, 1.5f, black);
+    const std::string t = tick_label(v, ay.step);
+    cv.text(px0 - 12 - Canvas::text_width(t, 2), y - Canvas::text_height(2) / 2, t, 2, black);
+  }
+  cv.line(px0, py1, px1, py1, 1.5f, black);
+  cv.line(px0, py0, px0, py1, 1.5f, black);
+
+  // Titles and axis labels.
+  char title[160];
+  std::snprintf(title, sizeof title, "mrgi bench: frame time vs error (%s, LP_NUM_THREADS=%s)",
+                result.device.c_str(), result.lp_num_threads.empty() ? "unset" : result.lp_num_threads.c_str());
+  cv.text(px0, 18, title, 2, black);
+  char sub[160];
+  std::snprintf(sub, sizeof sub, "suite aggregate per technique level, floor pass %.3f ms, %d frames + %d warm-up per run",
+                result.floor_median_ms, result.frames, result.warmup);
+  cv.text(px0, 40, sub, 1.5f, dark);
+  const std::string xl = "median frame GPU time, ms (mean over scenes)";
+  cv.text((px0 + px1) / 2 - Canvas::text_width(xl, 2) / 2, py1 + 44, xl, 2, black);
+  const std::string yl = "RDE, all pixels (pooled over scenes and frames)";
+  cv.text(22, (py0 + py1) / 2 + Canvas::text_width(yl, 2) / 2, yl, 2, black, true);
+
+  // One style per technique, in order of appearance.
+  std::map<std::string, size_t> style;
+  std::vector<std::string> techniques;
+  for (const LevelAggregate& l : levels)
+    if (style.emplace(l.technique, style.size()).second) techniques.push_back(l.technique);
+
+  const std::vector<size_t> front = pareto_front(points);
+  for (size_t k = 1; k < front.size(); ++k)
+    cv.line(sx(points[front[k - 1]].cost), sy(points[front[k - 1]].error), sx(points[front[k]].cost),
+            sy(points[front[k]].error), 2.0f, dark, 8.0f);
+  for (size_t k : front) cv.marker(sx(points[k].cost), sy(points[k].error), Marker::Circle, 10.0f, white, dark);
+
+  for (size_t k = 0; k < points.size(); ++k) {
+    const LevelAggregate& l = levels[plotted[k]];
+    const size_t st = style[l.technique];
+    const Rgb c = kPalette[st % std::size(kPalette)];
+    const float x = sx(points[k].cost), y = sy(points[k].error);
+    cv.marker(x, y, kMarkers[st % std::size(kMarkers)], 6.0f, c, black);
+    cv.text(x + 9, y - 12, l.level_name, 1.0f, dark);
+  }
+  if (points.empty()) {
+    const std::string msg = "no RDE to plot: the scenes have no reference frames";
+    cv.text((px0 + px1) / 2 - Canvas::text_width(msg, 2) / 2, (py0 + py1) / 2, msg, 2, {200, 0, 0});
+  }
+
+  // Legend.
+  float ly = py0 + 10;
+  const float lx = px1 + 20;
+  cv.text(lx, ly, "technique", 2, black);
+  ly += 26;
+  for (const std::string& t : techniques) {
+    const size_t st = style[t];
+    cv.marker(lx + 8, ly + 7, kMarkers[st % std::size(kMarkers)], 6.0f, kPalette[st % std::size(kPalette)], black);
+    cv.text(lx + 24, ly, t, 2, black);
+    ly += 24;
+  }
+  ly += 6;
+  cv.line(lx, ly + 7, lx + 18, ly + 7, 2.0f, dark, 5.0f);
+  cv.marker(lx + 8, ly + 7, Marker::Circle, 6.0f, white, dark);
+  cv.text(lx + 24, ly, "Pareto front", 2, black);
+  ly += 30;
+  cv.text(lx, ly, "lower left is better", 1.5f, dark);
+  return cv.image();
+}
+
+}  // namespace mrgi::perf

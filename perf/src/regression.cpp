@@ -1,0 +1,229 @@
+#include "mrgi/perf/regression.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <tuple>
+
+#include <nlohmann/json.hpp>
+
+namespace mrgi::perf {
+namespace {
+
+using Key = std::tuple<std::string, std::string, std::string>;  // scene, technique, level name
+
+std::string key_text(const std::string& scene, const std::string& technique, const std::string& level) {
+  return scene + "/" + technique + "/" + level;
+}
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
+nlohmann::json opt_json(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
+
+// Reads a finite non-negative number (or null when allowed) at `obj[key]`.
+Status read_number(const nlohmann::json& obj, const char* key, const std::string& where, bool nullable,
+                   std::optional<double>& out) {
+  if (!obj.contains(key)) return fail(ErrorKind::BadInput, where + ": missing \"" + key + "\"");
+  const nlohmann::json& v = obj[key];
+  if (v.is_null() && nullable) {
+    out.reset();
+    return ok_status();
+  }
+  if (!v.is_number())
+    return fail(ErrorKind::BadInput, where + "." + key + ": must be a number" + (nullable ? " or null" : ""));
+  const double d = v.get<double>();
+  if (!std::isfinite(d) || d < 0.0)
+    return fail(ErrorKind::BadInput, where + "." + key + ": must be finite and >= 0 (got " + num(d) + ")");
+  out = d;
+  return ok_status();
+}
+
+Status read_string(const nlohmann::json& obj, const char* key, const std::string& where, std::string& out) {
+  if (!obj.contains(key) || !obj[key].is_string())
+    return fail(ErrorKind::BadInput, where + ": \"" + key + "\" must be a string");
+  out = obj[key].get<std::string>();
+  return ok_status();
+}
+
+}  // namespace
+
+Baseline make_baseline(const BenchResult& result, const Tolerances& tolerances) {
+  Baseline b;
+  b.tolerances = tolerances;
+  b.device = result.device;
+  b.lp_num_threads = result.lp_num_threads;
+  b.commit = result.commit;
+  b.frames = result.frames;
+  b.warmup = result.warmup;
+  b.floor_median_ms = result.floor_median_ms;
+  for (const BenchEntry& e : result.entries) {
+    BaselineEntry be{e.scene, e.technique, e.level_name, e.level, e.frame.median_ratio, {}, {}};
+    if (e.has_reference) {
+      if (e.error.all.rde_defined) be.rde = e.error.all.rde;
+      be.delta_rms = e.error.all.delta_rms;
+    }
+    b.entries.push_back(be);
+  }
+  return b;
+}
+
+Status write_baseline(const std::string& path, const Baseline& b) {
+  nlohmann::json j;
+  j["version"] = 1;
+  j["tolerances"] = {{"ratio_relative", b.tolerances.ratio_relative},
+                     {"rde_absolute", b.tolerances.rde_absolute},
+                     {"delta_rms_absolute", b.tolerances.delta_rms_absolute}};
+  j["source"] = {{"device", b.device},   {"lp_num_threads", b.lp_num_threads}, {"commit", b.commit},
+                 {"frames", b.frames},   {"warmup", b.warmup},                 {"floor_median_ms", b.floor_median_ms}};
+  nlohmann::json entries = nlohmann::json::array();
+  for (const BaselineEntry& e : b.entries)
+    entries.push_back({{"scene", e.scene},
+                       {"technique", e.technique},
+                       {"level", e.level},
+                       {"level_name", e.level_name},
+                       {"ratio_to_floor", e.ratio_to_floor},
+                       {"rde", opt_json(e.rde)},
+                       {"delta_rms", opt_json(e.delta_rms)}});
+  j["entries"] = entries;
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp);
+    if (!f) return fail(ErrorKind::BadInput, tmp + ": cannot open for writing");
+    f << j.dump(2) << "\n";
+    if (!f) return fail(ErrorKind::Device, tmp + ": write failed");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) return fail(ErrorKind::Device, path + ": rename failed: " + ec.message());
+  return ok_status();
+}
+
+Expected<Baseline> load_baseline(const std::string& path) {
+  std::ifstream f(path);
+  if (!f) return fail(ErrorKind::NotFound, path + ": cannot open the baseline file");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(f);
+  } catch (const nlohmann::json::parse_error& e) {
+    return fail(ErrorKind::BadInput, path + ": not valid JSON: " + e.what());
+  }
+  if (!j.is_object()) return fail(ErrorKind::BadInput, path + ": must be a JSON object");
+  if (!j.contains("version") || j["version"] != 1)
+    return fail(ErrorKind::BadInput, path + ": \"version\" must be 1");
+  Baseline b;
+  if (!j.contains("tolerances") || !j["tolerances"].is_object())
+    return fail(ErrorKind::BadInput, path + ": missing \"tolerances\" object");
+  const std::string tw = path + ": tolerances";
+  std::optional<double> v;
+  MRGI_TRY(read_number(j["tolerances"], "ratio_relative", tw, false, v));
+  b.tolerances.ratio_relative = *v;
+  MRGI_TRY(read_number(j["tolerances"], "rde_absolute", tw, false, v));
+  b.tolerances.rde_absolute = *v;
+  MRGI_TRY(read_number(j["tolerances"], "delta_rms_absolute", tw, false, v));
+  b.tolerances.delta_rms_absolute = *v;
+  if (j.contains("source") && j["source"].is_object()) {
+    const auto& s = j["source"];
+    b.device = s.value("device", "");
+    b.lp_num_threads = s.value("lp_num_threads", "");
+    b.commit = s.value("commit", "");
+    b.frames = s.value("frames", 0);
+    b.warmup = s.value("warmup", 0);
+    b.floor_median_ms = s.value("floor_median_ms", 0.0);
+  }
+  if (!j.contains("entries") || !j["entries"].is_array())
+    return fail(ErrorKind::BadInput, path + ": missing \"entries\" array");
+  std::map<Key, size_t> seen;
+  for (size_t i = 0; i < j["entries"].size(); ++i) {
+    const nlohmann::json& e = j["entries"][i];
+    const std::string where = path + ": entries[" + std::to_string(i) + "]";
+    if (!e.is_object()) return fail(ErrorKind::BadInput, where + ": must be an object");
+    BaselineEntry be;
+    MRGI_TRY(read_string(e, "scene", where, be.scene));
+    MRGI_TRY(read_string(e, "technique", where, be.technique));
+    MRGI_TRY(read_string(e, "level_name", where, be.level_name));
+    if (!e.contains("level") || !e["level"].is_number_integer() || e["level"].get<int>() < 0)
+      return fail(ErrorKind::BadInput, where + ".level: must be an integer >= 0");
+    be.level = e["level"].get<int>();
+    MRGI_TRY(read_number(e, "ratio_to_floor", where, false, v));
+    be.ratio_to_floor = *v;
+    if (!(be.ratio_to_floor > 0.0)) return fail(ErrorKind::BadInput, where + ".ratio_to_floor: must be > 0");
+    MRGI_TRY(read_number(e, "rde", where, true, be.rde));
+    MRGI_TRY(read_number(e, "delta_rms", where, true, be.delta_rms));
+    const Key k{be.scene, be.technique, be.level_name};
+    if (!seen.emplace(k, i).second)
+      return fail(ErrorKind::BadInput, where + ": " + key_text(be.scene, be.technique, be.level_name) +
+                                           " appears twice (also entries[" + std::to_string(seen[k]) + "])");
+    b.entries.push_back(std::move(be));
+  }
+  return b;
+}
+
+CheckReport check_against(const BenchResult& result, const Baseline& b) {
+  CheckReport rep;
+  const Tolerances& tol = b.tolerances;
+  std::map<Key, const BaselineEntry*> base;
+  for (const BaselineEntry& e : b.entries) base[Key{e.scene, e.technique, e.level_name}] = &e;
+  std::map<Key, bool> matched;
+  for (const BenchEntry& e : result.entries) {
+    const Key k{e.scene, e.technique, e.level_name};
+    const std::string name = key_text(e.scene, e.technique, e.level_name);
+    auto it = base.find(k);
+    if (it == base.end()) {
+      rep.missing_in_baseline.push_back(name);
+      continue;
+    }
+    matched[k] = true;
+    rep.compared += 1;
+    const BaselineEntry& be = *it->second;
+    const double ratio_limit = be.ratio_to_floor * (1.0 + tol.ratio_relative);
+    if (!(e.frame.median_ratio <= ratio_limit))
+      rep.violations.push_back(name + ": frame time ratio to floor " + num(e.frame.median_ratio) + " > " +
+                               num(ratio_limit) + " (baseline " + num(be.ratio_to_floor) + " + " +
+                               num(100.0 * tol.ratio_relative) + " %)");
+    const bool have_rde = e.has_reference && e.error.all.rde_defined;
+    if (be.rde) {
+      if (!have_rde) {
+        rep.violations.push_back(name + ": RDE is undefined in this run (no reference, or nothing should change) "
+                                        "but the baseline has " + num(*be.rde));
+      } else if (!(e.error.all.rde <= *be.rde + tol.rde_absolute)) {
+        rep.violations.push_back(name + ": RDE " + num(e.error.all.rde) + " > " + num(*be.rde + tol.rde_absolute) +
+                                 " (baseline " + num(*be.rde) + " + " + num(tol.rde_absolute) + ")");
+      }
+    } else if (be.delta_rms) {
+      // Nothing should change in this scene: compare how much the output changed anyway.
+      if (!e.has_reference) {
+        rep.violations.push_back(name + ": the run has no reference frames but the baseline has error figures");
+      } else if (!(e.error.all.delta_rms <= *be.delta_rms + tol.delta_rms_absolute)) {
+        rep.violations.push_back(name + ": delta RMS " + num(e.error.all.delta_rms) + " > " +
+                                 num(*be.delta_rms + tol.delta_rms_absolute) + " (baseline " + num(*be.delta_rms) +
+                                 " + " + num(tol.delta_rms_absolute) + "; RDE undefined)");
+      }
+    }
+  }
+  for (const BaselineEntry& e : b.entries)
+    if (!matched.count(Key{e.scene, e.technique, e.level_name}))
+      rep.missing_in_run.push_back(key_text(e.scene, e.technique, e.level_name));
+  rep.subset_run = result.subset;
+  rep.passed = rep.violations.empty() && rep.compared > 0 && (result.subset || rep.missing_in_run.empty());
+  return rep;
+}
+
+std::string CheckReport::summary() const {
+  std::string s = std::string("regression check ") + (passed ? "PASSED" : "FAILED") + ": " +
+                  std::to_string(compared) + " entries compared, " + std::to_string(violations.size()) +
+                  " violations\n";
+  if (compared == 0) s += "  nothing compared: no run entry has a baseline entry\n";
+  for (const auto& v : violations) s += "  violation: " + v + "\n";
+  for (const auto& m : missing_in_run)
+    s += std::string(subset_run ? "  in the baseline, not in this (restricted) run: " : "  violation: in the baseline, not run: ") + m + "\n";
+  for (const auto& m : missing_in_baseline) s += "  in this run, not in the baseline: " + m + "\n";
+  return s;
+}
+
+}  // namespace mrgi::perf

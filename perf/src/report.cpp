@@ -1,0 +1,305 @@
+// bench.json, bench.csv and report.md, and writing all four outputs atomically.
+#include "mrgi/perf/report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "mrgi/perf/pareto.h"
+#include "mrgi/perf/stats.h"
+
+namespace fs = std::filesystem;
+
+namespace mrgi::perf {
+namespace {
+
+nlohmann::json time_json(const TimeSummary& t) {
+  return {{"samples", t.samples},          {"median_ms", t.median_ms},     {"p95_ms", t.p95_ms},
+          {"median_ratio", t.median_ratio}, {"p95_ratio", t.p95_ratio}};
+}
+
+nlohmann::json figures_json(const ErrorFigures& f) {
+  return {{"rde", f.rde_defined ? nlohmann::json(f.rde) : nlohmann::json(nullptr)},
+          {"delta_rms", f.delta_rms},
+          {"rmse8", f.rmse8},
+          {"ssim", f.ssim},
+          {"pixels", f.pixels}};
+}
+
+nlohmann::json error_json(bool has_reference, const RdeReport& r) {
+  if (!has_reference) return nullptr;
+  return {{"all", figures_json(r.all)}, {"real", figures_json(r.real)}, {"virtual", figures_json(r.virtual_)}};
+}
+
+std::string fmt(double v, int decimals) {
+  if (!std::isfinite(v)) return "nan";
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+
+// An RDE cell: "-" when there is no reference or the RDE is undefined over that set.
+std::string rde_cell(bool has_reference, const ErrorFigures& f) {
+  return has_reference && f.rde_defined ? fmt(f.rde, 3) : "-";
+}
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+std::vector<size_t> front_of(const std::vector<LevelAggregate>& levels, std::vector<size_t>* plotted) {
+  std::vector<ParetoPoint> points;
+  for (size_t i = 0; i < levels.size(); ++i)
+    if (levels[i].has_reference && levels[i].error.all.rde_defined) {
+      points.push_back({levels[i].mean_median_ms, levels[i].error.all.rde});
+      plotted->push_back(i);
+    }
+  std::vector<size_t> front;
+  for (size_t k : pareto_front(points)) front.push_back((*plotted)[k]);
+  return front;
+}
+
+Status write_text(const std::string& path, const std::string& text) {
+  std::ofstream f(path, std::ios::binary);
+  if (!f) return fail(ErrorKind::Device, path + ": cannot open for writing");
+  f << text;
+  if (!f) return fail(ErrorKind::Device, path + ": write failed");
+  return ok_status();
+}
+
+}  // namespace
+
+nlohmann::json bench_json(const BenchResult& r, const CheckReport* check) {
+  nlohmann::json j;
+  j["version"] = 1;
+  j["started_utc"] = r.started_utc;
+  j["duration_s"] = r.duration_s;
+  j["suite"] = r.suite;
+  j["subset"] = r.subset;
+  j["frames"] = r.frames;
+  j["warmup"] = r.warmup;
+  j["device"] = r.device;
+  j["driver"] = r.driver;
+  j["lp_num_threads"] = r.lp_num_threads;
+  j["commit"] = r.commit.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.commit);
+  j["dirty"] = r.dirty;
+  j["time_is"] = "GPU time from the frame graph's timestamps; ratio = ms / the scene's floor median ms";
+  j["floor_median_ms"] = r.floor_median_ms;
+  nlohmann::json floors = nlohmann::json::array();
+  for (const SceneFloor& f : r.floors)
+    floors.push_back({{"scene", f.scene}, {"width", f.width}, {"height", f.height}, {"samples", f.samples},
+                      {"median_ms", f.median_ms}, {"p95_ms", f.p95_ms}, {"min_ms", f.min_ms}});
+  j["floors"] = floors;
+  nlohmann::json entries = nlohmann::json::array();
+  for (const BenchEntry& e : r.entries) {
+    nlohmann::json passes = nlohmann::json::array();
+    for (const PassSummary& p : e.passes) {
+      nlohmann::json pj = time_json(p.time);
+      pj["name"] = p.name;
+      passes.push_back(pj);
+    }
+    entries.push_back({{"scene", e.scene},
+                       {"technique", e.technique},
+                       {"level", e.level},
+                       {"level_name", e.level_name},
+                       {"width", e.width},
+                       {"height", e.height},
+                       {"frame", time_json(e.frame)},
+                       {"median_wall_ms", e.median_wall_ms},
+                       {"passes", passes},
+                       {"memory_mib", e.memory_mib},
+                       {"error", error_json(e.has_reference, e.error)},
+                       {"skipped", e.skipped}});
+  }
+  j["entries"] = entries;
+  const std::vector<LevelAggregate> levels = aggregate_levels(r);
+  std::vector<size_t> plotted;
+  const std::vector<size_t> front = front_of(levels, &plotted);
+  nlohmann::json agg = nlohmann::json::array();
+  for (size_t i = 0; i < levels.size(); ++i) {
+    const LevelAggregate& l = levels[i];
+    agg.push_back({{"technique", l.technique},
+                   {"level", l.level},
+                   {"level_name", l.level_name},
+                   {"scenes", l.scenes},
+                   {"mean_median_ms", l.mean_median_ms},
+                   {"mean_median_ratio", l.mean_median_ratio},
+                   {"max_memory_mib", l.max_memory_mib},
+                   {"error", error_json(l.has_reference, l.error)},
+                   {"pareto", std::find(front.begin(), front.end(), i) != front.end()}});
+  }
+  j["suite_aggregate"] = agg;
+  if (check) {
+    j["check"] = {{"passed", check->passed},
+                  {"compared", check->compared},
+                  {"violations", check->violations},
+                  {"missing_in_run", check->missing_in_run},
+                  {"missing_in_baseline", check->missing_in_baseline}};
+  }
+  return j;
+}
+
+std::string bench_csv(const BenchResult& r) {
+  // Pass columns: the union of pass names, in first-seen order.
+  std::vector<std::string> pass_names;
+  std::set<std::string> seen;
+  for (const BenchEntry& e : r.entries)
+    for (const PassSummary& p : e.passes)
+      if (seen.insert(p.name).second) pass_names.push_back(p.name);
+  std::ostringstream o;
+  o << "scene,technique,level,level_name,width,height,frames,median_ms,p95_ms,median_ratio,p95_ratio,floor_ms,"
+       "memory_mib,rde_all,rde_real,rde_virtual,delta_rms,rmse8,ssim";
+  for (const std::string& p : pass_names)
+    o << "," << csv_field("pass_" + p + "_median_ms") << "," << csv_field("pass_" + p + "_p95_ms") << ","
+      << csv_field("pass_" + p + "_median_ratio");
+  o << "\n";
+  std::map<std::string, double> floor_of;
+  for (const SceneFloor& f : r.floors) floor_of[f.scene] = f.median_ms;
+  auto rde = [](const BenchEntry& e, const ErrorFigures& f) {
+    return e.has_reference && f.rde_defined ? fmt(f.rde, 6) : std::string();
+  };
+  for (const BenchEntry& e : r.entries) {
+    o << csv_field(e.scene) << "," << csv_field(e.technique) << "," << e.level << "," << csv_field(e.level_name)
+      << "," << e.width << "," << e.height << "," << e.frame.samples << "," << fmt(e.frame.median_ms, 4) << ","
+      << fmt(e.frame.p95_ms, 4) << "," << fmt(e.frame.median_ratio, 4) << "," << fmt(e.frame.p95_ratio, 4) << ","
+      << fmt(floor_of[e.scene], 4) << "," << fmt(e.memory_mib, 2) << "," << rde(e, e.error.all) << ","
+      << rde(e, e.error.real) << "," << rde(e, e.error.virtual_) << ","
+      << (e.has_reference ? fmt(e.error.all.delta_rms, 6) : "") << ","
+      << (e.has_reference ? fmt(e.error.all.rmse8, 4) : "") << "," << (e.has_reference ? fmt(e.error.all.ssim, 5) : "");
+    for (const std::string& name : pass_names) {
+      const PassSummary* p = nullptr;
+      for (const PassSummary& q : e.passes)
+        if (q.name == name) p = &q;
+      if (p)
+        o << "," << fmt(p->time.median_ms, 4) << "," << fmt(p->time.p95_ms, 4) << "," << fmt(p->time.median_ratio, 4);
+      else
+        o << ",,,";
+    }
+    o << "\n";
+  }
+  return o.str();
+}
+
+std::string report_markdown(const BenchResult& r, const CheckReport* check) {
+  std::ostringstream o;
+  o << "# mrgi bench\n\n";
+  o << "| | |\n|---|---|\n";
+  o << "| device | " << r.device << " (" << r.driver << ") |\n";
+  o << "| LP_NUM_THREADS | " << (r.lp_num_threads.empty() ? "unset" : r.lp_num_threads) << " |\n";
+  o << "| commit | " << (r.commit.empty() ? "unknown" : r.commit) << (r.dirty ? " (with uncommitted changes)" : "")
+    << " |\n";
+  o << "| started | " << r.started_utc << ", " << fmt(r.duration_s, 1) << " s |\n";
+  o << "| frames per run | " << r.frames << " measured after " << r.warmup << " warm-up |\n";
+  o << "| floor pass | " << fmt(r.floor_median_ms, 3) << " ms median over every floor sample |\n\n";
+  o << "Times are GPU times from the frame graph's timestamps (median and 95th percentile over the measured "
+       "frames); *ratio* is the median divided by the scene's floor-pass median, measured in the same process "
+       "before each run. RDE is pooled over the measured frames (0 = perfect, 1 = no better than the camera "
+       "frame; `-` = undefined: no reference, or nothing should change in that set of pixels). RMSE in 8-bit "
+       "units and SSIM are over all pixels.\n\n";
+
+  o << "## Floor pass per scene\n\n| scene | size | samples | median ms | p95 ms | min ms |\n|---|---|---:|---:|---:|---:|\n";
+  for (const SceneFloor& f : r.floors)
+    o << "| " << f.scene << " | " << f.width << "x" << f.height << " | " << f.samples << " | " << fmt(f.median_ms, 3)
+      << " | " << fmt(f.p95_ms, 3) << " | " << fmt(f.min_ms, 3) << " |\n";
+  o << "\n";
+
+  const std::vector<LevelAggregate> levels = aggregate_levels(r);
+  std::vector<size_t> plotted;
+  const std::vector<size_t> front = front_of(levels, &plotted);
+  std::vector<std::string> techniques;
+  for (const BenchEntry& e : r.entries)
+    if (std::find(techniques.begin(), techniques.end(), e.technique) == techniques.end()) techniques.push_back(e.technique);
+
+  for (const std::string& t : techniques) {
+    o << "## " << t << "\n\n";
+    o << "| scene | level | median ms | p95 ms | ratio | p95 ratio | memory MiB | RDE all | RDE real | RDE virtual | RMSE | SSIM |\n";
+    o << "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    for (const BenchEntry& e : r.entries) {
+      if (e.technique != t) continue;
+      o << "| " << e.scene << " | " << e.level << " " << e.level_name << " | " << fmt(e.frame.median_ms, 2) << " | "
+        << fmt(e.frame.p95_ms, 2) << " | " << fmt(e.frame.median_ratio, 1) << " | " << fmt(e.frame.p95_ratio, 1) << " | "
+        << fmt(e.memory_mib, 1) << " | " << rde_cell(e.has_reference, e.error.all) << " | "
+        << rde_cell(e.has_reference, e.error.real) << " | " << rde_cell(e.has_reference, e.error.virtual_) << " | "
+        << (e.has_reference ? fmt(e.error.all.rmse8, 2) : "-") << " | "
+        << (e.has_reference ? fmt(e.error.all.ssim, 4) : "-") << " |\n";
+    }
+    for (size_t i = 0; i < levels.size(); ++i) {
+      const LevelAggregate& l = levels[i];
+      if (l.technique != t) continue;
+      const bool on_front = std::find(front.begin(), front.end(), i) != front.end();
+      o << "| **suite** (" << l.scenes << " scenes, mean of medians) | " << l.level << " " << l.level_name
+        << (on_front ? " (Pareto)" : "") << " | " << fmt(l.mean_median_ms, 2) << " | | " << fmt(l.mean_median_ratio, 1)
+        << " | | " << fmt(l.max_memory_mib, 1) << " | " << rde_cell(l.has_reference, l.error.all) << " | "
+        << rde_cell(l.has_reference, l.error.real) << " | " << rde_cell(l.has_reference, l.error.virtual_) << " | "
+        << (l.has_reference ? fmt(l.error.all.rmse8, 2) : "-") << " | "
+        << (l.has_reference ? fmt(l.error.all.ssim, 4) : "-") << " |\n";
+    }
+    // Per-pass medians, median over scenes of each scene's median, per level.
+    o << "\nPer pass (median over scenes of the per-scene median and p95, ms; ratio to the floor):\n\n";
+    o << "| level | pass | median ms | p95 ms | ratio |\n|---|---|---:|---:|---:|\n";
+    for (const LevelAggregate& l : levels) {
+      if (l.technique != t) continue;
+      std::vector<std::string> order;
+      std::map<std::string, std::vector<double>> med, p95, ratio;
+      for (const BenchEntry& e : r.entries) {
+        if (e.technique != t || e.level != l.level) continue;
+        for (const PassSummary& p : e.passes) {
+          if (!med.count(p.name)) order.push_back(p.name);
+          med[p.name].push_back(p.time.median_ms);
+          p95[p.name].push_back(p.time.p95_ms);
+          ratio[p.name].push_back(p.time.median_ratio);
+        }
+      }
+      for (const std::string& p : order)
+        o << "| " << l.level << " " << l.level_name << " | " << p << " | " << fmt(percentile(med[p], 50), 3) << " | "
+          << fmt(percentile(p95[p], 50), 3) << " | " << fmt(percentile(ratio[p], 50), 2) << " |\n";
+    }
+    o << "\n";
+  }
+
+  o << "## Frame time against error\n\n![frame ms against RDE, Pareto front](pareto.png)\n\n";
+  o << "Pareto front (suite aggregate, no other level is both faster and more accurate):";
+  if (front.empty()) o << " none (no level has a defined RDE)";
+  o << "\n\n";
+  for (size_t i : front)
+    o << "- " << levels[i].technique << " level " << levels[i].level << " " << levels[i].level_name << ": "
+      << fmt(levels[i].mean_median_ms, 2) << " ms, RDE " << fmt(levels[i].error.all.rde, 3) << "\n";
+  if (check) {
+    o << "\n## Regression check\n\n```\n" << check->summary() << "```\n";
+  }
+  return o.str();
+}
+
+Status write_bench_outputs(const std::string& dir_in, const BenchResult& r, const CheckReport* check) {
+  std::string dir = fs::absolute(dir_in).lexically_normal().string();
+  while (dir.size() > 1 && dir.back() == '/') dir.pop_back();
+  const std::string partial = dir + ".partial";
+  std::error_code ec;
+  // Only an earlier bench output (or an empty folder) is replaced: --out must never wipe user data.
+  if (fs::exists(dir, ec) &&
+      !(fs::is_directory(dir, ec) && (fs::is_empty(dir, ec) || fs::exists(dir + "/bench.json", ec))))
+    return fail(ErrorKind::BadUsage, dir + ": --out exists and is not an earlier bench output (no bench.json); "
+                                           "refusing to overwrite it");
+  fs::remove_all(partial, ec);
+  fs::create_directories(partial, ec);
+  if (ec) return fail(ErrorKind::BadInput, partial + ": cannot create output folder: " + ec.message());
+  MRGI_TRY(write_text(partial + "/bench.json", bench_json(r, check).dump(2) + "\n"));
+  MRGI_TRY(write_text(partial + "/bench.csv", bench_csv(r)));
+  MRGI_TRY(write_text(partial + "/report.md", report_markdown(r, check)));
+  MRGI_TRY(write_png(partial + "/pareto.png", render_pareto_plot(r)));
+  fs::remove_all(dir, ec);
+  ec.clear();
+  fs::rename(partial, dir, ec);
+  if (ec) return fail(ErrorKind::Device, dir + ": cannot move the finished output into place: " + ec.message());
+  return ok_status();
+}
+
+}  // namespace mrgi::perf

@@ -1,0 +1,15 @@
+#include "mrgi/perf/stats.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mrgi::perf {
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const size_t rank = size_t(std::ceil(std::clamp(p, 0.0, 100.0) / 100.0 * double(v.size())));
+  return v[std::clamp<size_t>(rank, 1, v.size()) - 1];
+}
+
+}  // namespace mrgi::perf

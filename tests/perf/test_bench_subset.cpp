@@ -1,0 +1,170 @@
+// The bench end to end on a suite subset (the first scene of perf/suite.json, the `baseline`
+// technique at its best and cheapest level, a few frames) through the library API: the four
+// files exist and parse, the regression check passes against the run's own baseline and fails
+// on a doctored one.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "capture/temp_dir.h"
+#include "mrgi/image.h"
+#include "mrgi/perf/bench.h"
+#include "mrgi/perf/regression.h"
+#include "mrgi/perf/report.h"
+#include "mrgi/perf/suite.h"
+
+using mrgi::testing::TempDir;
+namespace fs = std::filesystem;
+namespace perf = mrgi::perf;
+
+namespace {
+
+const std::string kSuite = std::string(MRGI_SOURCE_DIR) + "/perf/suite.json";
+
+// One bench run shared by the tests below (a run takes seconds to a minute on lavapipe).
+const perf::BenchResult& subset_result() {
+  static const perf::BenchResult result = [] {
+    auto suite = perf::load_suite(kSuite);
+    EXPECT_TRUE(suite.ok()) << suite.error().message;
+    if (!suite.ok()) return perf::BenchResult{};
+    perf::BenchSettings s;
+    s.suite = kSuite;
+    s.scenes = {(*suite)[0].name};
+    s.techniques = {"baseline"};
+    s.levels = {"0", "last"};
+    s.frames = 3;
+    s.warmup = 1;
+    s.floor_frames = 5;
+    s.floor_warmup = 1;
+    auto r = perf::run_bench(s);
+    EXPECT_TRUE(r.ok()) << r.error().message;
+    return r.ok() ? std::move(r).value() : perf::BenchResult{};
+  }();
+  return result;
+}
+
+TEST(BenchSubset, RunsAndMeasures) {
+  const perf::BenchResult& r = subset_result();
+  ASSERT_FALSE(r.entries.empty());
+  EXPECT_EQ(r.lp_num_threads, "2");  // set by the bench when unset; CTest does not set it
+  EXPECT_TRUE(r.subset);
+  ASSERT_EQ(r.floors.size(), 1u);
+  EXPECT_GT(r.floors[0].median_ms, 0.0);
+  EXPECT_GE(r.floors[0].samples, 5u);
+  EXPECT_GT(r.floor_median_ms, 0.0);
+  auto levels = mrgi::technique_levels("baseline");
+  ASSERT_TRUE(levels.ok());
+  EXPECT_EQ(r.entries.size(), levels->size() > 1 ? 2u : 1u);
+  for (const perf::BenchEntry& e : r.entries) {
+    EXPECT_EQ(e.technique, "baseline");
+    EXPECT_EQ(e.frame.samples, 3u);
+    EXPECT_GT(e.frame.median_ms, 0.0);
+    EXPECT_GE(e.frame.p95_ms, e.frame.median_ms);
+    EXPECT_NEAR(e.frame.median_ratio, e.frame.median_ms / r.floors[0].median_ms, 1e-9);
+    EXPECT_FALSE(e.passes.empty());
+    for (const auto& p : e.passes) EXPECT_LE(p.time.median_ms, e.frame.p95_ms * 1.0001) << p.name;
+    EXPECT_GT(e.memory_mib, 0.0);
+    if (e.has_reference) {
+      EXPECT_TRUE(std::isfinite(e.error.all.rde));
+      EXPECT_GT(e.error.all.ssim, 0.0);
+    }
+  }
+  EXPECT_EQ(r.entries.front().level, 0);
+  EXPECT_EQ(r.entries.back().level, int(levels->size()) - 1);
+}
+
+TEST(BenchSubset, WritesFourFilesThatParse) {
+  const perf::BenchResult& r = subset_result();
+  ASSERT_FALSE(r.entries.empty());
+  TempDir dir;
+  const std::string out = dir.file("bench");
+  const perf::CheckReport check = perf::check_against(r, perf::make_baseline(r));
+  ASSERT_TRUE(perf::write_bench_outputs(out, r, &check).ok());
+  EXPECT_FALSE(fs::exists(out + ".partial"));
+  std::ifstream jf(out + "/bench.json");
+  const nlohmann::json j = nlohmann::json::parse(jf);  // throws (fails the test) when malformed
+  EXPECT_EQ(j["entries"].size(), r.entries.size());
+  EXPECT_EQ(j["lp_num_threads"], "2");
+  EXPECT_TRUE(j["check"]["passed"].get<bool>());
+  EXPECT_GT(j["floor_median_ms"].get<double>(), 0.0);
+  EXPECT_TRUE(j["entries"][0]["passes"].is_array());
+  std::ifstream cf(out + "/bench.csv");
+  std::string line;
+  size_t rows = 0;
+  std::getline(cf, line);
+  const size_t columns = size_t(std::count(line.begin(), line.end(), ',')) + 1;
+  while (std::getline(cf, line)) {
+    ++rows;
+    EXPECT_EQ(size_t(std::count(line.begin(), line.end(), ',')) + 1, columns) << line;
+  }
+  EXPECT_EQ(rows, r.entries.size());
+  std::ifstream mf(out + "/report.md");
+  const std::string md((std::istreambuf_iterator<char>(mf)), std::istreambuf_iterator<char>());
+  EXPECT_NE(md.find("## baseline"), std::string::npos);
+  EXPECT_NE(md.find("regression check PASSED"), std::string::npos);
+  auto png = mrgi::load_png_rgb8(out + "/pareto.png");
+  ASSERT_TRUE(png.ok()) << png.error().message;
+  EXPECT_EQ(png->width, 960);
+  // A second write replaces the earlier bench output; a folder that is not one is refused.
+  EXPECT_TRUE(perf::write_bench_outputs(out, r, nullptr).ok());
+  mrgi::testing::write_text(dir.file("precious/data.txt"), "x");
+  EXPECT_ERROR(perf::write_bench_outputs(dir.file("precious"), r, nullptr), BadUsage, "refusing to overwrite");
+  EXPECT_TRUE(fs::exists(dir.file("precious/data.txt")));
+}
+
+TEST(BenchSubset, CheckPassesAgainstItselfAndFailsDoctored) {
+  const perf::BenchResult& r = subset_result();
+  ASSERT_FALSE(r.entries.empty());
+  TempDir dir;
+  ASSERT_TRUE(perf::write_baseline(dir.file("baseline.json"), perf::make_baseline(r)).ok());
+  auto b = perf::load_baseline(dir.file("baseline.json"));
+  ASSERT_TRUE(b.ok()) << b.error().message;
+  const perf::CheckReport same = perf::check_against(r, *b);
+  EXPECT_TRUE(same.passed) << same.summary();
+  EXPECT_EQ(same.compared, r.entries.size());
+
+  perf::Baseline doctored = *b;
+  doctored.entries[0].ratio_to_floor /= 2.0;
+  perf::CheckReport rep = perf::check_against(r, doctored);
+  EXPECT_FALSE(rep.passed);
+  ASSERT_EQ(rep.violations.size(), 1u) << rep.summary();
+  EXPECT_NE(rep.violations[0].find("ratio"), std::string::npos);
+
+  doctored = *b;
+  bool lowered = false;
+  for (auto& e : doctored.entries)
+    if (e.rde) {
+      *e.rde = std::max(0.0, *e.rde - 0.1);
+      lowered = true;
+    } else if (e.delta_rms) {
+      *e.delta_rms = *e.delta_rms - 0.1;  // below zero: any output change now exceeds it
+      lowered = true;
+    }
+  ASSERT_TRUE(lowered) << "the subset scene has no reference frames";
+  rep = perf::check_against(r, doctored);
+  EXPECT_FALSE(rep.passed) << rep.summary();
+  EXPECT_EQ(rep.violations.size(), r.entries.size()) << rep.summary();
+}
+
+TEST(BenchSubset, BadSettingsAreRefused) {
+  perf::BenchSettings s;
+  s.suite = kSuite;
+  s.frames = 0;
+  EXPECT_ERROR(perf::run_bench(s), BadUsage, "--frames");
+  s.frames = 1;
+  s.techniques = {"no-such-technique"};
+  EXPECT_ERROR(perf::run_bench(s), BadUsage, "unknown technique 'no-such-technique'");
+  s.techniques = {"baseline"};
+  s.levels = {"99"};
+  EXPECT_ERROR(perf::run_bench(s), BadUsage, "--levels '99'", "technique 'baseline' has levels");
+  s.levels = {};
+  s.scenes = {"no-such-scene"};
+  EXPECT_ERROR(perf::run_bench(s), BadUsage, "no scene 'no-such-scene'");
+}
+
+}  // namespace

@@ -1,0 +1,271 @@
+// The bench's pure parts on constructed data: the Pareto front, the regression check and its
+// baseline file, the suite manifest reader, percentiles and the plot.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "capture/temp_dir.h"
+#include "mrgi/perf/pareto.h"
+#include "mrgi/perf/regression.h"
+#include "mrgi/perf/report.h"
+#include "mrgi/perf/stats.h"
+#include "mrgi/perf/suite.h"
+
+using mrgi::testing::TempDir;
+using mrgi::testing::write_text;
+namespace perf = mrgi::perf;
+
+namespace {
+
+TEST(Pareto, FrontOfConstructedPoints) {
+  // (cost, error): 0 and 2 and 4 are non-dominated; 1 is dominated by 0, 3 by 2, 5 by 4.
+  const std::vector<perf::ParetoPoint> pts = {{1.0, 0.9}, {1.5, 0.95}, {3.0, 0.5}, {3.5, 0.5}, {6.0, 0.1}, {6.0, 0.2}};
+  EXPECT_EQ(perf::pareto_front(pts), (std::vector<size_t>{0, 2, 4}));
+}
+
+TEST(Pareto, SortedByCostAndTiesKept) {
+  const std::vector<perf::ParetoPoint> pts = {{5.0, 0.1}, {1.0, 0.5}, {1.0, 0.5}, {2.0, 0.6}};
+  // Out of input order, sorted by cost; the identical pair both stays; (2, 0.6) is dominated.
+  EXPECT_EQ(perf::pareto_front(pts), (std::vector<size_t>{1, 2, 0}));
+}
+
+TEST(Pareto, NonFiniteNeverOnFrontNorDominates) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<perf::ParetoPoint> pts = {{0.0, nan}, {2.0, 0.3}, {-std::numeric_limits<double>::infinity(), 0.0}};
+  EXPECT_EQ(perf::pareto_front(pts), (std::vector<size_t>{1}));
+  EXPECT_TRUE(perf::pareto_front({}).empty());
+}
+
+TEST(Stats, PercentileNearestRank) {
+  EXPECT_EQ(perf::percentile({}, 50), 0.0);
+  EXPECT_EQ(perf::percentile({3, 1, 2}, 50), 2.0);
+  EXPECT_EQ(perf::percentile({1, 2, 3, 4}, 50), 2.0);
+  std::vector<double> v;
+  for (int i = 1; i <= 100; ++i) v.push_back(i);
+  EXPECT_EQ(perf::percentile(v, 95), 95.0);
+  EXPECT_EQ(perf::percentile(v, 100), 100.0);
+}
+
+// A result with two scenes x one technique x two levels, as run_bench would return it.
+perf::BenchResult constructed_result() {
+  perf::BenchResult r;
+  r.device = "test device";
+  r.lp_num_threads = "2";
+  r.frames = 4;
+  r.floor_median_ms = 2.0;
+  for (const char* scene : {"desk", "empty"}) {
+    r.floors.push_back({scene, 64, 48, 10, 2.0, 2.2, 1.9});
+    for (int level = 0; level < 2; ++level) {
+      perf::BenchEntry e;
+      e.scene = scene;
+      e.technique = "baseline";
+      e.level = level;
+      e.level_name = level == 0 ? "high" : "low";
+      e.width = 64;
+      e.height = 48;
+      e.frame = {4, 20.0 - 10.0 * level, 22.0, 10.0 - 5.0 * level, 11.0};
+      e.has_reference = true;
+      e.error.all.pixels = 64 * 48;
+      e.error.all.delta_rms = 0.004;
+      if (std::string(scene) == "desk") {
+        e.error.all.rde_defined = true;
+        e.error.all.rde = 0.3 + 0.2 * level;
+        e.error.all.err2 = e.error.all.rde * e.error.all.rde;
+        e.error.all.ref2 = 1.0;
+      }
+      e.passes.push_back({"shade", {4, 5.0, 6.0, 2.5, 3.0}});
+      r.entries.push_back(e);
+    }
+  }
+  return r;
+}
+
+TEST(Regression, PassesAgainstItself) {
+  const perf::BenchResult r = constructed_result();
+  const perf::CheckReport rep = perf::check_against(r, perf::make_baseline(r));
+  EXPECT_TRUE(rep.passed) << rep.summary();
+  EXPECT_EQ(rep.compared, 4u);
+  EXPECT_TRUE(rep.violations.empty());
+  EXPECT_TRUE(rep.missing_in_run.empty());
+  EXPECT_TRUE(rep.missing_in_baseline.empty());
+}
+
+TEST(Regression, RatioGrowthBeyondToleranceFails) {
+  const perf::BenchResult r = constructed_result();
+  perf::Baseline b = perf::make_baseline(r);
+  b.entries[1].ratio_to_floor /= 2.0;  // the run is now 100 % slower than the baseline
+  perf::CheckReport rep = perf::check_against(r, b);
+  EXPECT_FALSE(rep.passed);
+  ASSERT_EQ(rep.violations.size(), 1u) << rep.summary();
+  EXPECT_NE(rep.violations[0].find("desk/baseline/low"), std::string::npos) << rep.violations[0];
+  EXPECT_NE(rep.violations[0].find("ratio"), std::string::npos) << rep.violations[0];
+  // Within tolerance (run 30 % slower than the baseline, limit 35 %) passes.
+  b = perf::make_baseline(r);
+  b.entries[1].ratio_to_floor /= 1.30;
+  EXPECT_TRUE(perf::check_against(r, b).passed);
+  b.entries[1].ratio_to_floor = r.entries[1].frame.median_ratio / 1.40;
+  EXPECT_FALSE(perf::check_against(r, b).passed);
+}
+
+TEST(Regression, RdeGrowthBeyondToleranceFails) {
+  const perf::BenchResult r = constructed_result();
+  perf::Baseline b = perf::make_baseline(r);
+  *b.entries[0].rde -= 0.05;  // the run's RDE is now 0.05 above the baseline (tolerance 0.02)
+  perf::CheckReport rep = perf::check_against(r, b);
+  EXPECT_FALSE(rep.passed);
+  ASSERT_EQ(rep.violations.size(), 1u) << rep.summary();
+  EXPECT_NE(rep.violations[0].find("desk/baseline/high: RDE"), std::string::npos) << rep.violations[0];
+  b = perf::make_baseline(r);
+  *b.entries[0].rde -= 0.015;
+  EXPECT_TRUE(perf::check_against(r, b).passed);
+  // Both violations are listed, not just the first.
+  b = perf::make_baseline(r);
+  *b.entries[0].rde -= 0.05;
+  b.entries[3].ratio_to_floor /= 2.0;
+  EXPECT_EQ(perf::check_against(r, b).violations.size(), 2u);
+}
+
+TEST(Regression, UndefinedRdeComparesDeltaRms) {
+  const perf::BenchResult r = constructed_result();
+  perf::Baseline b = perf::make_baseline(r);
+  ASSERT_FALSE(b.entries[2].rde.has_value());  // scene "empty": nothing should change
+  ASSERT_TRUE(b.entries[2].delta_rms.has_value());
+  *b.entries[2].delta_rms = 0.004 - 0.02;  // run's delta RMS is 0.02 above, tolerance 0.01
+  const perf::CheckReport rep = perf::check_against(r, b);
+  ASSERT_EQ(rep.violations.size(), 1u) << rep.summary();
+  EXPECT_NE(rep.violations[0].find("empty/baseline/high: delta RMS"), std::string::npos) << rep.violations[0];
+}
+
+TEST(Regression, MissingEntriesReported) {
+  perf::BenchResult r = constructed_result();
+  perf::Baseline b = perf::make_baseline(r);
+  b.entries.push_back({"desk", "dir", "high", 0, 4.0, 0.2, 0.01});
+  r.entries.push_back(r.entries[0]);
+  r.entries.back().technique = "ssrt";
+  perf::CheckReport rep = perf::check_against(r, b);
+  EXPECT_EQ(rep.missing_in_run, (std::vector<std::string>{"desk/dir/high"}));
+  EXPECT_EQ(rep.missing_in_baseline, (std::vector<std::string>{"desk/ssrt/high"}));
+  EXPECT_FALSE(rep.passed) << "a full run that lacks a baseline entry must fail";
+  r.subset = true;
+  rep = perf::check_against(r, b);
+  EXPECT_TRUE(rep.passed) << "a restricted run is not blamed for what it did not run: " << rep.summary();
+  // Nothing in common: nothing compared is a failure even for a subset.
+  perf::Baseline other;
+  other.entries.push_back({"x", "y", "z", 0, 1.0, 0.1, 0.1});
+  EXPECT_FALSE(perf::check_against(r, other).passed);
+}
+
+TEST(Regression, BaselineFileRoundTripAndRefusals) {
+  TempDir dir;
+  const perf::BenchResult r = constructed_result();
+  perf::Tolerances tol;
+  tol.ratio_relative = 0.5;
+  ASSERT_TRUE(perf::write_baseline(dir.file("b.json"), perf::make_baseline(r, tol)).ok());
+  auto b = perf::load_baseline(dir.file("b.json"));
+  ASSERT_TRUE(b.ok()) << b.error().message;
+  EXPECT_EQ(b->tolerances.ratio_relative, 0.5);
+  ASSERT_EQ(b->entries.size(), 4u);
+  EXPECT_EQ(b->entries[1].level_name, "low");
+  EXPECT_DOUBLE_EQ(b->entries[1].ratio_to_floor, 5.0);
+  EXPECT_FALSE(b->entries[2].rde.has_value());
+  EXPECT_TRUE(perf::check_against(r, *b).passed);
+
+  EXPECT_ERROR(perf::load_baseline(dir.file("none.json")), NotFound, "none.json");
+  write_text(dir.file("bad.json"), "{\"version\": 1, ");
+  EXPECT_ERROR(perf::load_baseline(dir.file("bad.json")), BadInput, "bad.json", "not valid JSON");
+  write_text(dir.file("v2.json"), R"({"version": 2, "tolerances": {}, "entries": []})");
+  EXPECT_ERROR(perf::load_baseline(dir.file("v2.json")), BadInput, "\"version\" must be 1");
+  write_text(dir.file("tol.json"),
+             R"({"version": 1, "tolerances": {"ratio_relative": -1, "rde_absolute": 0.02, "delta_rms_absolute": 0.01}, "entries": []})");
+  EXPECT_ERROR(perf::load_baseline(dir.file("tol.json")), BadInput, "tolerances.ratio_relative", ">= 0");
+  const std::string tol_ok = R"("tolerances": {"ratio_relative": 0.35, "rde_absolute": 0.02, "delta_rms_absolute": 0.01})";
+  write_text(dir.file("ratio.json"), R"({"version": 1, )" + tol_ok +
+                                         R"(, "entries": [{"scene": "a", "technique": "b", "level": 0, "level_name": "c", "ratio_to_floor": "x", "rde": null, "delta_rms": null}]})");
+  EXPECT_ERROR(perf::load_baseline(dir.file("ratio.json")), BadInput, "entries[0].ratio_to_floor", "number");
+  const std::string e = R"({"scene": "a", "technique": "b", "level": 0, "level_name": "c", "ratio_to_floor": 2, "rde": 0.1, "delta_rms": null})";
+  write_text(dir.file("dup.json"), R"({"version": 1, )" + tol_ok + R"(, "entries": [)" + e + "," + e + "]}");
+  EXPECT_ERROR(perf::load_baseline(dir.file("dup.json")), BadInput, "entries[1]", "a/b/c appears twice");
+}
+
+TEST(Suite, ReadsScenesAndResolvesPaths) {
+  TempDir dir;
+  write_text(dir.file("perf/suite.json"),
+             R"({"scenes": [{"name": "desk", "capture": "perf/suite/desk", "description": "d", "effect": "shadow"},
+                            {"name": "abs", "capture": "/data/x"}]})");
+  auto s = perf::load_suite(dir.file("perf/suite.json"));
+  ASSERT_TRUE(s.ok()) << s.error().message;
+  ASSERT_EQ(s->size(), 2u);
+  EXPECT_EQ((*s)[0].capture, dir.file("perf/suite/desk"));  // relative to the repo root
+  EXPECT_EQ((*s)[0].effect, "shadow");
+  EXPECT_EQ((*s)[1].capture, "/data/x");
+  auto one = perf::select_scenes(*s, {"abs"});
+  ASSERT_TRUE(one.ok());
+  ASSERT_EQ(one->size(), 1u);
+  EXPECT_EQ((*one)[0].name, "abs");
+  EXPECT_ERROR(perf::select_scenes(*s, {"nope"}), BadUsage, "no scene 'nope'", "desk, abs");
+}
+
+TEST(Suite, Refusals) {
+  TempDir dir;
+  EXPECT_ERROR(perf::load_suite(dir.file("missing.json")), NotFound, "missing.json");
+  write_text(dir.file("a.json"), R"({"scenes": [{"capture": "x"}]})");
+  EXPECT_ERROR(perf::load_suite(dir.file("a.json")), BadInput, "scenes[0]", "\"name\"");
+  write_text(dir.file("b.json"), R"({"scenes": [{"name": "a b", "capture": "x"}]})");
+  EXPECT_ERROR(perf::load_suite(dir.file("b.json")), BadInput, "scenes[0].name", "'a b'");
+  write_text(dir.file("c.json"), R"({"scenes": [{"name": "a", "capture": "x"}, {"name": "a", "capture": "y"}]})");
+  EXPECT_ERROR(perf::load_suite(dir.file("c.json")), BadInput, "scenes[1].name", "twice");
+  write_text(dir.file("d.json"), R"({"scenes": []})");
+  EXPECT_ERROR(perf::load_suite(dir.file("d.json")), BadInput, "no scenes");
+  write_text(dir.file("e.json"), R"({"scenes": [{"name": "a", "capture": 3}]})");
+  EXPECT_ERROR(perf::load_suite(dir.file("e.json")), BadInput, "scenes[0].capture", "string");
+}
+
+TEST(Plot, DrawsSeriesFrontAndAxes) {
+  perf::BenchResult r = constructed_result();
+  const mrgi::ImageRGB8 img = perf::render_pareto_plot(r);
+  ASSERT_EQ(img.width, 960);
+  ASSERT_EQ(img.height, 640);
+  // The first technique's colour (31, 119, 180) appears (its markers), and so does black (axes,
+  // text); most of the picture stays white.
+  size_t blue = 0, black = 0, white = 0;
+  for (size_t i = 0; i < img.pixel_count(); ++i) {
+    const uint8_t* p = &img.data[i * 3];
+    blue += p[0] == 31 && p[1] == 119 && p[2] == 180;
+    black += p[0] == 0 && p[1] == 0 && p[2] == 0;
+    white += p[0] == 255 && p[1] == 255 && p[2] == 255;
+  }
+  EXPECT_GT(blue, 40u);
+  EXPECT_GT(black, 2000u);
+  EXPECT_GT(white, img.pixel_count() / 2);
+  // Without any defined RDE no marker is drawn.
+  for (auto& e : r.entries) e.has_reference = false;
+  const mrgi::ImageRGB8 empty = perf::render_pareto_plot(r);
+  size_t blue2 = 0;
+  for (size_t i = 0; i < empty.pixel_count(); ++i)
+    blue2 += empty.data[i * 3] == 31 && empty.data[i * 3 + 1] == 119 && empty.data[i * 3 + 2] == 180;
+  // Only the legend's marker is left: the two data markers (radius 6 px) are gone.
+  EXPECT_GT(blue, blue2 + 100) << blue << " vs " << blue2;
+  EXPECT_LT(blue2, 100u);
+}
+
+TEST(Report, CsvAndMarkdownHoldEveryEntry) {
+  const perf::BenchResult r = constructed_result();
+  const std::string csv = perf::bench_csv(r);
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 5);  // header + 4 rows
+  EXPECT_NE(csv.find("pass_shade_median_ms"), std::string::npos);
+  EXPECT_NE(csv.find("desk,baseline,1,low,64,48,4,10.0000,22.0000,5.0000"), std::string::npos) << csv;
+  const std::string md = perf::report_markdown(r, nullptr);
+  EXPECT_NE(md.find("## baseline"), std::string::npos);
+  EXPECT_NE(md.find("pareto.png"), std::string::npos);
+  EXPECT_NE(md.find("| desk | 1 low | 10.00 | 22.00 | 5.0 |"), std::string::npos) << md;
+  // Suite aggregate: level "low" is faster (mean 10 ms) and level "high" more accurate: both on the front.
+  const nlohmann::json j = perf::bench_json(r, nullptr);
+  ASSERT_EQ(j["suite_aggregate"].size(), 2u);
+  EXPECT_TRUE(j["suite_aggregate"][0]["pareto"].get<bool>());
+  EXPECT_TRUE(j["suite_aggregate"][1]["pareto"].get<bool>());
+  EXPECT_DOUBLE_EQ(j["suite_aggregate"][1]["mean_median_ms"].get<double>(), 10.0);
+}
+
+}  // namespace
