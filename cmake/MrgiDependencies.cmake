@@ -12,6 +12,8 @@ if(TARGET TinyGLTF::TinyGLTF AND NOT TARGET tinygltf::tinygltf)
   add_library(tinygltf::tinygltf ALIAS TinyGLTF::TinyGLTF)
 endif()
 find_package(tinyexr REQUIRED)
+# OpenEXR reads what tinyexr cannot decode (DWAA/DWAB compression, as in Blender's HDRI maps).
+find_package(OpenEXR 3 REQUIRED)
 find_package(embree 3 REQUIRED)
 find_package(CLI11 QUIET)
 find_package(PNG REQUIRED)

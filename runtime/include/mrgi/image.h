@@ -41,7 +41,9 @@ Status write_png(const std::string& path, const ImageRGBA8& img);
 Status write_png(const std::string& path, const ImageU16& img);
 Status write_png(const std::string& path, const ImageU8& img);
 
-// HDR images: .exr (tinyexr), .hdr (stb), .png (8-bit sRGB decoded to linear).
+// HDR images: .exr (read with OpenEXR: every compression, including DWAA/DWAB; written with
+// tinyexr as 32-bit float), .hdr (stb), .png (8-bit sRGB decoded to linear). NaN or Inf is
+// refused (BadInput naming file and pixel); negative values are clamped to 0 (lossy-codec ringing).
 Expected<ImageRGBF> load_hdr_image(const std::string& path);
 Status write_exr(const std::string& path, const ImageRGBF& img);
 

@@ -1,10 +1,17 @@
-// HDR environment images: OpenEXR through tinyexr, Radiance .hdr through stb_image, and 8-bit
-// sRGB PNG decoded to linear. All of them come back as linear RGB float.
+// HDR environment images: OpenEXR (read with the OpenEXR library, written with tinyexr), Radiance
+// .hdr through stb_image, and 8-bit sRGB PNG decoded to linear. All come back as linear RGB float.
+//
 // The one stb_image implementation in the program. It must be the full decoder: its symbols
 // also satisfy libtinygltf.so's references (ELF interposition), which decodes PNG/JPEG textures.
 #define STB_IMAGE_IMPLEMENTATION
 #include <stb/stb_image.h>
 #include <tinyexr.h>
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImathBox.h>
 
 #include <algorithm>
 #include <cctype>
@@ -41,23 +48,33 @@ Status check_finite(const std::string& path, const ImageRGBF& img) {
   return ok_status();
 }
 
+// Reading goes through the OpenEXR library rather than tinyexr: tinyexr cannot decode DWAA/DWAB,
+// the compression of the HDRI Haven maps Blender ships (../shared/data/env/*.exr).
 Expected<ImageRGBF> load_exr(const std::string& path) {
-  float* rgba = nullptr;
-  int w = 0, h = 0;
-  const char* err = nullptr;
-  const int rc = LoadEXR(&rgba, &w, &h, path.c_str(), &err);
-  if (rc != TINYEXR_SUCCESS) {
-    std::string why = err ? err : ("tinyexr error " + std::to_string(rc));
-    if (err) FreeEXRErrorMessage(err);
-    std::free(rgba);
-    return fail(ErrorKind::BadInput, path + ": cannot decode OpenEXR: " + why);
+  try {
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i window = file.header().dataWindow();
+    const int w = window.max.x - window.min.x + 1, h = window.max.y - window.min.y + 1;
+    if (w <= 0 || h <= 0) return fail(ErrorKind::BadInput, path + ": OpenEXR image has no pixels");
+    const Imf::ChannelList& channels = file.header().channels();
+    // RGB, or a single luminance channel Y repeated into all three.
+    const bool rgb = channels.findChannel("R") && channels.findChannel("G") && channels.findChannel("B");
+    const bool grey = !rgb && channels.findChannel("Y");
+    if (!rgb && !grey)
+      return fail(ErrorKind::BadInput, path + ": OpenEXR image has neither R, G, B nor Y channels");
+    ImageRGBF img(w, h);
+    const size_t xs = 3 * sizeof(float), ys = xs * size_t(w);
+    Imf::FrameBuffer fb;
+    const char* names[3] = {"R", "G", "B"};
+    for (int c = 0; c < 3; ++c)  // Slice::Make addresses the buffer in data-window coordinates
+      fb.insert(grey ? "Y" : names[c],
+                Imf::Slice::Make(Imf::FLOAT, img.data.data() + c, window, xs, ys));
+    file.setFrameBuffer(fb);
+    file.readPixels(window.min.y, window.max.y);
+    return img;
+  } catch (const std::exception& e) {
+    return fail(ErrorKind::BadInput, path + ": cannot decode OpenEXR: " + e.what());
   }
-  std::unique_ptr<float, decltype(&std::free)> owner(rgba, &std::free);
-  if (w <= 0 || h <= 0) return fail(ErrorKind::BadInput, path + ": OpenEXR image has no pixels");
-  ImageRGBF img(w, h);
-  for (size_t i = 0; i < img.pixel_count(); ++i)
-    for (int c = 0; c < 3; ++c) img.data[i * 3 + size_t(c)] = rgba[i * 4 + size_t(c)];
-  return img;
 }
 
 Expected<ImageRGBF> load_radiance_hdr(const std::string& path) {
@@ -98,6 +115,10 @@ Expected<ImageRGBF> load_hdr_image(const std::string& path) {
                                          "'; expected .exr, .hdr or .png");
   if (!img) return img.error();
   MRGI_TRY(check_finite(path, *img));
+  // Lossy EXR codecs (DWAA/DWAB) ring slightly below zero near sharp highlights (the shared
+  // HDRI maps hold values down to -0.003); radiance cannot be negative, and negative weights
+  // would break importance sampling and SH projection downstream.
+  for (float& v : img->data) v = std::max(v, 0.0f);
   return img;
 }
 
