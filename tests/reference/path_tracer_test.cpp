@@ -31,8 +31,8 @@ RefCamera small_camera(int w, int h, double fov_scale, glm::dmat4 pose) {
   cam.pinhole.width = w;
   cam.pinhole.height = h;
   cam.pinhole.fx = cam.pinhole.fy = fov_scale * w;
-  cam.pinhole.cx = 0.5 * w;
-  cam.pinhole.cy = 0.5 * h;
+  cam.pinhole.cx = 0.5 * (w - 1);
+  cam.pinhole.cy = 0.5 * (h - 1);
   cam.camera_to_world = pose;
   return cam;
 }
@@ -116,7 +116,7 @@ TEST(PathTracer, PointLampOnDiffusePlaneIsAnalytic) {
     // The pixel-centre ray hits depth_z along the axis; rebuild the hit point from the camera.
     const size_t i = size_t(py) * 32 + px;
     const glm::dmat4 pose = cam.camera_to_world;
-    const glm::dvec3 dc((px + 0.5 - cam.pinhole.cx) / cam.pinhole.fx, (py + 0.5 - cam.pinhole.cy) / cam.pinhole.fy, 1.0);
+    const glm::dvec3 dc((px - cam.pinhole.cx) / cam.pinhole.fx, (py - cam.pinhole.cy) / cam.pinhole.fy, 1.0);
     const glm::dvec3 p = glm::dvec3(pose * glm::dvec4(dc * double(out.depth_z[i]), 1.0));
     EXPECT_NEAR(p.y, 0.0, 1e-4);
     const glm::dvec3 to = glm::dvec3(lamp.position) - p;

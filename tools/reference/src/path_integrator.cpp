@@ -317,9 +317,10 @@ size_t Integrator::render_pixel(int x, int y, RenderOutput& out) const {
   const uint64_t pixel_key = hash_key(frame_key_, index);
   size_t dropped = 0;
 
-  // Pixel-centre ray: depth, incidence and virtual mask, no jitter.
+  // Pixel-centre ray: depth, incidence and virtual mask, no jitter. Integer pixel coordinates
+  // are pixel centres (OpenCV; shaders/shared/mrgi_shared.h project_pinhole).
   glm::vec3 o, d, dc;
-  if (camera_ray(x + 0.5, y + 0.5, &o, &d, &dc)) {
+  if (camera_ray(x, y, &o, &d, &dc)) {
     const Hit real_hit = intersect(o, d, kInf, false);
     if (real_hit.found) {
       const SurfacePoint s = surface(real_hit, o, d);
@@ -336,7 +337,7 @@ size_t Integrator::render_pixel(int x, int y, RenderOutput& out) const {
   for (int sample = 0; sample < settings_.spp; ++sample) {
     const SampleRng rng{hash_key(pixel_key, uint64_t(sample))};
     const glm::vec2 j = rng.uniform2(dims::kPixelJitter);
-    if (!camera_ray(x + j.x, y + j.y, &o, &d, &dc)) continue;
+    if (!camera_ray(x - 0.5 + j.x, y - 0.5 + j.y, &o, &d, &dc)) continue;
     glm::vec3 real(0.0f), combined(0.0f);
     if (settings_.real_only) {
       bool unused = false;

@@ -1,0 +1,199 @@
+// Scene descriptions (strict validation) and `synth` (bit-identical, readable captures).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "mrgi/platform/capture.h"
+#include "mrgi/reference/description.h"
+#include "mrgi/reference/synth.h"
+
+namespace fs = std::filesystem;
+
+namespace mrgi::reference {
+namespace {
+
+const std::string kShared = MRGI_SHARED_DIR;
+
+class SynthTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("mrgi_synth_test_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string write(const std::string& name, const std::string& text) {
+    const fs::path p = dir_ / name;
+    std::ofstream(p) << text;
+    return p.string();
+  }
+
+  // A tiny but complete description: real floor, box and spot lamp, a virtual bunny, an HDR
+  // environment seen by a fisheye env camera.
+  std::string tiny(const std::string& extra_root = "") {
+    return R"({
+  "version": 1, "frames": 2, "fps": 10,)" + extra_root + R"(
+  "camera": {"width": 32, "height": 24, "fx": 30, "fy": 30, "exposure": 1.5},
+  "camera_path": [{"time": 0, "position": [0, 0.6, -0.8], "look_at": [0, 0.05, 0]},
+                  {"time": 0.1, "position": [0.1, 0.6, -0.8], "look_at": [0, 0.05, 0]}],
+  "render": {"spp": 4, "max_depth": 3, "seed": 5},
+  "real_objects": [
+    {"shape": "plane", "size": [2, 2], "material": {"color": [0.7, 0.7, 0.7]}},
+    {"shape": "box", "size": [0.1, 0.1, 0.1], "position": [0.2, 0.05, 0], "material": {"color": [0.2, 0.2, 0.8]}}],
+  "lights": [{"type": "spot", "position": [0, 1, 0], "direction": [0, -1, 0], "intensity": 2,
+              "inner_angle_deg": 30, "outer_angle_deg": 50}],
+  "environment": {"image": ")" + kShared + R"(/data/env/courtyard.exr", "intensity": 0.3, "capture_width": 32},
+  "virtual_objects": [{"gltf": ")" + kShared + R"(/data/models/bunny.glb", "position": [0, 0, 0], "scale": 1.0,
+                       "velocity": [0.1, 0, 0]}],
+  "env_camera": {"position": [0, 0.5, 0], "look_at": [0, 2, 0], "up": [0, 0, 1], "size": 16, "spp": 2}
+})";
+  }
+
+  fs::path dir_;
+};
+
+std::string read_all(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+TEST_F(SynthTest, ReadsAValidDescription) {
+  auto d = load_scene_description(write("ok.json", tiny()));
+  ASSERT_TRUE(d.ok()) << d.error().message;
+  EXPECT_EQ(d->frames, 2);
+  EXPECT_EQ(d->intrinsics.width, 32);
+  EXPECT_DOUBLE_EQ(d->intrinsics.cx, 15.5);
+  EXPECT_EQ(d->real_objects.size(), 2u);
+  EXPECT_TRUE(d->env_camera.has_value());
+  const Pose mid = camera_pose_at(*d, 0.05);
+  EXPECT_NEAR(mid.translation.x, 0.05, 1e-9);
+  // The camera looks along +z in its own frame: that axis points at the look-at point.
+  const glm::dvec3 forward = glm::dmat3(mid.matrix()) * glm::dvec3(0, 0, 1);
+  EXPECT_GT(glm::dot(forward, glm::normalize(glm::dvec3(0, 0.05, 0) - mid.translation)), 0.99);
+}
+
+TEST_F(SynthTest, RefusesBrokenDescriptions) {
+  struct Case {
+    std::string text, must_mention;
+  };
+  const std::string base = tiny();
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string t = base;
+    const size_t at = t.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return t.replace(at, from.size(), to);
+  };
+  const Case cases[] = {
+      {with("\"frames\": 2", "\"frames\": 2, \"colour\": 1"), "colour"},                 // unknown key
+      {with("\"spp\": 4", "\"spp\": \"many\""), "render.spp"},                           // bad type
+      {with("\"spp\": 4", "\"spp\": 4, \"sample\": 1"), "sample"},                       // unknown nested key
+      {with("models/bunny.glb", "models/missing.glb"), "virtual_objects[0].gltf"},       // missing glTF
+      {with("\"intensity\": 2,", "\"intensity\": NaN,"), "ok.json"},                     // NaN is not JSON
+      {with("\"intensity\": 2,", "\"intensity\": -2,"), "lights[0].intensity"},          // negative
+      {with("\"outer_angle_deg\": 50", "\"outer_angle_deg\": 20"), "inner_angle_deg"},   // inner > outer
+      {with("\"size\": [2, 2]", "\"size\": [2, 2, 2]"), "real_objects[0].size"},         // plane is 2-D
+      {with("\"look_at\": [0, 0.05, 0]}", "\"look_at\": [0, 0.6, -0.8]}"), "look_at"},   // degenerate
+      {with("\"version\": 1", "\"version\": 2"), "version"},
+  };
+  for (const Case& c : cases) {
+    auto d = load_scene_description(write("ok.json", c.text));
+    ASSERT_FALSE(d.ok()) << "accepted; expected a complaint about " << c.must_mention;
+    EXPECT_EQ(d.error().kind, ErrorKind::BadInput);
+    EXPECT_NE(d.error().message.find(c.must_mention), std::string::npos) << d.error().message;
+    EXPECT_NE(d.error().message.find("ok.json"), std::string::npos) << d.error().message;
+  }
+}
+
+TEST_F(SynthTest, TwoSynthsAreBitIdenticalAndReadable) {
+  auto d = load_scene_description(write("tiny.json", tiny()));
+  ASSERT_TRUE(d.ok()) << d.error().message;
+  SynthOptions o;
+  o.threads = 2;
+  o.out = (dir_ / "a").string();
+  auto ra = synthesize_capture(*d, o);
+  ASSERT_TRUE(ra.ok()) << ra.error().message;
+  o.threads = 1;
+  o.out = (dir_ / "b").string();
+  ASSERT_TRUE(synthesize_capture(*d, o).ok());
+  size_t files = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir_ / "a")) {
+    if (!e.is_regular_file()) continue;
+    const fs::path rel = fs::relative(e.path(), dir_ / "a");
+    EXPECT_EQ(read_all(e.path()), read_all(dir_ / "b" / rel)) << rel;
+    ++files;
+  }
+  EXPECT_GE(files, 2u * 5u);  // rgb, depth, env, reference, mask per frame
+  // Writing over an existing capture is refused.
+  EXPECT_FALSE(synthesize_capture(*d, o).ok());
+
+  auto capture = CaptureReader::open((dir_ / "a").string());
+  ASSERT_TRUE(capture.ok()) << capture.error().message;
+  EXPECT_EQ(capture->frame_count(), 2u);
+  EXPECT_TRUE(capture->has_references());
+  ASSERT_TRUE(capture->info().env_camera.has_value());
+  EXPECT_EQ(capture->info().env_camera->model, EnvModel::FisheyeEquidistant);
+  ASSERT_TRUE(capture->scene().has_value());
+  ASSERT_EQ(capture->scene()->virtual_objects.size(), 1u);
+  EXPECT_TRUE(fs::exists(capture->scene()->virtual_objects[0].gltf));
+  EXPECT_TRUE(capture->scene()->environment.from_env_camera);
+  ASSERT_EQ(capture->scene()->lights.size(), 1u);
+  EXPECT_TRUE(capture->scene()->lights[0].real);
+  auto frame = capture->read_frame(1);
+  ASSERT_TRUE(frame.ok()) << frame.error().message;
+  ASSERT_TRUE(frame->pose.has_value());
+  EXPECT_NEAR(frame->pose->translation.x, 0.1, 1e-6);
+  ASSERT_TRUE(frame->env.has_value());
+  auto mask = capture->read_reference_mask(0);
+  ASSERT_TRUE(mask.ok());
+  auto reference = capture->read_reference(0);
+  ASSERT_TRUE(reference.ok());
+  auto f0 = capture->read_frame(0);
+  ASSERT_TRUE(f0.ok());
+  // The bunny is seen (mask), the reference differs from the camera frame there, and outside the
+  // mask most pixels are equal (the bunny only shadows and tints a part of the floor).
+  size_t virtual_pixels = 0, differing_inside = 0, equal_outside = 0, outside = 0, depth_pixels = 0;
+  for (size_t i = 0; i < mask->pixel_count(); ++i) {
+    const bool v = mask->data[i] != 0;
+    const bool same = std::equal(&f0->color.data[3 * i], &f0->color.data[3 * i + 3], &reference->data[3 * i]);
+    virtual_pixels += v;
+    differing_inside += v && !same;
+    outside += !v;
+    equal_outside += !v && same;
+    depth_pixels += f0->depth.data[i] != 0;
+  }
+  EXPECT_GT(virtual_pixels, 5u);
+  EXPECT_GT(differing_inside, virtual_pixels / 2);
+  EXPECT_GT(equal_outside, outside / 4);
+  EXPECT_GT(depth_pixels, mask->pixel_count() / 4);  // the upper part sees past the floor
+}
+
+TEST_F(SynthTest, ImageEnvironmentIsCopiedIntoTheCapture) {
+  std::string text = tiny();
+  const size_t at = text.find(",\n  \"env_camera\"");
+  text = text.substr(0, at) + "\n}";
+  auto d = load_scene_description(write("noenvcam.json", text));
+  ASSERT_TRUE(d.ok()) << d.error().message;
+  SynthOptions o;
+  o.out = (dir_ / "c").string();
+  o.frames = 1;
+  o.spp = 1;
+  ASSERT_TRUE(synthesize_capture(*d, o).ok());
+  auto capture = CaptureReader::open(o.out);
+  ASSERT_TRUE(capture.ok()) << capture.error().message;
+  ASSERT_TRUE(capture->scene()->environment.present);
+  EXPECT_FALSE(capture->scene()->environment.from_env_camera);
+  auto env = load_hdr_image(capture->scene()->environment.image);
+  ASSERT_TRUE(env.ok()) << env.error().message;
+  EXPECT_EQ(env->width, 32);
+  EXPECT_EQ(env->height, 16);
+}
+
+}  // namespace
+}  // namespace mrgi::reference

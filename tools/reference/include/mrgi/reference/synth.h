@@ -1,0 +1,57 @@
+// The synthetic capture generator behind `mrgi synth`: renders a scene description
+// (mrgi/reference/description.h) with the reference path tracer and its sensor models and
+// writes a capture v1 folder (DESIGN.md) through CaptureWriter:
+//   rgb/, depth/, groundtruth.txt   camera frames C (camera response of L_r, sensor noise), Kinect
+//                                   depth of the real scene, camera-to-world poses
+//   env/                            fisheye HDR frames (.exr) when the description has an env camera
+//   reference/                      G = camera response of L_rv with the same noise realisation,
+//                                   and *_mask.png (255 where the pixel-centre ray sees a virtual object)
+//   capture.json                    intrinsics, depth_scale, exposure, env camera model and pose
+//   scene.json                      virtual objects (glTF copied under virtual/, frame-0 placement),
+//                                   lamps with their `real` flags (area lamps cannot be listed),
+//                                   environment from the env camera or a downsampled copy under
+//                                   environment/; no real_geometry (the runtime reconstructs it)
+// The output is a pure function of the description and the options: two runs give identical files.
+#pragma once
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "mrgi/expected.h"
+#include "mrgi/reference/description.h"
+
+namespace mrgi::reference {
+
+struct SynthOptions {
+  std::string out;                      // capture folder to create (must not exist yet)
+  std::optional<int> frames, spp, width, height;  // overrides of the description
+  std::optional<uint64_t> seed;
+  int threads = 0;                      // 0 = hardware concurrency
+  // When set, frame 0 is rendered a second time with this seed (in memory only) to measure the
+  // reference noise floor (SynthReport::noise_floor).
+  std::optional<uint64_t> noise_floor_seed;
+  // Progress over all frames: (what, done, total, seconds elapsed).
+  std::function<void(const std::string&, size_t, size_t, double)> progress;
+};
+
+// How far the reference is from converged: the RDE a perfect system would score against this
+// capture's frame 0 if its answer came from an independent render (another seed B):
+//   RDE = ||(G_B - C_B) - (G_A - C_A)|| / ||G_A - C_A||, linear RGB decoded from the 8-bit frames,
+// over all pixels, real pixels (mask 0) and virtual pixels (mask non-zero). 0 = converged.
+struct NoiseFloor {
+  double rde_all = 0.0, rde_real = 0.0, rde_virtual = 0.0;
+  double delta_rms = 0.0;  // RMS of ||G_A - C_A|| per pixel, linear: how large the effect is
+};
+
+struct SynthReport {
+  int frames = 0;
+  int spp = 0;
+  double seconds = 0.0;
+  size_t dropped_samples = 0;
+  std::optional<NoiseFloor> noise_floor;
+};
+
+Expected<SynthReport> synthesize_capture(const SceneDescription& description, const SynthOptions& options);
+
+}  // namespace mrgi::reference
