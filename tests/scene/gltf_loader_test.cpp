@@ -186,6 +186,53 @@ TEST(GltfLoader, MissingAndBrokenFiles) {
   EXPECT_ERROR(load_gltf(dir.file("x.obj"), Placement{}), BadInput, "x.obj", ".gltf or .glb");
 }
 
+// Interleaved vertices (float position + normalised u16 UV + normalised i8 normal, 20-byte
+// stride) and u8 indices: the component types and strides glTF allows besides plain floats.
+TEST(GltfLoader, InterleavedNormalisedAttributesAndByteIndices) {
+  TempDir dir;
+  struct Vertex {
+    float pos[3];
+    uint16_t uv[2];
+    int8_t normal[4];  // xyz + padding to keep 4-byte alignment
+  };
+  static_assert(sizeof(Vertex) == 20);
+  const Vertex verts[3] = {{{0, 0, 0}, {0, 65535}, {0, 0, 127, 0}},
+                           {{1, 0, 0}, {65535, 65535}, {0, 0, 127, 0}},
+                           {{0, 1, 0}, {0, 0}, {0, -128, 0, 0}}};
+  const uint8_t indices[4] = {2, 0, 1, 0};  // one triangle, padded to 4 bytes
+  {
+    std::ofstream out(dir.file("v.bin"), std::ios::binary);
+    out.write(reinterpret_cast<const char*>(verts), sizeof(verts));
+    out.write(reinterpret_cast<const char*>(indices), sizeof(indices));
+  }
+  write_text(dir.file("v.gltf"), R"({
+  "asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}],
+  "nodes": [{"mesh": 0, "matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 5,0,0,1]}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1, "NORMAL": 2}, "indices": 3}]}],
+  "buffers": [{"uri": "v.bin", "byteLength": 64}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 60, "byteStride": 20},
+                  {"buffer": 0, "byteOffset": 60, "byteLength": 3}],
+  "accessors": [
+    {"bufferView": 0, "byteOffset": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+     "min": [0, 0, 0], "max": [1, 1, 0]},
+    {"bufferView": 0, "byteOffset": 12, "componentType": 5123, "normalized": true, "count": 3, "type": "VEC2"},
+    {"bufferView": 0, "byteOffset": 16, "componentType": 5120, "normalized": true, "count": 3, "type": "VEC3"},
+    {"bufferView": 1, "componentType": 5121, "count": 3, "type": "SCALAR"}]
+})");
+  auto model = load_gltf(dir.file("v.gltf"), Placement{});
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  const auto& prim = model->primitives[0];
+  EXPECT_EQ(prim.indices, (std::vector<uint32_t>{2, 0, 1}));
+  expect_vec3_near(prim.positions[1], {6, 0, 0}, 1e-6f);  // node matrix translates by x = 5
+  EXPECT_FLOAT_EQ(prim.uvs[1].x, 1.0f);
+  EXPECT_FLOAT_EQ(prim.uvs[1].y, 1.0f);
+  EXPECT_FLOAT_EQ(prim.uvs[2].y, 0.0f);
+  expect_vec3_near(prim.normals[0], {0, 0, 1}, 1e-6f);
+  expect_vec3_near(prim.normals[2], {0, -1, 0}, 1e-6f);  // -128 clamps to -1
+  EXPECT_EQ(model->materials.size(), 0u);
+  EXPECT_EQ(prim.material, -1);  // the glTF default material
+}
+
 TEST(GltfLoader, AccessorPastBufferEndIsRefused) {
   TinyGltf f;
   // Claim 4 vertices in a 48-byte view with a 16-byte stride: the 4th reads past the end.
