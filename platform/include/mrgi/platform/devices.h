@@ -1,0 +1,53 @@
+// Every adapter's view of the machine (for `mrgi devices`) and the source factory with options
+// (for `mrgi live` / `mrgi record`): the plain open_source(SOURCE) of source.h uses the defaults.
+#pragma once
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "mrgi/platform/libcamera.h"
+#include "mrgi/platform/openni.h"
+#include "mrgi/platform/source.h"
+#include "mrgi/platform/usb.h"
+#include "mrgi/platform/v4l2.h"
+
+namespace mrgi {
+
+struct DeviceReport {
+  Status openni_status = ok_status();     // error: OpenNI2 could not initialise
+  std::vector<OpenNIDeviceEntry> openni;
+  std::vector<V4L2NodeEntry> v4l2;
+  Status libcamera_status = ok_status();  // error: the camera manager did not start
+  std::vector<LibcameraEntry> libcamera;
+  UsbScan usb;
+};
+
+// Asks every adapter; never fails (each adapter's failure is kept in its status).
+DeviceReport list_devices_all_adapters();
+
+struct SourceOptions {
+  OpenNISettings openni;
+  CameraSettings camera;                  // v4l2: and libcamera: sources
+  // Optional second stream: a fisheye environment camera, "v4l2:/dev/videoN" or "libcamera:ID".
+  // Its 8-bit frames are decoded to linear radiance (sRGB curve, then divided by env_exposure)
+  // into InputFrame::env, using `env_model` (capture.json "env_camera"), which is also put in
+  // info().env_camera.
+  std::string env;
+  CameraSettings env_camera;
+  std::optional<EnvCamera> env_model;
+  double env_exposure = 1.0;              // linear radiance -> linear camera value of the env camera
+  // How long next() waits for the env camera after the main frame arrived (ms); when nothing
+  // comes, the last env image is reused (lighting changes slowly), and if there never was one,
+  // the frame has no env image.
+  int env_wait_ms = 50;
+};
+
+// SOURCE: a capture folder, "openni:", "openni:FILE.oni", "openni:URI", "v4l2:/dev/videoN",
+// "libcamera:" (first camera) or "libcamera:ID". Unknown prefixes are BadUsage.
+Expected<std::unique_ptr<InputSource>> open_source(const std::string& source, const SourceOptions& options);
+
+// Decodes an 8-bit sRGB env frame to linear radiance: srgb_to_linear(v) / exposure.
+void env_frame_to_radiance(const ImageRGB8& frame, double exposure, ImageRGBF& out);
+
+}  // namespace mrgi
