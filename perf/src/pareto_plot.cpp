@@ -90,9 +90,11 @@ ImageRGB8 render_pareto_plot(const BenchResult& result) {
   cv.line(px0, py0, px0, py1, 1.5f, black);
 
   // Titles and axis labels.
+  // The device's short name: lavapipe reports "llvmpipe (LLVM 15.0.6, 256 bits)".
+  const std::string device = result.device.substr(0, result.device.find(" ("));
   char title[160];
-  std::snprintf(title, sizeof title, "mrgi bench: frame time vs error (%s, LP_NUM_THREADS=%s)",
-                result.device.c_str(), result.lp_num_threads.empty() ? "unset" : result.lp_num_threads.c_str());
+  std::snprintf(title, sizeof title, "mrgi bench: frame time vs error, %s, LP_NUM_THREADS=%s", device.c_str(),
+                result.lp_num_threads.empty() ? "unset" : result.lp_num_threads.c_str());
   cv.text(px0, 18, title, 2, black);
   char sub[160];
   std::snprintf(sub, sizeof sub, "suite aggregate per technique level, floor pass %.3f ms, %d frames + %d warm-up per run",
@@ -121,7 +123,7 @@ ImageRGB8 render_pareto_plot(const BenchResult& result) {
     const Rgb c = kPalette[st % std::size(kPalette)];
     const float x = sx(points[k].cost), y = sy(points[k].error);
     cv.marker(x, y, kMarkers[st % std::size(kMarkers)], 6.0f, c, black);
-    cv.text(x + 9, y - 12, l.level_name, 1.0f, dark);
+    cv.text(x + 9, y - 14, l.level_name, 1.5f, dark);
   }
   if (points.empty()) {
     const std::string msg = "no RDE to plot: the scenes have no reference frames";

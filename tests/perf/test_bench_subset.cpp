@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -24,11 +25,14 @@ namespace perf = mrgi::perf;
 
 namespace {
 
-const std::string kSuite = std::string(MRGI_SOURCE_DIR) + "/perf/suite.json";
+// MRGI_PERF_TEST_SUITE points the subset at another suite file (e.g. while a suite is rebuilt).
+const std::string kSuite = std::getenv("MRGI_PERF_TEST_SUITE") ? std::getenv("MRGI_PERF_TEST_SUITE")
+                                                                : std::string(MRGI_SOURCE_DIR) + "/perf/suite.json";
 
-// One bench run shared by the tests below (a run takes seconds to a minute on lavapipe).
-const perf::BenchResult& subset_result() {
-  static const perf::BenchResult result = [] {
+// One bench run for the checks below (CTest runs each TEST in a process of its own, so they are
+// one TEST: the run takes seconds to a minute on lavapipe).
+perf::BenchResult run_subset() {
+  perf::BenchResult result = [] {
     auto suite = perf::load_suite(kSuite);
     EXPECT_TRUE(suite.ok()) << suite.error().message;
     if (!suite.ok()) return perf::BenchResult{};
@@ -48,8 +52,7 @@ const perf::BenchResult& subset_result() {
   return result;
 }
 
-TEST(BenchSubset, RunsAndMeasures) {
-  const perf::BenchResult& r = subset_result();
+void check_measures(const perf::BenchResult& r) {
   ASSERT_FALSE(r.entries.empty());
   EXPECT_EQ(r.lp_num_threads, "2");  // set by the bench when unset; CTest does not set it
   EXPECT_TRUE(r.subset);
@@ -78,8 +81,7 @@ TEST(BenchSubset, RunsAndMeasures) {
   EXPECT_EQ(r.entries.back().level, int(levels->size()) - 1);
 }
 
-TEST(BenchSubset, WritesFourFilesThatParse) {
-  const perf::BenchResult& r = subset_result();
+void check_outputs(const perf::BenchResult& r) {
   ASSERT_FALSE(r.entries.empty());
   TempDir dir;
   const std::string out = dir.file("bench");
@@ -117,8 +119,7 @@ TEST(BenchSubset, WritesFourFilesThatParse) {
   EXPECT_TRUE(fs::exists(dir.file("precious/data.txt")));
 }
 
-TEST(BenchSubset, CheckPassesAgainstItselfAndFailsDoctored) {
-  const perf::BenchResult& r = subset_result();
+void check_regression(const perf::BenchResult& r) {
   ASSERT_FALSE(r.entries.empty());
   TempDir dir;
   ASSERT_TRUE(perf::write_baseline(dir.file("baseline.json"), perf::make_baseline(r)).ok());
@@ -149,6 +150,22 @@ TEST(BenchSubset, CheckPassesAgainstItselfAndFailsDoctored) {
   rep = perf::check_against(r, doctored);
   EXPECT_FALSE(rep.passed) << rep.summary();
   EXPECT_EQ(rep.violations.size(), r.entries.size()) << rep.summary();
+}
+
+TEST(BenchSubset, EndToEnd) {
+  const perf::BenchResult r = run_subset();
+  {
+    SCOPED_TRACE("measures");
+    check_measures(r);
+  }
+  {
+    SCOPED_TRACE("outputs");
+    check_outputs(r);
+  }
+  {
+    SCOPED_TRACE("regression check");
+    check_regression(r);
+  }
 }
 
 TEST(BenchSubset, BadSettingsAreRefused) {
