@@ -13,7 +13,9 @@
 
 #include <glm/glm.hpp>
 
-#include "common/light_set.glsl"
+// Relative to this file (not through the include path) so tests, which do not have shaders/ on
+// their include path, can include this header too.
+#include "../../../../shaders/common/light_set.glsl"
 #include "mrgi/expected.h"
 #include "mrgi/scene.h"
 
