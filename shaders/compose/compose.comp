@@ -17,13 +17,12 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
 layout(std430, set = 0, binding = 1) readonly buffer ColorWords { uint color_words[]; };  // RGB8
-layout(set = 0, binding = 2) uniform sampler2D lit_rv;            // linear sampler
+layout(set = 0, binding = 2) uniform sampler2D lit_rv;            // texelFetch only
 layout(set = 0, binding = 3) uniform sampler2D lit_r;
 layout(set = 0, binding = 4) uniform sampler2D virtual_position;  // w: virtual coverage
 layout(std430, set = 0, binding = 5) writeonly buffer Output { uint out_rgba8[]; };
 layout(std430, set = 0, binding = 6) writeonly buffer Mask { uint out_mask[]; };
 layout(push_constant) uniform Params {
-  vec4 internal_uv;  // xy used internal extent / allocated extent, zw 1 / allocated extent
   vec4 compose;      // x eps (linear camera units), y alpha_max
 } params;
 
@@ -55,13 +54,19 @@ void main() {
   vec3 ci = mix(mix(camera_linear(c0), camera_linear(c0 + ivec2(1, 0)), f.x),
                 mix(camera_linear(c0 + ivec2(0, 1)), camera_linear(c0 + ivec2(1, 1)), f.x), f.y);
 
-  // The solutions at the internal resolution, upsampled bilinearly inside the used extent.
-  vec2 uv = clamp(rel * params.internal_uv.xy, 0.5f * params.internal_uv.zw,
-                  params.internal_uv.xy - 0.5f * params.internal_uv.zw);
-  vec3 rv = finite(textureLod(lit_rv, uv, 0.0f).rgb);
-  vec3 r = finite(textureLod(lit_r, uv, 0.0f).rgb);
-  ivec2 ip = min(ivec2(rel * params.internal_uv.xy / params.internal_uv.zw),
-                 frame.internal_output_size.xy - 1);
+  // The solutions at the internal resolution, upsampled bilinearly from texels of the used
+  // extent only: texels outside it hold whatever an earlier level left (possibly NaN), and a
+  // filtered fetch at the edge would give them weight 0, which still makes 0 * NaN = NaN.
+  ivec2 used = frame.internal_output_size.xy;
+  vec2 ipos = rel * vec2(used) - 0.5f;
+  ivec2 i0 = ivec2(floor(ipos));
+  vec2 w = ipos - vec2(i0);
+  ivec2 a = clamp(i0, ivec2(0), used - 1), b = clamp(i0 + 1, ivec2(0), used - 1);
+  vec3 rv = mix(mix(finite(texelFetch(lit_rv, ivec2(a.x, a.y), 0).rgb), finite(texelFetch(lit_rv, ivec2(b.x, a.y), 0).rgb), w.x),
+                mix(finite(texelFetch(lit_rv, ivec2(a.x, b.y), 0).rgb), finite(texelFetch(lit_rv, ivec2(b.x, b.y), 0).rgb), w.x), w.y);
+  vec3 r = mix(mix(finite(texelFetch(lit_r, ivec2(a.x, a.y), 0).rgb), finite(texelFetch(lit_r, ivec2(b.x, a.y), 0).rgb), w.x),
+               mix(finite(texelFetch(lit_r, ivec2(a.x, b.y), 0).rgb), finite(texelFetch(lit_r, ivec2(b.x, b.y), 0).rgb), w.x), w.y);
+  ivec2 ip = min(ivec2(rel * vec2(used)), used - 1);
   float is_virtual = texelFetch(virtual_position, ip, 0).w > 0.5f ? 1.0f : 0.0f;
 
   float exposure = frame.camera.y;

@@ -10,7 +10,6 @@ namespace mrgi::compose {
 namespace {
 
 struct ComposePush {
-  glm::vec4 internal_uv;
   glm::vec4 compose;
 };
 
@@ -46,7 +45,6 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
 
 void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
   in_ = inputs;
-  allocated_ = graph.allocated_extent(inputs.lit_rv);
   graph.add_pass(
       "compose", gpu::PassKind::Compute,
       [this](gpu::PassBuilder& b) {
@@ -75,11 +73,7 @@ void Compose::dispatch(VkCommandBuffer cmd, gpu::PassContext& pass) {
       .storage_buffer(5, pass.buffer(output_))
       .storage_buffer(6, pass.buffer(mask_))
       .push(ctx, cmd, *pipeline_);
-  const VkExtent2D used = pass.extent(in_.lit_rv);
   ComposePush pc;
-  const VkExtent2D full = allocated_;
-  pc.internal_uv = glm::vec4(float(used.width) / float(full.width), float(used.height) / float(full.height),
-                             1.0f / float(full.width), 1.0f / float(full.height));
   pc.compose = glm::vec4(settings_.eps, settings_.alpha_max, 0.0f, 0.0f);
   gpu::dispatch_2d(cmd, *pipeline_, &pc, sizeof(pc), width_, height_);
 }

@@ -40,7 +40,6 @@ class Compose {
   ComposeSettings settings_;
   uint32_t width_ = 0, height_ = 0;
   ComposeInputs in_;
-  VkExtent2D allocated_{1, 1};  // of the internal-resolution images (their used part varies)
   gpu::BufferHandle output_, mask_;
   gpu::PipelineHandle pipeline_;
 };

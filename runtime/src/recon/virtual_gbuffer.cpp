@@ -38,7 +38,6 @@ Expected<VirtualGBuffer> VirtualGBuffer::create(gpu::Context& context, gpu::Fram
   auto d = internal_image(graph, "virtual_depth", kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
   if (!d) return d.error();
   v.depth_ = *d;
-  v.allocated_ = graph.allocated_extent(v.position_);
   v.color_layout_ =
       gpu::access_info(gpu::PassKind::Graphics, gpu::Access::ColorAttachmentWrite, true, false).layout;
   v.depth_layout_ =
@@ -112,9 +111,7 @@ void VirtualGBuffer::draw(VkCommandBuffer cmd, gpu::PassContext& pass) {
   depth.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
   depth.clearValue.depthStencil = {1.0f, 0};
   VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-  // The whole allocation is cleared, not only the used extent: lavapipe was seen to leave stale
-  // texels at the right edge of a partial-render-area clear, which then read as virtual pixels.
-  ri.renderArea = {{0, 0}, allocated_};
+  ri.renderArea = {{0, 0}, e};
   ri.layerCount = 1;
   ri.colorAttachmentCount = 3;
   ri.pColorAttachments = colors;

@@ -31,7 +31,6 @@ class VirtualGBuffer {
   gpu::ImageHandle real_position_;
   gpu::ImageHandle position_, normal_, albedo_, depth_;
   gpu::PipelineHandle pipeline_;
-  VkExtent2D allocated_{1, 1};
   VkImageLayout color_layout_ = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
   VkImageLayout depth_layout_ = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
 };
