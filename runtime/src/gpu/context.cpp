@@ -152,7 +152,8 @@ T load_device_fn(VkDevice device, const char* core, const char* khr) {
 
 }  // namespace
 
-Expected<VkInstance> create_instance_for_listing() { return create_instance(false, nullptr); }
+// With validation requested, listing fails loudly if the layer is not installed.
+Expected<VkInstance> create_instance_for_listing(bool validate) { return create_instance(validate, nullptr); }
 Expected<std::vector<VkPhysicalDevice>> physical_devices_for_listing(VkInstance i) { return physical_devices(i); }
 std::vector<DeviceInfo> describe_all_devices(const std::vector<VkPhysicalDevice>& pds) { return describe_all(pds); }
 
@@ -707,7 +708,7 @@ uint32_t bytes_per_texel(VkFormat f) {
 namespace mrgi {
 
 Expected<std::vector<DeviceInfo>> list_devices(const DeviceSettings& settings) {
-  auto instance = gpu::create_instance_for_listing();
+  auto instance = gpu::create_instance_for_listing(settings.validate);
   if (!instance) return instance.error();
   auto pds = gpu::physical_devices_for_listing(*instance);
   std::vector<DeviceInfo> devices;

@@ -386,8 +386,8 @@ Status FrameGraph::execute(VkCommandBuffer cmd) {
   Slot& slot = slots_[slot_];
   const uint32_t n = uint32_t(compiled_.passes.size());
   if (n > 0) vkCmdResetQueryPool(cmd, slot.queries, 0, 2 * n);
-  std::vector<VkImageMemoryBarrier2> image_barriers;
-  std::vector<VkBufferMemoryBarrier2> buffer_barriers;
+  std::vector<VkImageMemoryBarrier2>& image_barriers = image_barrier_scratch_;
+  std::vector<VkBufferMemoryBarrier2>& buffer_barriers = buffer_barrier_scratch_;
   auto record_barriers = [&](const std::vector<Barrier>& barriers) {
     if (barriers.empty()) return;
     image_barriers.clear();

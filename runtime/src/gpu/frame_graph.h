@@ -315,6 +315,9 @@ class FrameGraph {
   std::vector<ResourceRef> outputs_;
   CompiledGraph compiled_;
   bool compiled_valid_ = false;
+  // Reused every frame (capacity kept) so recording allocates nothing once warm.
+  std::vector<VkImageMemoryBarrier2> image_barrier_scratch_;
+  std::vector<VkBufferMemoryBarrier2> buffer_barrier_scratch_;
   VkCommandPool pool_ = VK_NULL_HANDLE;
   VkExtent2D output_size_{0, 0};
   float render_scale_ = 1.0f;

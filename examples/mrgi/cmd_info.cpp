@@ -1,0 +1,127 @@
+// mrgi info: the Vulkan devices mrgi sees and the one it would use (--device / $MRGI_DEVICE;
+// default lavapipe if present, else device 0). With --technique it also builds that technique's
+// runtime for --level at --width x --height and states the memory it allocates at start-up
+// (everything the frame loop will ever use).
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "mrgi/runtime.h"
+
+namespace mrgi::tool {
+namespace {
+
+struct InfoOptions {
+  std::string device;
+  bool validate = false;
+  std::string technique;
+  std::string level = "0";
+  int width = 640;
+  int height = 480;
+  bool json = false;
+};
+
+std::string api_string(uint32_t v) {
+  return std::to_string(v >> 22) + "." + std::to_string((v >> 12) & 0x3ff) + "." + std::to_string(v & 0xfff);
+}
+
+int resolve_level(const InfoOptions& o) {
+  auto levels = technique_levels(o.technique);
+  if (!levels) fail_with(levels.error());
+  const int count = int(levels->size());
+  if (o.level == "last") return count - 1;
+  int level = -1;
+  try {
+    size_t used = 0;
+    level = std::stoi(o.level, &used);
+    if (used != o.level.size()) level = -1;
+  } catch (const std::exception&) {
+    level = -1;
+  }
+  if (level < 0 || level >= count)
+    fail_with(fail(ErrorKind::BadUsage, "--level '" + o.level + "': technique '" + o.technique + "' has levels 0.." +
+                                            std::to_string(count - 1) + " (or 'last')"));
+  return level;
+}
+
+void run_info(const InfoOptions& o) {
+  DeviceSettings ds;
+  ds.device = o.device;
+  ds.validate = o.validate;
+  const std::vector<DeviceInfo> devices = take(list_devices(ds));
+
+  nlohmann::json j;
+  j["devices"] = nlohmann::json::array();
+  for (const DeviceInfo& d : devices)
+    j["devices"].push_back({{"index", d.index},
+                            {"name", d.name},
+                            {"type", d.type},
+                            {"driver", d.driver},
+                            {"api_version", api_string(d.api_version)},
+                            {"device_local_mib", d.device_local_mib},
+                            {"selected", d.selected}});
+  j["validation"] = o.validate;
+
+  if (!o.technique.empty()) {
+    if (o.width <= 0 || o.height <= 0)
+      fail_with(fail(ErrorKind::BadUsage, "--width and --height must be > 0"));
+    RuntimeSettings rs;
+    rs.device = ds;
+    rs.technique = o.technique;
+    rs.level = resolve_level(o);
+    rs.output_width = o.width;
+    rs.output_height = o.height;
+    CameraSetup cameras;
+    cameras.color = cameras.color.scaled_to(o.width, o.height);
+    cameras.depth = cameras.depth.scaled_to(o.width, o.height);
+    // An empty scene: the allocation is sized by the technique, level and output size, which
+    // are what the budget depends on.
+    auto runtime = take(create_runtime(rs, cameras, SceneDesc{}));
+    const auto names = runtime->level_names();
+    j["budget"] = {{"technique", o.technique},
+                   {"level", rs.level},
+                   {"level_name", rs.level < int(names.size()) ? names[rs.level] : std::string()},
+                   {"width", o.width},
+                   {"height", o.height},
+                   {"memory_mib", runtime->memory_mib()}};
+  }
+
+  if (o.json) {
+    std::cout << j.dump(2) << "\n";
+    return;
+  }
+  std::cout << "Vulkan devices (" << devices.size() << "):\n";
+  for (const DeviceInfo& d : devices) {
+    std::cout << (d.selected ? " * " : "   ") << d.index << ": " << d.name << "\n"
+              << "       type " << d.type << ", driver " << d.driver << ", Vulkan " << api_string(d.api_version)
+              << ", device-local memory " << d.device_local_mib << " MiB\n";
+  }
+  std::cout << "(* = the device mrgi uses with this --device / MRGI_DEVICE; validation "
+            << (o.validate ? "on" : "off") << ")\n";
+  if (j.contains("budget")) {
+    const auto& b = j["budget"];
+    std::cout << "frame memory: " << b["technique"].get<std::string>() << " level " << b["level"].get<int>() << " ("
+              << b["level_name"].get<std::string>() << ") at " << o.width << "x" << o.height << ": "
+              << b["memory_mib"].get<double>() << " MiB allocated at start-up\n";
+  }
+}
+
+void setup(CLI::App& app) {
+  auto opts = std::make_shared<InfoOptions>();
+  CLI::App* cmd = app.add_subcommand("info", "Vulkan devices, the one mrgi uses, and a technique's memory budget");
+  cmd->add_option("--device", opts->device, "device index or name substring (default: $MRGI_DEVICE, else lavapipe)");
+  cmd->add_flag("--validate", opts->validate, "load the Khronos validation layer (fails if it is not installed)");
+  cmd->add_option("--technique", opts->technique, "also state this technique's start-up memory budget");
+  cmd->add_option("--level", opts->level, "quality level: 0 = best, or 'last'")->default_val("0");
+  cmd->add_option("--width", opts->width, "output width in pixels")->default_val(640);
+  cmd->add_option("--height", opts->height, "output height in pixels")->default_val(480);
+  cmd->add_flag("--json", opts->json, "machine-readable output");
+  cmd->callback([opts] { run_info(*opts); });
+}
+
+}  // namespace
+
+MRGI_COMMAND(info, setup);
+
+}  // namespace mrgi::tool
