@@ -161,6 +161,21 @@ TEST(OpenNISource, CorruptFilesAreNamedErrorsNotHangs) {
   });
 }
 
+TEST(OpenNISource, SecondOpenOfTheSameFileIsRefusedUntilTheFirstCloses) {
+  auto a = open_openni_source(kOni);
+  ASSERT_TRUE(a.ok()) << a.error().message;
+  auto b = open_openni_source(kOni);
+  ASSERT_FALSE(b.ok());
+  EXPECT_EQ(b.error().kind, ErrorKind::Device);
+  EXPECT_NE(b.error().message.find("already open"), std::string::npos) << b.error().message;
+  a.value().reset();
+  auto c = open_openni_source(kOni);
+  ASSERT_TRUE(c.ok()) << c.error().message;
+  auto f = (*c)->next(kWait);
+  ASSERT_TRUE(f.ok()) << f.error().message;
+  EXPECT_EQ(f->index, 0);
+}
+
 TEST(OpenNISource, MissingFileAndNoDeviceAreNotFound) {
   auto a = open_openni_source("/nonexistent/x.oni");
   ASSERT_FALSE(a.ok());

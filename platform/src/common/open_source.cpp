@@ -3,10 +3,7 @@
 
 #include "mrgi/metrics.h"
 #include "mrgi/platform/devices.h"
-#if __has_include("mrgi/platform/capture_source.h")
 #include "mrgi/platform/capture_source.h"
-#define MRGI_HAVE_CAPTURE_SOURCE 1
-#endif
 
 namespace mrgi {
 namespace {
@@ -75,14 +72,9 @@ void env_frame_to_radiance(const ImageRGB8& frame, double exposure, ImageRGBF& o
 Expected<std::unique_ptr<InputSource>> open_source(const std::string& source, const SourceOptions& options) {
   std::unique_ptr<InputSource> main;
   if (source.find(':') == std::string::npos || std::filesystem::is_directory(source)) {
-#ifdef MRGI_HAVE_CAPTURE_SOURCE
     auto s = make_capture_source(source);
     if (!s.ok()) return s.error();
     main = std::move(s.value());
-#else
-    return fail(ErrorKind::NotImplemented, source + ": capture replay source (make_capture_source in "
-                                                    "mrgi/platform/capture_source.h) is not in this build yet");
-#endif
   } else {
     auto s = open_camera_like(source, options.camera, options);
     if (!s.ok()) return s.error();

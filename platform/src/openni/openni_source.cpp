@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <mutex>
+#include <set>
 
 #include "openni/oni_file_inspector.h"
 
@@ -44,6 +45,17 @@ bool fov_valid(float hfov, float vfov) {
   return std::isfinite(hfov) && std::isfinite(vfov) && hfov > 0.05f && hfov < 3.1f && vfov > 0.05f && vfov < 3.1f;
 }
 
+// OpenNI2 hands a second Device::open of an already open URI the same underlying device (for a
+// file: the same, possibly finished, playback), so one URI is open at most once per process.
+std::mutex& open_uris_mutex() {
+  static std::mutex m;
+  return m;
+}
+std::set<std::string>& open_uris() {
+  static std::set<std::string> s;
+  return s;
+}
+
 class OpenNISource final : public InputSource {
  public:
   ~OpenNISource() override {
@@ -52,6 +64,10 @@ class OpenNISource final : public InputSource {
     depth_.destroy();
     color_.destroy();
     device_.close();
+    if (!claimed_.empty()) {
+      std::lock_guard<std::mutex> lock(open_uris_mutex());
+      open_uris().erase(claimed_);
+    }
   }
 
   static Expected<std::unique_ptr<InputSource>> open(const std::string& uri, const OpenNISettings& settings) {
@@ -132,6 +148,15 @@ class OpenNISource final : public InputSource {
       auto s = oni::inspect_oni_file(uri);
       if (!s.ok()) return s.error();
       summary = std::move(s.value());
+    }
+    {
+      std::error_code ec;
+      const std::string key = is_file ? std::filesystem::weakly_canonical(uri, ec).string() : uri;
+      std::lock_guard<std::mutex> lock(open_uris_mutex());
+      if (!key.empty() && !open_uris().insert(key).second)
+        return fail(ErrorKind::Device, name_ + ": already open in this process (OpenNI2 would share one playback "
+                                               "between both; close the other source first)");
+      claimed_ = key;
     }
     if (device_.open(uri.empty() ? openni::ANY_DEVICE : uri.c_str()) != openni::STATUS_OK) {
       if (is_file) return fail(ErrorKind::BadInput, uri + ": OpenNI2's file driver refused the file: " + openni_error_text());
@@ -316,6 +341,7 @@ class OpenNISource final : public InputSource {
   }
 
   std::string name_;
+  std::string claimed_;  // key in open_uris(), released on destruction
   OpenNISettings settings_;
   CaptureInfo info_;
   OpenNIStreamReport report_;

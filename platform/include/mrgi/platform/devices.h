@@ -1,6 +1,7 @@
 // Every adapter's view of the machine (for `mrgi devices`) and the source factory with options
 // (for `mrgi live` / `mrgi record`): the plain open_source(SOURCE) of source.h uses the defaults.
 #pragma once
+#include <chrono>
 #include <memory>
 #include <optional>
 #include <string>
@@ -46,6 +47,16 @@ struct SourceOptions {
 // SOURCE: a capture folder, "openni:", "openni:FILE.oni", "openni:URI", "v4l2:/dev/videoN",
 // "libcamera:" (first camera) or "libcamera:ID". Unknown prefixes are BadUsage.
 Expected<std::unique_ptr<InputSource>> open_source(const std::string& source, const SourceOptions& options);
+
+struct RecordSettings {
+  size_t max_frames = 0;                       // 0 = until the stream ends
+  std::chrono::milliseconds timeout{3000};     // longest wait for one frame
+};
+
+// Reads SOURCE until EndOfStream (or max_frames) and writes capture format v1 to FOLDER with the
+// source's info() as capture.json. Any other error (Timeout, Device, BadInput) stops the
+// recording, removes the partial folder and is returned naming the frame. Returns the frame count.
+Expected<size_t> record_to_capture(InputSource& source, const std::string& folder, const RecordSettings& settings);
 
 // Decodes an 8-bit sRGB env frame to linear radiance: srgb_to_linear(v) / exposure.
 void env_frame_to_radiance(const ImageRGB8& frame, double exposure, ImageRGBF& out);
