@@ -319,8 +319,7 @@ Expected<std::optional<FrameTimings>> FrameGraph::begin_frame() {
   VK_CHECK(vkResetCommandBuffer(slots_[slot].cmd, 0));
   frame_index_ = next;
   slot_ = slot;
-  decls_.clear();
-  executes_.clear();
+  pass_count_ = 0;
   outputs_.clear();
   compiled_valid_ = false;
   in_frame_ = true;
@@ -328,10 +327,20 @@ Expected<std::optional<FrameTimings>> FrameGraph::begin_frame() {
 }
 
 void FrameGraph::add_pass(const std::string& name, PassKind kind, const SetupFn& setup, ExecuteFn execute) {
-  decls_.push_back(PassDecl{name, kind, {}, false});
-  PassBuilder builder(*this, decls_.back());
+  // Reuse last frame's declarations in place so their strings and vectors keep their capacity.
+  if (pass_count_ == decls_.size()) {
+    decls_.emplace_back();
+    executes_.emplace_back();
+  }
+  PassDecl& d = decls_[pass_count_];
+  d.name.assign(name);
+  d.kind = kind;
+  d.uses.clear();
+  d.side_effect = false;
+  PassBuilder builder(*this, d);
   setup(builder);
-  executes_.push_back(std::move(execute));
+  executes_[pass_count_] = std::move(execute);
+  ++pass_count_;
   compiled_valid_ = false;
 }
 
@@ -340,29 +349,30 @@ void FrameGraph::mark_output(BufferHandle buffer) {
   outputs_.push_back(ResourceRef{false, uint32_t(images_.size()) + buffer.id});
 }
 
-std::vector<ResourceInfo> FrameGraph::resource_infos() const {
-  std::vector<ResourceInfo> infos;
-  infos.reserve(images_.size() + buffers_.size());
-  for (const ImageEntry& e : images_) {
-    ResourceInfo r;
-    r.name = e.desc.name;
+void FrameGraph::update_resource_infos() {
+  infos_.resize(images_.size() + buffers_.size());
+  for (size_t i = 0; i < images_.size(); ++i) {
+    ResourceInfo& r = infos_[i];
+    const ImageEntry& e = images_[i];
+    if (r.name != e.desc.name) r.name = e.desc.name;
     r.is_image = true;
+    r.is_output = false;
     r.history = e.desc.history;
+    r.host_read = false;
     r.initial = e.state;
-    infos.push_back(std::move(r));
   }
-  for (const BufferEntry& e : buffers_) {
-    ResourceInfo r;
-    r.name = e.desc.name;
+  for (size_t i = 0; i < buffers_.size(); ++i) {
+    ResourceInfo& r = infos_[images_.size() + i];
+    const BufferEntry& e = buffers_[i];
+    if (r.name != e.desc.name) r.name = e.desc.name;
     r.is_image = false;
+    r.is_output = false;
     r.history = e.desc.history;
     r.host_read = e.desc.memory == MemoryUsage::Readback;
     r.initial = e.states.size() > 1 ? e.states[slot_] : e.states[0];
-    infos.push_back(std::move(r));
   }
   for (const ResourceRef& o : outputs_)
-    if (o.id < infos.size()) infos[o.id].is_output = true;
-  return infos;
+    if (o.id < infos_.size()) infos_[o.id].is_output = true;
 }
 
 Status FrameGraph::compile() {
@@ -370,13 +380,31 @@ Status FrameGraph::compile() {
   for (const ResourceRef& o : outputs_)
     if (o.id >= images_.size() + buffers_.size())
       return fail(ErrorKind::BadUsage, "mark_output: invalid resource handle");
-  auto g = compile_graph(decls_, resource_infos());
+  update_resource_infos();
+  const std::span<const PassDecl> decls(decls_.data(), pass_count_);
+  for (const CacheEntry& e : cache_) {
+    if (e.decls.size() == decls.size() && std::equal(decls.begin(), decls.end(), e.decls.begin()) &&
+        e.infos == infos_) {
+      compiled_ = e.compiled;  // element-wise copy into kept capacity
+      compiled_valid_ = true;
+      ++compile_cache_hits_;
+      return ok_status();
+    }
+  }
+  auto g = compile_graph(decls, infos_);
   if (!g) return g.error();
   if (g->passes.size() > settings_.max_passes)
     return fail(ErrorKind::BadUsage, std::to_string(g->passes.size()) + " passes run this frame, more than "
                                      "FrameGraphSettings.max_passes = " + std::to_string(settings_.max_passes));
   compiled_ = std::move(*g);
   compiled_valid_ = true;
+  constexpr size_t kCacheEntries = 4;
+  if (cache_.size() < kCacheEntries) cache_.emplace_back();
+  CacheEntry& slot = cache_[cache_next_ % cache_.size()];
+  cache_next_ = uint32_t((cache_next_ + 1) % kCacheEntries);
+  slot.decls.assign(decls.begin(), decls.end());
+  slot.infos = infos_;
+  slot.compiled = compiled_;
   return ok_status();
 }
 
@@ -446,8 +474,8 @@ Status FrameGraph::execute(VkCommandBuffer cmd) {
       (e.states.size() > 1 ? e.states[slot_] : e.states[0]) = compiled_.final_states[r];
     }
   }
-  slot.pass_names.clear();
-  for (const CompiledPass& p : compiled_.passes) slot.pass_names.push_back(p.name);
+  slot.pass_names.resize(compiled_.passes.size());
+  for (size_t i = 0; i < compiled_.passes.size(); ++i) slot.pass_names[i].assign(compiled_.passes[i].name);
   slot.culled = compiled_.culled;
   slot.frame_index = frame_index_;
   return ok_status();

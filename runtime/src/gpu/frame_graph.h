@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -107,6 +108,7 @@ struct ResourceRef {
 struct ResourceUse {
   ResourceRef resource;
   Access access = Access::Sampled;
+  bool operator==(const ResourceUse&) const = default;
 };
 
 struct PassDecl {
@@ -114,6 +116,7 @@ struct PassDecl {
   PassKind kind = PassKind::Compute;
   std::vector<ResourceUse> uses;
   bool side_effect = false;  // never culled (e.g. writes something outside the graph)
+  bool operator==(const PassDecl&) const = default;
 };
 
 // What the GPU last did to a resource, carried from frame to frame.
@@ -124,6 +127,7 @@ struct ResourceState {
   VkAccessFlags2 visible_access = 0;       // accesses the last write was already made visible to
   VkPipelineStageFlags2 visible_stages = 0;
   VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
+  bool operator==(const ResourceState&) const = default;
 };
 
 struct ResourceInfo {
@@ -133,6 +137,7 @@ struct ResourceInfo {
   bool history = false;       // contents must be preserved across frames (no discard on write)
   bool host_read = false;     // a Readback buffer: the frame ends with a barrier to HOST_READ
   ResourceState initial;      // state at the start of the frame
+  bool operator==(const ResourceInfo&) const = default;
 };
 
 struct Barrier {
@@ -164,8 +169,8 @@ struct CompiledGraph {
 
 // Culls and derives barriers. Errors (BadUsage) name the pass and resource: a resource used twice
 // by one pass, an image access on a buffer or the reverse, an unknown resource id.
-Expected<CompiledGraph> compile_graph(const std::vector<PassDecl>& passes,
-                                      const std::vector<ResourceInfo>& resources);
+Expected<CompiledGraph> compile_graph(std::span<const PassDecl> passes,
+                                      std::span<const ResourceInfo> resources);
 
 // Stage/access/layout one use implies (what the barrier derivation uses).
 struct AccessInfo {
@@ -292,6 +297,9 @@ class FrameGraph {
   // Host pointer of a Readback/Upload buffer's copy in `slot` (e.g. FrameTimings::slot).
   void* mapped(BufferHandle buffer, uint32_t slot) const;
   Context& context() const { return context_; }
+  // Frames whose compile() reused a cached result (same passes, same resource states): in steady
+  // state the graph is compiled once and then only looked up.
+  uint64_t compile_cache_hits() const { return compile_cache_hits_; }
 
  private:
   friend class PassContext;
@@ -303,15 +311,25 @@ class FrameGraph {
   FrameGraph(Context& context, const FrameGraphSettings& settings);
   Status init();
   Expected<std::optional<FrameTimings>> collect(uint32_t slot_index);
-  std::vector<ResourceInfo> resource_infos() const;
+  void update_resource_infos();
+  struct CacheEntry {
+    std::vector<PassDecl> decls;
+    std::vector<ResourceInfo> infos;
+    CompiledGraph compiled;
+  };
 
   Context& context_;
   FrameGraphSettings settings_;
   std::vector<ImageEntry> images_;
   std::vector<BufferEntry> buffers_;
   std::vector<Slot> slots_;
-  std::vector<PassDecl> decls_;
+  std::vector<PassDecl> decls_;     // first pass_count_ are this frame's; the rest keep capacity
   std::vector<ExecuteFn> executes_;
+  uint32_t pass_count_ = 0;
+  std::vector<ResourceInfo> infos_;
+  std::vector<CacheEntry> cache_;   // the last few distinct compiled frames (ping-pong graphs)
+  uint32_t cache_next_ = 0;
+  uint64_t compile_cache_hits_ = 0;
   std::vector<ResourceRef> outputs_;
   CompiledGraph compiled_;
   bool compiled_valid_ = false;

@@ -161,8 +161,8 @@ bool CompiledGraph::runs(const std::string& pass_name) const {
   return std::any_of(passes.begin(), passes.end(), [&](const CompiledPass& p) { return p.name == pass_name; });
 }
 
-Expected<CompiledGraph> compile_graph(const std::vector<PassDecl>& passes,
-                                      const std::vector<ResourceInfo>& resources) {
+Expected<CompiledGraph> compile_graph(std::span<const PassDecl> passes,
+                                      std::span<const ResourceInfo> resources) {
   const size_t np = passes.size(), nr = resources.size();
   // 1. Validate the declarations.
   for (size_t p = 0; p < np; ++p) {
