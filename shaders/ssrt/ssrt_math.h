@@ -142,6 +142,24 @@ SSRT_FN vec3 ssrt_compose_real(vec3 camera, float r_d, float r_d_virtual, vec3 r
   return max(direct + bounce, vec3(0.0f));
 }
 
+// ---- GPU-side data -------------------------------------------------------------------------
+
+// The estimated light as the passes read it (std140 uniform; vec4 members only so GLM's layout
+// is the same). sh[i].xyz: RGB radiance SH coefficient i, sh[i].w: its luminance, the white
+// light the paper's transfer uses (Sec. 5). dominant: xyz unit direction towards the dominant
+// light, w 1 when it exists; dominant_irradiance.rgb: its irradiance at normal incidence.
+struct SsrtLight {
+  vec4 sh[16];
+  vec4 dominant;
+  vec4 dominant_irradiance;
+};
+
+// One visibility sample (std430; see runtime/src/technique/ssrt/sample_directions.h).
+struct SsrtSample {
+  vec4 direction_and_radius;  // xyz unit direction (world), w displacement / radius in (0, 1]
+  vec4 sh_weights[4];         // Y_0..15(w) * solid angle
+};
+
 #ifdef __cplusplus
 }  // namespace mrgi::shader
 #undef SSRT_FN

@@ -42,8 +42,10 @@ struct LightEstimatorSettings {
   // not modelled, light is assumed white). The estimate scales with 1/this.
   double gray_albedo = 0.5;
   // Tikhonov weight relative to the mean diagonal of T^T T (dimensionless), so the balance of
-  // data and prior does not depend on the number of pixels or on exposure.
-  double relative_regularisation = 1e-3;
+  // data and prior does not depend on the number of pixels or on exposure. 1e-2 keeps the
+  // directions that only the sampling noise of the jittered transfer spans (a few per cent of
+  // |T|, i.e. eigenvalues ~1e-3 of the largest) from being fitted.
+  double relative_regularisation = 1e-2;
   // Absolute floor of the weight (in units of T^T T), so a frame without any data (all black,
   // no valid pixel) returns the previous estimate instead of dividing by zero.
   double min_regularisation = 1e-9;
@@ -61,7 +63,7 @@ struct LightEstimatorSettings {
   // The prior before the first frame: a uniform (band 0 only) environment of this radiance.
   double prior_radiance = 0.5;
   // Eigenvalues of T^T T above this fraction of the largest count as constrained (confidence).
-  double confidence_eigen_fraction = 1e-3;
+  double confidence_eigen_fraction = 1e-2;
 };
 
 class LightEstimator {

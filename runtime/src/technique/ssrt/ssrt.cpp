@@ -1,0 +1,445 @@
+#include "technique/ssrt/ssrt.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <optional>
+#include <string>
+
+#include "common/frame_constants.glsl"
+#include "gpu/pipelines.h"
+#include "gpu/shaders.h"
+#include "ssrt/ssrt_math.h"
+#include "technique/scene_gpu.h"
+#include "technique/ssrt/light_estimator.h"
+#include "technique/ssrt/sample_directions.h"
+
+namespace mrgi::technique {
+namespace {
+
+constexpr uint32_t kCoarseLayers = 10;
+constexpr uint32_t kReduceEntries = 192;       // per tile, see light_reduce.comp
+constexpr uint32_t kTileW = 16, kTileH = 12;   // cells per reduction tile
+constexpr uint32_t kSampleSeed = 20140901;     // sample sets are a pure function of N and this
+
+// Settings shared by every level (units in the names).
+constexpr float kRadiusM = 0.5f;             // SSDO sampling radius
+constexpr float kNormalOffsetM = 0.01f;      // start of the samples above the surface
+constexpr float kMinSenderDistM = 0.05f;     // 1/d^2 clamp of the form factor
+constexpr float kDepthBias = 0.01f;          // occluder must be 1 % closer than the sample
+constexpr float kSaturation = 0.98f;         // camera values at/above are clipped: not used
+constexpr float kIndirectTolerance = 1e-3f;  // eq. 14
+constexpr float kGaussRadiusPx = 8.0f;       // paper OursFast
+
+struct TransferPush {
+  glm::ivec4 grid;
+  glm::ivec4 config;
+  glm::vec4 sampling;
+  glm::vec4 bounce;
+};
+struct ReducePush {
+  glm::ivec4 grid;
+};
+struct FinalPush {
+  glm::ivec4 counts;
+};
+struct BlurPush {
+  glm::ivec4 grid;
+  glm::vec4 filt;
+};
+struct ShadePush {
+  glm::ivec4 grid;
+  glm::ivec4 size;
+  glm::vec4 opts;
+};
+
+double knob(const QualityLevel& level, const std::string& name) {
+  for (const Knob& k : level.knobs)
+    if (k.name == name) return k.value;
+  return 0.0;
+}
+
+Expected<gpu::PipelineHandle> compute_pipeline(gpu::Context& ctx, const char* shader,
+                                               std::vector<gpu::DescriptorBinding> bindings,
+                                               uint32_t push_bytes) {
+  auto spirv = gpu::shader_spirv(shader);
+  if (!spirv) return spirv.error();
+  gpu::ComputePipelineDesc d;
+  d.name = shader;
+  d.spirv = *spirv;
+  d.bindings = std::move(bindings);
+  d.push_constant_bytes = push_bytes;
+  auto p = gpu::create_compute_pipeline(ctx, d);
+  if (!p) return p.error();
+  return gpu::PipelineHandle(ctx, std::move(*p));
+}
+
+class Ssrt final : public Technique {
+ public:
+  explicit Ssrt(const SharedResources& shared) : shared_(shared), ladder_(ssrt_ladder()) {}
+  const std::string& name() const override { return name_; }
+  const std::vector<QualityLevel>& levels() const override { return ladder_; }
+  Status init();
+  Status record(const FrameInfo& info, std::vector<std::string>& skipped) override;
+  const LightEstimate& estimate() const { return estimator_->estimate(); }
+
+ private:
+  void consume_readback(std::vector<std::string>& notes);
+  void write_light();
+  bool influence_in_view() const;
+
+  std::string name_ = "ssrt";
+  SharedResources shared_;
+  std::vector<QualityLevel> ladder_;
+  std::optional<ssrt::LightEstimator> estimator_;
+  std::vector<uint32_t> sample_base_;  // per level: first sample of its sets
+  std::vector<float> chi_;             // per level
+  gpu::BufferHandle samples_, light_, partials_, result_;
+  gpu::ImageHandle coarse_;
+  gpu::PipelineHandle transfer_, reduce_, reduce_final_, blur_, shade_;
+  std::vector<int64_t> pending_;       // per frame slot: frame whose sums its readback holds
+  // This frame's knobs (set by record before the passes are added).
+  uint32_t step_ = 1, directions_ = 64, bands_ = 4;
+  int level_ = 0;
+  glm::uvec2 grid_{1, 1};
+  VkExtent2D used_{1, 1};
+};
+
+Status Ssrt::init() {
+  gpu::Context& ctx = *shared_.context;
+  gpu::FrameGraph& graph = *shared_.graph;
+  auto est = ssrt::LightEstimator::create({});
+  if (!est) return est.error();
+  estimator_.emplace(std::move(*est));
+
+  // Sample sets of every level, one buffer.
+  std::vector<ssrt::GpuSample> all;
+  for (const QualityLevel& l : ladder_) {
+    auto sets = ssrt::make_sample_sets({uint32_t(knob(l, "directions")), kSampleSeed});
+    if (!sets) return sets.error();
+    sample_base_.push_back(uint32_t(all.size()));
+    chi_.push_back(sets->chi);
+    all.insert(all.end(), sets->samples.begin(), sets->samples.end());
+  }
+  const VkDeviceSize sample_bytes = all.size() * sizeof(ssrt::GpuSample);
+  auto samples = graph.create_buffer({"ssrt_samples", sample_bytes},
+                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  if (!samples) return samples.error();
+  samples_ = *samples;
+  MRGI_TRY(ctx.upload_buffer(graph.gpu_buffer(samples_, 0), all.data(), sample_bytes));
+
+  auto light = graph.create_buffer(
+      {"ssrt_light", sizeof(shader::SsrtLight), gpu::MemoryUsage::Upload, true},
+      VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  if (!light) return light.error();
+  light_ = *light;
+
+  // Everything sized for the top level: one cell per pixel of the largest internal image.
+  const VkExtent2D top = graph.allocated_extent(shared_.lit_r);
+  const uint32_t tiles = ((top.width + kTileW - 1) / kTileW) * ((top.height + kTileH - 1) / kTileH);
+  auto partials = graph.create_buffer(
+      {"ssrt_light_partials", VkDeviceSize(tiles) * kReduceEntries * sizeof(float)},
+      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  if (!partials) return partials.error();
+  partials_ = *partials;
+  auto result = graph.create_buffer(
+      {"ssrt_light_sums", kReduceEntries * sizeof(float), gpu::MemoryUsage::Readback, true},
+      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  if (!result) return result.error();
+  result_ = *result;
+  pending_.assign(graph.frames_in_flight(), -1);
+
+  gpu::ImageDesc cd;
+  cd.name = "ssrt_coarse";
+  cd.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+  cd.layers = kCoarseLayers;
+  auto coarse = graph.create_image(cd, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT);
+  if (!coarse) return coarse.error();
+  coarse_ = *coarse;
+
+  const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+  const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  const auto tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+  const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+  auto p = compute_pipeline(ctx, "ssrt/transfer.comp",
+                            {{ubo}, {ubo}, {ssbo}, {tex}, {tex}, {tex}, {tex}, {tex}, {tex}, {img}},
+                            sizeof(TransferPush));
+  if (!p) return p.error();
+  transfer_ = std::move(*p);
+  p = compute_pipeline(ctx, "ssrt/light_reduce.comp", {{tex}, {tex}, {ssbo}}, sizeof(ReducePush));
+  if (!p) return p.error();
+  reduce_ = std::move(*p);
+  p = compute_pipeline(ctx, "ssrt/light_reduce_final.comp", {{ssbo}, {ssbo}}, sizeof(FinalPush));
+  if (!p) return p.error();
+  reduce_final_ = std::move(*p);
+  p = compute_pipeline(ctx, "ssrt/upsample_blur.comp", {{img}}, sizeof(BlurPush));
+  if (!p) return p.error();
+  blur_ = std::move(*p);
+  p = compute_pipeline(ctx, "ssrt/shade.comp", {{tex}, {tex}, {tex}, {tex}, {tex}, {img}, {img}},
+                       sizeof(ShadePush));
+  if (!p) return p.error();
+  shade_ = std::move(*p);
+  return ok_status();
+}
+
+// The sums a slot's readback holds belong to the frame that last used the slot; that frame has
+// completed once begin_frame returned, so reading here never stalls.
+void Ssrt::consume_readback(std::vector<std::string>& notes) {
+  gpu::FrameGraph& graph = *shared_.graph;
+  const uint32_t slot = graph.slot();
+  const int64_t frame = pending_[slot];
+  if (frame < 0) return;
+  pending_[slot] = -1;
+  const gpu::GpuBuffer& buf = graph.gpu_buffer(result_, slot);
+  if (!shared_.context->invalidate(buf).ok()) {
+    notes.push_back("ssrt_light_estimation: readback invalidate failed, frame not used");
+    return;
+  }
+  const float* sums = static_cast<const float*>(graph.mapped(result_, slot));
+  ssrt::LightSystem sys;
+  int k = 0;
+  for (int i = 0; i < ssrt::kMaxShCoeffs; ++i) {
+    for (int j = i; j < ssrt::kMaxShCoeffs; ++j, ++k) {
+      sys.ata[i * ssrt::kMaxShCoeffs + j] = sums[k];
+      sys.ata[j * ssrt::kMaxShCoeffs + i] = sums[k];
+    }
+  }
+  for (int e = 0; e < ssrt::kMaxShCoeffs * 3; ++e) sys.atb[e] = sums[136 + e];
+  sys.samples = sums[184];
+  // The frame clock is not in FrameInfo: frames are spaced by the estimator's nominal step.
+  auto r = estimator_->update(sys, frame, double(frame) * estimator_->settings().nominal_frame_s);
+  if (!r) notes.push_back("ssrt_light_estimation: " + r.error().message);
+}
+
+void Ssrt::write_light() {
+  gpu::FrameGraph& graph = *shared_.graph;
+  shader::SsrtLight l{};
+  const LightEstimate& e = estimator_->estimate();
+  const ssrt::ShRgb& f = estimator_->filtered();
+  for (int i = 0; i < 16; ++i) {
+    const glm::dvec3 c = i < int(bands_ * bands_) ? f[i] : glm::dvec3(0.0);
+    const double y = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+    l.sh[i] = glm::vec4(float(c.x), float(c.y), float(c.z), float(y));
+  }
+  l.dominant = glm::vec4(e.direction_to_light[0], e.direction_to_light[1],
+                         e.direction_to_light[2], 1.0f);
+  l.dominant_irradiance =
+      glm::vec4(e.dominant_intensity[0], e.dominant_intensity[1], e.dominant_intensity[2], 0.0f);
+  std::memcpy(graph.mapped(light_, graph.slot()), &l, sizeof(l));
+}
+
+// The virtual objects' bounds grown by the sampling radius (the region where they can shadow or
+// light a real surface) against this frame's view frustum: in view unless all eight corners
+// lie outside one side of it.
+bool Ssrt::influence_in_view() const {
+  const SceneGpu& sg = *shared_.scene_gpu;
+  if (sg.virtual_objects.empty()) return false;
+  gpu::FrameGraph& graph = *shared_.graph;
+  const auto* fc =
+      static_cast<const shader::FrameConstants*>(graph.mapped(shared_.frame_constants, graph.slot()));
+  const glm::vec3 lo = sg.virtual_objects.bounds_min - glm::vec3(kRadiusM);
+  const glm::vec3 hi = sg.virtual_objects.bounds_max + glm::vec3(kRadiusM);
+  const glm::vec4 k = fc->internal_k;
+  const glm::vec2 size(fc->internal_output_size.x, fc->internal_output_size.y);
+  int out_count[5] = {0, 0, 0, 0, 0};  // behind, left, right, top, bottom
+  for (int c = 0; c < 8; ++c) {
+    const glm::vec3 p((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
+    const glm::vec3 q = glm::vec3(fc->world_to_camera * glm::vec4(p, 1.0f));
+    if (q.z <= 1e-4f) {
+      ++out_count[0];
+      continue;
+    }
+    const float u = k.x * q.x / q.z + k.z, v = k.y * q.y / q.z + k.w;
+    out_count[1] += u < -0.5f;
+    out_count[2] += u > size.x - 0.5f;
+    out_count[3] += v < -0.5f;
+    out_count[4] += v > size.y - 0.5f;
+  }
+  for (int side = 0; side < 5; ++side)
+    if (out_count[side] == 8) return false;
+  return true;
+}
+
+Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
+  if (info.level < 0 || info.level >= int(ladder_.size()))
+    return fail(ErrorKind::BadUsage, "ssrt: level " + std::to_string(info.level) + " outside 0.." +
+                                         std::to_string(ladder_.size() - 1));
+  const QualityLevel& level = ladder_[size_t(info.level)];
+  level_ = info.level;
+  step_ = uint32_t(knob(level, "subsample"));
+  directions_ = uint32_t(knob(level, "directions"));
+  bands_ = uint32_t(knob(level, "sh_bands"));
+  gpu::FrameGraph& graph = *shared_.graph;
+  used_ = graph.extent(shared_.lit_r);
+  grid_ = glm::uvec2((used_.width + step_ - 1) / step_, (used_.height + step_ - 1) / step_);
+
+  consume_readback(skipped);
+  write_light();
+
+  const bool run_transfer = info.virtual_objects_present && influence_in_view();
+  if (!run_transfer) {
+    const char* why = info.virtual_objects_present
+                          ? "no virtual object's influence region in view"
+                          : "no virtual object in the scene";
+    for (const char* pass : {"ssrt_transfer", "ssrt_light_reduce", "ssrt_light_reduce_final",
+                             "ssrt_upsample_blur"})
+      skipped.push_back(std::string(pass) + ": " + why);
+  } else {
+    graph.add_pass(
+        "ssrt_transfer", gpu::PassKind::Compute,
+        [this](gpu::PassBuilder& b) {
+          const SharedResources& r = shared_;
+          b.read(r.frame_constants, gpu::Access::UniformRead);
+          b.read(light_, gpu::Access::UniformRead);
+          b.read(samples_, gpu::Access::StorageRead);
+          for (gpu::ImageHandle h : {r.real_position, r.real_normal, r.real_albedo,
+                                     r.virtual_position, r.virtual_normal, r.virtual_albedo})
+            b.read(h, gpu::Access::Sampled);
+          b.write(coarse_, gpu::Access::StorageWrite);
+        },
+        [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
+          const gpu::Context& ctx = pass.context();
+          const SharedResources& r = shared_;
+          const VkSampler nearest = ctx.samplers().nearest_clamp;
+          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, transfer_->pipeline);
+          gpu::DescriptorPush()
+              .uniform_buffer(0, pass.buffer(r.frame_constants))
+              .uniform_buffer(1, pass.buffer(light_))
+              .storage_buffer(2, pass.buffer(samples_))
+              .sampled_image(3, pass.view(r.real_position), nearest)
+              .sampled_image(4, pass.view(r.real_normal), nearest)
+              .sampled_image(5, pass.view(r.real_albedo), nearest)
+              .sampled_image(6, pass.view(r.virtual_position), nearest)
+              .sampled_image(7, pass.view(r.virtual_normal), nearest)
+              .sampled_image(8, pass.view(r.virtual_albedo), nearest)
+              .storage_image(9, pass.view(coarse_))
+              .push(ctx, cmd, *transfer_);
+          const float sample_area = 3.14159265f * kRadiusM * kRadiusM / float(directions_);
+          TransferPush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), int(directions_)),
+                          glm::ivec4(int(sample_base_[size_t(level_)]), int(bands_), 0, 0),
+                          glm::vec4(kRadiusM, chi_[size_t(level_)], kNormalOffsetM, kMinSenderDistM),
+                          glm::vec4(sample_area, kSaturation, kDepthBias, 0.0f)};
+          gpu::dispatch_2d(cmd, *transfer_, &pc, sizeof(pc), grid_.x, grid_.y);
+        });
+    const uint32_t tiles_x = (grid_.x + kTileW - 1) / kTileW;
+    const uint32_t tiles_y = (grid_.y + kTileH - 1) / kTileH;
+    graph.add_pass(
+        "ssrt_light_reduce", gpu::PassKind::Compute,
+        [this](gpu::PassBuilder& b) {
+          b.read(coarse_, gpu::Access::Sampled);
+          b.read(shared_.real_albedo, gpu::Access::Sampled);
+          b.write(partials_, gpu::Access::StorageWrite);
+        },
+        [this, tiles_x, tiles_y](VkCommandBuffer cmd, gpu::PassContext& pass) {
+          const gpu::Context& ctx = pass.context();
+          const VkSampler nearest = ctx.samplers().nearest_clamp;
+          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, reduce_->pipeline);
+          gpu::DescriptorPush()
+              .sampled_image(0, pass.view(coarse_), nearest)
+              .sampled_image(1, pass.view(shared_.real_albedo), nearest)
+              .storage_buffer(2, pass.buffer(partials_))
+              .push(ctx, cmd, *reduce_);
+          ReducePush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), int(tiles_x))};
+          gpu::dispatch_2d(cmd, *reduce_, &pc, sizeof(pc), tiles_x * kTileW, tiles_y * kTileH,
+                           kTileW, kTileH);
+        });
+    graph.add_pass(
+        "ssrt_light_reduce_final", gpu::PassKind::Compute,
+        [this](gpu::PassBuilder& b) {
+          b.read(partials_, gpu::Access::StorageRead);
+          b.write(result_, gpu::Access::StorageWrite);
+        },
+        [this, tiles_x, tiles_y](VkCommandBuffer cmd, gpu::PassContext& pass) {
+          const gpu::Context& ctx = pass.context();
+          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, reduce_final_->pipeline);
+          gpu::DescriptorPush()
+              .storage_buffer(0, pass.buffer(partials_))
+              .storage_buffer(1, pass.buffer(result_))
+              .push(ctx, cmd, *reduce_final_);
+          FinalPush pc{glm::ivec4(int(tiles_x * tiles_y), 0, 0, 0)};
+          gpu::dispatch_2d(cmd, *reduce_final_, &pc, sizeof(pc), kReduceEntries, 1,
+                           kReduceEntries, 1);
+        });
+    graph.mark_output(result_);
+    pending_[graph.slot()] = info.frame_index;
+    if (step_ > 1) {
+      graph.add_pass(
+          "ssrt_upsample_blur", gpu::PassKind::Compute,
+          [this](gpu::PassBuilder& b) { b.write(coarse_, gpu::Access::StorageReadWrite); },
+          [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
+            const gpu::Context& ctx = pass.context();
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, blur_->pipeline);
+            gpu::DescriptorPush().storage_image(0, pass.view(coarse_)).push(ctx, cmd, *blur_);
+            BlurPush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), 0),
+                        glm::vec4(kGaussRadiusPx, 0.0f, 0.0f, 0.0f)};
+            gpu::dispatch_2d(cmd, *blur_, &pc, sizeof(pc), grid_.x, grid_.y);
+          });
+    } else {
+      skipped.push_back("ssrt_upsample_blur: level samples every pixel");
+    }
+  }
+  graph.add_pass(
+      "ssrt_shade", gpu::PassKind::Compute,
+      [this](gpu::PassBuilder& b) {
+        const SharedResources& r = shared_;
+        // Declared on skipped frames too (the shader binds it but does not read it then), so
+        // the binding is always in the layout the graph gave it.
+        b.read(coarse_, gpu::Access::Sampled);
+        for (gpu::ImageHandle h : {r.real_position, r.real_albedo, r.virtual_position,
+                                   r.virtual_albedo})
+          b.read(h, gpu::Access::Sampled);
+        b.write(r.lit_rv, gpu::Access::StorageWrite);
+        b.write(r.lit_r, gpu::Access::StorageWrite);
+      },
+      [this, run_transfer](VkCommandBuffer cmd, gpu::PassContext& pass) {
+        const gpu::Context& ctx = pass.context();
+        const SharedResources& r = shared_;
+        const VkSampler nearest = ctx.samplers().nearest_clamp;
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, shade_->pipeline);
+        gpu::DescriptorPush()
+            .sampled_image(0, pass.view(coarse_), nearest)
+            .sampled_image(1, pass.view(r.real_position), nearest)
+            .sampled_image(2, pass.view(r.real_albedo), nearest)
+            .sampled_image(3, pass.view(r.virtual_position), nearest)
+            .sampled_image(4, pass.view(r.virtual_albedo), nearest)
+            .storage_image(5, pass.view(r.lit_rv))
+            .storage_image(6, pass.view(r.lit_r))
+            .push(ctx, cmd, *shade_);
+        ShadePush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), run_transfer ? 0 : 1),
+                     glm::ivec4(int(used_.width), int(used_.height), 0, 0),
+                     glm::vec4(kIndirectTolerance, 0.0f, 0.0f, 0.0f)};
+        gpu::dispatch_2d(cmd, *shade_, &pc, sizeof(pc), used_.width, used_.height);
+      });
+  return ok_status();
+}
+
+}  // namespace
+
+std::vector<QualityLevel> ssrt_ladder() {
+  auto level = [](const char* name, double step, double n, double bands, double scale) {
+    QualityLevel l;
+    l.name = name;
+    l.internal_scale = float(scale);
+    l.knobs = {{"subsample", step, "pixels per cell side (transfer computed once per cell)"},
+               {"directions", n, "visibility directions per pixel (per 2x2 jitter set)"},
+               {"sh_bands", bands, "SH bands of transfer and estimated light"},
+               {"internal_scale", scale, "fraction of the output width and height"}};
+    return l;
+  };
+  return {level("full", 1, 64, 4, 1.0), level("half", 2, 32, 4, 1.0),
+          level("fast", 4, 32, 4, 1.0), level("fastest", 4, 16, 2, 0.5)};
+}
+
+Expected<std::unique_ptr<Technique>> create_ssrt(const SharedResources& shared) {
+  auto t = std::make_unique<Ssrt>(shared);
+  MRGI_TRY(t->init());
+  return std::unique_ptr<Technique>(std::move(t));
+}
+
+const LightEstimate* ssrt_light_estimate(const Technique& t) {
+  const auto* s = dynamic_cast<const Ssrt*>(&t);
+  return s ? &s->estimate() : nullptr;
+}
+
+}  // namespace mrgi::technique

@@ -1,0 +1,43 @@
+// The `ssrt` technique: image-space radiance transfer with probeless SH light estimation
+// ("Image-Space Illumination for Augmented Reality in Dynamic Environments", Sec. 5).
+//
+// Per frame (passes in order):
+//   ssrt_transfer            SSDO visibility of N jittered directions (2x2 sets) per cell of the
+//                            sub-sampled grid, projected to SH (eq. 6-9), real and real+virtual
+//                            in one pass, with one-bounce indirect light (eq. 10-12)
+//   ssrt_light_reduce(+final) the normal equations of T l = I_c summed on the GPU; the host
+//                            reads them back frames_in_flight frames later (no stall) and solves
+//                            them (light_estimator.h), the result lights the next frames
+//   ssrt_upsample_blur       fast levels only: Gauss radius 8 px over the coarse grid
+//   ssrt_shade               bicubic up-sampling, writes L_r and L_rv for the runtime's compose
+// Skips: no virtual object in the scene, or its bounds grown by the sampling radius (its
+// influence region) outside the view: the transfer passes do not run and L_rv = L_r = camera
+// colour (compose then returns the camera image unchanged); the light estimate is kept.
+//
+// Quality ladder (best first), knobs with units:
+//   level  name     subsample  directions  sh_bands  internal_scale
+//   0      full     1          64          4         1.0   (paper "Ours")
+//   1      half     2          32          4         1.0
+//   2      fast     4          32          4         1.0   (paper "OursFast": 4x4, up-sampled)
+//   3      fastest  4          16          2         0.5
+// subsample: cells are step x step pixels; directions: N per jitter set; sh_bands: SH bands of
+// the transfer and of the estimated light.
+//
+// Not yet here (issue 4): the TSDF volume, its ray-cast auxiliary buffers (left/right/top/light)
+// and the D'/D''/D''' filter chain on the GPU (the CPU reference is depth_filter.h); occlusion is
+// tested against the current view's G-buffer only.
+#pragma once
+#include <memory>
+#include <vector>
+
+#include "mrgi/light_estimate.h"
+#include "technique/technique.h"
+
+namespace mrgi::technique {
+
+std::vector<QualityLevel> ssrt_ladder();
+Expected<std::unique_ptr<Technique>> create_ssrt(const SharedResources& shared);
+// The light estimate of an ssrt technique (nullptr when `t` is not one).
+const LightEstimate* ssrt_light_estimate(const Technique& t);
+
+}  // namespace mrgi::technique

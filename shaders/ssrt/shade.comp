@@ -1,0 +1,107 @@
+#version 460
+// ssrt shading into the two solutions the runtime's compose turns into the frame (technique.h):
+//   real pixel     L_r  = A R_d,  L_rv = A R'_d + A I_i / pi   (I_i: eq. 14, R'_i where it
+//                  differs from R_i), A = the camera colour (recon), R_d = T . l (Sec. 5.4)
+//   virtual pixel  L_rv = A_v (R'_d + R'_i / pi), L_r = the real surface behind it
+// The compose multiplies the camera image by the ratio of the two (mrgi_shared.h
+// differential_compose), which is eq. 13's "multiply the buffers with the colour of I_c" without
+// eq. 13's tone mapper: the runtime's compose is shared by all techniques and works in linear
+// radiance; eq. 13 itself (ssrt_direct_differential) is kept in ssrt_math.h and tested.
+// At step 1 the coarse cells are the pixels; above it the Gauss-filtered layers 7..9 are read
+// with Catmull-Rom bicubic interpolation (paper OursFast), clamped at 0 (bicubic overshoots).
+#extension GL_GOOGLE_include_directive : require
+#include "shared/mrgi_shared.h"
+#include "ssrt/ssrt_math.h"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(set = 0, binding = 0) uniform sampler2DArray coarse;
+layout(set = 0, binding = 1) uniform sampler2D real_position;
+layout(set = 0, binding = 2) uniform sampler2D real_albedo;
+layout(set = 0, binding = 3) uniform sampler2D virtual_position;
+layout(set = 0, binding = 4) uniform sampler2D virtual_albedo;
+layout(set = 0, binding = 5, rgba16f) writeonly uniform image2D lit_rv;
+layout(set = 0, binding = 6, rgba16f) writeonly uniform image2D lit_r;
+layout(push_constant) uniform Push {
+  ivec4 grid;   // x, y cells; z step in pixels; w 1 = skip (pass the camera colour through)
+  ivec4 size;   // xy used extent of the solutions (internal resolution)
+  vec4 opts;    // x relative tolerance of eq. 14
+} pc;
+
+vec4 cubic_weights(float t) {
+  // Catmull-Rom.
+  float t2 = t * t, t3 = t2 * t;
+  return vec4(-0.5f * t3 + t2 - 0.5f * t, 1.5f * t3 - 2.5f * t2 + 1.0f,
+              -1.5f * t3 + 2.0f * t2 + 0.5f * t, 0.5f * t3 - 0.5f * t2);
+}
+
+// Bicubic over the cells that see the same kind of surface as the pixel (layer 7 w: 1 real,
+// 2 virtual; any surface when `kind` is 0), renormalised by the weights of the cells used.
+float sample_bicubic(vec2 c, float kind, out vec4 s4, out vec4 s5, out vec4 s6) {
+  vec2 base = floor(c);
+  vec2 f = c - base;
+  vec4 wx = cubic_weights(f.x), wy = cubic_weights(f.y);
+  s4 = vec4(0.0f); s5 = vec4(0.0f); s6 = vec4(0.0f);
+  float wsum = 0.0f;
+  for (int j = 0; j < 4; ++j) {
+    for (int i = 0; i < 4; ++i) {
+      ivec2 q = clamp(ivec2(base) + ivec2(i - 1, j - 1), ivec2(0), pc.grid.xy - ivec2(1));
+      vec4 a = texelFetch(coarse, ivec3(q, 7), 0);
+      if (a.w < 0.5f || (kind > 0.5f && abs(a.w - kind) > 0.5f)) continue;
+      float w = wx[i] * wy[j];
+      s4 += w * a;
+      s5 += w * texelFetch(coarse, ivec3(q, 8), 0);
+      s6 += w * texelFetch(coarse, ivec3(q, 9), 0);
+      wsum += w;
+    }
+  }
+  if (abs(wsum) > 1e-4f) {
+    s4 = max(s4 / wsum, vec4(0.0f));
+    s5 = max(s5 / wsum, vec4(0.0f));
+    s6 = max(s6 / wsum, vec4(0.0f));
+    return 1.0f;
+  }
+  s4 = vec4(0.0f); s5 = vec4(0.0f); s6 = vec4(0.0f);
+  return 0.0f;
+}
+
+void main() {
+  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 used = pc.size.xy;
+  if (pixel.x >= used.x || pixel.y >= used.y) return;
+  bool real_ok = texelFetch(real_position, pixel, 0).w > 0.0f;
+  bool virt = texelFetch(virtual_position, pixel, 0).w > 0.5f;
+  vec3 a = texelFetch(real_albedo, pixel, 0).rgb;
+  if (pc.grid.w != 0) {
+    // Skipped transfer: no virtual object can change this frame, L_rv = L_r.
+    vec4 v = vec4(real_ok ? a : vec3(0.0f), 1.0f);
+    imageStore(lit_r, pixel, v);
+    imageStore(lit_rv, pixel, v);
+    return;
+  }
+  vec4 s4, s5, s6;
+  int step = pc.grid.z;
+  if (step <= 1) {
+    ivec2 q = min(pixel, pc.grid.xy - ivec2(1));
+    s4 = texelFetch(coarse, ivec3(q, 4), 0);
+    s5 = texelFetch(coarse, ivec3(q, 5), 0);
+    s6 = texelFetch(coarse, ivec3(q, 6), 0);
+  } else {
+    // Cell c's centre is pixel c * step + step / 2.
+    vec2 c = (vec2(pixel) - vec2(float(step / 2))) / float(step);
+    // Same kind first; a pixel whose 4x4 neighbourhood holds no cell of its kind (thin
+    // virtual parts at 4x4) takes any surface rather than nothing.
+    if (sample_bicubic(c, virt ? 2.0f : 1.0f, s4, s5, s6) < 0.5f) sample_bicubic(c, 0.0f, s4, s5, s6);
+  }
+  float rd = s4.x, rd_v = s4.y;
+  vec3 ri = s5.xyz, ri_v = s6.xyz;
+  vec3 l_r = real_ok ? a * rd : vec3(0.0f);
+  vec3 l_rv;
+  if (virt) {
+    vec3 av = texelFetch(virtual_albedo, pixel, 0).rgb;
+    l_rv = av * (rd_v + ri_v / MRGI_PI);
+  } else {
+    l_rv = real_ok ? a * rd_v + a * ssrt_indirect_select(ri, ri_v, pc.opts.x) / MRGI_PI : vec3(0.0f);
+  }
+  imageStore(lit_r, pixel, vec4(l_r, 1.0f));
+  imageStore(lit_rv, pixel, vec4(l_rv, 1.0f));
+}
