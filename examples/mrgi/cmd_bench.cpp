@@ -74,6 +74,9 @@ void setup(CLI::App& app) {
   cmd->add_option("--floor-frames", opts->settings.floor_frames, "floor-pass samples taken before each run")
       ->check(CLI::Range(3, 100000))
       ->capture_default_str();
+  cmd->add_option("--floor-per-frame", opts->settings.floor_per_frame, "floor-pass samples after each measured frame")
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
   cmd->add_option("--out,-o", opts->out, "output folder (built as DIR.partial, renamed at the end)")->required();
   cmd->add_option("--check", opts->check, "baseline to compare with (perf/baseline.json); exit 1 on a regression");
   cmd->add_option("--write-baseline", opts->write_baseline, "write a baseline from this run to FILE");

@@ -10,6 +10,7 @@
 #include <set>
 
 #include "gpu/context.h"
+#include "floor_timer.h"
 #include "gpu/floor_pass.h"
 #include "mrgi/perf/bench.h"
 #include "mrgi/perf/stats.h"
@@ -159,9 +160,11 @@ struct Progress {
 };
 
 Expected<RunSamples> run_one(const LoadedScene& l, const std::string& technique, int level,
-                             const BenchSettings& s, const std::string& floor_device) {
+                             const BenchSettings& s, const std::string& floor_device, FloorTimer& floor,
+                             std::vector<double>& floor_ms) {
   RuntimeSettings rs;
   rs.device = s.device;
+  rs.frames_in_flight = 1;  // process() returns its own frame: nothing overlaps the timed GPU work
   rs.technique = technique;
   rs.level = level;
   rs.exposure = l.info.exposure;
@@ -237,6 +240,10 @@ Expected<RunSamples> run_one(const LoadedScene& l, const std::string& technique,
     auto outs = rt->process(work);
     if (!outs.ok()) return fail(outs.error().kind, what + ", frame " + std::to_string(k) + ": " + outs.error().message);
     MRGI_TRY(consume(*outs));
+    if (k >= warmup) {
+      auto st = floor.sample(uint32_t(s.floor_per_frame), floor_ms);
+      if (!st.ok()) return fail(st.error().kind, what + ": floor pass: " + st.error().message);
+    }
   }
   auto rest = rt->flush();
   if (!rest.ok()) return fail(rest.error().kind, what + ", flush: " + rest.error().message);
@@ -261,7 +268,8 @@ Expected<BenchResult> run_bench(const BenchSettings& s) {
   if (s.frames < 1) return fail(ErrorKind::BadUsage, "--frames must be at least 1 (got " + std::to_string(s.frames) + ")");
   if (s.warmup < 0) return fail(ErrorKind::BadUsage, "--warmup must not be negative");
   if (s.floor_frames < 3) return fail(ErrorKind::BadUsage, "floor_frames must be at least 3");
-  if (s.floor_warmup < 0) return fail(ErrorKind::BadUsage, "floor_warmup must not be negative");
+  if (s.floor_warmup < 0 || s.floor_per_frame < 0)
+    return fail(ErrorKind::BadUsage, "floor_warmup and floor_per_frame must not be negative");
 
   BenchResult result;
   result.lp_num_threads = ensure_lp_num_threads();
@@ -318,15 +326,15 @@ Expected<BenchResult> run_bench(const BenchSettings& s) {
     const int w = loaded->info.color.width, h = loaded->info.color.height;
     std::vector<double> floor_ms;
     std::vector<RunSamples> runs;
+    auto floor = FloorTimer::create(ctx, uint32_t(w), uint32_t(h), uint32_t(s.floor_warmup));
+    if (!floor.ok()) return fail(floor.error().kind, "floor pass (scene '" + sc.name + "'): " + floor.error().message);
     for (const auto& [t, levels] : plan)
       for (int level : levels) {
-        // The floor right before each run: machine load drifts, and a scene's ratios should
-        // divide by floor times taken alongside its own.
-        auto floor = gpu::measure_floor_pass(ctx, uint32_t(w), uint32_t(h), uint32_t(s.floor_frames),
-                                             uint32_t(s.floor_warmup));
-        if (!floor.ok()) return fail(floor.error().kind, "floor pass (scene '" + sc.name + "'): " + floor.error().message);
-        floor_ms.insert(floor_ms.end(), floor->samples_ms.begin(), floor->samples_ms.end());
-        auto run = run_one(*loaded, t, level, s, result.device);
+        // Floor samples before each run and between its frames: machine load drifts, and a
+        // scene's ratios should divide by floor times taken alongside its own.
+        auto st = floor->sample(uint32_t(s.floor_frames), floor_ms);
+        if (!st.ok()) return fail(st.error().kind, "floor pass (scene '" + sc.name + "'): " + st.error().message);
+        auto run = run_one(*loaded, t, level, s, result.device, *floor, floor_ms);
         if (!run.ok()) return run.error();
         runs.push_back(std::move(run).value());
         progress.step(sc.name + " " + t + " " + runs.back().entry.level_name, size_t(s.warmup + s.frames));

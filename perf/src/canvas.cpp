@@ -135,8 +135,8 @@ float Canvas::text_width(const std::string& s, float scale) {
 void Canvas::text(float x, float y, const std::string& s, float scale, Rgb c, bool vertical) {
   std::vector<char> buf(s.begin(), s.end());
   buf.push_back('\0');
-  // stb_easy_font needs ~270 bytes per character (quads of 4 vertices x 16 bytes).
-  std::vector<char> quads(buf.size() * 300 + 64);
+  // Each glyph is at most a dozen quads of 4 vertices x 16 bytes.
+  std::vector<char> quads(buf.size() * 1024 + 64);
   const int n = stb_easy_font_print(0.0f, 0.0f, buf.data(), nullptr, quads.data(), int(quads.size()));
   for (int q = 0; q < n; ++q) {
     const float* v = reinterpret_cast<const float*>(quads.data() + size_t(q) * 64);

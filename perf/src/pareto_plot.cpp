@@ -117,13 +117,33 @@ ImageRGB8 render_pareto_plot(const BenchResult& result) {
             sy(points[front[k]].error), 2.0f, dark, 8.0f);
   for (size_t k : front) cv.marker(sx(points[k].cost), sy(points[k].error), Marker::Circle, 10.0f, white, dark);
 
+  // Labels go to the first of four places around their point that overlaps no earlier label.
+  struct Box {
+    float x0, y0, x1, y1;
+  };
+  std::vector<Box> placed;
   for (size_t k = 0; k < points.size(); ++k) {
     const LevelAggregate& l = levels[plotted[k]];
     const size_t st = style[l.technique];
     const Rgb c = kPalette[st % std::size(kPalette)];
     const float x = sx(points[k].cost), y = sy(points[k].error);
     cv.marker(x, y, kMarkers[st % std::size(kMarkers)], 6.0f, c, black);
-    cv.text(x + 9, y - 14, l.level_name, 1.5f, dark);
+    const float tw = Canvas::text_width(l.level_name, 1.5f), th = Canvas::text_height(1.5f);
+    const Box candidates[] = {{x + 9, y - 9 - th, x + 9 + tw, y - 9},
+                              {x + 9, y + 9, x + 9 + tw, y + 9 + th},
+                              {x - 9 - tw, y - 9 - th, x - 9, y - 9},
+                              {x - 9 - tw, y + 9, x - 9, y + 9 + th}};
+    Box chosen = candidates[0];
+    for (const Box& b : candidates) {
+      bool free = true;
+      for (const Box& p : placed) free = free && (b.x1 < p.x0 || b.x0 > p.x1 || b.y1 < p.y0 || b.y0 > p.y1);
+      if (free) {
+        chosen = b;
+        break;
+      }
+    }
+    placed.push_back(chosen);
+    cv.text(chosen.x0, chosen.y0, l.level_name, 1.5f, dark);
   }
   if (points.empty()) {
     const std::string msg = "no RDE to plot: the scenes have no reference frames";
