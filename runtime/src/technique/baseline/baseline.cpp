@@ -60,6 +60,7 @@ class Baseline final : public Technique {
   // This frame's knobs (set by record before the passes are added).
   uint32_t shadow_size_ = kTopShadowSize;
   int pcf_radius_ = 1;
+  uint32_t grid_stride_ = 1;
 };
 
 Status Baseline::init() {
@@ -175,6 +176,7 @@ Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped
   const QualityLevel& level = ladder_[size_t(info.level)];
   shadow_size_ = uint32_t(knob(level, "shadow_map_size"));
   pcf_radius_ = int(knob(level, "pcf_radius"));
+  grid_stride_ = uint32_t(std::max(1.0, knob(level, "caster_grid_stride")));
   gpu::FrameGraph& graph = *shared_.graph;
   const SceneGpu& sg = *shared_.scene_gpu;
   const SharedResources& s = shared_;
@@ -239,7 +241,10 @@ void Baseline::render_faces(VkCommandBuffer cmd, gpu::PassContext& pass,
                             const std::vector<VkImageView>& layer_views) {
   const gpu::Context& ctx = pass.context();
   const SceneGpu& sg = *shared_.scene_gpu;
-  const VkExtent2D grid = pass.extent(shared_.real_position);
+  const VkExtent2D gbuffer = pass.extent(shared_.real_position);
+  // Vertices every grid_stride_ pixels, the last at or before the G-buffer's last pixel.
+  const uint32_t stride = grid_stride_;
+  const VkExtent2D grid{(gbuffer.width - 1) / stride + 1, (gbuffer.height - 1) / stride + 1};
   const uint32_t grid_vertices =
       grid.width > 1 && grid.height > 1 ? (grid.width - 1) * (grid.height - 1) * 6 : 0;
   const uint32_t s = shadow_size_;
@@ -264,7 +269,7 @@ void Baseline::render_faces(VkCommandBuffer cmd, gpu::PassContext& pass,
       gpu::DescriptorPush()
           .sampled_image(0, pass.view(shared_.real_position), ctx.samplers().nearest_clamp)
           .push(ctx, cmd, *grid_pipeline_);
-      GridPush pc{face.view_proj, glm::ivec4(int(grid.width), int(grid.height), 0, 0)};
+      GridPush pc{face.view_proj, glm::ivec4(int(grid.width), int(grid.height), int(stride), 0)};
       vkCmdPushConstants(cmd, grid_pipeline_->layout, grid_pipeline_->stages, 0, sizeof(pc), &pc);
       vkCmdDraw(cmd, grid_vertices, 1, 0, 0);
     }
@@ -311,17 +316,18 @@ void Baseline::shade(VkCommandBuffer cmd, gpu::PassContext& pass) {
 }  // namespace
 
 std::vector<QualityLevel> baseline_ladder() {
-  auto level = [](const char* name, double size, double scale, double pcf) {
+  auto level = [](const char* name, double size, double scale, double pcf, double stride) {
     QualityLevel l;
     l.name = name;
     l.internal_scale = float(scale);
     l.knobs = {{"shadow_map_size", size, "texels per side of each map face"},
                {"internal_scale", scale, "fraction of the output width and height"},
-               {"pcf_radius", pcf, "compare taps on each side of the centre tap"}};
+               {"pcf_radius", pcf, "compare taps on each side of the centre tap"},
+               {"caster_grid_stride", stride, "G-buffer pixels between real caster mesh vertices"}};
     return l;
   };
-  return {level("high", 2048, 1.0, 1), level("medium", 1024, 1.0, 1), level("low", 512, 0.75, 1),
-          level("lowest", 256, 0.5, 0)};
+  return {level("high", 2048, 1.0, 1, 1), level("medium", 1024, 1.0, 1, 2),
+          level("low", 512, 0.75, 1, 1), level("lowest", 256, 0.5, 0, 1)};
 }
 
 Expected<std::unique_ptr<Technique>> create_baseline(const SharedResources& shared) {

@@ -4,13 +4,17 @@
 // is added (runtime/, FrameConstants::ambient_*), without occlusion.
 //
 // Quality ladder (best first):
-//   level  name     shadow_map_size  internal_scale  pcf_radius
-//   0      high     2048             1.0             1  (3x3 bilinear compare taps)
-//   1      medium   1024             1.0             1
-//   2      low       512             0.75            1
-//   3      lowest    256             0.5             0  (1 bilinear compare tap)
+//   level  name     shadow_map_size  internal_scale  pcf_radius  caster_grid_stride
+//   0      high     2048             1.0             1 (3x3)     1
+//   1      medium   1024             1.0             1           2
+//   2      low       512             0.75            1           1
+//   3      lowest    256             0.5             0 (1 tap)   1
+// (Below full resolution the G-buffer grid is already coarser; a stride of 2 on top of it lost
+// small real casters in the tests' 64x48 scene, so only "medium" strides.)
 // Units: shadow_map_size in texels per side of each map face; internal_scale as a fraction of
-// the output width and height; pcf_radius in taps on each side of the centre tap.
+// the output width and height; pcf_radius in bilinear compare taps on each side of the centre
+// tap; caster_grid_stride in G-buffer pixels between the vertices of the real caster mesh (the
+// depth-camera grid drawn into the real-caster maps: 2 draws a quarter of the triangles).
 // Maps are allocated at 2048 for every lamp at start-up; lower levels render into and read the
 // top-left corner, so set_level never allocates.
 #pragma once
