@@ -467,6 +467,14 @@ Pose camera_pose_at(const SceneDescription& d, double t) {
     k.position = glm::mix(a.position, b.position, s);
     k.look_at = glm::mix(a.look_at, b.look_at, s);
     k.up = glm::normalize(glm::mix(a.up, b.up, s));
+    // Interpolation can pass through a degenerate frame (look-at on the camera, up along the view
+    // or opposite ups); hold the earlier keyframe's orientation there instead of producing NaN.
+    const glm::dvec3 fwd = k.look_at - k.position;
+    if (!(glm::length(fwd) > 1e-9) || !(glm::length(glm::cross(glm::normalize(fwd), k.up)) > 1e-6) ||
+        !std::isfinite(k.up.x)) {
+      k.look_at = k.position + (a.look_at - a.position);
+      k.up = a.up;
+    }
   }
   Pose pose;
   pose.translation = k.position;
