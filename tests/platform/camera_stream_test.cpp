@@ -342,5 +342,47 @@ TEST(EnvCamera, FrameToRadianceDecodesSRGBAndExposure) {
   EXPECT_NEAR(out.data[2], 2.0, 1e-6);
 }
 
+TEST(EnvCamera, SecondStreamIsPairedAsLinearRadiance) {
+  using E = RecordedBackend::Event;
+  auto main_backend = std::make_unique<RecordedBackend>();
+  main_backend->offered.supported = {{PixelFormat::RGB24, 64, 48}};
+  const ImageRGB8 main_img = test_pattern(64, 48);
+  main_backend->buffers = {main_img.data};
+  main_backend->script = {E::Frame, E::Frame, E::Frame};
+  auto env_backend = std::make_unique<RecordedBackend>();
+  env_backend->offered.supported = {{PixelFormat::RGB24, 32, 32}};
+  env_backend->buffers = {std::vector<uint8_t>(32 * 32 * 3, 255), std::vector<uint8_t>(32 * 32 * 3, 128)};
+  // Frame 1: env frame 0 (white). Frame 2: env times out, frame 0 reused. Frame 3: env frame 1.
+  env_backend->script = {E::Frame, E::Timeout, E::Timeout, E::Frame, E::Timeout};
+  CameraSettings main_settings, env_settings;
+  env_settings.width = env_settings.height = 32;
+  auto m = CameraStreamSource::open(std::move(main_backend), main_settings);
+  auto e = CameraStreamSource::open(std::move(env_backend), env_settings);
+  ASSERT_TRUE(m.ok() && e.ok());
+  SourceOptions o;
+  EnvCamera fisheye;
+  fisheye.model = EnvModel::FisheyeEquidistant;
+  fisheye.f = 10.0;
+  fisheye.cx = fisheye.cy = 15.5;
+  o.env_model = fisheye;
+  o.env_exposure = 0.25;
+  auto paired = pair_with_env_camera(std::move(m.value()), std::move(e.value()), o);
+  ASSERT_TRUE(paired->info().env_camera.has_value());
+  EXPECT_EQ(paired->info().env_camera->f, 10.0);
+  auto f0 = paired->next(std::chrono::milliseconds(10));
+  ASSERT_TRUE(f0.ok()) << f0.error().message;
+  ASSERT_TRUE(f0->env.has_value());
+  EXPECT_EQ(f0->env->width, 32);
+  EXPECT_NEAR(f0->env->data[0], 4.0, 1e-5);  // white / exposure 0.25
+  auto f1 = paired->next(std::chrono::milliseconds(10));
+  ASSERT_TRUE(f1.ok());
+  ASSERT_TRUE(f1->env.has_value());
+  EXPECT_NEAR(f1->env->data[0], 4.0, 1e-5);  // reused
+  auto f2 = paired->next(std::chrono::milliseconds(10));
+  ASSERT_TRUE(f2.ok());
+  EXPECT_NEAR(f2->env->data[0], 4.0 * 0.2158605, 1e-3);  // the newer frame (sRGB 128)
+  EXPECT_EQ(f2->color.data, main_img.data);
+}
+
 }  // namespace
 }  // namespace mrgi

@@ -1,6 +1,8 @@
 // Helpers shared by the platform tests: temp folders and a watchdog so that a hang fails the test
 // binary loudly instead of blocking CI.
 #pragma once
+#include <unistd.h>
+
 #include <atomic>
 #include <chrono>
 #include <cstdio>

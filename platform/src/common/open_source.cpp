@@ -88,7 +88,12 @@ Expected<std::unique_ptr<InputSource>> open_source(const std::string& source, co
                                      "model fisheye_equidistant with f > 0, cx, cy, fov_deg)");
   auto env = open_camera_like(options.env, options.env_camera, options);
   if (!env.ok()) return fail(env.error().kind, "environment camera: " + env.error().message);
-  return std::unique_ptr<InputSource>(new EnvPairedSource(std::move(main), std::move(env.value()), options));
+  return pair_with_env_camera(std::move(main), std::move(env.value()), options);
+}
+
+std::unique_ptr<InputSource> pair_with_env_camera(std::unique_ptr<InputSource> main, std::unique_ptr<InputSource> env,
+                                                  const SourceOptions& options) {
+  return std::make_unique<EnvPairedSource>(std::move(main), std::move(env), options);
 }
 
 Expected<std::unique_ptr<InputSource>> open_source(const std::string& source) { return open_source(source, SourceOptions{}); }

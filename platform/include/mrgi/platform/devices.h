@@ -48,6 +48,11 @@ struct SourceOptions {
 // "libcamera:" (first camera) or "libcamera:ID". Unknown prefixes are BadUsage.
 Expected<std::unique_ptr<InputSource>> open_source(const std::string& source, const SourceOptions& options);
 
+// The pairing open_source() does for options.env, for sources opened by other means (tests,
+// embedders): frames of `main` get the newest frame of `env` as InputFrame::env.
+std::unique_ptr<InputSource> pair_with_env_camera(std::unique_ptr<InputSource> main, std::unique_ptr<InputSource> env,
+                                                  const SourceOptions& options);
+
 struct RecordSettings {
   size_t max_frames = 0;                       // 0 = until the stream ends
   std::chrono::milliseconds timeout{3000};     // longest wait for one frame
