@@ -24,6 +24,7 @@ layout(set = 0, binding = 6, rgba16f) writeonly uniform image2D lit_r;
 layout(push_constant) uniform Push {
   ivec4 grid;   // x, y cells; z step in pixels; w 1 = skip (pass the camera colour through)
   ivec4 size;   // xy used extent of the solutions (internal resolution)
+  ivec4 influence;  // pixels [x0, x1) x [y0, y1) the virtual objects' influence region covers
   vec4 opts;    // x relative tolerance of eq. 14
 } pc;
 
@@ -71,8 +72,11 @@ void main() {
   bool real_ok = texelFetch(real_position, pixel, 0).w > 0.0f;
   bool virt = texelFetch(virtual_position, pixel, 0).w > 0.5f;
   vec3 a = texelFetch(real_albedo, pixel, 0).rgb;
-  if (pc.grid.w != 0) {
-    // Skipped transfer: no virtual object can change this frame, L_rv = L_r.
+  bool inside = pixel.x >= pc.influence.x && pixel.x < pc.influence.z &&
+                pixel.y >= pc.influence.y && pixel.y < pc.influence.w;
+  if (pc.grid.w != 0 || (!inside && !virt)) {
+    // Skipped transfer, or a pixel outside the influence region: nothing virtual changes it,
+    // so L_rv = L_r and the compose returns the camera colour whatever their common value.
     vec4 v = vec4(real_ok ? a : vec3(0.0f), 1.0f);
     imageStore(lit_r, pixel, v);
     imageStore(lit_rv, pixel, v);

@@ -34,7 +34,9 @@ layout(push_constant) uniform Push {
   ivec4 grid;     // x, y cells; z step in pixels; w directions N
   ivec4 config;   // x first sample of the level's sets, y SH bands, z/w unused
   vec4 sampling;  // x radius (m), y chi, z normal offset (m), w minimum sender distance (m)
-  vec4 bounce;    // x sample area (m^2), y saturation threshold, z depth test bias (fraction)
+  vec4 bounce;    // x sample area (m^2), y saturation threshold, z depth test bias (fraction),
+                  // w occluder range (m)
+  ivec4 influence;  // cells [x0, x1) x [y0, y1) that the virtual objects' influence region covers
 } pc;
 
 // Camera-space depth of a world point.
@@ -69,6 +71,12 @@ void main() {
   float chi = pc.sampling.y;
   float bias = pc.bounce.z;
   int set = (cell.x & 1) + 2 * (cell.y & 1);
+  // Outside the projected influence region nothing virtual lies within the occluder range of
+  // this surface, and the range check below makes sure only occluders within that range count,
+  // so the real + virtual solution equals the real one bit for bit: it is copied, not computed
+  // (DESIGN.md: tiles outside the influence region are not shaded).
+  bool influenced = virt || (cell.x >= pc.influence.x && cell.x < pc.influence.z &&
+                             cell.y >= pc.influence.y && cell.y < pc.influence.w);
   int base = pc.config.x + set * pc.grid.w;
 
   for (int j = 0; j < pc.grid.w; ++j) {
@@ -76,7 +84,7 @@ void main() {
     vec3 w = s.direction_and_radius.xyz;
     float r = s.direction_and_radius.w * pc.sampling.x;
     bool do_real = real_ok && dot(nr, w) > 0.0f;
-    bool do_rv = dot(nv, w) > 0.0f && (virt || real_ok);
+    bool do_rv = influenced && dot(nv, w) > 0.0f && (virt || real_ok);
     if (!do_real && !do_rv) continue;
 
     // Real receiver against real occluders.
@@ -90,7 +98,11 @@ void main() {
         ivec2 qi = ivec2(floor(q + 0.5f));
         if (all(greaterThanEqual(qi, ivec2(0))) && all(lessThan(qi, size))) {
           vec4 o = texelFetch(real_position, qi, 0);
-          if (o.w > 0.0f && o.w < yz * (1.0f - bias)) {
+          // Range check (standard SSDO/SSAO practice; the paper does not say): a surface
+          // farther from x than the range (push: twice the sampling radius, since the surface
+          // seen in front of y may lie well in front of it) is not what blocks this direction.
+          vec3 dr = o.xyz - xr;
+          if (o.w > 0.0f && o.w < yz * (1.0f - bias) && dot(dr, dr) <= pc.bounce.w * pc.bounce.w) {
             sp = o.xyz;
             sn = texelFetch(real_normal, qi, 0).xyz;
             sa = texelFetch(real_albedo, qi, 0).rgb;
@@ -120,7 +132,9 @@ void main() {
           // The virtual G-buffer only holds virtual surfaces in front of the real one.
           bool use_virtual = ov.w > 0.5f;
           float oz = use_virtual ? view_depth(ov.xyz) : o.w;
-          if ((use_virtual || o.w > 0.0f) && oz > 0.0f && oz < yz * (1.0f - bias)) {
+          vec3 dv = (use_virtual ? ov.xyz : o.xyz) - xv;
+          if ((use_virtual || o.w > 0.0f) && oz > 0.0f && oz < yz * (1.0f - bias) &&
+              dot(dv, dv) <= pc.bounce.w * pc.bounce.w) {
             sp = use_virtual ? ov.xyz : o.xyz;
             sn = use_virtual ? texelFetch(virtual_normal, qi, 0).xyz : texelFetch(real_normal, qi, 0).xyz;
             sa = use_virtual ? texelFetch(virtual_albedo, qi, 0).rgb : texelFetch(real_albedo, qi, 0).rgb;
@@ -137,6 +151,10 @@ void main() {
     }
   }
 
+  if (!influenced) {
+    t_rv = t_real;
+    ri_v = ri;
+  }
   // Bands above the level's count are dropped (their coefficients stay 0 in the light too).
   int n = pc.config.y * pc.config.y;
   float rd = 0.0f, rd_v = 0.0f;

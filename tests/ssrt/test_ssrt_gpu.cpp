@@ -5,7 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <algorithm>
+#include <cstdio>
 #include <cstring>
+#include <map>
 
 #include "../../shaders/common/frame_constants.glsl"
 #include "../../shaders/shared/mrgi_shared.h"
@@ -20,8 +23,15 @@ using namespace mrgi;
 using namespace mrgi::gpu;
 using mrgi::test::VulkanTest;
 
-constexpr uint32_t W = 64, H = 48;
-const glm::vec4 kK(60.0f, 60.0f, 31.5f, 23.5f);  // fx fy cx cy, pixels
+// The image size and intrinsics of the analytic scene (64 x 48; the timing run uses 640 x 480).
+uint32_t W = 64, H = 48;
+glm::vec4 kK(60.0f, 60.0f, 31.5f, 23.5f);  // fx fy cx cy, pixels
+void set_size(uint32_t w, uint32_t h) {
+  W = w;
+  H = h;
+  const float f = 60.0f * float(w) / 64.0f;
+  kK = glm::vec4(f, f, 0.5f * float(w) - 0.5f, 0.5f * float(h) - 0.5f);
+}
 constexpr float kCameraHeight = 2.0f;
 constexpr float kBoxHalf = 0.2f, kBoxTop = 0.4f;   // virtual box on the floor at the origin
 constexpr float kFloorCamera = 0.3f;              // the floor's camera colour (linear)
@@ -36,6 +46,33 @@ glm::mat4 camera_to_world() {
   return m;
 }
 
+// First hit of the camera ray through pixel (u, v) with the virtual box at `offset` (slab
+// method): true with the world point and the face normal.
+bool hit_box(glm::vec2 pixel, glm::vec3 offset, glm::vec3& point, glm::vec3& normal) {
+  const glm::vec3 ray = shader::unproject_pinhole(pixel, 1.0f, kK);
+  const glm::vec3 o(0.0f, kCameraHeight, 0.0f);
+  const glm::vec3 d = glm::normalize(glm::vec3(camera_to_world() * glm::vec4(ray, 0.0f)));
+  const glm::vec3 lo = offset + glm::vec3(-kBoxHalf, 0.0f, -kBoxHalf);
+  const glm::vec3 hi = offset + glm::vec3(kBoxHalf, kBoxTop, kBoxHalf);
+  float t0 = 0.0f, t1 = 1e9f;
+  int axis = -1;
+  for (int a = 0; a < 3; ++a) {
+    if (std::abs(d[a]) < 1e-12f) {
+      if (o[a] < lo[a] || o[a] > hi[a]) return false;
+      continue;
+    }
+    float ta = (lo[a] - o[a]) / d[a], tb = (hi[a] - o[a]) / d[a];
+    if (ta > tb) std::swap(ta, tb);
+    if (ta > t0) t0 = ta, axis = a;
+    t1 = std::min(t1, tb);
+  }
+  if (t0 > t1 || axis < 0) return false;
+  point = o + d * t0;
+  normal = glm::vec3(0.0f);
+  normal[axis] = d[axis] > 0.0f ? -1.0f : 1.0f;
+  return true;
+}
+
 struct Driver {
   std::unique_ptr<FrameGraph> graph;
   std::unique_ptr<technique::SceneGpu> scene_gpu;
@@ -44,6 +81,7 @@ struct Driver {
   std::unique_ptr<technique::Technique> tech;
   BufferHandle readback_r, readback_rv;
   std::vector<std::string> skipped;
+  std::vector<FrameTimings> timings;
 
   static Driver make(Context& ctx, bool with_virtual, glm::vec3 box_offset = glm::vec3(0.0f)) {
     Driver d;
@@ -120,13 +158,11 @@ struct Driver {
         rpos[i] = glm::vec4(p, kCameraHeight);
         const float n[4] = {0, 1, 0, 1}, a[4] = {kFloorCamera, kFloorCamera, kFloorCamera, 1};
         for (int c = 0; c < 4; ++c) rnrm[i * 4 + c] = half(n[c]), ralb[i * 4 + c] = half(a[c]);
-        // The box top seen from above (its sides are not visible from straight above enough).
-        const float top_depth = kCameraHeight - kBoxTop;
-        const glm::vec3 q = glm::vec3(c2w * glm::vec4(ray * top_depth, 1.0f)) - box_offset;
-        if (with_virtual && std::abs(q.x) <= kBoxHalf && std::abs(q.z) <= kBoxHalf) {
-          vpos[i] = glm::vec4(q + box_offset, 1.0f);
-          const float va[4] = {0.8f, 0.2f, 0.2f, 0.0f};
-          for (int c = 0; c < 4; ++c) vnrm[i * 4 + c] = half(n[c]), valb[i * 4 + c] = half(va[c]);
+        glm::vec3 hp, hn;
+        if (with_virtual && hit_box(glm::vec2(u, v), box_offset, hp, hn)) {
+          vpos[i] = glm::vec4(hp, 1.0f);
+          const float vn[4] = {hn.x, hn.y, hn.z, 0.0f}, va[4] = {0.8f, 0.2f, 0.2f, 0.0f};
+          for (int c = 0; c < 4; ++c) vnrm[i * 4 + c] = half(vn[c]), valb[i * 4 + c] = half(va[c]);
         }
       }
     }
@@ -155,6 +191,7 @@ struct Driver {
   uint32_t frame(int64_t index, int level) {
     auto begun = graph->begin_frame();
     EXPECT_TRUE(begun.ok()) << begun.error().message;
+    if (begun.ok() && begun->has_value()) timings.push_back(**begun);
     write_constants();
     skipped.clear();
     technique::FrameInfo info;
@@ -206,18 +243,21 @@ struct Driver {
   }
 };
 
+// The box off-centre, so the far corner of the view lies beyond its influence region.
+const glm::vec3 kCornerBox(-0.6f, 0.0f, -0.45f);
+
 // Floor distance of a pixel from the box's footprint (metres), or -1 on the box.
-float distance_to_box(uint32_t u, uint32_t v) {
+float distance_to_box(uint32_t u, uint32_t v, glm::vec3 offset) {
   const glm::vec3 ray = shader::unproject_pinhole(glm::vec2(u, v), 1.0f, kK);
-  const glm::vec3 p = glm::vec3(camera_to_world() * glm::vec4(ray * kCameraHeight, 1.0f));
+  const glm::vec3 p = glm::vec3(camera_to_world() * glm::vec4(ray * kCameraHeight, 1.0f)) - offset;
   const float dx = std::max(std::abs(p.x) - kBoxHalf, 0.0f), dz = std::max(std::abs(p.z) - kBoxHalf, 0.0f);
-  const glm::vec3 q = glm::vec3(camera_to_world() * glm::vec4(ray * (kCameraHeight - kBoxTop), 1.0f));
-  if (std::abs(q.x) <= kBoxHalf && std::abs(q.z) <= kBoxHalf) return -1.0f;
+  glm::vec3 hp, hn;
+  if (hit_box(glm::vec2(u, v), offset, hp, hn)) return -1.0f;
   return std::sqrt(dx * dx + dz * dz);
 }
 
 TEST_F(VulkanTest, SsrtEveryLevelShadowsNearTheBoxAndLeavesFarFloorUntouched) {
-  Driver d = Driver::make(ctx(), true);
+  Driver d = Driver::make(ctx(), true, kCornerBox);
   const int levels = int(d.tech->levels().size());
   ASSERT_EQ(levels, 4);
   for (int level = 0; level < levels; ++level) {
@@ -237,25 +277,27 @@ TEST_F(VulkanTest, SsrtEveryLevelShadowsNearTheBoxAndLeavesFarFloorUntouched) {
         const size_t i = size_t(v) * W + u;
         ASSERT_TRUE(std::isfinite(r[i]) && std::isfinite(rv[i])) << u << "," << v;
         ASSERT_GE(r[i], 0.0f);
-        const float dist = distance_to_box(uint32_t(u * scale), uint32_t(v * scale));
+        const float dist = distance_to_box(uint32_t(u * scale), uint32_t(v * scale), kCornerBox);
         if (dist < 0.0f) {
           ++virt;
           virt_lit += rv[i] > 0.0f;
         } else if (dist > 0.03f && dist < 0.12f) {
           ++near;
           darker_near += rv[i] < r[i] * 0.99f;
-        } else if (dist > 0.5f + (level >= 1 ? 0.4f : 0.0f)) {
-          // Beyond the sampling radius, plus the Gauss radius (8 px = 0.27 m here) and the
-          // bicubic footprint on the sub-sampled levels.
+        } else if (dist > 1.0f + (level >= 1 ? 0.4f : 0.0f)) {
+          // Beyond the occluder range (1 m), plus the Gauss radius (8 px = 0.27 m here) and
+          // the bicubic footprint on the sub-sampled levels.
           ++far;
           far_changed += rv[i] != r[i];
         }
       }
     }
     EXPECT_GT(near, 10) << "level " << level;
-    // SSDO with N samples misses the box for a few ring pixels; sub-sampled levels also
+    // Not every ring pixel: eq. 8's continuous K counts an occluder as visible when the
+    // surface found in front of the sample lies off the sample's direction, which is what the
+    // box's top face is for samples aimed at its sides low down; sub-sampled levels also
     // interpolate a coarse grid over the ring.
-    EXPECT_GE(darker_near, near * (level == 0 ? 90 : 85) / 100)
+    EXPECT_GE(darker_near, near * 70 / 100)
         << "level " << level << ": contact shadow missing";
     EXPECT_GT(far, 10);
     EXPECT_EQ(far_changed, 0) << "level " << level << ": the far floor must stay exactly as is";
@@ -321,6 +363,32 @@ TEST_F(VulkanTest, SsrtThousandStaticFramesStayFiniteAndStable) {
     ASSERT_TRUE(std::isfinite(late[i]));
     EXPECT_NEAR(late[i], early[i], 1e-3f + 1e-3f * std::abs(early[i])) << i;  // no drift
   }
+}
+
+// Per-pass GPU times at 640 x 480 (LP_NUM_THREADS=2 expected in the environment), every level.
+// A measurement, not a check: run with --gtest_also_run_disabled_tests.
+TEST_F(VulkanTest, DISABLED_SsrtTimingsAt640x480) {
+  set_size(640, 480);
+  for (int level = 0; level < 4; ++level) {
+    Driver d = Driver::make(ctx(), true);
+    for (int f = 0; f < 12; ++f) d.frame(f, level);
+    auto rest = d.graph->flush();
+    ASSERT_TRUE(rest.ok());
+    for (auto& t : *rest) d.timings.push_back(t);
+    std::map<std::string, std::vector<double>> per_pass;
+    for (size_t i = 3; i < d.timings.size(); ++i)  // after warm-up
+      for (const auto& p : d.timings[i].passes) per_pass[p.name].push_back(p.gpu_ms);
+    std::printf("level %d (%s):\n", level, d.tech->levels()[size_t(level)].name.c_str());
+    double total = 0.0;
+    for (auto& [name, v] : per_pass) {
+      std::sort(v.begin(), v.end());
+      const double median = v[v.size() / 2];
+      if (name.rfind("ssrt", 0) == 0) total += median;
+      std::printf("  %-26s %8.2f ms (median of %zu)\n", name.c_str(), median, v.size());
+    }
+    std::printf("  %-26s %8.2f ms\n", "ssrt total", total);
+  }
+  set_size(64, 48);
 }
 
 }  // namespace

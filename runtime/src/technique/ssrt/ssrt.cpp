@@ -24,6 +24,7 @@ constexpr uint32_t kSampleSeed = 20140901;     // sample sets are a pure functio
 
 // Settings shared by every level (units in the names).
 constexpr float kRadiusM = 0.5f;             // SSDO sampling radius
+constexpr float kRangeM = 2.0f * kRadiusM;   // occluders farther from the receiver do not count
 constexpr float kNormalOffsetM = 0.01f;      // start of the samples above the surface
 constexpr float kMinSenderDistM = 0.05f;     // 1/d^2 clamp of the form factor
 constexpr float kDepthBias = 0.01f;          // occluder must be 1 % closer than the sample
@@ -36,6 +37,7 @@ struct TransferPush {
   glm::ivec4 config;
   glm::vec4 sampling;
   glm::vec4 bounce;
+  glm::ivec4 influence;
 };
 struct ReducePush {
   glm::ivec4 grid;
@@ -50,6 +52,7 @@ struct BlurPush {
 struct ShadePush {
   glm::ivec4 grid;
   glm::ivec4 size;
+  glm::ivec4 influence;
   glm::vec4 opts;
 };
 
@@ -86,7 +89,15 @@ class Ssrt final : public Technique {
  private:
   void consume_readback(std::vector<std::string>& notes);
   void write_light();
-  bool influence_in_view() const;
+  // Whether the virtual objects' influence region (bounds grown by the sampling radius) is in
+  // view; `cells` gets its conservative screen rectangle in cells [x0, x1) x [y0, y1).
+  bool influence_in_view(glm::ivec4& cells) const;
+  glm::ivec4 influence_pixels() const {
+    const int st = int(step_);
+    const int grow = step_ > 1 ? int(kGaussRadiusPx) + 2 * st : 0;
+    return glm::ivec4(influence_cells_.x * st - grow, influence_cells_.y * st - grow,
+                      influence_cells_.z * st + grow, influence_cells_.w * st + grow);
+  }
 
   std::string name_ = "ssrt";
   SharedResources shared_;
@@ -102,6 +113,7 @@ class Ssrt final : public Technique {
   uint32_t step_ = 1, directions_ = 64, bands_ = 4;
   int level_ = 0;
   glm::uvec2 grid_{1, 1};
+  glm::ivec4 influence_cells_{0, 0, 0, 0};
   VkExtent2D used_{1, 1};
 };
 
@@ -232,17 +244,19 @@ void Ssrt::write_light() {
 // The virtual objects' bounds grown by the sampling radius (the region where they can shadow or
 // light a real surface) against this frame's view frustum: in view unless all eight corners
 // lie outside one side of it.
-bool Ssrt::influence_in_view() const {
+bool Ssrt::influence_in_view(glm::ivec4& cells) const {
   const SceneGpu& sg = *shared_.scene_gpu;
   if (sg.virtual_objects.empty()) return false;
   gpu::FrameGraph& graph = *shared_.graph;
   const auto* fc =
       static_cast<const shader::FrameConstants*>(graph.mapped(shared_.frame_constants, graph.slot()));
-  const glm::vec3 lo = sg.virtual_objects.bounds_min - glm::vec3(kRadiusM);
-  const glm::vec3 hi = sg.virtual_objects.bounds_max + glm::vec3(kRadiusM);
+  // Grown by the occluder range: no receiver farther away can see a virtual occluder.
+  const glm::vec3 lo = sg.virtual_objects.bounds_min - glm::vec3(kRangeM);
+  const glm::vec3 hi = sg.virtual_objects.bounds_max + glm::vec3(kRangeM);
   const glm::vec4 k = fc->internal_k;
   const glm::vec2 size(fc->internal_output_size.x, fc->internal_output_size.y);
   int out_count[5] = {0, 0, 0, 0, 0};  // behind, left, right, top, bottom
+  glm::vec2 pmin(1e30f), pmax(-1e30f);
   for (int c = 0; c < 8; ++c) {
     const glm::vec3 p((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
     const glm::vec3 q = glm::vec3(fc->world_to_camera * glm::vec4(p, 1.0f));
@@ -251,6 +265,8 @@ bool Ssrt::influence_in_view() const {
       continue;
     }
     const float u = k.x * q.x / q.z + k.z, v = k.y * q.y / q.z + k.w;
+    pmin = glm::min(pmin, glm::vec2(u, v));
+    pmax = glm::max(pmax, glm::vec2(u, v));
     out_count[1] += u < -0.5f;
     out_count[2] += u > size.x - 0.5f;
     out_count[3] += v < -0.5f;
@@ -258,6 +274,17 @@ bool Ssrt::influence_in_view() const {
   }
   for (int side = 0; side < 5; ++side)
     if (out_count[side] == 8) return false;
+  if (out_count[0] > 0) {
+    // A corner behind the camera: the projection is unbounded, take the whole grid.
+    cells = glm::ivec4(0, 0, int(grid_.x), int(grid_.y));
+    return true;
+  }
+  // Pixels -> cells (cell c covers pixels [c step, (c + 1) step)), one cell of margin.
+  const float st = float(step_);
+  cells = glm::ivec4(int(std::floor(pmin.x / st)) - 1, int(std::floor(pmin.y / st)) - 1,
+                     int(std::ceil(pmax.x / st)) + 2, int(std::ceil(pmax.y / st)) + 2);
+  cells = glm::clamp(cells, glm::ivec4(0), glm::ivec4(int(grid_.x), int(grid_.y),
+                                                      int(grid_.x), int(grid_.y)));
   return true;
 }
 
@@ -277,7 +304,7 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   consume_readback(skipped);
   write_light();
 
-  const bool run_transfer = info.virtual_objects_present && influence_in_view();
+  const bool run_transfer = info.virtual_objects_present && influence_in_view(influence_cells_);
   if (!run_transfer) {
     const char* why = info.virtual_objects_present
                           ? "no virtual object's influence region in view"
@@ -319,7 +346,8 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
           TransferPush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), int(directions_)),
                           glm::ivec4(int(sample_base_[size_t(level_)]), int(bands_), 0, 0),
                           glm::vec4(kRadiusM, chi_[size_t(level_)], kNormalOffsetM, kMinSenderDistM),
-                          glm::vec4(sample_area, kSaturation, kDepthBias, 0.0f)};
+                          glm::vec4(sample_area, kSaturation, kDepthBias, kRangeM),
+                          influence_cells_};
           gpu::dispatch_2d(cmd, *transfer_, &pc, sizeof(pc), grid_.x, grid_.y);
         });
     const uint32_t tiles_x = (grid_.x + kTileW - 1) / kTileW;
@@ -408,7 +436,9 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
             .push(ctx, cmd, *shade_);
         ShadePush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), run_transfer ? 0 : 1),
                      glm::ivec4(int(used_.width), int(used_.height), 0, 0),
-                     glm::vec4(kIndirectTolerance, 0.0f, 0.0f, 0.0f)};
+                     // Cells -> pixels, grown by the up-sampling footprint (Gauss radius plus
+                     // the bicubic's two cells) so every pixel the filters can reach is shaded.
+                     influence_pixels(), glm::vec4(kIndirectTolerance, 0.0f, 0.0f, 0.0f)};
         gpu::dispatch_2d(cmd, *shade_, &pc, sizeof(pc), used_.width, used_.height);
       });
   return ok_status();

@@ -10,9 +10,12 @@
 //                            them (light_estimator.h), the result lights the next frames
 //   ssrt_upsample_blur       fast levels only: Gauss radius 8 px over the coarse grid
 //   ssrt_shade               bicubic up-sampling, writes L_r and L_rv for the runtime's compose
-// Skips: no virtual object in the scene, or its bounds grown by the sampling radius (its
-// influence region) outside the view: the transfer passes do not run and L_rv = L_r = camera
-// colour (compose then returns the camera image unchanged); the light estimate is kept.
+// Skips: no virtual object in the scene, or its bounds grown by the occluder range (its
+// influence region, 2 x the 0.5 m sampling radius) outside the view: the transfer passes do not
+// run and L_rv = L_r = camera colour (compose then returns the camera image unchanged); the
+// light estimate is kept. Inside a frame, cells outside the influence region's screen rectangle
+// copy the real solution instead of computing the real + virtual one (bit-identical, by the
+// range check), and pixels outside it are written as pass-through.
 //
 // Quality ladder (best first), knobs with units:
 //   level  name     subsample  directions  sh_bands  internal_scale
