@@ -39,7 +39,9 @@ struct RuntimeSettings {
   int level = 0;                       // 0 = the technique's best quality
   int output_width = 0;                // 0 = the colour camera's width
   int output_height = 0;
-  double exposure = 1.0;               // camera exposure (capture.json), for the tone mapper
+  // Camera exposure (linear radiance -> linear camera value) for albedo and the tone curve;
+  // 0 = CameraSetup::exposure (capture.json). A positive value overrides it.
+  double exposure = 0.0;
   int frames_in_flight = 2;            // readback latency, frames (1..3)
 };
 
@@ -65,8 +67,6 @@ struct FrameOutput {
   // Output size; 255 where a virtual object is seen (composited as TM(L_rv)), 0 on real pixels.
   // For RDE over real / virtual pixels (metrics.h).
   Image<uint8_t, 1> virtual_mask;
-  // Linear RGB buffers for error measurement, output size (only when requested in settings):
-  // not part of the shipped path.
 };
 
 class Runtime {

@@ -128,6 +128,10 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
     return fail(ErrorKind::BadInput, "CameraSetup.depth_scale must be > 0 (depth units per metre)");
   if (!(cameras.exposure > 0.0))
     return fail(ErrorKind::BadInput, "CameraSetup.exposure must be > 0");
+  if (!(settings.exposure >= 0.0))
+    return fail(ErrorKind::BadUsage, "RuntimeSettings.exposure must be >= 0 (0 = the camera's)");
+  // The settings override the capture's exposure (e.g. a user correcting a badly exposed capture).
+  if (settings.exposure > 0.0) cameras_.exposure = settings.exposure;
   output_w_ = settings.output_width ? settings.output_width : c.width;
   output_h_ = settings.output_height ? settings.output_height : c.height;
   level_ = settings.level;
