@@ -86,7 +86,8 @@ struct Driver {
   std::vector<FrameTimings> timings;
 
   // Edits the analytic real G-buffer (positions, albedo as half floats) before the upload.
-  using Tweak = std::function<void(std::vector<glm::vec4>&, std::vector<uint16_t>&)>;
+  using Tweak = std::function<void(std::vector<glm::vec4>&, std::vector<uint16_t>&,
+                                   std::vector<uint16_t>&)>;  // positions, normals, albedo
 
   static Driver make(Context& ctx, bool with_virtual, glm::vec3 box_offset = glm::vec3(0.0f),
                      const Tweak& tweak = nullptr) {
@@ -172,7 +173,7 @@ struct Driver {
         }
       }
     }
-    if (tweak) tweak(rpos, ralb);
+    if (tweak) tweak(rpos, rnrm, ralb);
     const technique::SharedResources& s = shared;
     EXPECT_TRUE(graph->upload_image(s.real_position, rpos.data(), rpos.size() * 16).ok());
     EXPECT_TRUE(graph->upload_image(s.real_normal, rnrm.data(), rnrm.size() * 2).ok());
@@ -375,17 +376,17 @@ TEST_F(VulkanTest, SsrtThousandStaticFramesStayFiniteAndStable) {
 // Stress: no depth at all, saturated and HDR (1e6) camera values, and NaN positions: every
 // output finite, the light estimate finite (or still the prior when nothing is usable).
 TEST_F(VulkanTest, SsrtStressInputsStayFinite) {
-  const Driver::Tweak no_depth = [](auto& pos, auto&) {
+  const Driver::Tweak no_depth = [](auto& pos, auto&, auto&) {
     for (auto& p : pos) p = glm::vec4(0.0f);
   };
-  const Driver::Tweak saturated = [](auto&, auto& alb) {
+  const Driver::Tweak saturated = [](auto&, auto&, auto& alb) {
     for (size_t i = 0; i < alb.size(); ++i) alb[i] = uint16_t(glm::packHalf1x16(1.0f));
   };
-  const Driver::Tweak hdr = [](auto&, auto& alb) {
+  const Driver::Tweak hdr = [](auto&, auto&, auto& alb) {
     // 1e6 does not fit a half float; its largest finite value (65504) is what RGBA16F holds.
     for (size_t i = 0; i < alb.size(); ++i) alb[i] = uint16_t(glm::packHalf1x16(65504.0f));
   };
-  const Driver::Tweak nan_positions = [](auto& pos, auto&) {
+  const Driver::Tweak nan_positions = [](auto& pos, auto&, auto&) {
     for (size_t i = 0; i < pos.size(); i += 7) pos[i] = glm::vec4(NAN, NAN, NAN, NAN);
   };
   int which = 0;
@@ -402,6 +403,51 @@ TEST_F(VulkanTest, SsrtStressInputsStayFinite) {
     if (which == 0 || which == 1) EXPECT_FALSE(e->valid) << "nothing usable: still the prior";
     ++which;
   }
+}
+
+// The light-estimation round trip on a scene with several normals: a real box (top and two
+// visible sides) on the floor, its camera colour rendered from a known SH light (a directional
+// light plus ambient, gray-world albedo, no occlusion in the rendering): the estimated dominant
+// direction must come out near the true one.
+// DISABLED: it fails today (72-75 degrees, confidence 0.12): at 64 x 48 the box's two visible
+// sides are a few dozen pixels against ~3000 floor pixels, so T^T T has ~2 significant
+// directions and the x/z part of the light is left to the prior (the paper's Sec. 6.2 caveat
+// about unsampled normals). Needs a better-conditioned scene (several objects or a sphere) and
+// the env_fisheye capture through the runtime; kept so the next session starts from it.
+TEST_F(VulkanTest, DISABLED_SsrtEstimatedDominantDirectionOfARealBoxScene) {
+  const glm::dvec3 sun = glm::normalize(glm::dvec3(0.5, 0.8, 0.3));
+  ssrt::ShRgb light = ssrt::sh_directional_light(sun, glm::dvec3(2.0));
+  light[0] += glm::dvec3(0.2 * std::sqrt(4.0 * 3.14159265358979));
+  const Driver::Tweak real_box = [&](auto& pos, auto& nrm, auto& alb) {
+    for (uint32_t v = 0; v < H; ++v) {
+      for (uint32_t u = 0; u < W; ++u) {
+        const size_t i = size_t(v) * W + u;
+        glm::vec3 p(pos[i]), n(0.0f, 1.0f, 0.0f), hp, hn;
+        if (hit_box(glm::vec2(u, v), kCornerBox, hp, hn)) {
+          p = hp;
+          n = hn;
+          const glm::vec3 c = glm::vec3(glm::inverse(camera_to_world()) * glm::vec4(p, 1.0f));
+          pos[i] = glm::vec4(p, c.z);
+        }
+        const double e = ssrt::sh_irradiance(light, n).y;
+        const float cam = float(0.5 * e / 3.14159265358979);
+        for (int c = 0; c < 3; ++c) {
+          nrm[i * 4 + c] = uint16_t(glm::packHalf1x16(n[c]));
+          alb[i * 4 + c] = uint16_t(glm::packHalf1x16(cam));
+        }
+      }
+    }
+  };
+  // The estimate needs the transfer, which runs only with a virtual object in view: add one.
+  Driver dv = Driver::make(ctx(), true, glm::vec3(0.7f, 0.0f, 0.5f), real_box);
+  for (int f = 0; f < 40; ++f) dv.frame(f, 0);
+  ASSERT_TRUE(dv.graph->flush().ok());
+  const LightEstimate* e = technique::ssrt_light_estimate(*dv.tech);
+  ASSERT_TRUE(e->valid);
+  const glm::dvec3 got(e->direction_to_light[0], e->direction_to_light[1], e->direction_to_light[2]);
+  const double angle = std::acos(std::clamp(glm::dot(got, sun), -1.0, 1.0)) * 180.0 / 3.14159265358979;
+  std::printf("dominant direction error %.1f deg, confidence %.2f\n", angle, e->confidence);
+  EXPECT_LT(angle, 25.0);
 }
 
 // Per-pass GPU times at 640 x 480 (LP_NUM_THREADS=2 expected in the environment), every level.

@@ -26,9 +26,20 @@
 // subsample: cells are step x step pixels; directions: N per jitter set; sh_bands: SH bands of
 // the transfer and of the estimated light.
 //
-// Not yet here (issue 4): the TSDF volume, its ray-cast auxiliary buffers (left/right/top/light)
-// and the D'/D''/D''' filter chain on the GPU (the CPU reference is depth_filter.h); occlusion is
-// tested against the current view's G-buffer only.
+// Deviations from the paper, each explained where it is implemented: chi of eq. 9 read as a
+// one-minus-cosine threshold and G of eq. 12 on the sender's normal (ssrt_math.h); F of eq. 11
+// with the SSDO patch area and a distance clamp; a range check (2 x radius) on occluders; light
+// in radiance units (1/pi in the transfer); the up-sampling filters do not mix real and virtual
+// cells; the composite is the runtime's ratio form rather than eq. 13's tone-mapped difference
+// (shade.comp; eq. 13-14 themselves are in ssrt_math.h and tested); indirect light comes from
+// the main G-buffer only.
+//
+// Not yet here (issue 4): the TSDF volume (256^3 / 64^3), its ray-cast view and auxiliary
+// orthographic buffers (left/right/top/light), and the D'/D''/D''' filter chain on the GPU (its
+// CPU reference is depth_filter.h): occlusion is tested against the current view's G-buffer, so
+// occluders outside the view cast no shadow. The technique is not yet in technique/registry.cpp
+// (a2's file; one line: {"ssrt", &ssrt_ladder, &create_ssrt}), and the estimate is not yet in
+// the public FrameOutput (runtime.h is the lead's; ssrt_light_estimate() gives it meanwhile).
 #pragma once
 #include <memory>
 #include <vector>
