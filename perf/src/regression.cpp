@@ -24,7 +24,9 @@ std::string num(double v) {
   return buf;
 }
 
-nlohmann::json opt_json(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
+nlohmann::ordered_json opt_json(const std::optional<double>& v) {
+  return v ? nlohmann::ordered_json(*v) : nlohmann::ordered_json(nullptr);
+}
 
 // Reads a finite non-negative number (or null when allowed) at `obj[key]`.
 Status read_number(const nlohmann::json& obj, const char* key, const std::string& where, bool nullable,
@@ -74,14 +76,14 @@ Baseline make_baseline(const BenchResult& result, const Tolerances& tolerances) 
 }
 
 Status write_baseline(const std::string& path, const Baseline& b) {
-  nlohmann::json j;
+  nlohmann::ordered_json j;  // keeps version and tolerances at the top of the file
   j["version"] = 1;
   j["tolerances"] = {{"ratio_relative", b.tolerances.ratio_relative},
                      {"rde_absolute", b.tolerances.rde_absolute},
                      {"delta_rms_absolute", b.tolerances.delta_rms_absolute}};
   j["source"] = {{"device", b.device},   {"lp_num_threads", b.lp_num_threads}, {"commit", b.commit},
                  {"frames", b.frames},   {"warmup", b.warmup},                 {"floor_median_ms", b.floor_median_ms}};
-  nlohmann::json entries = nlohmann::json::array();
+  nlohmann::ordered_json entries = nlohmann::ordered_json::array();
   for (const BaselineEntry& e : b.entries)
     entries.push_back({{"scene", e.scene},
                        {"technique", e.technique},

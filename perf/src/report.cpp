@@ -201,7 +201,7 @@ std::string report_markdown(const BenchResult& r, const CheckReport* check) {
   o << "| floor pass | " << fmt(r.floor_median_ms, 3) << " ms median over every floor sample |\n\n";
   o << "Times are GPU times from the frame graph's timestamps (median and 95th percentile over the measured "
        "frames); *ratio* is the median divided by the scene's floor-pass median, measured in the same process "
-       "before each run. RDE is pooled over the measured frames (0 = perfect, 1 = no better than the camera "
+       "before each run and after each measured frame. RDE is pooled over the measured frames (0 = perfect, 1 = no better than the camera "
        "frame; `-` = undefined: no reference, or nothing should change in that set of pixels). RMSE in 8-bit "
        "units and SSIM are over all pixels.\n\n";
 
