@@ -4,9 +4,9 @@
 // summary.json, side_by_side.png) to --out, through the same ReplayOutput.
 //
 // Without --scene, a default virtual object is placed in front of the camera: a 15 cm box,
-// generated here as a .glb (in a temp folder, removed at exit), at 85% of the median measured
-// depth of the first frame's central quarter (1 m when there is no depth), lit by one real
-// directional light from above. Camera poses: the source's own (capture groundtruth), else
+// generated here as a .glb (in a temp folder, removed at exit), at 80% of the nearest measured
+// depth (10th percentile) of the first frame's central quarter, at most 1.2 m (1 m when there is
+// no depth), lit by one real directional light from above and behind the camera. Camera poses: the source's own (capture groundtruth), else
 // AprilTag tracking when the source's info has AprilTag settings, else a fixed pose (camera at
 // the world origin looking along world -z with world +y up) -- without tracking it stays fixed.
 #include <unistd.h>
@@ -116,7 +116,8 @@ Status write_box_glb(const std::string& path, float edge) {
   return ok_status();
 }
 
-// Median of the valid depth samples in the central quarter, metres; 0 when none.
+// 10th percentile of the valid depth samples in the central quarter (the nearest real surface
+// there, robust to a few outliers), metres; 0 when none.
 double central_depth_m(const InputFrame& f, double depth_scale) {
   std::vector<uint16_t> v;
   const ImageU16& d = f.depth;
@@ -124,8 +125,8 @@ double central_depth_m(const InputFrame& f, double depth_scale) {
     for (int x = d.width * 3 / 8; x < d.width * 5 / 8; ++x)
       if (*d.at(x, y)) v.push_back(*d.at(x, y));
   if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
-  return double(v[v.size() / 2]) / depth_scale;
+  std::nth_element(v.begin(), v.begin() + long(v.size() / 10), v.end());
+  return double(v[v.size() / 10]) / depth_scale;
 }
 
 Pose fixed_camera_pose() {
@@ -139,7 +140,8 @@ SceneDesc default_scene(const std::string& glb, double depth_m) {
   s.path = "(mrgi live default scene)";
   VirtualObjectDesc box;
   box.gltf = glb;
-  const double d = depth_m > 0.0 ? std::clamp(0.85 * depth_m, 0.4, 3.0) : 1.0;
+  // In front of the nearest central surface, and no farther than 1.2 m so the box stays visible.
+  const double d = depth_m > 0.0 ? std::clamp(0.8 * depth_m, 0.4, 1.2) : 1.0;
   box.placement.position = glm::vec3(0.0f, 0.0f, float(-d));  // straight ahead of the fixed camera
   box.placement.rotation = glm::angleAxis(glm::radians(30.0f), glm::vec3(0, 1, 0)) *
                            glm::angleAxis(glm::radians(20.0f), glm::vec3(1, 0, 0));
@@ -147,7 +149,7 @@ SceneDesc default_scene(const std::string& glb, double depth_m) {
   LightDesc sun;
   sun.type = LightType::Directional;
   sun.real = true;
-  sun.direction = glm::normalize(glm::vec3(0.3f, -1.0f, -0.4f));
+  sun.direction = glm::normalize(glm::vec3(0.3f, -0.7f, -0.65f));  // from above and behind the camera
   sun.intensity = 3.0f;
   s.lights.push_back(sun);
   return s;
