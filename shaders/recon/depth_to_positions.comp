@@ -1,11 +1,14 @@
 #version 460
-// Reconstruction v0, step 1: raw depth (u16) -> view-space -> world-space positions, and the
-// real albedo estimate from the camera colour, at the internal resolution.
-// 0 depth = invalid; an invalid pixel is written as all zeros and stays invalid in every later
-// step (normals, caster mesh, shading).
+// Reconstruction step 2: raw depth (u16), 3x3-median filtered, merged with the previous frame's
+// warped filtered depth (DIR paper section 4.2; recon/warp_depth.comp) -> view-space ->
+// world-space positions, and the real albedo estimate from the camera colour, at the internal
+// resolution. The merged depth and its weight are written for the next frame, and the warp
+// target is cleared for it. 0 depth = invalid; an invalid pixel is written as all zeros and
+// stays invalid in every later step (normals, caster mesh, shading).
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
 #include "common/frame_constants.glsl"
+#include "recon/depth_filter.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
@@ -13,9 +16,37 @@ layout(std430, set = 0, binding = 1) readonly buffer ColorWords { uint color_wor
 layout(std430, set = 0, binding = 2) readonly buffer DepthWords { uint depth_words[]; };  // u16
 layout(set = 0, binding = 3, rgba32f) writeonly uniform image2D real_position;  // xyz world, w z
 layout(set = 0, binding = 4, rgba16f) writeonly uniform image2D real_albedo;    // rgb, a valid
+layout(set = 0, binding = 5, r32ui) uniform uimage2D warped;                    // read, cleared
+layout(set = 0, binding = 6, rg32f) writeonly uniform image2D filtered_depth;   // z m, weight
+// x: 1 when `warped` holds the previous frame, y: weight cap (frames), z/w: same-surface rule
+// |z_new - z_warped| <= max(z * z_new, w metres); options.x: 1 = median on the raw depth.
+layout(push_constant) uniform Push { vec4 merge; ivec4 options; } pc;
 
 uint color_byte(uint index) { return (color_words[index >> 2] >> ((index & 3u) * 8u)) & 0xffu; }
 uint depth_value(uint index) { return (depth_words[index >> 1] >> ((index & 1u) * 16u)) & 0xffffu; }
+
+// Spatial step before the temporal merge: the median of the valid raw depths in the 3x3
+// neighbourhood of a valid pixel. Why: the sample's Kinect-like depth has single-pixel
+// outliers and disparity-quantisation steps that a running average only dilutes over many
+// frames (and the first frame has no history at all); a median removes the outliers without
+// blurring across depth edges (it returns one of the input depths). Holes stay holes.
+uint median_depth(ivec2 c, ivec2 size) {
+  uint centre = depth_value(uint(c.y * size.x + c.x));
+  if (centre == 0u) return 0u;
+  uint v[9];
+  int n = 0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      ivec2 q = c + ivec2(dx, dy);
+      if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
+      uint d = depth_value(uint(q.y * size.x + q.x));
+      if (d == 0u) continue;
+      int i = n++;
+      while (i > 0 && v[i - 1] > d) { v[i] = v[i - 1]; --i; }  // insertion sort
+      v[i] = d;
+    }
+  return n < 3 ? centre : v[n / 2];
+}
 
 // Nearest pixel of a camera with intrinsics k and size for a ray direction (camera space, z=1);
 // (-1, -1) outside the image.
@@ -39,12 +70,37 @@ void main() {
   // which would invent depths between a foreground and a background surface).
   vec3 ray = unproject_pinhole(vec2(pixel), 1.0f, frame.internal_k);
   ivec2 dp = nearest_pixel(ray, frame.depth_k, depth_size);
-  float z = 0.0f;
+  float z_new = 0.0f;
   if (dp.x >= 0) {
-    uint raw = depth_value(uint(dp.y * depth_size.x + dp.x));
-    z = raw == 0u ? 0.0f : float(raw) / frame.camera.x;
+    uint raw = pc.options.x != 0 ? median_depth(dp, depth_size)
+                                 : depth_value(uint(dp.y * depth_size.x + dp.x));
+    z_new = raw == 0u ? 0.0f : float(raw) / frame.camera.x;
   }
-  if (!(z > 0.0f) || isinf(z)) {
+  if (!(z_new > 0.0f) || isinf(z_new)) z_new = 0.0f;
+
+  // Merge (KinectFusion-style weighted running average, DIR section 4.2): same surface ->
+  // average with the warped history, weight + 1 up to the cap (so the filter becomes an
+  // exponential average that still follows slow changes); different surfaces -> the new depth
+  // only (no smearing of moved geometry); a hole in the new depth keeps the warped depth with
+  // one weight less, so a filled hole fades out after `cap` frames unless seen again.
+  vec2 old = vec2(0.0f);
+  if (pc.merge.x > 0.5f) old = unpack_warped(imageLoad(warped, pixel).x);
+  imageStore(warped, pixel, uvec4(MRGI_WARP_EMPTY));  // ready for the next frame's warp
+  float z = z_new, weight = z_new > 0.0f ? 1.0f : 0.0f;
+  if (old.x > 0.0f && old.y >= 1.0f) {
+    if (z_new > 0.0f) {
+      float tolerance = max(pc.merge.z * z_new, pc.merge.w);
+      if (abs(z_new - old.x) <= tolerance) {
+        z = (old.x * old.y + z_new) / (old.y + 1.0f);
+        weight = min(old.y + 1.0f, pc.merge.y);
+      }
+    } else if (old.y > 1.0f) {
+      z = old.x;
+      weight = old.y - 1.0f;
+    }
+  }
+  imageStore(filtered_depth, pixel, vec4(z, weight, 0.0f, 0.0f));
+  if (!(z > 0.0f)) {
     imageStore(real_position, pixel, vec4(0.0f));
     imageStore(real_albedo, pixel, vec4(0.0f));
     return;

@@ -1,8 +1,12 @@
 #version 460
-// Reconstruction v0, step 2: normals from neighbouring world positions (DIR paper section 4.2):
-//   N(u,v) = (V(u+1,v) - V(u,v)) x (V(u,v+1) - V(u,v)).
-// Where a forward neighbour is invalid or across a depth discontinuity the backward difference
-// is used instead (V(u,v) - V(u-1,v)); with neither, the normal faces the camera. Normals are
+// Reconstruction step 3: normals from neighbouring (temporally filtered) world positions, the
+// DIR paper's cross product of two tangents (section 4.2):
+//   N(u,v) = (V(u+1,v) - V(u,v)) x (V(u,v+1) - V(u,v)),
+// with the tangents taken as central differences over +-radius pixels where both ends lie on
+// the centre's surface. Why the wider stencil: the angular error of a difference tangent is
+// depth noise / baseline, so a 2r-pixel baseline cuts it by 2r at the cost of rounding normals
+// within r pixels of a crease. Where that fails the one-pixel forward difference is used, then
+// the backward one (V(u,v) - V(u-1,v)); with none, the normal faces the camera. Normals are
 // oriented towards the camera (a surface seen by the camera faces it).
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
@@ -12,6 +16,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
 layout(set = 0, binding = 1, rgba32f) readonly uniform image2D real_position;
 layout(set = 0, binding = 2, rgba16f) writeonly uniform image2D real_normal;  // xyz, w valid
+layout(push_constant) uniform Push { ivec4 stencil; } pc;  // x: central-difference radius >= 1
 
 ivec2 g_size;
 
@@ -26,10 +31,17 @@ bool neighbour(ivec2 p, float z0, out vec3 pos) {
   return true;
 }
 
-// Difference along one image axis: forward if possible, else backward.
+// Difference along one image axis: central over +-radius if possible, else forward, else
+// backward.
 bool axis_difference(ivec2 pixel, ivec2 step, vec4 centre, out vec3 d) {
-  vec3 q;
+  vec3 q, r;
   d = vec3(0.0f);
+  int radius = max(pc.stencil.x, 1);
+  if (radius > 1 && neighbour(pixel + step * radius, centre.w, q) &&
+      neighbour(pixel - step * radius, centre.w, r)) {
+    d = q - r;
+    return true;
+  }
   if (neighbour(pixel + step, centre.w, q)) { d = q - centre.xyz; return true; }
   if (neighbour(pixel - step, centre.w, q)) { d = centre.xyz - q; return true; }
   return false;

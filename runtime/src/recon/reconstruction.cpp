@@ -11,21 +11,40 @@ namespace {
 size_t words_bytes(size_t bytes) { return (bytes + 3) / 4 * 4; }
 
 Expected<gpu::ImageHandle> internal_image(gpu::FrameGraph& graph, const char* name, VkFormat format,
-                                          VkImageUsageFlags usage) {
+                                          VkImageUsageFlags usage, bool history = false) {
   gpu::ImageDesc d;
   d.name = name;
   d.format = format;
+  d.history = history;
   d.size_mode = gpu::SizeMode::OutputRelative;
   d.scale = 1.0f;
   d.follows_render_scale = true;
   return graph.create_image(d, usage);
 }
 
+Status check_settings(const ReconstructionSettings& s) {
+  const char* where = "recon/reconstruction.cpp ReconstructionSettings";
+  if (!(s.max_weight >= 1.0f && s.max_weight <= 255.0f))
+    return fail(ErrorKind::BadUsage,
+                std::string(where) + ".max_weight must be in [1, 255] (frames, packed in 8 bits)");
+  if (!(s.same_surface_relative >= 0.0f && s.same_surface_relative <= 1.0f) ||
+      !(s.same_surface_absolute >= 0.0f && s.same_surface_absolute <= 1.0f))
+    return fail(ErrorKind::BadUsage,
+                std::string(where) + ".same_surface_relative/_absolute must be in [0, 1]");
+  if (s.normal_radius < 1 || s.normal_radius > 8)
+    return fail(ErrorKind::BadUsage,
+                std::string(where) + ".normal_radius must be in [1, 8] pixels");
+  return ok_status();
+}
+
 }  // namespace
 
 Expected<Reconstruction> Reconstruction::create(gpu::Context& context, gpu::FrameGraph& graph,
-                                                const Intrinsics& color, const Intrinsics& depth) {
+                                                const Intrinsics& color, const Intrinsics& depth,
+                                                const ReconstructionSettings& settings) {
+  MRGI_TRY(check_settings(settings));
   Reconstruction r;
+  r.settings_ = settings;
   r.color_bytes_ = size_t(color.width) * color.height * 3;
   r.depth_bytes_ = size_t(depth.width) * depth.height * 2;
   gpu::BufferDesc cb{"color_upload", words_bytes(r.color_bytes_), gpu::MemoryUsage::Upload, true};
@@ -37,7 +56,9 @@ Expected<Reconstruction> Reconstruction::create(gpu::Context& context, gpu::Fram
   if (!d) return d.error();
   r.depth_upload_ = *d;
 
-  const VkImageUsageFlags usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+  // Transfer source: tests and debug tools read the reconstruction back.
+  const VkImageUsageFlags usage =
+      VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
   auto p = internal_image(graph, "real_position", VK_FORMAT_R32G32B32A32_SFLOAT, usage);
   if (!p) return p.error();
   r.position_ = *p;
@@ -47,6 +68,13 @@ Expected<Reconstruction> Reconstruction::create(gpu::Context& context, gpu::Fram
   auto a = internal_image(graph, "real_albedo", VK_FORMAT_R16G16B16A16_SFLOAT, usage);
   if (!a) return a.error();
   r.albedo_ = *a;
+  auto fd = internal_image(graph, "recon_filtered_depth", VK_FORMAT_R32G32_SFLOAT, usage, true);
+  if (!fd) return fd.error();
+  r.filtered_depth_ = *fd;
+  auto wp = internal_image(graph, "recon_warped_depth", VK_FORMAT_R32_UINT,
+                           VK_IMAGE_USAGE_STORAGE_BIT, true);
+  if (!wp) return wp.error();
+  r.warped_ = *wp;
 
   const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
   const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
@@ -54,24 +82,74 @@ Expected<Reconstruction> Reconstruction::create(gpu::Context& context, gpu::Fram
   auto pos_spv = gpu::shader_spirv("recon/depth_to_positions.comp");
   if (!pos_spv) return pos_spv.error();
   auto pp = gpu::create_compute_pipeline(
-      context, {"recon_positions", *pos_spv, {{ubo}, {ssbo}, {ssbo}, {img}, {img}}, 0});
+      context, {"recon_positions", *pos_spv, {{ubo}, {ssbo}, {ssbo}, {img}, {img}, {img}, {img}},
+                sizeof(MergePush)});
   if (!pp) return pp.error();
   r.positions_pipeline_ = gpu::PipelineHandle(context, std::move(*pp));
   auto nrm_spv = gpu::shader_spirv("recon/normals.comp");
   if (!nrm_spv) return nrm_spv.error();
-  auto np = gpu::create_compute_pipeline(context, {"recon_normals", *nrm_spv, {{ubo}, {img}, {img}}, 0});
+  auto np = gpu::create_compute_pipeline(
+      context, {"recon_normals", *nrm_spv, {{ubo}, {img}, {img}}, sizeof(glm::ivec4)});
   if (!np) return np.error();
   r.normals_pipeline_ = gpu::PipelineHandle(context, std::move(*np));
+  auto warp_spv = gpu::shader_spirv("recon/warp_depth.comp");
+  if (!warp_spv) return warp_spv.error();
+  auto wpp = gpu::create_compute_pipeline(
+      context, {"recon_warp", *warp_spv, {{ubo}, {img}, {img}}, sizeof(glm::mat4)});
+  if (!wpp) return wpp.error();
+  r.warp_pipeline_ = gpu::PipelineHandle(context, std::move(*wpp));
   return r;
 }
 
-void Reconstruction::upload(const gpu::FrameGraph& graph, const InputFrame& frame) const {
+void Reconstruction::upload(const gpu::FrameGraph& graph, const InputFrame& frame) {
   std::memcpy(graph.mapped(color_upload_, graph.slot()), frame.color.data.data(), color_bytes_);
   std::memcpy(graph.mapped(depth_upload_, graph.slot()), frame.depth.data.data(), depth_bytes_);
+  // Same rule as the runtime's frame constants: no pose = the last known one (not moved).
+  if (frame.pose) {
+    pose_ = frame.pose->matrix();
+  }
 }
 
 void Reconstruction::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_constants) {
   frame_constants_ = frame_constants;
+  const VkExtent2D extent = graph.extent(position_);
+  // The history is in pixels of the previous internal resolution: after a render-scale change
+  // it is dropped rather than warped with the wrong intrinsics.
+  const bool warp = settings_.temporal && have_history_ &&
+                    extent.width == history_extent_.width &&
+                    extent.height == history_extent_.height;
+  // Previous camera -> world -> current camera (the DIR paper's T_warp, eq. 12, with poses as
+  // camera-to-world), in double so small motions do not vanish in float round-off.
+  const glm::dmat4 previous_to_current = glm::inverse(pose_) * previous_pose_;
+  previous_to_current_ = glm::mat4(previous_to_current);
+  merge_push_.merge = glm::vec4(warp ? 1.0f : 0.0f, settings_.max_weight,
+                                settings_.same_surface_relative, settings_.same_surface_absolute);
+  merge_push_.options = glm::ivec4(settings_.median ? 1 : 0, 0, 0, 0);
+  normal_push_ = glm::ivec4(settings_.normal_radius, 0, 0, 0);
+  previous_pose_ = pose_;
+  have_history_ = true;
+  history_extent_ = extent;
+
+  if (warp) {
+    graph.add_pass(
+        "recon_warp", gpu::PassKind::Compute,
+        [this](gpu::PassBuilder& b) {
+          b.read(frame_constants_, gpu::Access::UniformRead);
+          b.read(filtered_depth_, gpu::Access::StorageRead);
+          b.write(warped_, gpu::Access::StorageReadWrite);
+        },
+        [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
+          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, warp_pipeline_->pipeline);
+          gpu::DescriptorPush()
+              .uniform_buffer(0, pass.buffer(frame_constants_))
+              .storage_image(1, pass.view(filtered_depth_))
+              .storage_image(2, pass.view(warped_))
+              .push(pass.context(), cmd, *warp_pipeline_);
+          const VkExtent2D e = pass.extent(filtered_depth_);
+          gpu::dispatch_2d(cmd, *warp_pipeline_, &previous_to_current_,
+                           sizeof(previous_to_current_), e.width, e.height);
+        });
+  }
   graph.add_pass(
       "recon_positions", gpu::PassKind::Compute,
       [this](gpu::PassBuilder& b) {
@@ -80,6 +158,8 @@ void Reconstruction::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_cons
         b.read(depth_upload_, gpu::Access::StorageRead);
         b.write(position_, gpu::Access::StorageWrite);
         b.write(albedo_, gpu::Access::StorageWrite);
+        b.write(warped_, gpu::Access::StorageReadWrite);
+        b.write(filtered_depth_, gpu::Access::StorageWrite);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, positions_pipeline_->pipeline);
@@ -89,9 +169,12 @@ void Reconstruction::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_cons
             .storage_buffer(2, pass.buffer(depth_upload_))
             .storage_image(3, pass.view(position_))
             .storage_image(4, pass.view(albedo_))
+            .storage_image(5, pass.view(warped_))
+            .storage_image(6, pass.view(filtered_depth_))
             .push(pass.context(), cmd, *positions_pipeline_);
         const VkExtent2D e = pass.extent(position_);
-        gpu::dispatch_2d(cmd, *positions_pipeline_, nullptr, 0, e.width, e.height);
+        gpu::dispatch_2d(cmd, *positions_pipeline_, &merge_push_, sizeof(merge_push_), e.width,
+                         e.height);
       });
   graph.add_pass(
       "recon_normals", gpu::PassKind::Compute,
@@ -108,7 +191,8 @@ void Reconstruction::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_cons
             .storage_image(2, pass.view(normal_))
             .push(pass.context(), cmd, *normals_pipeline_);
         const VkExtent2D e = pass.extent(normal_);
-        gpu::dispatch_2d(cmd, *normals_pipeline_, nullptr, 0, e.width, e.height);
+        gpu::dispatch_2d(cmd, *normals_pipeline_, &normal_push_, sizeof(normal_push_), e.width,
+                         e.height);
       });
 }
 

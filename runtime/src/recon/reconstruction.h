@@ -1,29 +1,51 @@
-// Reconstruction v0 (DESIGN.md "One frame, as data"): the real G-buffer from one RGB-D frame.
-//   upload          colour (sRGB8) and depth (u16) copied into this frame slot's upload buffers
-//   recon_positions depth -> view space (depth intrinsics, depth_scale; 0 = invalid) -> world
-//                   (frame pose); albedo from the camera colour (DIR approximation)
-//   recon_normals   normals from neighbouring positions (DIR eq. in section 4.2) with a
-//                   backward-difference fallback at holes and depth edges, facing the camera
+// Reconstruction (DESIGN.md "One frame, as data"): the real G-buffer from the RGB-D stream, with
+// the DIR paper's temporal depth filter (section 4.2, eq. 11-14).
+//   upload          colour (sRGB8) and depth (u16) copied into this frame slot's upload buffers;
+//                   the pose change since the previous frame is computed here (CPU, double)
+//   recon_warp      the previous frame's filtered depth + weight (history image) forward-
+//                   projected into this view (atomicMin scatter); skipped on the first frame,
+//                   after a render-scale change, or when settings.temporal is off
+//   recon_positions raw depth (3x3 median) merged with the warped depth (weighted running
+//                   average; new depth alone where the two are different surfaces) -> view
+//                   space -> world (frame pose); albedo from the camera colour (DIR
+//                   approximation); writes the filtered depth + weight for the next frame
+//   recon_normals   normals from neighbouring positions (DIR eq. in section 4.2) as central
+//                   differences over +-normal_radius pixels, one-pixel fallbacks at holes and
+//                   depth edges, facing the camera
 // Output images (internal resolution = output x render scale): real_position (RGBA32F: xyz
 // world, w depth in metres; all 0 = invalid), real_normal (RGBA16F: xyz, w 1 valid),
 // real_albedo (RGBA16F: linear rgb, w 1 valid). Invalid stays invalid in every later step.
-// No temporal filtering yet (the DIR paper's warp-and-merge is not in v0).
+// A frame without a pose is treated as not moved (the runtime keeps the previous pose for it).
 #pragma once
 #include "gpu/frame_graph.h"
 #include "gpu/pipelines.h"
 #include "mrgi/frame.h"
 
+#include <glm/glm.hpp>
+
 namespace mrgi::recon {
+
+struct ReconstructionSettings {
+  bool temporal = true;             // warp-and-merge with the previous frames (DIR 4.2)
+  float max_weight = 16.0f;         // frames: cap of the running average's weight, [1, 255]
+  // Two depths are one surface when |z_new - z_warped| <= max(relative x z_new, absolute m):
+  // a few sigma of Kinect noise plus disparity steps at 1-3 m (~1-2 cm at 2 m).
+  float same_surface_relative = 0.03f;
+  float same_surface_absolute = 0.02f;  // metres
+  bool median = true;               // 3x3 median of the raw depth before the merge
+  int normal_radius = 2;            // pixels: central-difference half-width for normals, [1, 8]
+};
 
 class Reconstruction {
  public:
   // Buffers sized for the colour and depth images; images allocated at the output size.
   static Expected<Reconstruction> create(gpu::Context& context, gpu::FrameGraph& graph,
-                                         const Intrinsics& color, const Intrinsics& depth);
+                                         const Intrinsics& color, const Intrinsics& depth,
+                                         const ReconstructionSettings& settings = {});
   // Copies the frame's images into the current slot's upload buffers (sizes checked by the
-  // caller). Call between FrameGraph::begin_frame and submit.
-  void upload(const gpu::FrameGraph& graph, const InputFrame& frame) const;
-  // Adds recon_positions and recon_normals.
+  // caller) and takes the frame's pose. Call between FrameGraph::begin_frame and submit.
+  void upload(const gpu::FrameGraph& graph, const InputFrame& frame);
+  // Adds recon_warp (when there is a history), recon_positions and recon_normals.
   void record(gpu::FrameGraph& graph, gpu::BufferHandle frame_constants);
 
   gpu::BufferHandle color_upload() const { return color_upload_; }
@@ -31,12 +53,27 @@ class Reconstruction {
   gpu::ImageHandle position() const { return position_; }
   gpu::ImageHandle normal() const { return normal_; }
   gpu::ImageHandle albedo() const { return albedo_; }
+  // RG32F history: filtered depth (metres, 0 = invalid) and its weight (frames).
+  gpu::ImageHandle filtered_depth() const { return filtered_depth_; }
 
  private:
   gpu::BufferHandle color_upload_, depth_upload_, frame_constants_;
-  gpu::ImageHandle position_, normal_, albedo_;
-  gpu::PipelineHandle positions_pipeline_, normals_pipeline_;
+  gpu::ImageHandle position_, normal_, albedo_, filtered_depth_, warped_;
+  gpu::PipelineHandle warp_pipeline_, positions_pipeline_, normals_pipeline_;
   size_t color_bytes_ = 0, depth_bytes_ = 0;
+  ReconstructionSettings settings_;
+  // Poses (camera-to-world) of this frame and the last recorded one; the history is usable
+  // when a frame was recorded before at the same internal extent.
+  glm::dmat4 pose_{1.0}, previous_pose_{1.0};
+  bool have_history_ = false;
+  VkExtent2D history_extent_{0, 0};
+  // Push constants, filled in record() (kept here so the callbacks need no allocation).
+  glm::mat4 previous_to_current_{1.0f};
+  struct MergePush {
+    glm::vec4 merge;
+    glm::ivec4 options;
+  } merge_push_{};
+  glm::ivec4 normal_push_{2, 0, 0, 0};
 };
 
 }  // namespace mrgi::recon
