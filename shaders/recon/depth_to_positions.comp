@@ -28,8 +28,9 @@ uint depth_value(uint index) { return (depth_words[index >> 1] >> ((index & 1u) 
 // Spatial step before the temporal merge: the median of the valid raw depths in the 3x3
 // neighbourhood of a valid pixel. Why: the sample's Kinect-like depth has single-pixel
 // outliers and disparity-quantisation steps that a running average only dilutes over many
-// frames (and the first frame has no history at all); a median removes the outliers without
-// blurring across depth edges (it returns one of the input depths). Holes stay holes.
+// frames (and the first frame has no history at all); a median of the centre's own surface
+// removes them without blurring or moving depth edges (it returns one of the input depths).
+// Holes stay holes.
 uint median_depth(ivec2 c, ivec2 size) {
   uint centre = depth_value(uint(c.y * size.x + c.x));
   if (centre == 0u) return 0u;
@@ -40,7 +41,10 @@ uint median_depth(ivec2 c, ivec2 size) {
       ivec2 q = c + ivec2(dx, dy);
       if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
       uint d = depth_value(uint(q.y * size.x + q.x));
-      if (d == 0u) continue;
+      // Same-surface neighbours only (the normals' depth-edge rule): a median over both sides
+      // of an edge would erode convex corners by a pixel and move real shadow outlines.
+      if (d == 0u || abs(float(d) - float(centre)) >
+                         MRGI_DEPTH_EDGE_RELATIVE * float(min(d, centre))) continue;
       int i = n++;
       while (i > 0 && v[i - 1] > d) { v[i] = v[i - 1]; --i; }  // insertion sort
       v[i] = d;
