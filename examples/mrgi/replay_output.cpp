@@ -1,5 +1,7 @@
 #include "replay_output.h"
 
+#include "mrgi/perf/stats.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -38,13 +40,6 @@ int lp_num_threads() {
 }
 
 }  // namespace
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const size_t rank = size_t(std::ceil(p / 100.0 * double(v.size())));
-  return v[std::clamp<size_t>(rank, 1, v.size()) - 1];
-}
 
 nlohmann::json figures_json(const ErrorFigures& f) {
   nlohmann::json j;
@@ -141,9 +136,9 @@ Status ReplayOutput::add(const FrameOutput& out, const ImageRGB8& camera, const 
 Expected<nlohmann::json> ReplayOutput::finish() {
   nlohmann::json summary;
   summary["frames"] = frame_ms_.size();
-  summary["median_frame_ms"] = percentile(frame_ms_, 50);
-  summary["p95_frame_ms"] = percentile(frame_ms_, 95);
-  summary["median_wall_ms"] = percentile(wall_ms_, 50);
+  summary["median_frame_ms"] = perf::percentile(frame_ms_, 50);
+  summary["p95_frame_ms"] = perf::percentile(frame_ms_, 95);
+  summary["median_wall_ms"] = perf::percentile(wall_ms_, 50);
   summary["frame_ms_is"] = "GPU time of the frame graph (first to last timestamp), per frame";
   summary["technique"] = meta_.technique;
   summary["level"] = meta_.level;

@@ -49,8 +49,6 @@ class ReplayOutput {
   ImageRGBA8 last_output_;
 };
 
-// Median and 95th percentile (nearest rank) of a sample; 0 for an empty one.
-double percentile(std::vector<double> v, double p);
 nlohmann::json figures_json(const ErrorFigures& f);
 // Resamples an 8-bit RGB image to w x h (bilinear), for cameras larger than the output.
 ImageRGB8 resize_rgb8(const ImageRGB8& src, int w, int h);

@@ -69,8 +69,11 @@ Status decode_mjpeg(const RawFrame& f, ImageRGB8& out) {
   const std::vector<uint8_t> jpeg = mjpeg_with_huffman_tables(f.data, f.size);
   int w = 0, h = 0, n = 0;
   uint8_t* pixels = stbi_load_from_memory(jpeg.data(), int(jpeg.size()), &w, &h, &n, 3);
-  if (!pixels)
-    return fail(ErrorKind::BadInput, describe(f) + ": corrupt JPEG data (" + stbi_failure_reason() + ")");
+  if (!pixels) {
+    // stb may have no reason to give (null), e.g. when built with STBI_NO_FAILURE_STRINGS.
+    const char* why = stbi_failure_reason();
+    return fail(ErrorKind::BadInput, describe(f) + ": corrupt JPEG data (" + (why ? why : "undecodable") + ")");
+  }
   if (w != f.width || h != f.height) {
     stbi_image_free(pixels);
     return fail(ErrorKind::BadInput, describe(f) + ": the JPEG is " + std::to_string(w) + "x" + std::to_string(h) +

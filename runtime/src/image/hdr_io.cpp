@@ -82,8 +82,10 @@ Expected<ImageRGBF> load_radiance_hdr(const std::string& path) {
   if (!bytes) return bytes.error();
   int w = 0, h = 0, channels = 0;
   float* pixels = stbi_loadf_from_memory(bytes->data(), int(bytes->size()), &w, &h, &channels, 3);
-  if (!pixels)
-    return fail(ErrorKind::BadInput, path + ": cannot decode Radiance HDR: " + stbi_failure_reason());
+  if (!pixels) {
+    const char* why = stbi_failure_reason();  // may be null (stb built without failure strings)
+    return fail(ErrorKind::BadInput, path + ": cannot decode Radiance HDR: " + (why ? why : "undecodable"));
+  }
   std::unique_ptr<float, decltype(&stbi_image_free)> owner(pixels, &stbi_image_free);
   ImageRGBF img(w, h);
   std::copy(pixels, pixels + img.data.size(), img.data.begin());
