@@ -10,7 +10,7 @@
 #include <set>
 
 #include "gpu/context.h"
-#include "floor_timer.h"
+#include "gpu/floor_pass.h"
 #include "gpu/floor_pass.h"
 #include "mrgi/perf/bench.h"
 #include "mrgi/perf/stats.h"
@@ -160,7 +160,7 @@ struct Progress {
 };
 
 Expected<RunSamples> run_one(const LoadedScene& l, const std::string& technique, int level,
-                             const BenchSettings& s, const std::string& floor_device, FloorTimer& floor,
+                             const BenchSettings& s, const std::string& floor_device, gpu::FloorTimer& floor,
                              std::vector<double>& floor_ms) {
   RuntimeSettings rs;
   rs.device = s.device;
@@ -326,7 +326,7 @@ Expected<BenchResult> run_bench(const BenchSettings& s) {
     const int w = loaded->info.color.width, h = loaded->info.color.height;
     std::vector<double> floor_ms;
     std::vector<RunSamples> runs;
-    auto floor = FloorTimer::create(ctx, uint32_t(w), uint32_t(h), uint32_t(s.floor_warmup));
+    auto floor = gpu::FloorTimer::create(ctx, uint32_t(w), uint32_t(h), uint32_t(s.floor_warmup));
     if (!floor.ok()) return fail(floor.error().kind, "floor pass (scene '" + sc.name + "'): " + floor.error().message);
     for (const auto& [t, levels] : plan)
       for (int level : levels) {

@@ -55,19 +55,17 @@ void FloorPass::add_to(FrameGraph& graph) {
   flip_ = 1 - flip_;
 }
 
-Expected<FloorMeasurement> measure_floor_pass(Context& context, uint32_t width, uint32_t height, uint32_t frames,
-                                              uint32_t warmup) {
-  if (width == 0 || height == 0 || frames == 0)
-    return fail(ErrorKind::BadUsage, "measure_floor_pass: width, height and frames must be > 0");
+Expected<FloorTimer> FloorTimer::create(Context& context, uint32_t width, uint32_t height, uint32_t warmup) {
+  if (width == 0 || height == 0) return fail(ErrorKind::BadUsage, "floor pass: width and height must be > 0");
   FrameGraphSettings fs;
   fs.max_output_width = width;
   fs.max_output_height = height;
-  fs.frames_in_flight = 2;
+  fs.frames_in_flight = 1;  // sample() waits for its frames anyway
   fs.max_passes = 4;
   auto graph = FrameGraph::create(context, fs);
   if (!graph) return graph.error();
-  auto floor = FloorPass::create(**graph);
-  if (!floor) return floor.error();
+  auto pass = FloorPass::create(**graph);
+  if (!pass) return pass.error();
   // Defined contents (a gradient) so the pass reads real data, not whatever memory held.
   std::vector<uint8_t> texels(size_t(width) * height * 4);
   for (uint32_t y = 0; y < height; ++y)
@@ -78,26 +76,46 @@ Expected<FloorMeasurement> measure_floor_pass(Context& context, uint32_t width, 
       p[2] = 128;
       p[3] = 255;
     }
-  MRGI_TRY((*graph)->upload_image(floor->source(), texels.data(), texels.size()));
-  FloorMeasurement m;
+  MRGI_TRY((*graph)->upload_image(pass->source(), texels.data(), texels.size()));
+  FloorTimer timer(std::move(graph).value(), std::move(pass).value());
+  std::vector<double> discarded;
+  MRGI_TRY(timer.sample(warmup, discarded));
+  return timer;
+}
+
+Status FloorTimer::sample(uint32_t frames, std::vector<double>& samples_ms) {
+  size_t got = 0;
   auto take = [&](const FrameTimings& t) {
-    if (t.frame_index < int64_t(warmup)) return;
     for (const PassTiming& p : t.passes)
-      if (p.name == "floor") m.samples_ms.push_back(p.gpu_ms);
+      if (p.name == "floor") {
+        samples_ms.push_back(p.gpu_ms);
+        ++got;
+      }
   };
-  for (uint32_t i = 0; i < frames + warmup; ++i) {
-    auto done = (*graph)->begin_frame();
+  for (uint32_t i = 0; i < frames; ++i) {
+    auto done = graph_->begin_frame();
     if (!done) return done.error();
     if (*done) take(**done);
-    floor->add_to(**graph);
-    MRGI_TRY((*graph)->submit());
+    pass_.add_to(*graph_);
+    MRGI_TRY(graph_->submit());
   }
-  auto rest = (*graph)->flush();
+  auto rest = graph_->flush();
   if (!rest) return rest.error();
   for (const FrameTimings& t : *rest) take(t);
-  if (m.samples_ms.size() != frames)
-    return fail(ErrorKind::Internal, "measure_floor_pass: " + std::to_string(m.samples_ms.size()) +
-                                         " timings came back for " + std::to_string(frames) + " frames");
+  if (got != frames)
+    return fail(ErrorKind::Internal, "floor pass: " + std::to_string(got) + " timings came back for " +
+                                         std::to_string(frames) + " frames");
+  return ok_status();
+}
+
+Expected<FloorMeasurement> measure_floor_pass(Context& context, uint32_t width, uint32_t height, uint32_t frames,
+                                              uint32_t warmup) {
+  if (width == 0 || height == 0 || frames == 0)
+    return fail(ErrorKind::BadUsage, "measure_floor_pass: width, height and frames must be > 0");
+  auto timer = FloorTimer::create(context, width, height, warmup);
+  if (!timer) return timer.error();
+  FloorMeasurement m;
+  MRGI_TRY(timer->sample(frames, m.samples_ms));
   std::vector<double> sorted = m.samples_ms;
   std::sort(sorted.begin(), sorted.end());
   const size_t n = sorted.size();
