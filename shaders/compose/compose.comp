@@ -23,7 +23,7 @@ layout(set = 0, binding = 4) uniform sampler2D virtual_position;  // w: virtual 
 layout(std430, set = 0, binding = 5) writeonly buffer Output { uint out_rgba8[]; };
 layout(std430, set = 0, binding = 6) writeonly buffer Mask { uint out_mask[]; };
 layout(push_constant) uniform Params {
-  vec4 compose;      // x eps (linear camera units), y alpha_max
+  vec4 compose;      // x eps (linear camera units), y alpha_max, z 1 = camera frame only
 } params;
 
 uint color_byte(uint index) { return (color_words[index >> 2] >> ((index & 3u) * 8u)) & 0xffu; }
@@ -53,6 +53,12 @@ void main() {
   vec2 f = cp - vec2(c0);
   vec3 ci = mix(mix(camera_linear(c0), camera_linear(c0 + ivec2(1, 0)), f.x),
                 mix(camera_linear(c0 + ivec2(0, 1)), camera_linear(c0 + ivec2(1, 1)), f.x), f.y);
+  uint index = uint(pixel.y * out_size.x + pixel.x);
+  if (params.compose.z > 0.5f) {  // nothing virtual in view: the solutions were not computed
+    out_rgba8[index] = packUnorm4x8(vec4(srgb_encode(clamp(ci, vec3(0.0f), vec3(1.0f))), 1.0f));
+    out_mask[index] = 0u;
+    return;
+  }
 
   // The solutions at the internal resolution, upsampled bilinearly from texels of the used
   // extent only: texels outside it hold whatever an earlier level left (possibly NaN), and a
@@ -75,7 +81,6 @@ void main() {
   vec3 out_linear = differential_compose(ci, tm_r, tm_rv, is_virtual, params.compose.x,
                                          params.compose.y);
   vec3 encoded = srgb_encode(clamp(finite(out_linear), vec3(0.0f), vec3(1.0f)));
-  uint index = uint(pixel.y * out_size.x + pixel.x);
   out_rgba8[index] = packUnorm4x8(vec4(encoded, 1.0f));
   out_mask[index] = is_virtual > 0.5f ? 1u : 0u;
 }

@@ -43,6 +43,9 @@ struct RuntimeSettings {
   // 0 = CameraSetup::exposure (capture.json). A positive value overrides it.
   double exposure = 0.0;
   int frames_in_flight = 2;            // readback latency, frames (1..3)
+  // Skip the virtual G-buffer and the technique on frames where no virtual object or its shadow
+  // can be seen (the output is then the camera frame; FrameStats::skipped says so).
+  bool skip_unaffected_frames = true;
 };
 
 struct PassTiming {

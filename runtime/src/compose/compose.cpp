@@ -74,7 +74,7 @@ void Compose::dispatch(VkCommandBuffer cmd, gpu::PassContext& pass) {
       .storage_buffer(6, pass.buffer(mask_))
       .push(ctx, cmd, *pipeline_);
   ComposePush pc;
-  pc.compose = glm::vec4(settings_.eps, settings_.alpha_max, 0.0f, 0.0f);
+  pc.compose = glm::vec4(settings_.eps, settings_.alpha_max, in_.camera_only ? 1.0f : 0.0f, 0.0f);
   gpu::dispatch_2d(cmd, *pipeline_, &pc, sizeof(pc), width_, height_);
 }
 

@@ -21,6 +21,9 @@ struct ComposeInputs {
   gpu::BufferHandle frame_constants;
   gpu::BufferHandle color_upload;
   gpu::ImageHandle lit_rv, lit_r, virtual_position;
+  // Nothing virtual affects this frame (runtime/influence.h): the output is the camera frame and
+  // the solutions, not computed this frame, are not looked at.
+  bool camera_only = false;
 };
 
 class Compose {

@@ -17,6 +17,7 @@
 #include "recon/reconstruction.h"
 #include "recon/virtual_gbuffer.h"
 #include "runtime/camera_math.h"
+#include "runtime/influence.h"
 #include "technique/scene_gpu.h"
 #include "technique/technique.h"
 
@@ -315,15 +316,31 @@ Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame)
   write_constants(frame, last_pose_, ambient_both, ambient_virtual);
   recon_->upload(*graph_, frame);
 
-  recon_->record(*graph_, frame_constants_);
-  virtual_gbuffer_->record(*graph_, frame_constants_, recon_->position());
-  technique::FrameInfo info;
-  info.frame_index = frame.index;
-  info.level = level_;
-  info.virtual_objects_present = !scene_gpu_->virtual_objects.empty();
-  MRGI_TRY(technique_->record(info, rec.skipped));
+  recon_->record(*graph_, frame_constants_);  // always: its temporal history must stay current
+  const bool has_objects = !scene_gpu_->virtual_objects.empty();
+  bool affected = has_objects;
+  for (const LightDesc& l : scene_.lights) affected = affected || !l.real;  // lights real surfaces
+  if (affected && has_objects && settings_.skip_unaffected_frames) {
+    runtime::InfluenceQuery q;
+    q.box_min = scene_gpu_->virtual_objects.bounds_min;
+    q.box_max = scene_gpu_->virtual_objects.bounds_max;
+    q.camera_to_world = last_pose_;
+    q.camera = cameras_.color;
+    affected = runtime::virtual_influence_in_view(q, scene_.lights);
+  }
+  if (affected) {
+    virtual_gbuffer_->record(*graph_, frame_constants_, recon_->position());
+    technique::FrameInfo info;
+    info.frame_index = frame.index;
+    info.level = level_;
+    info.virtual_objects_present = !scene_gpu_->virtual_objects.empty();
+    MRGI_TRY(technique_->record(info, rec.skipped));
+  } else {
+    rec.skipped.push_back(has_objects ? "technique: no virtual object or its shadow in view"
+                                      : "technique: no virtual object and no virtual lamp in the scene");
+  }
   compose_->record(*graph_, {frame_constants_, recon_->color_upload(), lit_rv_, lit_r_,
-                             virtual_gbuffer_->position()});
+                             virtual_gbuffer_->position(), !affected});
   MRGI_TRY(graph_->compile());
   MRGI_TRY(graph_->submit());
   rec.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -1,0 +1,126 @@
+// The per-frame skip of runtime/influence.h: frames where no virtual object or its shadow can be
+// seen run no virtual G-buffer and no technique, and their output must equal what the full
+// pipeline gives (the camera frame) within one 8-bit step. Validation layers on.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "mrgi/runtime.h"
+#include "runtime/influence.h"
+#include "synthetic_scene.h"
+
+namespace mrgi::test {
+namespace {
+
+runtime::InfluenceQuery camera_at_origin(glm::dvec3 lo, glm::dvec3 hi) {
+  runtime::InfluenceQuery q;
+  q.box_min = lo;
+  q.box_max = hi;
+  q.margin_m = 0.0;
+  q.camera_to_world = glm::dmat4(1.0);  // looking along +z, x right, y down
+  q.camera = Intrinsics{640, 480, 525.0, 525.0, 319.5, 239.5};
+  return q;
+}
+
+LightDesc point_lamp(glm::vec3 p, bool real = true) {
+  LightDesc l;
+  l.type = LightType::Point;
+  l.position = p;
+  l.real = real;
+  return l;
+}
+
+TEST(Influence, ObjectInViewIsInView) {
+  EXPECT_TRUE(runtime::virtual_influence_in_view(camera_at_origin({-0.1, -0.1, 2.0}, {0.1, 0.1, 2.2}), {}));
+}
+
+TEST(Influence, ObjectBesideTheViewWhoseShadowFallsIntoItIsInView) {
+  // Box 5 m to the right; a lamp further right throws its shadow to the left, into the view.
+  const auto q = camera_at_origin({5.0, -0.1, 5.0}, {5.2, 0.1, 5.2});
+  EXPECT_TRUE(runtime::virtual_influence_in_view(q, {point_lamp({10.0f, 0.0f, 5.1f})}));
+  // The same box with the lamp on the view's side throws its shadow away from the view.
+  EXPECT_FALSE(runtime::virtual_influence_in_view(q, {point_lamp({0.0f, 0.0f, 5.1f})}));
+  EXPECT_FALSE(runtime::virtual_influence_in_view(q, {}));
+}
+
+TEST(Influence, ObjectBehindTheCameraLitFromBehindIsInView) {
+  const auto q = camera_at_origin({-0.1, -0.1, -2.2}, {0.1, 0.1, -2.0});
+  EXPECT_FALSE(runtime::virtual_influence_in_view(q, {}));
+  EXPECT_TRUE(runtime::virtual_influence_in_view(q, {point_lamp({0.0f, 0.0f, -5.0f})}));
+  LightDesc sun;
+  sun.type = LightType::Directional;
+  sun.direction = {0.0f, 0.0f, -1.0f};  // light travels away from the view
+  EXPECT_FALSE(runtime::virtual_influence_in_view(q, {sun}));
+}
+
+TEST(Influence, AVirtualLampAffectsEveryFrame) {
+  const auto q = camera_at_origin({-0.1, -0.1, -2.2}, {0.1, 0.1, -2.0});
+  EXPECT_TRUE(runtime::virtual_influence_in_view(q, {point_lamp({0.0f, 0.0f, 5.0f}, false)}));
+}
+
+std::string temp_folder(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("mrgi_skip_" + name);
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+FrameOutput run_one(const SyntheticScene& s, const SceneDesc& scene, bool skips) {
+  RuntimeSettings rs;
+  rs.device.validate = true;
+  rs.technique = "baseline";
+  rs.level = 0;
+  rs.skip_unaffected_frames = skips;
+  auto rt = create_runtime(rs, s.cameras(), scene);
+  EXPECT_TRUE(rt.ok()) << rt.error().message;
+  if (!rt.ok()) return {};
+  auto a = (*rt)->process(s.frame(0));
+  EXPECT_TRUE(a.ok()) << a.error().message;
+  auto b = (*rt)->flush();
+  EXPECT_TRUE(b.ok()) << b.error().message;
+  std::vector<FrameOutput> outs;
+  if (a.ok())
+    for (auto& o : *a) outs.push_back(std::move(o));
+  if (b.ok())
+    for (auto& o : *b) outs.push_back(std::move(o));
+  EXPECT_EQ(outs.size(), 1u);
+  return outs.empty() ? FrameOutput{} : std::move(outs[0]);
+}
+
+bool reports_skip(const FrameOutput& o) {
+  for (const std::string& s : o.stats.skipped)
+    if (s.find("no virtual object or its shadow in view") != std::string::npos) return true;
+  return false;
+}
+
+TEST(FrameSkip, OutOfViewObjectSkipsTheTechniqueWithoutChangingTheOutput) {
+  const SyntheticScene s = SyntheticScene::create(temp_folder("out"));
+  SceneDesc far = s.scene;
+  for (auto& v : far.virtual_objects) v.placement.position += glm::vec3(30.0f, 0.0f, 0.0f);
+  const FrameOutput skipped = run_one(s, far, true);
+  const FrameOutput full = run_one(s, far, false);
+  ASSERT_FALSE(skipped.image.empty());
+  ASSERT_FALSE(full.image.empty());
+  EXPECT_TRUE(reports_skip(skipped));
+  EXPECT_FALSE(reports_skip(full));
+  int worst = 0;
+  for (size_t i = 0; i < full.image.data.size(); ++i)
+    worst = std::max(worst, std::abs(int(full.image.data[i]) - int(skipped.image.data[i])));
+  EXPECT_LE(worst, 1) << "skipping must not change the output beyond one 8-bit step";
+  bool ran_shadow = false;
+  for (const PassTiming& p : skipped.stats.passes) ran_shadow = ran_shadow || p.name.rfind("shadow", 0) == 0;
+  EXPECT_FALSE(ran_shadow);
+}
+
+TEST(FrameSkip, ObjectInViewIsNotSkipped) {
+  const SyntheticScene s = SyntheticScene::create(temp_folder("in"));
+  const FrameOutput o = run_one(s, s.scene, true);
+  ASSERT_FALSE(o.image.empty());
+  EXPECT_FALSE(reports_skip(o));
+  int virtual_pixels = 0;
+  for (uint8_t m : o.virtual_mask.data) virtual_pixels += m != 0;
+  EXPECT_GT(virtual_pixels, 0);
+}
+
+}  // namespace
+}  // namespace mrgi::test
