@@ -633,12 +633,12 @@ Status Context::upload_buffer(const GpuBuffer& dst, const void* data, VkDeviceSi
 
 Status Context::upload_image(const GpuImage& dst, const void* texels, VkDeviceSize size, VkImageLayout final_layout) {
   const uint32_t bpt = bytes_per_texel(dst.format);
-  const VkDeviceSize expected = VkDeviceSize(dst.extent.width) * dst.extent.height * bpt;
+  const VkDeviceSize expected = VkDeviceSize(dst.extent.width) * dst.extent.height * bpt * dst.layers;
   if (bpt == 0 || size != expected)
     return fail(ErrorKind::BadUsage, "image upload: " + std::to_string(size) + " bytes given, " +
                                          std::to_string(expected) + " expected for " +
-                                         std::to_string(dst.extent.width) + "x" + std::to_string(dst.extent.height) +
-                                         " (tightly packed mip 0, layer 0)");
+                                         std::to_string(dst.extent.width) + "x" + std::to_string(dst.extent.height) + "x" +
+                                         std::to_string(dst.layers) + " layers (tightly packed mip 0)");
   auto staging = create_buffer(size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUsage::Upload, "staging");
   if (!staging) return staging.error();
   std::memcpy(staging->mapped, texels, size);
@@ -657,7 +657,7 @@ Status Context::upload_image(const GpuImage& dst, const void* texels, VkDeviceSi
     di.pImageMemoryBarriers = &b;
     fn_.cmd_pipeline_barrier2(cmd, &di);
     VkBufferImageCopy region{};
-    region.imageSubresource = {dst.aspect, 0, 0, 1};
+    region.imageSubresource = {dst.aspect, 0, 0, dst.layers};
     region.imageExtent = {dst.extent.width, dst.extent.height, 1};
     vkCmdCopyBufferToImage(cmd, staging->buffer, dst.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
     b.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;

@@ -133,7 +133,8 @@ class Context {
   // Copies bytes into a device-local buffer through a temporary staging buffer.
   Status upload_buffer(const GpuBuffer& dst, const void* data, VkDeviceSize size,
                        VkDeviceSize dst_offset = 0);
-  // Uploads tightly packed texels into mip 0 / layer 0 and leaves the image in `final_layout`.
+  // Uploads tightly packed texels into mip 0 of every layer (layer after layer) and leaves the
+  // image in `final_layout`.
   Status upload_image(const GpuImage& dst, const void* texels, VkDeviceSize size,
                       VkImageLayout final_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
 

@@ -71,44 +71,6 @@ Expected<MeshSet> upload_meshes(gpu::Context& ctx, gpu::FrameGraph& graph, const
   return set;
 }
 
-// Uploads every layer of a layered image and leaves it SHADER_READ_ONLY_OPTIMAL.
-Status upload_layers(gpu::Context& ctx, const gpu::GpuImage& image,
-                     const std::vector<uint8_t>& texels, uint32_t side, uint32_t layers) {
-  auto staging = ctx.create_buffer(texels.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                                   gpu::MemoryUsage::Upload, "base_color_maps_staging");
-  if (!staging) return staging.error();
-  std::memcpy(staging->mapped, texels.data(), texels.size());
-  Status st = ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-    b.srcStageMask = VK_PIPELINE_STAGE_2_NONE;
-    b.dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-    b.dstAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.image = image.image;
-    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, layers};
-    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-    dep.imageMemoryBarrierCount = 1;
-    dep.pImageMemoryBarriers = &b;
-    vkCmdPipelineBarrier2(cmd, &dep);
-    VkBufferImageCopy region{};
-    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, layers};
-    region.imageExtent = {side, side, 1};
-    vkCmdCopyBufferToImage(cmd, staging->buffer, image.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                           1, &region);
-    b.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-    b.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-    b.dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-    b.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
-    b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-    b.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-    vkCmdPipelineBarrier2(cmd, &dep);
-  });
-  ctx.destroy(*staging);
-  return st;
-}
-
 }  // namespace
 
 void MeshSet::draw(VkCommandBuffer cmd, const gpu::PassContext& pass,
@@ -200,7 +162,7 @@ Expected<std::unique_ptr<SceneGpu>> SceneGpu::create(gpu::Context& context, gpu:
   auto image = context.create_image(desc);
   if (!image) return image.error();
   out->texture_array_ = *image;
-  MRGI_TRY(upload_layers(context, out->texture_array_, texels, side, layers));
+  MRGI_TRY(context.upload_image(out->texture_array_, texels.data(), texels.size()));
   out->views_ = ImageViews(context.device());
   auto view = out->views_.create(out->texture_array_, VK_IMAGE_VIEW_TYPE_2D_ARRAY, 0, layers);
   if (!view) return view.error();
