@@ -3,11 +3,13 @@
 #pragma once
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "mrgi/expected.h"
 #include "mrgi/frame.h"
+#include "mrgi/light_estimate.h"
 #include "mrgi/scene.h"
 
 namespace mrgi {
@@ -35,7 +37,7 @@ Expected<std::vector<DeviceInfo>> list_devices(const DeviceSettings& settings);
 // Level "last" in the CLI resolves to technique_level_count(name) - 1.
 struct RuntimeSettings {
   DeviceSettings device;
-  std::string technique = "baseline";  // baseline | (later) dir, dlpv, dvct, ssrt
+  std::string technique = "baseline";  // baseline | ssrt (later: dir, dlpv, dvct, specular)
   int level = 0;                       // 0 = the technique's best quality
   int output_width = 0;                // 0 = the colour camera's width
   int output_height = 0;
@@ -70,6 +72,10 @@ struct FrameOutput {
   // Output size; 255 where a virtual object is seen (composited as TM(L_rv)), 0 on real pixels.
   // For RDE over real / virtual pixels (metrics.h).
   Image<uint8_t, 1> virtual_mask;
+  // The real-world light estimated from the camera image, for techniques that estimate it
+  // (ssrt); empty for the others. The newest estimate when this frame completed: it was solved
+  // from an earlier frame (LightEstimate::frame_index says which).
+  std::optional<LightEstimate> light;
 };
 
 class Runtime {

@@ -189,6 +189,12 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   shared.virtual_albedo = virtual_gbuffer_->albedo();
   shared.lit_rv = lit_rv_;
   shared.lit_r = lit_r_;
+  shared.color_upload = recon_->color_upload();
+  shared.depth_upload = recon_->depth_upload();
+  shared.color_intrinsics = c;
+  shared.depth_intrinsics = d;
+  shared.depth_scale = cameras_.depth_scale;
+  shared.depth_registered = same_intrinsics(c, d);
   auto tech = (*entry)->create(shared);
   if (!tech) return tech.error();
   technique_ = std::move(*tech);
@@ -334,6 +340,8 @@ Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame)
     info.frame_index = frame.index;
     info.level = level_;
     info.virtual_objects_present = !scene_gpu_->virtual_objects.empty();
+    info.camera_to_world = last_pose_;
+    info.input = &frame;
     MRGI_TRY(technique_->record(info, rec.skipped));
   } else {
     rec.skipped.push_back(has_objects ? "technique: no virtual object or its shadow in view"
@@ -360,6 +368,7 @@ Expected<FrameOutput> RuntimeImpl::collect(const gpu::FrameTimings& timings) {
   out.stats.skipped = rec.skipped;
   for (const std::string& c : timings.culled) out.stats.skipped.push_back(c + ": culled (nothing reads it)");
   out.stats.notes = rec.notes;
+  if (const LightEstimate* e = technique_->light_estimate()) out.light = *e;
   rec.used = false;
   return out;
 }

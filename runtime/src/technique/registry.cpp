@@ -1,6 +1,7 @@
 #include <string>
 
 #include "technique/baseline/baseline.h"
+#include "technique/ssrt/ssrt.h"
 #include "technique/technique.h"
 
 namespace mrgi::technique {
@@ -10,6 +11,7 @@ namespace mrgi::technique {
 const std::vector<TechniqueEntry>& registered_techniques() {
   static const std::vector<TechniqueEntry> entries = {
       {"baseline", &baseline_ladder, &create_baseline},
+      {"ssrt", &ssrt_ladder, &create_ssrt},
   };
   return entries;
 }
@@ -25,7 +27,6 @@ Expected<const TechniqueEntry*> find_technique(const std::string& name) {
       {"dir", "Differential Instant Radiosity (VPLs, imperfect shadow maps)"},
       {"dlpv", "Delta Light Propagation Volumes"},
       {"dvct", "Delta Voxel Cone Tracing"},
-      {"ssrt", "image-space radiance transfer with probeless SH light estimation"},
       {"specular", "mirrors, glass and caustics inside DIR"},
   };
   for (const auto& [planned_name, what] : planned)

@@ -17,6 +17,8 @@
 
 #include "gpu/frame_graph.h"
 #include "mrgi/expected.h"
+#include "mrgi/frame.h"
+#include "mrgi/light_estimate.h"
 #include "mrgi/runtime.h"
 #include "mrgi/scene.h"
 
@@ -56,6 +58,13 @@ struct SharedResources {
   gpu::ImageHandle virtual_position, virtual_normal, virtual_albedo;
   // The solutions the technique writes (RGBA16F, internal resolution, linear radiance).
   gpu::ImageHandle lit_rv, lit_r;
+  // This frame's raw inputs as uploaded by recon/ (per-slot buffers): colour sRGB8 packed as
+  // 3 bytes per pixel (colour intrinsics' size), depth u16 (depth intrinsics' size, depth_scale
+  // units per metre, 0 = no measurement), and the cameras they come from.
+  gpu::BufferHandle color_upload, depth_upload;
+  Intrinsics color_intrinsics, depth_intrinsics;
+  double depth_scale = 5000.0;
+  bool depth_registered = true;  // depth pixels align with colour pixels (same intrinsics)
 };
 
 // What record() needs to know about the current frame.
@@ -63,6 +72,8 @@ struct FrameInfo {
   int64_t frame_index = 0;
   int level = 0;
   bool virtual_objects_present = false;
+  glm::dmat4 camera_to_world{1.0};   // this frame's pose (the previous one when none was given)
+  const InputFrame* input = nullptr; // the host copy of this frame's images (valid during record)
 };
 
 class Technique {
@@ -72,6 +83,9 @@ class Technique {
   virtual const std::vector<QualityLevel>& levels() const = 0;
   // Records this frame's passes for `info.level`; appends "pass: reason" for each pass left out.
   virtual Status record(const FrameInfo& info, std::vector<std::string>& skipped) = 0;
+  // The real-world light a technique estimates (ssrt), or nullptr for techniques that take it
+  // from the scene description.
+  virtual const LightEstimate* light_estimate() const { return nullptr; }
 };
 
 using TechniqueFactory = Expected<std::unique_ptr<Technique>> (*)(const SharedResources&);

@@ -85,6 +85,7 @@ class Ssrt final : public Technique {
   Status init();
   Status record(const FrameInfo& info, std::vector<std::string>& skipped) override;
   const LightEstimate& estimate() const { return estimator_->estimate(); }
+  const LightEstimate* light_estimate() const override { return &estimator_->estimate(); }
 
  private:
   void consume_readback(std::vector<std::string>& notes);
