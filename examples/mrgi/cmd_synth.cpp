@@ -15,6 +15,7 @@ struct SynthArgs {
   std::string description, out;
   std::optional<int> frames, spp, width, height, threads;
   std::optional<uint64_t> seed, noise_floor_seed;
+  std::string reference_format = "delta";
 };
 
 void run_synth(const SynthArgs& a) {
@@ -28,6 +29,7 @@ void run_synth(const SynthArgs& a) {
   options.seed = a.seed;
   options.threads = a.threads.value_or(0);
   options.noise_floor_seed = a.noise_floor_seed;
+  options.references = a.reference_format == "plain" ? ReferenceStorage::Plain : ReferenceStorage::Delta;
   options.progress = [](const std::string& what, size_t done, size_t total, double elapsed) {
     progress(what, done, total, elapsed);
   };
@@ -57,6 +59,10 @@ void setup(CLI::App& app) {
   cmd->add_option("--height", args->height, "image height; intrinsics are scaled")->check(CLI::Range(1, 8192));
   cmd->add_option("--noise-floor-seed", args->noise_floor_seed,
                   "also render frame 0 with this seed and print the reference noise floor (RDE)");
+  cmd->add_option("--reference-format", args->reference_format,
+                  "how references are stored: delta (reference/NNNNNN.delta.png, (reference - rgb) mod 256, "
+                  "lossless and smaller; default) or plain (reference/NNNNNN.png)")
+      ->check(CLI::IsMember({"delta", "plain"}));
   cmd->add_option("--threads", args->threads, "render threads (default: all cores)")->check(CLI::Range(1, 256));
   cmd->callback([args] { run_synth(*args); });
 }

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "mrgi/platform/capture.h"
+#include "mrgi/platform/capture_references.h"
 #include "mrgi/reference/description.h"
 #include "mrgi/reference/synth.h"
 
@@ -172,6 +173,45 @@ TEST_F(SynthTest, TwoSynthsAreBitIdenticalAndReadable) {
   EXPECT_GT(differing_inside, virtual_pixels / 2);
   EXPECT_GT(equal_outside, outside / 4);
   EXPECT_GT(depth_pixels, mask->pixel_count() / 4);  // the upper part sees past the floor
+}
+
+// References are stored as deltas by default; a plain render converted afterwards (how the suite's
+// older captures were converted) must give the very same files.
+TEST_F(SynthTest, DeltaReferencesEqualConvertedPlainOnes) {
+  auto d = load_scene_description(write("tiny.json", tiny()));
+  ASSERT_TRUE(d.ok()) << d.error().message;
+  SynthOptions o;
+  o.threads = 2;
+  o.frames = 2;
+  o.spp = 2;
+  o.out = (dir_ / "delta").string();
+  ASSERT_TRUE(synthesize_capture(*d, o).ok());
+  o.out = (dir_ / "plain").string();
+  o.references = ReferenceStorage::Plain;
+  ASSERT_TRUE(synthesize_capture(*d, o).ok());
+  EXPECT_TRUE(fs::exists(dir_ / "delta" / "reference" / "000001.delta.png"));
+  EXPECT_TRUE(fs::exists(dir_ / "plain" / "reference" / "000001.png"));
+  auto plain = CaptureReader::open((dir_ / "plain").string());
+  ASSERT_TRUE(plain.ok()) << plain.error().message;
+  auto plain_ref = plain->read_reference(1);
+  ASSERT_TRUE(plain_ref.ok());
+
+  auto converted = convert_capture_references((dir_ / "plain").string(), ReferenceStorage::Delta);
+  ASSERT_TRUE(converted.ok()) << converted.error().message;
+  EXPECT_EQ(converted->converted, 2u);
+  size_t files = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir_ / "delta")) {
+    if (!e.is_regular_file()) continue;
+    const fs::path rel = fs::relative(e.path(), dir_ / "delta");
+    EXPECT_EQ(read_all(e.path()), read_all(dir_ / "plain" / rel)) << rel;
+    ++files;
+  }
+  EXPECT_GE(files, 2u * 5u);
+  auto delta = CaptureReader::open((dir_ / "delta").string());
+  ASSERT_TRUE(delta.ok()) << delta.error().message;
+  auto delta_ref = delta->read_reference(1);
+  ASSERT_TRUE(delta_ref.ok()) << delta_ref.error().message;
+  EXPECT_EQ(delta_ref->data, plain_ref->data);
 }
 
 TEST_F(SynthTest, ImageEnvironmentIsCopiedIntoTheCapture) {

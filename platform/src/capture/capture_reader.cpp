@@ -11,13 +11,16 @@
 //   env        each colour frame takes the env image with the nearest timestamp (no limit: a
 //              static environment is one env.txt line).
 //   reference  each reference.txt line belongs to the colour frame nearest in time, which must be
-//              within 0.02 s; a line with no such colour frame is refused.
+//              within 0.02 s; a line with no such colour frame is refused. A *.delta.png
+//              reference is decoded against the colour frame of exactly its timestamp
+//              (mrgi/platform/capture_references.h), so that frame must exist.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 
 #include "capture/capture_text.h"
 #include "mrgi/platform/capture.h"
+#include "mrgi/platform/capture_references.h"
 
 namespace mrgi {
 namespace {
@@ -234,10 +237,17 @@ Expected<CaptureReader> CaptureReader::open(const std::string& folder) {
         return fail(ErrorKind::BadInput, ref_list + ":" + std::to_string(line.line) +
                                              ": no colour frame of rgb.txt within 0.02 s of timestamp " +
                                              capture::format_double(line.timestamp));
+      if (is_delta_reference_path(line.fields[0]) && all_color_times[size_t(c)] != line.timestamp)
+        return fail(ErrorKind::BadInput, ref_list + ":" + std::to_string(line.line) + ": delta reference '" +
+                                             line.fields[0] + "' needs the rgb.txt frame of exactly timestamp " +
+                                             capture::format_double(line.timestamp) + " (nearest is " +
+                                             capture::format_double(all_color_times[size_t(c)]) +
+                                             "); a .delta.png is stored relative to it");
       for (auto& e : reader.entries_) {  // the colour frame may have been dropped (no depth)
         if (e.timestamp != all_color_times[size_t(c)]) continue;
         e.reference = line.fields[0];
         if (line.fields.size() > 1) e.reference_mask = line.fields[1];
+        e.reference_line = line.line;
       }
     }
   }
@@ -298,10 +308,29 @@ Expected<InputFrame> CaptureReader::read_frame(size_t i) const {
 Expected<ImageRGB8> CaptureReader::read_reference(size_t i) const {
   if (i >= entries_.size() || entries_[i].reference.empty())
     return fail(ErrorKind::NotFound, folder_ + ": frame " + std::to_string(i) + " has no reference image");
-  auto img = load_png_rgb8(entries_[i].reference);
-  if (!img) return img.error();
-  MRGI_TRY(check_size(entries_[i].reference, img->width, img->height, info_.color, "colour"));
-  return img;
+  const CaptureFrameEntry& e = entries_[i];
+  auto img = load_png_rgb8(e.reference);
+  if (!is_delta_reference_path(e.reference)) {
+    if (!img) return img.error();
+    MRGI_TRY(check_size(e.reference, img->width, img->height, info_.color, "colour"));
+    return img;
+  }
+  const std::string where = (std::filesystem::path(folder_) / "reference.txt").string() + ":" +
+                            std::to_string(e.reference_line) + ": delta reference: ";
+  if (!img)
+    return fail(img.error().kind, where + img.error().message +
+                                      " (a .delta.png holds (reference - colour) mod 256 per channel as 8-bit RGB)");
+  auto color = load_png_rgb8(e.rgb);
+  if (!color) return fail(color.error().kind, where + "its colour frame: " + color.error().message);
+  if (img->width != color->width || img->height != color->height)
+    return fail(ErrorKind::BadInput, where + e.reference + " is " + std::to_string(img->width) + "x" +
+                                         std::to_string(img->height) + " but its colour frame " + e.rgb + " is " +
+                                         std::to_string(color->width) + "x" + std::to_string(color->height) +
+                                         "; a delta must be the size of the colour frame it is relative to");
+  auto reference = decode_reference_delta(*img, *color);
+  if (!reference) return reference.error();
+  MRGI_TRY(check_size(e.reference, reference->width, reference->height, info_.color, "colour"));
+  return reference;
 }
 
 Expected<Image<uint8_t, 1>> CaptureReader::read_reference_mask(size_t i) const {

@@ -1,13 +1,15 @@
 // Capture format v1 writer. Frames go to FOLDER.partial/{rgb,depth,env,reference}/NNNNNN.*, the
 // lists and JSON files are written by finish(), and only then is FOLDER.partial renamed to
 // FOLDER. Timestamps and poses are written in shortest round-trip decimal, so a reader gets back
-// bit-identical values. Env images are stored as 32-bit float OpenEXR.
+// bit-identical values. Env images are stored as 32-bit float OpenEXR. References are stored
+// plain or as deltas from the colour frame (ReferenceStorage, mrgi/platform/capture_references.h).
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 
 #include "capture/capture_text.h"
 #include "mrgi/platform/capture.h"
+#include "mrgi/platform/capture_references.h"
 
 namespace mrgi {
 namespace {
@@ -35,7 +37,8 @@ Status check_image_size(const std::string& folder, const char* what, int w, int 
 }  // namespace
 
 Expected<CaptureWriter> CaptureWriter::create(const std::string& folder, const CaptureInfo& info,
-                                              const std::optional<SceneDesc>& scene) {
+                                              const std::optional<SceneDesc>& scene,
+                                              ReferenceStorage references) {
   std::error_code ec;
   if (fs::exists(folder, ec) && !(fs::is_directory(folder, ec) && fs::is_empty(folder, ec)))
     return fail(ErrorKind::BadUsage, folder + ": already exists and is not an empty folder; remove it "
@@ -45,6 +48,7 @@ Expected<CaptureWriter> CaptureWriter::create(const std::string& folder, const C
   while (!w.folder_.empty() && w.folder_.back() == '/' && w.folder_.size() > 1) w.folder_.pop_back();
   w.partial_ = w.folder_ + ".partial";
   w.info_ = info;
+  w.reference_storage_ = references;
   // A left-over .partial is an earlier interrupted write of this same capture.
   fs::remove_all(w.partial_, ec);
   for (const char* sub : {"rgb", "depth"}) {
@@ -130,9 +134,17 @@ Status CaptureWriter::add_frame(const InputFrame& frame, const ImageRGB8* refere
   if (reference) {
     std::error_code ec;
     fs::create_directories(dir / "reference", ec);
-    const std::string ref = "reference/" + frame_name(count_, ".png");
-    MRGI_TRY(write_png((dir / ref).string(), *reference));
     if (ref_list_.empty()) ref_list_ = list_header("ground-truth augmented frames", "timestamp filename [mask_filename]");
+    const bool delta = reference_storage_ == ReferenceStorage::Delta;
+    const std::string ref = "reference/" + frame_name(count_, delta ? kDeltaReferenceSuffix : ".png");
+    if (delta) {
+      // Same size as the colour frame: both were checked against the intrinsics above.
+      auto stored = encode_reference_delta(*reference, frame.color);
+      if (!stored) return stored.error();
+      MRGI_TRY(write_png((dir / ref).string(), *stored));
+    } else {
+      MRGI_TRY(write_png((dir / ref).string(), *reference));
+    }
     ref_list_ += ts + " " + ref;
     if (reference_mask) {
       const std::string mask = "reference/" + frame_name(count_, "_mask.png");

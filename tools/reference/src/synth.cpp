@@ -178,7 +178,7 @@ Expected<SynthReport> synthesize_capture(const SceneDescription& description, co
     }
   }
 
-  auto writer = CaptureWriter::create(final_dir.string(), info, scene_json);
+  auto writer = CaptureWriter::create(final_dir.string(), info, scene_json, options.references);
   if (!writer) return writer.error();
   for (const Copy& c : copies) MRGI_TRY(copy_file(c.from, c.to));
   if (!env_copy.empty()) {

@@ -7,7 +7,11 @@
 //   scene.json               optional (mrgi/scene.h)
 //   reference.txt, reference/*  optional ground-truth augmented frames (8-bit sRGB PNG):
 //                            "timestamp path [mask_path]"; the optional mask is 8-bit grey,
-//                            non-zero where a virtual object is seen (for RDE over virtual pixels)
+//                            non-zero where a virtual object is seen (for RDE over virtual pixels).
+//                            A reference named *.delta.png is stored as (reference - colour) mod 256
+//                            per channel, 8-bit RGB, relative to the rgb.txt frame with exactly the
+//                            same timestamp (lossless; most pixels equal the colour frame, so it
+//                            compresses far better); read_reference returns the reconstructed frame.
 // Colour and depth are associated by nearest timestamp (TUM associate.py rule, max 0.02 s);
 // poses are interpolated (slerp) at the colour timestamp.
 #pragma once
@@ -52,6 +56,7 @@ struct CaptureFrameEntry {
   std::string env;                // empty when none
   std::string reference;          // empty when none
   std::string reference_mask;     // empty when none
+  int reference_line = 0;         // line of reference.txt that lists them (for messages)
 };
 
 class CaptureReader {
@@ -83,12 +88,17 @@ class CaptureReader {
   size_t dropped_color_frames_ = 0;
 };
 
+// How CaptureWriter stores reference frames: Plain as reference/NNNNNN.png, Delta as
+// reference/NNNNNN.delta.png (see the header comment; mrgi/platform/capture_references.h).
+enum class ReferenceStorage { Plain, Delta };
+
 // Writes a capture folder. The folder is built under FOLDER.partial and renamed on finish(),
 // so an interrupted write never leaves something that looks like a valid capture.
 class CaptureWriter {
  public:
   static Expected<CaptureWriter> create(const std::string& folder, const CaptureInfo& info,
-                                        const std::optional<SceneDesc>& scene);
+                                        const std::optional<SceneDesc>& scene,
+                                        ReferenceStorage references = ReferenceStorage::Plain);
   Status add_frame(const InputFrame& frame, const ImageRGB8* reference = nullptr,
                    const Image<uint8_t, 1>* reference_mask = nullptr);
   Status finish();
@@ -96,6 +106,7 @@ class CaptureWriter {
  private:
   std::string folder_, partial_;
   CaptureInfo info_;
+  ReferenceStorage reference_storage_ = ReferenceStorage::Plain;
   std::string rgb_list_, depth_list_, gt_list_, env_list_, ref_list_;
   size_t count_ = 0;
   double last_timestamp_ = 0.0;

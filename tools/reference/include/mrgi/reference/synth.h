@@ -5,7 +5,9 @@
 //                                   depth of the real scene, camera-to-world poses
 //   env/                            fisheye HDR frames (.exr) when the description has an env camera
 //   reference/                      G = camera response of L_rv with the same noise realisation,
-//                                   and *_mask.png (255 where the pixel-centre ray sees a virtual object)
+//                                   stored as *.delta.png (G - C mod 256, lossless, much smaller)
+//                                   or plain *.png (SynthOptions::references), and *_mask.png
+//                                   (255 where the pixel-centre ray sees a virtual object)
 //   capture.json                    intrinsics, depth_scale, exposure, env camera model and pose
 //   scene.json                      virtual objects (glTF copied under virtual/, frame-0 placement),
 //                                   lamps with their `real` flags (area lamps cannot be listed),
@@ -19,6 +21,7 @@
 #include <vector>
 
 #include "mrgi/expected.h"
+#include "mrgi/platform/capture.h"
 #include "mrgi/reference/description.h"
 
 namespace mrgi::reference {
@@ -31,6 +34,8 @@ struct SynthOptions {
   // When set, frame 0 is rendered a second time with this seed (in memory only) to measure the
   // reference noise floor (SynthReport::noise_floor).
   std::optional<uint64_t> noise_floor_seed;
+  // How references are stored: Delta (default; mrgi/platform/capture_references.h) or Plain PNG.
+  ReferenceStorage references = ReferenceStorage::Delta;
   // Progress over all frames: (what, done, total, seconds elapsed).
   std::function<void(const std::string&, size_t, size_t, double)> progress;
 };
