@@ -1,0 +1,254 @@
+#include "technique/ssrt/depth_filter_gpu.h"
+
+#include <string>
+
+#include "gpu/shaders.h"
+
+namespace mrgi::ssrt {
+namespace {
+
+constexpr uint32_t kGroup = 16;        // workgroup side of every pass (the shaders' GROUP)
+constexpr int kMaxReach = 16;          // the shaders' MAX_REACH, pixels
+constexpr int kMaxTapsPerSide = 5;     // the median networks hold 25 values
+
+const char* kWhere = "technique/ssrt/depth_filter_gpu.cpp DepthFilterSettings.";
+
+// The sub-sampled window of a paper k exactly as the CPU reference walks it: offsets -r..r by
+// `stride` (r = side / 2), i.e. 2 * (r / stride) + 1 taps per side reaching (r / stride) * stride.
+struct TapWindow {
+  int reach = 0, stride = 1, taps = 1;
+};
+TapWindow tap_window(uint32_t k, uint32_t median_taps) {
+  const uint32_t side = window_side(k);
+  const int r = int(side / 2);
+  const int stride = int(window_stride(side, median_taps));
+  const int half = r / stride;
+  return TapWindow{half * stride, stride, 2 * half + 1};
+}
+
+Status check_gpu_window(const char* field, const TapWindow& w) {
+  if (w.taps > kMaxTapsPerSide)
+    return fail(ErrorKind::BadUsage,
+                std::string(kWhere) + field + ": the GPU filter reads at most " +
+                    std::to_string(kMaxTapsPerSide) + " sub-sampled taps per side, this window has " +
+                    std::to_string(w.taps) + " (use a window that is <= median_taps or larger)");
+  if (w.reach > kMaxReach)
+    return fail(ErrorKind::BadUsage, std::string(kWhere) + field +
+                                         ": the GPU filter's taps reach at most " +
+                                         std::to_string(kMaxReach) + " pixels, this window " +
+                                         std::to_string(w.reach));
+  return ok_status();
+}
+
+Expected<gpu::PipelineHandle> pipeline(gpu::Context& ctx, const char* shader,
+                                       std::vector<gpu::DescriptorBinding> bindings,
+                                       uint32_t push_bytes) {
+  auto spirv = gpu::shader_spirv(shader);
+  if (!spirv) return spirv.error();
+  gpu::ComputePipelineDesc d;
+  d.name = shader;
+  d.spirv = *spirv;
+  d.bindings = std::move(bindings);
+  d.push_constant_bytes = push_bytes;
+  auto p = gpu::create_compute_pipeline(ctx, d);
+  if (!p) return p.error();
+  return gpu::PipelineHandle(ctx, std::move(*p));
+}
+
+Expected<gpu::ImageHandle> internal_image(gpu::FrameGraph& graph, const char* name,
+                                          VkFormat format) {
+  gpu::ImageDesc d;
+  d.name = name;
+  d.format = format;
+  d.size_mode = gpu::SizeMode::OutputRelative;
+  d.scale = 1.0f;
+  d.follows_render_scale = true;
+  // Sampled: the transfer reads the G-buffer through samplers; transfer source: tests and
+  // debug tools read every stage back.
+  return graph.create_image(d, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                                   VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
+}
+
+}  // namespace
+
+Expected<DepthFilterGpu> DepthFilterGpu::create(gpu::Context& ctx, gpu::FrameGraph& graph,
+                                                const technique::SharedResources& shared,
+                                                const DepthFilterSettings& settings) {
+  MRGI_TRY(validate(settings));
+  const TapWindow merge = tap_window(settings.merge_window, settings.median_taps);
+  const TapWindow bilateral = tap_window(settings.bilateral_window, settings.median_taps);
+  MRGI_TRY(check_gpu_window("merge_window", merge));
+  MRGI_TRY(check_gpu_window("bilateral_window", bilateral));
+  if (window_side(settings.final_window) > 5)
+    return fail(ErrorKind::BadUsage, std::string(kWhere) +
+                                         "final_window: the GPU filter's D''' window is at most "
+                                         "5 x 5 pixels (final_window <= 5)");
+  if (!shared.frame_constants.valid() || !shared.color_upload.valid() ||
+      !shared.depth_upload.valid())
+    return fail(ErrorKind::BadUsage,
+                "technique/ssrt/depth_filter_gpu.cpp: SharedResources needs frame_constants, "
+                "color_upload and depth_upload");
+
+  DepthFilterGpu f;
+  f.graph_ = &graph;
+  f.settings_ = settings;
+  f.frame_constants_ = shared.frame_constants;
+  f.color_upload_ = shared.color_upload;
+  f.depth_upload_ = shared.depth_upload;
+  const struct {
+    gpu::ImageHandle* handle;
+    const char* name;
+    VkFormat format;
+  } images[] = {
+      {&f.merged_, "ssrt_depth_merged", VK_FORMAT_R32_SFLOAT},
+      {&f.intensity_, "ssrt_intensity", VK_FORMAT_R32_SFLOAT},
+      {&f.bilateral_, "ssrt_depth_bilateral", VK_FORMAT_R32_SFLOAT},
+      {&f.final_, "ssrt_depth_final", VK_FORMAT_R32_SFLOAT},
+      {&f.position_, "ssrt_position", VK_FORMAT_R32G32B32A32_SFLOAT},
+      {&f.normal_, "ssrt_normal", VK_FORMAT_R16G16B16A16_SFLOAT},
+  };
+  for (const auto& im : images) {
+    auto h = internal_image(graph, im.name, im.format);
+    if (!h) return h.error();
+    *im.handle = *h;
+  }
+  gpu::ImageDesc nv;
+  nv.name = "ssrt_no_volume";
+  nv.format = VK_FORMAT_R32_SFLOAT;
+  nv.size_mode = gpu::SizeMode::Absolute;
+  nv.width = nv.height = 1;
+  auto no_volume =
+      graph.create_image(nv, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
+  if (!no_volume) return no_volume.error();
+  f.no_volume_ = *no_volume;
+  const float zero = 0.0f;  // defined contents and the GENERAL layout (never read by the shader)
+  MRGI_TRY(graph.upload_image(f.no_volume_, &zero, sizeof(zero)));
+
+  const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+  const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+  auto p = pipeline(ctx, "ssrt/depth_merge.comp", {{ubo}, {ssbo}, {ssbo}, {img}, {img}, {img}},
+                    sizeof(WindowPush));
+  if (!p) return p.error();
+  f.merge_ = std::move(*p);
+  p = pipeline(ctx, "ssrt/depth_bilateral.comp", {{ubo}, {img}, {img}, {img}}, sizeof(WindowPush));
+  if (!p) return p.error();
+  f.bilateral_pipe_ = std::move(*p);
+  p = pipeline(ctx, "ssrt/depth_final.comp", {{ubo}, {img}, {img}}, sizeof(glm::ivec4));
+  if (!p) return p.error();
+  f.final_pipe_ = std::move(*p);
+  p = pipeline(ctx, "ssrt/depth_gbuffer.comp", {{ubo}, {img}, {img}, {img}}, 0);
+  if (!p) return p.error();
+  f.gbuffer_ = std::move(*p);
+
+  f.merge_push_.window = glm::ivec4(merge.reach, merge.stride, merge.taps, 0);
+  f.merge_push_.thresholds =
+      glm::vec4(settings.intensity_threshold, settings.depth_threshold_m, 0.0f, 0.0f);
+  f.bilateral_push_.window = glm::ivec4(bilateral.reach, bilateral.stride, bilateral.taps, 0);
+  f.bilateral_push_.thresholds = f.merge_push_.thresholds;
+  f.final_push_ = glm::ivec4(int(window_side(settings.final_window) / 2), 0, 0, 0);
+  return f;
+}
+
+Status DepthFilterGpu::record(gpu::ImageHandle depth_volume, bool final_pass,
+                              std::vector<std::string>& skipped) {
+  if (!graph_)
+    return fail(ErrorKind::BadUsage, "technique/ssrt/depth_filter_gpu.cpp: record() before create()");
+  volume_ = depth_volume.valid() ? depth_volume : no_volume_;
+  merge_push_.window.w = depth_volume.valid() ? 1 : 0;
+  gpu::FrameGraph& graph = *graph_;
+
+  graph.add_pass(
+      "ssrt_depth_merge", gpu::PassKind::Compute,
+      [this](gpu::PassBuilder& b) {
+        b.read(frame_constants_, gpu::Access::UniformRead);
+        b.read(color_upload_, gpu::Access::StorageRead);
+        b.read(depth_upload_, gpu::Access::StorageRead);
+        b.read(volume_, gpu::Access::StorageRead);
+        b.write(merged_, gpu::Access::StorageWrite);
+        b.write(intensity_, gpu::Access::StorageWrite);
+      },
+      [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, merge_->pipeline);
+        gpu::DescriptorPush()
+            .uniform_buffer(0, pass.buffer(frame_constants_))
+            .storage_buffer(1, pass.buffer(color_upload_))
+            .storage_buffer(2, pass.buffer(depth_upload_))
+            .storage_image(3, pass.view(volume_))
+            .storage_image(4, pass.view(merged_))
+            .storage_image(5, pass.view(intensity_))
+            .push(pass.context(), cmd, *merge_);
+        const VkExtent2D e = pass.extent(merged_);
+        gpu::dispatch_2d(cmd, *merge_, &merge_push_, sizeof(merge_push_), e.width, e.height,
+                         kGroup, kGroup);
+      });
+
+  graph.add_pass(
+      "ssrt_depth_bilateral", gpu::PassKind::Compute,
+      [this](gpu::PassBuilder& b) {
+        b.read(frame_constants_, gpu::Access::UniformRead);
+        b.read(merged_, gpu::Access::StorageRead);
+        b.read(intensity_, gpu::Access::StorageRead);
+        b.write(bilateral_, gpu::Access::StorageWrite);
+      },
+      [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, bilateral_pipe_->pipeline);
+        gpu::DescriptorPush()
+            .uniform_buffer(0, pass.buffer(frame_constants_))
+            .storage_image(1, pass.view(merged_))
+            .storage_image(2, pass.view(intensity_))
+            .storage_image(3, pass.view(bilateral_))
+            .push(pass.context(), cmd, *bilateral_pipe_);
+        const VkExtent2D e = pass.extent(bilateral_);
+        gpu::dispatch_2d(cmd, *bilateral_pipe_, &bilateral_push_, sizeof(bilateral_push_),
+                         e.width, e.height, kGroup, kGroup);
+      });
+
+  if (final_pass) {
+    graph.add_pass(
+        "ssrt_depth_final", gpu::PassKind::Compute,
+        [this](gpu::PassBuilder& b) {
+          b.read(frame_constants_, gpu::Access::UniformRead);
+          b.read(bilateral_, gpu::Access::StorageRead);
+          b.write(final_, gpu::Access::StorageWrite);
+        },
+        [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
+          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, final_pipe_->pipeline);
+          gpu::DescriptorPush()
+              .uniform_buffer(0, pass.buffer(frame_constants_))
+              .storage_image(1, pass.view(bilateral_))
+              .storage_image(2, pass.view(final_))
+              .push(pass.context(), cmd, *final_pipe_);
+          const VkExtent2D e = pass.extent(final_);
+          gpu::dispatch_2d(cmd, *final_pipe_, &final_push_, sizeof(final_push_), e.width,
+                           e.height, kGroup, kGroup);
+        });
+    gbuffer_source_ = final_;
+  } else {
+    skipped.push_back("ssrt_depth_final: final_pass off at this level (D'' feeds the G-buffer)");
+    gbuffer_source_ = bilateral_;
+  }
+
+  graph.add_pass(
+      "ssrt_gbuffer", gpu::PassKind::Compute,
+      [this](gpu::PassBuilder& b) {
+        b.read(frame_constants_, gpu::Access::UniformRead);
+        b.read(gbuffer_source_, gpu::Access::StorageRead);
+        b.write(position_, gpu::Access::StorageWrite);
+        b.write(normal_, gpu::Access::StorageWrite);
+      },
+      [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, gbuffer_->pipeline);
+        gpu::DescriptorPush()
+            .uniform_buffer(0, pass.buffer(frame_constants_))
+            .storage_image(1, pass.view(gbuffer_source_))
+            .storage_image(2, pass.view(position_))
+            .storage_image(3, pass.view(normal_))
+            .push(pass.context(), cmd, *gbuffer_);
+        const VkExtent2D e = pass.extent(position_);
+        gpu::dispatch_2d(cmd, *gbuffer_, nullptr, 0, e.width, e.height, kGroup, kGroup);
+      });
+  return ok_status();
+}
+
+}  // namespace mrgi::ssrt

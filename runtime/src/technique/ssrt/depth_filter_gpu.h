@@ -1,0 +1,82 @@
+// The ssrt depth filter chain on the GPU (paper Sec. 4, eq. 1-5) and the real G-buffer it feeds.
+// Same rules as the CPU reference depth_filter.h (the tests compare them texel for texel); the
+// shaders are shaders/ssrt/depth_{merge,bilateral,final,gbuffer}.comp.
+//   ssrt_depth_merge      D'  (eq. 1-3) from this frame's colour/depth uploads and D_v; also
+//                         writes I_c (grey, see grey_level) for the next pass
+//   ssrt_depth_bilateral  D'' (eq. 4), joint bilateral median over Omega_I
+//   ssrt_depth_final      D''' (eq. 5), plain median; left out when final_pass is false
+//   ssrt_gbuffer          final depth -> world positions + camera-facing normals
+// Every image is at the internal resolution (OutputRelative, follows the render scale) and is
+// allocated once in create(). The D_c / I_c of a pixel are gathered from the raw uploads along
+// its ray (nearest depth / colour sample), like recon/depth_to_positions.comp, so unregistered
+// depth and render scales below 1 are handled; with registered depth at full resolution the
+// gather is the identity.
+//
+// GPU limits (create() returns BadUsage naming the field otherwise): at most 5 sub-sampled taps
+// per side for D' and D'' (the paper's 5 x 5; e.g. merge_window 6 would read 7 x 7 taps), a
+// tap reach of at most 16 pixels (merge_window / bilateral_window <= 33 with 5 taps), and a
+// D''' window of at most 5 x 5 (final_window <= 5).
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "gpu/frame_graph.h"
+#include "gpu/pipelines.h"
+#include "mrgi/expected.h"
+#include "technique/ssrt/depth_filter.h"
+#include "technique/technique.h"
+
+namespace mrgi::ssrt {
+
+// I_c of an sRGB8 colour, 0..255: Rec. 601 luma on the encoded bytes in 8-bit fixed point
+// (weights 77, 150, 29 sum to 256, so grey stays grey and white stays 255). Integer on both the
+// GPU and the CPU, so the reference is fed exactly the shader's values.
+constexpr uint32_t grey_level(uint32_t r, uint32_t g, uint32_t b) {
+  return (77u * r + 150u * g + 29u * b + 128u) >> 8;
+}
+
+class DepthFilterGpu {
+ public:
+  static Expected<DepthFilterGpu> create(gpu::Context& ctx, gpu::FrameGraph& graph,
+                                         const technique::SharedResources& shared,
+                                         const DepthFilterSettings& settings = {});
+  // Adds ssrt_depth_merge, ssrt_depth_bilateral, ssrt_depth_final (when final_pass is false it
+  // is left out and "ssrt_depth_final: <reason>" is appended to skipped) and ssrt_gbuffer.
+  // depth_volume: R32F D_v (metres along camera z, 0 = no surface) at the internal resolution,
+  // or a null handle when there is no volume (then every D_v is "missing").
+  Status record(gpu::ImageHandle depth_volume, bool final_pass, std::vector<std::string>& skipped);
+
+  gpu::ImageHandle position() const { return position_; }  // RGBA32F xyz world, w depth m; 0 = invalid
+  // RGBA16F xyz world unit normal facing the camera; w 1 where measured, 0 where the pixel has
+  // no same-surface neighbour along an axis (then xyz faces the camera) or no depth (all 0).
+  gpu::ImageHandle normal() const { return normal_; }
+  // D', D'', D''' (R32F metres, 0 = missing) and I_c (R32F grey 0..255).
+  gpu::ImageHandle merged() const { return merged_; }
+  gpu::ImageHandle bilateral() const { return bilateral_; }
+  gpu::ImageHandle final_depth() const { return final_; }
+  gpu::ImageHandle intensity() const { return intensity_; }
+  const DepthFilterSettings& settings() const { return settings_; }
+
+  struct WindowPush {
+    glm::ivec4 window;      // reach px, stride px, taps per side, has volume
+    glm::vec4 thresholds;   // lambda_I grey levels, lambda_D metres
+  };
+
+ private:
+  gpu::FrameGraph* graph_ = nullptr;
+  gpu::BufferHandle frame_constants_, color_upload_, depth_upload_;
+  gpu::ImageHandle merged_, intensity_, bilateral_, final_, position_, normal_;
+  gpu::ImageHandle no_volume_;   // 1 x 1 placeholder bound when there is no D_v (never read)
+  gpu::ImageHandle volume_;      // this frame's D_v (or no_volume_)
+  gpu::ImageHandle gbuffer_source_;  // this frame's final depth (D''' or D'')
+  gpu::PipelineHandle merge_, bilateral_pipe_, final_pipe_, gbuffer_;
+  DepthFilterSettings settings_;
+  // Push constants, filled at create / record (kept here so the callbacks allocate nothing).
+  WindowPush merge_push_{}, bilateral_push_{};
+  glm::ivec4 final_push_{1, 0, 0, 0};
+};
+
+}  // namespace mrgi::ssrt
