@@ -57,7 +57,11 @@ bool tsdf_clip(vec3 o, vec3 d, float t_min, out float t0, out float t1) {
   float h = volume.origin.w;
   vec3 lo = volume.origin.xyz + vec3(0.5f * h);
   vec3 hi = volume.origin.xyz + vec3((float(volume.grid.x) - 0.5f) * h - 1e-4f * h);
-  vec3 inv = 1.0f / d;  // +-inf on axis-parallel rays: the slab test below still holds
+  // Axis-parallel rays (the aux layers' rays often are): a tiny component instead of 0 keeps
+  // the slab test finite (0 * inf would be NaN for a ray starting on a slab plane).
+  vec3 safe = mix(d, mix(vec3(-1e-9f), vec3(1e-9f), greaterThanEqual(d, vec3(0.0f))),
+                  lessThan(abs(d), vec3(1e-9f)));
+  vec3 inv = 1.0f / safe;
   vec3 ta = (lo - o) * inv, tb = (hi - o) * inv;
   vec3 tn = min(ta, tb), tf = max(ta, tb);
   t0 = max(max(max(tn.x, tn.y), tn.z), t_min);

@@ -430,6 +430,32 @@ TEST_F(VulkanTest, VolumeAuxLayersSeeTheBoxLeftOfTheViewAndTheTopFromTheLight) {
   const glm::vec4* floor = texel(SSRT_AUX_LIGHT, glm::vec3(0.45f, 0.0f, 0.3f), d_floor);
   ASSERT_NE(floor, nullptr);
   EXPECT_NEAR(floor->y, 0.0f, 1.5f * voxel);
+  // Every layer: the axes of the looking-down camera (left -x, right +x, top -z world, light
+  // -y), aux_to_world inverting world_to_aux, and each stored surface projecting back onto its
+  // own texel at its stored depth.
+  const glm::vec3 axes[4] = {{-1, 0, 0}, {1, 0, 0}, {0, 0, -1}, {0, -1, 0}};
+  for (int layer = 0; layer < 4; ++layer) {
+    EXPECT_LT(glm::length(glm::vec3(views.direction[layer]) - axes[layer]), 1e-5f) << layer;
+    const glm::mat4 round_trip = views.world_to_aux[layer] * views.aux_to_world[layer];
+    for (int c = 0; c < 4; ++c)
+      for (int rr = 0; rr < 4; ++rr)
+        EXPECT_NEAR(round_trip[c][rr], c == rr ? 1.0f : 0.0f, 1e-4f) << layer;
+    int hits = 0, consistent = 0;
+    for (uint32_t y = 0; y < aux_res; ++y)
+      for (uint32_t x = 0; x < aux_res; ++x) {
+        const glm::vec4 s = aux[(size_t(layer) * aux_res + y) * aux_res + x];
+        ASSERT_TRUE(std::isfinite(s.x) && std::isfinite(s.w));
+        if (s.w <= 0.0f) continue;
+        ++hits;
+        const glm::vec4 p = views.world_to_aux[layer] * glm::vec4(glm::vec3(s), 1.0f);
+        consistent += std::abs(p.x * aux_res - (x + 0.5f)) < 0.01f &&
+                      std::abs(p.y * aux_res - (y + 0.5f)) < 0.01f && std::abs(p.z - s.w) < 1e-4f;
+      }
+    EXPECT_EQ(consistent, hits) << "layer " << layer;
+    // (The right and top layers' rays start inside box A and B, whose inside they leave through
+    // back faces, and find nothing else: no hits expected there.)
+    if (layer == SSRT_AUX_LEFT || layer == SSRT_AUX_LIGHT) EXPECT_GT(hits, 20) << "layer " << layer;
+  }
   // The current view matches too (64^3: 3.1 cm voxels).
   expect_view_matches(r, t, voxel, 1.5f, "64^3");
 }

@@ -19,6 +19,12 @@
 //     intrinsics): their images are persistent and keep that frame's result, which is then the
 //     view from a pose within the pose tolerances of the current one. When the fuse is skipped
 //     but something else changed, they run.
+// Inputs: the depth comes from shared.depth_upload (this slot's copy, written by recon before
+// these passes) with shared.depth_intrinsics / depth_scale; the view's intrinsics and size are
+// the frame constants' internal_k / internal_output_size; VolumeFrame::camera_to_world must be
+// the frame constants' pose (the passes use it in double-precision-derived form).
+// Measured on lavapipe (LP_NUM_THREADS=2, 640x480 view, 256^2 aux texels): 256^3 fuse ~140 ms,
+// raycast ~430 ms, aux ~300 ms; 64^3 fuse ~5 ms, raycast ~160-240 ms, aux ~80-130 ms.
 #pragma once
 #include <cstdint>
 #include <string>
