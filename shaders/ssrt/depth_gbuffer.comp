@@ -17,61 +17,48 @@
 #include "common/frame_constants.glsl"
 #include "ssrt/depth_median.glsl"
 
-#define GROUP 16
 #define NORMAL_RADIUS 2                    // pixels, as recon's default normal_radius
-#define TILE_W (GROUP + 2 * NORMAL_RADIUS)
 
-layout(local_size_x = GROUP, local_size_y = GROUP) in;
+layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
 layout(set = 0, binding = 1, r32f) readonly uniform image2D depth;       // metres, 0 = none
 layout(set = 0, binding = 2, rgba32f) writeonly uniform image2D position;
 layout(set = 0, binding = 3, rgba16f) writeonly uniform image2D normal;
 
-shared float s_z[TILE_W * TILE_W];  // depth, 0 = invalid or outside the image
+ivec2 g_size;
 
-ivec2 g_tile_origin;
-
-// Camera-space position of tile texel t if valid and on the centre's surface (depth z0).
-bool neighbour(ivec2 t, float z0, out vec3 pos) {
-  pos = vec3(0.0f);
-  float z = s_z[t.y * TILE_W + t.x];
-  if (!(z > 0.0f)) return false;
-  if (abs(z - z0) > MRGI_DEPTH_EDGE_RELATIVE * min(z, z0)) return false;
-  pos = unproject_pinhole(vec2(g_tile_origin + t), z, frame.internal_k);
-  return true;
+// Depth at pixel p if inside the image, valid and on the centre's surface (depth z0), else 0.
+// Fetched unconditionally from a clamped coordinate: the lanes of a SIMD chunk stay together.
+float same_surface(ivec2 p, float z0) {
+  bool inside = all(greaterThanEqual(p, ivec2(0))) && all(lessThan(p, g_size));
+  float z = imageLoad(depth, clamp(p, ivec2(0), g_size - 1)).x;
+  bool ok = inside && depth_valid(z) && abs(z - z0) <= MRGI_DEPTH_EDGE_RELATIVE * min(z, z0);
+  return ok ? z : 0.0f;
 }
 
-bool axis_difference(ivec2 t, ivec2 step, vec3 centre, float z0, out vec3 d) {
-  vec3 q, r;
-  d = vec3(0.0f);
-  if (neighbour(t + step * NORMAL_RADIUS, z0, q) && neighbour(t - step * NORMAL_RADIUS, z0, r)) {
-    d = q - r;
-    return true;
-  }
-  if (neighbour(t + step, z0, q)) { d = q - centre; return true; }
-  if (neighbour(t - step, z0, q)) { d = centre - q; return true; }
-  return false;
+vec3 camera_point(ivec2 p, float z) { return unproject_pinhole(vec2(p), z, frame.internal_k); }
+
+// Tangent along one image axis: central over +-NORMAL_RADIUS where both ends are on the
+// surface, else forward, else backward one pixel. The one-pixel fetches only happen where the
+// central difference fails (depth edges, holes), which whole SIMD chunks rarely need.
+bool axis_difference(ivec2 p, ivec2 step, vec3 centre, float z0, out vec3 d) {
+  float far_plus = same_surface(p + step * NORMAL_RADIUS, z0);
+  float far_minus = same_surface(p - step * NORMAL_RADIUS, z0);
+  d = camera_point(p + step * NORMAL_RADIUS, far_plus) -
+      camera_point(p - step * NORMAL_RADIUS, far_minus);
+  if (far_plus > 0.0f && far_minus > 0.0f) return true;
+  float plus = same_surface(p + step, z0);
+  float minus = same_surface(p - step, z0);
+  d = plus > 0.0f ? camera_point(p + step, plus) - centre : centre - camera_point(p - step, minus);
+  return plus > 0.0f || minus > 0.0f;
 }
 
 void main() {
-  ivec2 size = frame.internal_output_size.xy;
-  g_tile_origin = ivec2(gl_WorkGroupID.xy) * GROUP - NORMAL_RADIUS;
-  for (int i = int(gl_LocalInvocationIndex); i < TILE_W * TILE_W; i += GROUP * GROUP) {
-    ivec2 q = g_tile_origin + ivec2(i % TILE_W, i / TILE_W);
-    float z = 0.0f;
-    if (all(greaterThanEqual(q, ivec2(0))) && all(lessThan(q, size))) {
-      z = imageLoad(depth, q).x;
-      if (!depth_valid(z)) z = 0.0f;
-    }
-    s_z[i] = z;
-  }
-  barrier();
-
+  g_size = frame.internal_output_size.xy;
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
-  if (any(greaterThanEqual(pixel, size))) return;
-  ivec2 t = ivec2(gl_LocalInvocationID.xy) + NORMAL_RADIUS;
-  float z0 = s_z[t.y * TILE_W + t.x];
-  if (!(z0 > 0.0f)) {
+  if (any(greaterThanEqual(pixel, g_size))) return;
+  float z0 = imageLoad(depth, pixel).x;
+  if (!depth_valid(z0)) {
     imageStore(position, pixel, vec4(0.0f));
     imageStore(normal, pixel, vec4(0.0f));
     return;
@@ -84,8 +71,8 @@ void main() {
   vec3 n = to_camera;
   float measured = 0.0f;
   vec3 dx, dy;
-  if (axis_difference(t, ivec2(1, 0), centre, z0, dx) &&
-      axis_difference(t, ivec2(0, 1), centre, z0, dy)) {
+  if (axis_difference(pixel, ivec2(1, 0), centre, z0, dx) &&
+      axis_difference(pixel, ivec2(0, 1), centre, z0, dy)) {
     vec3 c = cross(dx, dy);
     float len = length(c);
     if (len > 1e-12f && !isnan(len) && !isinf(len)) {

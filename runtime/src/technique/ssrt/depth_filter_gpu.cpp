@@ -7,9 +7,10 @@
 namespace mrgi::ssrt {
 namespace {
 
-constexpr uint32_t kGroup = 16;        // workgroup side of every pass (the shaders' GROUP)
-constexpr int kMaxReach = 16;          // the shaders' MAX_REACH, pixels
 constexpr int kMaxTapsPerSide = 5;     // the median networks hold 25 values
+// Tap reach, pixels: no shader limit (taps are fetched directly), but a window beyond it mixes
+// surfaces that have nothing to do with each other at the paper's 640 x 480.
+constexpr int kMaxReach = 16;
 
 const char* kWhere = "technique/ssrt/depth_filter_gpu.cpp DepthFilterSettings.";
 
@@ -100,8 +101,9 @@ Expected<DepthFilterGpu> DepthFilterGpu::create(gpu::Context& ctx, gpu::FrameGra
     const char* name;
     VkFormat format;
   } images[] = {
+      {&f.input_, "ssrt_depth_input", VK_FORMAT_R32G32_SFLOAT},
       {&f.merged_, "ssrt_depth_merged", VK_FORMAT_R32_SFLOAT},
-      {&f.intensity_, "ssrt_intensity", VK_FORMAT_R32_SFLOAT},
+      {&f.merged_intensity_, "ssrt_depth_merged_intensity", VK_FORMAT_R32G32_SFLOAT},
       {&f.bilateral_, "ssrt_depth_bilateral", VK_FORMAT_R32_SFLOAT},
       {&f.final_, "ssrt_depth_final", VK_FORMAT_R32_SFLOAT},
       {&f.position_, "ssrt_position", VK_FORMAT_R32G32B32A32_SFLOAT},
@@ -127,11 +129,15 @@ Expected<DepthFilterGpu> DepthFilterGpu::create(gpu::Context& ctx, gpu::FrameGra
   const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
   const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-  auto p = pipeline(ctx, "ssrt/depth_merge.comp", {{ubo}, {ssbo}, {ssbo}, {img}, {img}, {img}},
+  auto p = pipeline(ctx, "ssrt/depth_input.comp", {{ubo}, {ssbo}, {ssbo}, {img}, {img}},
                     sizeof(WindowPush));
   if (!p) return p.error();
+  f.input_pipe_ = std::move(*p);
+  p = pipeline(ctx, "ssrt/depth_merge.comp", {{ubo}, {img}, {img}, {img}, {img}},
+               sizeof(WindowPush));
+  if (!p) return p.error();
   f.merge_ = std::move(*p);
-  p = pipeline(ctx, "ssrt/depth_bilateral.comp", {{ubo}, {img}, {img}, {img}}, sizeof(WindowPush));
+  p = pipeline(ctx, "ssrt/depth_bilateral.comp", {{ubo}, {img}, {img}}, sizeof(WindowPush));
   if (!p) return p.error();
   f.bilateral_pipe_ = std::move(*p);
   p = pipeline(ctx, "ssrt/depth_final.comp", {{ubo}, {img}, {img}}, sizeof(glm::ivec4));
@@ -159,49 +165,66 @@ Status DepthFilterGpu::record(gpu::ImageHandle depth_volume, bool final_pass,
   gpu::FrameGraph& graph = *graph_;
 
   graph.add_pass(
-      "ssrt_depth_merge", gpu::PassKind::Compute,
+      "ssrt_depth_input", gpu::PassKind::Compute,
       [this](gpu::PassBuilder& b) {
         b.read(frame_constants_, gpu::Access::UniformRead);
         b.read(color_upload_, gpu::Access::StorageRead);
         b.read(depth_upload_, gpu::Access::StorageRead);
         b.read(volume_, gpu::Access::StorageRead);
-        b.write(merged_, gpu::Access::StorageWrite);
-        b.write(intensity_, gpu::Access::StorageWrite);
+        b.write(input_, gpu::Access::StorageWrite);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, merge_->pipeline);
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, input_pipe_->pipeline);
         gpu::DescriptorPush()
             .uniform_buffer(0, pass.buffer(frame_constants_))
             .storage_buffer(1, pass.buffer(color_upload_))
             .storage_buffer(2, pass.buffer(depth_upload_))
             .storage_image(3, pass.view(volume_))
-            .storage_image(4, pass.view(merged_))
-            .storage_image(5, pass.view(intensity_))
+            .storage_image(4, pass.view(input_))
+            .push(pass.context(), cmd, *input_pipe_);
+        const VkExtent2D e = pass.extent(input_);
+        gpu::dispatch_2d(cmd, *input_pipe_, &merge_push_, sizeof(merge_push_), e.width, e.height);
+      });
+
+  graph.add_pass(
+      "ssrt_depth_merge", gpu::PassKind::Compute,
+      [this](gpu::PassBuilder& b) {
+        b.read(frame_constants_, gpu::Access::UniformRead);
+        b.read(input_, gpu::Access::StorageRead);
+        b.read(volume_, gpu::Access::StorageRead);
+        b.write(merged_, gpu::Access::StorageWrite);
+        b.write(merged_intensity_, gpu::Access::StorageWrite);
+      },
+      [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, merge_->pipeline);
+        gpu::DescriptorPush()
+            .uniform_buffer(0, pass.buffer(frame_constants_))
+            .storage_image(1, pass.view(input_))
+            .storage_image(2, pass.view(volume_))
+            .storage_image(3, pass.view(merged_))
+            .storage_image(4, pass.view(merged_intensity_))
             .push(pass.context(), cmd, *merge_);
         const VkExtent2D e = pass.extent(merged_);
-        gpu::dispatch_2d(cmd, *merge_, &merge_push_, sizeof(merge_push_), e.width, e.height,
-                         kGroup, kGroup);
+        gpu::dispatch_2d(cmd, *merge_, &merge_push_, sizeof(merge_push_), e.width, e.height);
       });
 
   graph.add_pass(
       "ssrt_depth_bilateral", gpu::PassKind::Compute,
       [this](gpu::PassBuilder& b) {
         b.read(frame_constants_, gpu::Access::UniformRead);
-        b.read(merged_, gpu::Access::StorageRead);
-        b.read(intensity_, gpu::Access::StorageRead);
+        b.read(merged_intensity_, gpu::Access::StorageRead);
         b.write(bilateral_, gpu::Access::StorageWrite);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, bilateral_pipe_->pipeline);
         gpu::DescriptorPush()
             .uniform_buffer(0, pass.buffer(frame_constants_))
-            .storage_image(1, pass.view(merged_))
-            .storage_image(2, pass.view(intensity_))
-            .storage_image(3, pass.view(bilateral_))
+            .storage_image(1, pass.view(merged_intensity_))
+            .storage_image(2, pass.view(bilateral_))
             .push(pass.context(), cmd, *bilateral_pipe_);
         const VkExtent2D e = pass.extent(bilateral_);
         gpu::dispatch_2d(cmd, *bilateral_pipe_, &bilateral_push_, sizeof(bilateral_push_),
-                         e.width, e.height, kGroup, kGroup);
+                         e.width, e.height);
       });
 
   if (final_pass) {
@@ -221,7 +244,7 @@ Status DepthFilterGpu::record(gpu::ImageHandle depth_volume, bool final_pass,
               .push(pass.context(), cmd, *final_pipe_);
           const VkExtent2D e = pass.extent(final_);
           gpu::dispatch_2d(cmd, *final_pipe_, &final_push_, sizeof(final_push_), e.width,
-                           e.height, kGroup, kGroup);
+                           e.height);
         });
     gbuffer_source_ = final_;
   } else {
@@ -246,7 +269,7 @@ Status DepthFilterGpu::record(gpu::ImageHandle depth_volume, bool final_pass,
             .storage_image(3, pass.view(normal_))
             .push(pass.context(), cmd, *gbuffer_);
         const VkExtent2D e = pass.extent(position_);
-        gpu::dispatch_2d(cmd, *gbuffer_, nullptr, 0, e.width, e.height, kGroup, kGroup);
+        gpu::dispatch_2d(cmd, *gbuffer_, nullptr, 0, e.width, e.height);
       });
   return ok_status();
 }

@@ -1,8 +1,9 @@
 // The ssrt depth filter chain on the GPU (paper Sec. 4, eq. 1-5) and the real G-buffer it feeds.
 // Same rules as the CPU reference depth_filter.h (the tests compare them texel for texel); the
 // shaders are shaders/ssrt/depth_{merge,bilateral,final,gbuffer}.comp.
-//   ssrt_depth_merge      D'  (eq. 1-3) from this frame's colour/depth uploads and D_v; also
-//                         writes I_c (grey, see grey_level) for the next pass
+//   ssrt_depth_input      D_c, I_c (grey, see grey_level) and the D_c-agrees-with-D_v bit per
+//                         pixel from this frame's colour/depth uploads and D_v
+//   ssrt_depth_merge      D'  (eq. 1-3); also D' packed with I_c for the next pass
 //   ssrt_depth_bilateral  D'' (eq. 4), joint bilateral median over Omega_I
 //   ssrt_depth_final      D''' (eq. 5), plain median; left out when final_pass is false
 //   ssrt_gbuffer          final depth -> world positions + camera-facing normals
@@ -16,6 +17,9 @@
 // per side for D' and D'' (the paper's 5 x 5; e.g. merge_window 6 would read 7 x 7 taps), a
 // tap reach of at most 16 pixels (merge_window / bilateral_window <= 33 with 5 taps), and a
 // D''' window of at most 5 x 5 (final_window <= 5).
+// Every pass fetches its taps straight from the images (8 x 8 workgroups, no shared memory):
+// on lavapipe a barrier turns each SIMD chunk of a workgroup into a coroutine, which cost
+// 3-8x more than the fetches it saved (measured: D''' 36 -> 4 ms at 640 x 480).
 #pragma once
 #include <cstdint>
 #include <string>
@@ -53,11 +57,14 @@ class DepthFilterGpu {
   // RGBA16F xyz world unit normal facing the camera; w 1 where measured, 0 where the pixel has
   // no same-surface neighbour along an axis (then xyz faces the camera) or no depth (all 0).
   gpu::ImageHandle normal() const { return normal_; }
-  // D', D'', D''' (R32F metres, 0 = missing) and I_c (R32F grey 0..255).
+  // D', D'', D''' (R32F metres, 0 = missing).
   gpu::ImageHandle merged() const { return merged_; }
   gpu::ImageHandle bilateral() const { return bilateral_; }
   gpu::ImageHandle final_depth() const { return final_; }
-  gpu::ImageHandle intensity() const { return intensity_; }
+  // RG32F: x D_c (metres, 0 = missing), y I_c (grey 0..255) + 256 where D_c agrees with D_v.
+  gpu::ImageHandle input() const { return input_; }
+  // RG32F: x D', y I_c (what the bilateral pass reads).
+  gpu::ImageHandle merged_intensity() const { return merged_intensity_; }
   const DepthFilterSettings& settings() const { return settings_; }
 
   struct WindowPush {
@@ -68,11 +75,11 @@ class DepthFilterGpu {
  private:
   gpu::FrameGraph* graph_ = nullptr;
   gpu::BufferHandle frame_constants_, color_upload_, depth_upload_;
-  gpu::ImageHandle merged_, intensity_, bilateral_, final_, position_, normal_;
+  gpu::ImageHandle input_, merged_, merged_intensity_, bilateral_, final_, position_, normal_;
   gpu::ImageHandle no_volume_;   // 1 x 1 placeholder bound when there is no D_v (never read)
   gpu::ImageHandle volume_;      // this frame's D_v (or no_volume_)
   gpu::ImageHandle gbuffer_source_;  // this frame's final depth (D''' or D'')
-  gpu::PipelineHandle merge_, bilateral_pipe_, final_pipe_, gbuffer_;
+  gpu::PipelineHandle input_pipe_, merge_, bilateral_pipe_, final_pipe_, gbuffer_;
   DepthFilterSettings settings_;
   // Push constants, filled at create / record (kept here so the callbacks allocate nothing).
   WindowPush merge_push_{}, bilateral_push_{};
