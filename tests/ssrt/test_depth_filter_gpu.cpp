@@ -29,9 +29,13 @@ using ssrt::DepthFilterSettings;
 
 constexpr float kDepthScale = 5000.0f;  // u16 units per metre (TUM)
 
-// One frame's host-side inputs at W x H (registered colour and depth, same intrinsics).
+// One frame's host-side inputs: colour at W x H; depth registered (same size and intrinsics)
+// unless resample() gives it a camera of its own; the filter runs at W x H x render_scale.
 struct Inputs {
   uint32_t w = 160, h = 120;
+  uint32_t depth_w = 160, depth_h = 120;
+  glm::vec4 depth_k{150.0f, 150.0f, 79.5f, 59.5f};
+  float render_scale = 1.0f;
   std::vector<uint8_t> rgb;      // sRGB8
   std::vector<uint16_t> raw;     // depth units
   std::vector<float> volume;     // D_v, metres
@@ -42,6 +46,7 @@ struct Inputs {
         volume(size_t(width) * height, 0.0f) {
     const float f = 150.0f * float(w) / 160.0f;
     k = glm::vec4(f, f, 0.5f * float(w) - 0.5f, 0.5f * float(h) - 0.5f);
+    depth_w = w, depth_h = h, depth_k = k;
   }
   void set_grey(uint32_t x, uint32_t y, uint8_t r, uint8_t g, uint8_t b) {
     uint8_t* p = &rgb[(size_t(y) * w + x) * 3];
@@ -75,8 +80,9 @@ struct Rig {
   std::optional<DepthFilterGpu> filter;
   std::vector<Readback> readbacks;
   std::vector<std::string> skipped;
-  uint32_t w = 0, h = 0;
+  uint32_t w = 0, h = 0;  // internal (used) size
   uint32_t last_slot = 0;
+  glm::vec4 internal_k{0.0f};
   // Frames still in flight use the filter's pipelines: wait for them before they go.
   ~Rig() {
     if (graph) (void)graph->flush();
@@ -85,7 +91,8 @@ struct Rig {
   static std::unique_ptr<Rig> make(Context& ctx, const Inputs& in,
                                    const DepthFilterSettings& settings = {}) {
     auto r = std::make_unique<Rig>();
-    r->w = in.w, r->h = in.h;
+    r->w = uint32_t(std::ceil(in.w * in.render_scale));
+    r->h = uint32_t(std::ceil(in.h * in.render_scale));
     FrameGraphSettings fs;
     fs.max_output_width = in.w;
     fs.max_output_height = in.h;
@@ -94,6 +101,7 @@ struct Rig {
     if (!g.ok()) return nullptr;
     r->graph = std::move(*g);
     EXPECT_TRUE(r->graph->set_output_size(in.w, in.h).ok());
+    EXPECT_TRUE(r->graph->set_render_scale(in.render_scale).ok());
     auto buffer = [&](const char* name, VkDeviceSize bytes, VkBufferUsageFlags usage) {
       auto b = r->graph->create_buffer({name, (bytes + 3) / 4 * 4, MemoryUsage::Upload, true}, usage);
       EXPECT_TRUE(b.ok()) << b.error().message;
@@ -138,11 +146,17 @@ struct Rig {
     fc.camera_to_world = in.camera_to_world;
     fc.world_to_camera = glm::inverse(in.camera_to_world);
     fc.camera_world = in.camera_to_world[3];
-    fc.internal_k = fc.output_k = fc.color_k = fc.depth_k = in.k;
-    fc.internal_output_size = glm::ivec4(in.w, in.h, in.w, in.h);
-    fc.color_depth_size = glm::ivec4(in.w, in.h, in.w, in.h);
+    fc.output_k = fc.color_k = in.k;
+    fc.depth_k = in.depth_k;
+    // The runtime's scaling (Intrinsics::scaled_to): pixel centres scale with the image.
+    const float sx = float(w) / float(in.w), sy = float(h) / float(in.h);
+    fc.internal_k = glm::vec4(in.k.x * sx, in.k.y * sy, (in.k.z + 0.5f) * sx - 0.5f,
+                              (in.k.w + 0.5f) * sy - 0.5f);
+    fc.internal_output_size = glm::ivec4(w, h, in.w, in.h);
+    fc.color_depth_size = glm::ivec4(in.w, in.h, in.depth_w, in.depth_h);
+    internal_k = fc.internal_k;
     fc.camera = glm::vec4(kDepthScale, 1.0f, 0.02f, 0.0f);
-    fc.flags = glm::ivec4(1, 0, 0, 0);
+    fc.flags = glm::ivec4(in.depth_k == in.k && in.depth_w == in.w ? 1 : 0, 0, 0, 0);
     const uint32_t slot = graph->slot();
     std::memcpy(graph->mapped(shared.frame_constants, slot), &fc, sizeof(fc));
     std::memcpy(graph->mapped(shared.color_upload, slot), in.rgb.data(), in.rgb.size());
@@ -316,6 +330,66 @@ void compare_chain(Context& ctx, bool with_volume) {
 TEST_F(VulkanTest, SsrtDepthFilterGpuMatchesCpuReferenceWithVolume) { compare_chain(ctx(), true); }
 
 TEST_F(VulkanTest, SsrtDepthFilterGpuMatchesCpuReferenceWithoutVolume) { compare_chain(ctx(), false); }
+
+// Unregistered depth (its own camera and size) and a render scale of 0.5: D_c and I_c are the
+// nearest samples along each internal pixel's ray (recon's gather); the chain on those equals
+// the CPU reference fed the same gathered images.
+TEST_F(VulkanTest, SsrtDepthFilterGpuResamplesUnregisteredDepthAtRenderScale) {
+  const Inputs registered = synthetic_frame(160, 120);
+  Inputs in = registered;
+  in.render_scale = 0.5f;
+  // A depth camera of 120 x 90 with a narrower field of view and another centre: each depth
+  // sample is the registered image's nearest pixel along the same ray.
+  in.depth_w = 120, in.depth_h = 90;
+  in.depth_k = glm::vec4(125.0f, 126.0f, 60.2f, 44.7f);  // narrower than the colour view
+  in.raw.assign(size_t(in.depth_w) * in.depth_h, 0);
+  for (uint32_t y = 0; y < in.depth_h; ++y)
+    for (uint32_t x = 0; x < in.depth_w; ++x) {
+      const glm::vec3 ray = shader::unproject_pinhole(glm::vec2(x, y), 1.0f, in.depth_k);
+      const glm::vec2 c = shader::project_pinhole(ray, in.k);
+      const int cx = std::clamp(int(std::floor(c.x + 0.5f)), 0, int(in.w) - 1);
+      const int cy = std::clamp(int(std::floor(c.y + 0.5f)), 0, int(in.h) - 1);
+      in.raw[size_t(y) * in.depth_w + x] = registered.raw[size_t(cy) * in.w + cx];
+    }
+  auto rig = Rig::make(ctx(), in);
+  ASSERT_TRUE(rig);
+  ASSERT_EQ(rig->w, 80u);
+  ASSERT_EQ(rig->h, 60u);
+  rig->frame(in, false, true);
+  ASSERT_TRUE(rig->graph->flush().ok());
+  // The gather on the CPU, with the shader's float formulas (mrgi_shared.h is shared).
+  const uint32_t w = rig->w, h = rig->h;
+  std::vector<float> dc(w * h, 0.0f), ic(w * h, 0.0f);
+  int outside = 0;
+  for (uint32_t y = 0; y < h; ++y)
+    for (uint32_t x = 0; x < w; ++x) {
+      const glm::vec3 ray = shader::unproject_pinhole(glm::vec2(x, y), 1.0f, rig->internal_k);
+      const glm::vec2 d = shader::project_pinhole(ray, in.depth_k);
+      const int dx = int(std::floor(d.x + 0.5f)), dy = int(std::floor(d.y + 0.5f));
+      if (dx >= 0 && dy >= 0 && dx < int(in.depth_w) && dy < int(in.depth_h)) {
+        const uint16_t raw = in.raw[size_t(dy) * in.depth_w + dx];
+        dc[y * w + x] = raw == 0 ? 0.0f : float(raw) / kDepthScale;
+      } else {
+        ++outside;
+      }
+      const glm::vec2 c = shader::project_pinhole(ray, in.k);
+      const int cx = int(std::floor(c.x + 0.5f)), cy = int(std::floor(c.y + 0.5f));
+      if (cx >= 0 && cy >= 0 && cx < int(in.w) && cy < int(in.h)) {
+        const uint8_t* p = &in.rgb[(size_t(cy) * in.w + cx) * 3];
+        ic[y * w + x] = float(ssrt::grey_level(p[0], p[1], p[2]));
+      }
+    }
+  EXPECT_GT(outside, 0);  // the depth camera does not cover the whole colour view
+  const std::vector<float> input = rig->read<float>(rig->filter->input(), 2);
+  int input_bad = 0;
+  for (size_t i = 0; i < dc.size(); ++i)
+    input_bad += input[i * 2] != dc[i] || input[i * 2 + 1] != ic[i];
+  EXPECT_EQ(input_bad, 0) << "of " << dc.size();
+  auto cpu = ssrt::filter_depth_reference({w, h, dc.data(), nullptr, ic.data()}, {});
+  ASSERT_TRUE(cpu.ok());
+  expect_same_depths(rig->read_depth(rig->filter->merged()), cpu->merged, w, "D' (resampled)");
+  expect_same_depths(rig->read_depth(rig->filter->final_depth()), cpu->final, w, "D''' (resampled)");
+}
 
 TEST_F(VulkanTest, SsrtDepthFilterGpuFinalPassOffIsSkippedAndReported) {
   const Inputs in = synthetic_frame(160, 120);
