@@ -26,24 +26,6 @@ std::string api_string(uint32_t v) {
   return std::to_string(v >> 22) + "." + std::to_string((v >> 12) & 0x3ff) + "." + std::to_string(v & 0xfff);
 }
 
-int resolve_level(const InfoOptions& o) {
-  auto levels = technique_levels(o.technique);
-  if (!levels) fail_with(levels.error());
-  const int count = int(levels->size());
-  if (o.level == "last") return count - 1;
-  int level = -1;
-  try {
-    size_t used = 0;
-    level = std::stoi(o.level, &used);
-    if (used != o.level.size()) level = -1;
-  } catch (const std::exception&) {
-    level = -1;
-  }
-  if (level < 0 || level >= count)
-    fail_with(fail(ErrorKind::BadUsage, "--level '" + o.level + "': technique '" + o.technique + "' has levels 0.." +
-                                            std::to_string(count - 1) + " (or 'last')"));
-  return level;
-}
 
 void run_info(const InfoOptions& o) {
   DeviceSettings ds;
@@ -69,7 +51,7 @@ void run_info(const InfoOptions& o) {
     RuntimeSettings rs;
     rs.device = ds;
     rs.technique = o.technique;
-    rs.level = resolve_level(o);
+    rs.level = resolve_level(o.technique, o.level);
     rs.output_width = o.width;
     rs.output_height = o.height;
     CameraSetup cameras;
@@ -113,7 +95,7 @@ void setup(CLI::App& app) {
   cmd->add_option("--device", opts->device, "device index or name substring (default: $MRGI_DEVICE, else lavapipe)");
   cmd->add_flag("--validate", opts->validate, "load the Khronos validation layer (fails if it is not installed)");
   cmd->add_option("--technique", opts->technique, "also state this technique's start-up memory budget");
-  cmd->add_option("--level", opts->level, "quality level: 0 = best, or 'last'")->default_val("0");
+  cmd->add_option("--level", opts->level, "quality level: 0 = best, N, a level name, or 'last' = cheapest")->default_val("0");
   cmd->add_option("--width", opts->width, "output width in pixels")->default_val(640);
   cmd->add_option("--height", opts->height, "output height in pixels")->default_val(480);
   cmd->add_flag("--json", opts->json, "machine-readable output");

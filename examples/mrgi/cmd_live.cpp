@@ -40,17 +40,6 @@ struct LiveOptions {
   bool quiet = false;
 };
 
-int resolve_level(const std::string& technique, const std::string& level) {
-  auto levels = take(technique_levels(technique));
-  if (level == "last") return int(levels.size()) - 1;
-  char* end = nullptr;
-  const long n = std::strtol(level.c_str(), &end, 10);
-  if (level.empty() || *end != '\0' || n < 0 || n >= long(levels.size()))
-    throw CommandFailure(2, "--level '" + level + "': technique '" + technique + "' has " + std::to_string(levels.size()) +
-                                " levels (0.." + std::to_string(levels.size() - 1) + " or 'last')");
-  return int(n);
-}
-
 // A unit-centred box of edge `edge` metres as a binary glTF (positions, normals, indices; one
 // grey-blue diffuse material).
 Status write_box_glb(const std::string& path, float edge) {
@@ -272,7 +261,7 @@ void setup(CLI::App& app) {
   cmd->add_option("--out,-o", o->out, "output folder (frames/, stats.json, summary.json, side_by_side.png); "
                                       "no preview window is implemented, so it is required")->required();
   cmd->add_option("--frames,-n", o->frames, "stop after N frames (0 = until the stream ends or Ctrl-C)")->check(CLI::NonNegativeNumber);
-  cmd->add_option("--level,-l", o->level, "quality level: 0 = best, N, or 'last'")->capture_default_str();
+  cmd->add_option("--level,-l", o->level, "quality level: 0 = best, N, a level name, or 'last' = cheapest")->capture_default_str();
   cmd->add_option("--device", o->device, "Vulkan device: index or name part");
   cmd->add_option("--env", o->env, "fisheye environment camera, v4l2:/dev/videoN or libcamera:ID (needs a calibrated model)");
   cmd->add_option("--env-model", o->env_model, "capture.json whose env_camera (fisheye equidistant) and exposure calibrate --env");

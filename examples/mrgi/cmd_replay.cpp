@@ -18,20 +18,6 @@ struct ReplayOptions {
   bool validate = false, quiet = false;
 };
 
-// "last" = the technique's cheapest level; a number must name an existing level.
-int resolve_level(const std::string& technique, const std::string& level) {
-  auto levels = take(technique_levels(technique));
-  if (level == "last") return int(levels.size()) - 1;
-  char* end = nullptr;
-  const long n = std::strtol(level.c_str(), &end, 10);
-  if (level.empty() || *end != '\0' || n < 0 || n >= long(levels.size())) {
-    std::string names;
-    for (size_t i = 0; i < levels.size(); ++i) names += (i ? ", " : "") + std::to_string(i) + "=" + levels[i];
-    throw CommandFailure(2, "--level '" + level + "': technique '" + technique + "' has levels " + names + " (or 'last')");
-  }
-  return int(n);
-}
-
 void run_replay(const ReplayOptions& o) {
   if ((o.width == 0) != (o.height == 0)) throw CommandFailure(2, "--width and --height go together");
   const int level = resolve_level(o.technique, o.level);
@@ -65,6 +51,10 @@ void run_replay(const ReplayOptions& o) {
 
   // Outputs come back frames_in_flight-1 calls late; keep each input's camera frame until then.
   std::vector<ImageRGB8> cameras_by_frame(frames);
+  // The true light of each frame's environment image (capture env camera), for the estimate's
+  // direction error.
+  std::vector<std::optional<LightEstimate>> truth_by_frame(frames);
+  const double env_intensity = scene.environment.present ? scene.environment.intensity : 1.0;
   size_t written = 0;
   const auto t0 = std::chrono::steady_clock::now();
   auto consume = [&](std::vector<FrameOutput>&& outs) {
@@ -77,7 +67,8 @@ void run_replay(const ReplayOptions& o) {
         if (!capture.entry(i).reference_mask.empty())
           mask = resize_mask_nearest(take(capture.read_reference_mask(i)), out_w, out_h);
       }
-      auto st = output.add(f, cameras_by_frame[i], ref ? &*ref : nullptr, mask ? &*mask : nullptr);
+      const LightEstimate* truth = truth_by_frame[i] ? &*truth_by_frame[i] : nullptr;
+      auto st = output.add(f, cameras_by_frame[i], ref ? &*ref : nullptr, mask ? &*mask : nullptr, truth);
       if (!st.ok()) fail_with(st.error());
       cameras_by_frame[i] = ImageRGB8{};
       ++written;
@@ -94,6 +85,7 @@ void run_replay(const ReplayOptions& o) {
       ++(frame.pose ? tracked : untracked);
     }
     cameras_by_frame[i] = resize_rgb8(frame.color, out_w, out_h);
+    if (frame.env && info.env_camera) truth_by_frame[i] = take(light_from_environment(*frame.env, *info.env_camera, env_intensity));
     consume(take(runtime->process(frame)));
   }
   consume(take(runtime->flush()));
@@ -116,7 +108,7 @@ void setup(CLI::App& app) {
     return s;
   }())->capture_default_str();
   cmd->add_option("--out,-o", opts->out, "output folder (frames/, stats.json, summary.json, side_by_side.png)")->required();
-  cmd->add_option("--level,-l", opts->level, "quality level: 0 = best, N, or 'last' = cheapest")->capture_default_str();
+  cmd->add_option("--level,-l", opts->level, "quality level: 0 = best, N, a level name, or 'last' = cheapest")->capture_default_str();
   cmd->add_option("--frames,-n", opts->frames, "replay at most N frames (0 = all)")->check(CLI::NonNegativeNumber);
   cmd->add_option("--width", opts->width, "output width in pixels (default: the colour camera's)")->check(CLI::Range(16, 8192));
   cmd->add_option("--height", opts->height, "output height in pixels")->check(CLI::Range(16, 8192));

@@ -38,6 +38,10 @@ T take(Expected<T>&& e) {
   return std::move(e).value();
 }
 
+// A --level value for `technique`: a number (0 = best), a level name ("fast"), or "last" (the
+// cheapest). Anything else ends the command with exit 2 and the list of levels.
+int resolve_level(const std::string& technique, const std::string& level);
+
 // Progress on stderr for long work (one line, rewritten in place when stderr is a terminal).
 void progress(const std::string& what, size_t done, size_t total, double elapsed_s);
 

@@ -2,11 +2,13 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <iostream>
 #include <map>
 
 #include "commands.h"
+#include "mrgi/runtime.h"
 
 namespace mrgi::tool {
 namespace {
@@ -22,6 +24,22 @@ int exit_code_for(ErrorKind kind) { return kind == ErrorKind::BadUsage ? 2 : 1; 
 
 void fail_with(const Error& error) {
   throw CommandFailure(exit_code_for(error.kind), std::string(to_string(error.kind)) + ": " + error.message);
+}
+
+int resolve_level(const std::string& technique, const std::string& level) {
+  auto levels = take(technique_levels(technique));
+  if (level == "last") return int(levels.size()) - 1;
+  for (size_t i = 0; i < levels.size(); ++i)
+    if (levels[i] == level) return int(i);
+  char* end = nullptr;
+  const long n = std::strtol(level.c_str(), &end, 10);
+  if (level.empty() || *end != '\0' || n < 0 || n >= long(levels.size())) {
+    std::string names;
+    for (size_t i = 0; i < levels.size(); ++i) names += (i ? ", " : "") + std::to_string(i) + "=" + levels[i];
+    throw CommandFailure(2, "--level '" + level + "': technique '" + technique + "' has levels " + names +
+                                " (a number, a name, or 'last')");
+  }
+  return int(n);
 }
 
 void progress(const std::string& what, size_t done, size_t total, double elapsed_s) {

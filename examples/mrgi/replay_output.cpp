@@ -98,8 +98,20 @@ Expected<ReplayOutput> ReplayOutput::create(const std::string& dir, const Replay
   return out;
 }
 
+nlohmann::json light_json(const LightEstimate& e) {
+  nlohmann::json sh = nlohmann::json::array();
+  for (int i = 0; i < e.bands * e.bands; ++i) sh.push_back(e.sh_radiance[size_t(i)]);
+  return {{"valid", e.valid},
+          {"solved_from_frame", e.frame_index},
+          {"direction_to_light", e.direction_to_light},
+          {"dominant_intensity", e.dominant_intensity},
+          {"confidence", e.confidence},
+          {"bands", e.bands},
+          {"sh_radiance", sh}};
+}
+
 Status ReplayOutput::add(const FrameOutput& out, const ImageRGB8& camera, const ImageRGB8* reference,
-                         const ImageU8* mask) {
+                         const ImageU8* mask, const LightEstimate* light_truth) {
   const size_t i = frame_ms_.size();
   MRGI_TRY(write_png(partial_ + "/frames/" + frame_name(i), out.image));
   nlohmann::json s;
@@ -111,6 +123,16 @@ Status ReplayOutput::add(const FrameOutput& out, const ImageRGB8& camera, const 
   for (const auto& p : out.stats.passes) passes[p.name] = p.gpu_ms;
   s["passes_ms"] = passes;
   s["skipped"] = out.stats.skipped;
+  if (out.light) {
+    s["light"] = light_json(*out.light);
+    last_light_ = s["light"];
+    if (light_truth && out.light->valid) {
+      const double err = direction_error_deg(*out.light, *light_truth);
+      s["light_truth"] = light_json(*light_truth);
+      s["light_direction_error_deg"] = err;
+      light_error_deg_.push_back(err);
+    }
+  }
   if (reference) {
     auto r = measure_error(out.image, camera, *reference, mask);
     if (!r.ok()) return r.error();
@@ -149,6 +171,14 @@ Expected<nlohmann::json> ReplayOutput::finish() {
   summary["width"] = meta_.width;
   summary["height"] = meta_.height;
   summary["source"] = meta_.source;
+  if (!last_light_.is_null()) summary["light"] = last_light_;
+  if (!light_error_deg_.empty()) {
+    summary["light_direction_error_deg"] = {
+        {"median", perf::percentile(light_error_deg_, 50)},
+        {"worst", *std::max_element(light_error_deg_.begin(), light_error_deg_.end())},
+        {"frames", light_error_deg_.size()},
+        {"truth", "dominant direction (SH band 1) of the frame's environment image"}};
+  }
   if (pooled_) {
     auto rde = [](const ErrorFigures& f) { return f.rde_defined ? nlohmann::json(f.rde) : nlohmann::json(nullptr); };
     summary["rde"] = {{"all", rde(pooled_->all)}, {"real", rde(pooled_->real)}, {"virtual", rde(pooled_->virtual_)}};

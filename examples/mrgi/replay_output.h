@@ -1,9 +1,12 @@
 // What `mrgi replay` and `mrgi live` write to --out DIR:
 //   DIR/frames/NNNNNN.png   composited RGBA8 frames
 //   DIR/stats.json          per frame: each pass's GPU ms, total ms, wall ms, level, skipped passes,
-//                           and the frame's error figures when a reference exists
+//                           the frame's error figures when a reference exists, and the
+//                           estimated light (ssrt) when the technique estimates one
 //   DIR/summary.json        frames, median_frame_ms, p95_frame_ms, technique, level, device,
-//                           lp_num_threads, memory_mib, and rde {all, real, virtual} with references
+//                           lp_num_threads, memory_mib, rde {all, real, virtual} with references,
+//                           and light_direction_error_deg {median, worst, frames} when the
+//                           capture has environment images and the technique estimates light
 //   DIR/side_by_side.png    camera | mrgi | reference (or camera | mrgi) of the last frame
 // Everything is written under DIR.partial and renamed over DIR by finish(), so a failed run leaves
 // no half-written output behind.
@@ -33,8 +36,10 @@ class ReplayOutput {
  public:
   static Expected<ReplayOutput> create(const std::string& dir, const ReplayMeta& meta);
   // camera: the input colour frame at output size; reference/mask optional (capture references).
+  // light_truth: the light of the frame's environment image (light_from_environment), when the
+  // capture has one; with an estimate it gives the frame's direction error.
   Status add(const FrameOutput& out, const ImageRGB8& camera, const ImageRGB8* reference,
-             const ImageU8* mask);
+             const ImageU8* mask, const LightEstimate* light_truth = nullptr);
   // Writes stats.json, summary.json and the side-by-side image, then renames DIR.partial to DIR.
   Expected<nlohmann::json> finish();
   size_t frames() const { return frame_ms_.size(); }
@@ -47,9 +52,13 @@ class ReplayOutput {
   std::optional<RdeReport> pooled_;
   ImageRGB8 last_camera_, last_reference_;
   ImageRGBA8 last_output_;
+  nlohmann::json last_light_;
+  std::vector<double> light_error_deg_;
 };
 
 nlohmann::json figures_json(const ErrorFigures& f);
+// The estimated light (techniques that estimate it): direction, intensity, confidence, SH.
+nlohmann::json light_json(const LightEstimate& e);
 // Resamples an 8-bit RGB image to w x h (bilinear), for cameras larger than the output.
 ImageRGB8 resize_rgb8(const ImageRGB8& src, int w, int h);
 ImageU8 resize_mask_nearest(const ImageU8& src, int w, int h);

@@ -18,6 +18,7 @@
 #include "shared/mrgi_shared.h"
 #include "common/frame_constants.glsl"
 #include "ssrt/ssrt_math.h"
+#include "ssrt/aux_views.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
@@ -30,6 +31,10 @@ layout(set = 0, binding = 6) uniform sampler2D virtual_position;
 layout(set = 0, binding = 7) uniform sampler2D virtual_normal;
 layout(set = 0, binding = 8) uniform sampler2D virtual_albedo;
 layout(set = 0, binding = 9, rgba32f) writeonly uniform image2DArray coarse;
+// The volume's auxiliary orthographic layers (left, right, top, light; aux_views.glsl): occluders
+// outside the camera frustum (paper Sec. 5.1).
+layout(set = 0, binding = 10) uniform sampler2DArray aux_position;
+layout(std140, set = 0, binding = 11) uniform AuxUbo { SsrtAuxViews aux; };
 layout(push_constant) uniform Push {
   ivec4 grid;     // x, y cells; z step in pixels; w directions N
   ivec4 config;   // x first sample of the level's sets, y SH bands, z/w unused
@@ -37,7 +42,29 @@ layout(push_constant) uniform Push {
   vec4 bounce;    // x sample area (m^2), y saturation threshold, z depth test bias (fraction),
                   // w occluder range (m)
   ivec4 influence;  // cells [x0, x1) x [y0, y1) that the virtual objects' influence region covers
+  vec4 aux_test;    // x depth bias in texels of each aux layer, y 1 = test the aux layers
 } pc;
+
+// Paper Fig. 5a: a sample the main buffer finds visible may lie behind a surface one of the
+// auxiliary buffers sees. Returns true with that surface's world position (the first layer
+// that occludes; its surface must lie within the occluder range of the receiver x).
+bool aux_occluder(vec3 x, vec3 y, out vec3 s) {
+  s = vec3(0.0f);
+  if (pc.aux_test.y < 0.5f) return false;
+  for (int i = 0; i < aux.info.x; ++i) {
+    ivec2 texel;
+    float depth;
+    if (!ssrt_aux_texel(aux, i, y, texel, depth)) continue;
+    vec4 o = texelFetch(aux_position, ivec3(texel, i), 0);
+    vec3 d = o.xyz - x;
+    if (o.w > 0.0f && o.w < depth - pc.aux_test.x * aux.extent[i].z &&
+        dot(d, d) <= pc.bounce.w * pc.bounce.w) {
+      s = o.xyz;
+      return true;
+    }
+  }
+  return false;
+}
 
 // Camera-space depth of a world point.
 float view_depth(vec3 p) { return (frame.world_to_camera * vec4(p, 1.0f)).z; }
@@ -110,9 +137,14 @@ void main() {
           }
         }
       }
+      // Occluders the view cannot see: visibility only (their normal and colour are unknown,
+      // so they send no indirect light).
+      vec3 s_aux;
+      bool from_view = k < 1.0f;
+      if (!from_view && aux_occluder(xr, y, s_aux)) k = ssrt_visibility_k(xr, s_aux, w, chi);
       float tw = ssrt_transfer_weight(nr, w, k, 1.0f);
       for (int c = 0; c < 4; ++c) t_real[c] += tw * s.sh_weights[c];
-      if (k < 1.0f) {
+      if (from_view) {
         ri += ssrt_indirect_term(xr, nr, sp, sn, sa, k, l_dir, e_light, pc.bounce.x,
                                  pc.sampling.w);
       }
@@ -142,9 +174,12 @@ void main() {
           }
         }
       }
+      vec3 sv_aux;
+      bool from_view_v = k < 1.0f;
+      if (!from_view_v && aux_occluder(xv, y, sv_aux)) k = ssrt_visibility_k(xv, sv_aux, w, chi);
       float tw = ssrt_transfer_weight(nv, w, k, 1.0f);
       for (int c = 0; c < 4; ++c) t_rv[c] += tw * s.sh_weights[c];
-      if (k < 1.0f) {
+      if (from_view_v) {
         ri_v += ssrt_indirect_term(xv, nv, sp, sn, sa, k, l_dir, e_light, pc.bounce.x,
                                    pc.sampling.w);
       }

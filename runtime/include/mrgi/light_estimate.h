@@ -10,6 +10,10 @@
 #include <array>
 #include <cstdint>
 
+#include "mrgi/expected.h"
+#include "mrgi/frame.h"
+#include "mrgi/image.h"
+
 namespace mrgi {
 
 using Rgb = std::array<float, 3>;
@@ -37,6 +41,19 @@ struct LightEstimate {
   // that sees one flat wall gives a low value; a room corner with floor and walls a higher one.
   float confidence = 0.0f;
 };
+
+// The light of an environment image (linear radiance; equirectangular with the path tracer's
+// convention u = 0.5 + atan2(x, -z) / 2pi, v = acos(y) / pi, or an equidistant fisheye with
+// pixel centres at integer coordinates) in the form an estimate has: radiance SH projected
+// from every pixel by its solid angle (a fisheye contributes only the directions it sees),
+// then the dominant direction and intensity from band 1 exactly as for an estimate. This is
+// the ground truth an estimate is compared with. `intensity` scales the radiance. confidence is
+// 1, frame_index -1. BadInput for an empty image or a fisheye without a focal length.
+Expected<LightEstimate> light_from_environment(const ImageRGBF& image, const EnvCamera& camera,
+                                               double intensity = 1.0, int bands = 4);
+
+// Angle in degrees between the dominant directions of two estimates.
+double direction_error_deg(const LightEstimate& a, const LightEstimate& b);
 
 // Irradiance E(n) of an estimate for a unit normal n (world space), linear RGB.
 Rgb irradiance_at(const LightEstimate& estimate, const std::array<float, 3>& normal);

@@ -8,7 +8,10 @@
 
 namespace mrgi::gpu {
 namespace {
-constexpr uint64_t kFrameTimeoutNs = 10ull * 1000 * 1000 * 1000;
+// A frame that has not finished after this long is treated as a hung device. Generous because
+// the CPU rasteriser (lavapipe, 2 threads) runs the best quality levels at seconds per frame.
+constexpr uint64_t kFrameTimeoutS = 120;
+constexpr uint64_t kFrameTimeoutNs = kFrameTimeoutS * 1000ull * 1000 * 1000;
 }
 
 struct FrameGraph::ImageEntry {
@@ -285,7 +288,8 @@ Expected<std::optional<FrameTimings>> FrameGraph::collect(uint32_t index) {
   VkDevice dev = context_.device();
   const VkResult w = vkWaitForFences(dev, 1, &s.fence, VK_TRUE, kFrameTimeoutNs);
   if (w == VK_TIMEOUT)
-    return fail(ErrorKind::Timeout, "frame " + std::to_string(s.frame_index) + " did not finish on the GPU within 10 s");
+    return fail(ErrorKind::Timeout, "frame " + std::to_string(s.frame_index) + " did not finish on the GPU within " +
+                                      std::to_string(kFrameTimeoutS) + " s (device hung or far too slow)");
   VK_CHECK(w);
   VK_CHECK(vkResetFences(dev, 1, &s.fence));
   s.submitted = false;

@@ -1,6 +1,9 @@
 #include "technique/ssrt/sh_tools.h"
 
+#include <algorithm>
 #include <cmath>
+
+#include <glm/gtc/quaternion.hpp>
 
 #include "shared/mrgi_shared.h"
 
@@ -110,6 +113,62 @@ Rgb irradiance_at(const LightEstimate& estimate, const std::array<float, 3>& nor
   for (int i = 0; i < 9; ++i)
     for (int c = 0; c < 3; ++c) out[c] += estimate.irradiance_sh9[i][c] * y[i];
   return out;
+}
+
+
+Expected<LightEstimate> light_from_environment(const ImageRGBF& image, const EnvCamera& camera,
+                                               double intensity, int bands) {
+  constexpr double kPi = 3.14159265358979323846;
+  if (image.empty() || image.width < 1 || image.height < 1)
+    return fail(ErrorKind::BadInput, "light_from_environment: empty environment image");
+  const bool fisheye = camera.model == EnvModel::FisheyeEquidistant;
+  if (fisheye && !(camera.f > 0.0))
+    return fail(ErrorKind::BadInput, "light_from_environment: fisheye env camera needs f > 0 (pixels)");
+  if (bands < 1 || bands > ssrt::kMaxShBands)
+    return fail(ErrorKind::BadUsage, "light_from_environment: bands must be 1..4");
+  const glm::dmat3 rot = glm::mat3_cast(camera.rotation);
+  const double half_fov = 0.5 * camera.fov_deg * kPi / 180.0;
+  ssrt::ShRgb sh{};
+  for (int v = 0; v < image.height; ++v) {
+    for (int u = 0; u < image.width; ++u) {
+      glm::dvec3 d;
+      double solid_angle = 0.0;
+      if (fisheye) {
+        const double dx = u - camera.cx, dy = v - camera.cy, r = std::sqrt(dx * dx + dy * dy);
+        const double theta = r / camera.f;
+        if (theta > half_fov) continue;
+        const double s = std::sin(theta);
+        d = r > 0.0 ? glm::dvec3(s * dx / r, s * dy / r, std::cos(theta)) : glm::dvec3(0, 0, 1);
+        // Equidistant: r dr dphi = f^2 theta dtheta dphi and dOmega = sin(theta) dtheta dphi.
+        solid_angle = theta > 1e-9 ? s / (theta * camera.f * camera.f) : 1.0 / (camera.f * camera.f);
+      } else {
+        const double pu = (u + 0.5) / image.width, pv = (v + 0.5) / image.height;
+        const double theta = pv * kPi, phi = (pu - 0.5) * 2.0 * kPi;
+        d = glm::dvec3(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
+        solid_angle = std::sin(theta) * (kPi / image.height) * (2.0 * kPi / image.width);
+      }
+      const float* t = image.at(u, v);
+      glm::dvec3 c(t[0], t[1], t[2]);
+      for (int i = 0; i < 3; ++i)
+        if (!(c[i] >= 0.0) || std::isinf(c[i])) c[i] = 0.0;
+      const ssrt::ShVector y = ssrt::sh_basis(glm::vec3(rot * d));
+      for (int i = 0; i < bands * bands; ++i)
+        sh[size_t(i)] += c * (intensity * solid_angle * double(y[size_t(i)]));
+    }
+  }
+  LightEstimate out;
+  ssrt::fill_light_estimate(sh, bands, out);
+  out.valid = true;
+  out.confidence = 1.0f;
+  out.frame_index = -1;
+  return out;
+}
+
+double direction_error_deg(const LightEstimate& a, const LightEstimate& b) {
+  const glm::dvec3 da(a.direction_to_light[0], a.direction_to_light[1], a.direction_to_light[2]);
+  const glm::dvec3 db(b.direction_to_light[0], b.direction_to_light[1], b.direction_to_light[2]);
+  const double c = glm::dot(glm::normalize(da), glm::normalize(db));
+  return std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / 3.14159265358979323846;
 }
 
 }  // namespace mrgi

@@ -11,8 +11,10 @@
 #include "gpu/shaders.h"
 #include "ssrt/ssrt_math.h"
 #include "technique/scene_gpu.h"
+#include "technique/ssrt/depth_filter_gpu.h"
 #include "technique/ssrt/light_estimator.h"
 #include "technique/ssrt/sample_directions.h"
+#include "technique/ssrt/volume.h"
 
 namespace mrgi::technique {
 namespace {
@@ -31,6 +33,11 @@ constexpr float kDepthBias = 0.01f;          // occluder must be 1 % closer than
 constexpr float kSaturation = 0.98f;         // camera values at/above are clipped: not used
 constexpr float kIndirectTolerance = 1e-3f;  // eq. 14
 constexpr float kGaussRadiusPx = 8.0f;       // paper OursFast
+// An auxiliary-buffer surface occludes a sample only if it lies this many of the layer's texels
+// in front of it (the aux layers are ray-cast from a TSDF with voxels about one texel wide).
+constexpr float kAuxBiasTexels = 1.5f;
+// Without a virtual object the volume is centred this far in front of the first camera pose.
+constexpr double kVolumeAheadM = 1.0;
 
 struct TransferPush {
   glm::ivec4 grid;
@@ -38,6 +45,7 @@ struct TransferPush {
   glm::vec4 sampling;
   glm::vec4 bounce;
   glm::ivec4 influence;
+  glm::vec4 aux;  // x bias in texels of the aux layer, y 1 = test the aux layers
 };
 struct ReducePush {
   glm::ivec4 grid;
@@ -89,6 +97,10 @@ class Ssrt final : public Technique {
 
  private:
   void consume_readback(std::vector<std::string>& notes);
+  // The paper's geometry stage (Sec. 4): fuse the volume, ray-cast G_v and the aux layers, run
+  // the depth filter chain into the G-buffer the transfer reads.
+  Status record_geometry(const FrameInfo& info, const QualityLevel& level,
+                         std::vector<std::string>& skipped);
   void write_light();
   // Whether the virtual objects' influence region (bounds grown by the sampling radius) is in
   // view; `cells` gets its conservative screen rectangle in cells [x0, x1) x [y0, y1).
@@ -104,6 +116,11 @@ class Ssrt final : public Technique {
   SharedResources shared_;
   std::vector<QualityLevel> ladder_;
   std::optional<ssrt::LightEstimator> estimator_;
+  std::optional<ssrt::Volume> volume_;
+  std::optional<ssrt::DepthFilterGpu> filter_;
+  // The real G-buffer the transfer uses: the filter chain's (paper Sec. 4), not recon's.
+  gpu::ImageHandle geo_position_, geo_normal_;
+  std::optional<glm::vec3> volume_center_;
   std::vector<uint32_t> sample_base_;  // per level: first sample of its sets
   std::vector<float> chi_;             // per level
   gpu::BufferHandle samples_, light_, partials_, result_;
@@ -124,6 +141,21 @@ Status Ssrt::init() {
   auto est = ssrt::LightEstimator::create({});
   if (!est) return est.error();
   estimator_.emplace(std::move(*est));
+  ssrt::VolumeSettings vs;
+  vs.max_resolution = 1;
+  vs.max_aux_resolution = 1;
+  for (const QualityLevel& l : ladder_) {
+    vs.max_resolution = std::max(vs.max_resolution, uint32_t(knob(l, "volume_resolution")));
+    vs.max_aux_resolution = std::max(vs.max_aux_resolution, uint32_t(knob(l, "aux_resolution")));
+  }
+  auto vol = ssrt::Volume::create(ctx, graph, shared_, vs);
+  if (!vol) return vol.error();
+  volume_.emplace(std::move(*vol));
+  auto filt = ssrt::DepthFilterGpu::create(ctx, graph, shared_);
+  if (!filt) return filt.error();
+  filter_.emplace(std::move(*filt));
+  geo_position_ = filter_->position();
+  geo_normal_ = filter_->normal();
 
   // Sample sets of every level, one buffer.
   std::vector<ssrt::GpuSample> all;
@@ -176,7 +208,8 @@ Status Ssrt::init() {
   const auto tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
   const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
   auto p = compute_pipeline(ctx, "ssrt/transfer.comp",
-                            {{ubo}, {ubo}, {ssbo}, {tex}, {tex}, {tex}, {tex}, {tex}, {tex}, {img}},
+                            {{ubo}, {ubo}, {ssbo}, {tex}, {tex}, {tex}, {tex}, {tex}, {tex}, {img},
+                             {tex}, {ubo}},
                             sizeof(TransferPush));
   if (!p) return p.error();
   transfer_ = std::move(*p);
@@ -194,6 +227,31 @@ Status Ssrt::init() {
   if (!p) return p.error();
   shade_ = std::move(*p);
   return ok_status();
+}
+
+Status Ssrt::record_geometry(const FrameInfo& info, const QualityLevel& level,
+                             std::vector<std::string>& skipped) {
+  if (!volume_center_) {
+    // The workspace cube sits on the virtual objects (where occluders matter); a scene without
+    // one keeps the cube in front of the first pose.
+    const SceneGpu& sg = *shared_.scene_gpu;
+    if (!sg.virtual_objects.empty()) {
+      volume_center_ = 0.5f * (sg.virtual_objects.bounds_min + sg.virtual_objects.bounds_max);
+    } else {
+      const glm::dvec4 ahead = info.camera_to_world * glm::dvec4(0.0, 0.0, kVolumeAheadM, 1.0);
+      volume_center_ = glm::vec3(ahead);
+    }
+  }
+  ssrt::VolumeFrame vf;
+  vf.resolution = uint32_t(knob(level, "volume_resolution"));
+  vf.aux_resolution = uint32_t(knob(level, "aux_resolution"));
+  vf.center = *volume_center_;
+  vf.camera_to_world = info.camera_to_world;
+  vf.depth = info.input ? &info.input->depth : nullptr;
+  const LightEstimate& e = estimator_->estimate();
+  vf.direction_to_light = glm::vec3(e.direction_to_light[0], e.direction_to_light[1], e.direction_to_light[2]);
+  MRGI_TRY(volume_->record(vf, skipped));
+  return filter_->record(volume_->depth_volume(), knob(level, "final_filter") > 0.5, skipped);
 }
 
 // The sums a slot's readback holds belong to the frame that last used the slot; that frame has
@@ -304,6 +362,7 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
 
   consume_readback(skipped);
   write_light();
+  MRGI_TRY(record_geometry(info, level, skipped));
 
   const bool run_transfer = info.virtual_objects_present && influence_in_view(influence_cells_);
   if (!run_transfer) {
@@ -321,9 +380,11 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
           b.read(r.frame_constants, gpu::Access::UniformRead);
           b.read(light_, gpu::Access::UniformRead);
           b.read(samples_, gpu::Access::StorageRead);
-          for (gpu::ImageHandle h : {r.real_position, r.real_normal, r.real_albedo,
-                                     r.virtual_position, r.virtual_normal, r.virtual_albedo})
+          for (gpu::ImageHandle h : {geo_position_, geo_normal_, r.real_albedo,
+                                     r.virtual_position, r.virtual_normal, r.virtual_albedo,
+                                     volume_->aux_position()})
             b.read(h, gpu::Access::Sampled);
+          b.read(volume_->aux_views(), gpu::Access::UniformRead);
           b.write(coarse_, gpu::Access::StorageWrite);
         },
         [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
@@ -335,20 +396,22 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
               .uniform_buffer(0, pass.buffer(r.frame_constants))
               .uniform_buffer(1, pass.buffer(light_))
               .storage_buffer(2, pass.buffer(samples_))
-              .sampled_image(3, pass.view(r.real_position), nearest)
-              .sampled_image(4, pass.view(r.real_normal), nearest)
+              .sampled_image(3, pass.view(geo_position_), nearest)
+              .sampled_image(4, pass.view(geo_normal_), nearest)
               .sampled_image(5, pass.view(r.real_albedo), nearest)
               .sampled_image(6, pass.view(r.virtual_position), nearest)
               .sampled_image(7, pass.view(r.virtual_normal), nearest)
               .sampled_image(8, pass.view(r.virtual_albedo), nearest)
               .storage_image(9, pass.view(coarse_))
+              .sampled_image(10, pass.view(volume_->aux_position()), nearest)
+              .uniform_buffer(11, pass.buffer(volume_->aux_views()))
               .push(ctx, cmd, *transfer_);
           const float sample_area = 3.14159265f * kRadiusM * kRadiusM / float(directions_);
           TransferPush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), int(directions_)),
                           glm::ivec4(int(sample_base_[size_t(level_)]), int(bands_), 0, 0),
                           glm::vec4(kRadiusM, chi_[size_t(level_)], kNormalOffsetM, kMinSenderDistM),
                           glm::vec4(sample_area, kSaturation, kDepthBias, kRangeM),
-                          influence_cells_};
+                          influence_cells_, glm::vec4(kAuxBiasTexels, 1.0f, 0.0f, 0.0f)};
           gpu::dispatch_2d(cmd, *transfer_, &pc, sizeof(pc), grid_.x, grid_.y);
         });
     const uint32_t tiles_x = (grid_.x + kTileW - 1) / kTileW;
@@ -415,7 +478,7 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
         // Declared on skipped frames too (the shader binds it but does not read it then), so
         // the binding is always in the layout the graph gave it.
         b.read(coarse_, gpu::Access::Sampled);
-        for (gpu::ImageHandle h : {r.real_position, r.real_albedo, r.virtual_position,
+        for (gpu::ImageHandle h : {geo_position_, r.real_albedo, r.virtual_position,
                                    r.virtual_albedo})
           b.read(h, gpu::Access::Sampled);
         b.write(r.lit_rv, gpu::Access::StorageWrite);
@@ -428,7 +491,7 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, shade_->pipeline);
         gpu::DescriptorPush()
             .sampled_image(0, pass.view(coarse_), nearest)
-            .sampled_image(1, pass.view(r.real_position), nearest)
+            .sampled_image(1, pass.view(geo_position_), nearest)
             .sampled_image(2, pass.view(r.real_albedo), nearest)
             .sampled_image(3, pass.view(r.virtual_position), nearest)
             .sampled_image(4, pass.view(r.virtual_albedo), nearest)
@@ -448,18 +511,24 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
 }  // namespace
 
 std::vector<QualityLevel> ssrt_ladder() {
-  auto level = [](const char* name, double step, double n, double bands, double scale) {
+  auto level = [](const char* name, double step, double n, double bands, double scale,
+                  double volume, double aux, double final_filter) {
     QualityLevel l;
     l.name = name;
     l.internal_scale = float(scale);
     l.knobs = {{"subsample", step, "pixels per cell side (transfer computed once per cell)"},
                {"directions", n, "visibility directions per pixel (per 2x2 jitter set)"},
                {"sh_bands", bands, "SH bands of transfer and estimated light"},
-               {"internal_scale", scale, "fraction of the output width and height"}};
+               {"internal_scale", scale, "fraction of the output width and height"},
+               {"volume_resolution", volume, "TSDF voxels per side of the 2 m workspace cube"},
+               {"aux_resolution", aux, "texels per side of each auxiliary orthographic buffer"},
+               {"final_filter", final_filter, "1 = the third median pass (eq. 5) on, 0 = off"}};
     return l;
   };
-  return {level("full", 1, 64, 4, 1.0), level("half", 2, 32, 4, 1.0),
-          level("fast", 4, 32, 4, 1.0), level("fastest", 4, 16, 2, 0.5)};
+  // Full is the paper's desktop set-up (256^3, eq. 5 pass on); fast its mobile one (64^3, eq. 5
+  // pass off) with the OursFast 4x4 sub-sampling.
+  return {level("full", 1, 64, 4, 1.0, 256, 256, 1), level("half", 2, 32, 4, 1.0, 256, 256, 1),
+          level("fast", 4, 32, 4, 1.0, 64, 64, 0), level("fastest", 4, 16, 2, 0.5, 64, 64, 0)};
 }
 
 Expected<std::unique_ptr<Technique>> create_ssrt(const SharedResources& shared) {
