@@ -519,6 +519,12 @@ TEST_F(VulkanTest, SsrtDepthFilterGpuBadInputGivesInvalidOutputWithoutNaN) {
     for (float v : rig->read<float>(rig->filter->position(), 4)) ASSERT_EQ(v, 0.0f);
     for (uint16_t v : rig->read<uint16_t>(rig->filter->normal(), 4)) ASSERT_EQ(v, 0u);
   }
+  // A volume that is not R32F is refused before any pass is added.
+  std::vector<std::string> skipped;
+  const Status wrong = rig->filter->record(rig->filter->position(), true, skipped);
+  ASSERT_FALSE(wrong.ok());
+  EXPECT_EQ(wrong.error().kind, ErrorKind::BadUsage);
+  EXPECT_NE(wrong.error().message.find("depth_volume"), std::string::npos);
 }
 
 TEST_F(VulkanTest, SsrtDepthFilterGpuRefusesWindowsBeyondItsLimits) {

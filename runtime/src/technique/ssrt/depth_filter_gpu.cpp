@@ -160,6 +160,17 @@ Status DepthFilterGpu::record(gpu::ImageHandle depth_volume, bool final_pass,
                               std::vector<std::string>& skipped) {
   if (!graph_)
     return fail(ErrorKind::BadUsage, "technique/ssrt/depth_filter_gpu.cpp: record() before create()");
+  if (depth_volume.valid()) {
+    const gpu::GpuImage& v = graph_->gpu_image(depth_volume);
+    const VkExtent2D need = graph_->allocated_extent(merged_);
+    if (v.format != VK_FORMAT_R32_SFLOAT || v.extent.width < need.width ||
+        v.extent.height < need.height)
+      return fail(ErrorKind::BadUsage,
+                  "technique/ssrt/depth_filter_gpu.cpp record: depth_volume '" +
+                      graph_->name(depth_volume) +
+                      "' must be R32F and at least the internal resolution (" +
+                      std::to_string(need.width) + "x" + std::to_string(need.height) + ")");
+  }
   volume_ = depth_volume.valid() ? depth_volume : no_volume_;
   merge_push_.window.w = depth_volume.valid() ? 1 : 0;
   gpu::FrameGraph& graph = *graph_;
