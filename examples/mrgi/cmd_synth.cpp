@@ -16,6 +16,8 @@ struct SynthArgs {
   std::optional<int> frames, spp, width, height, threads;
   std::optional<uint64_t> seed, noise_floor_seed;
   std::string reference_format = "delta";
+  bool resume = false;
+  std::optional<int> stop_after;
 };
 
 void run_synth(const SynthArgs& a) {
@@ -29,13 +31,24 @@ void run_synth(const SynthArgs& a) {
   options.seed = a.seed;
   options.threads = a.threads.value_or(0);
   options.noise_floor_seed = a.noise_floor_seed;
+  options.resume = a.resume;
+  options.stop_after = a.stop_after;
   options.references = a.reference_format == "plain" ? ReferenceStorage::Plain : ReferenceStorage::Delta;
   options.progress = [](const std::string& what, size_t done, size_t total, double elapsed) {
     progress(what, done, total, elapsed);
   };
   const auto report = take(reference::synthesize_capture(description, options));
-  std::fprintf(stderr, "synth: wrote %s: %d frames, %d spp, %.1f s%s\n", a.out.c_str(), report.frames, report.spp,
-               report.seconds, report.dropped_samples ? " (non-finite samples were dropped)" : "");
+  if (!report.finished) {
+    std::fprintf(stderr,
+                 "synth: stopped after %d frames (%d of %d done, %.1f s); %s.partial holds them: run the same "
+                 "command with --resume to go on\n",
+                 report.frames_rendered, report.frames_resumed + report.frames_rendered, report.frames,
+                 report.seconds, a.out.c_str());
+  } else {
+    std::fprintf(stderr, "synth: wrote %s: %d frames (%d resumed), %d spp, %.1f s%s\n", a.out.c_str(), report.frames,
+                 report.frames_resumed, report.spp, report.seconds,
+                 report.dropped_samples ? " (non-finite samples were dropped)" : "");
+  }
   if (report.noise_floor)
     std::printf("reference noise floor (frame 0, RDE vs an independent render): all %.4f real %.4f virtual %.4f; "
                 "delta rms %.5f\n",
@@ -63,6 +76,12 @@ void setup(CLI::App& app) {
                   "how references are stored: delta (reference/NNNNNN.delta.png, (reference - rgb) mod 256, "
                   "lossless and smaller; default) or plain (reference/NNNNNN.png)")
       ->check(CLI::IsMember({"delta", "plain"}));
+  cmd->add_flag("--resume", args->resume,
+               "keep the frames an interrupted run left in OUT.partial (same description, inputs and settings, "
+               "else refused) and render only the missing ones; starts from frame 0 when there is none");
+  cmd->add_option("--stop-after", args->stop_after,
+                  "render at most N frames in this run, then stop, leaving OUT.partial for --resume")
+      ->check(CLI::Range(1, 100000));
   cmd->add_option("--threads", args->threads, "render threads (default: all cores)")->check(CLI::Range(1, 256));
   cmd->callback([args] { run_synth(*args); });
 }

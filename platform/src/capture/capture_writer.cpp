@@ -1,11 +1,17 @@
 // Capture format v1 writer. Frames go to FOLDER.partial/{rgb,depth,env,reference}/NNNNNN.*, the
 // lists and JSON files are written by finish(), and only then is FOLDER.partial renamed to
 // FOLDER. Timestamps and poses are written in shortest round-trip decimal, so a reader gets back
-// bit-identical values. Env images are stored as 32-bit float OpenEXR. References are stored
-// plain or as deltas from the colour frame (ReferenceStorage, mrgi/platform/capture_references.h).
+// bit-identical values. Env images are stored as 32-bit float OpenEXR. References are stored plain
+// or as deltas from the colour frame (ReferenceStorage, mrgi/platform/capture_references.h). After
+// every frame the lists so far go to FOLDER.partial/writer_progress.json, so resume() can continue
+// a write that was cut off (long path-traced renders).
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
 
 #include "capture/capture_text.h"
 #include "mrgi/platform/capture.h"
@@ -15,6 +21,17 @@ namespace mrgi {
 namespace {
 
 namespace fs = std::filesystem;
+
+// Written into FOLDER.partial after every frame so resume() can continue; finish() removes it.
+constexpr const char* kProgressFile = "writer_progress.json";
+
+const char* storage_name(ReferenceStorage s) { return s == ReferenceStorage::Delta ? "delta" : "plain"; }
+
+std::string normalized_folder(const std::string& folder) {
+  std::string f = fs::path(folder).lexically_normal().string();
+  while (!f.empty() && f.back() == '/' && f.size() > 1) f.pop_back();
+  return f;
+}
 
 std::string frame_name(size_t index, const char* suffix) {
   char buf[32];
@@ -44,8 +61,7 @@ Expected<CaptureWriter> CaptureWriter::create(const std::string& folder, const C
     return fail(ErrorKind::BadUsage, folder + ": already exists and is not an empty folder; remove it "
                                               "first (a capture is never written over another)");
   CaptureWriter w;
-  w.folder_ = fs::path(folder).lexically_normal().string();
-  while (!w.folder_.empty() && w.folder_.back() == '/' && w.folder_.size() > 1) w.folder_.pop_back();
+  w.folder_ = normalized_folder(folder);
   w.partial_ = w.folder_ + ".partial";
   w.info_ = info;
   w.reference_storage_ = references;
@@ -67,6 +83,63 @@ Expected<CaptureWriter> CaptureWriter::create(const std::string& folder, const C
   w.env_list_.clear();
   w.ref_list_.clear();
   return w;
+}
+
+Expected<CaptureWriter> CaptureWriter::resume(const std::string& folder, const CaptureInfo& info,
+                                              const std::optional<SceneDesc>& scene,
+                                              ReferenceStorage references) {
+  std::error_code ec;
+  if (fs::exists(folder, ec) && !(fs::is_directory(folder, ec) && fs::is_empty(folder, ec)))
+    return fail(ErrorKind::BadUsage, folder + ": already exists and is not an empty folder; a finished "
+                                              "capture is not resumed");
+  CaptureWriter w;
+  w.folder_ = normalized_folder(folder);
+  w.partial_ = w.folder_ + ".partial";
+  w.info_ = info;
+  w.reference_storage_ = references;
+  if (!fs::is_directory(w.partial_, ec))
+    return fail(ErrorKind::NotFound, w.partial_ + ": does not exist; there is no interrupted write to resume");
+  const std::string progress = (fs::path(w.partial_) / kProgressFile).string();
+  std::ifstream in(progress, std::ios::binary);
+  if (!in)
+    return fail(ErrorKind::NotFound, progress + ": missing; " + w.partial_ +
+                                         " holds no finished frame of an interrupted write (remove it and start again)");
+  std::stringstream text;
+  text << in.rdbuf();
+  try {
+    const nlohmann::json j = nlohmann::json::parse(text.str());
+    if (j.at("version").get<int>() != 1)
+      return fail(ErrorKind::BadInput, progress + ": version must be 1");
+    const std::string stored = j.at("reference_storage").get<std::string>();
+    if (stored != storage_name(references))
+      return fail(ErrorKind::BadUsage, progress + ": reference_storage: the write started with " + stored +
+                                           " references and cannot go on with " + storage_name(references) + " ones");
+    w.count_ = j.at("frames").get<size_t>();
+    const std::string last = j.at("last_timestamp").get<std::string>();
+    if (!capture::parse_double(last, &w.last_timestamp_))
+      return fail(ErrorKind::BadInput, progress + ": last_timestamp '" + last + "' is not a finite number");
+    const nlohmann::json& lists = j.at("lists");
+    w.rgb_list_ = lists.at("rgb").get<std::string>();
+    w.depth_list_ = lists.at("depth").get<std::string>();
+    w.gt_list_ = lists.at("groundtruth").get<std::string>();
+    w.env_list_ = lists.at("env").get<std::string>();
+    w.ref_list_ = lists.at("reference").get<std::string>();
+  } catch (const nlohmann::json::exception& e) {
+    return fail(ErrorKind::BadInput, progress + ": " + e.what());
+  }
+  if (scene) MRGI_TRY(write_scene_json((fs::path(w.partial_) / "scene.json").string(), *scene));
+  return w;
+}
+
+Status CaptureWriter::save_progress() const {
+  nlohmann::json j;
+  j["version"] = 1;
+  j["frames"] = count_;
+  j["last_timestamp"] = capture::format_double(last_timestamp_);
+  j["reference_storage"] = storage_name(reference_storage_);
+  j["lists"] = {{"rgb", rgb_list_}, {"depth", depth_list_}, {"groundtruth", gt_list_}, {"env", env_list_},
+                {"reference", ref_list_}};
+  return capture::write_text((fs::path(partial_) / kProgressFile).string(), j.dump(2) + "\n");
 }
 
 Status CaptureWriter::add_frame(const InputFrame& frame, const ImageRGB8* reference,
@@ -155,7 +228,7 @@ Status CaptureWriter::add_frame(const InputFrame& frame, const ImageRGB8* refere
   }
   last_timestamp_ = frame.timestamp;
   ++count_;
-  return ok_status();
+  return save_progress();
 }
 
 Status CaptureWriter::finish() {
@@ -169,6 +242,8 @@ Status CaptureWriter::finish() {
   if (!ref_list_.empty()) MRGI_TRY(capture::write_text((dir / "reference.txt").string(), ref_list_));
   MRGI_TRY(write_capture_json((dir / "capture.json").string(), info_));
   std::error_code ec;
+  fs::remove(dir / kProgressFile, ec);
+  if (ec) return fail(ErrorKind::Device, (dir / kProgressFile).string() + ": cannot remove: " + ec.message());
   if (fs::exists(folder_, ec)) {
     if (!fs::is_empty(folder_, ec))
       return fail(ErrorKind::BadUsage, folder_ + ": appeared and is not empty while the capture was "

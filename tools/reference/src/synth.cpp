@@ -9,6 +9,7 @@
 #include "mrgi/reference/path_tracer.h"
 #include "mrgi/reference/sensors.h"
 #include "shared/mrgi_shared.h"
+#include "synth_resume.h"
 #include "synth_scene.h"
 
 namespace mrgi::reference {
@@ -106,6 +107,7 @@ Expected<SynthReport> synthesize_capture(const SceneDescription& description, co
     d.spp = *options.spp;
   }
   if (options.seed) d.seed = *options.seed;
+  if (options.stop_after && *options.stop_after < 1) return fail(ErrorKind::BadUsage, "--stop-after must be >= 1");
   if (options.width || options.height) {
     const int w = options.width.value_or(d.intrinsics.width), h = options.height.value_or(d.intrinsics.height);
     if (w < 1 || h < 1 || w > 8192 || h > 8192) return fail(ErrorKind::BadUsage, "--width/--height must be in [1, 8192]");
@@ -178,8 +180,32 @@ Expected<SynthReport> synthesize_capture(const SceneDescription& description, co
     }
   }
 
-  auto writer = CaptureWriter::create(final_dir.string(), info, scene_json, options.references);
+  auto identity = synth_resume_identity(d, options);
+  if (!identity) return identity.error();
+  const std::string resume_path = (staging / kSynthResumeFile).string();
+  SynthResumeState state = *identity;
+  const bool resuming = options.resume && fs::exists(staging, ec);
+  auto writer = resuming ? CaptureWriter::resume(final_dir.string(), info, scene_json, options.references)
+                         : CaptureWriter::create(final_dir.string(), info, scene_json, options.references);
   if (!writer) return writer.error();
+  if (resuming) {
+    auto saved = load_synth_resume(resume_path);
+    if (!saved) return saved.error();
+    if (saved->fingerprint != identity->fingerprint)
+      return fail(ErrorKind::BadUsage, staging.string() + " was started from another description, input files or "
+                                       "settings (fingerprint " + saved->fingerprint + " there, " +
+                                       identity->fingerprint + " now; there: " + saved->settings + "; now: " +
+                                       identity->settings + "); resume with the same ones, or remove it to start again");
+    const size_t done = writer->frame_count();
+    if (done > size_t(d.frames) || saved->frames.size() < done)
+      return fail(ErrorKind::BadInput, resume_path + ": records " + std::to_string(saved->frames.size()) +
+                                           " frames, the capture writer holds " + std::to_string(done) +
+                                           " of " + std::to_string(d.frames) + "; remove " + staging.string() +
+                                           " to start again");
+    state.frames.assign(saved->frames.begin(), saved->frames.begin() + long(done));
+  } else {
+    MRGI_TRY(save_synth_resume(resume_path, state));
+  }
   for (const Copy& c : copies) MRGI_TRY(copy_file(c.from, c.to));
   if (!env_copy.empty()) {
     fs::create_directories(staging / "environment", ec);
@@ -189,9 +215,14 @@ Expected<SynthReport> synthesize_capture(const SceneDescription& description, co
   SynthReport report;
   report.frames = d.frames;
   report.spp = d.spp;
+  report.frames_resumed = int(state.frames.size());
   const auto start = std::chrono::steady_clock::now();
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
-  for (int f = 0; f < d.frames; ++f) {
+  for (int f = report.frames_resumed; f < d.frames; ++f) {
+    if (options.stop_after && report.frames_rendered == *options.stop_after) {
+      report.finished = false;
+      break;
+    }
     const double t = f / d.fps;
     auto tracer = PathTracer::create(scene->at_time(t));
     if (!tracer) return tracer.error();
@@ -213,7 +244,8 @@ Expected<SynthReport> synthesize_capture(const SceneDescription& description, co
       };
     auto render = (*tracer)->render(cam, rs);
     if (!render) return render.error();
-    report.dropped_samples += render->dropped_samples;
+    SynthFrameRecord record;
+    record.dropped_samples = render->dropped_samples;
 
     InputFrame frame;
     frame.index = f;
@@ -248,11 +280,21 @@ Expected<SynthReport> synthesize_capture(const SceneDescription& description, co
       if (!c_b) return c_b.error();
       auto g_b = camera_frame(again->combined, d.exposure, d.noise, other.seed, 0);
       if (!g_b) return g_b.error();
-      report.noise_floor = noise_floor(frame.color, *reference, *c_b, *g_b, render->virtual_mask);
+      record.noise_floor = noise_floor(frame.color, *reference, *c_b, *g_b, render->virtual_mask);
     }
+    // The record goes first, so the records always cover the frames the writer holds.
+    state.frames.push_back(record);
+    MRGI_TRY(save_synth_resume(resume_path, state));
     MRGI_TRY(writer->add_frame(frame, &*reference, &render->virtual_mask));
+    ++report.frames_rendered;
   }
-  MRGI_TRY(writer->finish());
+  for (const SynthFrameRecord& r : state.frames) report.dropped_samples += r.dropped_samples;
+  if (!state.frames.empty()) report.noise_floor = state.frames[0].noise_floor;
+  if (report.finished) {
+    fs::remove(resume_path, ec);
+    if (ec) return fail(ErrorKind::Device, resume_path + ": cannot remove: " + ec.message());
+    MRGI_TRY(writer->finish());
+  }
   report.seconds = elapsed();
   return report;
 }

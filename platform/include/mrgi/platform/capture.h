@@ -99,11 +99,22 @@ class CaptureWriter {
   static Expected<CaptureWriter> create(const std::string& folder, const CaptureInfo& info,
                                         const std::optional<SceneDesc>& scene,
                                         ReferenceStorage references = ReferenceStorage::Plain);
+  // Continues a write that was cut off (process killed, or the writer dropped before finish()):
+  // FOLDER.partial must hold the progress file add_frame writes after every frame
+  // (writer_progress.json; finish() removes it), written with the same REFERENCES storage. Its
+  // frames are kept; files of a frame cut off half-way are overwritten by the next add_frame.
+  // The caller vouches that INFO and SCENE are those the write started with.
+  static Expected<CaptureWriter> resume(const std::string& folder, const CaptureInfo& info,
+                                        const std::optional<SceneDesc>& scene,
+                                        ReferenceStorage references = ReferenceStorage::Plain);
   Status add_frame(const InputFrame& frame, const ImageRGB8* reference = nullptr,
                    const Image<uint8_t, 1>* reference_mask = nullptr);
   Status finish();
+  size_t frame_count() const { return count_; }  // frames added so far (resumed ones included)
 
  private:
+  Status save_progress() const;
+
   std::string folder_, partial_;
   CaptureInfo info_;
   ReferenceStorage reference_storage_ = ReferenceStorage::Plain;

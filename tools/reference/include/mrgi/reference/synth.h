@@ -13,7 +13,8 @@
 //                                   lamps with their `real` flags (area lamps cannot be listed),
 //                                   environment from the env camera or a downsampled copy under
 //                                   environment/; no real_geometry (the runtime reconstructs it)
-// The output is a pure function of the description and the options: two runs give identical files.
+// The output is a pure function of the description and the options: two runs give identical files,
+// also when one of them was interrupted and resumed (SynthOptions::resume).
 #pragma once
 #include <functional>
 #include <optional>
@@ -36,6 +37,15 @@ struct SynthOptions {
   std::optional<uint64_t> noise_floor_seed;
   // How references are stored: Delta (default; mrgi/platform/capture_references.h) or Plain PNG.
   ReferenceStorage references = ReferenceStorage::Delta;
+  // Continue an interrupted render: the frames already finished in OUT.partial are kept and only
+  // the missing ones are rendered; OUT.partial must have been started from the same description,
+  // input files and settings (fingerprint in OUT.partial/synth_resume.json), else BadUsage. With
+  // no OUT.partial the render starts from frame 0. The result is bit-identical to one
+  // uninterrupted render.
+  bool resume = false;
+  // Render at most this many frames in this run, then stop and leave OUT.partial for `resume`
+  // (splits a long render over several runs). Unset: render to the end.
+  std::optional<int> stop_after;
   // Progress over all frames: (what, done, total, seconds elapsed).
   std::function<void(const std::string&, size_t, size_t, double)> progress;
 };
@@ -52,7 +62,10 @@ struct NoiseFloor {
 struct SynthReport {
   int frames = 0;
   int spp = 0;
-  double seconds = 0.0;
+  int frames_resumed = 0;    // kept from an interrupted render (SynthOptions::resume)
+  int frames_rendered = 0;   // rendered by this run
+  bool finished = true;      // false: stopped by stop_after; OUT.partial awaits resume
+  double seconds = 0.0;      // this run's wall time
   size_t dropped_samples = 0;
   std::optional<NoiseFloor> noise_floor;
 };
