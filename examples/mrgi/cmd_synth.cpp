@@ -40,14 +40,14 @@ void run_synth(const SynthArgs& a) {
   const auto report = take(reference::synthesize_capture(description, options));
   if (!report.finished) {
     std::fprintf(stderr,
-                 "synth: stopped after %d frames (%d of %d done, %.1f s); %s.partial holds them: run the same "
-                 "command with --resume to go on\n",
+                 "synth: stopped after %d frames (%d of %d done, %.1f s; %.1f s rendering over all runs); "
+                 "%s.partial holds them: run the same command with --resume to go on\n",
                  report.frames_rendered, report.frames_resumed + report.frames_rendered, report.frames,
-                 report.seconds, a.out.c_str());
+                 report.seconds, report.frame_seconds, a.out.c_str());
   } else {
-    std::fprintf(stderr, "synth: wrote %s: %d frames (%d resumed), %d spp, %.1f s%s\n", a.out.c_str(), report.frames,
-                 report.frames_resumed, report.spp, report.seconds,
-                 report.dropped_samples ? " (non-finite samples were dropped)" : "");
+    std::fprintf(stderr, "synth: wrote %s: %d frames (%d resumed), %d spp, %.1f s (%.1f s rendering over all runs)%s\n",
+                 a.out.c_str(), report.frames, report.frames_resumed, report.spp, report.seconds,
+                 report.frame_seconds, report.dropped_samples ? " (non-finite samples were dropped)" : "");
   }
   if (report.noise_floor)
     std::printf("reference noise floor (frame 0, RDE vs an independent render): all %.4f real %.4f virtual %.4f; "

@@ -8,8 +8,9 @@
 # stopped by STOP_AFTER keeps its finished frames in out/suite-render/<name>.partial and running
 # the script again goes on from there (`mrgi synth --resume`, which refuses a partial made from
 # another description, input files or settings). Only a finished capture replaces
-# perf/suite/<name>; then perf/suite.json is synced (sync_suite_json.py). render_seconds sums the
-# runs that ended normally (a killed run's time is not counted).
+# perf/suite/<name>; then perf/suite.json is synced (sync_suite_json.py). render_seconds is the
+# time spent rendering the frames, summed over the runs (synth keeps it per frame in the partial;
+# only a frame cut off by a kill is lost).
 # Needs the built tool (build/bin/mrgi or MRGI=path). Timings: LP_NUM_THREADS=2 does not apply
 # (no Vulkan); the renderer uses --threads 2.
 set -euo pipefail
@@ -20,21 +21,21 @@ if [ ${#names[@]} -eq 0 ]; then names=(desk_spot corner glass_mirror env_fisheye
 mkdir -p "$STAGE"
 for n in "${names[@]}"; do
   if [ ! -d "$STAGE/$n" ]; then
-    start=$(date +%s)
-    "$MRGI" synth "perf/suite/$n.json" --out "$STAGE/$n" --threads 2 --noise-floor-seed 1001 --resume \
-      ${STOP_AFTER:+--stop-after "$STOP_AFTER"} > "$STAGE/$n.out" 2> "$STAGE/$n.progress"
-    before=$(cat "$STAGE/$n.seconds" 2>/dev/null || echo 0)
-    echo $((before + $(date +%s) - start)) > "$STAGE/$n.seconds"
+    if ! "$MRGI" synth "perf/suite/$n.json" --out "$STAGE/$n" --threads 2 --noise-floor-seed 1001 --resume \
+        ${STOP_AFTER:+--stop-after "$STOP_AFTER"} > "$STAGE/$n.out" 2> "$STAGE/$n.progress"; then
+      tail -n 3 "$STAGE/$n.progress" >&2
+      exit 1
+    fi
   fi
   if [ ! -d "$STAGE/$n" ]; then
     echo "$n: $(tail -n 1 "$STAGE/$n.progress")"
     continue
   fi
-  { grep "^reference noise floor" "$STAGE/$n.out"; echo "render_seconds $(cat "$STAGE/$n.seconds")"; } \
-    > "perf/suite/$n.log"
+  seconds=$(sed -n 's/.*(\([0-9.]*\) s rendering over all runs).*/\1/p' "$STAGE/$n.progress" | tail -n 1)
+  { grep "^reference noise floor" "$STAGE/$n.out"; printf 'render_seconds %.0f\n' "$seconds"; } > "perf/suite/$n.log"
   rm -rf "perf/suite/$n"
   mv "$STAGE/$n" "perf/suite/$n"
-  rm -f "$STAGE/$n.out" "$STAGE/$n.progress" "$STAGE/$n.seconds"
+  rm -f "$STAGE/$n.out" "$STAGE/$n.progress"
   cat "perf/suite/$n.log"
 done
 python3 perf/suite/sync_suite_json.py

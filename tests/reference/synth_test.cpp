@@ -263,6 +263,10 @@ TEST_F(SynthTest, ResumedRenderIsBitIdenticalToAnUninterruptedOne) {
   EXPECT_EQ(last->noise_floor->rde_all, whole->noise_floor->rde_all);
   EXPECT_EQ(last->noise_floor->delta_rms, whole->noise_floor->delta_rms);
   EXPECT_EQ(last->dropped_samples, whole->dropped_samples);
+  // Render time adds up over the runs: more than this last run's one frame took.
+  EXPECT_GT(last->frame_seconds, 0.0);
+  EXPECT_GT(last->frame_seconds, second->frame_seconds - 1e-9);
+  EXPECT_GE(second->frame_seconds, first->frame_seconds);
 
   size_t files = 0, split_files = 0;
   for (const auto& e : fs::recursive_directory_iterator(dir_ / "whole")) {

@@ -224,6 +224,7 @@ Expected<SynthReport> synthesize_capture(const SceneDescription& description, co
       break;
     }
     const double t = f / d.fps;
+    const double frame_start = elapsed();
     auto tracer = PathTracer::create(scene->at_time(t));
     if (!tracer) return tracer.error();
     RefCamera cam;
@@ -283,12 +284,16 @@ Expected<SynthReport> synthesize_capture(const SceneDescription& description, co
       record.noise_floor = noise_floor(frame.color, *reference, *c_b, *g_b, render->virtual_mask);
     }
     // The record goes first, so the records always cover the frames the writer holds.
+    record.seconds = elapsed() - frame_start;
     state.frames.push_back(record);
     MRGI_TRY(save_synth_resume(resume_path, state));
     MRGI_TRY(writer->add_frame(frame, &*reference, &render->virtual_mask));
     ++report.frames_rendered;
   }
-  for (const SynthFrameRecord& r : state.frames) report.dropped_samples += r.dropped_samples;
+  for (const SynthFrameRecord& r : state.frames) {
+    report.dropped_samples += r.dropped_samples;
+    report.frame_seconds += r.seconds;
+  }
   if (!state.frames.empty()) report.noise_floor = state.frames[0].noise_floor;
   if (report.finished) {
     fs::remove(resume_path, ec);

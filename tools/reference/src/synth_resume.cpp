@@ -82,6 +82,7 @@ Expected<SynthResumeState> load_synth_resume(const std::string& path) {
     for (const nlohmann::json& f : j.at("frames")) {
       SynthFrameRecord r;
       r.dropped_samples = f.at("dropped_samples").get<size_t>();
+      r.seconds = f.at("seconds").get<double>();
       if (f.contains("noise_floor")) {
         const nlohmann::json& n = f.at("noise_floor");
         NoiseFloor nf;
@@ -108,6 +109,7 @@ Status save_synth_resume(const std::string& path, const SynthResumeState& state)
   for (const SynthFrameRecord& r : state.frames) {
     nlohmann::json f;
     f["dropped_samples"] = r.dropped_samples;
+    f["seconds"] = r.seconds;
     if (r.noise_floor)
       f["noise_floor"] = {{"all", r.noise_floor->rde_all},
                           {"real", r.noise_floor->rde_real},

@@ -18,6 +18,7 @@ inline constexpr const char* kSynthResumeFile = "synth_resume.json";
 
 struct SynthFrameRecord {
   size_t dropped_samples = 0;
+  double seconds = 0.0;  // wall time rendering the frame (frame 0: with the noise-floor render)
   std::optional<NoiseFloor> noise_floor;
 };
 

@@ -66,6 +66,7 @@ struct SynthReport {
   int frames_rendered = 0;   // rendered by this run
   bool finished = true;      // false: stopped by stop_after; OUT.partial awaits resume
   double seconds = 0.0;      // this run's wall time
+  double frame_seconds = 0.0;  // wall time rendering the frames done so far, over all runs
   size_t dropped_samples = 0;
   std::optional<NoiseFloor> noise_floor;
 };
