@@ -1,5 +1,6 @@
 #include "gpu/pipelines.h"
 
+#include "gpu/shaders.h"
 #include "gpu/vk_check.h"
 
 namespace mrgi::gpu {
@@ -267,6 +268,21 @@ void dispatch_2d(VkCommandBuffer cmd, const Pipeline& pipeline, const void* push
   if (bytes > 0 && push_constants)
     vkCmdPushConstants(cmd, pipeline.layout, pipeline.stages, 0, bytes, push_constants);
   vkCmdDispatch(cmd, (width + local_x - 1) / local_x, (height + local_y - 1) / local_y, 1);
+}
+
+Expected<PipelineHandle> load_compute_pipeline(const Context& ctx, const char* shader,
+                                               std::vector<DescriptorBinding> bindings,
+                                               uint32_t push_constant_bytes) {
+  auto spirv = shader_spirv(shader);
+  if (!spirv) return spirv.error();
+  ComputePipelineDesc d;
+  d.name = shader;
+  d.spirv = *spirv;
+  d.bindings = std::move(bindings);
+  d.push_constant_bytes = push_constant_bytes;
+  auto p = create_compute_pipeline(ctx, d);
+  if (!p) return p.error();
+  return PipelineHandle(ctx, std::move(*p));
 }
 
 }  // namespace mrgi::gpu

@@ -120,4 +120,9 @@ void dispatch_2d(VkCommandBuffer cmd, const Pipeline& pipeline, const void* push
                  uint32_t bytes, uint32_t width, uint32_t height, uint32_t local_x = 8,
                  uint32_t local_y = 8);
 
+// A compute pipeline from a registered shader (shaders.h: "folder/name.comp"), owned.
+Expected<PipelineHandle> load_compute_pipeline(const Context& ctx, const char* shader,
+                                               std::vector<DescriptorBinding> bindings,
+                                               uint32_t push_constant_bytes = 0);
+
 }  // namespace mrgi::gpu

@@ -2,7 +2,6 @@
 
 #include <string>
 
-#include "gpu/shaders.h"
 
 namespace mrgi::ssrt {
 namespace {
@@ -39,21 +38,6 @@ Status check_gpu_window(const char* field, const TapWindow& w) {
                                          std::to_string(kMaxReach) + " pixels, this window " +
                                          std::to_string(w.reach));
   return ok_status();
-}
-
-Expected<gpu::PipelineHandle> pipeline(gpu::Context& ctx, const char* shader,
-                                       std::vector<gpu::DescriptorBinding> bindings,
-                                       uint32_t push_bytes) {
-  auto spirv = gpu::shader_spirv(shader);
-  if (!spirv) return spirv.error();
-  gpu::ComputePipelineDesc d;
-  d.name = shader;
-  d.spirv = *spirv;
-  d.bindings = std::move(bindings);
-  d.push_constant_bytes = push_bytes;
-  auto p = gpu::create_compute_pipeline(ctx, d);
-  if (!p) return p.error();
-  return gpu::PipelineHandle(ctx, std::move(*p));
 }
 
 Expected<gpu::ImageHandle> internal_image(gpu::FrameGraph& graph, const char* name,
@@ -129,21 +113,21 @@ Expected<DepthFilterGpu> DepthFilterGpu::create(gpu::Context& ctx, gpu::FrameGra
   const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
   const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-  auto p = pipeline(ctx, "ssrt/depth_input.comp", {{ubo}, {ssbo}, {ssbo}, {img}, {img}},
+  auto p = gpu::load_compute_pipeline(ctx, "ssrt/depth_input.comp", {{ubo}, {ssbo}, {ssbo}, {img}, {img}},
                     sizeof(WindowPush));
   if (!p) return p.error();
   f.input_pipe_ = std::move(*p);
-  p = pipeline(ctx, "ssrt/depth_merge.comp", {{ubo}, {img}, {img}, {img}, {img}},
+  p = gpu::load_compute_pipeline(ctx, "ssrt/depth_merge.comp", {{ubo}, {img}, {img}, {img}, {img}},
                sizeof(WindowPush));
   if (!p) return p.error();
   f.merge_ = std::move(*p);
-  p = pipeline(ctx, "ssrt/depth_bilateral.comp", {{ubo}, {img}, {img}}, sizeof(WindowPush));
+  p = gpu::load_compute_pipeline(ctx, "ssrt/depth_bilateral.comp", {{ubo}, {img}, {img}}, sizeof(WindowPush));
   if (!p) return p.error();
   f.bilateral_pipe_ = std::move(*p);
-  p = pipeline(ctx, "ssrt/depth_final.comp", {{ubo}, {img}, {img}}, sizeof(glm::ivec4));
+  p = gpu::load_compute_pipeline(ctx, "ssrt/depth_final.comp", {{ubo}, {img}, {img}}, sizeof(glm::ivec4));
   if (!p) return p.error();
   f.final_pipe_ = std::move(*p);
-  p = pipeline(ctx, "ssrt/depth_gbuffer.comp", {{ubo}, {img}, {img}, {img}}, 0);
+  p = gpu::load_compute_pipeline(ctx, "ssrt/depth_gbuffer.comp", {{ubo}, {img}, {img}, {img}}, 0);
   if (!p) return p.error();
   f.gbuffer_ = std::move(*p);
 

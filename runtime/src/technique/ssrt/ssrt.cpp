@@ -8,7 +8,6 @@
 
 #include "common/frame_constants.glsl"
 #include "gpu/pipelines.h"
-#include "gpu/shaders.h"
 #include "ssrt/ssrt_math.h"
 #include "technique/scene_gpu.h"
 #include "technique/ssrt/depth_filter_gpu.h"
@@ -68,21 +67,6 @@ double knob(const QualityLevel& level, const std::string& name) {
   for (const Knob& k : level.knobs)
     if (k.name == name) return k.value;
   return 0.0;
-}
-
-Expected<gpu::PipelineHandle> compute_pipeline(gpu::Context& ctx, const char* shader,
-                                               std::vector<gpu::DescriptorBinding> bindings,
-                                               uint32_t push_bytes) {
-  auto spirv = gpu::shader_spirv(shader);
-  if (!spirv) return spirv.error();
-  gpu::ComputePipelineDesc d;
-  d.name = shader;
-  d.spirv = *spirv;
-  d.bindings = std::move(bindings);
-  d.push_constant_bytes = push_bytes;
-  auto p = gpu::create_compute_pipeline(ctx, d);
-  if (!p) return p.error();
-  return gpu::PipelineHandle(ctx, std::move(*p));
 }
 
 class Ssrt final : public Technique {
@@ -207,22 +191,22 @@ Status Ssrt::init() {
   const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   const auto tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
   const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-  auto p = compute_pipeline(ctx, "ssrt/transfer.comp",
+  auto p = gpu::load_compute_pipeline(ctx, "ssrt/transfer.comp",
                             {{ubo}, {ubo}, {ssbo}, {tex}, {tex}, {tex}, {tex}, {tex}, {tex}, {img},
                              {tex}, {ubo}},
                             sizeof(TransferPush));
   if (!p) return p.error();
   transfer_ = std::move(*p);
-  p = compute_pipeline(ctx, "ssrt/light_reduce.comp", {{tex}, {tex}, {ssbo}}, sizeof(ReducePush));
+  p = gpu::load_compute_pipeline(ctx, "ssrt/light_reduce.comp", {{tex}, {tex}, {ssbo}}, sizeof(ReducePush));
   if (!p) return p.error();
   reduce_ = std::move(*p);
-  p = compute_pipeline(ctx, "ssrt/light_reduce_final.comp", {{ssbo}, {ssbo}}, sizeof(FinalPush));
+  p = gpu::load_compute_pipeline(ctx, "ssrt/light_reduce_final.comp", {{ssbo}, {ssbo}}, sizeof(FinalPush));
   if (!p) return p.error();
   reduce_final_ = std::move(*p);
-  p = compute_pipeline(ctx, "ssrt/upsample_blur.comp", {{img}}, sizeof(BlurPush));
+  p = gpu::load_compute_pipeline(ctx, "ssrt/upsample_blur.comp", {{img}}, sizeof(BlurPush));
   if (!p) return p.error();
   blur_ = std::move(*p);
-  p = compute_pipeline(ctx, "ssrt/shade.comp", {{tex}, {tex}, {tex}, {tex}, {tex}, {img}, {img}},
+  p = gpu::load_compute_pipeline(ctx, "ssrt/shade.comp", {{tex}, {tex}, {tex}, {tex}, {tex}, {img}, {img}},
                        sizeof(ShadePush));
   if (!p) return p.error();
   shade_ = std::move(*p);

@@ -5,7 +5,6 @@
 #include <cstring>
 
 #include "common/frame_constants.glsl"
-#include "gpu/shaders.h"
 #include "ssrt/tsdf_volume.glsl"
 
 namespace mrgi::ssrt {
@@ -15,19 +14,6 @@ constexpr uint32_t kMaxResolution = 1024;      // 4 GiB of voxels beyond this
 constexpr uint32_t kMaxAuxResolution = 4096;
 constexpr float kMaxWeightLimit = 2048.0f;     // largest integer a half float holds exactly
 constexpr double kValidCountTolerance = 0.01;  // the skip's "valid-pixel count within 1 %"
-
-Expected<gpu::PipelineHandle> compute_pipeline(gpu::Context& ctx, const char* shader,
-                                               std::vector<gpu::DescriptorBinding> bindings) {
-  auto spirv = gpu::shader_spirv(shader);
-  if (!spirv) return spirv.error();
-  gpu::ComputePipelineDesc d;
-  d.name = shader;
-  d.spirv = *spirv;
-  d.bindings = std::move(bindings);
-  auto p = gpu::create_compute_pipeline(ctx, d);
-  if (!p) return p.error();
-  return gpu::PipelineHandle(ctx, std::move(*p));
-}
 
 bool finite(const glm::dmat4& m) {
   for (int c = 0; c < 4; ++c)
@@ -127,13 +113,13 @@ Expected<Volume> Volume::create(gpu::Context& ctx, gpu::FrameGraph& graph,
   const VkDescriptorType ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
   const VkDescriptorType ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   const VkDescriptorType img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-  auto p = compute_pipeline(ctx, "ssrt/tsdf_fuse.comp", {{ubo}, {ssbo}, {ssbo}});
+  auto p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_fuse.comp", {{ubo}, {ssbo}, {ssbo}});
   if (!p) return p.error();
   v.fuse_ = std::move(*p);
-  p = compute_pipeline(ctx, "ssrt/tsdf_raycast.comp", {{ubo}, {ubo}, {ssbo}, {img}, {img}});
+  p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_raycast.comp", {{ubo}, {ubo}, {ssbo}, {img}, {img}});
   if (!p) return p.error();
   v.raycast_ = std::move(*p);
-  p = compute_pipeline(ctx, "ssrt/tsdf_aux.comp", {{ubo}, {ubo}, {ssbo}, {img}});
+  p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_aux.comp", {{ubo}, {ubo}, {ssbo}, {img}});
   if (!p) return p.error();
   v.aux_ = std::move(*p);
 
