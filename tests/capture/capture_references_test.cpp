@@ -56,6 +56,7 @@ CaptureInfo info() {
 void write_capture(const std::string& folder, ReferenceStorage storage, int frames = 3) {
   auto w = CaptureWriter::create(folder, info(), std::nullopt, storage);
   ASSERT_TRUE(w.ok()) << w.error().message;
+  w->set_png_effort(PngEffort::Small);  // what the conversion writes (and synth)
   for (int i = 0; i < frames; ++i) {
     const InputFrame f = frame(i);
     const ImageRGB8 ref = reference_for(f.color, i);

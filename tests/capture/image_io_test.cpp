@@ -48,6 +48,24 @@ TEST(PngIo, RoundTripsEveryFormatBitExactly) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("rgb.png.tmp")));
 }
 
+// PngEffort::Small (zlib 9, for stored data) keeps the pixels and never makes a file larger than
+// Fast on data that compresses (a smooth gradient with a little deterministic noise).
+TEST(PngIo, SmallEffortKeepsPixelsAndIsNoLarger) {
+  TempDir dir;
+  ImageU16 depth(160, 120);
+  for (size_t i = 0; i < depth.data.size(); ++i)
+    depth.data[i] = uint16_t(4000 + (i % 160) * 10 + (i / 160) * 3 + (i * 2654435761u >> 28));
+  ASSERT_TRUE(write_png(dir.file("fast.png"), depth, PngEffort::Fast).ok());
+  ASSERT_TRUE(write_png(dir.file("small.png"), depth, PngEffort::Small).ok());
+  auto fast = load_png_u16(dir.file("fast.png"));
+  auto small = load_png_u16(dir.file("small.png"));
+  ASSERT_TRUE(fast.ok() && small.ok());
+  EXPECT_EQ(fast->data, depth.data);
+  EXPECT_EQ(small->data, depth.data);
+  EXPECT_LE(std::filesystem::file_size(dir.file("small.png")),
+            std::filesystem::file_size(dir.file("fast.png")));
+}
+
 TEST(PngIo, RgbaLoaderGivesRgbAnOpaqueAlpha) {
   TempDir dir;
   ImageRGB8 rgb(2, 1);

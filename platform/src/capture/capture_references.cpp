@@ -126,9 +126,9 @@ Expected<ReferenceConversion> convert_capture_references(const std::string& fold
     if (storage == ReferenceStorage::Delta) {
       auto delta = encode_reference_delta(reference, *color);
       if (!delta) return fail(ErrorKind::BadInput, where + ": " + delta.error().message);
-      MRGI_TRY(write_png(new_path, *delta));
+      MRGI_TRY(write_png(new_path, *delta, PngEffort::Small));
     } else {
-      MRGI_TRY(write_png(new_path, reference));
+      MRGI_TRY(write_png(new_path, reference, PngEffort::Small));
     }
     // Read the new file back through the same decoding the reader uses: it must give exactly the
     // original pixels, or nothing is changed.

@@ -183,8 +183,8 @@ Status CaptureWriter::add_frame(const InputFrame& frame, const ImageRGB8* refere
   const std::string ts = capture::format_double(frame.timestamp);
   const std::string rgb = "rgb/" + frame_name(count_, ".png");
   const std::string depth = "depth/" + frame_name(count_, ".png");
-  MRGI_TRY(write_png((dir / rgb).string(), frame.color));
-  MRGI_TRY(write_png((dir / depth).string(), frame.depth));
+  MRGI_TRY(write_png((dir / rgb).string(), frame.color, png_effort_));
+  MRGI_TRY(write_png((dir / depth).string(), frame.depth, png_effort_));
   rgb_list_ += ts + " " + rgb + "\n";
   depth_list_ += capture::format_double(frame.depth_timestamp) + " " + depth + "\n";
   if (has_pose) {
@@ -214,14 +214,14 @@ Status CaptureWriter::add_frame(const InputFrame& frame, const ImageRGB8* refere
       // Same size as the colour frame: both were checked against the intrinsics above.
       auto stored = encode_reference_delta(*reference, frame.color);
       if (!stored) return stored.error();
-      MRGI_TRY(write_png((dir / ref).string(), *stored));
+      MRGI_TRY(write_png((dir / ref).string(), *stored, png_effort_));
     } else {
-      MRGI_TRY(write_png((dir / ref).string(), *reference));
+      MRGI_TRY(write_png((dir / ref).string(), *reference, png_effort_));
     }
     ref_list_ += ts + " " + ref;
     if (reference_mask) {
       const std::string mask = "reference/" + frame_name(count_, "_mask.png");
-      MRGI_TRY(write_png((dir / mask).string(), *reference_mask));
+      MRGI_TRY(write_png((dir / mask).string(), *reference_mask, png_effort_));
       ref_list_ += " " + mask;
     }
     ref_list_ += "\n";

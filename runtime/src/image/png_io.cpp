@@ -144,6 +144,7 @@ Image<T, C> copy_pixels(const DecodedPng& d) {
 struct PngLayout {
   int color_type;
   int bit_depth;
+  PngEffort effort = PngEffort::Fast;
 };
 
 bool encode_png_file(const std::string& path, int width, int height, PngLayout layout,
@@ -168,8 +169,9 @@ bool encode_png_file(const std::string& path, int width, int height, PngLayout l
     return false;
   }
   png_init_io(png, fp);
-  // Level 3 keeps capture writing fast; files are ~10% larger than at the default 6.
-  png_set_compression_level(png, 3);
+  // Level 3 keeps capture writing fast (files ~10% larger than at the default 6); level 9 is for
+  // stored data (see PngEffort).
+  png_set_compression_level(png, layout.effort == PngEffort::Small ? 9 : 3);
   png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), layout.bit_depth,
                layout.color_type, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
                PNG_FILTER_TYPE_DEFAULT);
@@ -252,17 +254,17 @@ Expected<ImageU8> load_png_u8(const std::string& path) {
   return copy_pixels<uint8_t, 1>(*d);
 }
 
-Status write_png(const std::string& path, const ImageRGB8& img) {
-  return write_png_image(path, img, {PNG_COLOR_TYPE_RGB, 8});
+Status write_png(const std::string& path, const ImageRGB8& img, PngEffort effort) {
+  return write_png_image(path, img, {PNG_COLOR_TYPE_RGB, 8, effort});
 }
-Status write_png(const std::string& path, const ImageRGBA8& img) {
-  return write_png_image(path, img, {PNG_COLOR_TYPE_RGB_ALPHA, 8});
+Status write_png(const std::string& path, const ImageRGBA8& img, PngEffort effort) {
+  return write_png_image(path, img, {PNG_COLOR_TYPE_RGB_ALPHA, 8, effort});
 }
-Status write_png(const std::string& path, const ImageU16& img) {
-  return write_png_image(path, img, {PNG_COLOR_TYPE_GRAY, 16});
+Status write_png(const std::string& path, const ImageU16& img, PngEffort effort) {
+  return write_png_image(path, img, {PNG_COLOR_TYPE_GRAY, 16, effort});
 }
-Status write_png(const std::string& path, const ImageU8& img) {
-  return write_png_image(path, img, {PNG_COLOR_TYPE_GRAY, 8});
+Status write_png(const std::string& path, const ImageU8& img, PngEffort effort) {
+  return write_png_image(path, img, {PNG_COLOR_TYPE_GRAY, 8, effort});
 }
 
 }  // namespace mrgi

@@ -188,6 +188,7 @@ Expected<SynthReport> synthesize_capture(const SceneDescription& description, co
   auto writer = resuming ? CaptureWriter::resume(final_dir.string(), info, scene_json, options.references)
                          : CaptureWriter::create(final_dir.string(), info, scene_json, options.references);
   if (!writer) return writer.error();
+  writer->set_png_effort(PngEffort::Small);  // suite captures live in the repository
   if (resuming) {
     auto saved = load_synth_resume(resume_path);
     if (!saved) return saved.error();

@@ -111,6 +111,9 @@ class CaptureWriter {
                    const Image<uint8_t, 1>* reference_mask = nullptr);
   Status finish();
   size_t frame_count() const { return count_; }  // frames added so far (resumed ones included)
+  // PNG effort for the frames written from now on (default Fast, for live recording; synth and
+  // reference conversion use Small because their output is stored in the repository).
+  void set_png_effort(PngEffort effort) { png_effort_ = effort; }
 
  private:
   Status save_progress() const;
@@ -118,6 +121,7 @@ class CaptureWriter {
   std::string folder_, partial_;
   CaptureInfo info_;
   ReferenceStorage reference_storage_ = ReferenceStorage::Plain;
+  PngEffort png_effort_ = PngEffort::Fast;
   std::string rgb_list_, depth_list_, gt_list_, env_list_, ref_list_;
   size_t count_ = 0;
   double last_timestamp_ = 0.0;
