@@ -152,6 +152,35 @@ TEST(SsrtLightEstimation, OneFlatWallStaysFiniteBoundedAndReproducesTheWall) {
   }
 }
 
+// A frame of nothing but an open floor (normal up) that is darker than the prior predicts: the
+// data cannot tell ambient from an overhead light, so the estimate must lower the ambient, not
+// point the light downwards (what plain Tikhonov towards the prior did). With the ambient
+// re-fit off, the old behaviour comes back, so the test can fail.
+TEST(SsrtLightEstimation, DarkFloorLowersTheAmbientInsteadOfLightingFromBelow) {
+  const SampleSets sets = samples();
+  const ShVector t = transfer_vector(sets, 0, glm::vec3(0, 1, 0), glm::vec3(1, 0, 0), 2.0f);
+  LightSystem sys;
+  const double floor = 0.1;  // camera intensity; the prior (0.5 uniform) predicts 0.25
+  for (int p = 0; p < 5000; ++p) sys.add(t, glm::dvec3(floor));
+  for (bool refit : {true, false}) {
+    LightEstimatorSettings s;
+    s.refit_prior_ambient = refit;
+    auto est = LightEstimator::create(s);
+    ASSERT_TRUE(est.ok());
+    auto r = est->update(sys, 0, 0.0);
+    ASSERT_TRUE(r.ok());
+    // The floor is reproduced either way (the data direction is constrained).
+    EXPECT_NEAR(0.5 * dot_rgb(t, est->filtered(), 1), floor, 0.05 * floor);
+    // Band 1's "up" part (index 2 holds z; index 1 holds -y under the Condon-Shortley phase).
+    const double up = -est->filtered()[1].y;
+    if (refit) {
+      EXPECT_GE(up, -0.02 * est->filtered()[0].y) << "the light must not come from below";
+    } else {
+      EXPECT_LT(up, -0.05 * est->filtered()[0].y) << "plain Tikhonov points it down";
+    }
+  }
+}
+
 TEST(SsrtLightEstimation, AllBlackAlbedoKeepsThePrior) {
   auto est = LightEstimator::create({});
   ASSERT_TRUE(est.ok());

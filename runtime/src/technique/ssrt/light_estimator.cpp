@@ -105,7 +105,22 @@ Expected<LightEstimate> LightEstimator::update(const LightSystem& system, int64_
   for (int i = 0; i < n; ++i)
     if (max_ev > 0.0 && ev(i) > settings_.confidence_eigen_fraction * max_ev) ++constrained;
 
-  // Tikhonov towards the previous estimate (or the prior).
+  // Tikhonov towards the previous estimate (or the prior), with its band 0 re-fitted to this
+  // frame first. Why: the system is rank-deficient whenever the view shows few normals, and the
+  // regularised solution then moves from the prior only along the data's directions. For a floor
+  // those mix band 0 with the band-1 "up" coefficient, so a floor darker than the prior predicts
+  // was explained as light from below (session 2: the env_fisheye estimate pointed down, 143
+  // degrees off). Fitting the prior's ambient (band 0, always well constrained when any pixel is
+  // valid) to the frame makes the prior explain the overall brightness; what is left for the
+  // higher bands is what the data actually says about direction.
+  ShRgb prior = filtered_;
+  if (settings_.refit_prior_ambient && ata(0, 0) > 0.0) {
+    for (int c = 0; c < 3; ++c) {
+      double rest = 0.0;
+      for (int j = 1; j < n; ++j) rest += ata(0, j) * prior[j][c];
+      prior[0][c] = std::max(0.0, (atb(0, c) - rest) / ata(0, 0));
+    }
+  }
   const double mean_diag = ata.trace() / n;
   const double lambda = settings_.relative_regularisation * std::max(mean_diag, 0.0) +
                         settings_.min_regularisation;
@@ -115,7 +130,7 @@ Expected<LightEstimate> LightEstimator::update(const LightSystem& system, int64_
     const int l = sh_band(i);
     const double w = lambda * (1.0 + settings_.band_penalty * l * (l + 1));
     lhs(i, i) += w;
-    for (int c = 0; c < 3; ++c) rhs(i, c) += w * filtered_[i][c];
+    for (int c = 0; c < 3; ++c) rhs(i, c) += w * prior[i][c];
   }
   // lhs is symmetric positive definite (T^T T is PSD, the added diagonal > 0): LDLT is exact
   // and stable; a robust fallback is not needed, but a non-finite result is still refused.

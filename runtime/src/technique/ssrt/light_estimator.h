@@ -62,6 +62,10 @@ struct LightEstimatorSettings {
   bool white_light = true;
   // The prior before the first frame: a uniform (band 0 only) environment of this radiance.
   double prior_radiance = 0.5;
+  // Re-fit the prior's band 0 (ambient) to each frame before the regularised solve, so the
+  // frame's overall brightness is not pushed into directional bands the data does not constrain
+  // (a floor darker than the prior otherwise reads as light from below). false: plain Tikhonov.
+  bool refit_prior_ambient = true;
   // Eigenvalues of T^T T above this fraction of the largest count as constrained (confidence).
   double confidence_eigen_fraction = 1e-2;
 };
