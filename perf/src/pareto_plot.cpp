@@ -65,18 +65,38 @@ ImageRGB8 render_pareto_plot(const BenchResult& result) {
     max_x = std::max(max_x, p.cost);
     max_y = std::max(max_y, p.error);
   }
+  double min_x = max_x;
+  for (const ParetoPoint& p : points) min_x = std::min(min_x, p.cost);
   const Axis ax = nice_axis(max_x), ay = nice_axis(max_y);
-  auto sx = [&](double x) { return float(px0 + (px1 - px0) * x / ax.max); };
+  // Frame times of the levels of different techniques span decades (a 100 ms level beside a 10 s
+  // one): a linear axis would crowd every cheap level into one corner, so the x axis turns
+  // logarithmic when the largest time is over 20 times the smallest.
+  const bool log_x = min_x > 0.0 && max_x / min_x > 20.0;
+  const double lx0 = log_x ? std::floor(std::log10(min_x / 1.2)) : 0.0;
+  const double lx1 = log_x ? std::ceil(std::log10(max_x * 1.2)) : 1.0;
+  auto sx = [&](double x) {
+    if (log_x) return float(px0 + (px1 - px0) * (std::log10(std::max(x, 1e-300)) - lx0) / (lx1 - lx0));
+    return float(px0 + (px1 - px0) * x / ax.max);
+  };
   auto sy = [&](double y) { return float(py1 - (py1 - py0) * y / ay.max); };
 
   // Grid, ticks and tick labels.
-  for (int i = 0; i * ax.step <= ax.max + 1e-9; ++i) {
-    const double v = i * ax.step;
+  auto x_tick = [&](double v, const std::string& t, bool major) {
     const float x = sx(v);
-    cv.line(x, py0, x, py1, 1.0f, grid);
-    cv.line(x, py1, x, py1 + 6, 1.5f, black);
-    const std::string t = tick_label(v, ax.step);
-    cv.text(x - Canvas::text_width(t, 2) / 2, py1 + 12, t, 2, black);
+    cv.line(x, py0, x, py1, major ? 1.0f : 0.5f, grid);
+    cv.line(x, py1, x, py1 + (major ? 6 : 3), 1.5f, black);
+    if (!t.empty()) cv.text(x - Canvas::text_width(t, 2) / 2, py1 + 12, t, 2, black);
+  };
+  if (log_x) {
+    for (int e = int(lx0); e <= int(lx1); ++e)
+      for (int m : {1, 2, 5}) {
+        const double v = m * std::pow(10.0, e);
+        if (std::log10(v) > lx1 + 1e-9) break;
+        x_tick(v, m == 1 || (lx1 - lx0) <= 2.0 ? tick_label(v, std::min(1.0, v)) : "", m == 1);
+      }
+  } else {
+    for (int i = 0; i * ax.step <= ax.max + 1e-9; ++i)
+      x_tick(i * ax.step, tick_label(i * ax.step, ax.step), true);
   }
   for (int i = 0; i * ay.step <= ay.max + 1e-9; ++i) {
     const double v = i * ay.step;
@@ -100,7 +120,7 @@ ImageRGB8 render_pareto_plot(const BenchResult& result) {
   std::snprintf(sub, sizeof sub, "suite aggregate per technique level, floor pass %.3f ms, %d frames + %d warm-up per run",
                 result.floor_median_ms, result.frames, result.warmup);
   cv.text(px0, 40, sub, 1.5f, dark);
-  const std::string xl = "median frame GPU time, ms (mean over scenes)";
+  const std::string xl = std::string("median frame GPU time, ms (mean over scenes") + (log_x ? ", log scale)" : ")");
   cv.text((px0 + px1) / 2 - Canvas::text_width(xl, 2) / 2, py1 + 44, xl, 2, black);
   const std::string yl = "RDE, all pixels (pooled over scenes and frames)";
   cv.text(22, (py0 + py1) / 2 + Canvas::text_width(yl, 2) / 2, yl, 2, black, true);

@@ -169,6 +169,17 @@ Expected<Baseline> load_baseline(const std::string& path) {
 CheckReport check_against(const BenchResult& result, const Baseline& b) {
   CheckReport rep;
   const Tolerances& tol = b.tolerances;
+  // Medians over different numbers of frames, after different warm-ups, are not comparable: a
+  // 4-frame run after 1 warm-up frame read 35-45 % slower than the 16-after-4 baseline of the
+  // same commit on this machine (first frames still fill lavapipe's shader caches), which the
+  // ratio tolerance would report as a regression. A baseline without these fields (0) is old
+  // and is compared as before.
+  if (b.frames > 0 && (result.frames != b.frames || result.warmup != b.warmup))
+    rep.violations.push_back("the run measured " + std::to_string(result.frames) + " frames after " +
+                             std::to_string(result.warmup) + " warm-up, the baseline " +
+                             std::to_string(b.frames) + " after " + std::to_string(b.warmup) +
+                             ": the medians are not comparable (run with --frames " +
+                             std::to_string(b.frames) + " --warmup " + std::to_string(b.warmup) + ")");
   std::map<Key, const BaselineEntry*> base;
   for (const BaselineEntry& e : b.entries) base[Key{e.scene, e.technique, e.level_name}] = &e;
   std::map<Key, bool> matched;

@@ -109,6 +109,20 @@ TEST(Regression, RatioGrowthBeyondToleranceFails) {
   EXPECT_FALSE(perf::check_against(r, b).passed);
 }
 
+TEST(Regression, DifferentFrameCountsAreNotCompared) {
+  perf::BenchResult r = constructed_result();
+  const perf::Baseline b = perf::make_baseline(r);
+  r.warmup = b.warmup + 3;
+  perf::CheckReport rep = perf::check_against(r, b);
+  EXPECT_FALSE(rep.passed);
+  ASSERT_EQ(rep.violations.size(), 1u) << rep.summary();
+  EXPECT_NE(rep.violations[0].find("not comparable"), std::string::npos) << rep.violations[0];
+  EXPECT_NE(rep.violations[0].find("--frames 4 --warmup"), std::string::npos) << rep.violations[0];
+  r = constructed_result();
+  r.frames = 16;
+  EXPECT_FALSE(perf::check_against(r, b).passed);
+}
+
 TEST(Regression, RdeGrowthBeyondToleranceFails) {
   const perf::BenchResult r = constructed_result();
   perf::Baseline b = perf::make_baseline(r);
