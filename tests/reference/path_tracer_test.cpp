@@ -7,24 +7,13 @@
 
 #include "mrgi/reference/path_tracer.h"
 #include "mrgi/reference/shapes.h"
+#include "common/look_at.h"
 
 namespace mrgi::reference {
 namespace {
 
 constexpr float kPi = 3.14159265358979f;
 
-// Camera at `eye` looking at `target` (OpenCV axes: x right, y down, z forward).
-glm::dmat4 look_at(glm::dvec3 eye, glm::dvec3 target, glm::dvec3 up) {
-  const glm::dvec3 z = glm::normalize(target - eye);
-  const glm::dvec3 x = glm::normalize(glm::cross(z, up));
-  const glm::dvec3 y = glm::cross(z, x);
-  glm::dmat4 m(1.0);
-  m[0] = glm::dvec4(x, 0.0);
-  m[1] = glm::dvec4(y, 0.0);
-  m[2] = glm::dvec4(z, 0.0);
-  m[3] = glm::dvec4(eye, 1.0);
-  return m;
-}
 
 RefCamera small_camera(int w, int h, double fov_scale, glm::dmat4 pose) {
   RefCamera cam;
@@ -72,7 +61,7 @@ double mean_channel(const ImageRGBF& img, int c, const ImageU8* only_mask = null
 // everywhere: the white furnace. Run for a diffuse, a mirror and a glass sphere (glass and
 // mirror conserve energy too), and a rough white metal which may only lose energy.
 TEST(PathTracer, WhiteFurnace) {
-  const RefCamera cam = small_camera(24, 24, 1.2, look_at({0, 0, -3}, {0, 0, 0}, {0, 1, 0}));
+  const RefCamera cam = small_camera(24, 24, 1.2, mrgi::test::opencv_look_at({0, 0, -3}, {0, 0, 0}, {0, 1, 0}));
   for (MaterialType type : {MaterialType::Diffuse, MaterialType::Mirror, MaterialType::Glass, MaterialType::Glossy}) {
     RefScene scene;
     RefMaterial m;
@@ -110,7 +99,7 @@ TEST(PathTracer, PointLampOnDiffusePlaneIsAnalytic) {
   lamp.position = {0.3f, 1.5f, -0.2f};
   lamp.intensity = glm::vec3(10.0f);
   scene.lights.push_back(lamp);
-  const RefCamera cam = small_camera(32, 32, 3.0, look_at({0, 2.0, 0.001}, {0, 0, 0}, {0, 0, -1}));
+  const RefCamera cam = small_camera(32, 32, 3.0, mrgi::test::opencv_look_at({0, 2.0, 0.001}, {0, 0, 0}, {0, 0, -1}));
   const RenderOutput out = render(scene, cam, 1, 1, 4);
   for (auto [px, py] : {std::pair{16, 16}, {3, 5}, {28, 20}, {10, 30}}) {
     // The pixel-centre ray hits depth_z along the axis; rebuild the hit point from the camera.
@@ -143,7 +132,7 @@ TEST(PathTracer, SpotConeLimitsLight) {
   spot.cos_inner = std::cos(20.0f * kPi / 180.0f);
   spot.cos_outer = std::cos(30.0f * kPi / 180.0f);
   scene.lights.push_back(spot);
-  const RefCamera cam = small_camera(41, 41, 0.5, look_at({0, 3.0, 0.001}, {0, 0, 0}, {0, 0, -1}));
+  const RefCamera cam = small_camera(41, 41, 0.5, mrgi::test::opencv_look_at({0, 3.0, 0.001}, {0, 0, 0}, {0, 0, -1}));
   const RenderOutput out = render(scene, cam, 1, 1, 0);
   const float centre = out.real.data[(20 * 41 + 20) * 3];
   EXPECT_NEAR(centre, 0.8f / kPi * 5.0f, 0.01f);
@@ -163,7 +152,7 @@ TEST(PathTracer, ErrorFallsWithSquareRootOfSamples) {
   box.material = 1;
   scene.meshes.push_back(box);
   scene.environment = uniform_environment(1.0f);
-  const RefCamera cam = small_camera(16, 16, 0.7, look_at({1.5, 1.5, -1.5}, {0, 0, 0}, {0, 1, 0}));
+  const RefCamera cam = small_camera(16, 16, 0.7, mrgi::test::opencv_look_at({1.5, 1.5, -1.5}, {0, 0, 0}, {0, 1, 0}));
   const RenderOutput truth = render(scene, cam, 1024, 99, 4);
   auto rms_error = [&](int spp) {
     double sum = 0.0;
@@ -194,7 +183,7 @@ TEST(PathTracer, DeterministicPerSeed) {
   RefLight lamp;
   lamp.position = {0.5f, 1.0f, 0.5f};
   scene.lights.push_back(lamp);
-  const RefCamera cam = small_camera(20, 15, 0.8, look_at({0, 1.0, -1.5}, {0, 0, 0}, {0, 1, 0}));
+  const RefCamera cam = small_camera(20, 15, 0.8, mrgi::test::opencv_look_at({0, 1.0, -1.5}, {0, 0, 0}, {0, 1, 0}));
   auto tracer = PathTracer::create(scene);
   ASSERT_TRUE(tracer.ok());
   RenderSettings s;
@@ -223,7 +212,7 @@ TEST(PathTracer, DifferenceIsExactlyZeroWhereNothingVirtualMatters) {
   lamp.position = {1.0f, 2.0f, 0.0f};
   lamp.intensity = glm::vec3(4.0f);
   scene.lights.push_back(lamp);
-  const RefCamera cam = small_camera(32, 32, 0.5, look_at({0, 3.0, 0.001}, {0, 0, 0}, {0, 0, -1}));
+  const RefCamera cam = small_camera(32, 32, 0.5, mrgi::test::opencv_look_at({0, 3.0, 0.001}, {0, 0, 0}, {0, 0, -1}));
   const RenderOutput out = render(scene, cam, 8, 1, 2);
   // Centre: the ball itself. One pixel off the ball, in its shadow (the lamp is above it).
   EXPECT_EQ(out.virtual_mask.data[16 * 32 + 16], 255);
@@ -272,7 +261,7 @@ TEST(PathTracer, EnvironmentLightingMatchesNumericIntegral) {
           const double dw_solid = std::sin(theta) * (kPi / 16.0 / 16.0) * (2.0 * kPi / 32.0 / 16.0);
           for (int c = 0; c < 3; ++c) expected[c] += env.image.at(x, y)[c] * dw.y * dw_solid / kPi;
         }
-  const RefCamera cam = small_camera(8, 8, 2.0, look_at({0, 1.0, 0.001}, {0, 0, 0}, {0, 0, -1}));
+  const RefCamera cam = small_camera(8, 8, 2.0, mrgi::test::opencv_look_at({0, 1.0, 0.001}, {0, 0, 0}, {0, 0, -1}));
   const RenderOutput out = render(scene, cam, 512, 3, 0);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(mean_channel(out.real, c), expected[c], 0.02 * expected[c]) << "c" << c;
 }

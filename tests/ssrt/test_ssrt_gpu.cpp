@@ -19,6 +19,7 @@
 #include "technique/ssrt/ssrt.h"
 #include "technique/ssrt/sh_tools.h"
 #include "vulkan/vk_test_util.h"
+#include "common/look_at.h"
 
 namespace {
 using namespace mrgi;
@@ -49,19 +50,6 @@ glm::mat4 look_down() {
 }
 glm::mat4 g_camera_to_world = look_down();
 glm::mat4 camera_to_world() { return g_camera_to_world; }
-// An OpenCV-convention camera (x right, y down, z forward) at `eye` looking at `target`, world
-// y up: tests that must not depend on the camera looking straight down.
-glm::mat4 look_at(glm::vec3 eye, glm::vec3 target) {
-  const glm::vec3 z = glm::normalize(target - eye);
-  const glm::vec3 x = glm::normalize(glm::cross(z, glm::vec3(0, 1, 0)));
-  const glm::vec3 y = glm::cross(z, x);
-  glm::mat4 m(1.0f);
-  m[0] = glm::vec4(x, 0);
-  m[1] = glm::vec4(y, 0);
-  m[2] = glm::vec4(z, 0);
-  m[3] = glm::vec4(eye, 1);
-  return m;
-}
 
 // First hit of the camera ray through pixel (u, v) with the virtual box at `offset` (slab
 // method): true with the world point and the face normal.
@@ -470,7 +458,7 @@ TEST_F(VulkanTest, SsrtEstimatedDominantDirectionOfARealSphereScene) {
   set_size(128, 96);
   const glm::vec3 centre(0.1f, 0.45f, 0.05f);
   const float radius = 0.45f;
-  for (const glm::mat4 camera : {look_down(), look_at(glm::vec3(-0.1f, 1.2f, -1.6f), glm::vec3(0.1f, 0.3f, 0.05f))})
+  for (const glm::mat4 camera : {look_down(), glm::mat4(test::opencv_look_at({-0.1, 1.2, -1.6}, {0.1, 0.3, 0.05}, {0, 1, 0}))})
   for (const glm::dvec3 sun_raw : {glm::dvec3(0.5, 0.8, 0.3), glm::dvec3(-0.6, 0.6, 0.5),
                                    glm::dvec3(0.2, 0.7, -0.7)}) {
     g_camera_to_world = camera;

@@ -21,6 +21,7 @@
 #include "gpu/frame_graph.h"
 #include "technique/ssrt/volume.h"
 #include "vulkan/vk_test_util.h"
+#include "common/look_at.h"
 
 namespace {
 using namespace mrgi;
@@ -34,25 +35,13 @@ const Box kBoxA{{-0.15f, 0.0f, -0.15f}, {0.15f, 0.3f, 0.15f}};   // under the ca
 const Box kBoxB{{-0.95f, 0.0f, -0.1f}, {-0.75f, 0.3f, 0.1f}};    // left of the view
 const glm::vec3 kCenter(0.0f, 0.3f, 0.0f);                        // cube [-1,1]x[-0.7,1.3]x[-1,1]
 
-// OpenCV camera-to-world looking from `eye` at `target`; `down` roughly the image's down.
-glm::dmat4 look_at(glm::dvec3 eye, glm::dvec3 target, glm::dvec3 down) {
-  const glm::dvec3 z = glm::normalize(target - eye);
-  const glm::dvec3 x = glm::normalize(glm::cross(down, z));
-  const glm::dvec3 y = glm::cross(z, x);
-  glm::dmat4 m(1.0);
-  m[0] = glm::dvec4(x, 0.0);
-  m[1] = glm::dvec4(y, 0.0);
-  m[2] = glm::dvec4(z, 0.0);
-  m[3] = glm::dvec4(eye, 1.0);
-  return m;
-}
 // 1 m above the floor looking straight down: image x = world x, image y = world z.
 glm::dmat4 looking_down(glm::dvec3 offset = glm::dvec3(0.0)) {
-  return look_at(glm::dvec3(0, 1, 0) + offset, glm::dvec3(0, 0, 0) + offset, glm::dvec3(0, 0, 1));
+  return mrgi::test::opencv_look_at(glm::dvec3(0, 1, 0) + offset, glm::dvec3(0, 0, 0) + offset, glm::dvec3(0, 0, -1));
 }
 // Looking at box B's +x face from the right, slightly from above.
 glm::dmat4 looking_left() {
-  return look_at(glm::dvec3(-0.1, 0.45, 0.0), glm::dvec3(-0.85, 0.1, 0.0), glm::dvec3(0, -1, 0));
+  return mrgi::test::opencv_look_at(glm::dvec3(-0.1, 0.45, 0.0), glm::dvec3(-0.85, 0.1, 0.0), glm::dvec3(0, 1, 0));
 }
 
 // Slab test: entry distance of the ray o + t d into `b` (t > 0), and the entry face's normal.
