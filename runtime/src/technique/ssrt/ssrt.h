@@ -43,11 +43,15 @@
 // its colour and normal are unknown). The runtime's recon G-buffer is used only for the camera
 // colour (I_c) and the virtual objects' depth test.
 //
-// Known defects (issue 4 is open): on the suite the estimated dominant direction is 90-110
-// degrees off the environment's (env_fisheye) and horizontally mirrored in the lamp-lit scenes;
-// the estimate is poorly conditioned when the view holds one plane and a small object (the
-// paper's gray-world, white-light assumptions add bias on coloured walls). The fast level costs
-// far more than 33 ms on lavapipe: the TSDF ray-casts and the transfer dominate.
+// Known defects (issue 4 is open): the light estimate is what limits the technique. With the
+// true light (the environment's SH) in its place, ssrt beats baseline on env_fisheye (RDE 0.61
+// against 0.66, 320x240 capture); with its own estimate it does not (0.84 against 0.63 at
+// 640x480), and the dominant direction is 51 (fast) to 86 (full) degrees off. The system T l =
+// I_c is badly conditioned on a floor with a few objects (floor pixels dominate T^T T; faces
+// turned away from the camera are never seen), and the answer swings with the D''' filter and
+// the regularisation. On a large real sphere the chain recovers the direction within 13-20
+// degrees (test SsrtEstimatedDominantDirectionOfARealSphereScene), so no frame convention is
+// wrong. The fast level costs far more than 33 ms on lavapipe: the transfer is 480 ms of 727.
 #pragma once
 #include <memory>
 #include <vector>
