@@ -14,6 +14,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
 layout(std430, set = 0, binding = 1) readonly buffer ColorWords { uint color_words[]; };  // RGB8
 layout(std430, set = 0, binding = 2) readonly buffer DepthWords { uint depth_words[]; };  // u16
+#include "common/upload_gather.glsl"
 layout(set = 0, binding = 3, rgba32f) writeonly uniform image2D real_position;  // xyz world, w z
 layout(set = 0, binding = 4, rgba16f) writeonly uniform image2D real_albedo;    // rgb, a valid
 layout(set = 0, binding = 5, r32ui) uniform uimage2D warped;                    // read, cleared
@@ -21,9 +22,6 @@ layout(set = 0, binding = 6, rg32f) writeonly uniform image2D filtered_depth;   
 // x: 1 when `warped` holds the previous frame, y: weight cap (frames), z/w: same-surface rule
 // |z_new - z_warped| <= max(z * z_new, w metres); options.x: 1 = median on the raw depth.
 layout(push_constant) uniform Push { vec4 merge; ivec4 options; } pc;
-
-uint color_byte(uint index) { return (color_words[index >> 2] >> ((index & 3u) * 8u)) & 0xffu; }
-uint depth_value(uint index) { return (depth_words[index >> 1] >> ((index & 1u) * 16u)) & 0xffffu; }
 
 // Spatial step before the temporal merge: the median of the valid raw depths in the 3x3
 // neighbourhood of a valid pixel. Why: the sample's Kinect-like depth has single-pixel
@@ -50,15 +48,6 @@ uint median_depth(ivec2 c, ivec2 size) {
       v[i] = d;
     }
   return n < 3 ? centre : v[n / 2];
-}
-
-// Nearest pixel of a camera with intrinsics k and size for a ray direction (camera space, z=1);
-// (-1, -1) outside the image.
-ivec2 nearest_pixel(vec3 ray, vec4 k, ivec2 size) {
-  vec2 p = project_pinhole(ray, k);
-  ivec2 q = ivec2(floor(p + 0.5));
-  if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) return ivec2(-1);
-  return q;
 }
 
 void main() {

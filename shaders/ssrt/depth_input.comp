@@ -3,9 +3,8 @@
 // for the merge's 25-tap windows: D_c (metres, 0 = missing) and I_c (grey 0..255) gathered from
 // the upload buffers, and whether D_c agrees with the volume (|D_c - D_v| < lambda_D, both
 // valid: the Omega_D test of eq. 2).
-// The gather is the one of recon/depth_to_positions.comp: the internal pixel's ray -> nearest
-// depth / colour sample (identity when registered at full resolution; never interpolated, which
-// would invent depths between a foreground and a background surface).
+// The gather is recon/depth_to_positions.comp's (common/upload_gather.glsl): the internal
+// pixel's ray -> nearest depth / colour sample (identity when registered at full resolution).
 // Why a pass of its own: on lavapipe every tap of the merge would otherwise redo this gather
 // (projection, three byte loads, a volume fetch) 25 times, and shared-memory tiles cost more
 // than they save there (a barrier makes every SIMD chunk of the workgroup a coroutine).
@@ -19,23 +18,13 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
 layout(std430, set = 0, binding = 1) readonly buffer ColorWords { uint color_words[]; };  // RGB8
 layout(std430, set = 0, binding = 2) readonly buffer DepthWords { uint depth_words[]; };  // u16
+#include "common/upload_gather.glsl"
 layout(set = 0, binding = 3, r32f) readonly uniform image2D depth_volume;  // D_v, m, 0 = none
 // x: D_c (metres, 0 = missing); y: I_c + 256 when D_c and D_v agree.
 layout(set = 0, binding = 4, rg32f) writeonly uniform image2D depth_input;
 // window.w: 1 when depth_volume holds D_v (else a placeholder: every D_v is missing);
 // thresholds.y: lambda_D (metres). (The merge's push block; the other fields are unused here.)
 layout(push_constant) uniform Push { ivec4 window; vec4 thresholds; } pc;
-
-uint color_byte(uint index) { return (color_words[index >> 2] >> ((index & 3u) * 8u)) & 0xffu; }
-uint depth_value(uint index) { return (depth_words[index >> 1] >> ((index & 1u) * 16u)) & 0xffffu; }
-
-// Nearest pixel of a camera with intrinsics k and size for a camera-space ray; (-1, -1) outside.
-ivec2 nearest_pixel(vec3 ray, vec4 k, ivec2 size) {
-  vec2 p = project_pinhole(ray, k);
-  ivec2 q = ivec2(floor(p + 0.5));
-  if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) return ivec2(-1);
-  return q;
-}
 
 void main() {
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);

@@ -20,6 +20,7 @@
 #include "technique/ssrt/sh_tools.h"
 #include "vulkan/vk_test_util.h"
 #include "common/look_at.h"
+#include "common/frame_constants_for.h"
 
 namespace {
 using namespace mrgi;
@@ -219,14 +220,8 @@ struct Driver {
   }
 
   void write_constants() {
-    shader::FrameConstants fc{};
-    fc.camera_to_world = camera_to_world();
-    fc.world_to_camera = glm::inverse(fc.camera_to_world);
-    fc.camera_world = camera_to_world()[3];
-    fc.internal_k = fc.output_k = fc.color_k = fc.depth_k = kK;
-    fc.internal_output_size = glm::ivec4(W, H, W, H);
-    fc.color_depth_size = glm::ivec4(W, H, W, H);
-    fc.camera = glm::vec4(5000.0f, 1.0f, 0.02f, 0.0f);
+    const shader::FrameConstants fc =
+        test::pinhole_frame_constants(camera_to_world(), kK, int(W), int(H), 5000.0f);
     std::memcpy(graph->mapped(shared.frame_constants, graph->slot()), &fc, sizeof(fc));
   }
 

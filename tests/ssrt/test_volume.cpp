@@ -22,6 +22,7 @@
 #include "technique/ssrt/volume.h"
 #include "vulkan/vk_test_util.h"
 #include "common/look_at.h"
+#include "common/frame_constants_for.h"
 
 namespace {
 using namespace mrgi;
@@ -192,14 +193,8 @@ struct Rig {
     if (truth) *truth = t;
     std::memcpy(graph->mapped(shared.depth_upload, graph->slot()), depth.data.data(),
                 depth.data.size() * 2);
-    shader::FrameConstants fc{};
-    fc.camera_to_world = glm::mat4(pose);
-    fc.world_to_camera = glm::mat4(glm::inverse(pose));
-    fc.camera_world = glm::vec4(glm::vec3(pose[3]), 1.0f);
-    fc.internal_k = fc.output_k = fc.color_k = fc.depth_k = k;
-    fc.internal_output_size = glm::ivec4(w, h, w, h);
-    fc.color_depth_size = glm::ivec4(w, h, w, h);
-    fc.camera = glm::vec4(5000.0f, 1.0f, 0.02f, 0.0f);
+    const shader::FrameConstants fc =
+        test::pinhole_frame_constants(glm::mat4(pose), k, int(w), int(h), 5000.0f);
     std::memcpy(graph->mapped(shared.frame_constants, graph->slot()), &fc, sizeof(fc));
     vf.camera_to_world = pose;
     vf.depth = &depth;

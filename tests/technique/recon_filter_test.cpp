@@ -19,6 +19,7 @@
 #include "gpu/frame_graph.h"
 #include "recon/reconstruction.h"
 #include "vulkan/vk_test_util.h"
+#include "common/frame_constants_for.h"
 
 namespace mrgi::test {
 namespace {
@@ -132,16 +133,10 @@ class ReconFilterTest : public VulkanTest {
   Result frame(const InputFrame& input, const glm::dmat4& pose) {
     auto begun = graph_->begin_frame();
     EXPECT_TRUE(begun.ok()) << begun.error().message;
-    shader::FrameConstants fc{};
     const Intrinsics k = camera();
     const glm::vec4 kk(float(k.fx), float(k.fy), float(k.cx), float(k.cy));
-    fc.camera_to_world = glm::mat4(pose);
-    fc.world_to_camera = glm::mat4(glm::inverse(pose));
-    fc.camera_world = glm::vec4(glm::vec3(pose[3]), 1.0f);
-    fc.internal_k = fc.output_k = fc.color_k = fc.depth_k = kk;
-    fc.internal_output_size = glm::ivec4(W, H, W, H);
-    fc.color_depth_size = glm::ivec4(W, H, W, H);
-    fc.camera = glm::vec4(float(kDepthScale), 1.0f, 0.02f, 0.0f);
+    const shader::FrameConstants fc =
+        mrgi::test::pinhole_frame_constants(glm::mat4(pose), kk, int(W), int(H), float(kDepthScale));
     std::memcpy(graph_->mapped(constants_, graph_->slot()), &fc, sizeof(fc));
     recon_->upload(*graph_, input);
     recon_->record(*graph_, constants_);
