@@ -10,8 +10,9 @@
 // Output layers of `coarse` (cell grid in the top-left corner):
 //   0..3  T_real: 16 SH transfer coefficients of the real surface (for the light estimation)
 //   4     x R_d = T_real . l, y R'_d = T_rv . l (luminance), z 1 real surface usable for the
-//         light estimation (valid, unsaturated camera colour), w what the cell sees: 0 nothing,
-//         1 a real surface, 2 a virtual one (the up-sampling filters do not mix the two)
+//         light estimation (measured camera colour, green unclipped: see `usable`), w what the
+//         cell sees: 0 nothing, 1 a real surface, 2 a virtual one (the up-sampling filters do
+//         not mix the two)
 //   5     rgb R_i (real only), w 1 surface present
 //   6     rgb R'_i (real + virtual), w 1 surface present
 #extension GL_GOOGLE_include_directive : require
@@ -202,8 +203,13 @@ void main() {
     rd += ta * light.sh[i].w;
     rd_v += tb * light.sh[i].w;
   }
-  vec3 camera = texelFetch(real_albedo, pixel, 0).rgb;
-  float usable = real_ok && max(camera.r, max(camera.g, camera.b)) < pc.bounce.y ? 1.0f : 0.0f;
+  // Usable for the light estimation: the camera measured this pixel (recon's alpha; the volume's
+  // G-buffer also fills pixels the depth camera missed, whose recon colour is 0 and read as a
+  // black surface: 500 such cells at env_fisheye's far floor pulled the estimate down), and the
+  // green channel, 72 % of the luminance, is below clipping. A warm sun clips red first on a
+  // bright grey ball; rejecting such pixels removed exactly the surfaces facing the light.
+  vec4 camera = texelFetch(real_albedo, pixel, 0);
+  float usable = real_ok && camera.a > 0.5f && camera.g < pc.bounce.y ? 1.0f : 0.0f;
   for (int c = 0; c < 4; ++c) imageStore(coarse, ivec3(cell, c), real_ok ? t_real[c] : zero);
   imageStore(coarse, ivec3(cell, 4), vec4(max(rd, 0.0f), max(rd_v, 0.0f), usable, virt ? 2.0f : 1.0f));
   imageStore(coarse, ivec3(cell, 5), vec4(ri, 1.0f));
