@@ -4,6 +4,7 @@
 // that completed (pipelined over frames_in_flight slots).
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <optional>
 #include <string>
 
@@ -43,6 +44,7 @@ struct SlotRecord {
   int64_t frame_index = 0;
   int level = 0;
   double cpu_ms = 0.0;
+  bool priming = false;  // a technique's priming run of this frame: its output is dropped
   std::vector<std::string> skipped;
   std::vector<std::string> notes;
 };
@@ -67,6 +69,15 @@ class RuntimeImpl final : public Runtime {
   void write_constants(const InputFrame& frame, const glm::dmat4& camera_to_world,
                        const glm::vec3& ambient_both, const glm::vec3& ambient_virtual);
   Expected<FrameOutput> collect(const gpu::FrameTimings& timings);
+  // Waits for the frame that last used the next slot (its output joins `outputs`) and starts
+  // that slot's record for `frame`.
+  Expected<SlotRecord*> begin_slot(const InputFrame& frame, std::vector<FrameOutput>& outputs);
+  // Records the frame's passes into the current slot and submits them.
+  Status record_and_submit(const InputFrame& frame, SlotRecord& rec, bool affected);
+  // The technique's priming run (Technique::wants_priming_run): this frame run once, waited
+  // for, its output dropped; the frames still in flight before it are collected into `outputs`.
+  Status prime(const InputFrame& frame, SlotRecord& rec, std::vector<FrameOutput>& outputs,
+               std::string& note);
 
   RuntimeSettings settings_;
   CameraSetup cameras_;
@@ -277,10 +288,8 @@ void RuntimeImpl::write_constants(const InputFrame& frame, const glm::dmat4& cam
   *fc = f;
 }
 
-Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame) {
-  const auto t0 = std::chrono::steady_clock::now();
-  MRGI_TRY(check_frame(frame));
-  std::vector<FrameOutput> outputs;
+Expected<SlotRecord*> RuntimeImpl::begin_slot(const InputFrame& frame,
+                                              std::vector<FrameOutput>& outputs) {
   auto done = graph_->begin_frame();
   if (!done) return done.error();
   if (done->has_value()) {
@@ -290,20 +299,84 @@ Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame)
   }
   SlotRecord& rec = slots_[graph_->slot()];
   rec.used = true;
+  rec.priming = false;
   rec.frame_index = frame.index;
   rec.level = level_;
   rec.skipped.clear();
   rec.notes.clear();
+  return &rec;
+}
+
+Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame) {
+  const auto t0 = std::chrono::steady_clock::now();
+  MRGI_TRY(check_frame(frame));
+  std::vector<FrameOutput> outputs;
+  auto slot = begin_slot(frame, outputs);
+  if (!slot) return slot.error();
+  SlotRecord* rec = *slot;
 
   // A frame without a pose keeps the last known one (identity before any): the output is then
   // only right for a camera that did not move; the stats say so.
+  std::vector<std::string> notes;
   if (frame.pose) {
     last_pose_ = frame.pose->matrix();
     have_pose_ = true;
   } else {
-    rec.notes.push_back(have_pose_ ? "pose: none given, previous frame's pose used"
-                                   : "pose: none given and none before, identity used");
+    notes.push_back(have_pose_ ? "pose: none given, previous frame's pose used"
+                               : "pose: none given and none before, identity used");
   }
+  const bool has_objects = !scene_gpu_->virtual_objects.empty();
+  bool affected = has_objects;
+  for (const LightDesc& l : scene_.lights) affected = affected || !l.real;  // lights real surfaces
+  if (affected && has_objects && settings_.skip_unaffected_frames) {
+    runtime::InfluenceQuery q;
+    q.box_min = scene_gpu_->virtual_objects.bounds_min;
+    q.box_max = scene_gpu_->virtual_objects.bounds_max;
+    q.camera_to_world = last_pose_;
+    q.camera = cameras_.color;
+    affected = runtime::virtual_influence_in_view(q, scene_.lights);
+  }
+  if (affected && technique_->wants_priming_run()) {
+    std::string note;
+    MRGI_TRY(prime(frame, *rec, outputs, note));
+    slot = begin_slot(frame, outputs);
+    if (!slot) return slot.error();
+    rec = *slot;
+    notes.push_back(note);
+  }
+  rec->notes.insert(rec->notes.end(), notes.begin(), notes.end());
+  MRGI_TRY(record_and_submit(frame, *rec, affected));
+  rec->cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return outputs;
+}
+
+Status RuntimeImpl::prime(const InputFrame& frame, SlotRecord& rec,
+                          std::vector<FrameOutput>& outputs, std::string& note) {
+  rec.priming = true;
+  MRGI_TRY(record_and_submit(frame, rec, true));
+  auto all = graph_->flush();
+  if (!all) return all.error();
+  double prime_ms = 0.0;
+  for (const gpu::FrameTimings& t : *all) {
+    if (slots_[t.slot].priming) {
+      slots_[t.slot].used = false;
+      slots_[t.slot].priming = false;
+      prime_ms = t.total_ms;
+      continue;
+    }
+    auto out = collect(t);
+    if (!out) return out.error();
+    outputs.push_back(std::move(*out));
+  }
+  technique_->frames_completed();
+  char ms[32];
+  std::snprintf(ms, sizeof ms, "%.2f", prime_ms);
+  note = "technique: frame run twice, the first run (" + std::string(ms) +
+         " ms GPU, output dropped) primes " + technique_->name() + "'s estimate from this frame";
+  return ok_status();
+}
+
+Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, bool affected) {
   glm::vec3 env = env_mean_;
   const EnvironmentDesc& e = scene_.environment;
   if (e.present && e.from_env_camera) {
@@ -324,22 +397,12 @@ Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame)
 
   recon_->record(*graph_, frame_constants_);  // always: its temporal history must stay current
   const bool has_objects = !scene_gpu_->virtual_objects.empty();
-  bool affected = has_objects;
-  for (const LightDesc& l : scene_.lights) affected = affected || !l.real;  // lights real surfaces
-  if (affected && has_objects && settings_.skip_unaffected_frames) {
-    runtime::InfluenceQuery q;
-    q.box_min = scene_gpu_->virtual_objects.bounds_min;
-    q.box_max = scene_gpu_->virtual_objects.bounds_max;
-    q.camera_to_world = last_pose_;
-    q.camera = cameras_.color;
-    affected = runtime::virtual_influence_in_view(q, scene_.lights);
-  }
   if (affected) {
     virtual_gbuffer_->record(*graph_, frame_constants_, recon_->position());
     technique::FrameInfo info;
     info.frame_index = frame.index;
     info.level = level_;
-    info.virtual_objects_present = !scene_gpu_->virtual_objects.empty();
+    info.virtual_objects_present = has_objects;
     info.camera_to_world = last_pose_;
     info.input = &frame;
     MRGI_TRY(technique_->record(info, rec.skipped));
@@ -351,9 +414,7 @@ Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame)
                              virtual_gbuffer_->position(), !affected});
   MRGI_TRY(graph_->compile());
   MRGI_TRY(graph_->submit());
-  rec.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  MRGI_TRY(check_validation());
-  return outputs;
+  return check_validation();
 }
 
 Expected<FrameOutput> RuntimeImpl::collect(const gpu::FrameTimings& timings) {

@@ -86,6 +86,15 @@ class Technique {
   // The real-world light a technique estimates (ssrt), or nullptr for techniques that take it
   // from the scene description.
   virtual const LightEstimate* light_estimate() const { return nullptr; }
+  // Whether the next frame should be run twice: a technique whose output needs an estimate it
+  // derives from the frames themselves (ssrt's light, read back a few frames late so nothing
+  // stalls) and that has none yet asks once, so its first visible frame is not lit by a guess.
+  // The runtime then records and submits the frame, waits for it, drops its output, calls
+  // frames_completed() and records the frame again.
+  virtual bool wants_priming_run() const { return false; }
+  // Every frame submitted so far has completed (the runtime waited for all of them): what they
+  // wrote for the host may be read now.
+  virtual void frames_completed() {}
 };
 
 using TechniqueFactory = Expected<std::unique_ptr<Technique>> (*)(const SharedResources&);

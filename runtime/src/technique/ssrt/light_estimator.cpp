@@ -20,6 +20,41 @@ Status check_range(bool ok, const char* field, const std::string& rule) {
 
 double luminance(const glm::dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
 
+constexpr double kPi = 3.14159265358979323846;
+
+// The dominant normal of the frame's pixels: the principal axis of the band-1 block of T^T T
+// (T's band 1 is the visibility-weighted cosine lobe around the normal, so the block is a sum of
+// n n^T), signed so that the pixels are lit from its side (T^T I_c). Zero when undefined.
+glm::dvec3 dominant_surface_normal(const Mat& ata, const Rhs& atb) {
+  Eigen::Matrix3d b = ata.block(1, 1, 3, 3);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(b);
+  if (eig.info() != Eigen::Success || !(eig.eigenvalues()(2) > 0.0)) return glm::dvec3(0.0);
+  Eigen::Vector3d e = eig.eigenvectors().col(2);
+  const Eigen::Vector3d side = atb.block(1, 0, 3, 1);
+  if (e.dot(side) < 0.0) e = -e;
+  // Band 1 in Sloan order is c * (-y, z, -x).
+  const glm::dvec3 n(-e(2), -e(0), e(1));
+  const double len = glm::length(n);
+  return len > 0.0 && std::isfinite(len) ? n / len : glm::dvec3(0.0);
+}
+
+// integral over {w : w . normal < 0} of Y(w) Y(w)^T dw, by a Fibonacci sphere of 512 directions.
+Mat below_surface_gram(const glm::dvec3& normal, int n) {
+  constexpr int kDirections = 512;
+  Mat m = Mat::Zero(n, n);
+  for (int k = 0; k < kDirections; ++k) {
+    const double z = 1.0 - 2.0 * (k + 0.5) / kDirections;
+    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const double phi = kPi * (3.0 - std::sqrt(5.0)) * k;
+    const glm::dvec3 w(r * std::cos(phi), z, r * std::sin(phi));
+    if (glm::dot(w, normal) >= 0.0) continue;
+    const ShVector y = sh_basis(glm::vec3(w));
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) m(i, j) += double(y[i]) * double(y[j]);
+  }
+  return m * (4.0 * kPi / kDirections);
+}
+
 }  // namespace
 
 void LightSystem::add(const ShVector& transfer, const glm::dvec3& intensity) {
@@ -43,6 +78,11 @@ Expected<LightEstimator> LightEstimator::create(const LightEstimatorSettings& s)
                        "min_regularisation", "must be finite and > 0"));
   MRGI_TRY(check_range(s.band_penalty >= 0.0 && std::isfinite(s.band_penalty), "band_penalty",
                        "must be finite and >= 0"));
+  MRGI_TRY(check_range(s.below_surface_penalty >= 0.0 && std::isfinite(s.below_surface_penalty),
+                       "below_surface_penalty", "must be finite and >= 0"));
+  MRGI_TRY(check_range(s.below_surface_penalty_two_bands >= 0.0 &&
+                           std::isfinite(s.below_surface_penalty_two_bands),
+                       "below_surface_penalty_two_bands", "must be finite and >= 0"));
   MRGI_TRY(check_range(s.time_constant_s >= 0.0 && std::isfinite(s.time_constant_s),
                        "time_constant_s", "must be finite and >= 0 seconds"));
   MRGI_TRY(check_range(s.nominal_frame_s > 0.0 && s.nominal_frame_s <= 1.0, "nominal_frame_s",
@@ -69,7 +109,7 @@ void LightEstimator::reset() {
 }
 
 Expected<LightEstimate> LightEstimator::update(const LightSystem& system, int64_t frame_index,
-                                               double timestamp_s) {
+                                               double timestamp_s, int solve_bands) {
   for (double v : system.ata)
     if (!std::isfinite(v))
       return fail(ErrorKind::BadInput, "ssrt light estimation: frame " +
@@ -80,7 +120,12 @@ Expected<LightEstimate> LightEstimator::update(const LightSystem& system, int64_
       return fail(ErrorKind::BadInput, "ssrt light estimation: frame " +
                                            std::to_string(frame_index) +
                                            ": T^T I_c holds NaN or Inf; frame not used");
-  const int n = settings_.bands * settings_.bands;
+  if (solve_bands < 0 || solve_bands > settings_.bands)
+    return fail(ErrorKind::BadUsage, "ssrt light estimation: solve_bands " +
+                                         std::to_string(solve_bands) + " outside 0.." +
+                                         std::to_string(settings_.bands));
+  const int bands = solve_bands > 0 ? solve_bands : settings_.bands;
+  const int n = bands * bands;
   Mat ata(n, n);
   Rhs atb(n, 3);
   for (int i = 0; i < n; ++i) {
@@ -126,6 +171,11 @@ Expected<LightEstimate> LightEstimator::update(const LightSystem& system, int64_
                         settings_.min_regularisation;
   Mat lhs = ata;
   Rhs rhs = atb;
+  dominant_normal_ = n >= 4 ? dominant_surface_normal(ata, atb) : glm::dvec3(0.0);
+  const double mu = bands >= 3 ? settings_.below_surface_penalty
+                               : settings_.below_surface_penalty_two_bands;
+  if (mu > 0.0 && glm::length(dominant_normal_) > 0.5)
+    lhs += (mu * std::max(mean_diag, 0.0)) * below_surface_gram(dominant_normal_, n);
   for (int i = 0; i < n; ++i) {
     const int l = sh_band(i);
     const double w = lambda * (1.0 + settings_.band_penalty * l * (l + 1));

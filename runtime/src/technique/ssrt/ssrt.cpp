@@ -78,9 +78,14 @@ class Ssrt final : public Technique {
   Status record(const FrameInfo& info, std::vector<std::string>& skipped) override;
   const LightEstimate& estimate() const { return estimator_->estimate(); }
   const LightEstimate* light_estimate() const override { return &estimator_->estimate(); }
+  // Once, before the first estimate: the first frame is lit by its own estimate instead of the
+  // prior (a uniform grey guess that made the first frames_in_flight frames' RDE about 1).
+  bool wants_priming_run() const override { return !primed_ && !estimator_->estimate().valid; }
+  void frames_completed() override;
 
  private:
-  void consume_readback(std::vector<std::string>& notes);
+  // Solves the sums the frame that last used `slot` read back (it must have completed).
+  void consume_readback(uint32_t slot, std::vector<std::string>& notes);
   // The paper's geometry stage (Sec. 4): fuse the volume, ray-cast G_v and the aux layers, run
   // the depth filter chain into the G-buffer the transfer reads.
   Status record_geometry(const FrameInfo& info, const QualityLevel& level,
@@ -111,6 +116,9 @@ class Ssrt final : public Technique {
   gpu::ImageHandle coarse_;
   gpu::PipelineHandle transfer_, reduce_, reduce_final_, blur_, shade_;
   std::vector<int64_t> pending_;       // per frame slot: frame whose sums its readback holds
+  std::vector<int> pending_bands_;     // per frame slot: SH bands of that frame's transfer
+  bool primed_ = false;                // a priming run was asked for (only ever once)
+  std::vector<std::string> deferred_notes_;  // from frames_completed, reported by the next record
   // This frame's knobs (set by record before the passes are added).
   uint32_t step_ = 1, directions_ = 64, bands_ = 4;
   int level_ = 0;
@@ -178,6 +186,7 @@ Status Ssrt::init() {
   if (!result) return result.error();
   result_ = *result;
   pending_.assign(graph.frames_in_flight(), -1);
+  pending_bands_.assign(graph.frames_in_flight(), 0);
 
   gpu::ImageDesc cd;
   cd.name = "ssrt_coarse";
@@ -238,11 +247,22 @@ Status Ssrt::record_geometry(const FrameInfo& info, const QualityLevel& level,
   return filter_->record(volume_->depth_volume(), knob(level, "final_filter") > 0.5, skipped);
 }
 
-// The sums a slot's readback holds belong to the frame that last used the slot; that frame has
-// completed once begin_frame returned, so reading here never stalls.
-void Ssrt::consume_readback(std::vector<std::string>& notes) {
+// After the runtime waited for every frame (the priming run): all readbacks are complete, and
+// are solved oldest first.
+void Ssrt::frames_completed() {
+  primed_ = true;
+  std::vector<uint32_t> slots;
+  for (uint32_t s = 0; s < pending_.size(); ++s)
+    if (pending_[s] >= 0) slots.push_back(s);
+  std::sort(slots.begin(), slots.end(), [&](uint32_t a, uint32_t b) { return pending_[a] < pending_[b]; });
+  for (uint32_t s : slots) consume_readback(s, deferred_notes_);
+}
+
+// The sums a slot's readback holds belong to the frame that last used the slot. record() calls
+// this for its own slot, whose previous frame has completed once begin_frame returned, so
+// reading never stalls.
+void Ssrt::consume_readback(uint32_t slot, std::vector<std::string>& notes) {
   gpu::FrameGraph& graph = *shared_.graph;
-  const uint32_t slot = graph.slot();
   const int64_t frame = pending_[slot];
   if (frame < 0) return;
   pending_[slot] = -1;
@@ -263,7 +283,8 @@ void Ssrt::consume_readback(std::vector<std::string>& notes) {
   for (int e = 0; e < ssrt::kMaxShCoeffs * 3; ++e) sys.atb[e] = sums[136 + e];
   sys.samples = sums[184];
   // The frame clock is not in FrameInfo: frames are spaced by the estimator's nominal step.
-  auto r = estimator_->update(sys, frame, double(frame) * estimator_->settings().nominal_frame_s);
+  auto r = estimator_->update(sys, frame, double(frame) * estimator_->settings().nominal_frame_s,
+                              pending_bands_[slot]);
   if (!r) notes.push_back("ssrt_light_estimation: " + r.error().message);
 }
 
@@ -344,7 +365,9 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   used_ = graph.extent(shared_.lit_r);
   grid_ = glm::uvec2((used_.width + step_ - 1) / step_, (used_.height + step_ - 1) / step_);
 
-  consume_readback(skipped);
+  skipped.insert(skipped.end(), deferred_notes_.begin(), deferred_notes_.end());
+  deferred_notes_.clear();
+  consume_readback(graph.slot(), skipped);
   write_light();
   MRGI_TRY(record_geometry(info, level, skipped));
 
@@ -439,6 +462,7 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
         });
     graph.mark_output(result_);
     pending_[graph.slot()] = info.frame_index;
+    pending_bands_[graph.slot()] = int(bands_);
     if (step_ > 1) {
       graph.add_pass(
           "ssrt_upsample_blur", gpu::PassKind::Compute,
