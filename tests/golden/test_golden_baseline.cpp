@@ -12,8 +12,7 @@
 
 #include <cstdio>
 
-#include "mrgi/metrics.h"
-#include "mrgi/platform/capture.h"
+#include "common/replay_capture.h"
 #include "mrgi/runtime.h"
 
 namespace mrgi {
@@ -21,57 +20,7 @@ namespace {
 
 const std::string kCapture = std::string(MRGI_SOURCE_DIR) + "/tests/data/golden_desk_160";
 
-struct Golden {
-  RdeReport pooled;
-  bool any = false;
-};
-
-Golden replay(int level) {
-  auto capture = CaptureReader::open(kCapture);
-  EXPECT_TRUE(capture.ok()) << (capture.ok() ? "" : capture.error().message);
-  Golden g;
-  if (!capture.ok()) return g;
-  const CaptureInfo& info = capture->info();
-  RuntimeSettings s;
-  s.device.validate = true;
-  s.technique = "baseline";
-  s.level = level;
-  s.exposure = info.exposure;
-  auto rt = create_runtime(s, CameraSetup{info.color, info.depth, info.depth_scale, info.exposure},
-                           *capture->scene());
-  EXPECT_TRUE(rt.ok()) << (rt.ok() ? "" : rt.error().message);
-  if (!rt.ok()) return g;
-  std::vector<ImageRGB8> cameras(capture->frame_count());
-  auto consume = [&](Expected<std::vector<FrameOutput>>&& outs) {
-    ASSERT_TRUE(outs.ok()) << outs.error().message;  // includes any validation message
-    for (const FrameOutput& o : *outs) {
-      const size_t i = size_t(o.stats.frame_index);
-      auto ref = capture->read_reference(i);
-      auto mask = capture->read_reference_mask(i);
-      ASSERT_TRUE(ref.ok() && mask.ok());
-      auto r = measure_error(o.image, cameras[i], *ref, &*mask);
-      ASSERT_TRUE(r.ok()) << r.error().message;
-      if (!g.any) {
-        g.pooled = *r;
-        g.any = true;
-      } else {
-        g.pooled.all = pool(g.pooled.all, r->all);
-        g.pooled.real = pool(g.pooled.real, r->real);
-        g.pooled.virtual_ = pool(g.pooled.virtual_, r->virtual_);
-      }
-    }
-  };
-  for (size_t i = 0; i < capture->frame_count(); ++i) {
-    auto f = capture->read_frame(i);
-    EXPECT_TRUE(f.ok()) << f.error().message;
-    if (!f.ok()) return g;
-    f->index = int64_t(i);
-    cameras[i] = f->color;
-    consume((*rt)->process(*f));
-  }
-  consume((*rt)->flush());
-  return g;
-}
+test::ReplayResult replay(int level) { return test::replay_capture(kCapture, "baseline", level); }
 
 struct Bound {
   double all, real, virtual_;
@@ -87,7 +36,7 @@ TEST(GoldenBaseline, EveryLevelBeatsTheUntouchedCameraFrame) {
   ASSERT_TRUE(levels.ok());
   ASSERT_GE(levels->size(), 2u);
   for (int level = 0; level < int(levels->size()); ++level) {
-    const Golden g = replay(level);
+    const test::ReplayResult g = replay(level);
     ASSERT_TRUE(g.any) << "level " << level << " produced no frame";
     std::printf("baseline level %d (%s): RDE all %.3f real %.3f virtual %.3f, SSIM %.3f\n", level,
                 (*levels)[level].c_str(), g.pooled.all.rde, g.pooled.real.rde, g.pooled.virtual_.rde,

@@ -1,0 +1,82 @@
+// Replays a capture with references through the public runtime (validation layers on) and pools
+// the error figures over its frames, as `mrgi replay` does; the golden tests use it. When the
+// capture has environment frames, each output's light estimate (if the technique has one) is
+// compared with the environment's dominant direction.
+#pragma once
+#include <gtest/gtest.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "mrgi/light_estimate.h"
+#include "mrgi/metrics.h"
+#include "mrgi/platform/capture.h"
+#include "mrgi/runtime.h"
+
+namespace mrgi::test {
+
+struct ReplayResult {
+  RdeReport pooled;
+  bool any = false;
+  std::vector<double> light_error_deg;  // per frame with an estimate and an environment image
+};
+
+inline ReplayResult replay_capture(const std::string& path, const std::string& technique, int level) {
+  ReplayResult g;
+  auto capture = CaptureReader::open(path);
+  EXPECT_TRUE(capture.ok()) << (capture.ok() ? "" : capture.error().message);
+  if (!capture.ok()) return g;
+  const CaptureInfo& info = capture->info();
+  const SceneDesc& scene = *capture->scene();
+  RuntimeSettings s;
+  s.device.validate = true;
+  s.technique = technique;
+  s.level = level;
+  s.exposure = info.exposure;
+  auto rt = create_runtime(s, CameraSetup{info.color, info.depth, info.depth_scale, info.exposure},
+                           scene);
+  EXPECT_TRUE(rt.ok()) << (rt.ok() ? "" : rt.error().message);
+  if (!rt.ok()) return g;
+  const double env_intensity = scene.environment.present ? scene.environment.intensity : 1.0;
+  std::vector<ImageRGB8> cameras(capture->frame_count());
+  std::vector<std::optional<LightEstimate>> truth(capture->frame_count());
+  auto consume = [&](Expected<std::vector<FrameOutput>>&& outs) {
+    ASSERT_TRUE(outs.ok()) << outs.error().message;  // includes any validation message
+    for (const FrameOutput& o : *outs) {
+      const size_t i = size_t(o.stats.frame_index);
+      auto ref = capture->read_reference(i);
+      auto mask = capture->read_reference_mask(i);
+      ASSERT_TRUE(ref.ok() && mask.ok());
+      auto r = measure_error(o.image, cameras[i], *ref, &*mask);
+      ASSERT_TRUE(r.ok()) << r.error().message;
+      if (!g.any) {
+        g.pooled = *r;
+        g.any = true;
+      } else {
+        g.pooled.all = pool(g.pooled.all, r->all);
+        g.pooled.real = pool(g.pooled.real, r->real);
+        g.pooled.virtual_ = pool(g.pooled.virtual_, r->virtual_);
+      }
+      if (o.light && o.light->valid && truth[i])
+        g.light_error_deg.push_back(direction_error_deg(*o.light, *truth[i]));
+    }
+  };
+  for (size_t i = 0; i < capture->frame_count(); ++i) {
+    auto f = capture->read_frame(i);
+    EXPECT_TRUE(f.ok()) << f.error().message;
+    if (!f.ok()) return g;
+    f->index = int64_t(i);
+    cameras[i] = f->color;
+    if (f->env && info.env_camera) {
+      auto t = light_from_environment(*f->env, *info.env_camera, env_intensity);
+      EXPECT_TRUE(t.ok());
+      if (t.ok()) truth[i] = *t;
+    }
+    consume((*rt)->process(*f));
+  }
+  consume((*rt)->flush());
+  return g;
+}
+
+}  // namespace mrgi::test
