@@ -51,5 +51,48 @@ TEST(GoldenSsrt, EnvFisheyeLightDirectionAndRdeBeatBaseline) {
   }
 }
 
+// The priming run: ssrt's first frame is run twice (once to estimate, output dropped), so it is
+// already lit by its own estimate; every frame still gives exactly one output, the first says
+// so in its notes, and baseline (nothing to estimate) is never primed.
+TEST(GoldenSsrt, FirstFrameIsPrimedOnceAndEveryFrameGivesOneOutput) {
+  auto capture = CaptureReader::open(std::string(MRGI_SOURCE_DIR) + "/tests/data/golden_desk_160");
+  ASSERT_TRUE(capture.ok()) << capture.error().message;
+  const CaptureInfo& info = capture->info();
+  for (const char* technique : {"ssrt", "baseline"}) {
+    RuntimeSettings s;
+    s.device.validate = true;
+    s.technique = technique;
+    s.level = 3;
+    auto rt = create_runtime(s, CameraSetup{info.color, info.depth, info.depth_scale, info.exposure},
+                             *capture->scene());
+    ASSERT_TRUE(rt.ok()) << rt.error().message;
+    std::vector<FrameOutput> outs;
+    for (size_t i = 0; i < capture->frame_count(); ++i) {
+      auto f = capture->read_frame(i);
+      ASSERT_TRUE(f.ok());
+      f->index = int64_t(i);
+      auto o = (*rt)->process(*f);
+      ASSERT_TRUE(o.ok()) << o.error().message;
+      for (auto& x : *o) outs.push_back(std::move(x));
+    }
+    auto rest = (*rt)->flush();
+    ASSERT_TRUE(rest.ok()) << rest.error().message;
+    for (auto& x : *rest) outs.push_back(std::move(x));
+    ASSERT_EQ(outs.size(), capture->frame_count()) << technique;
+    int primed = 0;
+    for (size_t i = 0; i < outs.size(); ++i) {
+      EXPECT_EQ(outs[i].stats.frame_index, int64_t(i)) << technique;
+      for (const std::string& n : outs[i].stats.notes)
+        if (n.find("primes") != std::string::npos) ++primed;
+    }
+    const bool ssrt = std::string(technique) == "ssrt";
+    EXPECT_EQ(primed, ssrt ? 1 : 0) << technique;
+    if (ssrt) {
+      ASSERT_TRUE(outs[0].light.has_value());
+      EXPECT_TRUE(outs[0].light->valid) << "frame 0 is lit by an estimate, not the prior";
+    }
+  }
+}
+
 }  // namespace
 }  // namespace mrgi

@@ -82,7 +82,10 @@ class Runtime {
  public:
   virtual ~Runtime() = default;
   // Processes one frame. Frames are pipelined: the output returned belongs to the frame given
-  // frames_in_flight-1 calls earlier; flush() drains the rest at the end of a stream.
+  // frames_in_flight-1 calls earlier; flush() drains the rest at the end of a stream. Once per
+  // runtime, a technique that estimates from the frames themselves (ssrt's light) has its first
+  // frame run twice, waiting for the first run, so that frame is lit by its own estimate; that
+  // call returns the frames still in flight at once, and the frame's stats note the extra run.
   virtual Expected<std::vector<FrameOutput>> process(const InputFrame& frame) = 0;
   virtual Expected<std::vector<FrameOutput>> flush() = 0;
   virtual const DeviceInfo& device() const = 0;
