@@ -123,6 +123,7 @@ Status ReplayOutput::add(const FrameOutput& out, const ImageRGB8& camera, const 
   for (const auto& p : out.stats.passes) passes[p.name] = p.gpu_ms;
   s["passes_ms"] = passes;
   s["skipped"] = out.stats.skipped;
+  s["notes"] = out.stats.notes;  // e.g. the priming run, a frame without a pose
   if (out.light) {
     s["light"] = light_json(*out.light);
     last_light_ = s["light"];

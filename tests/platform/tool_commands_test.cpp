@@ -69,6 +69,28 @@ TEST_F(ToolCommands, LiveRendersEveryFrameOfTheOniWithTheDefaultObject) {
   EXPECT_FALSE(std::filesystem::exists(bad));
 }
 
+// ssrt on a real Kinect recording: every frame has a finite light estimate from the frame it was
+// primed on, and stats.json says which frame was run twice for that.
+TEST_F(ToolCommands, LiveSsrtOnTheKinectRecordingEstimatesLightFromTheFirstFrame) {
+  test::TempDir dir("live-ssrt");
+  const std::string out = dir.file("out");
+  ASSERT_EQ(run(std::string("LP_NUM_THREADS=2 timeout 300 ") + MRGI_TOOL + " live openni:" + kOni +
+                " --technique ssrt --level fastest --frames 3 --out " + out + " -q > /dev/null 2> " +
+                dir.file("err.txt")), 0) << slurp(dir.file("err.txt"));
+  const auto stats = nlohmann::json::parse(slurp(out + "/stats.json"));
+  ASSERT_EQ(stats.size(), 3u);
+  int primed = 0;
+  for (const auto& f : stats) {
+    ASSERT_TRUE(f.contains("light")) << f.dump();
+    EXPECT_TRUE(f["light"]["valid"].get<bool>()) << "frame " << f["frame"];
+    for (const auto& c : f["light"]["sh_radiance"])
+      for (const auto& v : c) EXPECT_TRUE(v.is_number()) << "a non-finite coefficient is written as null";
+    for (const auto& n : f["notes"]) primed += n.get<std::string>().find("primes") != std::string::npos;
+  }
+  EXPECT_EQ(primed, 1);
+  EXPECT_NE(stats[0]["notes"].dump().find("primes"), std::string::npos) << "frame 0 is the primed one";
+}
+
 TEST_F(ToolCommands, RecordedCaptureReplays) {
   test::TempDir dir("record-replay");
   const std::string cap = dir.file("cap"), out = dir.file("out");
