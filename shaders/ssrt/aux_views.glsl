@@ -52,15 +52,18 @@ struct SsrtAuxViews {
 static_assert(sizeof(SsrtAuxViews) == 8 * 64 + 8 * 16 + 16, "std140 mirror");
 }  // namespace mrgi::shader
 #else
-// Layer `layer`'s texel for world point `y` and y's depth along that layer's axis; false when y
-// projects outside the layer's square or lies behind its image plane.
-bool ssrt_aux_texel(SsrtAuxViews views, int layer, vec3 y, out ivec2 texel, out float depth) {
-  vec4 p = views.world_to_aux[layer] * vec4(y, 1.0f);
+// The texel of an aux layer (its world_to_aux matrix, `texels` used per side) for world point
+// `y`, and y's depth along that layer's axis; false when y projects outside the layer's square
+// or lies behind its image plane. Takes the one matrix, not the whole SsrtAuxViews: a struct
+// parameter indexed by a loop variable was copied into scratch memory on every call, which
+// made the aux test 55 % of ssrt_transfer on lavapipe.
+bool ssrt_aux_texel(mat4 world_to_aux, int texels, vec3 y, out ivec2 texel, out float depth) {
+  vec4 p = world_to_aux * vec4(y, 1.0f);
   texel = ivec2(0);
   depth = p.z;
   if (any(lessThan(p.xy, vec2(0.0f))) || any(greaterThan(p.xy, vec2(1.0f))) || !(p.z > 0.0f))
     return false;
-  texel = min(ivec2(p.xy * float(views.info.y)), ivec2(views.info.y - 1));
+  texel = min(ivec2(p.xy * float(texels)), ivec2(texels - 1));
   return true;
 }
 #endif

@@ -55,7 +55,7 @@ bool aux_occluder(vec3 x, vec3 y, out vec3 s) {
   for (int i = 0; i < aux.info.x; ++i) {
     ivec2 texel;
     float depth;
-    if (!ssrt_aux_texel(aux, i, y, texel, depth)) continue;
+    if (!ssrt_aux_texel(aux.world_to_aux[i], aux.info.y, y, texel, depth)) continue;
     vec4 o = texelFetch(aux_position, ivec3(texel, i), 0);
     vec3 d = o.xyz - x;
     if (o.w > 0.0f && o.w < depth - pc.aux_test.x * aux.extent[i].z &&
