@@ -57,7 +57,7 @@
 // Known defects: the grey-world albedo (paper Sec. 6.4) reads brighter objects as more light
 // from their side (env_fisheye's boxes and ball are 0.6-0.7, its floor 0.5); two SH bands cannot hold a dark lower hemisphere, so
 // the fastest level trades direction for RDE; the fast level costs far more than 33 ms on
-// lavapipe (the transfer is 480 ms of 727).
+// lavapipe (static camera, 640x480: transfer 90 ms, ray-cast 71, shade 46, all passes 267).
 #pragma once
 #include <memory>
 #include <vector>
