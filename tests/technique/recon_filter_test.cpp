@@ -271,6 +271,53 @@ TEST_F(ReconFilterTest, LargePoseChangeFollowsTheNewFrameAndKeepsHistoryWhereItM
   EXPECT_GT(plane_kept, plane * 7 / 10);
 }
 
+// The 3x3 same-surface median (depth_to_positions.comp, a sorting network with fillers for the
+// neighbours that do not count) against a plain CPU reference: the valid same-surface
+// neighbours sorted, element n / 2; the centre itself when fewer than 3 count; holes stay holes.
+// Random depths on two surfaces (1.0 and 1.5 m, +-2 %) with 25 % holes exercise every count.
+TEST_F(ReconFilterTest, MedianEqualsTheSortedSameSurfaceNeighbours) {
+  recon::ReconstructionSettings settings;
+  settings.temporal = false;
+  start(settings);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  InputFrame f;
+  f.color = ImageRGB8(W, H, 128);
+  f.depth = ImageU16(W, H, 0);
+  for (int v = 0; v < H; ++v)
+    for (int x = 0; x < W; ++x) {
+      if (u(rng) < 0.25) continue;
+      const double z = (u(rng) < 0.5 ? 1.0 : 1.5) * (0.98 + 0.04 * u(rng));
+      *f.depth.at(x, v) = uint16_t(std::lround(z * kDepthScale));
+    }
+  const Result r = frame(f, glm::dmat4(1.0));
+  int checked = 0, by_count[10] = {};
+  for (int v = 0; v < H; ++v)
+    for (int x = 0; x < W; ++x) {
+      const uint32_t c = *f.depth.at(x, v);
+      uint32_t expect = 0;
+      if (c != 0) {
+        std::vector<uint32_t> same;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int qx = x + dx, qy = v + dy;
+            if (qx < 0 || qy < 0 || qx >= W || qy >= H) continue;
+            const uint32_t d = *f.depth.at(qx, qy);
+            if (d == 0 || std::abs(double(d) - double(c)) > 0.05 * double(std::min(d, c))) continue;
+            same.push_back(d);
+          }
+        std::sort(same.begin(), same.end());
+        expect = same.size() < 3 ? c : same[same.size() / 2];
+        ++by_count[same.size()];
+      }
+      const float got = r.depth[size_t(v) * W + x].x;
+      ASSERT_NEAR(got, float(expect / kDepthScale), 1e-6f) << "pixel " << x << "," << v;
+      ++checked;
+    }
+  EXPECT_EQ(checked, W * H);
+  for (int n = 1; n <= 8; ++n) EXPECT_GT(by_count[n], 0) << n << " same-surface neighbours";
+}
+
 TEST_F(ReconFilterTest, SettingsOutOfRangeAreRefusedWithTheFieldName) {
   gpu::FrameGraphSettings fs;
   auto g = gpu::FrameGraph::create(ctx(), fs);
