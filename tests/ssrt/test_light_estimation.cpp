@@ -353,4 +353,21 @@ TEST(SsrtLightEstimation, FewerBandsSolveOnlyThoseCoefficients) {
   EXPECT_NEAR(r->direction_to_light[1], 1.0f, 1e-2f);
 }
 
+// A 4-band estimator fed a level's 2-band transfer (the fastest level): only 4 coefficients
+// are solved, the others come out 0; more bands than the estimator has are refused.
+TEST(SsrtLightEstimation, SolveBandsOfTheFrameLimitTheSolve) {
+  const SampleSets sets = samples(32);
+  ShRgb lit = sh_directional_light(glm::dvec3(0, 1, 0), glm::dvec3(2.0), 2);
+  lit[0] += glm::dvec3(0.3);
+  auto est = LightEstimator::create({});
+  ASSERT_TRUE(est.ok());
+  auto r = est->update(synthetic_frame(sets, lit, 0.5, 2000, 8), 0, 0.0, 2);
+  ASSERT_TRUE(r.ok());
+  for (int i = 4; i < 16; ++i) EXPECT_EQ(est->frame_solution()[i].y, 0.0) << i;
+  EXPECT_GT(r->direction_to_light[1], 0.95f);
+  auto bad = est->update(synthetic_frame(sets, lit, 0.5, 100, 8), 1, 0.1, 5);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message.find("solve_bands"), std::string::npos);
+}
+
 }  // namespace
