@@ -57,7 +57,8 @@
 // Known defects: the grey-world albedo (paper Sec. 6.4) reads brighter objects as more light
 // from their side (env_fisheye's boxes and ball are 0.6-0.7, its floor 0.5); two SH bands cannot hold a dark lower hemisphere, so
 // the fastest level trades direction for RDE; the fast level costs far more than 33 ms on
-// lavapipe (static camera, 640x480: transfer 90 ms, ray-cast 71, shade 46, all passes 267).
+// lavapipe (static camera, 640x480: transfer 90-97 ms, ray-cast 71-74, shade 46-53, all passes
+// 267-277).
 #pragma once
 #include <memory>
 #include <vector>
