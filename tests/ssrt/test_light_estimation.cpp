@@ -353,7 +353,7 @@ TEST(SsrtLightEstimation, FewerBandsSolveOnlyThoseCoefficients) {
   EXPECT_NEAR(r->direction_to_light[1], 1.0f, 1e-2f);
 }
 
-// A 4-band estimator fed a level's 2-band transfer (the fastest level): only 4 coefficients
+// A 4-band estimator fed a level's 2-band transfer (a level with sh_bands 2): only 4 coefficients
 // are solved, the others come out 0; more bands than the estimator has are refused.
 TEST(SsrtLightEstimation, SolveBandsOfTheFrameLimitTheSolve) {
   const SampleSets sets = samples(32);

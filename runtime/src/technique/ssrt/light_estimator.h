@@ -65,9 +65,9 @@ struct LightEstimatorSettings {
   // dominant surface's normal is the principal axis of the band-1 block of T^T T (the normals
   // the pixels have), signed by T^T I_c. 0 disables; needs bands >= 2.
   double below_surface_penalty = 0.3;
-  // The same prior when only 2 bands are solved (the fastest level). Two bands cannot hold a
+  // The same prior when only 2 bands are solved (a level with sh_bands 2). Two bands cannot hold a
   // dark hemisphere beside a lit one (the best they do is a strong band 1), so the full weight
-  // makes the visible side too directional. On env_fisheye at the fastest level (RDE, direction
+  // makes the visible side too directional. On env_fisheye at the fastest level with 2 bands (RDE, direction
   // error): 0.3 -> 0.707, 7 degrees; 0.03 -> 0.620, 39; 0.02 -> 0.611, 45; 0 -> 0.602, 76.
   double below_surface_penalty_two_bands = 0.02;
   // Exponential temporal filter: after a step of dt seconds the estimate moves a fraction

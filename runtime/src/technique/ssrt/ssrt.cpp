@@ -536,7 +536,7 @@ std::vector<QualityLevel> ssrt_ladder() {
   // Full is the paper's desktop set-up (256^3, eq. 5 pass on); fast its mobile one (64^3, eq. 5
   // pass off) with the OursFast 4x4 sub-sampling.
   return {level("full", 1, 64, 4, 1.0, 256, 256, 1), level("half", 2, 32, 4, 1.0, 256, 256, 1),
-          level("fast", 4, 32, 4, 1.0, 64, 64, 0), level("fastest", 4, 16, 2, 0.5, 64, 64, 0)};
+          level("fast", 4, 32, 4, 1.0, 64, 64, 0), level("fastest", 4, 16, 4, 0.5, 64, 64, 0)};
 }
 
 Expected<std::unique_ptr<Technique>> create_ssrt(const SharedResources& shared) {

@@ -22,7 +22,7 @@
 //   0      full     1          64          4         1.0   (paper "Ours")
 //   1      half     2          32          4         1.0
 //   2      fast     4          32          4         1.0   (paper "OursFast": 4x4, up-sampled)
-//   3      fastest  4          16          2         0.5
+//   3      fastest  4          16          4         0.5
 // subsample: cells are step x step pixels; directions: N per jitter set; sh_bands: SH bands of
 // the transfer and of the estimated light.
 //
@@ -47,7 +47,7 @@
 // band 1 of each frame's environment image; test GoldenSsrt): direction error median / worst
 // and pooled RDE (baseline, which reads the environment image itself: 0.629):
 //   full 16.4 / 16.8 degrees, RDE 0.568;  half 7.4 / 7.6, 0.564;  fast 8.5 / 9.0, 0.583;
-//   fastest (2 bands) 45.8 / 46.6, 0.611.
+//   fastest 7.4 / 7.8, 0.618.
 // What made it work (session 4): only pixels the camera measured and whose green is unclipped
 // feed the sums (transfer.comp), a prior that no light comes from behind the dominant surface
 // (LightEstimatorSettings::below_surface_penalty), and the first frame primed from itself
@@ -55,10 +55,11 @@
 // fast level scores RDE 0.563, so the estimate costs about 0.02.
 //
 // Known defects: the grey-world albedo (paper Sec. 6.4) reads brighter objects as more light
-// from their side (env_fisheye's boxes and ball are 0.6-0.7, its floor 0.5); two SH bands cannot hold a dark lower hemisphere, so
-// the fastest level trades direction for RDE; the fast level costs far more than 33 ms on
-// lavapipe (static camera, 640x480: transfer 90-97 ms, ray-cast 71-74, shade 46-53, all passes
-// 267-277).
+// from their side (env_fisheye's boxes and ball are 0.6-0.7, its floor 0.5); the fast level
+// costs far more than 33 ms on lavapipe (static camera, 640x480: transfer 90-97 ms, ray-cast
+// 71-74, shade 46-53, all passes 267-277). The fastest level had 2 SH bands until session 4; the
+// transfer accumulates all 16 coefficients whatever the level, so 2 bands saved nothing and
+// cost the direction (46 degrees off, LightEstimatorSettings::below_surface_penalty_two_bands).
 #pragma once
 #include <memory>
 #include <vector>
