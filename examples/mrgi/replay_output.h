@@ -1,8 +1,9 @@
 // What `mrgi replay` and `mrgi live` write to --out DIR:
 //   DIR/frames/NNNNNN.png   composited RGBA8 frames
 //   DIR/stats.json          per frame: each pass's GPU ms, total ms, wall ms, level, skipped passes,
-//                           notes (a priming run, a missing pose), the frame's error figures when a reference exists, and the
-//                           estimated light (ssrt) when the technique estimates one
+//                           notes (a priming run, a missing pose), the frame's error figures
+//                           when a reference exists, and the estimated light (ssrt) when the
+//                           technique estimates one
 //   DIR/summary.json        frames, median_frame_ms, p95_frame_ms, technique, level, device,
 //                           lp_num_threads, memory_mib, rde {all, real, virtual} with references,
 //                           and light_direction_error_deg {median, worst, frames} when the

@@ -6,6 +6,7 @@
 
 #include <glm/glm.hpp>
 
+#include "technique/ssrt/sample_directions.h"
 #include "technique/ssrt/sh_tools.h"
 
 namespace mrgi::test {
@@ -14,9 +15,7 @@ inline void add_sh_sky(ssrt::ShRgb& l, double radiance, const glm::dvec3& up = {
   constexpr int kDirections = 4000;
   constexpr double kPi = 3.14159265358979323846;
   for (int k = 0; k < kDirections; ++k) {
-    const double z = 1.0 - 2.0 * (k + 0.5) / kDirections;
-    const double r = std::sqrt(std::max(0.0, 1.0 - z * z)), phi = kPi * (3.0 - std::sqrt(5.0)) * k;
-    const glm::dvec3 w(r * std::cos(phi), z, r * std::sin(phi));
+    const glm::dvec3 w = ssrt::fibonacci_direction(k, kDirections);
     if (glm::dot(w, up) <= 0.0) continue;
     const ssrt::ShVector b = ssrt::sh_basis(glm::vec3(w));
     for (int i = 0; i < ssrt::kMaxShCoeffs; ++i)

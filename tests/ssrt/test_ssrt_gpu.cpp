@@ -435,7 +435,9 @@ TEST_F(VulkanTest, SsrtStressInputsStayFinite) {
     const LightEstimate* e = technique::ssrt_light_estimate(*d.tech);
     for (const auto& c : e->sh_radiance)
       ASSERT_TRUE(std::isfinite(c[0]) && std::isfinite(c[1]) && std::isfinite(c[2])) << which;
-    if (which == 0 || which == 1) EXPECT_FALSE(e->valid) << "nothing usable: still the prior";
+    if (which == 0 || which == 1) {
+      EXPECT_FALSE(e->valid) << "nothing usable: still the prior";
+    }
     ++which;
   }
 }

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <string>
 
+#include "technique/ssrt/sample_directions.h"
+
 namespace mrgi::ssrt {
 namespace {
 
@@ -43,10 +45,7 @@ Mat below_surface_gram(const glm::dvec3& normal, int n) {
   constexpr int kDirections = 512;
   Mat m = Mat::Zero(n, n);
   for (int k = 0; k < kDirections; ++k) {
-    const double z = 1.0 - 2.0 * (k + 0.5) / kDirections;
-    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-    const double phi = kPi * (3.0 - std::sqrt(5.0)) * k;
-    const glm::dvec3 w(r * std::cos(phi), z, r * std::sin(phi));
+    const glm::dvec3 w = fibonacci_direction(k, kDirections);
     if (glm::dot(w, normal) >= 0.0) continue;
     const ShVector y = sh_basis(glm::vec3(w));
     for (int i = 0; i < n; ++i)
@@ -80,9 +79,6 @@ Expected<LightEstimator> LightEstimator::create(const LightEstimatorSettings& s)
                        "must be finite and >= 0"));
   MRGI_TRY(check_range(s.below_surface_penalty >= 0.0 && std::isfinite(s.below_surface_penalty),
                        "below_surface_penalty", "must be finite and >= 0"));
-  MRGI_TRY(check_range(s.below_surface_penalty_two_bands >= 0.0 &&
-                           std::isfinite(s.below_surface_penalty_two_bands),
-                       "below_surface_penalty_two_bands", "must be finite and >= 0"));
   MRGI_TRY(check_range(s.time_constant_s >= 0.0 && std::isfinite(s.time_constant_s),
                        "time_constant_s", "must be finite and >= 0 seconds"));
   MRGI_TRY(check_range(s.nominal_frame_s > 0.0 && s.nominal_frame_s <= 1.0, "nominal_frame_s",
@@ -172,8 +168,7 @@ Expected<LightEstimate> LightEstimator::update(const LightSystem& system, int64_
   Mat lhs = ata;
   Rhs rhs = atb;
   dominant_normal_ = n >= 4 ? dominant_surface_normal(ata, atb) : glm::dvec3(0.0);
-  const double mu = bands >= 3 ? settings_.below_surface_penalty
-                               : settings_.below_surface_penalty_two_bands;
+  const double mu = settings_.below_surface_penalty;
   if (mu > 0.0 && glm::length(dominant_normal_) > 0.5)
     lhs += (mu * std::max(mean_diag, 0.0)) * below_surface_gram(dominant_normal_, n);
   for (int i = 0; i < n; ++i) {

@@ -63,13 +63,12 @@ struct LightEstimatorSettings {
   // horizon (env_fisheye: 68 degrees off, 10 with this prior). An opaque surface blocks that
   // light for everything in front of it, so the prior costs nothing where it is right. The
   // dominant surface's normal is the principal axis of the band-1 block of T^T T (the normals
-  // the pixels have), signed by T^T I_c. 0 disables; needs bands >= 2.
+  // the pixels have), signed by T^T I_c. 0 disables; needs bands >= 2. Every level solves 4
+  // bands. With 2 bands a dark hemisphere beside a lit one can only be a strong band 1, and this
+  // weight makes the visible side too directional (env_fisheye fastest with 2 bands, RDE and
+  // direction error: 0.3 -> 0.707, 7 degrees; 0.02 -> 0.611, 45; 0 -> 0.602, 76): a 2-band
+  // level would want about 0.02.
   double below_surface_penalty = 0.3;
-  // The same prior when only 2 bands are solved (a level with sh_bands 2). Two bands cannot hold a
-  // dark hemisphere beside a lit one (the best they do is a strong band 1), so the full weight
-  // makes the visible side too directional. On env_fisheye at the fastest level with 2 bands (RDE, direction
-  // error): 0.3 -> 0.707, 7 degrees; 0.03 -> 0.620, 39; 0.02 -> 0.611, 45; 0 -> 0.602, 76.
-  double below_surface_penalty_two_bands = 0.02;
   // Exponential temporal filter: after a step of dt seconds the estimate moves a fraction
   // 1 - exp(-dt / time_constant_s) towards the frame's solution. 0 disables filtering.
   double time_constant_s = 0.5;

@@ -59,7 +59,7 @@
 // costs far more than 33 ms on lavapipe (static camera, 640x480: transfer 90-97 ms, ray-cast
 // 71-74, shade 46-53, all passes 267-277). The fastest level had 2 SH bands until session 4; the
 // transfer accumulates all 16 coefficients whatever the level, so 2 bands saved nothing and
-// cost the direction (46 degrees off, LightEstimatorSettings::below_surface_penalty_two_bands).
+// cost the direction (46 degrees off; LightEstimatorSettings::below_surface_penalty says why).
 #pragma once
 #include <memory>
 #include <vector>
