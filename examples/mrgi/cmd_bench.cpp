@@ -71,10 +71,17 @@ void setup(CLI::App& app) {
   cmd->add_option("--warmup", opts->settings.warmup, "frames run before measuring, per run")
       ->check(CLI::Range(0, 100000))
       ->capture_default_str();
+  cmd->add_option("--profile-frames", opts->settings.profile_frames,
+                  "frames per run in profiling mode (each pass alone, host-timed) for the per-pass split; 0 = none")
+      ->check(CLI::Range(0, 100000))
+      ->capture_default_str();
+  cmd->add_option("--width", opts->settings.width, "output width for every scene (default: each capture's)")
+      ->check(CLI::Range(16, 8192));
+  cmd->add_option("--height", opts->settings.height, "output height for every scene")->check(CLI::Range(16, 8192));
   cmd->add_option("--floor-frames", opts->settings.floor_frames, "floor-pass samples taken before each run")
       ->check(CLI::Range(3, 100000))
       ->capture_default_str();
-  cmd->add_option("--floor-per-frame", opts->settings.floor_per_frame, "floor-pass samples after each measured frame")
+  cmd->add_option("--floor-per-frame", opts->settings.floor_per_frame, "floor-pass samples after each profiled frame")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
   cmd->add_option("--out,-o", opts->out, "output folder (built as DIR.partial, renamed at the end)")->required();

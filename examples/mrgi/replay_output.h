@@ -1,10 +1,11 @@
 // What `mrgi replay` and `mrgi live` write to --out DIR:
 //   DIR/frames/NNNNNN.png   composited RGBA8 frames
-//   DIR/stats.json          per frame: each pass's GPU ms, total ms, wall ms, level, skipped passes,
+//   DIR/stats.json          per frame: each pass's ms, total ms, record ms, level, skipped passes,
 //                           notes (a priming run, a missing pose), the frame's error figures
 //                           when a reference exists, and the estimated light (ssrt) when the
 //                           technique estimates one
-//   DIR/summary.json        frames, median_frame_ms, p95_frame_ms, technique, level, device,
+//   DIR/summary.json        frames, median_frame_ms, p95_frame_ms, achieved {fps, ms_per_frame},
+//                           technique, level, device,
 //                           lp_num_threads, memory_mib, rde {all, real, virtual} with references,
 //                           and light_direction_error_deg {median, worst, frames} when the
 //                           capture has environment images and the technique estimates light
@@ -44,12 +45,21 @@ class ReplayOutput {
   // Writes stats.json, summary.json and the side-by-side image, then renames DIR.partial to DIR.
   Expected<nlohmann::json> finish();
   size_t frames() const { return frame_ms_.size(); }
+  // The command's own rate over the run (summary.json "achieved"): frames over wall seconds.
+  struct Achieved {
+    size_t frames = 0;
+    double seconds = 0.0;
+    std::string what;  // what the interval covers
+  };
+  void set_achieved(const Achieved& a) { achieved_ = a; }
 
  private:
   std::string dir_, partial_;
   ReplayMeta meta_;
   nlohmann::json stats_ = nlohmann::json::array();
-  std::vector<double> frame_ms_, wall_ms_;
+  std::vector<double> frame_ms_;
+  bool profiled_ = false;
+  Achieved achieved_;
   std::optional<RdeReport> pooled_;
   ImageRGB8 last_camera_, last_reference_;
   ImageRGBA8 last_output_;

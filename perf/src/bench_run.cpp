@@ -11,7 +11,6 @@
 
 #include "gpu/context.h"
 #include "gpu/floor_pass.h"
-#include "gpu/floor_pass.h"
 #include "mrgi/perf/bench.h"
 #include "mrgi/perf/stats.h"
 #include "mrgi/perf/suite.h"
@@ -143,7 +142,9 @@ TimeSummary summarize(const std::vector<double>& ms, double floor_ms) {
 // Raw samples of one run, summarized once the scene's floor is known.
 struct RunSamples {
   BenchEntry entry;
-  std::vector<double> frame_ms, wall_ms;
+  std::vector<double> interval_ms;   // sustained phase: completion to completion
+  double sustained_ms = 0.0;         // sustained phase: wall clock over the measured frames / frames
+  std::vector<double> profiled_ms;   // profiling phase: sum of the passes per frame
   std::vector<std::string> pass_order;
   std::map<std::string, std::vector<double>> pass_ms;
 };
@@ -159,15 +160,35 @@ struct Progress {
   }
 };
 
+// Feeds frame k of the replay order (ping-pong over the capture, timestamps continued).
+struct FrameFeeder {
+  const LoadedScene& l;
+  InputFrame work;  // reused: copy-assignment keeps the image buffers' capacity
+  const InputFrame& operator()(size_t k) {
+    const InputFrame& src = l.frames[ping_pong(k, l.frames.size())];
+    work.color = src.color;
+    work.depth = src.depth;
+    work.pose = src.pose;
+    work.env = src.env;
+    work.index = int64_t(k);
+    const double t_first = l.frames.front().timestamp;
+    work.timestamp = t_first + double(k) * l.frame_interval_s;
+    work.depth_timestamp = work.timestamp + (src.depth_timestamp - src.timestamp);
+    return work;
+  }
+};
+
 Expected<RunSamples> run_one(const LoadedScene& l, const std::string& technique, int level,
                              const BenchSettings& s, const std::string& floor_device, gpu::FloorTimer& floor,
                              std::vector<double>& floor_ms) {
   RuntimeSettings rs;
   rs.device = s.device;
-  rs.frames_in_flight = 1;  // process() returns its own frame: nothing overlaps the timed GPU work
+  rs.frames_in_flight = s.frames_in_flight;
   rs.technique = technique;
   rs.level = level;
   rs.exposure = l.info.exposure;
+  rs.output_width = s.width;
+  rs.output_height = s.height;
   const CameraSetup cameras{l.info.color, l.info.depth, l.info.depth_scale, l.info.exposure};
   auto created = create_runtime(rs, cameras, l.scene);
   const std::string what = "scene '" + l.suite.name + "', technique '" + technique + "', level " + std::to_string(level);
@@ -184,74 +205,98 @@ Expected<RunSamples> run_one(const LoadedScene& l, const std::string& technique,
   e.level = level;
   const auto level_names = rt->level_names();
   e.level_name = level < int(level_names.size()) ? level_names[size_t(level)] : std::to_string(level);
-  e.width = l.info.color.width;
-  e.height = l.info.color.height;
+  e.width = s.width ? s.width : l.info.color.width;
+  e.height = s.height ? s.height : l.info.color.height;
   e.memory_mib = rt->memory_mib();
   std::set<std::string> skipped;
-  const size_t warmup = size_t(s.warmup), total = warmup + size_t(s.frames), n = l.frames.size();
-  std::optional<Status> failure;
-  bool pooled_any = false;
+  const size_t warmup = size_t(s.warmup), measured = size_t(s.frames);
+  const size_t total = warmup + measured, profiled_total = total + size_t(s.profile_frames), n = l.frames.size();
+  FrameFeeder feed{l, {}};
 
-  auto consume = [&](std::vector<FrameOutput>& outs) -> Status {
-    for (const FrameOutput& out : outs) {
+  // Phase 1, sustained: frames fed back to back with frames_in_flight in flight, as a live
+  // device runs; the outputs are kept and measured afterwards, so no host work of the bench
+  // competes with the frames for the CPU. The interval is from the completion of the last
+  // warm-up frame to that of the last measured one.
+  std::vector<FrameOutput> kept;
+  kept.reserve(measured);
+  double start_s = -1.0, end_s = -1.0;
+  auto keep = [&](std::vector<FrameOutput>& outs) -> Status {
+    for (FrameOutput& out : outs) {
       const int64_t k = out.stats.frame_index;
       if (k < 0 || size_t(k) >= total)
         return fail(ErrorKind::Internal, what + ": runtime returned frame index " + std::to_string(k) +
                                              " outside 0.." + std::to_string(total - 1));
+      if (warmup > 0 && size_t(k) + 1 == warmup) start_s = out.stats.completed_s;
       if (size_t(k) < warmup) continue;
-      const size_t src = ping_pong(size_t(k), n);
-      r.frame_ms.push_back(out.stats.gpu_total_ms);
-      r.wall_ms.push_back(out.stats.cpu_ms);
-      for (const PassTiming& p : out.stats.passes) {
-        auto [it, inserted] = r.pass_ms.try_emplace(p.name);
-        if (inserted) r.pass_order.push_back(p.name);
-        it->second.push_back(p.gpu_ms);
-      }
+      const double previous = kept.empty() ? start_s : kept.back().stats.completed_s;
+      if (previous >= 0.0) r.interval_ms.push_back(1000.0 * (out.stats.completed_s - previous));
+      if (size_t(k) + 1 == total) end_s = out.stats.completed_s;
       for (const std::string& sk : out.stats.skipped) skipped.insert(sk);
-      if (l.references[src]) {
-        const ImageU8* mask = l.masks[src] ? &*l.masks[src] : nullptr;
-        auto err = measure_error(out.image, l.frames[src].color, *l.references[src], mask);
-        if (!err.ok()) return fail(err.error().kind, what + ", frame " + std::to_string(src) + ": " + err.error().message);
-        if (!pooled_any) {
-          e.error = *err;
-        } else {
-          e.error.all = pool(e.error.all, err->all);
-          e.error.real = pool(e.error.real, err->real);
-          e.error.virtual_ = pool(e.error.virtual_, err->virtual_);
-        }
-        pooled_any = true;
-      }
+      kept.push_back(std::move(out));
     }
     return ok_status();
   };
-
-  // One InputFrame reused for every call: copy-assignment keeps the image buffers' capacity.
-  InputFrame work;
-  const double t_first = l.frames.front().timestamp;
+  const auto loop_start = std::chrono::steady_clock::now();
   for (size_t k = 0; k < total; ++k) {
-    const InputFrame& src = l.frames[ping_pong(k, n)];
-    work.color = src.color;
-    work.depth = src.depth;
-    work.pose = src.pose;
-    work.env = src.env;
-    work.index = int64_t(k);
-    work.timestamp = t_first + double(k) * l.frame_interval_s;
-    work.depth_timestamp = work.timestamp + (src.depth_timestamp - src.timestamp);
-    auto outs = rt->process(work);
+    auto outs = rt->process(feed(k));
     if (!outs.ok()) return fail(outs.error().kind, what + ", frame " + std::to_string(k) + ": " + outs.error().message);
-    MRGI_TRY(consume(*outs));
-    if (k >= warmup) {
-      auto st = floor.sample(uint32_t(s.floor_per_frame), floor_ms);
-      if (!st.ok()) return fail(st.error().kind, what + ": floor pass: " + st.error().message);
-    }
+    MRGI_TRY(keep(*outs));
   }
   auto rest = rt->flush();
   if (!rest.ok()) return fail(rest.error().kind, what + ", flush: " + rest.error().message);
-  MRGI_TRY(consume(*rest));
-  if (r.frame_ms.size() != size_t(s.frames))
-    return fail(ErrorKind::Internal, what + ": " + std::to_string(r.frame_ms.size()) + " of " +
-                                         std::to_string(s.frames) + " measured frames came back");
+  MRGI_TRY(keep(*rest));
+  if (kept.size() != measured)
+    return fail(ErrorKind::Internal, what + ": " + std::to_string(kept.size()) + " of " + std::to_string(measured) +
+                                         " measured frames came back");
+  if (start_s < 0.0)  // no warm-up: from the first call (includes filling the pipeline)
+    start_s = std::chrono::duration<double>(loop_start.time_since_epoch()).count();
+  r.sustained_ms = 1000.0 * (end_s - start_s) / double(measured);
+
+  bool pooled_any = false;
+  for (const FrameOutput& out : kept) {
+    const size_t src = ping_pong(size_t(out.stats.frame_index), n);
+    if (!l.references[src]) continue;
+    const ImageU8* mask = l.masks[src] ? &*l.masks[src] : nullptr;
+    auto err = measure_error(out.image, l.frames[src].color, *l.references[src], mask);
+    if (!err.ok()) return fail(err.error().kind, what + ", frame " + std::to_string(src) + ": " + err.error().message);
+    if (!pooled_any) {
+      e.error = *err;
+    } else {
+      e.error.all = pool(e.error.all, err->all);
+      e.error.real = pool(e.error.real, err->real);
+      e.error.virtual_ = pool(e.error.virtual_, err->virtual_);
+    }
+    pooled_any = true;
+  }
   e.has_reference = pooled_any;
+  kept.clear();
+
+  // Phase 2, profiling mode: the same runtime, warm, each pass submitted alone and host-timed,
+  // so the split adds up; floor samples between its frames track the machine's load.
+  if (s.profile_frames > 0) {
+    MRGI_TRY(rt->set_profiling(true));
+    auto take = [&](std::vector<FrameOutput>& outs) {
+      for (const FrameOutput& out : outs) {
+        if (size_t(out.stats.frame_index) < total) continue;  // sustained frames still in flight
+        r.profiled_ms.push_back(out.stats.gpu_total_ms);
+        for (const PassTiming& p : out.stats.passes) {
+          auto [it, inserted] = r.pass_ms.try_emplace(p.name);
+          if (inserted) r.pass_order.push_back(p.name);
+          it->second.push_back(p.gpu_ms);
+        }
+      }
+    };
+    for (size_t k = total; k < profiled_total; ++k) {
+      auto outs = rt->process(feed(k));
+      if (!outs.ok()) return fail(outs.error().kind, what + ", profiled frame " + std::to_string(k) + ": " + outs.error().message);
+      take(*outs);
+      auto st = floor.sample(uint32_t(s.floor_per_frame), floor_ms);
+      if (!st.ok()) return fail(st.error().kind, what + ": floor pass: " + st.error().message);
+    }
+    auto tail = rt->flush();
+    if (!tail.ok()) return fail(tail.error().kind, what + ", flush: " + tail.error().message);
+    take(*tail);
+  }
   e.skipped.assign(skipped.begin(), skipped.end());
   return r;
 }
@@ -267,6 +312,11 @@ std::string ensure_lp_num_threads() {
 Expected<BenchResult> run_bench(const BenchSettings& s) {
   if (s.frames < 1) return fail(ErrorKind::BadUsage, "--frames must be at least 1 (got " + std::to_string(s.frames) + ")");
   if (s.warmup < 0) return fail(ErrorKind::BadUsage, "--warmup must not be negative");
+  if (s.profile_frames < 0) return fail(ErrorKind::BadUsage, "--profile-frames must not be negative");
+  if (s.frames_in_flight < 1 || s.frames_in_flight > 3)
+    return fail(ErrorKind::BadUsage, "frames_in_flight must be 1..3");
+  if ((s.width == 0) != (s.height == 0) || s.width < 0 || s.height < 0)
+    return fail(ErrorKind::BadUsage, "--width and --height go together (both 0 = each capture's size)");
   if (s.floor_frames < 3) return fail(ErrorKind::BadUsage, "floor_frames must be at least 3");
   if (s.floor_warmup < 0 || s.floor_per_frame < 0)
     return fail(ErrorKind::BadUsage, "floor_warmup and floor_per_frame must not be negative");
@@ -316,7 +366,7 @@ Expected<BenchResult> run_bench(const BenchSettings& s) {
   progress.fn = &s.progress;
   size_t runs_per_scene = 0;
   for (const auto& [t, levels] : plan) runs_per_scene += levels.size();
-  progress.total = scenes->size() * runs_per_scene * size_t(s.warmup + s.frames);
+  progress.total = scenes->size() * runs_per_scene * size_t(s.warmup + s.frames + s.profile_frames);
   const auto t0 = std::chrono::steady_clock::now();
 
   std::vector<double> all_floor;
@@ -337,7 +387,8 @@ Expected<BenchResult> run_bench(const BenchSettings& s) {
         auto run = run_one(*loaded, t, level, s, result.device, *floor, floor_ms);
         if (!run.ok()) return run.error();
         runs.push_back(std::move(run).value());
-        progress.step(sc.name + " " + t + " " + runs.back().entry.level_name, size_t(s.warmup + s.frames));
+        progress.step(sc.name + " " + t + " " + runs.back().entry.level_name,
+                      size_t(s.warmup + s.frames + s.profile_frames));
       }
     SceneFloor f;
     f.scene = sc.name;
@@ -353,8 +404,10 @@ Expected<BenchResult> run_bench(const BenchSettings& s) {
     all_floor.insert(all_floor.end(), floor_ms.begin(), floor_ms.end());
     result.floors.push_back(f);
     for (RunSamples& r : runs) {
-      r.entry.frame = summarize(r.frame_ms, f.median_ms);
-      r.entry.median_wall_ms = percentile(r.wall_ms, 50);
+      r.entry.frame = summarize(r.interval_ms, f.median_ms);
+      r.entry.sustained_ms = r.sustained_ms;
+      r.entry.sustained_ratio = r.sustained_ms / f.median_ms;
+      r.entry.profiled = summarize(r.profiled_ms, f.median_ms);
       for (const std::string& name : r.pass_order)
         r.entry.passes.push_back(PassSummary{name, summarize(r.pass_ms[name], f.median_ms)});
       result.entries.push_back(std::move(r.entry));
@@ -376,8 +429,8 @@ std::vector<LevelAggregate> aggregate_levels(const BenchResult& result) {
       it = out.end() - 1;
     }
     it->scenes += 1;
-    it->mean_median_ms += e.frame.median_ms;
-    it->mean_median_ratio += e.frame.median_ratio;
+    it->mean_median_ms += e.sustained_ms;
+    it->mean_median_ratio += e.sustained_ratio;
     it->max_memory_mib = std::max(it->max_memory_mib, e.memory_mib);
     if (e.has_reference) {
       if (!it->has_reference) {

@@ -65,7 +65,7 @@ Baseline make_baseline(const BenchResult& result, const Tolerances& tolerances) 
   b.warmup = result.warmup;
   b.floor_median_ms = result.floor_median_ms;
   for (const BenchEntry& e : result.entries) {
-    BaselineEntry be{e.scene, e.technique, e.level_name, e.level, e.frame.median_ratio, {}, {}};
+    BaselineEntry be{e.scene, e.technique, e.level_name, e.level, e.sustained_ratio, {}, {}};
     if (e.has_reference) {
       if (e.error.all.rde_defined) be.rde = e.error.all.rde;
       be.delta_rms = e.error.all.delta_rms;
@@ -195,8 +195,8 @@ CheckReport check_against(const BenchResult& result, const Baseline& b) {
     rep.compared += 1;
     const BaselineEntry& be = *it->second;
     const double ratio_limit = be.ratio_to_floor * (1.0 + tol.ratio_relative);
-    if (!(e.frame.median_ratio <= ratio_limit))
-      rep.violations.push_back(name + ": frame time ratio to floor " + num(e.frame.median_ratio) + " > " +
+    if (!(e.sustained_ratio <= ratio_limit))
+      rep.violations.push_back(name + ": sustained frame time ratio to floor " + num(e.sustained_ratio) + " > " +
                                num(ratio_limit) + " (baseline " + num(be.ratio_to_floor) + " + " +
                                num(100.0 * tol.ratio_relative) + " %)");
     const bool have_rde = e.has_reference && e.error.all.rde_defined;

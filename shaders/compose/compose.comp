@@ -10,11 +10,20 @@
 // 1 where TM(L_r) < eps (no modelled light: the delta is added as is) and is clamped to
 // [0, alpha_max] (a barely lit model point would otherwise multiply a virtual lamp's light by
 // an unbounded factor). NaN or Inf never reach the output: inputs are sanitised first.
+//
+// Two pipelines from this file, chosen per frame by the runtime, specialised on whether the
+// camera and output sizes match (kSameSize): kCameraOnly (nothing virtual in view) writes the
+// camera frame, a byte copy when the sizes match; the other runs the composite. Not one shader
+// with branches: on lavapipe a shader costs about as much as all of its code, taken or not
+// (measured at 640x480, x2 threads: the copy alone 0.85 ms as its own pipeline, 8 ms with the
+// composite behind a never-entered uniform `if`), so each path is compiled out of the other.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
 #include "common/frame_constants.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
+layout(constant_id = 0) const bool kSameSize = true;     // camera size == output size
+layout(constant_id = 1) const bool kCameraOnly = false;  // output = camera frame
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
 layout(std430, set = 0, binding = 1) readonly buffer ColorWords { uint color_words[]; };  // RGB8
 layout(set = 0, binding = 2) uniform sampler2D lit_rv;            // texelFetch only
@@ -23,63 +32,73 @@ layout(set = 0, binding = 4) uniform sampler2D virtual_position;  // w: virtual 
 layout(std430, set = 0, binding = 5) writeonly buffer Output { uint out_rgba8[]; };
 layout(std430, set = 0, binding = 6) writeonly buffer Mask { uint out_mask[]; };
 layout(push_constant) uniform Params {
-  vec4 compose;      // x eps (linear camera units), y alpha_max, z 1 = camera frame only
+  vec4 compose;      // x eps (linear camera units), y alpha_max
 } params;
 
 uint color_byte(uint index) { return (color_words[index >> 2] >> ((index & 3u) * 8u)) & 0xffu; }
 
-vec3 camera_linear(ivec2 p) {
+uvec3 camera_bytes(ivec2 p) {
   ivec2 size = frame.color_depth_size.xy;
   p = clamp(p, ivec2(0), size - 1);
   uint base = uint(p.y * size.x + p.x) * 3u;
-  vec3 encoded = vec3(color_byte(base), color_byte(base + 1u), color_byte(base + 2u)) / 255.0f;
-  return srgb_decode(encoded);
+  return uvec3(color_byte(base), color_byte(base + 1u), color_byte(base + 2u));
 }
+
+vec3 camera_linear(ivec2 p) { return srgb_decode(vec3(camera_bytes(p)) / 255.0f); }
 
 vec3 finite(vec3 c) {
   return vec3(isnan(c.x) || isinf(c.x) ? 0.0f : c.x, isnan(c.y) || isinf(c.y) ? 0.0f : c.y,
               isnan(c.z) || isinf(c.z) ? 0.0f : c.z);
 }
 
-void main() {
-  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
-  ivec2 out_size = frame.internal_output_size.zw;
-  if (any(greaterThanEqual(pixel, out_size))) return;
-  vec2 rel = (vec2(pixel) + 0.5f) / vec2(out_size);
-
-  // Camera colour at this output pixel (bilinear on linear values; exact when sizes match).
+// Camera colour at an output pixel, linear; bilinear on linear values when the sizes differ.
+vec3 camera_at(vec2 rel, ivec2 pixel) {
+  if (kSameSize) return camera_linear(pixel);
   vec2 cp = rel * vec2(frame.color_depth_size.xy) - 0.5f;
   ivec2 c0 = ivec2(floor(cp));
   vec2 f = cp - vec2(c0);
-  vec3 ci = mix(mix(camera_linear(c0), camera_linear(c0 + ivec2(1, 0)), f.x),
-                mix(camera_linear(c0 + ivec2(0, 1)), camera_linear(c0 + ivec2(1, 1)), f.x), f.y);
-  uint index = uint(pixel.y * out_size.x + pixel.x);
-  if (params.compose.z > 0.5f) {  // nothing virtual in view: the solutions were not computed
-    out_rgba8[index] = packUnorm4x8(vec4(srgb_encode(clamp(ci, vec3(0.0f), vec3(1.0f))), 1.0f));
-    out_mask[index] = 0u;
-    return;
-  }
+  return mix(mix(camera_linear(c0), camera_linear(c0 + ivec2(1, 0)), f.x),
+             mix(camera_linear(c0 + ivec2(0, 1)), camera_linear(c0 + ivec2(1, 1)), f.x), f.y);
+}
 
-  // The solutions at the internal resolution, upsampled bilinearly from texels of the used
-  // extent only: texels outside it hold whatever an earlier level left (possibly NaN), and a
-  // filtered fetch at the edge would give them weight 0, which still makes 0 * NaN = NaN.
-  ivec2 used = frame.internal_output_size.xy;
+// Bilinear fetch of the solution at the internal resolution, from texels of the used extent
+// only: texels outside it hold whatever an earlier level left (possibly NaN), and a filtered
+// fetch at the edge would give them weight 0, which still makes 0 * NaN = NaN.
+vec3 solution_at(sampler2D s, vec2 rel, ivec2 used) {
   vec2 ipos = rel * vec2(used) - 0.5f;
   ivec2 i0 = ivec2(floor(ipos));
   vec2 w = ipos - vec2(i0);
   ivec2 a = clamp(i0, ivec2(0), used - 1), b = clamp(i0 + 1, ivec2(0), used - 1);
-  vec3 rv = mix(mix(finite(texelFetch(lit_rv, ivec2(a.x, a.y), 0).rgb), finite(texelFetch(lit_rv, ivec2(b.x, a.y), 0).rgb), w.x),
-                mix(finite(texelFetch(lit_rv, ivec2(a.x, b.y), 0).rgb), finite(texelFetch(lit_rv, ivec2(b.x, b.y), 0).rgb), w.x), w.y);
-  vec3 r = mix(mix(finite(texelFetch(lit_r, ivec2(a.x, a.y), 0).rgb), finite(texelFetch(lit_r, ivec2(b.x, a.y), 0).rgb), w.x),
-               mix(finite(texelFetch(lit_r, ivec2(a.x, b.y), 0).rgb), finite(texelFetch(lit_r, ivec2(b.x, b.y), 0).rgb), w.x), w.y);
+  return mix(mix(finite(texelFetch(s, ivec2(a.x, a.y), 0).rgb), finite(texelFetch(s, ivec2(b.x, a.y), 0).rgb), w.x),
+             mix(finite(texelFetch(s, ivec2(a.x, b.y), 0).rgb), finite(texelFetch(s, ivec2(b.x, b.y), 0).rgb), w.x), w.y);
+}
+
+void main() {
+  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 out_size = frame.internal_output_size.zw;
+  if (any(greaterThanEqual(pixel, out_size))) return;
+  uint index = uint(pixel.y * out_size.x + pixel.x);
+  vec2 rel = (vec2(pixel) + 0.5f) / vec2(out_size);
+  if (kCameraOnly) {  // nothing virtual in view: the solutions were not computed
+    if (kSameSize) {
+      uvec3 c = camera_bytes(pixel);
+      out_rgba8[index] = c.x | (c.y << 8u) | (c.z << 16u) | 0xff000000u;
+    } else {
+      out_rgba8[index] = packUnorm4x8(vec4(srgb_encode(clamp(camera_at(rel, pixel), vec3(0.0f), vec3(1.0f))), 1.0f));
+    }
+    out_mask[index] = 0u;
+    return;
+  }
+  ivec2 used = frame.internal_output_size.xy;
+  vec3 rv = solution_at(lit_rv, rel, used);
+  vec3 r = solution_at(lit_r, rel, used);
   ivec2 ip = min(ivec2(rel * vec2(used)), used - 1);
   float is_virtual = texelFetch(virtual_position, ip, 0).w > 0.5f ? 1.0f : 0.0f;
-
   float exposure = frame.camera.y;
   vec3 tm_rv = clamp(rv * exposure, vec3(0.0f), vec3(1.0f));
   vec3 tm_r = clamp(r * exposure, vec3(0.0f), vec3(1.0f));
-  vec3 out_linear = differential_compose(ci, tm_r, tm_rv, is_virtual, params.compose.x,
-                                         params.compose.y);
+  vec3 out_linear = differential_compose(camera_at(rel, pixel), tm_r, tm_rv, is_virtual,
+                                         params.compose.x, params.compose.y);
   vec3 encoded = srgb_encode(clamp(finite(out_linear), vec3(0.0f), vec3(1.0f)));
   out_rgba8[index] = packUnorm4x8(vec4(encoded, 1.0f));
   out_mask[index] = is_virtual > 0.5f ? 1u : 0u;

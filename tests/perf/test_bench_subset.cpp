@@ -43,6 +43,7 @@ perf::BenchResult run_subset() {
     s.levels = {"0", "last"};
     s.frames = 3;
     s.warmup = 1;
+    s.profile_frames = 2;
     s.floor_frames = 5;
     s.floor_warmup = 1;
     auto r = perf::run_bench(s);
@@ -65,12 +66,24 @@ void check_measures(const perf::BenchResult& r) {
   EXPECT_EQ(r.entries.size(), levels->size() > 1 ? 2u : 1u);
   for (const perf::BenchEntry& e : r.entries) {
     EXPECT_EQ(e.technique, "baseline");
+    // Sustained: one completion interval per measured frame (the first from the last warm-up
+    // frame), and the headline is their mean.
     EXPECT_EQ(e.frame.samples, 3u);
     EXPECT_GT(e.frame.median_ms, 0.0);
     EXPECT_GE(e.frame.p95_ms, e.frame.median_ms);
-    EXPECT_NEAR(e.frame.median_ratio, e.frame.median_ms / r.floors[0].median_ms, 1e-9);
+    EXPECT_GT(e.sustained_ms, 0.0);
+    EXPECT_NEAR(e.sustained_ratio, e.sustained_ms / r.floors[0].median_ms, 1e-9);
+    // Profiling phase: its passes add up to its frame (the split is the frame, by construction).
+    EXPECT_EQ(e.profiled.samples, 2u);
     EXPECT_FALSE(e.passes.empty());
-    for (const auto& p : e.passes) EXPECT_LE(p.time.median_ms, e.frame.p95_ms * 1.0001) << p.name;
+    double pass_sum = 0.0;
+    for (const auto& p : e.passes) {
+      EXPECT_EQ(p.time.samples, 2u) << p.name;
+      EXPECT_LE(p.time.median_ms, e.profiled.p95_ms * 1.0001) << p.name;
+      pass_sum += p.time.median_ms;
+    }
+    EXPECT_GT(pass_sum, 0.5 * e.profiled.median_ms);
+    EXPECT_LT(pass_sum, 2.0 * e.profiled.p95_ms);
     EXPECT_GT(e.memory_mib, 0.0);
     if (e.has_reference) {
       EXPECT_TRUE(std::isfinite(e.error.all.rde));

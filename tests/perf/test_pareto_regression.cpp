@@ -66,6 +66,9 @@ perf::BenchResult constructed_result() {
       e.width = 64;
       e.height = 48;
       e.frame = {4, 20.0 - 10.0 * level, 22.0, 10.0 - 5.0 * level, 11.0};
+      e.sustained_ms = e.frame.median_ms;
+      e.sustained_ratio = e.frame.median_ratio;
+      e.profiled = e.frame;
       e.has_reference = true;
       e.error.all.pixels = 64 * 48;
       e.error.all.delta_rms = 0.004;
@@ -105,7 +108,7 @@ TEST(Regression, RatioGrowthBeyondToleranceFails) {
   b = perf::make_baseline(r);
   b.entries[1].ratio_to_floor /= 1.30;
   EXPECT_TRUE(perf::check_against(r, b).passed);
-  b.entries[1].ratio_to_floor = r.entries[1].frame.median_ratio / 1.40;
+  b.entries[1].ratio_to_floor = r.entries[1].sustained_ratio / 1.40;
   EXPECT_FALSE(perf::check_against(r, b).passed);
 }
 
@@ -269,7 +272,8 @@ TEST(Report, CsvAndMarkdownHoldEveryEntry) {
   const std::string csv = perf::bench_csv(r);
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 5);  // header + 4 rows
   EXPECT_NE(csv.find("pass_shade_median_ms"), std::string::npos);
-  EXPECT_NE(csv.find("desk,baseline,1,low,64,48,4,10.0000,22.0000,5.0000"), std::string::npos) << csv;
+  // sustained ms, its ratio, the p95 interval, the profiled frame's median.
+  EXPECT_NE(csv.find("desk,baseline,1,low,64,48,4,10.0000,5.0000,22.0000,10.0000"), std::string::npos) << csv;
   const std::string md = perf::report_markdown(r, nullptr);
   EXPECT_NE(md.find("## baseline"), std::string::npos);
   EXPECT_NE(md.find("pareto.png"), std::string::npos);
@@ -279,7 +283,7 @@ TEST(Report, CsvAndMarkdownHoldEveryEntry) {
   ASSERT_EQ(j["suite_aggregate"].size(), 2u);
   EXPECT_TRUE(j["suite_aggregate"][0]["pareto"].get<bool>());
   EXPECT_TRUE(j["suite_aggregate"][1]["pareto"].get<bool>());
-  EXPECT_DOUBLE_EQ(j["suite_aggregate"][1]["mean_median_ms"].get<double>(), 10.0);
+  EXPECT_DOUBLE_EQ(j["suite_aggregate"][1]["mean_sustained_ms"].get<double>(), 10.0);
 }
 
 }  // namespace

@@ -29,6 +29,11 @@ struct DeviceSettings {
   // A number picks by index; other text picks the first device whose name contains it.
   std::string device;
   bool validate = false;    // Vulkan validation layers; a message becomes an error in tests
+  // Process-wide (glibc): keep memory the driver frees at the end of a frame instead of
+  // returning it to the kernel, so a CPU driver does not page-fault its per-frame memory back
+  // in every frame (lavapipe: 2.2x faster frames; gpu/context.cpp keep_freed_memory). Costs the
+  // process its peak heap for its life. Set false where the host application tunes malloc itself.
+  bool keep_freed_memory = true;
 };
 
 // Lists the Vulkan devices and marks the one `settings` would pick.
@@ -48,6 +53,11 @@ struct RuntimeSettings {
   // Skip the virtual G-buffer and the technique on frames where no virtual object or its shadow
   // can be seen (the output is then the camera frame; FrameStats::skipped says so).
   bool skip_unaffected_frames = true;
+  // Profiling mode (also Runtime::set_profiling): each pass of a frame submitted on its own and
+  // waited for, timed by the host clock, so FrameStats::passes add up to the frame. Frames then
+  // do not overlap: use it to see where the time goes (bench, scheduler cost model), not to run.
+  // Needed on lavapipe, whose timestamps misattribute work between passes.
+  bool profile_passes = false;
 };
 
 struct PassTiming {
@@ -57,9 +67,17 @@ struct PassTiming {
 
 struct FrameStats {
   int64_t frame_index = 0;
-  std::vector<PassTiming> passes;      // GPU time per pass that ran
-  double gpu_total_ms = 0.0;           // sum of the passes (first to last timestamp)
-  double cpu_ms = 0.0;                 // wall time of process() on the host
+  // Time per pass that ran, ms: host-timed submissions when `profiled`, else GPU timestamps
+  // (on lavapipe those do not bracket the work: see RuntimeSettings::profile_passes).
+  std::vector<PassTiming> passes;
+  double gpu_total_ms = 0.0;           // first to last timestamp; profiled: the sum of the passes
+  bool profiled = false;               // the frame ran in profiling mode
+  // Host time of process() for this frame: checks, upload, recording and submission. Not the
+  // frame time: the GPU runs the frame after process() returns (frames are pipelined).
+  double record_ms = 0.0;
+  // Host std::chrono::steady_clock seconds when the runtime saw the frame complete: the
+  // difference between two frames' values is the sustained frame interval a live device sees.
+  double completed_s = 0.0;
   int level = 0;
   std::vector<std::string> skipped;    // passes culled or skipped this frame, with reason
   // Conditions worth knowing about this frame, e.g. "pose: none given, previous pose used".
@@ -93,6 +111,8 @@ class Runtime {
   virtual int level_count() const = 0;
   virtual std::vector<std::string> level_names() const = 0;
   virtual Status set_level(int level) = 0;   // the scheduler's knob; never allocates
+  // Profiling mode from the next frame on (RuntimeSettings::profile_passes); never allocates.
+  virtual Status set_profiling(bool on) = 0;
 };
 
 struct CameraSetup {

@@ -16,7 +16,8 @@ struct ComposePush {
 }  // namespace
 
 Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph, uint32_t width,
-                                  uint32_t height, const ComposeSettings& settings) {
+                                  uint32_t height, bool same_size_as_camera,
+                                  const ComposeSettings& settings) {
   Compose c;
   c.settings_ = settings;
   c.width_ = width;
@@ -35,11 +36,15 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
   const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
   const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   const auto tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-  auto p = gpu::create_compute_pipeline(
-      context, {"compose", *spv, {{ubo}, {ssbo}, {tex}, {tex}, {tex}, {ssbo}, {ssbo}},
-                sizeof(ComposePush)});
-  if (!p) return p.error();
-  c.pipeline_ = gpu::PipelineHandle(context, std::move(*p));
+  // compose.comp: kSameSize, kCameraOnly; each path compiled out of the other's pipeline.
+  for (uint32_t camera_only = 0; camera_only < 2; ++camera_only) {
+    gpu::ComputePipelineDesc d{camera_only ? "compose_camera_only" : "compose", *spv,
+                               {{ubo}, {ssbo}, {tex}, {tex}, {tex}, {ssbo}, {ssbo}},
+                               sizeof(ComposePush), {same_size_as_camera ? 1u : 0u, camera_only}};
+    auto p = gpu::create_compute_pipeline(context, d);
+    if (!p) return p.error();
+    (camera_only ? c.camera_pipeline_ : c.pipeline_) = gpu::PipelineHandle(context, std::move(*p));
+  }
   return c;
 }
 
@@ -63,7 +68,8 @@ void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
 
 void Compose::dispatch(VkCommandBuffer cmd, gpu::PassContext& pass) {
   const gpu::Context& ctx = pass.context();
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_->pipeline);
+  const gpu::Pipeline& pipeline = in_.camera_only ? *camera_pipeline_ : *pipeline_;
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline);
   gpu::DescriptorPush()
       .uniform_buffer(0, pass.buffer(in_.frame_constants))
       .storage_buffer(1, pass.buffer(in_.color_upload))
@@ -72,10 +78,10 @@ void Compose::dispatch(VkCommandBuffer cmd, gpu::PassContext& pass) {
       .sampled_image(4, pass.view(in_.virtual_position), ctx.samplers().nearest_clamp)
       .storage_buffer(5, pass.buffer(output_))
       .storage_buffer(6, pass.buffer(mask_))
-      .push(ctx, cmd, *pipeline_);
+      .push(ctx, cmd, pipeline);
   ComposePush pc;
-  pc.compose = glm::vec4(settings_.eps, settings_.alpha_max, in_.camera_only ? 1.0f : 0.0f, 0.0f);
-  gpu::dispatch_2d(cmd, *pipeline_, &pc, sizeof(pc), width_, height_);
+  pc.compose = glm::vec4(settings_.eps, settings_.alpha_max, 0.0f, 0.0f);
+  gpu::dispatch_2d(cmd, pipeline, &pc, sizeof(pc), width_, height_);
 }
 
 Status Compose::read(const gpu::FrameGraph& graph, uint32_t slot, ImageRGBA8& image,

@@ -28,8 +28,11 @@ struct ComposeInputs {
 
 class Compose {
  public:
+  // same_size_as_camera: the output has the colour camera's size (the camera pixel is read
+  // as it is instead of resampled); fixed for the Compose's life.
   static Expected<Compose> create(gpu::Context& context, gpu::FrameGraph& graph, uint32_t width,
-                                  uint32_t height, const ComposeSettings& settings = {});
+                                  uint32_t height, bool same_size_as_camera,
+                                  const ComposeSettings& settings = {});
   // Adds the pass "compose" and marks both readback buffers as outputs.
   void record(gpu::FrameGraph& graph, const ComposeInputs& inputs);
   // Copies slot `slot`'s results (after its frame completed) into `image` and `mask`
@@ -44,7 +47,7 @@ class Compose {
   uint32_t width_ = 0, height_ = 0;
   ComposeInputs in_;
   gpu::BufferHandle output_, mask_;
-  gpu::PipelineHandle pipeline_;
+  gpu::PipelineHandle pipeline_, camera_pipeline_;  // composite; camera frame only
 };
 
 }  // namespace mrgi::compose

@@ -1,6 +1,7 @@
 // The runtime half of the frame graph: resources, frame slots, recording and timestamps. The
 // culling and barrier rules are in frame_graph_compile.cpp.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "gpu/frame_graph.h"
@@ -36,6 +37,8 @@ struct FrameGraph::Slot {
   int64_t frame_index = -1;
   std::vector<std::string> pass_names;
   std::vector<std::string> culled;
+  bool profiled = false;             // this slot's frame ran in profiling mode
+  std::vector<double> host_ms;       // profiling mode: per pass, submit to fence
 };
 
 // --- PassBuilder / PassContext -------------------------------------------------------------------
@@ -112,6 +115,17 @@ Status FrameGraph::init() {
     qci.queryCount = 2 * settings_.max_passes;
     VK_CHECK(vkCreateQueryPool(dev, &qci, nullptr, &s.queries));
     s.pass_names.reserve(settings_.max_passes);
+    s.host_ms.reserve(settings_.max_passes);
+  }
+  if (settings_.allow_profiling) {
+    profile_cmds_.resize(settings_.max_passes);
+    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    ai.commandPool = pool_;
+    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    ai.commandBufferCount = settings_.max_passes;
+    VK_CHECK(vkAllocateCommandBuffers(dev, &ai, profile_cmds_.data()));
+    VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    VK_CHECK(vkCreateFence(dev, &fci, nullptr, &profile_fence_));
   }
   decls_.reserve(settings_.max_passes);
   executes_.reserve(settings_.max_passes);
@@ -121,6 +135,7 @@ Status FrameGraph::init() {
 FrameGraph::~FrameGraph() {
   VkDevice dev = context_.device();
   vkDeviceWaitIdle(dev);
+  if (profile_fence_) vkDestroyFence(dev, profile_fence_, nullptr);
   for (Slot& s : slots_) {
     if (s.fence) vkDestroyFence(dev, s.fence, nullptr);
     if (s.queries) vkDestroyQueryPool(dev, s.queries, nullptr);
@@ -291,14 +306,21 @@ Expected<std::optional<FrameTimings>> FrameGraph::collect(uint32_t index) {
     return fail(ErrorKind::Timeout, "frame " + std::to_string(s.frame_index) + " did not finish on the GPU within " +
                                       std::to_string(kFrameTimeoutS) + " s (device hung or far too slow)");
   VK_CHECK(w);
+  FrameTimings t;
+  t.completed_s = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
   VK_CHECK(vkResetFences(dev, 1, &s.fence));
   s.submitted = false;
-  FrameTimings t;
   t.frame_index = s.frame_index;
   t.slot = index;
   t.culled = s.culled;
   const uint32_t n = uint32_t(s.pass_names.size());
-  if (n > 0) {
+  t.profiled = s.profiled;
+  if (s.profiled) {
+    for (uint32_t i = 0; i < n; ++i) {
+      t.passes.push_back(PassTiming{s.pass_names[i], s.host_ms[i]});
+      t.total_ms += s.host_ms[i];
+    }
+  } else if (n > 0) {
     uint64_t ticks[2 * 1024];
     VK_CHECK(vkGetQueryPoolResults(dev, s.queries, 0, 2 * n, sizeof(uint64_t) * 2 * n, ticks, sizeof(uint64_t),
                                    VK_QUERY_RESULT_64_BIT));
@@ -412,63 +434,50 @@ Status FrameGraph::compile() {
   return ok_status();
 }
 
-Status FrameGraph::execute(VkCommandBuffer cmd) {
-  if (!compiled_valid_) return fail(ErrorKind::BadUsage, "execute: compile() the frame first");
-  const DeviceFunctions& fn = context_.fn();
-  Slot& slot = slots_[slot_];
-  const uint32_t n = uint32_t(compiled_.passes.size());
-  if (n > 0) vkCmdResetQueryPool(cmd, slot.queries, 0, 2 * n);
+void FrameGraph::record_barriers(VkCommandBuffer cmd, const std::vector<Barrier>& barriers) {
+  if (barriers.empty()) return;
   std::vector<VkImageMemoryBarrier2>& image_barriers = image_barrier_scratch_;
   std::vector<VkBufferMemoryBarrier2>& buffer_barriers = buffer_barrier_scratch_;
-  auto record_barriers = [&](const std::vector<Barrier>& barriers) {
-    if (barriers.empty()) return;
-    image_barriers.clear();
-    buffer_barriers.clear();
-    for (const Barrier& b : barriers) {
-      if (b.resource.is_image) {
-        const GpuImage& img = images_[b.resource.id].gpu;
-        VkImageMemoryBarrier2 ib{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-        ib.srcStageMask = b.src_stages;
-        ib.srcAccessMask = b.src_access;
-        ib.dstStageMask = b.dst_stages;
-        ib.dstAccessMask = b.dst_access;
-        ib.oldLayout = b.old_layout;
-        ib.newLayout = b.new_layout;
-        ib.srcQueueFamilyIndex = ib.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        ib.image = img.image;
-        ib.subresourceRange = {img.aspect, 0, img.mip_levels, 0, img.layers};
-        image_barriers.push_back(ib);
-      } else {
-        const uint32_t id = b.resource.id - uint32_t(images_.size());
-        const GpuBuffer& buf = gpu_buffer(BufferHandle{id}, slot_);
-        VkBufferMemoryBarrier2 bb{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
-        bb.srcStageMask = b.src_stages;
-        bb.srcAccessMask = b.src_access;
-        bb.dstStageMask = b.dst_stages;
-        bb.dstAccessMask = b.dst_access;
-        bb.srcQueueFamilyIndex = bb.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        bb.buffer = buf.buffer;
-        bb.offset = 0;
-        bb.size = VK_WHOLE_SIZE;
-        buffer_barriers.push_back(bb);
-      }
+  image_barriers.clear();
+  buffer_barriers.clear();
+  for (const Barrier& b : barriers) {
+    if (b.resource.is_image) {
+      const GpuImage& img = images_[b.resource.id].gpu;
+      VkImageMemoryBarrier2 ib{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+      ib.srcStageMask = b.src_stages;
+      ib.srcAccessMask = b.src_access;
+      ib.dstStageMask = b.dst_stages;
+      ib.dstAccessMask = b.dst_access;
+      ib.oldLayout = b.old_layout;
+      ib.newLayout = b.new_layout;
+      ib.srcQueueFamilyIndex = ib.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+      ib.image = img.image;
+      ib.subresourceRange = {img.aspect, 0, img.mip_levels, 0, img.layers};
+      image_barriers.push_back(ib);
+    } else {
+      const uint32_t id = b.resource.id - uint32_t(images_.size());
+      const GpuBuffer& buf = gpu_buffer(BufferHandle{id}, slot_);
+      VkBufferMemoryBarrier2 bb{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
+      bb.srcStageMask = b.src_stages;
+      bb.srcAccessMask = b.src_access;
+      bb.dstStageMask = b.dst_stages;
+      bb.dstAccessMask = b.dst_access;
+      bb.srcQueueFamilyIndex = bb.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+      bb.buffer = buf.buffer;
+      bb.offset = 0;
+      bb.size = VK_WHOLE_SIZE;
+      buffer_barriers.push_back(bb);
     }
-    VkDependencyInfo di{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-    di.imageMemoryBarrierCount = uint32_t(image_barriers.size());
-    di.pImageMemoryBarriers = image_barriers.data();
-    di.bufferMemoryBarrierCount = uint32_t(buffer_barriers.size());
-    di.pBufferMemoryBarriers = buffer_barriers.data();
-    fn.cmd_pipeline_barrier2(cmd, &di);
-  };
-  PassContext ctx(*this);
-  for (uint32_t i = 0; i < n; ++i) {
-    const CompiledPass& p = compiled_.passes[i];
-    record_barriers(p.barriers);
-    fn.cmd_write_timestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, slot.queries, 2 * i);
-    if (executes_[p.pass_index]) executes_[p.pass_index](cmd, ctx);
-    fn.cmd_write_timestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, slot.queries, 2 * i + 1);
   }
-  record_barriers(compiled_.final_barriers);
+  VkDependencyInfo di{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  di.imageMemoryBarrierCount = uint32_t(image_barriers.size());
+  di.pImageMemoryBarriers = image_barriers.data();
+  di.bufferMemoryBarrierCount = uint32_t(buffer_barriers.size());
+  di.pBufferMemoryBarriers = buffer_barriers.data();
+  context_.fn().cmd_pipeline_barrier2(cmd, &di);
+}
+
+void FrameGraph::finish_execute(bool profiled) {
   // The GPU state at the end of this frame is where the next frame starts.
   for (size_t r = 0; r < compiled_.final_states.size(); ++r) {
     if (r < images_.size()) {
@@ -478,16 +487,95 @@ Status FrameGraph::execute(VkCommandBuffer cmd) {
       (e.states.size() > 1 ? e.states[slot_] : e.states[0]) = compiled_.final_states[r];
     }
   }
+  Slot& slot = slots_[slot_];
   slot.pass_names.resize(compiled_.passes.size());
   for (size_t i = 0; i < compiled_.passes.size(); ++i) slot.pass_names[i].assign(compiled_.passes[i].name);
   slot.culled = compiled_.culled;
   slot.frame_index = frame_index_;
+  slot.profiled = profiled;
+}
+
+Status FrameGraph::execute(VkCommandBuffer cmd) {
+  if (!compiled_valid_) return fail(ErrorKind::BadUsage, "execute: compile() the frame first");
+  const DeviceFunctions& fn = context_.fn();
+  Slot& slot = slots_[slot_];
+  const uint32_t n = uint32_t(compiled_.passes.size());
+  if (n > 0) vkCmdResetQueryPool(cmd, slot.queries, 0, 2 * n);
+  PassContext ctx(*this);
+  for (uint32_t i = 0; i < n; ++i) {
+    const CompiledPass& p = compiled_.passes[i];
+    record_barriers(cmd, p.barriers);
+    fn.cmd_write_timestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, slot.queries, 2 * i);
+    if (executes_[p.pass_index]) executes_[p.pass_index](cmd, ctx);
+    fn.cmd_write_timestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, slot.queries, 2 * i + 1);
+  }
+  record_barriers(cmd, compiled_.final_barriers);
+  finish_execute(false);
+  return ok_status();
+}
+
+Status FrameGraph::set_profiling(bool on) {
+  if (on && profile_cmds_.empty())
+    return fail(ErrorKind::BadUsage, "set_profiling: the frame graph was created without "
+                                     "FrameGraphSettings::allow_profiling");
+  if (in_frame_) return fail(ErrorKind::BadUsage, "set_profiling: between frames only");
+  profiling_ = on;
+  return ok_status();
+}
+
+Status FrameGraph::submit_profiled() {
+  VkDevice dev = context_.device();
+  const uint32_t n = uint32_t(compiled_.passes.size());
+  if (n > profile_cmds_.size())
+    return fail(ErrorKind::BadUsage, std::to_string(n) + " passes, more than the " +
+                                         std::to_string(profile_cmds_.size()) + " profiling command buffers");
+  // The frame that used this slot before has completed (begin_frame waited), but the other
+  // slots' frames may still run: wait for them, so the first pass's time is its own.
+  VK_CHECK(vkQueueWaitIdle(context_.queue()));
+  Slot& slot = slots_[slot_];
+  slot.host_ms.assign(n, 0.0);
+  PassContext ctx(*this);
+  VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  for (uint32_t i = 0; i < n; ++i) {
+    const CompiledPass& p = compiled_.passes[i];
+    VkCommandBuffer cmd = profile_cmds_[i];
+    VK_CHECK(vkResetCommandBuffer(cmd, 0));
+    VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
+    record_barriers(cmd, p.barriers);
+    if (executes_[p.pass_index]) executes_[p.pass_index](cmd, ctx);
+    if (i + 1 == n) record_barriers(cmd, compiled_.final_barriers);
+    VK_CHECK(vkEndCommandBuffer(cmd));
+    VkCommandBufferSubmitInfo cbi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+    cbi.commandBuffer = cmd;
+    VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+    si.commandBufferInfoCount = 1;
+    si.pCommandBufferInfos = &cbi;
+    // Recording is not timed: the pass's time is what the queue spends on it.
+    const auto t0 = std::chrono::steady_clock::now();
+    VK_CHECK(context_.fn().queue_submit2(context_.queue(), 1, &si, profile_fence_));
+    const VkResult w = vkWaitForFences(dev, 1, &profile_fence_, VK_TRUE, kFrameTimeoutNs);
+    const auto t1 = std::chrono::steady_clock::now();
+    if (w == VK_TIMEOUT)
+      return fail(ErrorKind::Timeout, "pass '" + p.name + "' did not finish within " +
+                                          std::to_string(kFrameTimeoutS) + " s (profiling mode)");
+    VK_CHECK(w);
+    VK_CHECK(vkResetFences(dev, 1, &profile_fence_));
+    slot.host_ms[i] = std::chrono::duration<double, std::milli>(t1 - t0).count();
+  }
+  finish_execute(true);
+  // The slot's fence marks the frame done, as in normal mode (an empty submission signals it).
+  VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+  VK_CHECK(context_.fn().queue_submit2(context_.queue(), 1, &si, slot.fence));
+  slot.submitted = true;
+  in_frame_ = false;
   return ok_status();
 }
 
 Status FrameGraph::submit() {
   if (!in_frame_) return fail(ErrorKind::BadUsage, "submit: call begin_frame first");
   if (!compiled_valid_) MRGI_TRY(compile());
+  if (profiling_) return submit_profiled();
   Slot& slot = slots_[slot_];
   VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;

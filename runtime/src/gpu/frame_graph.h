@@ -227,6 +227,14 @@ struct FrameGraphSettings {
   float max_render_scale = 1.0f;     // (0, 1]; OutputRelative images also x this at most
   uint32_t frames_in_flight = 2;     // 1..3
   uint32_t max_passes = 64;          // timestamp queries per slot = 2 x this
+  // Profiling mode (set_profiling): each pass is submitted on its own and waited for, and its
+  // time is the host's wall clock from submit to fence. Needed where the driver's timestamps do
+  // not bracket the work they surround: lavapipe writes a timestamp when a rasteriser thread
+  // reaches it in its bins, while compute dispatches and vertex work run on the queue thread,
+  // so a compute pass after a draw reads as the draw's tail and a draw's fragments land in the
+  // next pass (see FrameTimings::profiled). Costs the overlap of passes and one submit and
+  // wake-up per pass (about 0.05 ms each on lavapipe).
+  bool allow_profiling = true;       // allocates max_passes command buffers for it at start-up
 };
 
 // Per-pass GPU times of one completed frame.
@@ -234,8 +242,13 @@ struct FrameTimings {
   int64_t frame_index = -1;
   uint32_t slot = 0;
   std::vector<PassTiming> passes;    // passes that ran, in order, milliseconds
-  double total_ms = 0.0;             // first pass start to last pass end
+  double total_ms = 0.0;             // first pass start to last pass end (profiled: the sum)
   std::vector<std::string> culled;
+  // True when the frame ran in profiling mode: pass times are host-timed submissions and add up
+  // to total_ms. False: GPU timestamps (on lavapipe they misattribute; see FrameGraphSettings).
+  bool profiled = false;
+  // Host steady-clock seconds when the host saw the frame complete (its fence wait returned).
+  double completed_s = 0.0;
 };
 
 class FrameGraph {
@@ -290,6 +303,10 @@ class FrameGraph {
   Status submit();
   // Waits for every frame in flight; returns their timings oldest first.
   Expected<std::vector<FrameTimings>> flush();
+  // Profiling mode from the next submit() on (FrameGraphSettings::allow_profiling must be set):
+  // each pass its own submission, host-timed. BadUsage when the graph was made without it.
+  Status set_profiling(bool on);
+  bool profiling() const { return profiling_; }
 
   int64_t frame_index() const { return frame_index_; }   // of the frame being built
   uint32_t slot() const { return slot_; }
@@ -337,6 +354,13 @@ class FrameGraph {
   std::vector<VkImageMemoryBarrier2> image_barrier_scratch_;
   std::vector<VkBufferMemoryBarrier2> buffer_barrier_scratch_;
   VkCommandPool pool_ = VK_NULL_HANDLE;
+  // Profiling mode: one command buffer per pass and a fence, allocated at start-up.
+  std::vector<VkCommandBuffer> profile_cmds_;
+  VkFence profile_fence_ = VK_NULL_HANDLE;
+  bool profiling_ = false;
+  Status submit_profiled();
+  void record_barriers(VkCommandBuffer cmd, const std::vector<Barrier>& barriers);
+  void finish_execute(bool profiled);
   VkExtent2D output_size_{0, 0};
   float render_scale_ = 1.0f;
   int64_t frame_index_ = -1;

@@ -65,6 +65,11 @@ Expected<Pipeline> create_compute_pipeline(const Context& ctx, const ComputePipe
     ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
     ci.stage.module = *module;
     ci.stage.pName = "main";
+    std::vector<VkSpecializationMapEntry> entries(desc.specialization.size());
+    for (uint32_t i = 0; i < entries.size(); ++i) entries[i] = {i, i * 4u, 4u};
+    VkSpecializationInfo spec{uint32_t(entries.size()), entries.data(), desc.specialization.size() * 4,
+                              desc.specialization.data()};
+    if (!entries.empty()) ci.stage.pSpecializationInfo = &spec;
     ci.layout = p.layout;
     s = VK_STATUS(vkCreateComputePipelines(ctx.device(), VK_NULL_HANDLE, 1, &ci, nullptr, &p.pipeline));
   }

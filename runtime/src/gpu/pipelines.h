@@ -26,6 +26,10 @@ struct ComputePipelineDesc {
   std::span<const uint32_t> spirv;     // entry point "main"
   std::vector<DescriptorBinding> bindings;
   uint32_t push_constant_bytes = 0;    // <= 128 (the guaranteed minimum)
+  // Specialization constants: value i sets `layout(constant_id = i)` (32-bit int, uint or bool).
+  // A path a configuration never takes should be compiled out this way, not branched around:
+  // lavapipe runs every path of a shader at every invocation (compose.comp measured it).
+  std::vector<uint32_t> specialization;
 };
 
 struct VertexAttribute {

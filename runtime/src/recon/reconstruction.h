@@ -47,6 +47,10 @@ class Reconstruction {
   void upload(const gpu::FrameGraph& graph, const InputFrame& frame);
   // Adds recon_warp (when there is a history), recon_positions and recon_normals.
   void record(gpu::FrameGraph& graph, gpu::BufferHandle frame_constants);
+  // A frame on which the reconstruction is not recorded (nothing virtual in view): the temporal
+  // history is dropped, so the next recorded frame starts from its own depth instead of
+  // merging a history that stopped frames ago.
+  void skip_frame() { have_history_ = false; }
 
   gpu::BufferHandle color_upload() const { return color_upload_; }
   gpu::BufferHandle depth_upload() const { return depth_upload_; }

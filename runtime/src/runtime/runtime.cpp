@@ -43,7 +43,7 @@ struct SlotRecord {
   bool used = false;
   int64_t frame_index = 0;
   int level = 0;
-  double cpu_ms = 0.0;
+  double record_ms = 0.0;
   bool priming = false;  // a technique's priming run of this frame: its output is dropped
   std::vector<std::string> skipped;
   std::vector<std::string> notes;
@@ -62,6 +62,7 @@ class RuntimeImpl final : public Runtime {
   int level_count() const override { return int(technique_->levels().size()); }
   std::vector<std::string> level_names() const override;
   Status set_level(int level) override;
+  Status set_profiling(bool on) override { return graph_->set_profiling(on); }
 
  private:
   Status check_validation() const;
@@ -161,6 +162,7 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   if (!graph) return graph.error();
   graph_ = std::move(*graph);
   MRGI_TRY(graph_->set_output_size(uint32_t(output_w_), uint32_t(output_h_)));
+  MRGI_TRY(graph_->set_profiling(settings.profile_passes));
 
   auto sg = technique::SceneGpu::create(*context_, *graph_, scene_);
   if (!sg) return sg.error();
@@ -210,7 +212,8 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   if (!tech) return tech.error();
   technique_ = std::move(*tech);
 
-  auto comp = compose::Compose::create(*context_, *graph_, uint32_t(output_w_), uint32_t(output_h_));
+  auto comp = compose::Compose::create(*context_, *graph_, uint32_t(output_w_), uint32_t(output_h_),
+                                       output_w_ == c.width && output_h_ == c.height);
   if (!comp) return comp.error();
   compose_.emplace(std::move(*comp));
 
@@ -346,7 +349,7 @@ Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame)
   }
   rec->notes.insert(rec->notes.end(), notes.begin(), notes.end());
   MRGI_TRY(record_and_submit(frame, *rec, affected));
-  rec->cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  rec->record_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return outputs;
 }
 
@@ -395,8 +398,16 @@ Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, 
   write_constants(frame, last_pose_, ambient_both, ambient_virtual);
   recon_->upload(*graph_, frame);
 
-  recon_->record(*graph_, frame_constants_);  // always: its temporal history must stay current
   const bool has_objects = !scene_gpu_->virtual_objects.empty();
+  // A frame nothing virtual affects is the camera frame: upload and compose's copy only (the
+  // lean skeleton, about two floor passes). The reconstruction is not needed for it; its
+  // temporal history restarts on the next affected frame (one frame of unfiltered depth).
+  if (affected) {
+    recon_->record(*graph_, frame_constants_);
+  } else {
+    recon_->skip_frame();
+    rec.skipped.push_back("recon: nothing virtual in view (its temporal history restarts when there is)");
+  }
   if (affected) {
     virtual_gbuffer_->record(*graph_, frame_constants_, recon_->position());
     technique::FrameInfo info;
@@ -424,7 +435,9 @@ Expected<FrameOutput> RuntimeImpl::collect(const gpu::FrameTimings& timings) {
   out.stats.frame_index = rec.frame_index;
   out.stats.passes = timings.passes;
   out.stats.gpu_total_ms = timings.total_ms;
-  out.stats.cpu_ms = rec.cpu_ms;
+  out.stats.record_ms = rec.record_ms;
+  out.stats.profiled = timings.profiled;
+  out.stats.completed_s = timings.completed_s;
   out.stats.level = rec.level;
   out.stats.skipped = rec.skipped;
   for (const std::string& c : timings.culled) out.stats.skipped.push_back(c + ": culled (nothing reads it)");

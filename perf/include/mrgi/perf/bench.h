@@ -1,15 +1,21 @@
 // The bench: replays the scene suite through every technique and quality level on one Vulkan
 // device, times a floor pass in the same process, and measures error against the captures'
-// references. Timings are GPU times from the frame graph's timestamps (FrameStats).
+// references.
 //
-// One run (scene, technique, level) = a fresh Runtime at that level fed `warmup` frames (not
-// measured) and then `frames` measured ones. A capture shorter than warmup + frames is replayed
-// forth and back (0,1,..,n-1,n-2,..,1,0,1,..) with timestamps continued, so the motion stays
-// continuous for temporal filters. The runtime runs with one frame in flight, so no host work
-// (error measurement) and no floor pass overlaps a timed frame on a CPU device. The floor pass
-// is timed at the scene's output size before every run and again after every measured frame; a
-// scene's floor is the median of all its floor samples, so ratios compare times taken in the
-// same process under the same machine load.
+// One run (scene, technique, level) = a fresh Runtime at that level, in two phases:
+//  1. sustained: `warmup` frames then `frames` measured ones fed back to back with
+//     frames_in_flight in flight and every input preloaded (what a live device sees). The
+//     headline, sustained_ms, is the wall clock from the completion of the last warm-up frame
+//     to that of the last measured one, over `frames`. RDE is measured on these frames' outputs
+//     after the phase, so the bench's own host work never competes with a timed frame.
+//  2. profiling: `profile_frames` more frames in the runtime's profiling mode (each pass
+//     submitted alone and host-timed), which gives the per-pass split that adds up; its frame
+//     total (profiled) is compared with sustained_ms in the report.
+// A capture shorter than the run is replayed forth and back (0,1,..,n-1,n-2,..,1,0,1,..) with
+// timestamps continued, so the motion stays continuous for temporal filters. The floor pass is
+// timed at the output size before every run and after every profiled frame; a scene's floor is
+// the median of all its floor samples, so ratios compare times taken in the same process under
+// the same machine load.
 #pragma once
 #include <cstddef>
 #include <functional>
@@ -33,6 +39,9 @@ struct BenchSettings {
   std::vector<std::string> levels;
   int frames = 16;                       // measured frames per run (>= 1)
   int warmup = 4;                        // frames per run before measuring (>= 0)
+  int profile_frames = 6;                // profiling-mode frames per run for the split (>= 0)
+  int frames_in_flight = 2;              // sustained phase, as a live device runs (1..3)
+  int width = 0, height = 0;             // output size; 0 = each capture's colour size
   int floor_frames = 10;                 // floor pass samples before each run (>= 3)
   int floor_per_frame = 2;               // floor pass samples after each measured frame (>= 0)
   int floor_warmup = 3;                  // unmeasured floor frames per scene
@@ -49,15 +58,18 @@ struct TimeSummary {
 
 struct PassSummary {
   std::string name;
-  TimeSummary time;  // over the measured frames in which the pass ran (samples says how many)
+  TimeSummary time;  // profiling phase: over the frames in which the pass ran (samples says how many)
 };
 
 struct BenchEntry {
   std::string scene, technique, level_name;
   int level = 0;
   int width = 0, height = 0;             // output size
-  TimeSummary frame;                     // FrameStats::gpu_total_ms
-  double median_wall_ms = 0.0;           // FrameStats::cpu_ms (host wall time of process())
+  // The headline: wall-clock ms per frame sustained over the measured frames (phase 1), and
+  // its ratio to the scene's floor.
+  double sustained_ms = 0.0, sustained_ratio = 0.0;
+  TimeSummary frame;                     // phase 1: intervals between frame completions
+  TimeSummary profiled;                  // phase 2: per frame, the sum of its passes
   std::vector<PassSummary> passes;       // in first-seen order
   double memory_mib = 0.0;               // Runtime::memory_mib()
   bool has_reference = false;            // error below is meaningful only when true
@@ -93,7 +105,7 @@ std::string ensure_lp_num_threads();
 
 Expected<BenchResult> run_bench(const BenchSettings& settings);
 
-// Suite-wide figures of one technique level: mean over scenes of the median frame ms and ratio,
+// Suite-wide figures of one technique level: mean over scenes of the sustained ms and ratio,
 // error pooled over every measured frame of every scene. Used by the report and the plot.
 struct LevelAggregate {
   std::string technique, level_name;

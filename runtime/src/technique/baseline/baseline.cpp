@@ -1,6 +1,7 @@
 #include "technique/baseline/baseline.h"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "gpu/pipelines.h"
@@ -23,6 +24,26 @@ struct GridPush {
   glm::mat4 view_proj;
   glm::ivec4 grid;
 };
+struct CasterGrid {
+  VkExtent2D points{0, 0};  // grid points per row, column
+  uint32_t stride = 1;      // G-buffer pixels between points
+  uint32_t index_count() const {
+    return points.width > 1 && points.height > 1 ? (points.width - 1) * (points.height - 1) * 6 : 0;
+  }
+};
+
+// The real caster grid for a G-buffer and a shadow map: a cell covers about `cell_texels`
+// shadow texels across the G-buffer's larger side (the map's resolution over the view's
+// geometry; a finer grid adds vertices the map cannot resolve). At most one point a pixel.
+CasterGrid caster_grid(VkExtent2D gbuffer, uint32_t shadow_size, double cell_texels) {
+  const uint32_t side = std::max(gbuffer.width, gbuffer.height);
+  const double cells = std::max(1.0, double(shadow_size) / std::max(1.0, cell_texels));
+  CasterGrid g;
+  g.stride = std::max<uint32_t>(1, uint32_t(std::ceil(double(side) / cells)));
+  g.points = {(gbuffer.width - 1) / g.stride + 1, (gbuffer.height - 1) / g.stride + 1};
+  return g;
+}
+
 struct ShadePush {
   glm::vec4 shadow;
 };
@@ -55,12 +76,14 @@ class Baseline final : public Technique {
   ImageViews views_;
   std::vector<VkImageView> primary_layer_views_, virtual_layer_views_;
   VkImageView primary_array_view_ = VK_NULL_HANDLE, virtual_array_view_ = VK_NULL_HANDLE;
-  gpu::PipelineHandle grid_pipeline_, mesh_pipeline_, shade_pipeline_;
+  gpu::PipelineHandle grid_pipeline_, mesh_pipeline_, shade_pipeline_, caster_indices_pipeline_;
+  gpu::BufferHandle caster_indices_;  // this frame's real caster mesh (shadow_caster_indices.comp)
+  bool real_caster_faces_ = false;     // some face of the plan draws the real casters
   VkImageLayout depth_write_layout_ = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
   // This frame's knobs (set by record before the passes are added).
   uint32_t shadow_size_ = kTopShadowSize;
   int pcf_radius_ = 1;
-  uint32_t grid_stride_ = 1;
+  CasterGrid grid_;
 };
 
 Status Baseline::init() {
@@ -137,6 +160,20 @@ Status Baseline::init() {
   if (!gp) return gp.error();
   grid_pipeline_ = gpu::PipelineHandle(ctx, std::move(*gp));
 
+  // Index buffer for the finest grid any level uses (one point a G-buffer pixel).
+  const VkExtent2D gbuffer = graph.allocated_extent(shared_.real_position);
+  const CasterGrid finest{gbuffer, 1};
+  auto ib = graph.create_buffer({"shadow_caster_indices", std::max<VkDeviceSize>(4, VkDeviceSize(finest.index_count()) * 4)},
+                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
+  if (!ib) return ib.error();
+  caster_indices_ = *ib;
+  auto cip = gpu::load_compute_pipeline(ctx, "baseline/shadow_caster_indices.comp",
+                                        {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER}, {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
+                                        sizeof(glm::ivec4));
+  if (!cip) return cip.error();
+  caster_indices_pipeline_ = std::move(*cip);
+  for (const ShadowFace& f : plan_.primary) real_caster_faces_ = real_caster_faces_ || f.real_casters;
+
   auto mesh_vs = gpu::shader_spirv("baseline/shadow_mesh.vert");
   if (!mesh_vs) return mesh_vs.error();
   gpu::GraphicsPipelineDesc mesh;
@@ -176,18 +213,38 @@ Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped
   const QualityLevel& level = ladder_[size_t(info.level)];
   shadow_size_ = uint32_t(knob(level, "shadow_map_size"));
   pcf_radius_ = int(knob(level, "pcf_radius"));
-  grid_stride_ = uint32_t(std::max(1.0, knob(level, "caster_grid_stride")));
   gpu::FrameGraph& graph = *shared_.graph;
+  grid_ = caster_grid(graph.extent(shared_.real_position), shadow_size_, knob(level, "caster_cell_shadow_texels"));
   const SceneGpu& sg = *shared_.scene_gpu;
   const SharedResources& s = shared_;
 
   if (plan_.primary.empty()) {
     skipped.push_back("shadow_primary: no lamp in the scene");
   } else {
+    if (real_caster_faces_ && grid_.index_count() > 0) {
+      graph.add_pass(
+          "shadow_caster_mesh", gpu::PassKind::Compute,
+          [this](gpu::PassBuilder& b) {
+            b.read(shared_.real_position, gpu::Access::Sampled);
+            b.write(caster_indices_, gpu::Access::StorageWrite);
+          },
+          [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
+            const gpu::Context& c = pass.context();
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, caster_indices_pipeline_->pipeline);
+            gpu::DescriptorPush()
+                .sampled_image(0, pass.view(shared_.real_position), c.samplers().nearest_clamp)
+                .storage_buffer(1, pass.buffer(caster_indices_))
+                .push(c, cmd, *caster_indices_pipeline_);
+            const glm::ivec4 g(int(grid_.points.width), int(grid_.points.height), int(grid_.stride), 0);
+            gpu::dispatch_2d(cmd, *caster_indices_pipeline_, &g, sizeof(g), grid_.points.width - 1,
+                             grid_.points.height - 1);
+          });
+    }
     graph.add_pass(
         "shadow_primary", gpu::PassKind::Graphics,
         [this](gpu::PassBuilder& b) {
           b.read(shared_.real_position, gpu::Access::Sampled);
+          if (real_caster_faces_ && grid_.index_count() > 0) b.read(caster_indices_, gpu::Access::IndexBuffer);
           b.read(shared_.scene_gpu->real_proxies.vertices, gpu::Access::VertexBuffer);
           b.read(shared_.scene_gpu->real_proxies.indices, gpu::Access::IndexBuffer);
           b.read(shared_.scene_gpu->virtual_objects.vertices, gpu::Access::VertexBuffer);
@@ -241,12 +298,7 @@ void Baseline::render_faces(VkCommandBuffer cmd, gpu::PassContext& pass,
                             const std::vector<VkImageView>& layer_views) {
   const gpu::Context& ctx = pass.context();
   const SceneGpu& sg = *shared_.scene_gpu;
-  const VkExtent2D gbuffer = pass.extent(shared_.real_position);
-  // Vertices every grid_stride_ pixels, the last at or before the G-buffer's last pixel.
-  const uint32_t stride = grid_stride_;
-  const VkExtent2D grid{(gbuffer.width - 1) / stride + 1, (gbuffer.height - 1) / stride + 1};
-  const uint32_t grid_vertices =
-      grid.width > 1 && grid.height > 1 ? (grid.width - 1) * (grid.height - 1) * 6 : 0;
+  const uint32_t grid_indices = grid_.index_count();
   const uint32_t s = shadow_size_;
   for (const ShadowFace& face : faces) {
     VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
@@ -264,14 +316,15 @@ void Baseline::render_faces(VkCommandBuffer cmd, gpu::PassContext& pass,
     const VkRect2D sc{{0, 0}, {s, s}};
     vkCmdSetViewport(cmd, 0, 1, &vp);
     vkCmdSetScissor(cmd, 0, 1, &sc);
-    if (face.real_casters && grid_vertices > 0) {
+    if (face.real_casters && grid_indices > 0) {
       vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, grid_pipeline_->pipeline);
       gpu::DescriptorPush()
           .sampled_image(0, pass.view(shared_.real_position), ctx.samplers().nearest_clamp)
           .push(ctx, cmd, *grid_pipeline_);
-      GridPush pc{face.view_proj, glm::ivec4(int(grid.width), int(grid.height), int(stride), 0)};
+      GridPush pc{face.view_proj, glm::ivec4(int(grid_.points.width), int(grid_.points.height), int(grid_.stride), 0)};
       vkCmdPushConstants(cmd, grid_pipeline_->layout, grid_pipeline_->stages, 0, sizeof(pc), &pc);
-      vkCmdDraw(cmd, grid_vertices, 1, 0, 0);
+      vkCmdBindIndexBuffer(cmd, pass.buffer(caster_indices_), 0, VK_INDEX_TYPE_UINT32);
+      vkCmdDrawIndexed(cmd, grid_indices, 1, 0, 0, 0);
     }
     const bool proxies = face.real_casters && !sg.real_proxies.empty();
     const bool virtuals = face.virtual_casters && !sg.virtual_objects.empty();
@@ -316,18 +369,19 @@ void Baseline::shade(VkCommandBuffer cmd, gpu::PassContext& pass) {
 }  // namespace
 
 std::vector<QualityLevel> baseline_ladder() {
-  auto level = [](const char* name, double size, double scale, double pcf, double stride) {
+  auto level = [](const char* name, double size, double scale, double pcf, double cell_texels) {
     QualityLevel l;
     l.name = name;
     l.internal_scale = float(scale);
     l.knobs = {{"shadow_map_size", size, "texels per side of each map face"},
                {"internal_scale", scale, "fraction of the output width and height"},
                {"pcf_radius", pcf, "compare taps on each side of the centre tap"},
-               {"caster_grid_stride", stride, "G-buffer pixels between real caster mesh vertices"}};
+               {"caster_cell_shadow_texels", cell_texels,
+                "shadow texels a real caster grid cell spans across the G-buffer's larger side"}};
     return l;
   };
-  return {level("high", 2048, 1.0, 1, 1), level("medium", 1024, 1.0, 1, 2),
-          level("low", 512, 0.75, 1, 1), level("lowest", 256, 0.5, 0, 1)};
+  return {level("high", 2048, 1.0, 1, 2), level("medium", 1024, 1.0, 1, 2),
+          level("low", 512, 0.75, 1, 2), level("lowest", 256, 0.5, 0, 2)};
 }
 
 Expected<std::unique_ptr<Technique>> create_baseline(const SharedResources& shared) {

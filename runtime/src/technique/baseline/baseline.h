@@ -4,17 +4,19 @@
 // is added (runtime/, FrameConstants::ambient_*), without occlusion.
 //
 // Quality ladder (best first):
-//   level  name     shadow_map_size  internal_scale  pcf_radius  caster_grid_stride
-//   0      high     2048             1.0             1 (3x3)     1
+//   level  name     shadow_map_size  internal_scale  pcf_radius  caster_cell_shadow_texels
+//   0      high     2048             1.0             1 (3x3)     2
 //   1      medium   1024             1.0             1           2
-//   2      low       512             0.75            1           1
-//   3      lowest    256             0.5             0 (1 tap)   1
-// (Below full resolution the G-buffer grid is already coarser; a stride of 2 on top of it lost
-// small real casters in the tests' 64x48 scene, so only "medium" strides.)
+//   2      low       512             0.75            1           2
+//   3      lowest    256             0.5             0 (1 tap)   2
 // Units: shadow_map_size in texels per side of each map face; internal_scale as a fraction of
 // the output width and height; pcf_radius in bilinear compare taps on each side of the centre
-// tap; caster_grid_stride in G-buffer pixels between the vertices of the real caster mesh (the
-// depth-camera grid drawn into the real-caster maps: 2 draws a quarter of the triangles).
+// tap; caster_cell_shadow_texels: the real caster mesh (the depth-camera grid drawn into the
+// real-caster maps) has one point every ceil(side / (shadow_map_size / this)) G-buffer pixels,
+// side = the G-buffer's larger side, so its cells match what the map can resolve (640x480 at
+// high: every pixel; lowest, 320x240 into 256^2: every third). Built once a frame as an indexed
+// mesh (pass shadow_caster_mesh), so each point is shaded once per face; the grid of one
+// unshared vertex triple per triangle it replaced cost 100+ ms at high (1.8 M vertices).
 // Maps are allocated at 2048 for every lamp at start-up; lower levels render into and read the
 // top-left corner, so set_level never allocates.
 #pragma once
