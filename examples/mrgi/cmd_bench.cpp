@@ -2,7 +2,10 @@
 //            [--warmup N] --out DIR [--check BASELINE] [--write-baseline FILE]
 // Exit 0: done (and the check passed); 1: bad input, failure, or the regression check failed;
 // 2: bad usage.
+#include <algorithm>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <optional>
 
@@ -17,12 +20,63 @@ namespace {
 struct BenchOptions {
   perf::BenchSettings settings;
   std::string out, check, write_baseline;
+  std::vector<std::string> sizes;  // --sizes WxH,...: one run per size and a scaling table
   bool quiet = false;
 };
+
+std::pair<int, int> parse_size(const std::string& text) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') || w < 16 ||
+      h < 16 || w > 8192 || h > 8192)
+    throw CommandFailure(2, "--sizes '" + text + "': each size is WIDTHxHEIGHT, 16..8192 (e.g. 640x480)");
+  return {w, h};
+}
+
+// --sizes: the same bench once per output size, each written to DIR/WxH/, and DIR/scaling.md
+// and scaling.json comparing them (built under DIR.partial like every bench output).
+void run_scaling(BenchOptions& o) {
+  if (!o.check.empty() || !o.write_baseline.empty())
+    throw CommandFailure(2, "--sizes cannot be combined with --check or --write-baseline");
+  if (o.settings.width || o.settings.height) throw CommandFailure(2, "--sizes replaces --width/--height");
+  std::vector<std::pair<int, int>> sizes;
+  for (const std::string& s : o.sizes) sizes.push_back(parse_size(s));
+  std::sort(sizes.begin(), sizes.end(), [](auto a, auto b) { return a.first * a.second < b.first * b.second; });
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const std::string dir = fs::absolute(o.out).lexically_normal().string();
+  if (fs::exists(dir, ec) && !(fs::is_empty(dir, ec) || fs::exists(dir + "/scaling.json", ec)))
+    throw CommandFailure(2, dir + ": --out exists and is not an earlier scaling output (no scaling.json); refusing to overwrite it");
+  const std::string partial = dir + ".partial";
+  fs::remove_all(partial, ec);
+  fs::create_directories(partial, ec);
+  if (ec) throw CommandFailure(1, partial + ": cannot create: " + ec.message());
+  std::vector<perf::BenchResult> results;
+  for (auto [w, h] : sizes) {
+    perf::BenchSettings s = o.settings;
+    s.width = w;
+    s.height = h;
+    const std::string name = std::to_string(w) + "x" + std::to_string(h);
+    if (!o.quiet) s.progress = [name](const std::string& what, size_t done, size_t total, double elapsed) {
+      progress("bench " + name + " " + what, done, total, elapsed);
+    };
+    results.push_back(take(perf::run_bench(s)));
+    auto st = perf::write_bench_outputs(partial + "/" + name, results.back(), nullptr);
+    if (!st.ok()) fail_with(st.error());
+  }
+  std::ofstream(partial + "/scaling.md") << perf::scaling_markdown(results);
+  std::ofstream(partial + "/scaling.json") << perf::scaling_json(results).dump(2) << "\n";
+  fs::remove_all(dir, ec);
+  ec.clear();
+  fs::rename(partial, dir, ec);
+  if (ec) throw CommandFailure(1, dir + ": cannot move the finished output into place: " + ec.message());
+  std::cout << perf::scaling_markdown(results);
+}
 
 void run_bench_command(BenchOptions& o) {
   // Before any Vulkan instance exists: lavapipe reads it when the device is created.
   perf::ensure_lp_num_threads();
+  if (!o.sizes.empty()) return run_scaling(o);
   std::optional<perf::Baseline> baseline;
   if (!o.check.empty()) baseline = take(perf::load_baseline(o.check));  // fail before hours of work
   if (!o.quiet) o.settings.progress = [](const std::string& what, size_t done, size_t total, double elapsed) {
@@ -75,6 +129,14 @@ void setup(CLI::App& app) {
                   "frames per run in profiling mode (each pass alone, host-timed) for the per-pass split; 0 = none")
       ->check(CLI::Range(0, 100000))
       ->capture_default_str();
+  cmd->add_option("--frames-in-flight", opts->settings.frames_in_flight,
+                  "frames in flight in the sustained phase (a live device runs 2)")
+      ->check(CLI::Range(1, 3))
+      ->capture_default_str();
+  cmd->add_option("--sizes", opts->sizes,
+                  "comma-separated output sizes WxH (e.g. 320x240,640x480,1280x960): one run per size into DIR/WxH/ "
+                  "and DIR/scaling.md, how cost grows with pixels")
+      ->delimiter(',');
   cmd->add_option("--width", opts->settings.width, "output width for every scene (default: each capture's)")
       ->check(CLI::Range(16, 8192));
   cmd->add_option("--height", opts->settings.height, "output height for every scene")->check(CLI::Range(16, 8192));

@@ -286,6 +286,80 @@ std::string report_markdown(const BenchResult& r, const CheckReport* check) {
   return o.str();
 }
 
+namespace {
+struct ScalingRow {
+  std::string technique, level_name;
+  int level = 0;
+  std::vector<double> ms;  // per size: mean over scenes of the sustained ms (0 = not run)
+};
+
+std::vector<ScalingRow> scaling_rows(const std::vector<BenchResult>& by_size) {
+  std::vector<ScalingRow> rows;
+  for (size_t k = 0; k < by_size.size(); ++k)
+    for (const LevelAggregate& a : aggregate_levels(by_size[k])) {
+      auto it = std::find_if(rows.begin(), rows.end(), [&](const ScalingRow& r) {
+        return r.technique == a.technique && r.level == a.level;
+      });
+      if (it == rows.end()) {
+        rows.push_back({a.technique, a.level_name, a.level, std::vector<double>(by_size.size(), 0.0)});
+        it = rows.end() - 1;
+      }
+      it->ms[k] = a.mean_median_ms;
+    }
+  return rows;
+}
+
+double size_pixels(const BenchResult& r) {
+  return r.entries.empty() ? 0.0 : double(r.entries.front().width) * double(r.entries.front().height);
+}
+std::string size_name(const BenchResult& r) {
+  return r.entries.empty() ? "-" : std::to_string(r.entries.front().width) + "x" + std::to_string(r.entries.front().height);
+}
+}  // namespace
+
+std::string scaling_markdown(const std::vector<BenchResult>& by_size) {
+  std::ostringstream o;
+  o << "# mrgi bench: cost against output size\n\n";
+  o << "Sustained ms per frame (mean over the scenes), per technique level and output size; *ms/MP* is that per "
+       "megapixel of output; *growth* is the cost ratio between the largest and the smallest size divided by the "
+       "pixel ratio (1.0 = cost grows in proportion to pixels, below 1 = per-pixel cost falls: fixed costs spread). "
+       "Each size is its own run (floors and figures per size in its folder).\n\n";
+  o << "| technique | level |";
+  for (const BenchResult& r : by_size) o << " " << size_name(r) << " ms | ms/MP |";
+  o << " growth |\n|---|---|";
+  for (size_t k = 0; k < by_size.size(); ++k) o << "---:|---:|";
+  o << "---:|\n";
+  for (const ScalingRow& row : scaling_rows(by_size)) {
+    o << "| " << row.technique << " | " << row.level << " " << row.level_name << " |";
+    for (size_t k = 0; k < by_size.size(); ++k) {
+      const double mp = size_pixels(by_size[k]) / 1e6;
+      o << " " << (row.ms[k] > 0 ? fmt(row.ms[k], 2) : "-") << " | "
+        << (row.ms[k] > 0 && mp > 0 ? fmt(row.ms[k] / mp, 1) : "-") << " |";
+    }
+    const size_t a = 0, b = by_size.size() - 1;
+    const double pixel_ratio = size_pixels(by_size[b]) / std::max(1.0, size_pixels(by_size[a]));
+    if (b > a && row.ms[a] > 0 && row.ms[b] > 0 && pixel_ratio > 0)
+      o << " " << fmt(row.ms[b] / row.ms[a] / pixel_ratio, 2) << " |\n";
+    else
+      o << " - |\n";
+  }
+  return o.str();
+}
+
+nlohmann::json scaling_json(const std::vector<BenchResult>& by_size) {
+  nlohmann::json j;
+  nlohmann::json sizes = nlohmann::json::array();
+  for (const BenchResult& r : by_size)
+    sizes.push_back({{"size", size_name(r)}, {"pixels", size_pixels(r)}, {"floor_median_ms", r.floor_median_ms}});
+  j["sizes"] = sizes;
+  nlohmann::json rows = nlohmann::json::array();
+  for (const ScalingRow& row : scaling_rows(by_size))
+    rows.push_back({{"technique", row.technique}, {"level", row.level}, {"level_name", row.level_name},
+                    {"mean_sustained_ms", row.ms}});
+  j["levels"] = rows;
+  return j;
+}
+
 Status write_bench_outputs(const std::string& dir_in, const BenchResult& r, const CheckReport* check) {
   std::string dir = fs::absolute(dir_in).lexically_normal().string();
   while (dir.size() > 1 && dir.back() == '/') dir.pop_back();

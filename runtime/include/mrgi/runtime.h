@@ -78,6 +78,11 @@ struct FrameStats {
   // Host std::chrono::steady_clock seconds when the runtime saw the frame complete: the
   // difference between two frames' values is the sustained frame interval a live device sees.
   double completed_s = 0.0;
+  // Host time spent on this frame outside the GPU work: process() (record_ms, less the passes'
+  // own time in profiling mode, where process() waits for each) plus reading the output back.
+  // On a CPU device this competes with the passes for the same cores, so a frame's sustained
+  // wall clock is about its passes plus this.
+  double host_ms = 0.0;
   int level = 0;
   std::vector<std::string> skipped;    // passes culled or skipped this frame, with reason
   // Conditions worth knowing about this frame, e.g. "pose: none given, previous pose used".

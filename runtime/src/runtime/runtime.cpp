@@ -431,13 +431,17 @@ Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, 
 Expected<FrameOutput> RuntimeImpl::collect(const gpu::FrameTimings& timings) {
   SlotRecord& rec = slots_[timings.slot];
   FrameOutput out;
+  const auto read_start = std::chrono::steady_clock::now();
   MRGI_TRY(compose_->read(*graph_, timings.slot, out.image, out.virtual_mask));
+  const double readback_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - read_start).count();
   out.stats.frame_index = rec.frame_index;
   out.stats.passes = timings.passes;
   out.stats.gpu_total_ms = timings.total_ms;
   out.stats.record_ms = rec.record_ms;
   out.stats.profiled = timings.profiled;
   out.stats.completed_s = timings.completed_s;
+  out.stats.host_ms = std::max(0.0, rec.record_ms - (timings.profiled ? timings.total_ms : 0.0)) + readback_ms;
   out.stats.level = rec.level;
   out.stats.skipped = rec.skipped;
   for (const std::string& c : timings.culled) out.stats.skipped.push_back(c + ": culled (nothing reads it)");

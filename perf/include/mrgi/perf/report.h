@@ -27,4 +27,10 @@ ImageRGB8 render_pareto_plot(const BenchResult& result);
 // Writes the four files. DIR must be absent, empty or an earlier bench output (has bench.json).
 Status write_bench_outputs(const std::string& dir, const BenchResult& result, const CheckReport* check);
 
+// Cost scaling (`mrgi bench --sizes`): one run of the same scenes, techniques and levels per
+// output size, smallest first. Per technique level (mean over scenes): sustained ms at each
+// size, ms per megapixel, and how cost grew against pixels (1.0 = in proportion).
+std::string scaling_markdown(const std::vector<BenchResult>& by_size);
+nlohmann::json scaling_json(const std::vector<BenchResult>& by_size);
+
 }  // namespace mrgi::perf
