@@ -65,9 +65,10 @@ std::string temp_folder(const std::string& name) {
   return dir.string();
 }
 
-FrameOutput run_one(const SyntheticScene& s, const SceneDesc& scene, bool skips) {
+FrameOutput run_one(const SyntheticScene& s, const SceneDesc& scene, bool skips, bool profiled = false) {
   RuntimeSettings rs;
   rs.device.validate = true;
+  rs.profile_passes = profiled;
   rs.technique = "baseline";
   rs.level = 0;
   rs.skip_unaffected_frames = skips;
@@ -110,6 +111,48 @@ TEST(FrameSkip, OutOfViewObjectSkipsTheTechniqueWithoutChangingTheOutput) {
   bool ran_shadow = false;
   for (const PassTiming& p : skipped.stats.passes) ran_shadow = ran_shadow || p.name.rfind("shadow", 0) == 0;
   EXPECT_FALSE(ran_shadow);
+}
+
+// The lean skeleton: a frame nothing virtual affects runs one pass (compose's camera copy), and
+// its output is the camera frame byte for byte.
+TEST(FrameSkip, UnaffectedFrameRunsOnlyTheCameraCopy) {
+  const SyntheticScene s = SyntheticScene::create(temp_folder("lean"));
+  SceneDesc far = s.scene;
+  for (auto& v : far.virtual_objects) v.placement.position += glm::vec3(30.0f, 0.0f, 0.0f);
+  const FrameOutput o = run_one(s, far, true);
+  ASSERT_FALSE(o.image.empty());
+  std::vector<std::string> names;
+  for (const PassTiming& p : o.stats.passes) names.push_back(p.name);
+  EXPECT_EQ(names, std::vector<std::string>{"compose"});
+  bool recon_skip = false;
+  for (const std::string& sk : o.stats.skipped) recon_skip = recon_skip || sk.rfind("recon:", 0) == 0;
+  EXPECT_TRUE(recon_skip);
+  const InputFrame in = s.frame(0);
+  ASSERT_EQ(size_t(o.image.width) * o.image.height, size_t(in.color.width) * in.color.height);
+  int different = 0;
+  for (size_t i = 0; i < size_t(in.color.width) * in.color.height; ++i)
+    for (int c = 0; c < 3; ++c) different += o.image.data[i * 4 + c] != in.color.data[i * 3 + c];
+  EXPECT_EQ(different, 0);
+  for (uint8_t m : o.virtual_mask.data) EXPECT_EQ(m, 0);
+}
+
+// Profiling mode: every pass its own host-timed submission, and they add up to the frame.
+TEST(FrameSkip, ProfiledFramePassesAddUpAndMatchTheNormalOutput) {
+  const SyntheticScene s = SyntheticScene::create(temp_folder("profiled"));
+  const FrameOutput normal = run_one(s, s.scene, true, false);
+  const FrameOutput profiled = run_one(s, s.scene, true, true);
+  ASSERT_FALSE(profiled.image.empty());
+  EXPECT_FALSE(normal.stats.profiled);
+  EXPECT_TRUE(profiled.stats.profiled);
+  ASSERT_GT(profiled.stats.passes.size(), 2u);
+  double sum = 0.0;
+  for (const PassTiming& p : profiled.stats.passes) {
+    EXPECT_GT(p.gpu_ms, 0.0) << p.name;
+    sum += p.gpu_ms;
+  }
+  EXPECT_NEAR(profiled.stats.gpu_total_ms, sum, 1e-9);
+  EXPECT_GE(profiled.stats.host_ms, 0.0);
+  EXPECT_EQ(normal.image.data, profiled.image.data);
 }
 
 TEST(FrameSkip, ObjectInViewIsNotSkipped) {

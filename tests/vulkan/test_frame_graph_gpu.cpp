@@ -184,6 +184,62 @@ TEST_F(VulkanTest, TimestampsArriveFramesLaterWithoutStalling) {
   EXPECT_EQ(px[(5 * W + 7) * 4 + 1], pattern(7, 5, 1));
 }
 
+TEST_F(VulkanTest, ProfilingModeTimesEachPassAloneAndTheyAddUpToTheFrame) {
+  InvertGraph t = InvertGraph::make(ctx());
+  std::vector<FrameTimings> got;
+  // Normal, profiled, profiled, normal, profiled: the mode switches between frames, in flight.
+  const bool profiled[] = {false, true, true, false, true};
+  for (bool on : profiled) {
+    ASSERT_TRUE(t.graph->set_profiling(on).ok());
+    auto begun = t.graph->begin_frame();
+    ASSERT_TRUE(begun.ok()) << begun.error().message;
+    if (*begun) got.push_back(**begun);
+    EXPECT_EQ(t.graph->set_profiling(!on).error().kind, ErrorKind::BadUsage);  // not inside a frame
+    ASSERT_TRUE(t.record_frame().ok());
+  }
+  auto rest = t.graph->flush();
+  ASSERT_TRUE(rest.ok()) << rest.error().message;
+  for (const FrameTimings& f : *rest) got.push_back(f);
+  ASSERT_EQ(got.size(), 5u);
+  for (size_t i = 0; i < got.size(); ++i) {
+    const FrameTimings& f = got[i];
+    EXPECT_EQ(f.frame_index, int64_t(i));
+    EXPECT_EQ(f.profiled, profiled[i]) << "frame " << i;
+    ASSERT_EQ(f.passes.size(), 3u);
+    double sum = 0.0;
+    for (const PassTiming& p : f.passes) {
+      EXPECT_GT(p.gpu_ms, 0.0) << p.name;
+      sum += p.gpu_ms;
+    }
+    if (f.profiled) EXPECT_NEAR(f.total_ms, sum, 1e-9) << "profiled passes are the frame";
+    EXPECT_GT(f.completed_s, 0.0);
+    if (i > 0) EXPECT_GE(f.completed_s, got[i - 1].completed_s);
+  }
+  // The output is the same in both modes.
+  const uint32_t slot = got.back().slot;
+  ASSERT_TRUE(ctx().invalidate(t.graph->gpu_buffer(t.readback, slot)).ok());
+  const uint8_t* px = static_cast<const uint8_t*>(t.graph->mapped(t.readback, slot));
+  int wrong = 0;
+  for (uint32_t y = 0; y < H; ++y)
+    for (uint32_t x = 0; x < W; ++x)
+      for (uint32_t c = 0; c < 4; ++c) wrong += px[(y * W + x) * 4 + c] != pattern(x, y, c);
+  EXPECT_EQ(wrong, 0);
+}
+
+TEST_F(VulkanTest, ProfilingModeNeedsItsCommandBuffersAllocated) {
+  FrameGraphSettings fs;
+  fs.max_output_width = W;
+  fs.max_output_height = H;
+  fs.allow_profiling = false;
+  auto g = FrameGraph::create(ctx(), fs);
+  ASSERT_TRUE(g.ok()) << g.error().message;
+  const Status st = (*g)->set_profiling(true);
+  ASSERT_FALSE(st.ok());
+  EXPECT_EQ(st.error().kind, ErrorKind::BadUsage);
+  EXPECT_NE(st.error().message.find("allow_profiling"), std::string::npos) << st.error().message;
+  EXPECT_TRUE((*g)->set_profiling(false).ok());
+}
+
 TEST_F(VulkanTest, NoAllocationAfterStartUp) {
   InvertGraph t = InvertGraph::make(ctx());
   auto floor = FloorPass::create(*t.graph);
