@@ -27,6 +27,7 @@
 #include "mrgi/platform/devices.h"
 #include "mrgi/runtime.h"
 #include "replay_output.h"
+#include "stage_thread.h"
 
 namespace mrgi::tool {
 namespace {
@@ -203,17 +204,38 @@ void run_live(const LiveOptions& o) {
   Pose last_pose = fixed_camera_pose();
   size_t submitted = 0, written = 0;
   const auto t0 = std::chrono::steady_clock::now();
+  // Encoding (PNG writes, stats) runs on its own thread behind a bounded queue, so the runtime's
+  // loop only waits for the sensor and the GPU.
+  struct Finished {
+    FrameOutput output;
+    ImageRGB8 camera;
+  };
+  BoundedQueue<Finished> finished(2);
+  StageThread encode(
+      [&] {
+        while (auto f = finished.pop()) {
+          auto st = output.add(f->output, f->camera, nullptr, nullptr);
+          if (!st.ok()) fail_with(st.error());
+          ++written;
+          if (!o.quiet)
+            progress("live " + o.technique, written, o.frames > 0 ? size_t(o.frames) : written,
+                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+        }
+      },
+      [&] { finished.close(); });
+  // Declared after `encode`, so on an error below the queue is closed before the encoder is
+  // joined (and it drains instead of waiting forever).
+  struct CloseOnExit {
+    BoundedQueue<Finished>& q;
+    ~CloseOnExit() { q.close(); }
+  } close_on_exit{finished};
   auto consume = [&](std::vector<FrameOutput>&& outs) {
     for (FrameOutput& f : outs) {
       auto cam = cameras_by_frame.find(f.stats.frame_index);
       if (cam == cameras_by_frame.end()) throw CommandFailure(1, "internal: output for unknown frame " + std::to_string(f.stats.frame_index));
-      auto st = output.add(f, cam->second, nullptr, nullptr);
-      if (!st.ok()) fail_with(st.error());
+      Finished item{std::move(f), std::move(cam->second)};
       cameras_by_frame.erase(cam);
-      ++written;
-      if (!o.quiet)
-        progress("live " + o.technique, written, o.frames > 0 ? size_t(o.frames) : written,
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      if (!finished.push(std::move(item))) encode.join();  // the encoder failed: rethrow its error
     }
   };
   std::optional<InputFrame> pending = std::move(first.value());
@@ -237,12 +259,19 @@ void run_live(const LiveOptions& o) {
     if (frame.pose) last_pose = *frame.pose;
     else frame.pose = last_pose;  // without tracking the camera pose stays where it was
     frame.index = int64_t(submitted++);
-    cameras_by_frame[frame.index] = resize_rgb8(frame.color, out_w, out_h);
+    cameras_by_frame[frame.index] = resize_bilinear(frame.color, out_w, out_h);
     consume(take(runtime->process(frame)));
   }
   consume(take(runtime->flush()));
+  finished.close();
+  encode.join();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (written != submitted)
     throw CommandFailure(1, "internal: " + std::to_string(written) + " of " + std::to_string(submitted) + " frames came back");
+  output.set_achieved({written, seconds, "from the first frame to the last encoded, sensor waits included"});
+  if (!o.quiet && seconds > 0.0)
+    std::cerr << "mrgi live: " << written << " frames in " << seconds << " s: " << double(written) / seconds
+              << " fps achieved\n";
   nlohmann::json summary = take(output.finish());
   if (!tracking_states.empty()) {
     std::cerr << "mrgi live: AprilTag tracking:";

@@ -79,7 +79,7 @@ void run_replay(const ReplayOptions& o) {
             tracker->fill_pose(d.frame);
             ++(d.frame.pose ? tracked : untracked);
           }
-          d.camera = resize_rgb8(d.frame.color, out_w, out_h);
+          d.camera = resize_bilinear(d.frame.color, out_w, out_h);
           if (d.frame.env && info.env_camera)
             d.truth = take(light_from_environment(*d.frame.env, *info.env_camera, env_intensity));
           if (!decoded.push(std::move(d))) return;  // a later stage failed
@@ -93,9 +93,9 @@ void run_replay(const ReplayOptions& o) {
           std::optional<ImageRGB8> ref;
           std::optional<ImageU8> mask;
           if (!capture.entry(i).reference.empty()) {
-            ref = resize_rgb8(take(capture.read_reference(i)), out_w, out_h);
+            ref = resize_bilinear(take(capture.read_reference(i)), out_w, out_h);
             if (!capture.entry(i).reference_mask.empty())
-              mask = resize_mask_nearest(take(capture.read_reference_mask(i)), out_w, out_h);
+              mask = resize_nearest(take(capture.read_reference_mask(i)), out_w, out_h);
           }
           const LightEstimate* truth = f->truth ? &*f->truth : nullptr;
           auto st = output.add(f->output, f->camera, ref ? &*ref : nullptr, mask ? &*mask : nullptr, truth);

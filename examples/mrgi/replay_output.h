@@ -70,8 +70,5 @@ class ReplayOutput {
 nlohmann::json figures_json(const ErrorFigures& f);
 // The estimated light (techniques that estimate it): direction, intensity, confidence, SH.
 nlohmann::json light_json(const LightEstimate& e);
-// Resamples an 8-bit RGB image to w x h (bilinear), for cameras larger than the output.
-ImageRGB8 resize_rgb8(const ImageRGB8& src, int w, int h);
-ImageU8 resize_mask_nearest(const ImageU8& src, int w, int h);
 
 }  // namespace mrgi::tool

@@ -16,6 +16,7 @@ namespace mrgi::tool {
 
 template <class T>
 class BoundedQueue {
+  // (StageThread's destructor joins: close the queues it waits on before it is destroyed.)
  public:
   explicit BoundedQueue(size_t capacity) : capacity_(capacity ? capacity : 1) {}
   // Blocks while full. False once the queue was closed (the item is dropped).

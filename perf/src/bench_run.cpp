@@ -258,8 +258,15 @@ Expected<RunSamples> run_one(const LoadedScene& l, const std::string& technique,
   for (const FrameOutput& out : kept) {
     const size_t src = ping_pong(size_t(out.stats.frame_index), n);
     if (!l.references[src]) continue;
-    const ImageU8* mask = l.masks[src] ? &*l.masks[src] : nullptr;
-    auto err = measure_error(out.image, l.frames[src].color, *l.references[src], mask);
+    // At another output size (--width/--height, --sizes) camera, reference and mask are resampled
+    // to it, as `mrgi replay` does.
+    const int w = out.image.width, h = out.image.height;
+    const ImageRGB8 camera = resize_bilinear(l.frames[src].color, w, h);
+    const ImageRGB8 reference = resize_bilinear(*l.references[src], w, h);
+    std::optional<ImageU8> mask_resized;
+    if (l.masks[src]) mask_resized = resize_nearest(*l.masks[src], w, h);
+    const ImageU8* mask = mask_resized ? &*mask_resized : nullptr;
+    auto err = measure_error(out.image, camera, reference, mask);
     if (!err.ok()) return fail(err.error().kind, what + ", frame " + std::to_string(src) + ": " + err.error().message);
     if (!pooled_any) {
       e.error = *err;

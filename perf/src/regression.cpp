@@ -65,7 +65,8 @@ Baseline make_baseline(const BenchResult& result, const Tolerances& tolerances) 
   b.warmup = result.warmup;
   b.floor_median_ms = result.floor_median_ms;
   for (const BenchEntry& e : result.entries) {
-    BaselineEntry be{e.scene, e.technique, e.level_name, e.level, e.sustained_ratio, {}, {}};
+    BaselineEntry be{e.scene, e.technique, e.level_name, e.level, e.sustained_ratio, {}, {}, e.profiled.median_ratio, {}};
+    for (const PassSummary& p : e.passes) be.pass_ratios.emplace_back(p.name, p.time.median_ratio);
     if (e.has_reference) {
       if (e.error.all.rde_defined) be.rde = e.error.all.rde;
       be.delta_rms = e.error.all.delta_rms;
@@ -80,18 +81,25 @@ Status write_baseline(const std::string& path, const Baseline& b) {
   j["version"] = 1;
   j["tolerances"] = {{"ratio_relative", b.tolerances.ratio_relative},
                      {"rde_absolute", b.tolerances.rde_absolute},
-                     {"delta_rms_absolute", b.tolerances.delta_rms_absolute}};
+                     {"delta_rms_absolute", b.tolerances.delta_rms_absolute},
+                     {"pass_ratio_relative", b.tolerances.pass_ratio_relative},
+                     {"pass_min_share", b.tolerances.pass_min_share}};
   j["source"] = {{"device", b.device},   {"lp_num_threads", b.lp_num_threads}, {"commit", b.commit},
                  {"frames", b.frames},   {"warmup", b.warmup},                 {"floor_median_ms", b.floor_median_ms}};
   nlohmann::ordered_json entries = nlohmann::ordered_json::array();
-  for (const BaselineEntry& e : b.entries)
+  for (const BaselineEntry& e : b.entries) {
+    nlohmann::ordered_json passes = nlohmann::ordered_json::object();
+    for (const auto& [name, ratio] : e.pass_ratios) passes[name] = ratio;
     entries.push_back({{"scene", e.scene},
                        {"technique", e.technique},
                        {"level", e.level},
                        {"level_name", e.level_name},
                        {"ratio_to_floor", e.ratio_to_floor},
                        {"rde", opt_json(e.rde)},
-                       {"delta_rms", opt_json(e.delta_rms)}});
+                       {"delta_rms", opt_json(e.delta_rms)},
+                       {"profiled_ratio", e.profiled_ratio},
+                       {"pass_ratios", passes}});
+  }
   j["entries"] = entries;
   const std::string tmp = path + ".tmp";
   {
@@ -129,6 +137,15 @@ Expected<Baseline> load_baseline(const std::string& path) {
   b.tolerances.rde_absolute = *v;
   MRGI_TRY(read_number(j["tolerances"], "delta_rms_absolute", tw, false, v));
   b.tolerances.delta_rms_absolute = *v;
+  // Optional (baselines written before the per-pass rule have neither): the defaults apply.
+  if (j["tolerances"].contains("pass_ratio_relative")) {
+    MRGI_TRY(read_number(j["tolerances"], "pass_ratio_relative", tw, false, v));
+    b.tolerances.pass_ratio_relative = *v;
+  }
+  if (j["tolerances"].contains("pass_min_share")) {
+    MRGI_TRY(read_number(j["tolerances"], "pass_min_share", tw, false, v));
+    b.tolerances.pass_min_share = *v;
+  }
   if (j.contains("source") && j["source"].is_object()) {
     const auto& s = j["source"];
     b.device = s.value("device", "");
@@ -157,6 +174,18 @@ Expected<Baseline> load_baseline(const std::string& path) {
     if (!(be.ratio_to_floor > 0.0)) return fail(ErrorKind::BadInput, where + ".ratio_to_floor: must be > 0");
     MRGI_TRY(read_number(e, "rde", where, true, be.rde));
     MRGI_TRY(read_number(e, "delta_rms", where, true, be.delta_rms));
+    if (e.contains("profiled_ratio")) {
+      MRGI_TRY(read_number(e, "profiled_ratio", where, false, v));
+      be.profiled_ratio = *v;
+    }
+    if (e.contains("pass_ratios")) {
+      if (!e["pass_ratios"].is_object())
+        return fail(ErrorKind::BadInput, where + ".pass_ratios: must be an object of pass name -> ratio");
+      for (const auto& [name, value] : e["pass_ratios"].items()) {
+        MRGI_TRY(read_number(e["pass_ratios"], name.c_str(), where + ".pass_ratios", false, v));
+        be.pass_ratios.emplace_back(name, *v);
+      }
+    }
     const Key k{be.scene, be.technique, be.level_name};
     if (!seen.emplace(k, i).second)
       return fail(ErrorKind::BadInput, where + ": " + key_text(be.scene, be.technique, be.level_name) +
@@ -199,6 +228,20 @@ CheckReport check_against(const BenchResult& result, const Baseline& b) {
       rep.violations.push_back(name + ": sustained frame time ratio to floor " + num(e.sustained_ratio) + " > " +
                                num(ratio_limit) + " (baseline " + num(be.ratio_to_floor) + " + " +
                                num(100.0 * tol.ratio_relative) + " %)");
+    // Per pass: only passes that carried a real share of the baseline's frame; their noise is
+    // below the tolerance, a small pass's is not.
+    for (const auto& [pass, base_ratio] : be.pass_ratios) {
+      if (!(be.profiled_ratio > 0.0) || base_ratio < tol.pass_min_share * be.profiled_ratio) continue;
+      const PassSummary* now = nullptr;
+      for (const PassSummary& p : e.passes)
+        if (p.name == pass) now = &p;
+      if (!now) continue;  // a pass the run culled or skipped is no slowdown
+      const double limit = base_ratio * (1.0 + tol.pass_ratio_relative);
+      if (!(now->time.median_ratio <= limit))
+        rep.violations.push_back(name + ": pass " + pass + " ratio to floor " + num(now->time.median_ratio) + " > " +
+                                 num(limit) + " (baseline " + num(base_ratio) + " + " +
+                                 num(100.0 * tol.pass_ratio_relative) + " %)");
+    }
     const bool have_rde = e.has_reference && e.error.all.rde_defined;
     if (be.rde) {
       if (!have_rde) {

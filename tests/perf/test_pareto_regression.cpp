@@ -112,6 +112,45 @@ TEST(Regression, RatioGrowthBeyondToleranceFails) {
   EXPECT_FALSE(perf::check_against(r, b).passed);
 }
 
+// The per-pass rule: a pass with at least pass_min_share of the profiled frame fails at more than
+// pass_ratio_relative growth, though the frame as a whole stays within its tolerance.
+TEST(Regression, APassTwentyPercentSlowerFailsWhileTheFramePasses) {
+  perf::BenchResult r = constructed_result();
+  for (perf::BenchEntry& e : r.entries) {
+    e.profiled = {4, 10.0, 11.0, 5.0, 5.5};             // ratio 5 for the whole profiled frame
+    e.passes = {{"shade", {4, 6.0, 6.5, 3.0, 3.2}},      // 60 % of the frame
+                {"tiny", {4, 0.2, 0.3, 0.1, 0.15}}};     // 2 %: not checked
+  }
+  const perf::Baseline b = perf::make_baseline(r);
+  ASSERT_EQ(b.entries[0].pass_ratios.size(), 2u);
+  EXPECT_TRUE(perf::check_against(r, b).passed);
+  perf::BenchResult slow = r;
+  slow.entries[2].passes[0].time.median_ratio *= 1.20;   // planted: +20 % on one pass
+  slow.entries[2].passes[1].time.median_ratio *= 3.0;    // noise on a tiny pass: ignored
+  const perf::CheckReport rep = perf::check_against(slow, b);
+  EXPECT_FALSE(rep.passed);
+  ASSERT_EQ(rep.violations.size(), 1u) << rep.summary();
+  EXPECT_NE(rep.violations[0].find("empty/baseline/high: pass shade"), std::string::npos) << rep.violations[0];
+  perf::BenchResult noisy = r;
+  noisy.entries[2].passes[0].time.median_ratio *= 1.12;  // within the 15 % tolerance
+  EXPECT_TRUE(perf::check_against(noisy, b).passed);
+}
+
+TEST(Regression, PassRatiosRoundTripThroughTheFile) {
+  perf::BenchResult r = constructed_result();
+  r.entries[0].profiled = {4, 10.0, 11.0, 5.0, 5.5};
+  const perf::Baseline b = perf::make_baseline(r);
+  TempDir dir;
+  ASSERT_TRUE(perf::write_baseline(dir.file("b.json"), b).ok());
+  auto back = perf::load_baseline(dir.file("b.json"));
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  ASSERT_EQ(back->entries[0].pass_ratios.size(), 1u);
+  EXPECT_EQ(back->entries[0].pass_ratios[0].first, "shade");
+  EXPECT_DOUBLE_EQ(back->entries[0].pass_ratios[0].second, 2.5);
+  EXPECT_DOUBLE_EQ(back->entries[0].profiled_ratio, 5.0);
+  EXPECT_DOUBLE_EQ(back->tolerances.pass_ratio_relative, 0.15);
+}
+
 TEST(Regression, DifferentFrameCountsAreNotCompared) {
   perf::BenchResult r = constructed_result();
   const perf::Baseline b = perf::make_baseline(r);

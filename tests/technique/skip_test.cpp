@@ -147,7 +147,7 @@ TEST(FrameSkip, ProfiledFramePassesAddUpAndMatchTheNormalOutput) {
   ASSERT_GT(profiled.stats.passes.size(), 2u);
   double sum = 0.0;
   for (const PassTiming& p : profiled.stats.passes) {
-    EXPECT_GT(p.gpu_ms, 0.0) << p.name;
+    EXPECT_GE(p.gpu_ms, 0.0) << p.name;  // the submission overhead is subtracted
     sum += p.gpu_ms;
   }
   EXPECT_NEAR(profiled.stats.gpu_total_ms, sum, 1e-9);

@@ -45,6 +45,11 @@ Status write_png(const std::string& path, const ImageRGBA8& img, PngEffort effor
 Status write_png(const std::string& path, const ImageU16& img, PngEffort effort = PngEffort::Fast);
 Status write_png(const std::string& path, const ImageU8& img, PngEffort effort = PngEffort::Fast);
 
+// Resampling to w x h, for outputs of another size than the camera: colour bilinear on the
+// encoded values (as a display would scale it), masks nearest. The same size returns a copy.
+ImageRGB8 resize_bilinear(const ImageRGB8& src, int w, int h);
+ImageU8 resize_nearest(const ImageU8& src, int w, int h);
+
 // HDR images: .exr (read with OpenEXR: every compression, including DWAA/DWAB; written with
 // tinyexr as 32-bit float), .hdr (stb), .png (8-bit sRGB decoded to linear). NaN or Inf is
 // refused (BadInput naming file and pixel); negative values are clamped to 0 (lossy-codec ringing).

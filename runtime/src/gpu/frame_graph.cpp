@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <string>
 
 #include "gpu/frame_graph.h"
 #include "gpu/vk_check.h"
@@ -126,9 +128,19 @@ Status FrameGraph::init() {
     VK_CHECK(vkAllocateCommandBuffers(dev, &ai, profile_cmds_.data()));
     VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
     VK_CHECK(vkCreateFence(dev, &fci, nullptr, &profile_fence_));
+    MRGI_TRY(measure_submission_overhead());
   }
   decls_.reserve(settings_.max_passes);
   executes_.reserve(settings_.max_passes);
+  if (const char* plant = std::getenv("MRGI_PLANT_SLOWDOWN")) {
+    const std::string spec = plant;
+    const size_t colon = spec.rfind(':');
+    const double factor = colon == std::string::npos ? 0.0 : std::atof(spec.c_str() + colon + 1);
+    if (colon == std::string::npos || colon == 0 || !(factor >= 1.0 && factor <= 100.0))
+      return fail(ErrorKind::BadUsage, "MRGI_PLANT_SLOWDOWN='" + spec + "': must be PASS:FACTOR with FACTOR in [1, 100]");
+    plant_pass_ = spec.substr(0, colon);
+    plant_factor_ = factor;
+  }
   return ok_status();
 }
 
@@ -523,6 +535,33 @@ Status FrameGraph::set_profiling(bool on) {
   return ok_status();
 }
 
+Status FrameGraph::measure_submission_overhead() {
+  VkDevice dev = context_.device();
+  VkCommandBuffer cmd = profile_cmds_[0];
+  VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  constexpr int kSamples = 7;
+  std::vector<double> ms;
+  for (int i = 0; i < kSamples; ++i) {
+    VK_CHECK(vkResetCommandBuffer(cmd, 0));
+    VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
+    VK_CHECK(vkEndCommandBuffer(cmd));
+    VkCommandBufferSubmitInfo cbi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+    cbi.commandBuffer = cmd;
+    VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+    si.commandBufferInfoCount = 1;
+    si.pCommandBufferInfos = &cbi;
+    const auto t0 = std::chrono::steady_clock::now();
+    VK_CHECK(context_.fn().queue_submit2(context_.queue(), 1, &si, profile_fence_));
+    VK_CHECK(vkWaitForFences(dev, 1, &profile_fence_, VK_TRUE, kFrameTimeoutNs));
+    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    VK_CHECK(vkResetFences(dev, 1, &profile_fence_));
+  }
+  std::sort(ms.begin(), ms.end());
+  submission_overhead_ms_ = ms[ms.size() / 2];
+  return ok_status();
+}
+
 Status FrameGraph::submit_profiled() {
   VkDevice dev = context_.device();
   const uint32_t n = uint32_t(compiled_.passes.size());
@@ -555,13 +594,20 @@ Status FrameGraph::submit_profiled() {
     const auto t0 = std::chrono::steady_clock::now();
     VK_CHECK(context_.fn().queue_submit2(context_.queue(), 1, &si, profile_fence_));
     const VkResult w = vkWaitForFences(dev, 1, &profile_fence_, VK_TRUE, kFrameTimeoutNs);
-    const auto t1 = std::chrono::steady_clock::now();
+    auto t1 = std::chrono::steady_clock::now();
     if (w == VK_TIMEOUT)
       return fail(ErrorKind::Timeout, "pass '" + p.name + "' did not finish within " +
                                           std::to_string(kFrameTimeoutS) + " s (profiling mode)");
     VK_CHECK(w);
     VK_CHECK(vkResetFences(dev, 1, &profile_fence_));
-    slot.host_ms[i] = std::chrono::duration<double, std::milli>(t1 - t0).count();
+    if (!plant_pass_.empty() && p.name == plant_pass_) {  // test hook: see frame_graph.h
+      const auto until = t0 + (t1 - t0) * plant_factor_;
+      while (std::chrono::steady_clock::now() < until) {
+      }
+      t1 = std::chrono::steady_clock::now();
+    }
+    slot.host_ms[i] =
+        std::max(0.0, std::chrono::duration<double, std::milli>(t1 - t0).count() - submission_overhead_ms_);
   }
   finish_execute(true);
   // The slot's fence marks the frame done, as in normal mode (an empty submission signals it).

@@ -307,6 +307,10 @@ class FrameGraph {
   // each pass its own submission, host-timed. BadUsage when the graph was made without it.
   Status set_profiling(bool on);
   bool profiling() const { return profiling_; }
+  // What one empty submission costs from submit to fence here (median of a few, measured at
+  // start-up when profiling is allowed): subtracted from every profiled pass, so a pass's time
+  // is its work and a frame of many short passes does not read longer than it runs.
+  double submission_overhead_ms() const { return submission_overhead_ms_; }
 
   int64_t frame_index() const { return frame_index_; }   // of the frame being built
   uint32_t slot() const { return slot_; }
@@ -358,7 +362,14 @@ class FrameGraph {
   std::vector<VkCommandBuffer> profile_cmds_;
   VkFence profile_fence_ = VK_NULL_HANDLE;
   bool profiling_ = false;
+  double submission_overhead_ms_ = 0.0;
+  // Test hook for the regression check (perf/README.md): MRGI_PLANT_SLOWDOWN=PASS:FACTOR makes
+  // pass PASS take FACTOR times as long in profiling mode (the host waits the extra time after
+  // its fence). Read once at creation; empty = off.
+  std::string plant_pass_;
+  double plant_factor_ = 1.0;
   Status submit_profiled();
+  Status measure_submission_overhead();
   void record_barriers(VkCommandBuffer cmd, const std::vector<Barrier>& barriers);
   void finish_execute(bool profiled);
   VkExtent2D output_size_{0, 0};
