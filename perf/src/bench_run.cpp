@@ -127,15 +127,17 @@ Expected<std::vector<int>> resolve_levels(const std::string& technique, const st
   return std::vector<int>(picked.begin(), picked.end());
 }
 
-TimeSummary summarize(const std::vector<double>& ms, double floor_ms) {
+TimeSummary summarize(const std::vector<double>& ms, double floor_ms, double floor_min_ms) {
   TimeSummary t;
   t.samples = ms.size();
   t.median_ms = percentile(ms, 50);
   t.p95_ms = percentile(ms, 95);
+  t.min_ms = ms.empty() ? 0.0 : *std::min_element(ms.begin(), ms.end());
   if (floor_ms > 0.0) {
     t.median_ratio = t.median_ms / floor_ms;
     t.p95_ratio = t.p95_ms / floor_ms;
   }
+  if (floor_min_ms > 0.0) t.min_ratio = t.min_ms / floor_min_ms;
   return t;
 }
 
@@ -417,12 +419,12 @@ Expected<BenchResult> run_bench(const BenchSettings& s) {
     all_floor.insert(all_floor.end(), floor_ms.begin(), floor_ms.end());
     result.floors.push_back(f);
     for (RunSamples& r : runs) {
-      r.entry.frame = summarize(r.interval_ms, f.median_ms);
+      r.entry.frame = summarize(r.interval_ms, f.median_ms, f.min_ms);
       r.entry.sustained_ms = r.sustained_ms;
       r.entry.sustained_ratio = r.sustained_ms / f.median_ms;
-      r.entry.profiled = summarize(r.profiled_ms, f.median_ms);
+      r.entry.profiled = summarize(r.profiled_ms, f.median_ms, f.min_ms);
       for (const std::string& name : r.pass_order)
-        r.entry.passes.push_back(PassSummary{name, summarize(r.pass_ms[name], f.median_ms)});
+        r.entry.passes.push_back(PassSummary{name, summarize(r.pass_ms[name], f.median_ms, f.min_ms)});
       result.entries.push_back(std::move(r.entry));
     }
   }

@@ -65,8 +65,8 @@ Baseline make_baseline(const BenchResult& result, const Tolerances& tolerances) 
   b.warmup = result.warmup;
   b.floor_median_ms = result.floor_median_ms;
   for (const BenchEntry& e : result.entries) {
-    BaselineEntry be{e.scene, e.technique, e.level_name, e.level, e.sustained_ratio, {}, {}, e.profiled.median_ratio, {}};
-    for (const PassSummary& p : e.passes) be.pass_ratios.emplace_back(p.name, p.time.median_ratio);
+    BaselineEntry be{e.scene, e.technique, e.level_name, e.level, e.sustained_ratio, {}, {}, e.profiled.min_ratio, {}};
+    for (const PassSummary& p : e.passes) be.pass_ratios.emplace_back(p.name, p.time.min_ratio);
     if (e.has_reference) {
       if (e.error.all.rde_defined) be.rde = e.error.all.rde;
       be.delta_rms = e.error.all.delta_rms;
@@ -82,6 +82,7 @@ Status write_baseline(const std::string& path, const Baseline& b) {
   j["tolerances"] = {{"ratio_relative", b.tolerances.ratio_relative},
                      {"rde_absolute", b.tolerances.rde_absolute},
                      {"delta_rms_absolute", b.tolerances.delta_rms_absolute},
+                     {"ratio_absolute", b.tolerances.ratio_absolute},
                      {"pass_ratio_relative", b.tolerances.pass_ratio_relative},
                      {"pass_min_share", b.tolerances.pass_min_share}};
   j["source"] = {{"device", b.device},   {"lp_num_threads", b.lp_num_threads}, {"commit", b.commit},
@@ -138,6 +139,10 @@ Expected<Baseline> load_baseline(const std::string& path) {
   MRGI_TRY(read_number(j["tolerances"], "delta_rms_absolute", tw, false, v));
   b.tolerances.delta_rms_absolute = *v;
   // Optional (baselines written before the per-pass rule have neither): the defaults apply.
+  if (j["tolerances"].contains("ratio_absolute")) {
+    MRGI_TRY(read_number(j["tolerances"], "ratio_absolute", tw, false, v));
+    b.tolerances.ratio_absolute = *v;
+  }
   if (j["tolerances"].contains("pass_ratio_relative")) {
     MRGI_TRY(read_number(j["tolerances"], "pass_ratio_relative", tw, false, v));
     b.tolerances.pass_ratio_relative = *v;
@@ -223,11 +228,11 @@ CheckReport check_against(const BenchResult& result, const Baseline& b) {
     matched[k] = true;
     rep.compared += 1;
     const BaselineEntry& be = *it->second;
-    const double ratio_limit = be.ratio_to_floor * (1.0 + tol.ratio_relative);
+    const double ratio_limit = be.ratio_to_floor * (1.0 + tol.ratio_relative) + tol.ratio_absolute;
     if (!(e.sustained_ratio <= ratio_limit))
       rep.violations.push_back(name + ": sustained frame time ratio to floor " + num(e.sustained_ratio) + " > " +
                                num(ratio_limit) + " (baseline " + num(be.ratio_to_floor) + " + " +
-                               num(100.0 * tol.ratio_relative) + " %)");
+                               num(100.0 * tol.ratio_relative) + " % + " + num(tol.ratio_absolute) + " floor)");
     // Per pass: only passes that carried a real share of the baseline's frame; their noise is
     // below the tolerance, a small pass's is not.
     for (const auto& [pass, base_ratio] : be.pass_ratios) {
@@ -237,8 +242,8 @@ CheckReport check_against(const BenchResult& result, const Baseline& b) {
         if (p.name == pass) now = &p;
       if (!now) continue;  // a pass the run culled or skipped is no slowdown
       const double limit = base_ratio * (1.0 + tol.pass_ratio_relative);
-      if (!(now->time.median_ratio <= limit))
-        rep.violations.push_back(name + ": pass " + pass + " ratio to floor " + num(now->time.median_ratio) + " > " +
+      if (!(now->time.min_ratio <= limit))
+        rep.violations.push_back(name + ": pass " + pass + " fastest-frame ratio to floor " + num(now->time.min_ratio) + " > " +
                                  num(limit) + " (baseline " + num(base_ratio) + " + " +
                                  num(100.0 * tol.pass_ratio_relative) + " %)");
     }

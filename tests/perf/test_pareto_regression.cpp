@@ -106,10 +106,14 @@ TEST(Regression, RatioGrowthBeyondToleranceFails) {
   EXPECT_NE(rep.violations[0].find("ratio"), std::string::npos) << rep.violations[0];
   // Within tolerance (run 30 % slower than the baseline, limit 35 %) passes.
   b = perf::make_baseline(r);
+  b.tolerances.ratio_absolute = 0.0;
   b.entries[1].ratio_to_floor /= 1.30;
   EXPECT_TRUE(perf::check_against(r, b).passed);
   b.entries[1].ratio_to_floor = r.entries[1].sustained_ratio / 1.40;
   EXPECT_FALSE(perf::check_against(r, b).passed);
+  // The absolute slack (1 floor pass by default): 5.0 <= 3.57 x 1.35 + 1 = 5.82.
+  b.tolerances.ratio_absolute = 1.0;
+  EXPECT_TRUE(perf::check_against(r, b).passed);
 }
 
 // The per-pass rule: a pass with at least pass_min_share of the profiled frame fails at more than
@@ -117,28 +121,29 @@ TEST(Regression, RatioGrowthBeyondToleranceFails) {
 TEST(Regression, APassTwentyPercentSlowerFailsWhileTheFramePasses) {
   perf::BenchResult r = constructed_result();
   for (perf::BenchEntry& e : r.entries) {
-    e.profiled = {4, 10.0, 11.0, 5.0, 5.5};             // ratio 5 for the whole profiled frame
-    e.passes = {{"shade", {4, 6.0, 6.5, 3.0, 3.2}},      // 60 % of the frame
-                {"tiny", {4, 0.2, 0.3, 0.1, 0.15}}};     // 2 %: not checked
+    e.profiled = {4, 10.0, 11.0, 5.0, 5.5, 10.0, 5.0};             // min ratio 5 for the frame
+    e.passes = {{"shade", {4, 6.0, 6.5, 3.0, 3.2, 6.0, 3.0}},      // 60 % of the frame
+                {"tiny", {4, 0.2, 0.3, 0.1, 0.15, 0.2, 0.1}}};     // 2 %: not checked
   }
   const perf::Baseline b = perf::make_baseline(r);
   ASSERT_EQ(b.entries[0].pass_ratios.size(), 2u);
   EXPECT_TRUE(perf::check_against(r, b).passed);
   perf::BenchResult slow = r;
-  slow.entries[2].passes[0].time.median_ratio *= 1.20;   // planted: +20 % on one pass
-  slow.entries[2].passes[1].time.median_ratio *= 3.0;    // noise on a tiny pass: ignored
+  slow.entries[2].passes[0].time.min_ratio *= 1.20;      // planted: +20 % on one pass
+  slow.entries[2].passes[1].time.min_ratio *= 3.0;       // noise on a tiny pass: ignored
   const perf::CheckReport rep = perf::check_against(slow, b);
   EXPECT_FALSE(rep.passed);
   ASSERT_EQ(rep.violations.size(), 1u) << rep.summary();
   EXPECT_NE(rep.violations[0].find("empty/baseline/high: pass shade"), std::string::npos) << rep.violations[0];
   perf::BenchResult noisy = r;
-  noisy.entries[2].passes[0].time.median_ratio *= 1.12;  // within the 15 % tolerance
+  noisy.entries[2].passes[0].time.min_ratio *= 1.12;     // within the 15 % tolerance
   EXPECT_TRUE(perf::check_against(noisy, b).passed);
 }
 
 TEST(Regression, PassRatiosRoundTripThroughTheFile) {
   perf::BenchResult r = constructed_result();
-  r.entries[0].profiled = {4, 10.0, 11.0, 5.0, 5.5};
+  r.entries[0].profiled = {4, 10.0, 11.0, 5.0, 5.5, 10.0, 5.0};
+  r.entries[0].passes[0].time.min_ratio = 2.5;
   const perf::Baseline b = perf::make_baseline(r);
   TempDir dir;
   ASSERT_TRUE(perf::write_baseline(dir.file("b.json"), b).ok());

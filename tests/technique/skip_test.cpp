@@ -65,10 +65,13 @@ std::string temp_folder(const std::string& name) {
   return dir.string();
 }
 
-FrameOutput run_one(const SyntheticScene& s, const SceneDesc& scene, bool skips, bool profiled = false) {
+FrameOutput run_one(const SyntheticScene& s, const SceneDesc& scene, bool skips, bool profiled = false,
+                    int output_width = 0, int output_height = 0) {
   RuntimeSettings rs;
   rs.device.validate = true;
   rs.profile_passes = profiled;
+  rs.output_width = output_width;
+  rs.output_height = output_height;
   rs.technique = "baseline";
   rs.level = 0;
   rs.skip_unaffected_frames = skips;
@@ -113,27 +116,45 @@ TEST(FrameSkip, OutOfViewObjectSkipsTheTechniqueWithoutChangingTheOutput) {
   EXPECT_FALSE(ran_shadow);
 }
 
-// The lean skeleton: a frame nothing virtual affects runs one pass (compose's camera copy), and
-// its output is the camera frame byte for byte.
-TEST(FrameSkip, UnaffectedFrameRunsOnlyTheCameraCopy) {
+// The lean skeleton: a frame nothing virtual affects runs no GPU pass at the camera's size, and
+// its output is the camera frame byte for byte; at another output size compose's camera-copy
+// pipeline resamples it, and nothing else runs.
+TEST(FrameSkip, UnaffectedFrameIsTheCameraFrameWithoutAPass) {
   const SyntheticScene s = SyntheticScene::create(temp_folder("lean"));
   SceneDesc far = s.scene;
   for (auto& v : far.virtual_objects) v.placement.position += glm::vec3(30.0f, 0.0f, 0.0f);
   const FrameOutput o = run_one(s, far, true);
   ASSERT_FALSE(o.image.empty());
-  std::vector<std::string> names;
-  for (const PassTiming& p : o.stats.passes) names.push_back(p.name);
-  EXPECT_EQ(names, std::vector<std::string>{"compose"});
-  bool recon_skip = false;
-  for (const std::string& sk : o.stats.skipped) recon_skip = recon_skip || sk.rfind("recon:", 0) == 0;
+  EXPECT_TRUE(o.stats.passes.empty());
+  bool recon_skip = false, compose_skip = false;
+  for (const std::string& sk : o.stats.skipped) {
+    recon_skip = recon_skip || sk.rfind("recon:", 0) == 0;
+    compose_skip = compose_skip || sk.rfind("compose:", 0) == 0;
+  }
   EXPECT_TRUE(recon_skip);
+  EXPECT_TRUE(compose_skip);
   const InputFrame in = s.frame(0);
   ASSERT_EQ(size_t(o.image.width) * o.image.height, size_t(in.color.width) * in.color.height);
   int different = 0;
-  for (size_t i = 0; i < size_t(in.color.width) * in.color.height; ++i)
+  for (size_t i = 0; i < size_t(in.color.width) * in.color.height; ++i) {
     for (int c = 0; c < 3; ++c) different += o.image.data[i * 4 + c] != in.color.data[i * 3 + c];
+    different += o.image.data[i * 4 + 3] != 255;
+  }
   EXPECT_EQ(different, 0);
   for (uint8_t m : o.virtual_mask.data) EXPECT_EQ(m, 0);
+
+  const int w = in.color.width / 2, h = in.color.height / 2;
+  const FrameOutput half = run_one(s, far, true, false, w, h);
+  ASSERT_EQ(half.image.width, w);
+  std::vector<std::string> names;
+  for (const PassTiming& p : half.stats.passes) names.push_back(p.name);
+  EXPECT_EQ(names, std::vector<std::string>{"compose"});
+  const ImageRGB8 expect = resize_bilinear(in.color, w, h);
+  int worst = 0;
+  for (size_t i = 0; i < size_t(w) * h; ++i)
+    for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(int(half.image.data[i * 4 + c]) - int(expect.data[i * 3 + c])));
+  // compose resamples on linear values, resize_bilinear on encoded ones: close, not equal.
+  EXPECT_LE(worst, 24);
 }
 
 // Profiling mode: every pass its own host-timed submission, and they add up to the frame.

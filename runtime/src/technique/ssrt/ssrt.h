@@ -56,10 +56,13 @@
 //
 // Known defects: the grey-world albedo (paper Sec. 6.4) reads brighter objects as more light
 // from their side (env_fisheye's boxes and ball are 0.6-0.7, its floor 0.5); the fast level
-// costs far more than 33 ms on lavapipe (static camera, 640x480: transfer 90-97 ms, ray-cast
-// 71-74, shade 46-53, all passes 267-277). The fastest level had 2 SH bands until session 4; the
-// transfer accumulates all 16 coefficients whatever the level, so 2 bands saved nothing and
-// cost the direction (46 degrees off; LightEstimatorSettings::below_surface_penalty says why).
+// costs far more than 33 ms on lavapipe: 208 ms sustained, suite mean at 640x480 (session 5,
+// `mrgi bench --techniques ssrt --frames 4 --warmup 1`), of which the profiled split gives the
+// TSDF ray cast 68 ms and the transfer 80 ms, shade 34 ms; the ray cast and the volume's
+// G-buffer still run per pixel of the internal resolution, not per transfer cell as the level
+// allows. The fastest level had 2 SH bands until session 4; the transfer accumulates all 16
+// coefficients whatever the level, so 2 bands saved nothing and cost the direction (46 degrees
+// off; LightEstimatorSettings::below_surface_penalty says why).
 #pragma once
 #include <memory>
 #include <vector>
