@@ -20,7 +20,8 @@ namespace {
 
 nlohmann::json time_json(const TimeSummary& t) {
   return {{"samples", t.samples},          {"median_ms", t.median_ms},     {"p95_ms", t.p95_ms},
-          {"median_ratio", t.median_ratio}, {"p95_ratio", t.p95_ratio}};
+          {"median_ratio", t.median_ratio}, {"p95_ratio", t.p95_ratio},  {"min_ms", t.min_ms},
+          {"min_ratio", t.min_ratio}};
 }
 
 nlohmann::json figures_json(const ErrorFigures& f) {

@@ -36,33 +36,47 @@ vec4 cubic_weights(float t) {
 }
 
 // Bicubic over the cells that see the same kind of surface as the pixel (layer 7 w: 1 real,
-// 2 virtual; any surface when `kind` is 0), renormalised by the weights of the cells used.
-float sample_bicubic(vec2 c, float kind, out vec4 s4, out vec4 s5, out vec4 s6) {
+// 2 virtual), renormalised by the weights of the cells used; where the 4x4 neighbourhood holds
+// no cell of the pixel's kind (thin virtual parts at 4x4), over the cells of any surface.
+// Both sums are accumulated in one pass over the 16 cells: as two calls (same kind, then any
+// kind where the first found nothing) lavapipe ran the second for every pixel, since a
+// divergent `if` runs under a lane mask, which doubled this pass's 48 fetches a pixel. Each sum
+// takes the same terms in the same order as one call would, so the result is unchanged.
+void sample_bicubic(vec2 c, float kind, out vec4 s4, out vec4 s5, out vec4 s6) {
   vec2 base = floor(c);
   vec2 f = c - base;
   vec4 wx = cubic_weights(f.x), wy = cubic_weights(f.y);
-  s4 = vec4(0.0f); s5 = vec4(0.0f); s6 = vec4(0.0f);
-  float wsum = 0.0f;
+  vec4 k4 = vec4(0.0f), k5 = vec4(0.0f), k6 = vec4(0.0f);  // same kind
+  vec4 a4 = vec4(0.0f), a5 = vec4(0.0f), a6 = vec4(0.0f);  // any surface
+  float kw = 0.0f, aw = 0.0f;
   for (int j = 0; j < 4; ++j) {
     for (int i = 0; i < 4; ++i) {
       ivec2 q = clamp(ivec2(base) + ivec2(i - 1, j - 1), ivec2(0), pc.grid.xy - ivec2(1));
       vec4 a = texelFetch(coarse, ivec3(q, 7), 0);
-      if (a.w < 0.5f || (kind > 0.5f && abs(a.w - kind) > 0.5f)) continue;
+      if (a.w < 0.5f) continue;
       float w = wx[i] * wy[j];
-      s4 += w * a;
-      s5 += w * texelFetch(coarse, ivec3(q, 8), 0);
-      s6 += w * texelFetch(coarse, ivec3(q, 9), 0);
-      wsum += w;
+      vec4 t5 = texelFetch(coarse, ivec3(q, 8), 0);
+      vec4 t6 = texelFetch(coarse, ivec3(q, 9), 0);
+      a4 += w * a;
+      a5 += w * t5;
+      a6 += w * t6;
+      aw += w;
+      if (abs(a.w - kind) > 0.5f) continue;
+      k4 += w * a;
+      k5 += w * t5;
+      k6 += w * t6;
+      kw += w;
     }
   }
+  bool same = abs(kw) > 1e-4f;
+  float wsum = same ? kw : aw;
   if (abs(wsum) > 1e-4f) {
-    s4 = max(s4 / wsum, vec4(0.0f));
-    s5 = max(s5 / wsum, vec4(0.0f));
-    s6 = max(s6 / wsum, vec4(0.0f));
-    return 1.0f;
+    s4 = max((same ? k4 : a4) / wsum, vec4(0.0f));
+    s5 = max((same ? k5 : a5) / wsum, vec4(0.0f));
+    s6 = max((same ? k6 : a6) / wsum, vec4(0.0f));
+    return;
   }
   s4 = vec4(0.0f); s5 = vec4(0.0f); s6 = vec4(0.0f);
-  return 0.0f;
 }
 
 void main() {
@@ -92,9 +106,7 @@ void main() {
   } else {
     // Cell c's centre is pixel c * step + step / 2.
     vec2 c = (vec2(pixel) - vec2(float(step / 2))) / float(step);
-    // Same kind first; a pixel whose 4x4 neighbourhood holds no cell of its kind (thin
-    // virtual parts at 4x4) takes any surface rather than nothing.
-    if (sample_bicubic(c, virt ? 2.0f : 1.0f, s4, s5, s6) < 0.5f) sample_bicubic(c, 0.0f, s4, s5, s6);
+    sample_bicubic(c, virt ? 2.0f : 1.0f, s4, s5, s6);
   }
   float rd = s4.x, rd_v = s4.y;
   vec3 ri = s5.xyz, ri_v = s6.xyz;

@@ -117,7 +117,8 @@ TEST(Regression, RatioGrowthBeyondToleranceFails) {
 }
 
 // The per-pass rule: a pass with at least pass_min_share of the profiled frame fails at more than
-// pass_ratio_relative growth, though the frame as a whole stays within its tolerance.
+// pass_ratio_relative growth, though the frame as a whole stays within its tolerance (checked
+// with a 15 % tolerance here: the rule, not the default's width, is under test).
 TEST(Regression, APassTwentyPercentSlowerFailsWhileTheFramePasses) {
   perf::BenchResult r = constructed_result();
   for (perf::BenchEntry& e : r.entries) {
@@ -125,7 +126,8 @@ TEST(Regression, APassTwentyPercentSlowerFailsWhileTheFramePasses) {
     e.passes = {{"shade", {4, 6.0, 6.5, 3.0, 3.2, 6.0, 3.0}},      // 60 % of the frame
                 {"tiny", {4, 0.2, 0.3, 0.1, 0.15, 0.2, 0.1}}};     // 2 %: not checked
   }
-  const perf::Baseline b = perf::make_baseline(r);
+  perf::Baseline b = perf::make_baseline(r);
+  b.tolerances.pass_ratio_relative = 0.15;
   ASSERT_EQ(b.entries[0].pass_ratios.size(), 2u);
   EXPECT_TRUE(perf::check_against(r, b).passed);
   perf::BenchResult slow = r;
@@ -153,7 +155,7 @@ TEST(Regression, PassRatiosRoundTripThroughTheFile) {
   EXPECT_EQ(back->entries[0].pass_ratios[0].first, "shade");
   EXPECT_DOUBLE_EQ(back->entries[0].pass_ratios[0].second, 2.5);
   EXPECT_DOUBLE_EQ(back->entries[0].profiled_ratio, 5.0);
-  EXPECT_DOUBLE_EQ(back->tolerances.pass_ratio_relative, 0.15);
+  EXPECT_DOUBLE_EQ(back->tolerances.pass_ratio_relative, 0.50);
 }
 
 TEST(Regression, DifferentFrameCountsAreNotCompared) {

@@ -116,6 +116,18 @@ struct InvertGraph {
   }
 };
 
+// Pixels of the slot's readback that differ from the input pattern (the graph inverts twice).
+int wrong_pixels(Context& ctx, const InvertGraph& t, uint32_t slot) {
+  EXPECT_TRUE(ctx.invalidate(t.graph->gpu_buffer(t.readback, slot)).ok());
+  const uint8_t* px = static_cast<const uint8_t*>(t.graph->mapped(t.readback, slot));
+  if (!px) return -1;
+  int wrong = 0;
+  for (uint32_t y = 0; y < H; ++y)
+    for (uint32_t x = 0; x < W; ++x)
+      for (uint32_t c = 0; c < 4; ++c) wrong += px[(y * W + x) * 4 + c] != pattern(x, y, c);
+  return wrong;
+}
+
 TEST_F(VulkanTest, GraphRunsComputeChainAndReadsBackExactPixels) {
   InvertGraph t = InvertGraph::make(ctx());
   auto begun = t.graph->begin_frame();
@@ -128,14 +140,7 @@ TEST_F(VulkanTest, GraphRunsComputeChainAndReadsBackExactPixels) {
   ASSERT_TRUE(done.ok()) << done.error().message;
   ASSERT_EQ(done->size(), 1u);
   EXPECT_EQ((*done)[0].slot, slot);
-  ASSERT_TRUE(ctx().invalidate(t.graph->gpu_buffer(t.readback, slot)).ok());
-  const uint8_t* px = static_cast<const uint8_t*>(t.graph->mapped(t.readback, slot));
-  ASSERT_NE(px, nullptr);
-  int wrong = 0;
-  for (uint32_t y = 0; y < H; ++y)
-    for (uint32_t x = 0; x < W; ++x)
-      for (uint32_t c = 0; c < 4; ++c) wrong += px[(y * W + x) * 4 + c] != pattern(x, y, c);
-  EXPECT_EQ(wrong, 0);
+  EXPECT_EQ(wrong_pixels(ctx(), t, slot), 0);
 }
 
 TEST_F(VulkanTest, TimestampsArriveFramesLaterWithoutStalling) {
@@ -216,14 +221,7 @@ TEST_F(VulkanTest, ProfilingModeTimesEachPassAloneAndTheyAddUpToTheFrame) {
     if (i > 0) EXPECT_GE(f.completed_s, got[i - 1].completed_s);
   }
   // The output is the same in both modes.
-  const uint32_t slot = got.back().slot;
-  ASSERT_TRUE(ctx().invalidate(t.graph->gpu_buffer(t.readback, slot)).ok());
-  const uint8_t* px = static_cast<const uint8_t*>(t.graph->mapped(t.readback, slot));
-  int wrong = 0;
-  for (uint32_t y = 0; y < H; ++y)
-    for (uint32_t x = 0; x < W; ++x)
-      for (uint32_t c = 0; c < 4; ++c) wrong += px[(y * W + x) * 4 + c] != pattern(x, y, c);
-  EXPECT_EQ(wrong, 0);
+  EXPECT_EQ(wrong_pixels(ctx(), t, got.back().slot), 0);
 }
 
 TEST_F(VulkanTest, ProfilingModeNeedsItsCommandBuffersAllocated) {

@@ -535,8 +535,32 @@ Status FrameGraph::set_profiling(bool on) {
   return ok_status();
 }
 
-Status FrameGraph::measure_submission_overhead() {
+Expected<double> FrameGraph::submit_and_wait(VkCommandBuffer cmd, const std::string& what) {
   VkDevice dev = context_.device();
+  VkCommandBufferSubmitInfo cbi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+  cbi.commandBuffer = cmd;
+  VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+  si.commandBufferInfoCount = 1;
+  si.pCommandBufferInfos = &cbi;
+  const auto t0 = std::chrono::steady_clock::now();
+  VK_CHECK(context_.fn().queue_submit2(context_.queue(), 1, &si, profile_fence_));
+  const VkResult w = vkWaitForFences(dev, 1, &profile_fence_, VK_TRUE, kFrameTimeoutNs);
+  auto t1 = std::chrono::steady_clock::now();
+  if (w == VK_TIMEOUT)
+    return fail(ErrorKind::Timeout, what + " did not finish within " + std::to_string(kFrameTimeoutS) +
+                                        " s (profiling mode)");
+  VK_CHECK(w);
+  VK_CHECK(vkResetFences(dev, 1, &profile_fence_));
+  if (!plant_pass_.empty() && what == "pass '" + plant_pass_ + "'") {  // test hook: see frame_graph.h
+    const auto until = t0 + (t1 - t0) * plant_factor_;
+    while (std::chrono::steady_clock::now() < until) {
+    }
+    t1 = std::chrono::steady_clock::now();
+  }
+  return std::chrono::duration<double, std::milli>(t1 - t0).count();
+}
+
+Status FrameGraph::measure_submission_overhead() {
   VkCommandBuffer cmd = profile_cmds_[0];
   VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -546,16 +570,9 @@ Status FrameGraph::measure_submission_overhead() {
     VK_CHECK(vkResetCommandBuffer(cmd, 0));
     VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
     VK_CHECK(vkEndCommandBuffer(cmd));
-    VkCommandBufferSubmitInfo cbi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
-    cbi.commandBuffer = cmd;
-    VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-    si.commandBufferInfoCount = 1;
-    si.pCommandBufferInfos = &cbi;
-    const auto t0 = std::chrono::steady_clock::now();
-    VK_CHECK(context_.fn().queue_submit2(context_.queue(), 1, &si, profile_fence_));
-    VK_CHECK(vkWaitForFences(dev, 1, &profile_fence_, VK_TRUE, kFrameTimeoutNs));
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    VK_CHECK(vkResetFences(dev, 1, &profile_fence_));
+    auto t = submit_and_wait(cmd, "an empty submission");
+    if (!t) return t.error();
+    ms.push_back(*t);
   }
   std::sort(ms.begin(), ms.end());
   submission_overhead_ms_ = ms[ms.size() / 2];
@@ -563,7 +580,6 @@ Status FrameGraph::measure_submission_overhead() {
 }
 
 Status FrameGraph::submit_profiled() {
-  VkDevice dev = context_.device();
   const uint32_t n = uint32_t(compiled_.passes.size());
   if (n > profile_cmds_.size())
     return fail(ErrorKind::BadUsage, std::to_string(n) + " passes, more than the " +
@@ -585,29 +601,10 @@ Status FrameGraph::submit_profiled() {
     if (executes_[p.pass_index]) executes_[p.pass_index](cmd, ctx);
     if (i + 1 == n) record_barriers(cmd, compiled_.final_barriers);
     VK_CHECK(vkEndCommandBuffer(cmd));
-    VkCommandBufferSubmitInfo cbi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
-    cbi.commandBuffer = cmd;
-    VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-    si.commandBufferInfoCount = 1;
-    si.pCommandBufferInfos = &cbi;
     // Recording is not timed: the pass's time is what the queue spends on it.
-    const auto t0 = std::chrono::steady_clock::now();
-    VK_CHECK(context_.fn().queue_submit2(context_.queue(), 1, &si, profile_fence_));
-    const VkResult w = vkWaitForFences(dev, 1, &profile_fence_, VK_TRUE, kFrameTimeoutNs);
-    auto t1 = std::chrono::steady_clock::now();
-    if (w == VK_TIMEOUT)
-      return fail(ErrorKind::Timeout, "pass '" + p.name + "' did not finish within " +
-                                          std::to_string(kFrameTimeoutS) + " s (profiling mode)");
-    VK_CHECK(w);
-    VK_CHECK(vkResetFences(dev, 1, &profile_fence_));
-    if (!plant_pass_.empty() && p.name == plant_pass_) {  // test hook: see frame_graph.h
-      const auto until = t0 + (t1 - t0) * plant_factor_;
-      while (std::chrono::steady_clock::now() < until) {
-      }
-      t1 = std::chrono::steady_clock::now();
-    }
-    slot.host_ms[i] =
-        std::max(0.0, std::chrono::duration<double, std::milli>(t1 - t0).count() - submission_overhead_ms_);
+    auto ms = submit_and_wait(cmd, "pass '" + p.name + "'");
+    if (!ms) return ms.error();
+    slot.host_ms[i] = std::max(0.0, *ms - submission_overhead_ms_);
   }
   finish_execute(true);
   // The slot's fence marks the frame done, as in normal mode (an empty submission signals it).

@@ -9,9 +9,9 @@
 //           its fastest profiled frame's time over the fastest floor sample
 //           (TimeSummary::min_ratio) > baseline x (1 + pass_ratio_relative)          -> violation
 //   error:  RDE > baseline + rde_absolute (or delta RMS, where the RDE is undefined) -> violation
-// The frame tolerance is wide because a whole frame's wall clock on a shared machine moves with
-// the load; a pass measured alone against a floor measured between the same frames moves less,
-// so a 20 % slowdown of one pass is caught even where it is a small part of the frame.
+// Both tolerances are wide because this machine is shared: see pass_ratio_relative for the
+// measured run-to-run noise of a pass. A pass is still checked on its own, so its slowdown is
+// caught even where it is a small part of the frame.
 //
 // baseline.json (version 1):
 //   {"version": 1,
@@ -41,7 +41,12 @@ struct Tolerances {
   // Plus this many floor passes: a frame of a few floors (the camera pass-through) moves by
   // more than 35 % with the machine's load alone.
   double ratio_absolute = 1.0;
-  double pass_ratio_relative = 0.15; // a checked pass's ratio may grow by 15 %
+  // A checked pass's ratio may grow by 50 %: two reruns of one commit here moved checked passes'
+  // ratios by up to +34 % and +43 % (p95 +33 %, +29 %; 73 pass/entry pairs each), and their
+  // shares of the frame by up to +24 % and +30 %, so a tighter rule alarms on unchanged code
+  // (at 15 % it raised 10 and 13 violations) and a 20 % slowdown of one pass is below what one
+  // run on this machine can tell apart.
+  double pass_ratio_relative = 0.50;
   double pass_min_share = 0.10;      // passes below 10 % of the frame are not checked (noise)
 };
 
