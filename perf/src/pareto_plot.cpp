@@ -120,7 +120,7 @@ ImageRGB8 render_pareto_plot(const BenchResult& result) {
   std::snprintf(sub, sizeof sub, "suite aggregate per technique level, floor pass %.3f ms, %d frames + %d warm-up per run",
                 result.floor_median_ms, result.frames, result.warmup);
   cv.text(px0, 40, sub, 1.5f, dark);
-  const std::string xl = std::string("median frame GPU time, ms (mean over scenes") + (log_x ? ", log scale)" : ")");
+  const std::string xl = std::string("sustained ms per frame (mean over scenes") + (log_x ? ", log scale)" : ")");
   cv.text((px0 + px1) / 2 - Canvas::text_width(xl, 2) / 2, py1 + 44, xl, 2, black);
   const std::string yl = "RDE, all pixels (pooled over scenes and frames)";
   cv.text(22, (py0 + py1) / 2 + Canvas::text_width(yl, 2) / 2, yl, 2, black, true);
