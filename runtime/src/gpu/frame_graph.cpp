@@ -535,7 +535,7 @@ Status FrameGraph::set_profiling(bool on) {
   return ok_status();
 }
 
-Expected<double> FrameGraph::submit_and_wait(VkCommandBuffer cmd, const std::string& what) {
+Expected<double> FrameGraph::submit_and_wait(VkCommandBuffer cmd, const std::string* pass) {
   VkDevice dev = context_.device();
   VkCommandBufferSubmitInfo cbi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
   cbi.commandBuffer = cmd;
@@ -547,11 +547,12 @@ Expected<double> FrameGraph::submit_and_wait(VkCommandBuffer cmd, const std::str
   const VkResult w = vkWaitForFences(dev, 1, &profile_fence_, VK_TRUE, kFrameTimeoutNs);
   auto t1 = std::chrono::steady_clock::now();
   if (w == VK_TIMEOUT)
-    return fail(ErrorKind::Timeout, what + " did not finish within " + std::to_string(kFrameTimeoutS) +
+    return fail(ErrorKind::Timeout, (pass ? "pass '" + *pass + "'" : std::string("an empty submission")) +
+                                        " did not finish within " + std::to_string(kFrameTimeoutS) +
                                         " s (profiling mode)");
   VK_CHECK(w);
   VK_CHECK(vkResetFences(dev, 1, &profile_fence_));
-  if (!plant_pass_.empty() && what == "pass '" + plant_pass_ + "'") {  // test hook: see frame_graph.h
+  if (pass && !plant_pass_.empty() && *pass == plant_pass_) {  // test hook: see frame_graph.h
     const auto until = t0 + (t1 - t0) * plant_factor_;
     while (std::chrono::steady_clock::now() < until) {
     }
@@ -570,7 +571,7 @@ Status FrameGraph::measure_submission_overhead() {
     VK_CHECK(vkResetCommandBuffer(cmd, 0));
     VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
     VK_CHECK(vkEndCommandBuffer(cmd));
-    auto t = submit_and_wait(cmd, "an empty submission");
+    auto t = submit_and_wait(cmd, nullptr);
     if (!t) return t.error();
     ms.push_back(*t);
   }
@@ -602,7 +603,7 @@ Status FrameGraph::submit_profiled() {
     if (i + 1 == n) record_barriers(cmd, compiled_.final_barriers);
     VK_CHECK(vkEndCommandBuffer(cmd));
     // Recording is not timed: the pass's time is what the queue spends on it.
-    auto ms = submit_and_wait(cmd, "pass '" + p.name + "'");
+    auto ms = submit_and_wait(cmd, &p.name);
     if (!ms) return ms.error();
     slot.host_ms[i] = std::max(0.0, *ms - submission_overhead_ms_);
   }

@@ -371,7 +371,8 @@ class FrameGraph {
   Status submit_profiled();
   Status measure_submission_overhead();
   // Submits `cmd` alone with the profiling fence and waits: host ms from submit to fence.
-  Expected<double> submit_and_wait(VkCommandBuffer cmd, const std::string& what);
+  // `pass` names the pass for errors and the test hook (nullptr: the empty calibration submit).
+  Expected<double> submit_and_wait(VkCommandBuffer cmd, const std::string* pass);
   void record_barriers(VkCommandBuffer cmd, const std::vector<Barrier>& barriers);
   void finish_execute(bool profiled);
   VkExtent2D output_size_{0, 0};

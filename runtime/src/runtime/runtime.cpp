@@ -419,9 +419,9 @@ Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, 
   recon_->upload(*graph_, frame);
 
   const bool has_objects = !scene_gpu_->virtual_objects.empty();
-  // A frame nothing virtual affects is the camera frame: upload and compose's copy only (the
-  // lean skeleton, about two floor passes). The reconstruction is not needed for it; its
-  // temporal history restarts on the next affected frame (one frame of unfiltered depth).
+  // A frame nothing virtual affects is the camera frame (the lean skeleton above): the
+  // reconstruction is not needed for it; its temporal history restarts on the next affected
+  // frame (one frame of unfiltered depth).
   if (affected) {
     recon_->record(*graph_, frame_constants_);
   } else {
