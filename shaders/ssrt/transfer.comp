@@ -16,6 +16,7 @@
 //   5     rgb R_i (real only), w 1 surface present
 //   6     rgb R'_i (real + virtual), w 1 surface present
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 #include "shared/mrgi_shared.h"
 #include "common/frame_constants.glsl"
 #include "ssrt/ssrt_math.h"
@@ -25,20 +26,22 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
 layout(std140, set = 0, binding = 1) uniform LightUbo { SsrtLight light; };
 layout(std430, set = 0, binding = 2) readonly buffer SampleBuffer { SsrtSample samples[]; };
-layout(set = 0, binding = 3) uniform sampler2D real_position;
-layout(set = 0, binding = 4) uniform sampler2D real_normal;
-layout(set = 0, binding = 5) uniform sampler2D real_albedo;
-layout(set = 0, binding = 6) uniform sampler2D virtual_position;
-layout(set = 0, binding = 7) uniform sampler2D virtual_normal;
-layout(set = 0, binding = 8) uniform sampler2D virtual_albedo;
+// Storage images read with imageLoad: on lavapipe a sampled texelFetch costs 2-3x as much.
+layout(set = 0, binding = 3, rgba32f) readonly uniform image2D real_position;
+layout(set = 0, binding = 4, rgba16f) readonly uniform image2D real_normal;
+layout(set = 0, binding = 5, rgba16f) readonly uniform image2D real_albedo;
+layout(set = 0, binding = 6, rgba32f) readonly uniform image2D virtual_position;
+layout(set = 0, binding = 7, rgba16f) readonly uniform image2D virtual_normal;
+layout(set = 0, binding = 8, rgba16f) readonly uniform image2D virtual_albedo;
 layout(set = 0, binding = 9, rgba32f) writeonly uniform image2DArray coarse;
 // The volume's auxiliary orthographic layers (left, right, top, light; aux_views.glsl): occluders
 // outside the camera frustum (paper Sec. 5.1).
-layout(set = 0, binding = 10) uniform sampler2DArray aux_position;
+layout(set = 0, binding = 10, rgba32f) readonly uniform image2DArray aux_position;
 layout(std140, set = 0, binding = 11) uniform AuxUbo { SsrtAuxViews aux; };
 layout(push_constant) uniform Push {
   ivec4 grid;     // x, y cells; z step in pixels; w directions N
-  ivec4 config;   // x first sample of the level's sets, y SH bands, z/w unused
+  ivec4 config;   // x first sample of the level's sets, y SH bands, z geometry step (internal
+                  // pixels per texel of real_position / real_normal), w unused
   vec4 sampling;  // x radius (m), y chi, z normal offset (m), w minimum sender distance (m)
   vec4 bounce;    // x sample area (m^2), y saturation threshold, z depth test bias (fraction),
                   // w occluder range (m)
@@ -49,22 +52,38 @@ layout(push_constant) uniform Push {
 // Paper Fig. 5a: a sample the main buffer finds visible may lie behind a surface one of the
 // auxiliary buffers sees. Returns true with that surface's world position (the first layer
 // that occludes; its surface must lie within the occluder range of the receiver x).
+// Unrolled over the layers: with a constant layer index lavapipe reads world_to_aux once per
+// SIMD chunk, with a loop index it gathers the matrix per lane.
 bool aux_occluder(vec3 x, vec3 y, out vec3 s) {
   s = vec3(0.0f);
   if (pc.aux_test.y < 0.5f) return false;
-  for (int i = 0; i < aux.info.x; ++i) {
+  bool found = false;
+  [[unroll]] for (int i = 0; i < SSRT_AUX_LAYERS; ++i) {
     ivec2 texel;
     float depth;
-    if (!ssrt_aux_texel(aux.world_to_aux[i], aux.info.y, y, texel, depth)) continue;
-    vec4 o = texelFetch(aux_position, ivec3(texel, i), 0);
+    bool in_layer = i < aux.info.x && ssrt_aux_texel(aux.world_to_aux[i], aux.info.y, y, texel, depth);
+    vec4 o = imageLoad(aux_position, ivec3(texel, i));
     vec3 d = o.xyz - x;
-    if (o.w > 0.0f && o.w < depth - pc.aux_test.x * aux.extent[i].z &&
-        dot(d, d) <= pc.bounce.w * pc.bounce.w) {
-      s = o.xyz;
-      return true;
-    }
+    bool hit = in_layer && o.w > 0.0f && o.w < depth - pc.aux_test.x * aux.extent[i].z &&
+               dot(d, d) <= pc.bounce.w * pc.bounce.w;
+    s = hit && !found ? o.xyz : s;
+    found = found || hit;
   }
-  return false;
+  return found;
+}
+
+// The real surface seen through internal pixel position q (qi its nearest pixel): xyz world,
+// w camera depth; n its world normal. At geometry step 1 the texel itself; coarser, the point
+// of the texel's tangent plane on q's camera ray (ssrt_plane_depth).
+vec4 real_surface(vec2 q, ivec2 qi, int gstep, out vec3 n) {
+  ivec2 g = qi / gstep;
+  vec4 o = imageLoad(real_position, g);
+  n = imageLoad(real_normal, g).xyz;
+  vec3 ray = unproject_pinhole(q, 1.0f, frame.internal_k);
+  vec3 p = (frame.world_to_camera * vec4(o.xyz, 1.0f)).xyz;
+  float z = ssrt_plane_depth(ray, p, mat3(frame.world_to_camera) * n, MRGI_DEPTH_EDGE_RELATIVE);
+  vec4 plane = vec4((frame.camera_to_world * vec4(ray * z, 1.0f)).xyz, z);
+  return gstep > 1 && o.w > 0.0f ? plane : o;
 }
 
 // Camera-space depth of a world point.
@@ -77,8 +96,9 @@ void main() {
   int step = pc.grid.z;
   ivec2 pixel = min(cell * step + ivec2(step / 2), size - ivec2(1));
 
-  vec4 rp = texelFetch(real_position, pixel, 0);
-  vec4 vp = texelFetch(virtual_position, pixel, 0);
+  int gstep = pc.config.z;
+  vec4 rp = imageLoad(real_position, pixel / gstep);
+  vec4 vp = imageLoad(virtual_position, pixel);
   bool real_ok = rp.w > 0.0f;
   bool virt = vp.w > 0.5f;
   vec4 zero = vec4(0.0f);
@@ -87,9 +107,9 @@ void main() {
     return;
   }
   vec3 xr = rp.xyz;
-  vec3 nr = normalize(texelFetch(real_normal, pixel, 0).xyz + vec3(1e-9f));
+  vec3 nr = normalize(imageLoad(real_normal, pixel / gstep).xyz + vec3(1e-9f));
   vec3 xv = virt ? vp.xyz : xr;
-  vec3 nv = virt ? normalize(texelFetch(virtual_normal, pixel, 0).xyz + vec3(1e-9f)) : nr;
+  vec3 nv = virt ? normalize(imageLoad(virtual_normal, pixel).xyz + vec3(1e-9f)) : nr;
 
   vec4 t_real[4] = vec4[4](zero, zero, zero, zero);
   vec4 t_rv[4] = vec4[4](zero, zero, zero, zero);
@@ -107,17 +127,33 @@ void main() {
                              cell.y >= pc.influence.y && cell.y < pc.influence.w);
   int base = pc.config.x + set * pc.grid.w;
 
-  for (int j = 0; j < pc.grid.w; ++j) {
+  // Each set holds antipodal pairs (sample j + N/2 = -sample j, sample_directions.h), so exactly
+  // one of a pair faces any normal: the loop runs over the N/2 pairs and takes the member in
+  // the receiver's hemisphere, with its own displacement and the pair's SH weights with the odd
+  // bands negated (Y_l(-w) = (-1)^l Y_l(w)). The sum is the one over all N samples whose back-
+  // facing half contributes 0; lavapipe runs a skipped sample's body under a lane mask, so
+  // looping over all N paid for both halves.
+  const vec4 kOdd0 = vec4(1.0f, -1.0f, -1.0f, -1.0f);  // Y0..3: bands 0, 1, 1, 1
+  const vec4 kOdd2 = vec4(1.0f, -1.0f, -1.0f, -1.0f);  // Y8..11: band 2, then 3, 3, 3
+  const vec4 kOdd3 = vec4(-1.0f);                      // Y12..15: band 3 (Y4..7: band 2, even)
+  int half_n = pc.grid.w / 2;
+  for (int j = 0; j < half_n; ++j) {
     SsrtSample s = samples[base + j];
-    vec3 w = s.direction_and_radius.xyz;
-    float r = s.direction_and_radius.w * pc.sampling.x;
-    bool do_real = real_ok && dot(nr, w) > 0.0f;
-    bool do_rv = influenced && dot(nv, w) > 0.0f && (virt || real_ok);
-    if (!do_real && !do_rv) continue;
+    float r_anti = samples[base + j + half_n].direction_and_radius.w;
+    vec3 w0 = s.direction_and_radius.xyz;
+    bool flip_r = dot(nr, w0) < 0.0f;
+    bool flip_v = dot(nv, w0) < 0.0f;
+    vec3 w_r = flip_r ? -w0 : w0;
+    vec3 w_v = flip_v ? -w0 : w0;
+    float r_r = (flip_r ? r_anti : s.direction_and_radius.w) * pc.sampling.x;
+    float r_v = (flip_v ? r_anti : s.direction_and_radius.w) * pc.sampling.x;
+    bool do_real = real_ok && dot(nr, w_r) > 0.0f;
+    bool do_rv = influenced && dot(nv, w_v) > 0.0f && (virt || real_ok);
 
     // Real receiver against real occluders.
     if (do_real) {
-      vec3 y = xr + nr * pc.sampling.z + w * r;
+      vec3 w = w_r;
+      vec3 y = xr + nr * pc.sampling.z + w * r_r;
       float k = 1.0f;
       vec3 sp = vec3(0.0f), sn = vec3(0.0f), sa = vec3(0.0f);
       float yz = view_depth(y);
@@ -125,15 +161,16 @@ void main() {
         vec2 q = project_pinhole((frame.world_to_camera * vec4(y, 1.0f)).xyz, frame.internal_k);
         ivec2 qi = ivec2(floor(q + 0.5f));
         if (all(greaterThanEqual(qi, ivec2(0))) && all(lessThan(qi, size))) {
-          vec4 o = texelFetch(real_position, qi, 0);
+          vec3 on;
+          vec4 o = real_surface(q, qi, gstep, on);
           // Range check (standard SSDO/SSAO practice; the paper does not say): a surface
           // farther from x than the range (push: twice the sampling radius, since the surface
           // seen in front of y may lie well in front of it) is not what blocks this direction.
           vec3 dr = o.xyz - xr;
           if (o.w > 0.0f && o.w < yz * (1.0f - bias) && dot(dr, dr) <= pc.bounce.w * pc.bounce.w) {
             sp = o.xyz;
-            sn = texelFetch(real_normal, qi, 0).xyz;
-            sa = texelFetch(real_albedo, qi, 0).rgb;
+            sn = on;
+            sa = imageLoad(real_albedo, qi).rgb;
             k = ssrt_visibility_k(xr, sp, w, chi);
           }
         }
@@ -144,7 +181,10 @@ void main() {
       bool from_view = k < 1.0f;
       if (!from_view && aux_occluder(xr, y, s_aux)) k = ssrt_visibility_k(xr, s_aux, w, chi);
       float tw = ssrt_transfer_weight(nr, w, k, 1.0f);
-      for (int c = 0; c < 4; ++c) t_real[c] += tw * s.sh_weights[c];
+      t_real[0] += tw * (flip_r ? s.sh_weights[0] * kOdd0 : s.sh_weights[0]);
+      t_real[1] += tw * s.sh_weights[1];
+      t_real[2] += tw * (flip_r ? s.sh_weights[2] * kOdd2 : s.sh_weights[2]);
+      t_real[3] += tw * (flip_r ? s.sh_weights[3] * kOdd3 : s.sh_weights[3]);
       if (from_view) {
         ri += ssrt_indirect_term(xr, nr, sp, sn, sa, k, l_dir, e_light, pc.bounce.x,
                                  pc.sampling.w);
@@ -152,7 +192,8 @@ void main() {
     }
     // Visible receiver against real + virtual occluders.
     if (do_rv) {
-      vec3 y = xv + nv * pc.sampling.z + w * r;
+      vec3 w = w_v;
+      vec3 y = xv + nv * pc.sampling.z + w * r_v;
       float k = 1.0f;
       vec3 sp = vec3(0.0f), sn = vec3(0.0f), sa = vec3(0.0f);
       float yz = view_depth(y);
@@ -160,8 +201,9 @@ void main() {
         vec2 q = project_pinhole((frame.world_to_camera * vec4(y, 1.0f)).xyz, frame.internal_k);
         ivec2 qi = ivec2(floor(q + 0.5f));
         if (all(greaterThanEqual(qi, ivec2(0))) && all(lessThan(qi, size))) {
-          vec4 ov = texelFetch(virtual_position, qi, 0);
-          vec4 o = texelFetch(real_position, qi, 0);
+          vec4 ov = imageLoad(virtual_position, qi);
+          vec3 on;
+          vec4 o = real_surface(q, qi, gstep, on);
           // The virtual G-buffer only holds virtual surfaces in front of the real one.
           bool use_virtual = ov.w > 0.5f;
           float oz = use_virtual ? view_depth(ov.xyz) : o.w;
@@ -169,8 +211,8 @@ void main() {
           if ((use_virtual || o.w > 0.0f) && oz > 0.0f && oz < yz * (1.0f - bias) &&
               dot(dv, dv) <= pc.bounce.w * pc.bounce.w) {
             sp = use_virtual ? ov.xyz : o.xyz;
-            sn = use_virtual ? texelFetch(virtual_normal, qi, 0).xyz : texelFetch(real_normal, qi, 0).xyz;
-            sa = use_virtual ? texelFetch(virtual_albedo, qi, 0).rgb : texelFetch(real_albedo, qi, 0).rgb;
+            sn = use_virtual ? imageLoad(virtual_normal, qi).xyz : on;
+            sa = use_virtual ? imageLoad(virtual_albedo, qi).rgb : imageLoad(real_albedo, qi).rgb;
             k = ssrt_visibility_k(xv, sp, w, chi);
           }
         }
@@ -179,7 +221,10 @@ void main() {
       bool from_view_v = k < 1.0f;
       if (!from_view_v && aux_occluder(xv, y, sv_aux)) k = ssrt_visibility_k(xv, sv_aux, w, chi);
       float tw = ssrt_transfer_weight(nv, w, k, 1.0f);
-      for (int c = 0; c < 4; ++c) t_rv[c] += tw * s.sh_weights[c];
+      t_rv[0] += tw * (flip_v ? s.sh_weights[0] * kOdd0 : s.sh_weights[0]);
+      t_rv[1] += tw * s.sh_weights[1];
+      t_rv[2] += tw * (flip_v ? s.sh_weights[2] * kOdd2 : s.sh_weights[2]);
+      t_rv[3] += tw * (flip_v ? s.sh_weights[3] * kOdd3 : s.sh_weights[3]);
       if (from_view_v) {
         ri_v += ssrt_indirect_term(xv, nv, sp, sn, sa, k, l_dir, e_light, pc.bounce.x,
                                    pc.sampling.w);
@@ -208,7 +253,7 @@ void main() {
   // black surface: 500 such cells at env_fisheye's far floor pulled the estimate down), and the
   // green channel, 72 % of the luminance, is below clipping. A warm sun clips red first on a
   // bright grey ball; rejecting such pixels removed exactly the surfaces facing the light.
-  vec4 camera = texelFetch(real_albedo, pixel, 0);
+  vec4 camera = imageLoad(real_albedo, pixel);
   float usable = real_ok && camera.a > 0.5f && camera.g < pc.bounce.y ? 1.0f : 0.0f;
   for (int c = 0; c < 4; ++c) imageStore(coarse, ivec3(cell, c), real_ok ? t_real[c] : zero);
   imageStore(coarse, ivec3(cell, 4), vec4(max(rd, 0.0f), max(rd_v, 0.0f), usable, virt ? 2.0f : 1.0f));

@@ -21,6 +21,7 @@ struct FrameGraph::ImageEntry {
   ImageDesc desc;
   GpuImage gpu;
   bool owned = true;
+  uint32_t divisor = 1;  // set_extent_divisor: used extent = ceil(relative extent / divisor)
   ResourceState state;
 };
 
@@ -294,7 +295,23 @@ VkExtent2D FrameGraph::extent(ImageHandle image) const {
   if (e.desc.size_mode == SizeMode::Absolute) return e.gpu.extent;
   const float s = e.desc.scale * (e.desc.follows_render_scale ? render_scale_ : 1.0f);
   const VkExtent2D r = relative_extent(output_size_.width, output_size_.height, s);
-  return {std::min(r.width, e.gpu.extent.width), std::min(r.height, e.gpu.extent.height)};
+  const uint32_t d = e.divisor;
+  return {std::min((r.width + d - 1) / d, e.gpu.extent.width),
+          std::min((r.height + d - 1) / d, e.gpu.extent.height)};
+}
+
+Status FrameGraph::set_extent_divisor(ImageHandle image, uint32_t divisor) {
+  if (image.id >= images_.size())
+    return fail(ErrorKind::BadUsage, "set_extent_divisor: invalid image handle");
+  ImageEntry& e = images_[image.id];
+  if (e.desc.size_mode != SizeMode::OutputRelative)
+    return fail(ErrorKind::BadUsage, "set_extent_divisor: image '" + e.desc.name +
+                                         "' is not OutputRelative (its size is absolute)");
+  if (divisor < 1 || divisor > 64)
+    return fail(ErrorKind::BadUsage, "set_extent_divisor: image '" + e.desc.name + "': divisor " +
+                                         std::to_string(divisor) + " must be in 1..64");
+  e.divisor = divisor;
+  return ok_status();
 }
 
 VkExtent2D FrameGraph::allocated_extent(ImageHandle image) const { return images_.at(image.id).gpu.extent; }

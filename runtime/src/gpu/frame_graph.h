@@ -277,6 +277,10 @@ class FrameGraph {
   // beyond what was allocated for are BadUsage.
   Status set_output_size(uint32_t width, uint32_t height);
   Status set_render_scale(float scale);
+  // Per image: its used extent becomes ceil(relative extent / divisor) (1 = the relative extent),
+  // for a technique stage that runs at a fraction of the internal resolution on some levels
+  // (ssrt's geometry at its transfer's cell size). Never reallocates; OutputRelative images only.
+  Status set_extent_divisor(ImageHandle image, uint32_t divisor);
   VkExtent2D output_size() const { return output_size_; }
   float render_scale() const { return render_scale_; }
   VkExtent2D extent(ImageHandle image) const;  // used extent now

@@ -1,5 +1,7 @@
 #include "technique/ssrt/depth_filter_gpu.h"
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 
@@ -141,9 +143,23 @@ Expected<DepthFilterGpu> DepthFilterGpu::create(gpu::Context& ctx, gpu::FrameGra
 }
 
 Status DepthFilterGpu::record(gpu::ImageHandle depth_volume, bool final_pass,
-                              std::vector<std::string>& skipped) {
+                              std::vector<std::string>& skipped, uint32_t texel_pixels) {
   if (!graph_)
     return fail(ErrorKind::BadUsage, "technique/ssrt/depth_filter_gpu.cpp: record() before create()");
+  if (texel_pixels < 1 || texel_pixels > 64)
+    return fail(ErrorKind::BadUsage, "technique/ssrt/depth_filter_gpu.cpp record: texel_pixels " +
+                                         std::to_string(texel_pixels) + " must be in 1..64");
+  {
+    // Windows at this texel size (create() checked the largest, texel_pixels 1).
+    auto scaled = [&](uint32_t k) {
+      return std::max(1u, uint32_t(std::lround(double(k) / double(texel_pixels))));
+    };
+    const TapWindow merge = tap_window(scaled(settings_.merge_window), settings_.median_taps);
+    const TapWindow bilateral = tap_window(scaled(settings_.bilateral_window), settings_.median_taps);
+    merge_push_.window = glm::ivec4(merge.reach, merge.stride, merge.taps, 0);
+    bilateral_push_.window = glm::ivec4(bilateral.reach, bilateral.stride, bilateral.taps, 0);
+    final_push_ = glm::ivec4(int(window_side(scaled(settings_.final_window)) / 2), 0, 0, 0);
+  }
   if (depth_volume.valid()) {
     const gpu::GpuImage& v = graph_->gpu_image(depth_volume);
     const VkExtent2D need = graph_->allocated_extent(merged_);

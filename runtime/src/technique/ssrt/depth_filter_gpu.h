@@ -55,7 +55,12 @@ class DepthFilterGpu {
   // is left out and "ssrt_depth_final: <reason>" is appended to skipped) and ssrt_gbuffer.
   // depth_volume: R32F D_v (metres along camera z, 0 = no surface) at the internal resolution,
   // or a null handle when there is no volume (then every D_v is "missing").
-  Status record(gpu::ImageHandle depth_volume, bool final_pass, std::vector<std::string>& skipped);
+  // texel_pixels: internal pixels per side of one texel of the chain's images (the frame
+  // constants the chain reads are at that resolution): the windows, given in pixels of the
+  // paper's 640x480, shrink by it (k / texel_pixels, at least 1) so they cover the same part of
+  // the scene; a 20 px D' window read as 20 coarse texels smeared depth edges over 80 px.
+  Status record(gpu::ImageHandle depth_volume, bool final_pass, std::vector<std::string>& skipped,
+                uint32_t texel_pixels = 1);
 
   gpu::ImageHandle position() const { return position_; }  // RGBA32F xyz world, w depth m; 0 = invalid
   // RGBA16F xyz world unit normal facing the camera; w 1 where measured, 0 where the pixel has
