@@ -2,7 +2,7 @@
 // ssrt depth filter, last pass: the filtered depth (D''', or D'' without the final pass) ->
 // the technique's real G-buffer: world positions (internal_k unprojection, then the frame's
 // camera_to_world) and normals from neighbouring positions, with the same rule as
-// recon/normals.comp: tangents as central differences over +-NORMAL_RADIUS pixels where both
+// recon/normals.comp: tangents as central differences over +-r texels (push constant) where both
 // ends lie on the centre's surface (the MRGI_DEPTH_EDGE_RELATIVE rule), else the one-pixel
 // forward, else the backward difference; oriented towards the camera. The cross product is
 // taken in camera space and rotated to world (a rotation keeps it). Where an axis has no
@@ -17,7 +17,9 @@
 #include "common/frame_constants.glsl"
 #include "ssrt/depth_median.glsl"
 
-#define NORMAL_RADIUS 2                    // pixels, as recon's default normal_radius
+// x: tangent radius in texels (recon's default normal_radius, 2 px, shrunk with the texel size
+// so the tangents span the same part of the scene: a crease blends normals over the radius).
+layout(push_constant) uniform Push { ivec4 normal; } pc;
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
@@ -38,14 +40,14 @@ float same_surface(ivec2 p, float z0) {
 
 vec3 camera_point(ivec2 p, float z) { return unproject_pinhole(vec2(p), z, frame.internal_k); }
 
-// Tangent along one image axis: central over +-NORMAL_RADIUS where both ends are on the
+// Tangent along one image axis: central over +-r texels where both ends are on the
 // surface, else forward, else backward one pixel. The one-pixel fetches only happen where the
 // central difference fails (depth edges, holes), which whole SIMD chunks rarely need.
 bool axis_difference(ivec2 p, ivec2 step, vec3 centre, float z0, out vec3 d) {
-  float far_plus = same_surface(p + step * NORMAL_RADIUS, z0);
-  float far_minus = same_surface(p - step * NORMAL_RADIUS, z0);
-  d = camera_point(p + step * NORMAL_RADIUS, far_plus) -
-      camera_point(p - step * NORMAL_RADIUS, far_minus);
+  float far_plus = same_surface(p + step * pc.normal.x, z0);
+  float far_minus = same_surface(p - step * pc.normal.x, z0);
+  d = camera_point(p + step * pc.normal.x, far_plus) -
+      camera_point(p - step * pc.normal.x, far_minus);
   if (far_plus > 0.0f && far_minus > 0.0f) return true;
   float plus = same_surface(p + step, z0);
   float minus = same_surface(p - step, z0);

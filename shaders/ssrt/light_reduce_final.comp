@@ -6,7 +6,7 @@ layout(local_size_x = 192) in;
 layout(std430, set = 0, binding = 0) readonly buffer Partials { float partials[]; };
 layout(std430, set = 0, binding = 1) writeonly buffer Result { float result[]; };
 layout(push_constant) uniform Push {
-  ivec4 counts;  // x number of tiles
+  ivec4 counts;  // x number of partials (light_reduce.comp invocations)
 } pc;
 
 void main() {

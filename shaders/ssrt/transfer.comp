@@ -46,7 +46,8 @@ layout(push_constant) uniform Push {
   vec4 bounce;    // x sample area (m^2), y saturation threshold, z depth test bias (fraction),
                   // w occluder range (m)
   ivec4 influence;  // cells [x0, x1) x [y0, y1) that the virtual objects' influence region covers
-  vec4 aux_test;    // x depth bias in texels of each aux layer, y 1 = test the aux layers
+  vec4 aux_test;    // x depth bias in texels of each aux layer, y 1 = test the aux layers,
+                    // z solid angle of one sample (4 pi / N)
 } pc;
 
 // Paper Fig. 5a: a sample the main buffer finds visible may lie behind a surface one of the
@@ -129,24 +130,23 @@ void main() {
 
   // Each set holds antipodal pairs (sample j + N/2 = -sample j, sample_directions.h), so exactly
   // one of a pair faces any normal: the loop runs over the N/2 pairs and takes the member in
-  // the receiver's hemisphere, with its own displacement and the pair's SH weights with the odd
-  // bands negated (Y_l(-w) = (-1)^l Y_l(w)). The sum is the one over all N samples whose back-
-  // facing half contributes 0; lavapipe runs a skipped sample's body under a lane mask, so
-  // looping over all N paid for both halves.
-  const vec4 kOdd0 = vec4(1.0f, -1.0f, -1.0f, -1.0f);  // Y0..3: bands 0, 1, 1, 1
-  const vec4 kOdd2 = vec4(1.0f, -1.0f, -1.0f, -1.0f);  // Y8..11: band 2, then 3, 3, 3
-  const vec4 kOdd3 = vec4(-1.0f);                      // Y12..15: band 3 (Y4..7: band 2, even)
+  // the receiver's hemisphere, with its own displacement. The sum is the one over all N samples
+  // whose back-facing half contributes 0; lavapipe runs a skipped sample's body under a lane
+  // mask, so looping over all N paid for both halves. The SH basis of the direction is
+  // evaluated here (sh_basis16, the function that made the buffer's weights) and the solid
+  // angle applied once at the end: a lane's 16 weights were a gather of 16 floats per sample on
+  // lavapipe, about a quarter of this pass.
   int half_n = pc.grid.w / 2;
   for (int j = 0; j < half_n; ++j) {
-    SsrtSample s = samples[base + j];
+    vec4 dr = samples[base + j].direction_and_radius;
     float r_anti = samples[base + j + half_n].direction_and_radius.w;
-    vec3 w0 = s.direction_and_radius.xyz;
+    vec3 w0 = dr.xyz;
     bool flip_r = dot(nr, w0) < 0.0f;
     bool flip_v = dot(nv, w0) < 0.0f;
     vec3 w_r = flip_r ? -w0 : w0;
     vec3 w_v = flip_v ? -w0 : w0;
-    float r_r = (flip_r ? r_anti : s.direction_and_radius.w) * pc.sampling.x;
-    float r_v = (flip_v ? r_anti : s.direction_and_radius.w) * pc.sampling.x;
+    float r_r = (flip_r ? r_anti : dr.w) * pc.sampling.x;
+    float r_v = (flip_v ? r_anti : dr.w) * pc.sampling.x;
     bool do_real = real_ok && dot(nr, w_r) > 0.0f;
     bool do_rv = influenced && dot(nv, w_v) > 0.0f && (virt || real_ok);
 
@@ -181,10 +181,11 @@ void main() {
       bool from_view = k < 1.0f;
       if (!from_view && aux_occluder(xr, y, s_aux)) k = ssrt_visibility_k(xr, s_aux, w, chi);
       float tw = ssrt_transfer_weight(nr, w, k, 1.0f);
-      t_real[0] += tw * (flip_r ? s.sh_weights[0] * kOdd0 : s.sh_weights[0]);
-      t_real[1] += tw * s.sh_weights[1];
-      t_real[2] += tw * (flip_r ? s.sh_weights[2] * kOdd2 : s.sh_weights[2]);
-      t_real[3] += tw * (flip_r ? s.sh_weights[3] * kOdd3 : s.sh_weights[3]);
+      SH16 y_sh = sh_basis16(w);
+      t_real[0] += tw * y_sh.c0;
+      t_real[1] += tw * y_sh.c1;
+      t_real[2] += tw * y_sh.c2;
+      t_real[3] += tw * y_sh.c3;
       if (from_view) {
         ri += ssrt_indirect_term(xr, nr, sp, sn, sa, k, l_dir, e_light, pc.bounce.x,
                                  pc.sampling.w);
@@ -221,10 +222,11 @@ void main() {
       bool from_view_v = k < 1.0f;
       if (!from_view_v && aux_occluder(xv, y, sv_aux)) k = ssrt_visibility_k(xv, sv_aux, w, chi);
       float tw = ssrt_transfer_weight(nv, w, k, 1.0f);
-      t_rv[0] += tw * (flip_v ? s.sh_weights[0] * kOdd0 : s.sh_weights[0]);
-      t_rv[1] += tw * s.sh_weights[1];
-      t_rv[2] += tw * (flip_v ? s.sh_weights[2] * kOdd2 : s.sh_weights[2]);
-      t_rv[3] += tw * (flip_v ? s.sh_weights[3] * kOdd3 : s.sh_weights[3]);
+      SH16 y_sh = sh_basis16(w);
+      t_rv[0] += tw * y_sh.c0;
+      t_rv[1] += tw * y_sh.c1;
+      t_rv[2] += tw * y_sh.c2;
+      t_rv[3] += tw * y_sh.c3;
       if (from_view_v) {
         ri_v += ssrt_indirect_term(xv, nv, sp, sn, sa, k, l_dir, e_light, pc.bounce.x,
                                    pc.sampling.w);
@@ -232,6 +234,10 @@ void main() {
     }
   }
 
+  for (int c = 0; c < 4; ++c) {
+    t_real[c] *= pc.aux_test.z;  // the solid angle of one sample, 4 pi / N
+    t_rv[c] *= pc.aux_test.z;
+  }
   if (!influenced) {
     t_rv = t_real;
     ri_v = ri;

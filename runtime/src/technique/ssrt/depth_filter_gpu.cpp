@@ -12,6 +12,8 @@ constexpr int kMaxTapsPerSide = 5;     // the median networks hold 25 values
 // Tap reach, pixels: no shader limit (taps are fetched directly), but a window beyond it mixes
 // surfaces that have nothing to do with each other at the paper's 640 x 480.
 constexpr int kMaxReach = 16;
+// Tangent radius of the G-buffer's normals, pixels (recon's default normal_radius).
+constexpr uint32_t kNormalRadiusPx = 2;
 
 const char* kWhere = "technique/ssrt/depth_filter_gpu.cpp DepthFilterSettings.";
 
@@ -129,7 +131,8 @@ Expected<DepthFilterGpu> DepthFilterGpu::create(gpu::Context& ctx, gpu::FrameGra
   p = gpu::load_compute_pipeline(ctx, "ssrt/depth_final.comp", {{ubo}, {img}, {img}}, sizeof(glm::ivec4));
   if (!p) return p.error();
   f.final_pipe_ = std::move(*p);
-  p = gpu::load_compute_pipeline(ctx, "ssrt/depth_gbuffer.comp", {{ubo}, {img}, {img}, {img}}, 0);
+  p = gpu::load_compute_pipeline(ctx, "ssrt/depth_gbuffer.comp", {{ubo}, {img}, {img}, {img}},
+                                 sizeof(glm::ivec4));
   if (!p) return p.error();
   f.gbuffer_ = std::move(*p);
 
@@ -159,6 +162,7 @@ Status DepthFilterGpu::record(gpu::ImageHandle depth_volume, bool final_pass,
     merge_push_.window = glm::ivec4(merge.reach, merge.stride, merge.taps, 0);
     bilateral_push_.window = glm::ivec4(bilateral.reach, bilateral.stride, bilateral.taps, 0);
     final_push_ = glm::ivec4(int(window_side(scaled(settings_.final_window)) / 2), 0, 0, 0);
+    gbuffer_push_ = glm::ivec4(int(scaled(kNormalRadiusPx)), 0, 0, 0);
   }
   if (depth_volume.valid()) {
     const gpu::GpuImage& v = graph_->gpu_image(depth_volume);
@@ -280,7 +284,7 @@ Status DepthFilterGpu::record(gpu::ImageHandle depth_volume, bool final_pass,
             .storage_image(3, pass.view(normal_))
             .push(pass.context(), cmd, *gbuffer_);
         const VkExtent2D e = pass.extent(position_);
-        gpu::dispatch_2d(cmd, *gbuffer_, nullptr, 0, e.width, e.height);
+        gpu::dispatch_2d(cmd, *gbuffer_, &gbuffer_push_, sizeof(gbuffer_push_), e.width, e.height);
       });
   return ok_status();
 }

@@ -93,6 +93,7 @@ class DepthFilterGpu {
   // Push constants, filled at create / record (kept here so the callbacks allocate nothing).
   WindowPush merge_push_{}, bilateral_push_{};
   glm::ivec4 final_push_{1, 0, 0, 0};
+  glm::ivec4 gbuffer_push_{2, 0, 0, 0};  // x normal tangent radius, texels
 };
 
 }  // namespace mrgi::ssrt

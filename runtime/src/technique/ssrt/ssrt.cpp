@@ -19,8 +19,8 @@ namespace mrgi::technique {
 namespace {
 
 constexpr uint32_t kCoarseLayers = 10;
-constexpr uint32_t kReduceEntries = 192;       // per tile, see light_reduce.comp
-constexpr uint32_t kTileW = 16, kTileH = 12;   // cells per reduction tile
+constexpr uint32_t kReduceEntries = 192;       // per partial sum, see light_reduce.comp
+constexpr uint32_t kStripCells = 32;           // cells of a row per light_reduce invocation
 constexpr uint32_t kSampleSeed = 20140901;     // sample sets are a pure function of N and this
 
 // Settings shared by every level (units in the names).
@@ -44,10 +44,11 @@ struct TransferPush {
   glm::vec4 sampling;
   glm::vec4 bounce;
   glm::ivec4 influence;
-  glm::vec4 aux;  // x bias in texels of the aux layer, y 1 = test the aux layers
+  glm::vec4 aux;  // x bias in texels of the aux layer, y 1 = test the aux layers, z solid angle
 };
 struct ReducePush {
   glm::ivec4 grid;
+  glm::ivec4 size;
 };
 struct FinalPush {
   glm::ivec4 counts;
@@ -194,9 +195,9 @@ Status Ssrt::init() {
 
   // Everything sized for the top level: one cell per pixel of the largest internal image.
   const VkExtent2D top = graph.allocated_extent(shared_.lit_r);
-  const uint32_t tiles = ((top.width + kTileW - 1) / kTileW) * ((top.height + kTileH - 1) / kTileH);
+  const uint32_t strips = ((top.width + kStripCells - 1) / kStripCells) * top.height;
   auto partials = graph.create_buffer(
-      {"ssrt_light_partials", VkDeviceSize(tiles) * kReduceEntries * sizeof(float)},
+      {"ssrt_light_partials", VkDeviceSize(strips) * kReduceEntries * sizeof(float)},
       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (!partials) return partials.error();
   partials_ = *partials;
@@ -218,7 +219,6 @@ Status Ssrt::init() {
 
   const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
   const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-  const auto tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
   const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
   auto p = gpu::load_compute_pipeline(ctx, "ssrt/transfer.comp",
                             {{ubo}, {ubo}, {ssbo}, {img}, {img}, {img}, {img}, {img}, {img}, {img},
@@ -226,7 +226,7 @@ Status Ssrt::init() {
                             sizeof(TransferPush));
   if (!p) return p.error();
   transfer_ = std::move(*p);
-  p = gpu::load_compute_pipeline(ctx, "ssrt/light_reduce.comp", {{tex}, {tex}, {ssbo}}, sizeof(ReducePush));
+  p = gpu::load_compute_pipeline(ctx, "ssrt/light_reduce.comp", {{img}, {img}, {ssbo}}, sizeof(ReducePush));
   if (!p) return p.error();
   reduce_ = std::move(*p);
   p = gpu::load_compute_pipeline(ctx, "ssrt/light_reduce_final.comp", {{ssbo}, {ssbo}}, sizeof(FinalPush));
@@ -459,30 +459,31 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
                                      int(geometry_step_), 0),
                           glm::vec4(kRadiusM, chi_[size_t(level_)], kNormalOffsetM, kMinSenderDistM),
                           glm::vec4(sample_area, kSaturation, kDepthBias, kRangeM),
-                          influence_cells_, glm::vec4(kAuxBiasTexels, 1.0f, 0.0f, 0.0f)};
+                          influence_cells_,
+                          glm::vec4(kAuxBiasTexels, 1.0f, 4.0f * 3.14159265f / float(directions_),
+                                    0.0f)};
           gpu::dispatch_2d(cmd, *transfer_, &pc, sizeof(pc), grid_.x, grid_.y);
         });
-    const uint32_t tiles_x = (grid_.x + kTileW - 1) / kTileW;
-    const uint32_t tiles_y = (grid_.y + kTileH - 1) / kTileH;
+    const uint32_t strips_x = (grid_.x + kStripCells - 1) / kStripCells;
+    const uint32_t partial_count = strips_x * grid_.y;
     graph.add_pass(
         "ssrt_light_reduce", gpu::PassKind::Compute,
         [this](gpu::PassBuilder& b) {
-          b.read(coarse_, gpu::Access::Sampled);
-          b.read(shared_.real_albedo, gpu::Access::Sampled);
+          b.read(coarse_, gpu::Access::StorageRead);
+          b.read(shared_.real_albedo, gpu::Access::StorageRead);
           b.write(partials_, gpu::Access::StorageWrite);
         },
-        [this, tiles_x, tiles_y](VkCommandBuffer cmd, gpu::PassContext& pass) {
+        [this, strips_x, partial_count](VkCommandBuffer cmd, gpu::PassContext& pass) {
           const gpu::Context& ctx = pass.context();
-          const VkSampler nearest = ctx.samplers().nearest_clamp;
           vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, reduce_->pipeline);
           gpu::DescriptorPush()
-              .sampled_image(0, pass.view(coarse_), nearest)
-              .sampled_image(1, pass.view(shared_.real_albedo), nearest)
+              .storage_image(0, pass.view(coarse_))
+              .storage_image(1, pass.view(shared_.real_albedo))
               .storage_buffer(2, pass.buffer(partials_))
               .push(ctx, cmd, *reduce_);
-          ReducePush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), int(tiles_x))};
-          gpu::dispatch_2d(cmd, *reduce_, &pc, sizeof(pc), tiles_x * kTileW, tiles_y * kTileH,
-                           kTileW, kTileH);
+          ReducePush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), int(kStripCells)),
+                        glm::ivec4(int(used_.width), int(used_.height), int(strips_x), 0)};
+          gpu::dispatch_2d(cmd, *reduce_, &pc, sizeof(pc), partial_count, 1, 64, 1);
         });
     graph.add_pass(
         "ssrt_light_reduce_final", gpu::PassKind::Compute,
@@ -490,14 +491,14 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
           b.read(partials_, gpu::Access::StorageRead);
           b.write(result_, gpu::Access::StorageWrite);
         },
-        [this, tiles_x, tiles_y](VkCommandBuffer cmd, gpu::PassContext& pass) {
+        [this, partial_count](VkCommandBuffer cmd, gpu::PassContext& pass) {
           const gpu::Context& ctx = pass.context();
           vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, reduce_final_->pipeline);
           gpu::DescriptorPush()
               .storage_buffer(0, pass.buffer(partials_))
               .storage_buffer(1, pass.buffer(result_))
               .push(ctx, cmd, *reduce_final_);
-          FinalPush pc{glm::ivec4(int(tiles_x * tiles_y), 0, 0, 0)};
+          FinalPush pc{glm::ivec4(int(partial_count), 0, 0, 0)};
           gpu::dispatch_2d(cmd, *reduce_final_, &pc, sizeof(pc), kReduceEntries, 1,
                            kReduceEntries, 1);
         });
