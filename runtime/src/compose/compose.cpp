@@ -35,15 +35,23 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
   if (!spv) return spv.error();
   const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
   const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-  const auto tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-  // compose.comp: kSameSize, kCameraOnly; each path compiled out of the other's pipeline.
-  for (uint32_t camera_only = 0; camera_only < 2; ++camera_only) {
-    gpu::ComputePipelineDesc d{camera_only ? "compose_camera_only" : "compose", *spv,
-                               {{ubo}, {ssbo}, {tex}, {tex}, {tex}, {ssbo}, {ssbo}},
-                               sizeof(ComposePush), {same_size_as_camera ? 1u : 0u, camera_only}};
+  const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+  // compose.comp: kSameSize, kCameraOnly, kSameInternal; each path compiled out of the others'.
+  const struct {
+    const char* name;
+    uint32_t camera_only, same_internal;
+    gpu::PipelineHandle* handle;
+  } variants[] = {{"compose", 0, 0, &c.pipeline_},
+                  {"compose_same_internal", 0, 1, &c.same_internal_pipeline_},
+                  {"compose_camera_only", 1, 0, &c.camera_pipeline_}};
+  for (const auto& v : variants) {
+    gpu::ComputePipelineDesc d{v.name, *spv,
+                               {{ubo}, {ssbo}, {img}, {img}, {img}, {ssbo}, {ssbo}},
+                               sizeof(ComposePush),
+                               {same_size_as_camera ? 1u : 0u, v.camera_only, v.same_internal}};
     auto p = gpu::create_compute_pipeline(context, d);
     if (!p) return p.error();
-    (camera_only ? c.camera_pipeline_ : c.pipeline_) = gpu::PipelineHandle(context, std::move(*p));
+    *v.handle = gpu::PipelineHandle(context, std::move(*p));
   }
   return c;
 }
@@ -55,9 +63,9 @@ void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
       [this](gpu::PassBuilder& b) {
         b.read(in_.frame_constants, gpu::Access::UniformRead);
         b.read(in_.color_upload, gpu::Access::StorageRead);
-        b.read(in_.lit_rv, gpu::Access::Sampled);
-        b.read(in_.lit_r, gpu::Access::Sampled);
-        b.read(in_.virtual_position, gpu::Access::Sampled);
+        b.read(in_.lit_rv, gpu::Access::StorageRead);
+        b.read(in_.lit_r, gpu::Access::StorageRead);
+        b.read(in_.virtual_position, gpu::Access::StorageRead);
         b.write(output_, gpu::Access::StorageWrite);
         b.write(mask_, gpu::Access::StorageWrite);
       },
@@ -68,14 +76,18 @@ void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
 
 void Compose::dispatch(VkCommandBuffer cmd, gpu::PassContext& pass) {
   const gpu::Context& ctx = pass.context();
-  const gpu::Pipeline& pipeline = in_.camera_only ? *camera_pipeline_ : *pipeline_;
+  const VkExtent2D used = pass.extent(in_.lit_r);
+  const bool same_internal = used.width == width_ && used.height == height_;
+  const gpu::Pipeline& pipeline = in_.camera_only ? *camera_pipeline_
+                                  : same_internal ? *same_internal_pipeline_
+                                                  : *pipeline_;
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline);
   gpu::DescriptorPush()
       .uniform_buffer(0, pass.buffer(in_.frame_constants))
       .storage_buffer(1, pass.buffer(in_.color_upload))
-      .sampled_image(2, pass.view(in_.lit_rv), ctx.samplers().linear_clamp)
-      .sampled_image(3, pass.view(in_.lit_r), ctx.samplers().linear_clamp)
-      .sampled_image(4, pass.view(in_.virtual_position), ctx.samplers().nearest_clamp)
+      .storage_image(2, pass.view(in_.lit_rv))
+      .storage_image(3, pass.view(in_.lit_r))
+      .storage_image(4, pass.view(in_.virtual_position))
       .storage_buffer(5, pass.buffer(output_))
       .storage_buffer(6, pass.buffer(mask_))
       .push(ctx, cmd, pipeline);

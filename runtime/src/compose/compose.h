@@ -47,7 +47,8 @@ class Compose {
   uint32_t width_ = 0, height_ = 0;
   ComposeInputs in_;
   gpu::BufferHandle output_, mask_;
-  gpu::PipelineHandle pipeline_, camera_pipeline_;  // composite; camera frame only
+  // Composite (solutions resampled), composite at the solutions' own size, camera frame only.
+  gpu::PipelineHandle pipeline_, same_internal_pipeline_, camera_pipeline_;
 };
 
 }  // namespace mrgi::compose
