@@ -7,11 +7,13 @@
 // differential_compose), which is eq. 13's "multiply the buffers with the colour of I_c" without
 // eq. 13's tone mapper: the runtime's compose is shared by all techniques and works in linear
 // radiance; eq. 13 itself (ssrt_direct_differential) is kept in ssrt_math.h and tested.
-// At step 1 the coarse cells are the pixels; above it the Gauss-filtered layers 7..9 are read
-// with Catmull-Rom bicubic interpolation (paper OursFast), clamped at 0 (bicubic overshoots).
+// At step 1 the coarse cells are the pixels; above it the Gauss-filtered cells (`upsampled`,
+// upsampled.glsl) are read with Catmull-Rom bicubic interpolation (paper OursFast), clamped at 0
+// (bicubic overshoots).
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
 #include "ssrt/ssrt_math.h"
+#include "ssrt/upsampled.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 // Storage images read with imageLoad: on lavapipe a sampled texelFetch costs 2-3x as much.
@@ -22,6 +24,7 @@ layout(set = 0, binding = 3, rgba32f) readonly uniform image2D virtual_position;
 layout(set = 0, binding = 4, rgba16f) readonly uniform image2D virtual_albedo;
 layout(set = 0, binding = 5, rgba16f) writeonly uniform image2D lit_rv;
 layout(set = 0, binding = 6, rgba16f) writeonly uniform image2D lit_r;
+layout(set = 0, binding = 7, rgba32ui) readonly uniform uimage2D upsampled;
 layout(push_constant) uniform Push {
   ivec4 grid;   // x, y cells; z step in pixels; w 1 = skip (pass the camera colour through)
   ivec4 size;   // xy used extent of the solutions (internal resolution), z geometry step
@@ -37,12 +40,12 @@ vec4 cubic_weights(float t) {
               -1.5f * t3 + 2.0f * t2 + 0.5f * t, 0.5f * t3 - 0.5f * t2);
 }
 
-// Bicubic over the cells that see the same kind of surface as the pixel (layer 7 w: 1 real,
-// 2 virtual), renormalised by the weights of the cells used; where the 4x4 neighbourhood holds
-// no cell of the pixel's kind (thin virtual parts at 4x4), over the cells of any surface.
+// Bicubic over the cells that see the same kind of surface as the pixel (1 real, 2 virtual),
+// renormalised by the weights of the cells used; where the 4x4 neighbourhood holds no cell of
+// the pixel's kind (thin virtual parts at 4x4), over the cells of any surface.
 // Both sums are accumulated in one pass over the 16 cells: as two calls (same kind, then any
 // kind where the first found nothing) lavapipe ran the second for every pixel, since a
-// divergent `if` runs under a lane mask, which doubled this pass's 48 fetches a pixel. Each sum
+// divergent `if` runs under a lane mask, which doubled this pass's fetches. Each sum
 // takes the same terms in the same order as one call would, so the result is unchanged.
 void sample_bicubic(vec2 c, float kind, out vec4 s4, out vec4 s5, out vec4 s6) {
   vec2 base = floor(c);
@@ -54,11 +57,14 @@ void sample_bicubic(vec2 c, float kind, out vec4 s4, out vec4 s5, out vec4 s6) {
   for (int j = 0; j < 4; ++j) {
     for (int i = 0; i < 4; ++i) {
       ivec2 q = clamp(ivec2(base) + ivec2(i - 1, j - 1), ivec2(0), pc.grid.xy - ivec2(1));
-      vec4 a = imageLoad(coarse, ivec3(q, 7));
-      if (a.w < 0.5f) continue;
+      float rd, rd_v, kind_q;
+      vec3 ri, ri_v;
+      ssrt_unpack_upsampled(imageLoad(upsampled, q), rd, rd_v, ri, ri_v, kind_q);
+      if (kind_q < 0.5f) continue;
       float w = wx[i] * wy[j];
-      vec4 t5 = imageLoad(coarse, ivec3(q, 8));
-      vec4 t6 = imageLoad(coarse, ivec3(q, 9));
+      vec4 a = vec4(rd, rd_v, 0.0f, kind_q);
+      vec4 t5 = vec4(ri, 1.0f);
+      vec4 t6 = vec4(ri_v, 1.0f);
       a4 += w * a;
       a5 += w * t5;
       a6 += w * t6;

@@ -2,11 +2,15 @@
 // ssrt fast path up-sampling, step 1 of 2 (paper Sec. 5.1, OursFast: "bicubic interpolation and
 // standard Gauss filtering with a kernel radius of eight"): a Gauss filter of radius 8 output
 // pixels (radius / step cells, sigma = radius / 2) over the coarse shading layers 4..6, written
-// to layers 7..9. Only cells that see the same kind of surface as the centre (real or virtual,
+// packed to `upsampled` (upsampled.glsl). Only cells that see the same kind of surface as the centre (real or virtual,
 // layer 4 w) carry weight: the paper's plain Gauss smeared the virtual object's own shading into
 // the contact shadow around it at 4x4. The bicubic step follows in shade.comp.
+#extension GL_GOOGLE_include_directive : require
+#include "ssrt/upsampled.glsl"
+
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(set = 0, binding = 0, rgba32f) uniform image2DArray coarse;
+layout(set = 0, binding = 0, rgba32f) readonly uniform image2DArray coarse;
+layout(set = 0, binding = 1, rgba32ui) writeonly uniform uimage2D upsampled;
 layout(push_constant) uniform Push {
   ivec4 grid;   // x, y cells; z step in pixels
   vec4 filt;    // x radius in output pixels
@@ -36,13 +40,9 @@ void main() {
       wsum += w;
     }
   }
-  if (wsum > 0.0f && centre.w > 0.5f) {
-    imageStore(coarse, ivec3(cell, 7), vec4((acc4 / wsum).xyz, centre.w));
-    imageStore(coarse, ivec3(cell, 8), vec4((acc5 / wsum).xyz, 1.0f));
-    imageStore(coarse, ivec3(cell, 9), vec4((acc6 / wsum).xyz, 1.0f));
-  } else {
-    imageStore(coarse, ivec3(cell, 7), vec4(0.0f));
-    imageStore(coarse, ivec3(cell, 8), vec4(0.0f));
-    imageStore(coarse, ivec3(cell, 9), vec4(0.0f));
-  }
+  bool surface = wsum > 0.0f && centre.w > 0.5f;
+  vec4 s4 = surface ? acc4 / wsum : vec4(0.0f);
+  vec3 s5 = surface ? acc5.xyz / wsum : vec3(0.0f), s6 = surface ? acc6.xyz / wsum : vec3(0.0f);
+  imageStore(upsampled, cell,
+             ssrt_pack_upsampled(s4.x, s4.y, s5, s6, surface ? centre.w : 0.0f));
 }

@@ -18,7 +18,7 @@
 namespace mrgi::technique {
 namespace {
 
-constexpr uint32_t kCoarseLayers = 10;
+constexpr uint32_t kCoarseLayers = 7;
 constexpr uint32_t kReduceEntries = 192;       // per partial sum, see light_reduce.comp
 constexpr uint32_t kStripCells = 32;           // cells of a row per light_reduce invocation
 constexpr uint32_t kSampleSeed = 20140901;     // sample sets are a pure function of N and this
@@ -125,6 +125,7 @@ class Ssrt final : public Technique {
   std::vector<float> chi_;             // per level
   gpu::BufferHandle samples_, light_, partials_, result_;
   gpu::ImageHandle coarse_;
+  gpu::ImageHandle upsampled_;  // RGBA32UI per cell, shaders/ssrt/upsampled.glsl
   gpu::PipelineHandle transfer_, reduce_, reduce_final_, blur_, shade_;
   std::vector<int64_t> pending_;       // per frame slot: frame whose sums its readback holds
   std::vector<int> pending_bands_;     // per frame slot: SH bands of that frame's transfer
@@ -216,6 +217,12 @@ Status Ssrt::init() {
   auto coarse = graph.create_image(cd, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT);
   if (!coarse) return coarse.error();
   coarse_ = *coarse;
+  gpu::ImageDesc ud;
+  ud.name = "ssrt_upsampled";
+  ud.format = VK_FORMAT_R32G32B32A32_UINT;
+  auto upsampled = graph.create_image(ud, VK_IMAGE_USAGE_STORAGE_BIT);
+  if (!upsampled) return upsampled.error();
+  upsampled_ = *upsampled;
 
   const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
   const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
@@ -232,10 +239,11 @@ Status Ssrt::init() {
   p = gpu::load_compute_pipeline(ctx, "ssrt/light_reduce_final.comp", {{ssbo}, {ssbo}}, sizeof(FinalPush));
   if (!p) return p.error();
   reduce_final_ = std::move(*p);
-  p = gpu::load_compute_pipeline(ctx, "ssrt/upsample_blur.comp", {{img}}, sizeof(BlurPush));
+  p = gpu::load_compute_pipeline(ctx, "ssrt/upsample_blur.comp", {{img}, {img}}, sizeof(BlurPush));
   if (!p) return p.error();
   blur_ = std::move(*p);
-  p = gpu::load_compute_pipeline(ctx, "ssrt/shade.comp", {{img}, {img}, {img}, {img}, {img}, {img}, {img}},
+  p = gpu::load_compute_pipeline(ctx, "ssrt/shade.comp",
+                                 {{img}, {img}, {img}, {img}, {img}, {img}, {img}, {img}},
                        sizeof(ShadePush));
   if (!p) return p.error();
   shade_ = std::move(*p);
@@ -508,11 +516,17 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     if (step_ > 1) {
       graph.add_pass(
           "ssrt_upsample_blur", gpu::PassKind::Compute,
-          [this](gpu::PassBuilder& b) { b.write(coarse_, gpu::Access::StorageReadWrite); },
+          [this](gpu::PassBuilder& b) {
+            b.read(coarse_, gpu::Access::StorageRead);
+            b.write(upsampled_, gpu::Access::StorageWrite);
+          },
           [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
             const gpu::Context& ctx = pass.context();
             vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, blur_->pipeline);
-            gpu::DescriptorPush().storage_image(0, pass.view(coarse_)).push(ctx, cmd, *blur_);
+            gpu::DescriptorPush()
+                .storage_image(0, pass.view(coarse_))
+                .storage_image(1, pass.view(upsampled_))
+                .push(ctx, cmd, *blur_);
             BlurPush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), 0),
                         glm::vec4(kGaussRadiusPx, 0.0f, 0.0f, 0.0f)};
             gpu::dispatch_2d(cmd, *blur_, &pc, sizeof(pc), grid_.x, grid_.y);
@@ -528,6 +542,7 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
         // Declared on skipped frames too (the shader binds it but does not read it then), so
         // the binding is always in the layout the graph gave it.
         b.read(coarse_, gpu::Access::StorageRead);
+        b.read(upsampled_, gpu::Access::StorageRead);
         for (gpu::ImageHandle h : {geo_position_, r.real_albedo, r.virtual_position,
                                    r.virtual_albedo})
           b.read(h, gpu::Access::StorageRead);
@@ -546,6 +561,7 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
             .storage_image(4, pass.view(r.virtual_albedo))
             .storage_image(5, pass.view(r.lit_rv))
             .storage_image(6, pass.view(r.lit_r))
+            .storage_image(7, pass.view(upsampled_))
             .push(ctx, cmd, *shade_);
         ShadePush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), run_transfer ? 0 : 1),
                      glm::ivec4(int(used_.width), int(used_.height), int(geometry_step_), 0),
