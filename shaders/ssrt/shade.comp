@@ -16,6 +16,12 @@
 #include "ssrt/upsampled.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
+// Pipelines from this file (a path a pipeline never takes is compiled out, not branched around:
+// lavapipe runs all of a shader's code): kPassThrough writes the camera colour as both solutions
+// (skipped transfer, and the first of the two fast-level passes); kTiled shades the 8 x 8 tiles
+// ssrt_shade_tiles listed (workgroup i = tiles.list[i]); neither: every pixel.
+layout(constant_id = 0) const bool kPassThrough = false;
+layout(constant_id = 1) const bool kTiled = false;
 // Storage images read with imageLoad: on lavapipe a sampled texelFetch costs 2-3x as much.
 layout(set = 0, binding = 0, rgba32f) readonly uniform image2DArray coarse;
 layout(set = 0, binding = 1, rgba32f) readonly uniform image2D real_position;
@@ -25,8 +31,9 @@ layout(set = 0, binding = 4, rgba16f) readonly uniform image2D virtual_albedo;
 layout(set = 0, binding = 5, rgba16f) writeonly uniform image2D lit_rv;
 layout(set = 0, binding = 6, rgba16f) writeonly uniform image2D lit_r;
 layout(set = 0, binding = 7, rgba32ui) readonly uniform uimage2D upsampled;
+layout(std430, set = 0, binding = 8) readonly buffer Tiles { uint list[]; } tiles;
 layout(push_constant) uniform Push {
-  ivec4 grid;   // x, y cells; z step in pixels; w 1 = skip (pass the camera colour through)
+  ivec4 grid;   // x, y cells; z step in pixels; w unused
   ivec4 size;   // xy used extent of the solutions (internal resolution), z geometry step
                 // (internal pixels per texel of real_position)
   ivec4 influence;  // pixels [x0, x1) x [y0, y1) the virtual objects' influence region covers
@@ -89,6 +96,11 @@ void sample_bicubic(vec2 c, float kind, out vec4 s4, out vec4 s5, out vec4 s6) {
 
 void main() {
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+  if (kTiled) {
+    uint t = tiles.list[gl_WorkGroupID.x];
+    int tiles_x = (pc.size.x + 7) / 8;
+    pixel = ivec2(int(t) % tiles_x, int(t) / tiles_x) * 8 + ivec2(gl_LocalInvocationID.xy);
+  }
   ivec2 used = pc.size.xy;
   if (pixel.x >= used.x || pixel.y >= used.y) return;
   bool real_ok = imageLoad(real_position, pixel / pc.size.z).w > 0.0f;
@@ -96,7 +108,7 @@ void main() {
   vec3 a = imageLoad(real_albedo, pixel).rgb;
   bool inside = pixel.x >= pc.influence.x && pixel.x < pc.influence.z &&
                 pixel.y >= pc.influence.y && pixel.y < pc.influence.w;
-  if (pc.grid.w != 0 || (!inside && !virt)) {
+  if (kPassThrough || (!inside && !virt)) {
     // Skipped transfer, or a pixel outside the influence region: nothing virtual changes it,
     // so L_rv = L_r and the compose returns the camera colour whatever their common value.
     vec4 v = vec4(real_ok ? a : vec3(0.0f), 1.0f);

@@ -8,6 +8,7 @@
 
 #include "common/frame_constants.glsl"
 #include "gpu/pipelines.h"
+#include "gpu/shaders.h"
 #include "ssrt/ssrt_math.h"
 #include "technique/scene_gpu.h"
 #include "technique/ssrt/depth_filter_gpu.h"
@@ -57,6 +58,11 @@ struct BlurPush {
   glm::ivec4 grid;
   glm::vec4 filt;
 };
+struct TilesPush {
+  glm::ivec4 grid;
+  glm::ivec4 counts;
+  glm::ivec4 virt;
+};
 struct ShadePush {
   glm::ivec4 grid;
   glm::ivec4 size;
@@ -95,6 +101,10 @@ class Ssrt final : public Technique {
   // Whether the virtual objects' influence region (bounds grown by the sampling radius) is in
   // view; `cells` gets its conservative screen rectangle in cells [x0, x1) x [y0, y1).
   bool influence_in_view(glm::ivec4& cells) const;
+  bool project_virtual_bounds(float grow_m, glm::vec2& pmin, glm::vec2& pmax, bool& behind) const;
+  glm::ivec4 virtual_pixels() const;
+  enum class ShadeMode { Full, PassThrough, Tiled };
+  void add_shade_pass(const char* name, ShadeMode mode, bool run_transfer);
   glm::ivec4 influence_pixels() const {
     const int st = int(step_);
     const int grow = step_ > 1 ? int(kGaussRadiusPx) + 2 * st : 0;
@@ -126,7 +136,10 @@ class Ssrt final : public Technique {
   gpu::BufferHandle samples_, light_, partials_, result_;
   gpu::ImageHandle coarse_;
   gpu::ImageHandle upsampled_;  // RGBA32UI per cell, shaders/ssrt/upsampled.glsl
-  gpu::PipelineHandle transfer_, reduce_, reduce_final_, blur_, shade_;
+  gpu::PipelineHandle transfer_, reduce_, reduce_final_, blur_, shade_, shade_pass_,
+      shade_tiled_, shade_tiles_;
+  // Fast levels' shade tiles (shade_tiles.comp): indirect dispatch arguments and tile indices.
+  gpu::BufferHandle tile_args_, tile_list_;
   std::vector<int64_t> pending_;       // per frame slot: frame whose sums its readback holds
   std::vector<int> pending_bands_;     // per frame slot: SH bands of that frame's transfer
   bool primed_ = false;                // a priming run was asked for (only ever once)
@@ -242,11 +255,38 @@ Status Ssrt::init() {
   p = gpu::load_compute_pipeline(ctx, "ssrt/upsample_blur.comp", {{img}, {img}}, sizeof(BlurPush));
   if (!p) return p.error();
   blur_ = std::move(*p);
-  p = gpu::load_compute_pipeline(ctx, "ssrt/shade.comp",
-                                 {{img}, {img}, {img}, {img}, {img}, {img}, {img}, {img}},
-                       sizeof(ShadePush));
+  auto shade_spv = gpu::shader_spirv("ssrt/shade.comp");
+  if (!shade_spv) return shade_spv.error();
+  const struct {
+    const char* name;
+    uint32_t pass_through, tiled;
+    gpu::PipelineHandle* handle;
+  } shade_variants[] = {{"ssrt_shade", 0, 0, &shade_},
+                        {"ssrt_shade_pass_through", 1, 0, &shade_pass_},
+                        {"ssrt_shade_tiled", 0, 1, &shade_tiled_}};
+  for (const auto& v : shade_variants) {
+    gpu::ComputePipelineDesc d{v.name, *shade_spv,
+                               {{img}, {img}, {img}, {img}, {img}, {img}, {img}, {img}, {ssbo}},
+                               sizeof(ShadePush), {v.pass_through, v.tiled}};
+    auto sp = gpu::create_compute_pipeline(ctx, d);
+    if (!sp) return sp.error();
+    *v.handle = gpu::PipelineHandle(ctx, std::move(*sp));
+  }
+  p = gpu::load_compute_pipeline(ctx, "ssrt/shade_tiles.comp", {{img}, {ssbo}, {ssbo}},
+                                 sizeof(TilesPush));
   if (!p) return p.error();
-  shade_ = std::move(*p);
+  shade_tiles_ = std::move(*p);
+  const uint32_t max_tiles = ((top.width + 7) / 8) * ((top.height + 7) / 8);
+  auto args = graph.create_buffer({"ssrt_shade_tile_args", 16},
+                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                      VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
+                                      VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  if (!args) return args.error();
+  tile_args_ = *args;
+  auto list = graph.create_buffer({"ssrt_shade_tile_list", VkDeviceSize(max_tiles) * 4},
+                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  if (!list) return list.error();
+  tile_list_ = *list;
   return ok_status();
 }
 
@@ -353,22 +393,23 @@ void Ssrt::write_light() {
   std::memcpy(graph.mapped(light_, graph.slot()), &l, sizeof(l));
 }
 
-// The virtual objects' bounds grown by the sampling radius (the region where they can shadow or
-// light a real surface) against this frame's view frustum: in view unless all eight corners
-// lie outside one side of it.
-bool Ssrt::influence_in_view(glm::ivec4& cells) const {
+// The virtual objects' bounds grown by `grow_m` against this frame's view frustum: false when
+// all eight corners lie outside one side of it; else their projection's pixel rectangle in
+// pmin/pmax, and `behind` when a corner lies behind the camera (the projection is unbounded).
+bool Ssrt::project_virtual_bounds(float grow_m, glm::vec2& pmin, glm::vec2& pmax,
+                                  bool& behind) const {
   const SceneGpu& sg = *shared_.scene_gpu;
   if (sg.virtual_objects.empty()) return false;
   gpu::FrameGraph& graph = *shared_.graph;
   const auto* fc =
       static_cast<const shader::FrameConstants*>(graph.mapped(shared_.frame_constants, graph.slot()));
-  // Grown by the occluder range: no receiver farther away can see a virtual occluder.
-  const glm::vec3 lo = sg.virtual_objects.bounds_min - glm::vec3(kRangeM);
-  const glm::vec3 hi = sg.virtual_objects.bounds_max + glm::vec3(kRangeM);
+  const glm::vec3 lo = sg.virtual_objects.bounds_min - glm::vec3(grow_m);
+  const glm::vec3 hi = sg.virtual_objects.bounds_max + glm::vec3(grow_m);
   const glm::vec4 k = fc->internal_k;
   const glm::vec2 size(fc->internal_output_size.x, fc->internal_output_size.y);
   int out_count[5] = {0, 0, 0, 0, 0};  // behind, left, right, top, bottom
-  glm::vec2 pmin(1e30f), pmax(-1e30f);
+  pmin = glm::vec2(1e30f);
+  pmax = glm::vec2(-1e30f);
   for (int c = 0; c < 8; ++c) {
     const glm::vec3 p((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
     const glm::vec3 q = glm::vec3(fc->world_to_camera * glm::vec4(p, 1.0f));
@@ -386,8 +427,17 @@ bool Ssrt::influence_in_view(glm::ivec4& cells) const {
   }
   for (int side = 0; side < 5; ++side)
     if (out_count[side] == 8) return false;
-  if (out_count[0] > 0) {
-    // A corner behind the camera: the projection is unbounded, take the whole grid.
+  behind = out_count[0] > 0;
+  return true;
+}
+
+// The region where the virtual objects can shadow or light a real surface: their bounds grown
+// by the occluder range (no receiver farther away can see a virtual occluder).
+bool Ssrt::influence_in_view(glm::ivec4& cells) const {
+  glm::vec2 pmin, pmax;
+  bool behind = false;
+  if (!project_virtual_bounds(kRangeM, pmin, pmax, behind)) return false;
+  if (behind) {
     cells = glm::ivec4(0, 0, int(grid_.x), int(grid_.y));
     return true;
   }
@@ -398,6 +448,70 @@ bool Ssrt::influence_in_view(glm::ivec4& cells) const {
   cells = glm::clamp(cells, glm::ivec4(0), glm::ivec4(int(grid_.x), int(grid_.y),
                                                       int(grid_.x), int(grid_.y)));
   return true;
+}
+
+// The virtual objects' own pixels (bounds projected, one pixel of margin; empty when out of
+// view, everything when a corner is behind the camera).
+glm::ivec4 Ssrt::virtual_pixels() const {
+  glm::vec2 pmin, pmax;
+  bool behind = false;
+  if (!project_virtual_bounds(0.0f, pmin, pmax, behind)) return glm::ivec4(0);
+  if (behind) return glm::ivec4(0, 0, int(used_.width), int(used_.height));
+  return glm::ivec4(int(std::floor(pmin.x)) - 1, int(std::floor(pmin.y)) - 1,
+                    int(std::ceil(pmax.x)) + 2, int(std::ceil(pmax.y)) + 2);
+}
+
+void Ssrt::add_shade_pass(const char* name, ShadeMode mode, bool run_transfer) {
+  gpu::FrameGraph& graph = *shared_.graph;
+  graph.add_pass(
+      name, gpu::PassKind::Compute,
+      [this, mode](gpu::PassBuilder& b) {
+        const SharedResources& r = shared_;
+        // Declared on skipped frames too (the shader binds them but does not read them then),
+        // so the bindings are always in the layout the graph gave them.
+        b.read(coarse_, gpu::Access::StorageRead);
+        b.read(upsampled_, gpu::Access::StorageRead);
+        for (gpu::ImageHandle h : {geo_position_, r.real_albedo, r.virtual_position,
+                                   r.virtual_albedo})
+          b.read(h, gpu::Access::StorageRead);
+        b.read(tile_list_, gpu::Access::StorageRead);
+        // The tiled pass rewrites some tiles of what the pass-through one wrote.
+        const gpu::Access out = mode == ShadeMode::Tiled ? gpu::Access::StorageReadWrite
+                                                         : gpu::Access::StorageWrite;
+        if (mode == ShadeMode::Tiled) b.read(tile_args_, gpu::Access::IndirectRead);
+        b.write(r.lit_rv, out);
+        b.write(r.lit_r, out);
+      },
+      [this, mode, run_transfer](VkCommandBuffer cmd, gpu::PassContext& pass) {
+        const gpu::Context& ctx = pass.context();
+        const SharedResources& r = shared_;
+        const gpu::Pipeline& pipe = mode == ShadeMode::Tiled        ? *shade_tiled_
+                                    : mode == ShadeMode::PassThrough ? *shade_pass_
+                                                                     : *shade_;
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipe.pipeline);
+        gpu::DescriptorPush()
+            .storage_image(0, pass.view(coarse_))
+            .storage_image(1, pass.view(geo_position_))
+            .storage_image(2, pass.view(r.real_albedo))
+            .storage_image(3, pass.view(r.virtual_position))
+            .storage_image(4, pass.view(r.virtual_albedo))
+            .storage_image(5, pass.view(r.lit_rv))
+            .storage_image(6, pass.view(r.lit_r))
+            .storage_image(7, pass.view(upsampled_))
+            .storage_buffer(8, pass.buffer(tile_list_))
+            .push(ctx, cmd, pipe);
+        ShadePush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), run_transfer ? 0 : 1),
+                     glm::ivec4(int(used_.width), int(used_.height), int(geometry_step_), 0),
+                     // Cells -> pixels, grown by the up-sampling footprint (Gauss radius plus
+                     // the bicubic's two cells) so every pixel the filters can reach is shaded.
+                     influence_pixels(), glm::vec4(kIndirectTolerance, 0.0f, 0.0f, 0.0f)};
+        if (mode == ShadeMode::Tiled) {
+          vkCmdPushConstants(cmd, pipe.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
+          vkCmdDispatchIndirect(cmd, pass.buffer(tile_args_), 0);
+        } else {
+          gpu::dispatch_2d(cmd, pipe, &pc, sizeof(pc), used_.width, used_.height);
+        }
+      });
 }
 
 Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
@@ -535,41 +649,42 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
       skipped.push_back("ssrt_upsample_blur: level samples every pixel");
     }
   }
-  graph.add_pass(
-      "ssrt_shade", gpu::PassKind::Compute,
-      [this](gpu::PassBuilder& b) {
-        const SharedResources& r = shared_;
-        // Declared on skipped frames too (the shader binds it but does not read it then), so
-        // the binding is always in the layout the graph gave it.
-        b.read(coarse_, gpu::Access::StorageRead);
-        b.read(upsampled_, gpu::Access::StorageRead);
-        for (gpu::ImageHandle h : {geo_position_, r.real_albedo, r.virtual_position,
-                                   r.virtual_albedo})
-          b.read(h, gpu::Access::StorageRead);
-        b.write(r.lit_rv, gpu::Access::StorageWrite);
-        b.write(r.lit_r, gpu::Access::StorageWrite);
-      },
-      [this, run_transfer](VkCommandBuffer cmd, gpu::PassContext& pass) {
-        const gpu::Context& ctx = pass.context();
-        const SharedResources& r = shared_;
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, shade_->pipeline);
-        gpu::DescriptorPush()
-            .storage_image(0, pass.view(coarse_))
-            .storage_image(1, pass.view(geo_position_))
-            .storage_image(2, pass.view(r.real_albedo))
-            .storage_image(3, pass.view(r.virtual_position))
-            .storage_image(4, pass.view(r.virtual_albedo))
-            .storage_image(5, pass.view(r.lit_rv))
-            .storage_image(6, pass.view(r.lit_r))
-            .storage_image(7, pass.view(upsampled_))
-            .push(ctx, cmd, *shade_);
-        ShadePush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), run_transfer ? 0 : 1),
-                     glm::ivec4(int(used_.width), int(used_.height), int(geometry_step_), 0),
-                     // Cells -> pixels, grown by the up-sampling footprint (Gauss radius plus
-                     // the bicubic's two cells) so every pixel the filters can reach is shaded.
-                     influence_pixels(), glm::vec4(kIndirectTolerance, 0.0f, 0.0f, 0.0f)};
-        gpu::dispatch_2d(cmd, *shade_, &pc, sizeof(pc), used_.width, used_.height);
-      });
+  if (!run_transfer) {
+    add_shade_pass("ssrt_shade", ShadeMode::PassThrough, false);
+  } else if (step_ <= 1) {
+    add_shade_pass("ssrt_shade", ShadeMode::Full, true);
+  } else {
+    // Fast levels: pass-through everywhere, then the tiles whose result can differ from it.
+    const glm::uvec2 tiles((used_.width + 7) / 8, (used_.height + 7) / 8);
+    graph.add_pass(
+        "ssrt_shade_tiles_clear", gpu::PassKind::Transfer,
+        [this](gpu::PassBuilder& b) { b.write(tile_args_, gpu::Access::TransferDst); },
+        [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
+          vkCmdFillBuffer(cmd, pass.buffer(tile_args_), 0, 4, 0u);  // x groups
+          vkCmdFillBuffer(cmd, pass.buffer(tile_args_), 4, 8, 1u);  // y, z
+        });
+    graph.add_pass(
+        "ssrt_shade_tiles", gpu::PassKind::Compute,
+        [this](gpu::PassBuilder& b) {
+          b.read(upsampled_, gpu::Access::StorageRead);
+          b.write(tile_args_, gpu::Access::StorageReadWrite);
+          b.write(tile_list_, gpu::Access::StorageWrite);
+        },
+        [this, tiles](VkCommandBuffer cmd, gpu::PassContext& pass) {
+          const gpu::Context& ctx = pass.context();
+          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, shade_tiles_->pipeline);
+          gpu::DescriptorPush()
+              .storage_image(0, pass.view(upsampled_))
+              .storage_buffer(1, pass.buffer(tile_args_))
+              .storage_buffer(2, pass.buffer(tile_list_))
+              .push(ctx, cmd, *shade_tiles_);
+          TilesPush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), 0),
+                       glm::ivec4(int(tiles.x), int(tiles.y), 0, 0), virtual_pixels()};
+          gpu::dispatch_2d(cmd, *shade_tiles_, &pc, sizeof(pc), tiles.x * tiles.y, 1, 64, 1);
+        });
+    add_shade_pass("ssrt_shade", ShadeMode::PassThrough, true);
+    add_shade_pass("ssrt_shade_tiled", ShadeMode::Tiled, true);
+  }
   return ok_status();
 }
 
