@@ -23,6 +23,13 @@
 #include "ssrt/aux_views.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
+// kRealReceivers: the dispatch covers only cells whose receiver is real (outside the virtual
+// objects' projected bounds), so both solutions share the receiver, the sample point and every
+// lookup at it: one real G-buffer read, one virtual G-buffer read, one aux test and one SH basis
+// per sample instead of two of each (lavapipe pays for every instruction of every lane, so
+// halving the reads is the only way to save them). Same results as the general path, which
+// runs over the cells inside those bounds.
+layout(constant_id = 0) const bool kRealReceivers = false;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
 layout(std140, set = 0, binding = 1) uniform LightUbo { SsrtLight light; };
 layout(std430, set = 0, binding = 2) readonly buffer SampleBuffer { SsrtSample samples[]; };
@@ -48,6 +55,7 @@ layout(push_constant) uniform Push {
   ivec4 influence;  // cells [x0, x1) x [y0, y1) that the virtual objects' influence region covers
   vec4 aux_test;    // x depth bias in texels of each aux layer, y 1 = test the aux layers,
                     // z solid angle of one sample (4 pi / N)
+  ivec4 region;     // cells [x0, x1) x [y0, y1) of this dispatch
 } pc;
 
 // Paper Fig. 5a: a sample the main buffer finds visible may lie behind a surface one of the
@@ -91,8 +99,8 @@ vec4 real_surface(vec2 q, ivec2 qi, int gstep, out vec3 n) {
 float view_depth(vec3 p) { return (frame.world_to_camera * vec4(p, 1.0f)).z; }
 
 void main() {
-  ivec2 cell = ivec2(gl_GlobalInvocationID.xy);
-  if (cell.x >= pc.grid.x || cell.y >= pc.grid.y) return;
+  ivec2 cell = pc.region.xy + ivec2(gl_GlobalInvocationID.xy);
+  if (cell.x >= pc.region.z || cell.y >= pc.region.w) return;
   ivec2 size = frame.internal_output_size.xy;
   int step = pc.grid.z;
   ivec2 pixel = min(cell * step + ivec2(step / 2), size - ivec2(1));
@@ -109,6 +117,8 @@ void main() {
   }
   vec3 xr = rp.xyz;
   vec3 nr = normalize(imageLoad(real_normal, pixel / gstep).xyz + vec3(1e-9f));
+  if (kRealReceivers) virt = false;  // the host's bounds say so; a stray coverage bit must not
+                                     // change the solution between the two paths
   vec3 xv = virt ? vp.xyz : xr;
   vec3 nv = virt ? normalize(imageLoad(virtual_normal, pixel).xyz + vec3(1e-9f)) : nr;
 
@@ -137,103 +147,162 @@ void main() {
   // angle applied once at the end: a lane's 16 weights were a gather of 16 floats per sample on
   // lavapipe, about a quarter of this pass.
   int half_n = pc.grid.w / 2;
-  for (int j = 0; j < half_n; ++j) {
-    vec4 dr = samples[base + j].direction_and_radius;
-    float r_anti = samples[base + j + half_n].direction_and_radius.w;
-    vec3 w0 = dr.xyz;
-    bool flip_r = dot(nr, w0) < 0.0f;
-    bool flip_v = dot(nv, w0) < 0.0f;
-    vec3 w_r = flip_r ? -w0 : w0;
-    vec3 w_v = flip_v ? -w0 : w0;
-    float r_r = (flip_r ? r_anti : dr.w) * pc.sampling.x;
-    float r_v = (flip_v ? r_anti : dr.w) * pc.sampling.x;
-    bool do_real = real_ok && dot(nr, w_r) > 0.0f;
-    bool do_rv = influenced && dot(nv, w_v) > 0.0f && (virt || real_ok);
-
-    // Real receiver against real occluders.
-    if (do_real) {
-      vec3 w = w_r;
-      vec3 y = xr + nr * pc.sampling.z + w * r_r;
-      float k = 1.0f;
-      vec3 sp = vec3(0.0f), sn = vec3(0.0f), sa = vec3(0.0f);
+  if (kRealReceivers) {
+    float range2 = pc.bounce.w * pc.bounce.w;
+    for (int j = 0; j < half_n; ++j) {
+      vec4 dr = samples[base + j].direction_and_radius;
+      float r_anti = samples[base + j + half_n].direction_and_radius.w;
+      bool flip = dot(nr, dr.xyz) < 0.0f;
+      vec3 w = flip ? -dr.xyz : dr.xyz;
+      float r = (flip ? r_anti : dr.w) * pc.sampling.x;
+      if (!(real_ok && dot(nr, w) > 0.0f)) continue;
+      vec3 y = xr + nr * pc.sampling.z + w * r;
       float yz = view_depth(y);
-      if (yz > 0.0f) {
-        vec2 q = project_pinhole((frame.world_to_camera * vec4(y, 1.0f)).xyz, frame.internal_k);
-        ivec2 qi = ivec2(floor(q + 0.5f));
-        if (all(greaterThanEqual(qi, ivec2(0))) && all(lessThan(qi, size))) {
-          vec3 on;
-          vec4 o = real_surface(q, qi, gstep, on);
-          // Range check (standard SSDO/SSAO practice; the paper does not say): a surface
-          // farther from x than the range (push: twice the sampling radius, since the surface
-          // seen in front of y may lie well in front of it) is not what blocks this direction.
-          vec3 dr = o.xyz - xr;
-          if (o.w > 0.0f && o.w < yz * (1.0f - bias) && dot(dr, dr) <= pc.bounce.w * pc.bounce.w) {
-            sp = o.xyz;
-            sn = on;
-            sa = imageLoad(real_albedo, qi).rgb;
-            k = ssrt_visibility_k(xr, sp, w, chi);
-          }
-        }
-      }
-      // Occluders the view cannot see: visibility only (their normal and colour are unknown,
-      // so they send no indirect light).
+      vec2 q = project_pinhole((frame.world_to_camera * vec4(y, 1.0f)).xyz, frame.internal_k);
+      ivec2 qi = ivec2(floor(q + 0.5f));
+      bool in_view = yz > 0.0f && all(greaterThanEqual(qi, ivec2(0))) && all(lessThan(qi, size));
+      qi = clamp(qi, ivec2(0), size - 1);
+      vec3 on;
+      vec4 o = real_surface(q, qi, gstep, on);
+      vec4 ov = imageLoad(virtual_position, qi);
+      vec3 oa = imageLoad(real_albedo, qi).rgb;
+      // Real scene: the real surface in front of the sample within the range (see the general
+      // path below for the rules); real + virtual: the virtual surface where the virtual
+      // G-buffer holds one (it is in front of the real one there), else the real one.
+      vec3 dr_r = o.xyz - xr;
+      bool hit_r = in_view && o.w > 0.0f && o.w < yz * (1.0f - bias) && dot(dr_r, dr_r) <= range2;
+      bool use_virtual = in_view && influenced && ov.w > 0.5f;
+      float oz_v = view_depth(ov.xyz);
+      vec3 dr_v = ov.xyz - xr;
+      bool hit_vo = oz_v > 0.0f && oz_v < yz * (1.0f - bias) && dot(dr_v, dr_v) <= range2;
+      bool hit_v = use_virtual ? hit_vo : hit_r;
+      vec3 sp_v = use_virtual ? ov.xyz : o.xyz;
+      float k = hit_r ? ssrt_visibility_k(xr, o.xyz, w, chi) : 1.0f;
+      float k_v = hit_v ? ssrt_visibility_k(xr, sp_v, w, chi) : 1.0f;
+      bool from_view = k < 1.0f, from_view_v = k_v < 1.0f;
       vec3 s_aux;
-      bool from_view = k < 1.0f;
-      if (!from_view && aux_occluder(xr, y, s_aux)) k = ssrt_visibility_k(xr, s_aux, w, chi);
-      float tw = ssrt_transfer_weight(nr, w, k, 1.0f);
+      bool aux_hit = aux_occluder(xr, y, s_aux);
+      float k_aux = ssrt_visibility_k(xr, s_aux, w, chi);
+      if (!from_view && aux_hit) k = k_aux;
+      if (!from_view_v && aux_hit) k_v = k_aux;
       SH16 y_sh = sh_basis16(w);
+      float tw = ssrt_transfer_weight(nr, w, k, 1.0f);
+      float tw_v = ssrt_transfer_weight(nr, w, k_v, 1.0f);
       t_real[0] += tw * y_sh.c0;
       t_real[1] += tw * y_sh.c1;
       t_real[2] += tw * y_sh.c2;
       t_real[3] += tw * y_sh.c3;
-      if (from_view) {
-        ri += ssrt_indirect_term(xr, nr, sp, sn, sa, k, l_dir, e_light, pc.bounce.x,
+      t_rv[0] += tw_v * y_sh.c0;
+      t_rv[1] += tw_v * y_sh.c1;
+      t_rv[2] += tw_v * y_sh.c2;
+      t_rv[3] += tw_v * y_sh.c3;
+      vec3 sn_v = use_virtual ? imageLoad(virtual_normal, qi).xyz : on;
+      vec3 sa_v = use_virtual ? imageLoad(virtual_albedo, qi).rgb : oa;
+      if (from_view)
+        ri += ssrt_indirect_term(xr, nr, o.xyz, on, oa, k, l_dir, e_light, pc.bounce.x,
                                  pc.sampling.w);
-      }
+      if (from_view_v)
+        ri_v += ssrt_indirect_term(xr, nr, sp_v, sn_v, sa_v, k_v, l_dir, e_light, pc.bounce.x,
+                                   pc.sampling.w);
     }
-    // Visible receiver against real + virtual occluders.
-    if (do_rv) {
-      vec3 w = w_v;
-      vec3 y = xv + nv * pc.sampling.z + w * r_v;
-      float k = 1.0f;
-      vec3 sp = vec3(0.0f), sn = vec3(0.0f), sa = vec3(0.0f);
-      float yz = view_depth(y);
-      if (yz > 0.0f) {
-        vec2 q = project_pinhole((frame.world_to_camera * vec4(y, 1.0f)).xyz, frame.internal_k);
-        ivec2 qi = ivec2(floor(q + 0.5f));
-        if (all(greaterThanEqual(qi, ivec2(0))) && all(lessThan(qi, size))) {
-          vec4 ov = imageLoad(virtual_position, qi);
-          vec3 on;
-          vec4 o = real_surface(q, qi, gstep, on);
-          // The virtual G-buffer only holds virtual surfaces in front of the real one.
-          bool use_virtual = ov.w > 0.5f;
-          float oz = use_virtual ? view_depth(ov.xyz) : o.w;
-          vec3 dv = (use_virtual ? ov.xyz : o.xyz) - xv;
-          if ((use_virtual || o.w > 0.0f) && oz > 0.0f && oz < yz * (1.0f - bias) &&
-              dot(dv, dv) <= pc.bounce.w * pc.bounce.w) {
-            sp = use_virtual ? ov.xyz : o.xyz;
-            sn = use_virtual ? imageLoad(virtual_normal, qi).xyz : on;
-            sa = use_virtual ? imageLoad(virtual_albedo, qi).rgb : imageLoad(real_albedo, qi).rgb;
-            k = ssrt_visibility_k(xv, sp, w, chi);
+  } else {
+    for (int j = 0; j < half_n; ++j) {
+      vec4 dr = samples[base + j].direction_and_radius;
+      float r_anti = samples[base + j + half_n].direction_and_radius.w;
+      vec3 w0 = dr.xyz;
+      bool flip_r = dot(nr, w0) < 0.0f;
+      bool flip_v = dot(nv, w0) < 0.0f;
+      vec3 w_r = flip_r ? -w0 : w0;
+      vec3 w_v = flip_v ? -w0 : w0;
+      float r_r = (flip_r ? r_anti : dr.w) * pc.sampling.x;
+      float r_v = (flip_v ? r_anti : dr.w) * pc.sampling.x;
+      bool do_real = real_ok && dot(nr, w_r) > 0.0f;
+      bool do_rv = influenced && dot(nv, w_v) > 0.0f && (virt || real_ok);
+
+      // Real receiver against real occluders.
+      if (do_real) {
+        vec3 w = w_r;
+        vec3 y = xr + nr * pc.sampling.z + w * r_r;
+        float k = 1.0f;
+        vec3 sp = vec3(0.0f), sn = vec3(0.0f), sa = vec3(0.0f);
+        float yz = view_depth(y);
+        if (yz > 0.0f) {
+          vec2 q = project_pinhole((frame.world_to_camera * vec4(y, 1.0f)).xyz, frame.internal_k);
+          ivec2 qi = ivec2(floor(q + 0.5f));
+          if (all(greaterThanEqual(qi, ivec2(0))) && all(lessThan(qi, size))) {
+            vec3 on;
+            vec4 o = real_surface(q, qi, gstep, on);
+            // Range check (standard SSDO/SSAO practice; the paper does not say): a surface
+            // farther from x than the range (push: twice the sampling radius, since the surface
+            // seen in front of y may lie well in front of it) is not what blocks this direction.
+            vec3 dr = o.xyz - xr;
+            if (o.w > 0.0f && o.w < yz * (1.0f - bias) && dot(dr, dr) <= pc.bounce.w * pc.bounce.w) {
+              sp = o.xyz;
+              sn = on;
+              sa = imageLoad(real_albedo, qi).rgb;
+              k = ssrt_visibility_k(xr, sp, w, chi);
+            }
           }
         }
-      }
-      vec3 sv_aux;
-      bool from_view_v = k < 1.0f;
-      if (!from_view_v && aux_occluder(xv, y, sv_aux)) k = ssrt_visibility_k(xv, sv_aux, w, chi);
-      float tw = ssrt_transfer_weight(nv, w, k, 1.0f);
-      SH16 y_sh = sh_basis16(w);
-      t_rv[0] += tw * y_sh.c0;
-      t_rv[1] += tw * y_sh.c1;
-      t_rv[2] += tw * y_sh.c2;
-      t_rv[3] += tw * y_sh.c3;
-      if (from_view_v) {
-        ri_v += ssrt_indirect_term(xv, nv, sp, sn, sa, k, l_dir, e_light, pc.bounce.x,
+        // Occluders the view cannot see: visibility only (their normal and colour are unknown,
+        // so they send no indirect light).
+        vec3 s_aux;
+        bool from_view = k < 1.0f;
+        if (!from_view && aux_occluder(xr, y, s_aux)) k = ssrt_visibility_k(xr, s_aux, w, chi);
+        float tw = ssrt_transfer_weight(nr, w, k, 1.0f);
+        SH16 y_sh = sh_basis16(w);
+        t_real[0] += tw * y_sh.c0;
+        t_real[1] += tw * y_sh.c1;
+        t_real[2] += tw * y_sh.c2;
+        t_real[3] += tw * y_sh.c3;
+        if (from_view) {
+          ri += ssrt_indirect_term(xr, nr, sp, sn, sa, k, l_dir, e_light, pc.bounce.x,
                                    pc.sampling.w);
+        }
+      }
+      // Visible receiver against real + virtual occluders.
+      if (do_rv) {
+        vec3 w = w_v;
+        vec3 y = xv + nv * pc.sampling.z + w * r_v;
+        float k = 1.0f;
+        vec3 sp = vec3(0.0f), sn = vec3(0.0f), sa = vec3(0.0f);
+        float yz = view_depth(y);
+        if (yz > 0.0f) {
+          vec2 q = project_pinhole((frame.world_to_camera * vec4(y, 1.0f)).xyz, frame.internal_k);
+          ivec2 qi = ivec2(floor(q + 0.5f));
+          if (all(greaterThanEqual(qi, ivec2(0))) && all(lessThan(qi, size))) {
+            vec4 ov = imageLoad(virtual_position, qi);
+            vec3 on;
+            vec4 o = real_surface(q, qi, gstep, on);
+            // The virtual G-buffer only holds virtual surfaces in front of the real one.
+            bool use_virtual = ov.w > 0.5f;
+            float oz = use_virtual ? view_depth(ov.xyz) : o.w;
+            vec3 dv = (use_virtual ? ov.xyz : o.xyz) - xv;
+            if ((use_virtual || o.w > 0.0f) && oz > 0.0f && oz < yz * (1.0f - bias) &&
+                dot(dv, dv) <= pc.bounce.w * pc.bounce.w) {
+              sp = use_virtual ? ov.xyz : o.xyz;
+              sn = use_virtual ? imageLoad(virtual_normal, qi).xyz : on;
+              sa = use_virtual ? imageLoad(virtual_albedo, qi).rgb : imageLoad(real_albedo, qi).rgb;
+              k = ssrt_visibility_k(xv, sp, w, chi);
+            }
+          }
+        }
+        vec3 sv_aux;
+        bool from_view_v = k < 1.0f;
+        if (!from_view_v && aux_occluder(xv, y, sv_aux)) k = ssrt_visibility_k(xv, sv_aux, w, chi);
+        float tw = ssrt_transfer_weight(nv, w, k, 1.0f);
+        SH16 y_sh = sh_basis16(w);
+        t_rv[0] += tw * y_sh.c0;
+        t_rv[1] += tw * y_sh.c1;
+        t_rv[2] += tw * y_sh.c2;
+        t_rv[3] += tw * y_sh.c3;
+        if (from_view_v) {
+          ri_v += ssrt_indirect_term(xv, nv, sp, sn, sa, k, l_dir, e_light, pc.bounce.x,
+                                     pc.sampling.w);
+        }
       }
     }
   }
-
   for (int c = 0; c < 4; ++c) {
     t_real[c] *= pc.aux_test.z;  // the solid angle of one sample, 4 pi / N
     t_rv[c] *= pc.aux_test.z;

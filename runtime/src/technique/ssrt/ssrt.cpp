@@ -46,6 +46,7 @@ struct TransferPush {
   glm::vec4 bounce;
   glm::ivec4 influence;
   glm::vec4 aux;  // x bias in texels of the aux layer, y 1 = test the aux layers, z solid angle
+  glm::ivec4 region;  // cells [x0, x1) x [y0, y1) of one dispatch
 };
 struct ReducePush {
   glm::ivec4 grid;
@@ -103,6 +104,7 @@ class Ssrt final : public Technique {
   bool influence_in_view(glm::ivec4& cells) const;
   bool project_virtual_bounds(float grow_m, glm::vec2& pmin, glm::vec2& pmax, bool& behind) const;
   glm::ivec4 virtual_pixels() const;
+  glm::ivec4 virtual_cells() const;
   enum class ShadeMode { Full, PassThrough, Tiled };
   void add_shade_pass(const char* name, ShadeMode mode, bool run_transfer);
   glm::ivec4 influence_pixels() const {
@@ -136,7 +138,7 @@ class Ssrt final : public Technique {
   gpu::BufferHandle samples_, light_, partials_, result_;
   gpu::ImageHandle coarse_;
   gpu::ImageHandle upsampled_;  // RGBA32UI per cell, shaders/ssrt/upsampled.glsl
-  gpu::PipelineHandle transfer_, reduce_, reduce_final_, blur_, shade_, shade_pass_,
+  gpu::PipelineHandle transfer_, transfer_real_, reduce_, reduce_final_, blur_, shade_, shade_pass_,
       shade_tiled_, shade_tiles_;
   // Fast levels' shade tiles (shade_tiles.comp): indirect dispatch arguments and tile indices.
   gpu::BufferHandle tile_args_, tile_list_;
@@ -240,13 +242,19 @@ Status Ssrt::init() {
   const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
   const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-  auto p = gpu::load_compute_pipeline(ctx, "ssrt/transfer.comp",
-                            {{ubo}, {ubo}, {ssbo}, {img}, {img}, {img}, {img}, {img}, {img}, {img},
-                             {img}, {ubo}},
-                            sizeof(TransferPush));
-  if (!p) return p.error();
-  transfer_ = std::move(*p);
-  p = gpu::load_compute_pipeline(ctx, "ssrt/light_reduce.comp", {{img}, {img}, {ssbo}}, sizeof(ReducePush));
+  auto transfer_spv = gpu::shader_spirv("ssrt/transfer.comp");
+  if (!transfer_spv) return transfer_spv.error();
+  for (uint32_t real_receivers = 0; real_receivers < 2; ++real_receivers) {
+    gpu::ComputePipelineDesc d{real_receivers ? "ssrt_transfer_real_receivers" : "ssrt_transfer",
+                               *transfer_spv,
+                               {{ubo}, {ubo}, {ssbo}, {img}, {img}, {img}, {img}, {img}, {img},
+                                {img}, {img}, {ubo}},
+                               sizeof(TransferPush), {real_receivers}};
+    auto tp = gpu::create_compute_pipeline(ctx, d);
+    if (!tp) return tp.error();
+    (real_receivers ? transfer_real_ : transfer_) = gpu::PipelineHandle(ctx, std::move(*tp));
+  }
+  auto p = gpu::load_compute_pipeline(ctx, "ssrt/light_reduce.comp", {{img}, {img}, {ssbo}}, sizeof(ReducePush));
   if (!p) return p.error();
   reduce_ = std::move(*p);
   p = gpu::load_compute_pipeline(ctx, "ssrt/light_reduce_final.comp", {{ssbo}, {ssbo}}, sizeof(FinalPush));
@@ -461,6 +469,20 @@ glm::ivec4 Ssrt::virtual_pixels() const {
                     int(std::ceil(pmax.x)) + 2, int(std::ceil(pmax.y)) + 2);
 }
 
+// The cells whose receiver pixel (c step + step / 2) lies in virtual_pixels(), [x0, x1) x
+// [y0, y1); an empty rectangle at (0, 0) when there is none.
+glm::ivec4 Ssrt::virtual_cells() const {
+  const glm::ivec4 vp = virtual_pixels();
+  const float st = float(step_), half = float(step_ / 2);
+  glm::ivec4 c(int(std::ceil((float(vp.x) - half) / st)), int(std::ceil((float(vp.y) - half) / st)),
+               int(std::floor((float(vp.z) - 1.0f - half) / st)) + 1,
+               int(std::floor((float(vp.w) - 1.0f - half) / st)) + 1);
+  c = glm::clamp(c, glm::ivec4(0), glm::ivec4(int(grid_.x), int(grid_.y), int(grid_.x),
+                                              int(grid_.y)));
+  if (vp.z <= vp.x || vp.w <= vp.y || c.z <= c.x || c.w <= c.y) return glm::ivec4(0);
+  return c;
+}
+
 void Ssrt::add_shade_pass(const char* name, ShadeMode mode, bool run_transfer) {
   gpu::FrameGraph& graph = *shared_.graph;
   graph.add_pass(
@@ -560,8 +582,8 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
         [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
           const gpu::Context& ctx = pass.context();
           const SharedResources& r = shared_;
-          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, transfer_->pipeline);
-          gpu::DescriptorPush()
+          gpu::DescriptorPush descriptors;
+          descriptors
               .uniform_buffer(0, pass.buffer(r.frame_constants))
               .uniform_buffer(1, pass.buffer(light_))
               .storage_buffer(2, pass.buffer(samples_))
@@ -573,8 +595,7 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
               .storage_image(8, pass.view(r.virtual_albedo))
               .storage_image(9, pass.view(coarse_))
               .storage_image(10, pass.view(volume_->aux_position()))
-              .uniform_buffer(11, pass.buffer(volume_->aux_views()))
-              .push(ctx, cmd, *transfer_);
+              .uniform_buffer(11, pass.buffer(volume_->aux_views()));
           const float sample_area = 3.14159265f * kRadiusM * kRadiusM / float(directions_);
           TransferPush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), int(directions_)),
                           glm::ivec4(int(sample_base_[size_t(level_)]), int(bands_),
@@ -583,8 +604,28 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
                           glm::vec4(sample_area, kSaturation, kDepthBias, kRangeM),
                           influence_cells_,
                           glm::vec4(kAuxBiasTexels, 1.0f, 4.0f * 3.14159265f / float(directions_),
-                                    0.0f)};
-          gpu::dispatch_2d(cmd, *transfer_, &pc, sizeof(pc), grid_.x, grid_.y);
+                                    0.0f),
+                          glm::ivec4(0)};
+          // Cells whose receiver may be virtual (centre pixel inside the virtual objects'
+          // projected bounds) take the general path; the rest, up to four bands around them,
+          // the real-receiver one.
+          const glm::ivec4 v = virtual_cells();
+          const int gx = int(grid_.x), gy = int(grid_.y);
+          const glm::ivec4 regions[5] = {v,                   // general path
+                                         {0, 0, gx, v.y},     // real receivers: above,
+                                         {0, v.w, gx, gy},    // below,
+                                         {0, v.y, v.x, v.w},  // left,
+                                         {v.z, v.y, gx, v.w}};  // right
+          for (int i = 0; i < 5; ++i) {
+            pc.region = regions[i];
+            if (pc.region.z <= pc.region.x || pc.region.w <= pc.region.y) continue;
+            const gpu::Pipeline& pipe = i == 0 ? *transfer_ : *transfer_real_;
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipe.pipeline);
+            descriptors.push(ctx, cmd, pipe);
+            gpu::dispatch_2d(cmd, pipe, &pc, sizeof(pc), uint32_t(pc.region.z - pc.region.x),
+                             uint32_t(pc.region.w - pc.region.y));
+          }
+
         });
     const uint32_t strips_x = (grid_.x + kStripCells - 1) / kStripCells;
     const uint32_t partial_count = strips_x * grid_.y;
