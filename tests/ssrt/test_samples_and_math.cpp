@@ -190,3 +190,68 @@ TEST(SsrtMath, ToneMapAndDifferentialComposite) {
 }
 
 }  // namespace
+
+namespace {
+
+// The transfer loops over the N/2 antipodal pairs of a set and takes the member facing the
+// receiver, with the SH basis evaluated in the shader (transfer.comp); that must be the sum over
+// all N samples with the buffer's pre-computed weights, where back-facing samples contribute 0.
+TEST(SsrtSamples, PairLoopEqualsTheSumOverAllSamples) {
+  for (uint32_t n : {16u, 32u, 64u}) {
+    auto s = make_sample_sets({n, 20140901});
+    ASSERT_TRUE(s.ok());
+    std::mt19937 rng(n);
+    std::normal_distribution<float> g(0.0f, 1.0f);
+    const float solid_angle = 4.0f * float(kPi) / float(n);
+    for (int trial = 0; trial < 20; ++trial) {
+      const vec3 normal = glm::normalize(vec3(g(rng), g(rng), g(rng)));
+      for (int set = 0; set < kJitterSets; ++set) {
+        const GpuSample* base = &s->samples[size_t(set) * n];
+        double all[16] = {}, pairs[16] = {};
+        double radius_all = 0.0, radius_pairs = 0.0;
+        for (uint32_t j = 0; j < n; ++j) {
+          const vec3 w(base[j].direction_and_radius);
+          if (!(glm::dot(normal, w) > 0.0f)) continue;
+          const float tw = shader::ssrt_transfer_weight(normal, w, 1.0f, 1.0f);
+          for (int c = 0; c < 16; ++c) all[c] += tw * base[j].sh_weights[c / 4][c % 4];
+          radius_all += base[j].direction_and_radius.w;
+        }
+        for (uint32_t j = 0; j < n / 2; ++j) {
+          const vec3 w0(base[j].direction_and_radius);
+          const bool flip = glm::dot(normal, w0) < 0.0f;
+          const vec3 w = flip ? -w0 : w0;
+          // The antipode really is the other member of the pair.
+          ASSERT_LT(glm::length(vec3(base[j + n / 2].direction_and_radius) + w0), 1e-6f);
+          if (!(glm::dot(normal, w) > 0.0f)) continue;
+          const float tw = shader::ssrt_transfer_weight(normal, w, 1.0f, 1.0f);
+          const shader::SH16 y = shader::sh_basis16(w);
+          for (int c = 0; c < 16; ++c) pairs[c] += tw * shader::sh_get(y, c) * solid_angle;
+          radius_pairs += (flip ? base[j + n / 2] : base[j]).direction_and_radius.w;
+        }
+        for (int c = 0; c < 16; ++c) EXPECT_NEAR(pairs[c], all[c], 1e-5) << "n " << n << " c " << c;
+        EXPECT_NEAR(radius_pairs, radius_all, 1e-5);
+      }
+    }
+  }
+}
+
+// ssrt_plane_depth: a coarse G-buffer texel's tangent plane met by another pixel's ray.
+TEST(SsrtMath, PlaneDepthIsExactOnAPlaneAndFallsBackWhereItCannotBe) {
+  // Plane z = 2 + 0.5 x (camera space), texel centre at x = 0.
+  const vec3 n = glm::normalize(vec3(-0.5f, 0.0f, 1.0f));
+  const vec3 p(0.0f, 0.0f, 2.0f);
+  for (float u : {-0.02f, -0.01f, 0.0f, 0.01f, 0.02f}) {
+    const vec3 ray(u, 0.0f, 1.0f);  // z = 1
+    const float z = shader::ssrt_plane_depth(ray, p, n, 0.05f);
+    // On the plane: z = 2 + 0.5 (u z)  =>  z = 2 / (1 - 0.5 u).
+    EXPECT_NEAR(z, 2.0f / (1.0f - 0.5f * u), 1e-5f) << u;
+  }
+  // Farther than 5 % from the texel's depth: a depth edge, not the plane.
+  EXPECT_FLOAT_EQ(shader::ssrt_plane_depth(vec3(0.3f, 0.0f, 1.0f), p, n, 0.05f), 2.0f);
+  // A ray grazing the plane, a plane through the camera: the texel's depth, never NaN or inf.
+  const vec3 side = glm::normalize(vec3(1.0f, 0.0f, 0.0f));
+  EXPECT_FLOAT_EQ(shader::ssrt_plane_depth(vec3(0.0f, 0.0f, 1.0f), p, side, 0.05f), 2.0f);
+  EXPECT_FLOAT_EQ(shader::ssrt_plane_depth(vec3(0.0f, 0.0f, 1.0f), vec3(0.0f), n, 0.05f), 0.0f);
+}
+
+}  // namespace

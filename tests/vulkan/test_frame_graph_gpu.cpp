@@ -295,6 +295,24 @@ TEST_F(VulkanTest, RelativeImagesFollowOutputSizeAndRenderScaleWithoutReallocati
   ImageDesc dup;
   dup.name = "half";
   EXPECT_EQ((*g)->create_image(dup, VK_IMAGE_USAGE_STORAGE_BIT).error().kind, ErrorKind::BadUsage);
+  // An extent divisor (a stage at a fraction of the internal size): ceil(extent / d), no
+  // reallocation, relative images only, 1..64.
+  ASSERT_TRUE((*g)->set_output_size(640, 480).ok());
+  ASSERT_TRUE((*g)->set_render_scale(1.0f).ok());
+  ASSERT_TRUE((*g)->set_extent_divisor(*fr, 4).ok());
+  EXPECT_EQ((*g)->extent(*fr).width, 160u);
+  EXPECT_EQ((*g)->extent(*fr).height, 120u);
+  ASSERT_TRUE((*g)->set_output_size(638, 477).ok());
+  EXPECT_EQ((*g)->extent(*fr).width, 160u);  // ceil(638 / 4)
+  EXPECT_EQ((*g)->extent(*fr).height, 120u);  // ceil(477 / 4)
+  EXPECT_EQ((*g)->extent(*h).width, 319u);    // others unaffected
+  ASSERT_TRUE((*g)->set_extent_divisor(*fr, 1).ok());
+  EXPECT_EQ((*g)->extent(*fr).width, 638u);
+  EXPECT_EQ(ctx().allocated_bytes(), bytes);
+  EXPECT_EQ((*g)->set_extent_divisor(*f, 2).error().kind, ErrorKind::BadUsage);   // absolute
+  EXPECT_EQ((*g)->set_extent_divisor(*fr, 0).error().kind, ErrorKind::BadUsage);
+  EXPECT_EQ((*g)->set_extent_divisor(*fr, 65).error().kind, ErrorKind::BadUsage);
+  EXPECT_EQ((*g)->set_extent_divisor(ImageHandle{}, 2).error().kind, ErrorKind::BadUsage);
 }
 
 TEST_F(VulkanTest, FloorPassRunsAndIsTimed) {
