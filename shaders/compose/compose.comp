@@ -27,6 +27,9 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(constant_id = 0) const bool kSameSize = true;     // camera size == output size
 layout(constant_id = 1) const bool kCameraOnly = false;  // output = camera frame
 layout(constant_id = 2) const bool kSameInternal = false; // solutions' used size == output size
+// kTiled (with kSameInternal): only the 8 x 8 tiles the technique listed (Technique::
+// compose_tiles), workgroup i = tiles.list[i]; the camera-only pipeline wrote every pixel first.
+layout(constant_id = 3) const bool kTiled = false;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
 layout(std430, set = 0, binding = 1) readonly buffer ColorWords { uint color_words[]; };  // RGB8
 // Storage images read with imageLoad: on lavapipe a sampled texelFetch costs 2-3x as much.
@@ -35,6 +38,7 @@ layout(set = 0, binding = 3, rgba16f) readonly uniform image2D lit_r;
 layout(set = 0, binding = 4, rgba32f) readonly uniform image2D virtual_position;  // w: coverage
 layout(std430, set = 0, binding = 5) writeonly buffer Output { uint out_rgba8[]; };
 layout(std430, set = 0, binding = 6) writeonly buffer Mask { uint out_mask[]; };
+layout(std430, set = 0, binding = 7) readonly buffer Tiles { uint list[]; } tiles;
 layout(push_constant) uniform Params {
   vec4 compose;      // x eps (linear camera units), y alpha_max
 } params;
@@ -87,6 +91,11 @@ SOLUTION_AT(solution_r, lit_r)
 void main() {
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
   ivec2 out_size = frame.internal_output_size.zw;
+  if (kTiled) {
+    uint t = tiles.list[gl_WorkGroupID.x];
+    int tiles_x = (out_size.x + 7) / 8;
+    pixel = ivec2(int(t) % tiles_x, int(t) / tiles_x) * 8 + ivec2(gl_LocalInvocationID.xy);
+  }
   if (any(greaterThanEqual(pixel, out_size))) return;
   uint index = uint(pixel.y * out_size.x + pixel.x);
   vec2 rel = (vec2(pixel) + 0.5f) / vec2(out_size);

@@ -39,16 +39,21 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
   // compose.comp: kSameSize, kCameraOnly, kSameInternal; each path compiled out of the others'.
   const struct {
     const char* name;
-    uint32_t camera_only, same_internal;
+    uint32_t camera_only, same_internal, tiled;
     gpu::PipelineHandle* handle;
-  } variants[] = {{"compose", 0, 0, &c.pipeline_},
-                  {"compose_same_internal", 0, 1, &c.same_internal_pipeline_},
-                  {"compose_camera_only", 1, 0, &c.camera_pipeline_}};
+  } variants[] = {{"compose", 0, 0, 0, &c.pipeline_},
+                  {"compose_same_internal", 0, 1, 0, &c.same_internal_pipeline_},
+                  {"compose_tiled", 0, 1, 1, &c.tiled_pipeline_},
+                  {"compose_camera_only", 1, 0, 0, &c.camera_pipeline_}};
+  auto no_tiles = graph.create_buffer({"compose_no_tiles", 16}, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  if (!no_tiles) return no_tiles.error();
+  c.no_tiles_ = *no_tiles;
   for (const auto& v : variants) {
     gpu::ComputePipelineDesc d{v.name, *spv,
-                               {{ubo}, {ssbo}, {img}, {img}, {img}, {ssbo}, {ssbo}},
+                               {{ubo}, {ssbo}, {img}, {img}, {img}, {ssbo}, {ssbo}, {ssbo}},
                                sizeof(ComposePush),
-                               {same_size_as_camera ? 1u : 0u, v.camera_only, v.same_internal}};
+                               {same_size_as_camera ? 1u : 0u, v.camera_only, v.same_internal,
+                                v.tiled}};
     auto p = gpu::create_compute_pipeline(context, d);
     if (!p) return p.error();
     *v.handle = gpu::PipelineHandle(context, std::move(*p));
@@ -58,6 +63,25 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
 
 void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
   in_ = inputs;
+  const VkExtent2D used = graph.extent(in_.lit_r);
+  tiled_ = !in_.camera_only && in_.tile_args.valid() && in_.tile_list.valid() &&
+           used.width == width_ && used.height == height_;
+  if (tiled_) {
+    // The camera frame everywhere, then the composite over the technique's tiles.
+    graph.add_pass(
+        "compose_camera", gpu::PassKind::Compute,
+        [this](gpu::PassBuilder& b) {
+          b.read(in_.frame_constants, gpu::Access::UniformRead);
+          b.read(in_.color_upload, gpu::Access::StorageRead);
+          b.read(in_.lit_rv, gpu::Access::StorageRead);  // bound, not read by this pipeline
+          b.read(in_.lit_r, gpu::Access::StorageRead);
+          b.read(in_.virtual_position, gpu::Access::StorageRead);
+          b.read(no_tiles_, gpu::Access::StorageRead);
+          b.write(output_, gpu::Access::StorageWrite);
+          b.write(mask_, gpu::Access::StorageWrite);
+        },
+        [this](VkCommandBuffer cmd, gpu::PassContext& pass) { dispatch(cmd, pass, false); });
+  }
   graph.add_pass(
       "compose", gpu::PassKind::Compute,
       [this](gpu::PassBuilder& b) {
@@ -66,21 +90,31 @@ void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
         b.read(in_.lit_rv, gpu::Access::StorageRead);
         b.read(in_.lit_r, gpu::Access::StorageRead);
         b.read(in_.virtual_position, gpu::Access::StorageRead);
-        b.write(output_, gpu::Access::StorageWrite);
-        b.write(mask_, gpu::Access::StorageWrite);
+        if (tiled_) {
+          b.read(in_.tile_args, gpu::Access::IndirectRead);
+          b.read(in_.tile_list, gpu::Access::StorageRead);
+        } else {
+          b.read(no_tiles_, gpu::Access::StorageRead);
+        }
+        const gpu::Access out = tiled_ ? gpu::Access::StorageReadWrite : gpu::Access::StorageWrite;
+        b.write(output_, out);
+        b.write(mask_, out);
       },
-      [this](VkCommandBuffer cmd, gpu::PassContext& pass) { dispatch(cmd, pass); });
+      [this](VkCommandBuffer cmd, gpu::PassContext& pass) { dispatch(cmd, pass, tiled_); });
   graph.mark_output(output_);
   graph.mark_output(mask_);
 }
 
-void Compose::dispatch(VkCommandBuffer cmd, gpu::PassContext& pass) {
+// tiled_pass: the composite over the listed tiles; otherwise the camera copy of a tiled frame
+// (tiled_ set) or the whole compose of an untiled one.
+void Compose::dispatch(VkCommandBuffer cmd, gpu::PassContext& pass, bool tiled_pass) {
   const gpu::Context& ctx = pass.context();
   const VkExtent2D used = pass.extent(in_.lit_r);
   const bool same_internal = used.width == width_ && used.height == height_;
-  const gpu::Pipeline& pipeline = in_.camera_only ? *camera_pipeline_
-                                  : same_internal ? *same_internal_pipeline_
-                                                  : *pipeline_;
+  const gpu::Pipeline& pipeline = tiled_pass                         ? *tiled_pipeline_
+                                  : (in_.camera_only || tiled_)      ? *camera_pipeline_
+                                  : same_internal                    ? *same_internal_pipeline_
+                                                                     : *pipeline_;
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline);
   gpu::DescriptorPush()
       .uniform_buffer(0, pass.buffer(in_.frame_constants))
@@ -90,10 +124,16 @@ void Compose::dispatch(VkCommandBuffer cmd, gpu::PassContext& pass) {
       .storage_image(4, pass.view(in_.virtual_position))
       .storage_buffer(5, pass.buffer(output_))
       .storage_buffer(6, pass.buffer(mask_))
+      .storage_buffer(7, pass.buffer(tiled_pass ? in_.tile_list : no_tiles_))
       .push(ctx, cmd, pipeline);
   ComposePush pc;
   pc.compose = glm::vec4(settings_.eps, settings_.alpha_max, 0.0f, 0.0f);
-  gpu::dispatch_2d(cmd, pipeline, &pc, sizeof(pc), width_, height_);
+  if (tiled_pass) {
+    vkCmdPushConstants(cmd, pipeline.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
+    vkCmdDispatchIndirect(cmd, pass.buffer(in_.tile_args), 0);
+  } else {
+    gpu::dispatch_2d(cmd, pipeline, &pc, sizeof(pc), width_, height_);
+  }
 }
 
 Status Compose::read(const gpu::FrameGraph& graph, uint32_t slot, ImageRGBA8& image,

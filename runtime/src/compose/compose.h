@@ -24,6 +24,10 @@ struct ComposeInputs {
   // Nothing virtual affects this frame (runtime/influence.h): the output is the camera frame and
   // the solutions, not computed this frame, are not looked at.
   bool camera_only = false;
+  // The technique's Technique::compose_tiles() (valid handles): outside the listed 8 x 8 tiles
+  // the output is the camera frame. Used when the solutions are at the output size; then
+  // compose runs as a camera copy over the frame and the composite over the tiles.
+  gpu::BufferHandle tile_args, tile_list;
 };
 
 class Compose {
@@ -41,14 +45,16 @@ class Compose {
               Image<uint8_t, 1>& mask) const;
 
  private:
-  void dispatch(VkCommandBuffer cmd, gpu::PassContext& pass);
+  void dispatch(VkCommandBuffer cmd, gpu::PassContext& pass, bool tiled_pass);
 
   ComposeSettings settings_;
   uint32_t width_ = 0, height_ = 0;
   ComposeInputs in_;
   gpu::BufferHandle output_, mask_;
   // Composite (solutions resampled), composite at the solutions' own size, camera frame only.
-  gpu::PipelineHandle pipeline_, same_internal_pipeline_, camera_pipeline_;
+  gpu::PipelineHandle pipeline_, same_internal_pipeline_, camera_pipeline_, tiled_pipeline_;
+  gpu::BufferHandle no_tiles_;  // bound as the tile list when there is none (never read)
+  bool tiled_ = false;          // this frame: camera copy + composite over the listed tiles
 };
 
 }  // namespace mrgi::compose

@@ -448,8 +448,14 @@ Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, 
   if (rec.camera_copy) {
     rec.skipped.push_back("compose: nothing virtual in view, the camera frame is copied on the host");
   } else {
-    compose_->record(*graph_, {frame_constants_, recon_->color_upload(), lit_rv_, lit_r_,
-                               virtual_gbuffer_->position(), !affected});
+    compose::ComposeInputs ci{frame_constants_, recon_->color_upload(), lit_rv_, lit_r_,
+                              virtual_gbuffer_->position(), !affected};
+    if (affected) {
+      const technique::Technique::ComposeTiles tiles = technique_->compose_tiles();
+      ci.tile_args = tiles.args;
+      ci.tile_list = tiles.list;
+    }
+    compose_->record(*graph_, ci);
   }
   MRGI_TRY(graph_->compile());
   MRGI_TRY(graph_->submit());

@@ -95,6 +95,16 @@ class Technique {
   // Every frame submitted so far has completed (the runtime waited for all of them): what they
   // wrote for the host may be read now.
   virtual void frames_completed() {}
+  // After record(): the 8 x 8 output tiles outside which this frame's output is the camera
+  // frame (L_rv == L_r and nothing virtual there), as an indirect-dispatch argument buffer
+  // (VkDispatchIndirectCommand, x = tile count) and the tile indices (ty * ceil(w / 8) + tx),
+  // both written by this frame's passes. The solutions are then defined only inside the tiles,
+  // and compose copies the camera frame elsewhere. Null handles (the default): compose every
+  // pixel from the solutions.
+  struct ComposeTiles {
+    gpu::BufferHandle args, list;
+  };
+  virtual ComposeTiles compose_tiles() const { return {}; }
 };
 
 using TechniqueFactory = Expected<std::unique_ptr<Technique>> (*)(const SharedResources&);

@@ -90,6 +90,7 @@ class Ssrt final : public Technique {
   // prior (a uniform grey guess that made the first frames_in_flight frames' RDE about 1).
   bool wants_priming_run() const override { return !primed_ && !estimator_->estimate().valid; }
   void frames_completed() override;
+  ComposeTiles compose_tiles() const override { return compose_tiles_; }
 
  private:
   // Solves the sums the frame that last used `slot` read back (it must have completed).
@@ -142,6 +143,7 @@ class Ssrt final : public Technique {
       shade_tiled_, shade_tiles_;
   // Fast levels' shade tiles (shade_tiles.comp): indirect dispatch arguments and tile indices.
   gpu::BufferHandle tile_args_, tile_list_;
+  ComposeTiles compose_tiles_;  // this frame's (set by record)
   std::vector<int64_t> pending_;       // per frame slot: frame whose sums its readback holds
   std::vector<int> pending_bands_;     // per frame slot: SH bands of that frame's transfer
   bool primed_ = false;                // a priming run was asked for (only ever once)
@@ -690,6 +692,7 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
       skipped.push_back("ssrt_upsample_blur: level samples every pixel");
     }
   }
+  compose_tiles_ = {};
   if (!run_transfer) {
     add_shade_pass("ssrt_shade", ShadeMode::PassThrough, false);
   } else if (step_ <= 1) {
@@ -723,7 +726,16 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
                        glm::ivec4(int(tiles.x), int(tiles.y), 0, 0), virtual_pixels()};
           gpu::dispatch_2d(cmd, *shade_tiles_, &pc, sizeof(pc), tiles.x * tiles.y, 1, 64, 1);
         });
-    add_shade_pass("ssrt_shade", ShadeMode::PassThrough, true);
+    // At the output size the tiles are the compose's too: it copies the camera frame outside
+    // them, so the pass-through solutions there would never be read.
+    const VkExtent2D out = graph.output_size();
+    if (used_.width == out.width && used_.height == out.height) {
+      compose_tiles_ = {tile_args_, tile_list_};
+      skipped.push_back("ssrt_shade: pass-through left out, compose copies the camera frame "
+                        "outside the shaded tiles");
+    } else {
+      add_shade_pass("ssrt_shade", ShadeMode::PassThrough, true);
+    }
     add_shade_pass("ssrt_shade_tiled", ShadeMode::Tiled, true);
   }
   return ok_status();
