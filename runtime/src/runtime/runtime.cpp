@@ -205,6 +205,7 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   shared.virtual_albedo = virtual_gbuffer_->albedo();
   shared.lit_rv = lit_rv_;
   shared.lit_r = lit_r_;
+  shared.compose_honours_tiles = true;  // record(): compose uses Technique::compose_tiles()
   shared.color_upload = recon_->color_upload();
   shared.depth_upload = recon_->depth_upload();
   shared.color_intrinsics = c;

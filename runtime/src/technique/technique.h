@@ -65,6 +65,10 @@ struct SharedResources {
   Intrinsics color_intrinsics, depth_intrinsics;
   double depth_scale = 5000.0;
   bool depth_registered = true;  // depth pixels align with colour pixels (same intrinsics)
+  // The consumer of lit_rv / lit_r composes through Technique::compose_tiles() (the runtime
+  // does): a technique may then leave the solutions undefined outside the tiles it lists.
+  // False (tests and tools reading the solutions themselves): they are defined everywhere.
+  bool compose_honours_tiles = false;
 };
 
 // What record() needs to know about the current frame.

@@ -729,7 +729,8 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     // At the output size the tiles are the compose's too: it copies the camera frame outside
     // them, so the pass-through solutions there would never be read.
     const VkExtent2D out = graph.output_size();
-    if (used_.width == out.width && used_.height == out.height) {
+    if (shared_.compose_honours_tiles && used_.width == out.width &&
+        used_.height == out.height) {
       compose_tiles_ = {tile_args_, tile_list_};
       skipped.push_back("ssrt_shade: pass-through left out, compose copies the camera frame "
                         "outside the shaded tiles");
