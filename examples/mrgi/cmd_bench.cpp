@@ -22,6 +22,7 @@ struct BenchOptions {
   std::string out, check, write_baseline;
   std::vector<std::string> sizes;  // --sizes WxH,...: one run per size and a scaling table
   bool quiet = false;
+  int confirm = 1;  // re-runs of an entry whose only finding is its frame time, before failing
 };
 
 std::pair<int, int> parse_size(const std::string& text) {
@@ -82,9 +83,35 @@ void run_bench_command(BenchOptions& o) {
   if (!o.quiet) o.settings.progress = [](const std::string& what, size_t done, size_t total, double elapsed) {
     progress("bench " + what, done, total, elapsed);
   };
-  const perf::BenchResult result = take(perf::run_bench(o.settings));
+  perf::BenchResult result = take(perf::run_bench(o.settings));
   std::optional<perf::CheckReport> check;
   if (baseline) check = perf::check_against(result, *baseline);
+  // A frame-time finding alone is re-measured (up to --confirm times) before it fails the check:
+  // on a shared machine a burst of load during one run crosses the limit (measured: 1 of 24
+  // entries at +45 % in an otherwise clean rerun), while a real slowdown stays on re-running.
+  for (int attempt = 0; check && !check->passed && attempt < o.confirm && !check->timing_only.empty();
+       ++attempt) {
+    std::vector<std::string> rerun;
+    for (size_t index : check->timing_only) {
+      perf::BenchEntry& e = result.entries[index];
+      perf::BenchSettings one = o.settings;
+      one.scenes = {e.scene};
+      one.techniques = {e.technique};
+      one.levels = {std::to_string(e.level)};
+      one.progress = nullptr;
+      const perf::BenchResult again = take(perf::run_bench(one));
+      if (again.entries.size() != 1)
+        throw CommandFailure(1, "bench: re-running " + e.scene + "/" + e.technique + "/" + e.level_name +
+                                    " gave " + std::to_string(again.entries.size()) + " entries");
+      rerun.push_back(e.scene + "/" + e.technique + "/" + e.level_name + " (" +
+                      std::to_string(e.sustained_ratio) + " -> " +
+                      std::to_string(again.entries[0].sustained_ratio) + " floors)");
+      e = again.entries[0];
+    }
+    check = perf::check_against(result, *baseline);
+    for (const std::string& r : rerun)
+      check->notes.push_back("re-measured after a frame-time finding: " + r);
+  }
   auto st = perf::write_bench_outputs(o.out, result, check ? &*check : nullptr);
   if (!st.ok()) fail_with(st.error());
   if (!o.write_baseline.empty()) {
@@ -147,6 +174,11 @@ void setup(CLI::App& app) {
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
   cmd->add_option("--out,-o", opts->out, "output folder (built as DIR.partial, renamed at the end)")->required();
+  cmd->add_option("--confirm", opts->confirm,
+                  "re-runs of an entry whose only regression finding is its frame time, before "
+                  "the check fails (0 = fail at once)")
+      ->check(CLI::Range(0, 5))
+      ->capture_default_str();
   cmd->add_option("--check", opts->check, "baseline to compare with (perf/baseline.json); exit 1 on a regression");
   cmd->add_option("--write-baseline", opts->write_baseline, "write a baseline from this run to FILE");
   cmd->add_option("--device", opts->settings.device.device,

@@ -226,9 +226,12 @@ CheckReport check_against(const BenchResult& result, const Baseline& b) {
   for (const BaselineEntry& e : b.entries) base[Key{e.scene, e.technique, e.level_name}] = &e;
   std::map<Key, bool> matched;
   std::map<std::string, std::vector<double>> pass_changes;  // pass -> run / baseline, per entry
-  for (const BenchEntry& e : result.entries) {
+  for (size_t index = 0; index < result.entries.size(); ++index) {
+    const BenchEntry& e = result.entries[index];
     const Key k{e.scene, e.technique, e.level_name};
     const std::string name = key_text(e.scene, e.technique, e.level_name);
+    const size_t findings_before = rep.violations.size();
+    bool timing = false;
     auto it = base.find(k);
     if (it == base.end()) {
       rep.missing_in_baseline.push_back(name);
@@ -238,10 +241,12 @@ CheckReport check_against(const BenchResult& result, const Baseline& b) {
     rep.compared += 1;
     const BaselineEntry& be = *it->second;
     const double ratio_limit = be.ratio_to_floor * (1.0 + tol.ratio_relative) + tol.ratio_absolute;
-    if (!(e.sustained_ratio <= ratio_limit))
+    if (!(e.sustained_ratio <= ratio_limit)) {
+      timing = true;
       rep.violations.push_back(name + ": sustained frame time ratio to floor " + num(e.sustained_ratio) + " > " +
                                num(ratio_limit) + " (baseline " + num(be.ratio_to_floor) + " + " +
                                num(100.0 * tol.ratio_relative) + " % + " + num(tol.ratio_absolute) + " floor)");
+    }
     // Per pass (judged over the whole run below): the change of each checked pass's fastest
     // frame against the baseline's, in every entry that runs it.
     for (const auto& [pass, base_ratio] : be.pass_ratios) {
@@ -270,6 +275,7 @@ CheckReport check_against(const BenchResult& result, const Baseline& b) {
                                  " + " + num(tol.delta_rms_absolute) + "; RDE undefined)");
       }
     }
+    if (timing && rep.violations.size() == findings_before + 1) rep.timing_only.push_back(index);
   }
   for (const BaselineEntry& e : b.entries)
     if (!matched.count(Key{e.scene, e.technique, e.level_name}))
@@ -305,6 +311,7 @@ std::string CheckReport::summary() const {
   for (const auto& m : missing_in_run)
     s += std::string(subset_run ? "  in the baseline, not in this (restricted) run: " : "  violation: in the baseline, not run: ") + m + "\n";
   for (const auto& m : missing_in_baseline) s += "  in this run, not in the baseline: " + m + "\n";
+  for (const auto& n : notes) s += "  note: " + n + "\n";
   return s;
 }
 

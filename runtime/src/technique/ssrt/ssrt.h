@@ -4,12 +4,19 @@
 // Per frame (passes in order):
 //   ssrt_transfer            SSDO visibility of N jittered directions (2x2 sets) per cell of the
 //                            sub-sampled grid, projected to SH (eq. 6-9), real and real+virtual
-//                            in one pass, with one-bounce indirect light (eq. 10-12)
+//                            in one pass, with one-bounce indirect light (eq. 10-12); cells
+//                            outside the virtual objects' projected bounds take a path that
+//                            shares every lookup between both solutions
 //   ssrt_light_reduce(+final) the normal equations of T l = I_c summed on the GPU; the host
 //                            reads them back frames_in_flight frames later (no stall) and solves
 //                            them (light_estimator.h), the result lights the next frames
-//   ssrt_upsample_blur       fast levels only: Gauss radius 8 px over the coarse grid
-//   ssrt_shade               bicubic up-sampling, writes L_r and L_rv for the runtime's compose
+//   ssrt_upsample_blur       fast levels only: Gauss radius 8 px over the coarse grid, packed
+//                            to one RGBA32UI texel per cell (upsampled.glsl)
+//   ssrt_shade               bicubic up-sampling, writes L_r and L_rv for the runtime's compose;
+//                            at subsample > 1: ssrt_shade_tiles lists the 8x8 tiles whose result
+//                            can differ from the camera, ssrt_shade_tiled shades only those
+//                            (indirect dispatch) and hands them to compose (compose_tiles),
+//                            which copies the camera frame elsewhere
 // Skips: no virtual object in the scene, or its bounds grown by the occluder range (its
 // influence region, 2 x the 0.5 m sampling radius) outside the view: the transfer passes do not
 // run and L_rv = L_r = camera colour (compose then returns the camera image unchanged); the
@@ -18,13 +25,15 @@
 // range check), and pixels outside it are written as pass-through.
 //
 // Quality ladder (best first), knobs with units:
-//   level  name     subsample  directions  sh_bands  internal_scale
-//   0      full     1          64          4         1.0   (paper "Ours")
-//   1      half     2          32          4         1.0
-//   2      fast     4          32          4         1.0   (paper "OursFast": 4x4, up-sampled)
-//   3      fastest  4          16          4         0.5
+//   level  name     subsample  directions  sh_bands  internal_scale  geometry_step
+//   0      full     1          64          4         1.0             1  (paper "Ours")
+//   1      half     2          32          4         1.0             1
+//   2      fast     4          32          4         1.0             4  (paper "OursFast": 4x4)
+//   3      fastest  4          16          4         0.5             2
 // subsample: cells are step x step pixels; directions: N per jitter set; sh_bands: SH bands of
-// the transfer and of the estimated light.
+// the transfer and of the estimated light; geometry_step: internal pixels per texel side of the
+// volume ray cast, the depth filters (windows shrunk to match) and their G-buffer, which the
+// transfer reads at its cell centres (occluder lookups through the texel's tangent plane).
 //
 // Deviations from the paper, each explained where it is implemented: chi of eq. 9 read as a
 // one-minus-cosine threshold and G of eq. 12 on the sender's normal (ssrt_math.h); F of eq. 11
@@ -46,23 +55,28 @@
 // Light estimate on the suite's environment-lit scene (perf/suite/env_fisheye, 8 frames, truth:
 // band 1 of each frame's environment image; test GoldenSsrt): direction error median / worst
 // and pooled RDE (baseline, which reads the environment image itself: 0.629):
-//   full 16.4 / 16.8 degrees, RDE 0.568;  half 7.4 / 7.6, 0.564;  fast 8.5 / 9.0, 0.583;
-//   fastest 7.4 / 7.8, 0.618.
+//   full 16.4 / 16.8 degrees, RDE 0.568;  half 7.4 / 7.6, 0.564;  fast 7.9 / 8.1, 0.561;
+//   fastest 5.2 / 5.4, 0.619.
 // What made it work (session 4): only pixels the camera measured and whose green is unclipped
 // feed the sums (transfer.comp), a prior that no light comes from behind the dominant surface
 // (LightEstimatorSettings::below_surface_penalty), and the first frame primed from itself
 // (Technique::wants_priming_run). With the environment's true SH in place of the estimate the
 // fast level scores RDE 0.563, so the estimate costs about 0.02.
 //
+// Cost on lavapipe (LP_NUM_THREADS=2, 640x480, `mrgi bench --techniques ssrt --frames 4
+// --warmup 1`, perf/results/report-ssrt-640x480.md, floor 1.78 ms): suite mean sustained full
+// 1164 ms, half 603, fast 84.2 (46x floor), fastest 39.7 (22x); median over the five scenes
+// with a virtual object: fast 102, fastest 49. Fast level split (median over scenes): transfer
+// 27.8, recon 18.6, shade 11 (tiles), compose 7.8 (camera copy + tiles), ray cast 5.5, virtual
+// G-buffer 4.2, aux 3.8, light sums 4.2, fuse 3.1, filters 2.5, blur 1.6, host 2.6.
 // Known defects: the grey-world albedo (paper Sec. 6.4) reads brighter objects as more light
-// from their side (env_fisheye's boxes and ball are 0.6-0.7, its floor 0.5); the fast level
-// costs far more than 33 ms on lavapipe: 208 ms sustained, suite mean at 640x480 (session 5,
-// `mrgi bench --techniques ssrt --frames 4 --warmup 1`), of which the profiled split gives the
-// TSDF ray cast 68 ms and the transfer 80 ms, shade 34 ms; the ray cast and the volume's
-// G-buffer still run per pixel of the internal resolution, not per transfer cell as the level
-// allows. The fastest level had 2 SH bands until session 4; the transfer accumulates all 16
-// coefficients whatever the level, so 2 bands saved nothing and cost the direction (46 degrees
-// off; LightEstimatorSettings::below_surface_penalty says why).
+// from their side (env_fisheye's boxes and ball are 0.6-0.7, its floor 0.5); the fast level is
+// above 33 ms on lavapipe (perf/results/peaks-lavapipe-x2.md: at ~2 ns per image access the
+// full-resolution passes alone need ~28 ms); its coarse geometry costs corner 0.017 RDE (0.748
+// -> 0.765; geometry_step 2 gives 0.741 but ~24 ms more). The fastest level had 2 SH bands
+// until session 4; the transfer accumulates all 16 coefficients whatever the level, so 2 bands
+// saved nothing and cost the direction (46 degrees off; LightEstimatorSettings::
+// below_surface_penalty says why).
 #pragma once
 #include <memory>
 #include <vector>
