@@ -9,6 +9,7 @@
 #include <iostream>
 #include <optional>
 
+#include "mrgi/platform/output_dir.h"
 #include "commands.h"
 #include "mrgi/perf/bench.h"
 #include "mrgi/perf/regression.h"
@@ -43,15 +44,10 @@ void run_scaling(BenchOptions& o) {
   std::vector<std::pair<int, int>> sizes;
   for (const std::string& s : o.sizes) sizes.push_back(parse_size(s));
   std::sort(sizes.begin(), sizes.end(), [](auto a, auto b) { return a.first * a.second < b.first * b.second; });
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  const std::string dir = fs::absolute(o.out).lexically_normal().string();
-  if (fs::exists(dir, ec) && !(fs::is_empty(dir, ec) || fs::exists(dir + "/scaling.json", ec)))
-    throw CommandFailure(2, dir + ": --out exists and is not an earlier scaling output (no scaling.json); refusing to overwrite it");
-  const std::string partial = dir + ".partial";
-  fs::remove_all(partial, ec);
-  fs::create_directories(partial, ec);
-  if (ec) throw CommandFailure(1, partial + ": cannot create: " + ec.message());
+  // Only an earlier mrgi output (or an empty folder) is replaced; a failed run removes its own
+  // DIR.partial (mrgi/platform/output_dir.h).
+  OutputDir out = take(OutputDir::begin(o.out, "--out"));
+  const std::string partial = out.partial();
   std::vector<perf::BenchResult> results;
   for (auto [w, h] : sizes) {
     perf::BenchSettings s = o.settings;
@@ -67,10 +63,8 @@ void run_scaling(BenchOptions& o) {
   }
   std::ofstream(partial + "/scaling.md") << perf::scaling_markdown(results);
   std::ofstream(partial + "/scaling.json") << perf::scaling_json(results).dump(2) << "\n";
-  fs::remove_all(dir, ec);
-  ec.clear();
-  fs::rename(partial, dir, ec);
-  if (ec) throw CommandFailure(1, dir + ": cannot move the finished output into place: " + ec.message());
+  auto committed = out.commit();
+  if (!committed.ok()) fail_with(committed.error());
   std::cout << perf::scaling_markdown(results);
 }
 

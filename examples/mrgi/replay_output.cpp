@@ -54,18 +54,15 @@ nlohmann::json figures_json(const ErrorFigures& f) {
 
 Expected<ReplayOutput> ReplayOutput::create(const std::string& dir, const ReplayMeta& meta) {
   ReplayOutput out;
-  out.dir_ = fs::absolute(dir).lexically_normal().string();
-  if (!out.dir_.empty() && out.dir_.back() == '/') out.dir_.pop_back();
-  out.partial_ = out.dir_ + ".partial";
+  // Only an earlier mrgi output (or an empty folder) is replaced, and a failed run removes its
+  // own DIR.partial (mrgi/platform/output_dir.h).
+  auto od = OutputDir::begin(dir, "--out");
+  if (!od) return od.error();
+  out.output_.emplace(std::move(*od));
+  out.dir_ = out.output_->dir();
+  out.partial_ = out.output_->partial();
   out.meta_ = meta;
   std::error_code ec;
-  // Only an earlier mrgi output (or an empty folder) is replaced: --out must never wipe user data.
-  if (fs::exists(out.dir_, ec) &&
-      !(fs::is_directory(out.dir_, ec) &&
-        (fs::is_empty(out.dir_, ec) || fs::exists(out.dir_ + "/summary.json", ec))))
-    return fail(ErrorKind::BadUsage, out.dir_ + ": --out exists and is not an earlier mrgi output "
-                                                "(no summary.json); refusing to overwrite it");
-  fs::remove_all(out.partial_, ec);
   fs::create_directories(out.partial_ + "/frames", ec);
   if (ec) return fail(ErrorKind::BadInput, out.partial_ + ": cannot create output folder: " + ec.message());
   return out;
@@ -182,10 +179,7 @@ Expected<nlohmann::json> ReplayOutput::finish() {
         }
     MRGI_TRY(write_png(partial_ + "/side_by_side.png", sbs));
   }
-  std::error_code ec;
-  fs::remove_all(dir_, ec);
-  fs::rename(partial_, dir_, ec);
-  if (ec) return fail(ErrorKind::Device, dir_ + ": cannot move finished output into place: " + ec.message());
+  MRGI_TRY(output_->commit());
   return summary;
 }
 

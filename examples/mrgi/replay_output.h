@@ -19,6 +19,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "mrgi/platform/output_dir.h"
 #include "mrgi/metrics.h"
 #include "mrgi/runtime.h"
 
@@ -54,6 +55,7 @@ class ReplayOutput {
   void set_achieved(const Achieved& a) { achieved_ = a; }
 
  private:
+  std::optional<OutputDir> output_;
   std::string dir_, partial_;
   ReplayMeta meta_;
   nlohmann::json stats_ = nlohmann::json::array();

@@ -1,4 +1,5 @@
 // bench.json, bench.csv and report.md, and writing all four outputs atomically.
+#include "mrgi/platform/output_dir.h"
 #include "mrgi/perf/report.h"
 
 #include <algorithm>
@@ -362,27 +363,16 @@ nlohmann::json scaling_json(const std::vector<BenchResult>& by_size) {
 }
 
 Status write_bench_outputs(const std::string& dir_in, const BenchResult& r, const CheckReport* check) {
-  std::string dir = fs::absolute(dir_in).lexically_normal().string();
-  while (dir.size() > 1 && dir.back() == '/') dir.pop_back();
-  const std::string partial = dir + ".partial";
-  std::error_code ec;
-  // Only an earlier bench output (or an empty folder) is replaced: --out must never wipe user data.
-  if (fs::exists(dir, ec) &&
-      !(fs::is_directory(dir, ec) && (fs::is_empty(dir, ec) || fs::exists(dir + "/bench.json", ec))))
-    return fail(ErrorKind::BadUsage, dir + ": --out exists and is not an earlier bench output (no bench.json); "
-                                           "refusing to overwrite it");
-  fs::remove_all(partial, ec);
-  fs::create_directories(partial, ec);
-  if (ec) return fail(ErrorKind::BadInput, partial + ": cannot create output folder: " + ec.message());
+  // Only an earlier mrgi output (or an empty folder) is replaced, and a failed write removes
+  // its own DIR.partial (mrgi/platform/output_dir.h).
+  auto out = OutputDir::begin(dir_in, "--out");
+  if (!out) return out.error();
+  const std::string partial = out->partial();
   MRGI_TRY(write_text(partial + "/bench.json", bench_json(r, check).dump(2) + "\n"));
   MRGI_TRY(write_text(partial + "/bench.csv", bench_csv(r)));
   MRGI_TRY(write_text(partial + "/report.md", report_markdown(r, check)));
   MRGI_TRY(write_png(partial + "/pareto.png", render_pareto_plot(r)));
-  fs::remove_all(dir, ec);
-  ec.clear();
-  fs::rename(partial, dir, ec);
-  if (ec) return fail(ErrorKind::Device, dir + ": cannot move the finished output into place: " + ec.message());
-  return ok_status();
+  return out->commit();
 }
 
 }  // namespace mrgi::perf

@@ -128,7 +128,7 @@ void check_outputs(const perf::BenchResult& r) {
   // A second write replaces the earlier bench output; a folder that is not one is refused.
   EXPECT_TRUE(perf::write_bench_outputs(out, r, nullptr).ok());
   mrgi::testing::write_text(dir.file("precious/data.txt"), "x");
-  EXPECT_ERROR(perf::write_bench_outputs(dir.file("precious"), r, nullptr), BadUsage, "refusing to overwrite");
+  EXPECT_ERROR(perf::write_bench_outputs(dir.file("precious"), r, nullptr), BadUsage, "refusing to replace");
   EXPECT_TRUE(fs::exists(dir.file("precious/data.txt")));
 }
 

@@ -101,5 +101,29 @@ TEST_F(ToolCommands, RecordedCaptureReplays) {
   EXPECT_EQ(count_files(out + "/frames"), 12u);
 }
 
+// `--out` never removes what mrgi did not create (OutputDir): a user's folder, even one holding
+// a summary.json, and the capture being replayed are refused with exit 2 and left as they were,
+// and nothing half-written is left behind.
+TEST_F(ToolCommands, OutNeverReplacesWhatMrgiDidNotCreate) {
+  test::TempDir dir("out-safety");
+  const std::string capture = std::string(MRGI_SOURCE_DIR) + "/perf/suite/desk_spot";
+  const std::string user = dir.file("user");
+  std::filesystem::create_directories(user);
+  std::ofstream(user + "/summary.json") << "{\"mine\": true}\n";
+  const std::string replay = std::string("LP_NUM_THREADS=2 timeout 300 ") + MRGI_TOOL + " replay " + capture +
+                             " --technique baseline --level last --frames 1 -q --out ";
+  EXPECT_EQ(run(replay + user + " > /dev/null 2> " + dir.file("err.txt")), 2);
+  EXPECT_NE(slurp(dir.file("err.txt")).find("not written by mrgi"), std::string::npos) << slurp(dir.file("err.txt"));
+  EXPECT_EQ(slurp(user + "/summary.json"), "{\"mine\": true}\n");
+  EXPECT_FALSE(std::filesystem::exists(user + ".partial"));
+  EXPECT_EQ(run(replay + capture + " > /dev/null 2> " + dir.file("err2.txt")), 2);
+  EXPECT_TRUE(std::filesystem::exists(capture + "/capture.json"));
+  // Its own output is replaced on the next run.
+  const std::string out = dir.file("out");
+  ASSERT_EQ(run(replay + out + " > /dev/null 2> " + dir.file("err3.txt")), 0) << slurp(dir.file("err3.txt"));
+  ASSERT_EQ(run(replay + out + " > /dev/null 2> " + dir.file("err4.txt")), 0) << slurp(dir.file("err4.txt"));
+  EXPECT_EQ(count_files(out + "/frames"), 1u);
+}
+
 }  // namespace
 }  // namespace mrgi

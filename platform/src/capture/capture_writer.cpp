@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "mrgi/platform/output_dir.h"
 #include "capture/capture_text.h"
 #include "mrgi/platform/capture.h"
 #include "mrgi/platform/capture_references.h"
@@ -65,8 +66,16 @@ Expected<CaptureWriter> CaptureWriter::create(const std::string& folder, const C
   w.partial_ = w.folder_ + ".partial";
   w.info_ = info;
   w.reference_storage_ = references;
-  // A left-over .partial is an earlier interrupted write of this same capture.
+  // A left-over .partial is replaced only when an mrgi writer made it (its marker file; user
+  // data under that name is refused, untouched). The marker is written first into the new one.
+  if (fs::exists(fs::symlink_status(w.partial_, ec)) && !is_replaceable_output(w.partial_))
+    return fail(ErrorKind::BadUsage, w.partial_ + ": exists and was not written by mrgi (no " +
+                                         std::string(OutputDir::kMarker) +
+                                         " marker in it); refusing to replace it: remove it yourself");
   fs::remove_all(w.partial_, ec);
+  fs::create_directories(w.partial_, ec);
+  std::ofstream(fs::path(w.partial_) / OutputDir::kMarker)
+      << "Written by mrgi: an unfinished capture, which a later run may replace.\n";
   for (const char* sub : {"rgb", "depth"}) {
     fs::create_directories(fs::path(w.partial_) / sub, ec);
     if (ec)
@@ -244,6 +253,9 @@ Status CaptureWriter::finish() {
   std::error_code ec;
   fs::remove(dir / kProgressFile, ec);
   if (ec) return fail(ErrorKind::Device, (dir / kProgressFile).string() + ": cannot remove: " + ec.message());
+  // A finished capture is data, not an output a later run may replace: the marker goes.
+  fs::remove(dir / OutputDir::kMarker, ec);
+  ec.clear();
   if (fs::exists(folder_, ec)) {
     if (!fs::is_empty(folder_, ec))
       return fail(ErrorKind::BadUsage, folder_ + ": appeared and is not empty while the capture was "
