@@ -1,7 +1,10 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <filesystem>
 #include <fstream>
+
+#include <sys/stat.h>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -244,6 +247,95 @@ TEST(GltfLoader, AccessorPastBufferEndIsRefused) {
   ASSERT_FALSE(model.ok());
   EXPECT_EQ(model.error().kind, ErrorKind::BadInput);
   EXPECT_TRUE(testing::contains(model.error().message, "tri.gltf")) << model.error().message;
+}
+
+}  // namespace
+}  // namespace mrgi
+
+namespace mrgi {
+namespace {
+
+// A triangle glTF whose JSON the test controls around the fixed parts.
+std::string triangle_gltf(const std::string& extra_top, const std::string& nodes, const std::string& buffer_uri) {
+  return R"({"asset": {"version": "2.0"}, )" + extra_top + R"(
+  "scene": 0, "scenes": [{"nodes": [0]}], "nodes": )" + nodes + R"(,
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+  "buffers": [{"uri": ")" + buffer_uri + R"(", "byteLength": 36}],
+  "bufferViews": [{"buffer": 0, "byteLength": 36}],
+  "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                 "min": [0, 0, 0], "max": [1, 1, 0]}]})";
+}
+
+void write_triangle_bin(const std::string& path) {
+  const float tri[] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(tri), sizeof(tri));
+}
+
+// Issue 12 case 1: 15,000 nested arrays overflowed the stack inside tinygltf's JSON parser.
+TEST(GltfHardening, DeeplyNestedJsonIsRefusedBeforeParsing) {
+  TempDir dir;
+  write_triangle_bin(dir.file("t.bin"));
+  std::string deep(15000, '[');
+  deep += std::string(15000, ']');
+  write_text(dir.file("deep.gltf"), triangle_gltf("\"extras\": " + deep + ",", "[{\"mesh\": 0}]", "t.bin"));
+  EXPECT_ERROR(load_gltf(dir.file("deep.gltf"), Placement{}), BadInput, "deep.gltf", "nested deeper than 128");
+  // Brackets inside strings do not count.
+  write_text(dir.file("strings.gltf"),
+             triangle_gltf("\"extras\": {\"s\": \"" + std::string(500, '[') + "\\\"[\"},", "[{\"mesh\": 0}]", "t.bin"));
+  auto ok = load_gltf(dir.file("strings.gltf"), Placement{});
+  EXPECT_TRUE(ok.ok()) << ok.error().message;
+}
+
+// Issue 12 case 4: a node listed twice as a child per level expands to 2^levels instances.
+TEST(GltfHardening, ExponentialNodeInstancingIsBounded) {
+  TempDir dir;
+  write_triangle_bin(dir.file("t.bin"));
+  std::string nodes = "[";
+  const int levels = 40;
+  for (int i = 0; i < levels; ++i) nodes += "{\"children\": [" + std::to_string(i + 1) + ", " + std::to_string(i + 1) + "]},";
+  nodes += "{\"mesh\": 0}]";
+  write_text(dir.file("bomb.gltf"), triangle_gltf("", nodes, "t.bin"));
+  EXPECT_ERROR(load_gltf(dir.file("bomb.gltf"), Placement{}), BadInput, "bomb.gltf", "node instances", "limit");
+}
+
+// Issue 12 case 5: URIs outside the model's folder, and FIFOs, are never opened.
+TEST(GltfHardening, BufferUrisStayInsideTheModelFolderAndRegularFiles) {
+  TempDir dir;
+  std::filesystem::create_directories(dir.file("model"));
+  write_triangle_bin(dir.file("outside.bin"));
+  write_text(dir.file("model/escape.gltf"), triangle_gltf("", "[{\"mesh\": 0}]", "../outside.bin"));
+  EXPECT_ERROR(load_gltf(dir.file("model/escape.gltf"), Placement{}), BadInput, "escape.gltf", "outside the model's folder");
+  write_text(dir.file("model/abs.gltf"), triangle_gltf("", "[{\"mesh\": 0}]", dir.file("outside.bin")));
+  // An absolute URI is resolved under the model's folder, where it does not exist.
+  EXPECT_ERROR(load_gltf(dir.file("model/abs.gltf"), Placement{}), BadInput, "abs.gltf", "outside.bin");
+  ASSERT_EQ(mkfifo(dir.file("model/fifo.bin").c_str(), 0600), 0);
+  write_text(dir.file("model/fifo.gltf"), triangle_gltf("", "[{\"mesh\": 0}]", "fifo.bin"));
+  EXPECT_ERROR(load_gltf(dir.file("model/fifo.gltf"), Placement{}), BadInput, "fifo.gltf", "not a regular file");
+  // The model file itself as a FIFO or a folder.
+  ASSERT_EQ(mkfifo(dir.file("pipe.gltf").c_str(), 0600), 0);
+  EXPECT_ERROR(load_gltf(dir.file("pipe.gltf"), Placement{}), NotFound, "pipe.gltf");
+}
+
+// Issue 12 case 8: a required extension mrgi does not implement is refused by name.
+TEST(GltfHardening, RequiredExtensionsAreRefusedByName) {
+  TempDir dir;
+  write_triangle_bin(dir.file("t.bin"));
+  write_text(dir.file("draco.gltf"),
+             triangle_gltf("\"extensionsUsed\": [\"KHR_draco_mesh_compression\"], "
+                           "\"extensionsRequired\": [\"KHR_draco_mesh_compression\"],",
+                           "[{\"mesh\": 0}]", "t.bin"));
+  EXPECT_ERROR(load_gltf(dir.file("draco.gltf"), Placement{}), NotImplemented, "draco.gltf",
+               "KHR_draco_mesh_compression", "extensionsRequired");
+}
+
+TEST(GltfHardening, TruncatedOrForeignGlbHeadersAreRefused) {
+  TempDir dir;
+  std::ofstream(dir.file("short.glb"), std::ios::binary) << "glTF";
+  EXPECT_ERROR(load_gltf(dir.file("short.glb"), Placement{}), BadInput, "short.glb", "header");
+  // Header claiming more bytes than the file has.
+  unsigned char h[20] = {'g', 'l', 'T', 'F', 2, 0, 0, 0, 0xff, 0xff, 0xff, 0x7f, 8, 0, 0, 0, 'J', 'S', 'O', 'N'};
+  std::ofstream(dir.file("big.glb"), std::ios::binary).write(reinterpret_cast<const char*>(h), sizeof(h));
+  EXPECT_ERROR(load_gltf(dir.file("big.glb"), Placement{}), BadInput, "big.glb", "truncated");
 }
 
 }  // namespace

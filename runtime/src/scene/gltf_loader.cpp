@@ -21,6 +21,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "mrgi/scene.h"
+#include "scene/gltf_input.h"
 
 namespace mrgi {
 namespace {
@@ -32,6 +33,7 @@ struct LoadContext {
   const tinygltf::Model& gltf;
   Model* out;
   std::map<int, int> texture_of_gltf_texture;
+  size_t node_visits = 0, vertices = 0;  // against gltf::kMaxNodeVisits / kMaxVertices
 };
 
 std::string mesh_label(const tinygltf::Model& m, int mesh, size_t primitive) {
@@ -311,6 +313,14 @@ Status add_primitive(LoadContext& ctx, int mesh_index, size_t prim_index, const 
     return fail(ErrorKind::BadInput, ctx.path + ": " + what + ": material " +
                                          std::to_string(prim.material) + " does not exist");
 
+  if (ctx.out->primitives.size() >= gltf::kMaxPrimitives)
+    return fail(ErrorKind::BadInput, ctx.path + ": more than " + std::to_string(gltf::kMaxPrimitives) +
+                                         " primitive instances in the default scene (limit)");
+  const size_t adds = normals.empty() ? indices->size() : vcount;
+  if (ctx.vertices + adds > gltf::kMaxVertices)
+    return fail(ErrorKind::BadInput, ctx.path + ": " + what + ": the default scene would hold more than " +
+                                         std::to_string(gltf::kMaxVertices) + " vertices (limit)");
+  ctx.vertices += adds;
   MeshPrimitive out;
   out.material = prim.material;
   const glm::dmat3 normal_matrix = glm::inverseTranspose(glm::dmat3(world));
@@ -365,6 +375,12 @@ Status visit_node(LoadContext& ctx, int node_index, const glm::dmat4& parent, in
     return fail(ErrorKind::BadInput, ctx.path + ": node " + std::to_string(node_index) +
                                          ": node tree deeper than " + std::to_string(kMaxNodeDepth) +
                                          " (a cycle?)");
+  // A node listed twice as a child at every level expands to 2^depth instances: bounded.
+  if (++ctx.node_visits > gltf::kMaxNodeVisits)
+    return fail(ErrorKind::BadInput, ctx.path + ": the node tree expands to more than " +
+                                         std::to_string(gltf::kMaxNodeVisits) +
+                                         " node instances (limit; nodes listed as children of several parents "
+                                         "are instanced once per path)");
   const auto& node = ctx.gltf.nodes[size_t(node_index)];
   const glm::dmat4 world = parent * node_local_matrix(node);
   if (node.mesh >= 0) {
@@ -389,15 +405,33 @@ Expected<Model> load_gltf(const std::string& path, const Placement& placement) {
   if (ext != ".gltf" && ext != ".glb")
     return fail(ErrorKind::BadInput, path + ": expected a .gltf or .glb file, got '" + ext + "'");
 
+  // Read and bounded here, parsed by tinygltf with file access confined to the model's folder
+  // (scene/gltf_input.h).
+  auto input = gltf::read_input(path, ext == ".glb");
+  if (!input) return input.error();
   tinygltf::TinyGLTF loader;
+  loader.SetFsCallbacks(gltf::confined_fs(&input->base_dir));
   tinygltf::Model gltf;
   std::string err, warn;
-  const bool loaded = ext == ".glb" ? loader.LoadBinaryFromFile(&gltf, &err, &warn, path)
-                                    : loader.LoadASCIIFromFile(&gltf, &err, &warn, path);
+  const bool loaded =
+      input->binary
+          ? loader.LoadBinaryFromMemory(&gltf, &err, &warn, input->bytes.data(),
+                                        unsigned(input->bytes.size()), input->base_dir)
+          : loader.LoadASCIIFromString(&gltf, &err, &warn,
+                                       reinterpret_cast<const char*>(input->bytes.data()),
+                                       unsigned(input->bytes.size()), input->base_dir);
   if (!loaded) {
     if (!err.empty() && err.back() == '\n') err.pop_back();
     return fail(ErrorKind::BadInput, path + ": cannot load glTF: " + (err.empty() ? warn : err));
   }
+  input->bytes = {};
+  // An extension the file requires changes how it must be read (Draco-compressed geometry
+  // otherwise reads as "accessor invalid bufferView"); none is implemented, so each is refused
+  // by name.
+  if (!gltf.extensionsRequired.empty())
+    return fail(ErrorKind::NotImplemented, path + ": requires the glTF extension '" +
+                                               gltf.extensionsRequired.front() +
+                                               "', which mrgi does not support (extensionsRequired)");
   if (gltf.scenes.empty())
     return fail(ErrorKind::BadInput, path + ": the file has no scene (glTF 'scenes' is empty)");
   const int scene_index = gltf.defaultScene >= 0 ? gltf.defaultScene : 0;
