@@ -188,7 +188,29 @@ INSTANTIATE_TEST_SUITE_P(
         BadScene{R"({"version": 1, "real_geometry": [{"gltf": "models/box.glb", "material": {"shiny": 1}}]})",
                  ErrorKind::BadInput, "real_geometry[0].material.shiny", "unknown key"},
         BadScene{"{\"version\": 1,\n  \"lights\": [,]}", ErrorKind::BadInput, "line 2", "invalid JSON"},
-        BadScene{R"([1, 2])", ErrorKind::BadInput, "top level", "must be an object"}));
+        BadScene{R"([1, 2])", ErrorKind::BadInput, "top level", "must be an object"},
+        // Issue 12 case 8: a repeated key (JSON keeps the last one silently) and numbers finite as
+        // doubles but infinite as the floats they end up in.
+        BadScene{R"({"version": 1, "version": 1})", ErrorKind::BadInput, "'version'", "appears twice"},
+        BadScene{R"({"version": 1, "lights": [{"type": "point", "real": true, "position": [0,0,0]},
+                   {"type": "point", "real": true, "real": false, "position": [0,0,0]}]})",
+                 ErrorKind::BadInput, "'real' appears twice in 'lights[]'", "each key once"},
+        BadScene{R"({"version": 1, "lights": [{"type": "point", "real": true, "position": [0,0,0], "intensity": 1e39}]})",
+                 ErrorKind::BadInput, "lights[0].intensity", "32-bit float"},
+        BadScene{R"({"version": 1, "virtual_objects": [{"gltf": "models/box.glb", "scale": 1e39}]})",
+                 ErrorKind::BadInput, "virtual_objects[0].scale", "32-bit float"},
+        BadScene{R"({"version": 1, "virtual_objects": [{"gltf": "models/box.glb", "position": [0, -1e39, 0]}]})",
+                 ErrorKind::BadInput, "virtual_objects[0].position[1]", "32-bit float"}));
+
+// The same key in different objects is fine.
+TEST(SceneJson, SameKeyInDifferentObjectsIsAccepted) {
+  SceneFixture f;
+  auto scene = load_scene_json(f.write(R"({"version": 1, "lights": [
+    {"type": "point", "real": true, "position": [0, 2, 0]},
+    {"type": "point", "real": false, "position": [1, 2, 0]}]})"));
+  ASSERT_TRUE(scene.ok()) << scene.error().message;
+  EXPECT_EQ(scene->lights.size(), 2u);
+}
 
 TEST(SceneJson, MissingFileIsNotFound) {
   TempDir dir;

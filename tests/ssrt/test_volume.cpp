@@ -438,7 +438,9 @@ TEST_F(VulkanTest, VolumeAuxLayersSeeTheBoxLeftOfTheViewAndTheTopFromTheLight) {
     EXPECT_EQ(consistent, hits) << "layer " << layer;
     // (The right and top layers' rays start inside box A and B, whose inside they leave through
     // back faces, and find nothing else: no hits expected there.)
-    if (layer == SSRT_AUX_LEFT || layer == SSRT_AUX_LIGHT) EXPECT_GT(hits, 20) << "layer " << layer;
+    if (layer == SSRT_AUX_LEFT || layer == SSRT_AUX_LIGHT) {
+      EXPECT_GT(hits, 20) << "layer " << layer;
+    }
   }
   // The current view matches too (64^3: 3.1 cm voxels).
   expect_view_matches(r, t, voxel, 1.5f, "64^3");

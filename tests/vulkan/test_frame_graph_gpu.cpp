@@ -216,9 +216,13 @@ TEST_F(VulkanTest, ProfilingModeTimesEachPassAloneAndTheyAddUpToTheFrame) {
       EXPECT_GE(p.gpu_ms, 0.0) << p.name;  // the submission overhead is subtracted
       sum += p.gpu_ms;
     }
-    if (f.profiled) EXPECT_NEAR(f.total_ms, sum, 1e-9) << "profiled passes are the frame";
+    if (f.profiled) {
+      EXPECT_NEAR(f.total_ms, sum, 1e-9) << "profiled passes are the frame";
+    }
     EXPECT_GT(f.completed_s, 0.0);
-    if (i > 0) EXPECT_GE(f.completed_s, got[i - 1].completed_s);
+    if (i > 0) {
+      EXPECT_GE(f.completed_s, got[i - 1].completed_s);
+    }
   }
   // The output is the same in both modes.
   EXPECT_EQ(wrong_pixels(ctx(), t, got.back().slot), 0);
@@ -316,7 +320,10 @@ TEST_F(VulkanTest, RelativeImagesFollowOutputSizeAndRenderScaleWithoutReallocati
 }
 
 TEST_F(VulkanTest, FloorPassRunsAndIsTimed) {
-  auto m = measure_floor_pass(ctx(), 160, 120, 8, 2);
+  // 640 x 480: the pass (about 1.5 ms) is far above the empty-submission cost subtracted from it
+  // (about 0.05 ms); at 160 x 120 a loaded machine's overhead estimate could exceed it, and the
+  // pass read 0 (seen once in CI).
+  auto m = measure_floor_pass(ctx(), 640, 480, 8, 2);
   ASSERT_TRUE(m.ok()) << m.error().message;
   EXPECT_EQ(m->samples_ms.size(), 8u);
   EXPECT_GT(m->median_ms, 0.0);

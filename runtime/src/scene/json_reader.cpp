@@ -1,5 +1,6 @@
 #include "mrgi/json_reader.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -7,6 +8,52 @@
 
 namespace mrgi {
 namespace {
+
+// Numbers end up in 32-bit floats (GPU data, images): one finite as a double but not as a float
+// (1e39) would become inf there.
+constexpr double kMaxFloat = 3.4028234663852886e38;
+const char* const kFloatRule = "must fit a 32-bit float (|value| <= 3.4e38)";
+
+// JSON lets an object repeat a key and nlohmann keeps the last one silently
+// ("depth_scale": -1, "depth_scale": 5000 would pass the range check): the parser callback
+// records the first repeated key, with the key of the object holding it.
+struct DuplicateKeys {
+  std::vector<std::vector<std::string>> keys;  // per open object (arrays push an empty frame)
+  std::vector<std::string> owner;               // the key each open container was under
+  std::string last_key, found, found_in;
+  bool operator()(int, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+    using E = nlohmann::json::parse_event_t;
+    switch (event) {
+      case E::object_start:
+      case E::array_start:
+        // An element of an array is labelled after the array ("lights[]").
+        owner.push_back(last_key.empty() && !owner.empty() ? owner.back() + "[]" : last_key);
+        keys.emplace_back();
+        last_key.clear();
+        break;
+      case E::object_end:
+      case E::array_end:
+        if (!keys.empty()) keys.pop_back();
+        if (!owner.empty()) owner.pop_back();
+        last_key.clear();
+        break;
+      case E::key: {
+        last_key = parsed.get<std::string>();
+        if (keys.empty()) break;
+        auto& seen = keys.back();
+        if (found.empty() && std::find(seen.begin(), seen.end(), last_key) != seen.end()) {
+          found = last_key;
+          found_in = owner.empty() || owner.back().empty() ? "the top-level object" : "'" + owner.back() + "'";
+        }
+        seen.push_back(last_key);
+        break;
+      }
+      case E::value:
+        break;
+    }
+    return true;
+  }
+};
 
 const char* type_name(const nlohmann::json& v) {
   if (v.is_boolean()) return "a boolean";
@@ -38,7 +85,16 @@ Expected<nlohmann::json> load_json_file(const std::string& path) {
   auto bytes = read_file_bytes(path);
   if (!bytes) return bytes.error();
   try {
-    return nlohmann::json::parse(bytes->begin(), bytes->end());
+    DuplicateKeys dup;
+    nlohmann::json j = nlohmann::json::parse(
+        bytes->begin(), bytes->end(),
+        [&dup](int depth, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+          return dup(depth, event, parsed);
+        });
+    if (!dup.found.empty())
+      return fail(ErrorKind::BadInput, path + ": key '" + dup.found + "' appears twice in " + dup.found_in +
+                                           " (JSON would keep the last silently; each key once)");
+    return j;
   } catch (const nlohmann::json::parse_error& e) {
     std::string what = e.what();
     // Drop nlohmann's "[json.exception.parse_error.101] parse error at line 1, column 2: " prefix
@@ -97,6 +153,7 @@ Expected<double> JsonObject::number(std::string_view key, std::optional<double> 
   if (!v.is_number()) return error(key, std::string("must be a number, got ") + type_name(v));
   const double d = v.get<double>();
   if (!std::isfinite(d)) return error(key, "must be finite");
+  if (std::abs(d) > kMaxFloat) return error(key, kFloatRule);
   return d;
 }
 
@@ -144,6 +201,7 @@ Expected<std::vector<double>> JsonObject::numbers(std::string_view key, size_t c
                    std::string("must be a number, got ") + type_name(v[i]));
     const double d = v[i].get<double>();
     if (!std::isfinite(d)) return error(std::string(key) + "[" + std::to_string(i) + "]", "must be finite");
+    if (std::abs(d) > kMaxFloat) return error(std::string(key) + "[" + std::to_string(i) + "]", kFloatRule);
     out.push_back(d);
   }
   return out;
