@@ -17,6 +17,8 @@ find_package(OpenEXR 3 REQUIRED)
 find_package(embree 3 REQUIRED)
 find_package(CLI11 QUIET)
 find_package(PNG REQUIRED)
+# glTF textures decode through libpng and libjpeg-turbo (image/texture_decode.h), not stb.
+find_package(JPEG REQUIRED)
 
 find_program(GLSLANG_VALIDATOR glslangValidator REQUIRED)
 

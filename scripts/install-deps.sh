@@ -9,7 +9,7 @@ PKGS=(
   libglm-dev libeigen3-dev libtinygltf-dev nlohmann-json3-dev libstb-dev libtinyexr-dev libopenexr-dev
   libcli11-dev libembree-dev libgtest-dev libgmock-dev libbenchmark-dev
   libapriltag-dev libv4l-dev libcamera-dev libopenni2-dev libusb-1.0-0-dev
-  libpng-dev zlib1g-dev
+  libpng-dev zlib1g-dev libjpeg62-turbo-dev
 )
 missing=()
 for p in "${PKGS[@]}"; do

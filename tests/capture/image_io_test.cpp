@@ -159,6 +159,15 @@ TEST(HdrIo, RadianceHdrFromStb) {
   EXPECT_NEAR(img->data[3], 0.5f, 1e-2f);
 }
 
+// Issue 12 case 4: a 2 KB .hdr whose header asks for 120 GB is refused before allocating.
+TEST(HdrIo, RadianceHeaderBeyondTheSizeLimitIsRefused) {
+  TempDir dir;
+  std::string hdr = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 100000 +X 100000\n";
+  hdr += std::string(2000, '\x80');
+  testing::write_text(dir.file("huge.hdr"), hdr);
+  EXPECT_ERROR(load_hdr_image(dir.file("huge.hdr")), BadInput, "huge.hdr", "100000x100000", "limit");
+}
+
 // The shared maps are DWAB-compressed half floats (tinyexr cannot decode them).
 TEST(HdrIo, RealDwabEnvironmentMapsLoadFinite) {
   for (const char* name : {"interior.exr", "courtyard.exr"}) {

@@ -2,7 +2,10 @@
 // .hdr through stb_image, and 8-bit sRGB PNG decoded to linear. All come back as linear RGB float.
 //
 // The one stb_image implementation in the program. It must be the full decoder: its symbols
-// also satisfy libtinygltf.so's references (ELF interposition), which decodes PNG/JPEG textures.
+// also satisfy libtinygltf.so's references (ELF interposition) for its default image loader,
+// which mrgi no longer uses: glTF textures go through libpng / libjpeg-turbo
+// (image/texture_decode.h, set by the glTF loader), since a mutated JPEG made stb 2.27 write out
+// of bounds. stb decodes Radiance .hdr only here, after its header's size is checked.
 #define STB_IMAGE_IMPLEMENTATION
 #include <stb/stb_image.h>
 #include <tinyexr.h>
@@ -26,6 +29,9 @@
 
 namespace mrgi {
 namespace {
+
+// Environment images up to 16384 x 8192 (a 16k equirectangular map, 1.5 GiB as RGB float).
+constexpr uint64_t kMaxHdrPixels = 16384ull * 8192ull;
 
 std::string lower_extension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
@@ -81,6 +87,12 @@ Expected<ImageRGBF> load_radiance_hdr(const std::string& path) {
   auto bytes = read_file_bytes(path);
   if (!bytes) return bytes.error();
   int w = 0, h = 0, channels = 0;
+  // The header's size is checked before stb allocates it (a 2 KB file can ask for 120 GB).
+  if (!stbi_info_from_memory(bytes->data(), int(bytes->size()), &w, &h, &channels))
+    return fail(ErrorKind::BadInput, path + ": not a Radiance HDR image (header unreadable)");
+  if (w <= 0 || h <= 0 || uint64_t(w) * uint64_t(h) > kMaxHdrPixels)
+    return fail(ErrorKind::BadInput, path + ": Radiance HDR is " + std::to_string(w) + "x" + std::to_string(h) +
+                                         ", over the limit of " + std::to_string(kMaxHdrPixels) + " pixels (or empty)");
   float* pixels = stbi_loadf_from_memory(bytes->data(), int(bytes->size()), &w, &h, &channels, 3);
   if (!pixels) {
     const char* why = stbi_failure_reason();  // may be null (stb built without failure strings)

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "image/file_io.h"
+#include "image/texture_decode.h"
 #include "mrgi/image.h"
 
 namespace mrgi {
@@ -265,6 +266,37 @@ Status write_png(const std::string& path, const ImageU16& img, PngEffort effort)
 }
 Status write_png(const std::string& path, const ImageU8& img, PngEffort effort) {
   return write_png_image(path, img, {PNG_COLOR_TYPE_GRAY, 8, effort});
+}
+
+Expected<ImageRGBA8> decode_png_rgba8(const uint8_t* data, size_t size) {
+  DecodedPng d;
+  PngErrorSink sink{};
+  const std::vector<uint8_t> file(data, data + size);
+  if (!decode_png_bytes(file, &d, &sink)) return fail(ErrorKind::BadInput, std::string("cannot decode PNG: ") + sink.message);
+  if (uint64_t(d.width) * uint64_t(d.height) > kMaxTexturePixels)
+    return fail(ErrorKind::BadInput, "PNG is " + std::to_string(d.width) + "x" + std::to_string(d.height) +
+                                         ", over the limit of " + std::to_string(kMaxTexturePixels) + " pixels");
+  ImageRGBA8 out(d.width, d.height, 255);
+  const int bytes_per_sample = d.bit_depth / 8;
+  const int ch = d.channels;
+  for (size_t i = 0; i < out.pixel_count(); ++i) {
+    // The high byte of a 16-bit sample is its 8-bit value (host order: little-endian high last).
+    auto sample = [&](int c) -> uint8_t {
+      const size_t at = (i * size_t(ch) + size_t(c)) * size_t(bytes_per_sample);
+      return bytes_per_sample == 2 ? d.bytes[at + 1] : d.bytes[at];
+    };
+    uint8_t* px = &out.data[i * 4];
+    if (ch >= 3) {
+      px[0] = sample(0);
+      px[1] = sample(1);
+      px[2] = sample(2);
+      if (ch == 4) px[3] = sample(3);
+    } else {
+      px[0] = px[1] = px[2] = sample(0);
+      if (ch == 2) px[3] = sample(1);
+    }
+  }
+  return out;
 }
 
 }  // namespace mrgi

@@ -1,5 +1,7 @@
 #include "scene/gltf_input.h"
 
+#include "image/texture_decode.h"
+
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -159,6 +161,43 @@ tinygltf::FsCallbacks confined_fs(const std::string* base_dir) {
   cb.WriteWholeFile = &write_whole;
   cb.user_data = const_cast<std::string*>(base_dir);
   return cb;
+}
+
+bool load_image(tinygltf::Image* image, int index, std::string* err, std::string*, int, int,
+                const unsigned char* bytes, int size, void* state_ptr) {
+  auto* state = static_cast<ImageLoaderState*>(state_ptr);
+  const std::string which = "image " + std::to_string(index) + (image->uri.empty() ? "" : " ('" + image->uri + "')");
+  if (!bytes || size <= 0) {
+    if (err) *err += which + ": no image data\n";
+    return false;
+  }
+  const size_t n = size_t(size);
+  Expected<ImageRGBA8> decoded = fail(ErrorKind::BadInput, "");
+  if (n >= 8 && bytes[0] == 0x89 && bytes[1] == 'P' && bytes[2] == 'N' && bytes[3] == 'G') {
+    decoded = decode_png_rgba8(bytes, n);
+  } else if (n >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF) {
+    decoded = decode_jpeg_rgba8(bytes, n);
+  } else {
+    if (err) *err += which + ": not a PNG or JPEG (the only texture formats read)\n";
+    return false;
+  }
+  if (!decoded) {
+    if (err) *err += which + ": " + decoded.error().message + "\n";
+    return false;
+  }
+  const uint64_t add = uint64_t(decoded->data.size());
+  if (state && state->bytes + add > kMaxTextureBytes) {
+    if (err) *err += which + ": the model's textures exceed " + std::to_string(kMaxTextureBytes) + " bytes (limit)\n";
+    return false;
+  }
+  if (state) state->bytes += add;
+  image->width = decoded->width;
+  image->height = decoded->height;
+  image->component = 4;
+  image->bits = 8;
+  image->pixel_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+  image->image = std::move(decoded->data);
+  return true;
 }
 
 }  // namespace mrgi::gltf

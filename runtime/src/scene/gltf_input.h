@@ -41,4 +41,14 @@ int json_nesting_depth(const char* text, size_t size, int limit);
 // within kMaxFileBytes, and never write. `base_dir` must outlive the loader.
 tinygltf::FsCallbacks confined_fs(const std::string* base_dir);
 
+// The loader's image decoder (TinyGLTF::SetImageLoader): PNG through libpng and JPEG through
+// libjpeg-turbo (image/texture_decode.h), as 8-bit RGBA; any other format refused naming the
+// image; the model's textures together capped at kMaxTextureBytes. `state` counts the bytes.
+constexpr uint64_t kMaxTextureBytes = 1ull << 30;
+struct ImageLoaderState {
+  uint64_t bytes = 0;
+};
+bool load_image(tinygltf::Image* image, int index, std::string* err, std::string* warn, int req_width,
+                int req_height, const unsigned char* bytes, int size, void* state);
+
 }  // namespace mrgi::gltf

@@ -411,6 +411,8 @@ Expected<Model> load_gltf(const std::string& path, const Placement& placement) {
   if (!input) return input.error();
   tinygltf::TinyGLTF loader;
   loader.SetFsCallbacks(gltf::confined_fs(&input->base_dir));
+  gltf::ImageLoaderState images;
+  loader.SetImageLoader(&gltf::load_image, &images);
   tinygltf::Model gltf;
   std::string err, warn;
   const bool loaded =
