@@ -1,4 +1,6 @@
 #include <gtest/gtest.h>
+
+#include <sys/stat.h>
 #include <png.h>
 
 #include <filesystem>
@@ -135,6 +137,18 @@ TEST(CaptureRefuses, LineWithTooFewOrTooManyFields) {
   EXPECT_ERROR(CaptureReader::open(f.folder()), BadInput, "rgb.txt:2:", "expected 'timestamp path', got 1 field");
   write_text(f.file("rgb.txt"), "\n# comment\n1.0 rgb/0.png\n1.1 rgb/1.png extra\n");
   EXPECT_ERROR(CaptureReader::open(f.folder()), BadInput, "rgb.txt:4:", "expected 'timestamp path', got 3 fields");
+}
+
+// Issue 12 cases 5 and 8: a NUL byte inside a listed path (it would name another file where the
+// file system reads it) and a list that is a FIFO (opening it would block for ever).
+TEST(CaptureRefuses, NulByteInAListedPathAndAFifoList) {
+  CaptureFixture f(2);
+  write_text(f.file("rgb.txt"), std::string("1.0 rgb/0.png\n1.1 rgb/1.png\0.evil\n", 34));
+  EXPECT_ERROR(CaptureReader::open(f.folder()), BadInput, "rgb.txt:2:", "NUL byte");
+  std::filesystem::remove(f.file("depth.txt"));
+  ASSERT_EQ(mkfifo(f.file("depth.txt").c_str(), 0600), 0);
+  write_text(f.file("rgb.txt"), "1.0 rgb/0.png\n1.1 rgb/1.png\n");
+  EXPECT_ERROR(CaptureReader::open(f.folder()), NotFound, "depth.txt");  // refused, not opened
 }
 
 TEST(CaptureRefuses, NonNumericTimestamp) {

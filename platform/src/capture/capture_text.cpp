@@ -27,6 +27,9 @@ std::string format_double(double v) {
 
 Expected<std::vector<ListLine>> read_list(const std::string& path, size_t min_fields, size_t max_fields,
                                           const char* format) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))  // a FIFO would block the open for ever
+    return fail(ErrorKind::NotFound, path + ": does not exist or is not a regular file");
   std::ifstream in(path);
   if (!in) return fail(ErrorKind::NotFound, path + ": file does not exist or cannot be read");
   std::vector<ListLine> out;
@@ -35,6 +38,10 @@ Expected<std::vector<ListLine>> read_list(const std::string& path, size_t min_fi
   while (std::getline(in, text)) {
     ++line_no;
     if (!text.empty() && text.back() == '\r') text.pop_back();  // lists written on Windows
+    // A NUL byte would cut a path short where the file system reads it, naming another file.
+    if (text.find('\0') != std::string::npos)
+      return fail(ErrorKind::BadInput, path + ":" + std::to_string(line_no) +
+                                           ": holds a NUL byte (lists are text; a path cannot contain one)");
     std::istringstream words(text);
     std::vector<std::string> tokens;
     for (std::string w; words >> w;) tokens.push_back(w);

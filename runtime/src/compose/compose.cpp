@@ -129,8 +129,7 @@ void Compose::dispatch(VkCommandBuffer cmd, gpu::PassContext& pass, bool tiled_p
   ComposePush pc;
   pc.compose = glm::vec4(settings_.eps, settings_.alpha_max, 0.0f, 0.0f);
   if (tiled_pass) {
-    vkCmdPushConstants(cmd, pipeline.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
-    vkCmdDispatchIndirect(cmd, pass.buffer(in_.tile_args), 0);
+    gpu::dispatch_indirect(cmd, pipeline, &pc, sizeof(pc), pass.buffer(in_.tile_args));
   } else {
     gpu::dispatch_2d(cmd, pipeline, &pc, sizeof(pc), width_, height_);
   }

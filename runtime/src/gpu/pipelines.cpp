@@ -275,6 +275,14 @@ void dispatch_2d(VkCommandBuffer cmd, const Pipeline& pipeline, const void* push
   vkCmdDispatch(cmd, (width + local_x - 1) / local_x, (height + local_y - 1) / local_y, 1);
 }
 
+void dispatch_indirect(VkCommandBuffer cmd, const Pipeline& pipeline, const void* push_constants,
+                       uint32_t bytes, VkBuffer args, VkDeviceSize offset) {
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline);
+  if (bytes > 0 && push_constants)
+    vkCmdPushConstants(cmd, pipeline.layout, pipeline.stages, 0, bytes, push_constants);
+  vkCmdDispatchIndirect(cmd, args, offset);
+}
+
 Expected<PipelineHandle> load_compute_pipeline(const Context& ctx, const char* shader,
                                                std::vector<DescriptorBinding> bindings,
                                                uint32_t push_constant_bytes) {

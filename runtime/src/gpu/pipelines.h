@@ -124,6 +124,11 @@ void dispatch_2d(VkCommandBuffer cmd, const Pipeline& pipeline, const void* push
                  uint32_t bytes, uint32_t width, uint32_t height, uint32_t local_x = 8,
                  uint32_t local_y = 8);
 
+// Binds, pushes the constants and dispatches the workgroup counts a GPU pass wrote into `args`
+// at `offset` (a VkDispatchIndirectCommand; the pass declares it Access::IndirectRead).
+void dispatch_indirect(VkCommandBuffer cmd, const Pipeline& pipeline, const void* push_constants,
+                       uint32_t bytes, VkBuffer args, VkDeviceSize offset = 0);
+
 // A compute pipeline from a registered shader (shaders.h: "folder/name.comp"), owned.
 Expected<PipelineHandle> load_compute_pipeline(const Context& ctx, const char* shader,
                                                std::vector<DescriptorBinding> bindings,

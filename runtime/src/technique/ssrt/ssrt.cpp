@@ -530,8 +530,7 @@ void Ssrt::add_shade_pass(const char* name, ShadeMode mode, bool run_transfer) {
                      // the bicubic's two cells) so every pixel the filters can reach is shaded.
                      influence_pixels(), glm::vec4(kIndirectTolerance, 0.0f, 0.0f, 0.0f)};
         if (mode == ShadeMode::Tiled) {
-          vkCmdPushConstants(cmd, pipe.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
-          vkCmdDispatchIndirect(cmd, pass.buffer(tile_args_), 0);
+          gpu::dispatch_indirect(cmd, pipe, &pc, sizeof(pc), pass.buffer(tile_args_));
         } else {
           gpu::dispatch_2d(cmd, pipe, &pc, sizeof(pc), used_.width, used_.height);
         }
