@@ -8,6 +8,7 @@
 // (so the volume can still follow slow scene changes).
 #extension GL_GOOGLE_include_directive : require
 #include "ssrt/tsdf_volume.glsl"
+#include "common/opaque_uniform.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, set = 0, binding = 0) uniform VolumeUbo { SsrtVolumeParams volume; };
@@ -17,7 +18,7 @@ layout(std430, set = 0, binding = 2) buffer Voxels { uint voxels[]; };
 uint depth_value(uint index) { return (depth_words[index >> 1] >> ((index & 1u) * 16u)) & 0xffffu; }
 
 void main() {
-  int r = volume.grid.x;
+  int r = MRGI_OPAQUE_INT(volume.grid.x);  // the loop bound (common/opaque_uniform.glsl)
   ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
   if (any(greaterThanEqual(xy, ivec2(r)))) return;
   float h = volume.origin.w, mu = volume.tsdf.x, max_weight = volume.tsdf.y;
