@@ -2,6 +2,10 @@
 // 12 depth + 12 colour frames, 640x480, depth in mm), plus truncated and corrupt copies.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
+#include <filesystem>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -159,6 +163,20 @@ TEST(OpenNISource, CorruptFilesAreNamedErrorsNotHangs) {
       ASSERT_LE(++frames, 12);
     }
   });
+}
+
+// Issue 12 case 9: a folder named like a recording gave std::bad_alloc; a FIFO would block.
+TEST(OpenNISource, AFolderOrFifoNamedOniIsABadInputNotACrash) {
+  test::TempDir dir("oni-not-a-file");
+  std::filesystem::create_directories(dir.file("folder.oni"));
+  auto a = open_openni_source(dir.file("folder.oni"));
+  ASSERT_FALSE(a.ok());
+  EXPECT_EQ(a.error().kind, ErrorKind::BadInput);
+  EXPECT_NE(a.error().message.find("not a regular file"), std::string::npos) << a.error().message;
+  ASSERT_EQ(mkfifo(dir.file("pipe.oni").c_str(), 0600), 0);
+  auto b = open_openni_source(dir.file("pipe.oni"));
+  ASSERT_FALSE(b.ok());
+  EXPECT_EQ(b.error().kind, ErrorKind::BadInput);
 }
 
 TEST(OpenNISource, SecondOpenOfTheSameFileIsRefusedUntilTheFirstCloses) {

@@ -328,6 +328,22 @@ TEST(GltfHardening, RequiredExtensionsAreRefusedByName) {
                "KHR_draco_mesh_compression", "extensionsRequired");
 }
 
+// Issue 12 cases 8 and 9: glTF 1.0 (it said "no scene"), a primitive without triangles.
+TEST(GltfHardening, VersionOneAndEmptyPrimitivesAreNamed) {
+  TempDir dir;
+  write_triangle_bin(dir.file("t.bin"));
+  std::string v1 = triangle_gltf("", "[{\"mesh\": 0}]", "t.bin");
+  v1.replace(v1.find("\"2.0\""), 5, "\"1.0\"");
+  write_text(dir.file("v1.gltf"), v1);
+  EXPECT_ERROR(load_gltf(dir.file("v1.gltf"), Placement{}), BadInput, "v1.gltf", "only glTF 2.0");
+  std::string empty = triangle_gltf("", "[{\"mesh\": 0}]", "t.bin");
+  empty.replace(empty.find("\"count\": 3"), 10, "\"count\": 0");
+  write_text(dir.file("empty.gltf"), empty);
+  auto r = load_gltf(dir.file("empty.gltf"), Placement{});
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().kind, ErrorKind::BadInput) << r.error().message;
+}
+
 TEST(GltfHardening, TruncatedOrForeignGlbHeadersAreRefused) {
   TempDir dir;
   std::ofstream(dir.file("short.glb"), std::ios::binary) << "glTF";

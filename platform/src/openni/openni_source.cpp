@@ -143,6 +143,10 @@ class OpenNISource final : public InputSource {
     oni::FileSummary summary;
     if (is_file) {
       if (!std::filesystem::exists(uri)) return fail(ErrorKind::NotFound, uri + ": no such OpenNI file");
+      // A folder gave std::bad_alloc inside the inspection, a FIFO would block the open.
+      std::error_code ec;
+      if (!std::filesystem::is_regular_file(uri, ec))
+        return fail(ErrorKind::BadInput, uri + ": not a regular file (an .oni recording is a file)");
       // OpenNI2's file driver refuses a truncated file with no message and can stall on a broken
       // one, so the record structure is checked first to give the reason.
       auto s = oni::inspect_oni_file(uri);

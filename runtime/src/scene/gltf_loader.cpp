@@ -309,6 +309,8 @@ Status add_primitive(LoadContext& ctx, int mesh_index, size_t prim_index, const 
   if (indices->size() % 3 != 0)
     return fail(ErrorKind::BadInput, ctx.path + ": " + what + ": index count " +
                                          std::to_string(indices->size()) + " is not a multiple of 3");
+  if (indices->empty())
+    return fail(ErrorKind::BadInput, ctx.path + ": " + what + ": has no triangles (zero indices or vertices)");
   if (prim.material >= int(ctx.gltf.materials.size()))
     return fail(ErrorKind::BadInput, ctx.path + ": " + what + ": material " +
                                          std::to_string(prim.material) + " does not exist");
@@ -434,6 +436,9 @@ Expected<Model> load_gltf(const std::string& path, const Placement& placement) {
     return fail(ErrorKind::NotImplemented, path + ": requires the glTF extension '" +
                                                gltf.extensionsRequired.front() +
                                                "', which mrgi does not support (extensionsRequired)");
+  if (gltf.asset.version.rfind("2.", 0) != 0)
+    return fail(ErrorKind::BadInput, path + ": glTF version '" + gltf.asset.version +
+                                         "' (asset.version): only glTF 2.0 is read");
   if (gltf.scenes.empty())
     return fail(ErrorKind::BadInput, path + ": the file has no scene (glTF 'scenes' is empty)");
   const int scene_index = gltf.defaultScene >= 0 ? gltf.defaultScene : 0;
