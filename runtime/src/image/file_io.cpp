@@ -9,14 +9,20 @@
 
 namespace mrgi {
 
-Expected<std::vector<uint8_t>> read_file_bytes(const std::string& path) {
+Expected<std::vector<uint8_t>> read_file_bytes(const std::string& path, uint64_t max_bytes) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     return fail(ErrorKind::NotFound, path + ": file does not exist (or is not a regular file)");
+  const uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) return fail(ErrorKind::BadInput, path + ": cannot read its size: " + ec.message());
+  if (size > max_bytes)
+    return fail(ErrorKind::BadInput, path + ": " + std::to_string(size) + " bytes, over the limit of " +
+                                         std::to_string(max_bytes));
   std::ifstream in(path, std::ios::binary);
   if (!in) return fail(ErrorKind::BadInput, path + ": cannot open for reading: " + std::strerror(errno));
-  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) return fail(ErrorKind::BadInput, path + ": read failed");
+  std::vector<uint8_t> bytes(static_cast<size_t>(size));
+  if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(size)))
+    return fail(ErrorKind::BadInput, path + ": read failed");
   return bytes;
 }
 

@@ -1,46 +1,15 @@
 #include "scene/gltf_input.h"
 
+#include "image/file_io.h"
 #include "image/texture_decode.h"
 
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 
 namespace mrgi::gltf {
 namespace fs = std::filesystem;
 
 namespace {
-
-// Regular file within the size cap, read whole; a FIFO, device or folder is refused before
-// it is opened (opening a FIFO for reading blocks until a writer appears).
-bool read_regular(const fs::path& p, std::vector<unsigned char>& out, std::string& why) {
-  std::error_code ec;
-  const fs::file_status st = fs::status(p, ec);
-  if (ec || !fs::exists(st)) {
-    why = "does not exist";
-    return false;
-  }
-  if (!fs::is_regular_file(st)) {
-    why = "is not a regular file (a folder, FIFO or device is never read)";
-    return false;
-  }
-  const uintmax_t size = fs::file_size(p, ec);
-  if (ec) {
-    why = "cannot read its size: " + ec.message();
-    return false;
-  }
-  if (size > kMaxFileBytes) {
-    why = "is " + std::to_string(size) + " bytes, over the limit of " + std::to_string(kMaxFileBytes);
-    return false;
-  }
-  std::ifstream in(p, std::ios::binary);
-  out.resize(size_t(size));
-  if (size > 0 && !in.read(reinterpret_cast<char*>(out.data()), std::streamsize(size))) {
-    why = "cannot be read";
-    return false;
-  }
-  return true;
-}
 
 uint32_t le32(const unsigned char* p) {
   return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
@@ -79,11 +48,12 @@ bool read_whole(std::vector<unsigned char>* out, std::string* err, const std::st
     if (err) *err += "'" + path + "' lies outside the model's folder " + base + " (refused)\n";
     return false;
   }
-  std::string why;
-  if (!read_regular(resolved, *out, why)) {
-    if (err) *err += "'" + path + "' " + why + "\n";
+  auto bytes = read_file_bytes(resolved.string(), kMaxFileBytes);
+  if (!bytes) {
+    if (err) *err += "'" + path + "': " + bytes.error().message + "\n";
     return false;
   }
+  *out = std::move(*bytes);
   return true;
 }
 
@@ -119,9 +89,9 @@ int json_nesting_depth(const char* text, size_t size, int limit) {
 Expected<Input> read_input(const std::string& path, bool binary) {
   Input in;
   in.binary = binary;
-  std::string why;
-  if (!read_regular(fs::path(path), in.bytes, why))
-    return fail(ErrorKind::BadInput, path + ": glTF file " + why);
+  auto bytes = read_file_bytes(path, kMaxFileBytes);
+  if (!bytes) return bytes.error();
+  in.bytes = std::move(*bytes);
   std::error_code ec;
   in.base_dir = fs::weakly_canonical(fs::absolute(fs::path(path)).parent_path(), ec).string();
   if (ec) return fail(ErrorKind::BadInput, path + ": cannot resolve its folder: " + ec.message());

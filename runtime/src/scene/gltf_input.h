@@ -10,6 +10,7 @@
 
 #include <tiny_gltf.h>
 
+#include "image/file_io.h"
 #include "mrgi/expected.h"
 
 namespace mrgi::gltf {
@@ -17,7 +18,7 @@ namespace mrgi::gltf {
 // Input limits (README "Input limits"); beyond them the file is refused with BadInput naming
 // the limit. Sized far above any asset meant for a headset: 1 GiB per file, 128 levels of JSON
 // nesting (glTF files use under 10), 65,536 node visits and primitive instances, 16 M vertices.
-constexpr uint64_t kMaxFileBytes = 1ull << 30;
+constexpr uint64_t kMaxFileBytes = kMaxInputFileBytes;  // image/file_io.h
 constexpr int kMaxJsonDepth = 128;
 constexpr size_t kMaxNodeVisits = 1u << 16;
 constexpr size_t kMaxPrimitives = 1u << 16;
