@@ -137,6 +137,8 @@ Expected<Peaks> measure_peaks(const PeaksSettings& s) {
   if (!copy) return copy.error();
   auto load = gpu::load_compute_pipeline(ctx, "perf/peak_image_load.comp", {{img}, {ssbo}}, 16);
   if (!load) return load.error();
+  auto buffer_floor = gpu::load_compute_pipeline(ctx, "perf/peak_buffer_floor.comp", {{ssbo}, {ssbo}}, 16);
+  if (!buffer_floor) return buffer_floor.error();
   const gpu::BufferHandle res = *results, a = *src, b = *dst;
   const gpu::ImageHandle im = *image;
 
@@ -204,6 +206,28 @@ Expected<Peaks> measure_peaks(const PeaksSettings& s) {
     if (!ms) return ms.error();
     const double loads = double(kWidth) * kHeight * s.image_loads;
     out.results.push_back(result("image_load", *ms, loads, "Gload/s", 1e9));
+  }
+  {
+    const gpu::Pipeline& p = **buffer_floor;
+    const glm::ivec4 pc(int(kWidth), int(kHeight), 0, 0);
+    auto ms = time_pass(
+        graph, "peak_buffer_floor", s.repeats,
+        [&](gpu::PassBuilder& pb) {
+          pb.read(a, gpu::Access::StorageRead);
+          pb.write(b, gpu::Access::StorageWrite);
+          pb.side_effect();
+        },
+        [&](VkCommandBuffer cmd, gpu::PassContext& pass) {
+          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+          gpu::DescriptorPush()
+              .storage_buffer(0, pass.buffer(a))
+              .storage_buffer(1, pass.buffer(b))
+              .push(ctx, cmd, p);
+          gpu::dispatch_2d(cmd, p, &pc, sizeof(pc), kWidth, kHeight);
+        });
+    if (!ms) return ms.error();
+    // Accesses (one load, one store per pixel), the unit the floor pass spends through images.
+    out.results.push_back(result("buffer_floor", *ms, 2.0 * kWidth * kHeight, "Gaccess/s", 1e9));
   }
   return out;
 }

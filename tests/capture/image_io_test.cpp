@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "capture/temp_dir.h"
+#include "common/shared_data.h"
 #include "image/srgb.h"
 #include "mrgi/image.h"
 
@@ -170,8 +171,9 @@ TEST(HdrIo, RadianceHeaderBeyondTheSizeLimitIsRefused) {
 
 // The shared maps are DWAB-compressed half floats (tinyexr cannot decode them).
 TEST(HdrIo, RealDwabEnvironmentMapsLoadFinite) {
+  MRGI_SKIP_WITHOUT_SHARED(mrgi::test::shared_data("env"));
   for (const char* name : {"interior.exr", "courtyard.exr"}) {
-    auto img = load_hdr_image(std::string(MRGI_SHARED_DIR) + "/data/env/" + name);
+    auto img = load_hdr_image(mrgi::test::shared_data("env/") + name);
     ASSERT_TRUE(img.ok()) << img.error().message;
     EXPECT_EQ(img->width, 2 * img->height) << name;  // equirectangular
     double sum = 0, peak = 0;

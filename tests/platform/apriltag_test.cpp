@@ -66,6 +66,7 @@ ImageRGB8 load_jpeg(const std::string& path) {
 constexpr double kCornerTolPx = 1.0;
 
 TEST(AprilTagPhotos, EveryListedTagFoundWithCornersWithinTolerance) {
+  MRGI_SKIP_WITHOUT_SHARED(test::shared_data("apriltag"));
   const char* photos[] = {"33369213973_9d9bb4cc96_c", "34085369442_304b6bafd9_c", "34139872896_defdb2f8d9_c"};
   AprilTagTrackerSettings s;
   s.min_decision_margin = 0;  // the reference detector's defaults: accept every decode with <= 2 bit errors

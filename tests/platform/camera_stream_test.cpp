@@ -127,6 +127,7 @@ TEST(PixelConvert, ShortBuffersAndOddSizesAreNamedErrors) {
 }
 
 TEST(PixelConvert, MJPEGDecodesRealPhotoAndDHTLessFrames) {
+  MRGI_SKIP_WITHOUT_SHARED(test::shared_data("apriltag/33369213973_9d9bb4cc96_c.jpg"));
   // A real JPEG photo (800x534, with its own Huffman tables).
   std::ifstream in(test::shared_data("apriltag/33369213973_9d9bb4cc96_c.jpg"), std::ios::binary);
   std::vector<uint8_t> photo((std::istreambuf_iterator<char>(in)), {});

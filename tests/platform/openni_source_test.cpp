@@ -31,6 +31,7 @@ void write_all(const std::string& path, const char* data, size_t n) {
 }
 
 TEST(OniFileInspector, RealRecordingStructure) {
+  MRGI_SKIP_WITHOUT_SHARED(kOni);
   auto s = oni::inspect_oni_file(kOni);
   ASSERT_TRUE(s.ok()) << s.error().message;
   EXPECT_EQ(s->nodes.at(s->depth_node).name, "Depth1");
@@ -43,6 +44,7 @@ TEST(OniFileInspector, RealRecordingStructure) {
 }
 
 TEST(OpenNISource, ReadsEveryFrameOfTheKinectRecording) {
+  MRGI_SKIP_WITHOUT_SHARED(kOni);
   test::run_with_deadline(std::chrono::seconds(60), "reading kinect-12frames.oni", [] {
     auto src = open_openni_source(kOni);
     ASSERT_TRUE(src.ok()) << src.error().message;
@@ -106,6 +108,7 @@ TEST(OpenNISource, ReadsEveryFrameOfTheKinectRecording) {
 }
 
 TEST(OpenNISource, TruncatedFileIsANamedError) {
+  MRGI_SKIP_WITHOUT_SHARED(kOni);
   test::run_with_deadline(std::chrono::seconds(30), "opening a truncated .oni", [] {
     test::TempDir dir("oni-trunc");
     const auto bytes = read_all(kOni);
@@ -123,6 +126,7 @@ TEST(OpenNISource, TruncatedFileIsANamedError) {
 }
 
 TEST(OpenNISource, CorruptFilesAreNamedErrorsNotHangs) {
+  MRGI_SKIP_WITHOUT_SHARED(kOni);
   test::run_with_deadline(std::chrono::seconds(60), "reading corrupt .oni files", [] {
     test::TempDir dir("oni-corrupt");
     auto bytes = read_all(kOni);
@@ -180,6 +184,7 @@ TEST(OpenNISource, AFolderOrFifoNamedOniIsABadInputNotACrash) {
 }
 
 TEST(OpenNISource, SecondOpenOfTheSameFileIsRefusedUntilTheFirstCloses) {
+  MRGI_SKIP_WITHOUT_SHARED(kOni);
   auto a = open_openni_source(kOni);
   ASSERT_TRUE(a.ok()) << a.error().message;
   auto b = open_openni_source(kOni);

@@ -54,6 +54,7 @@ void expect_capture_equals_oni(const std::string& folder) {
 }
 
 TEST(Record, OniToCaptureRoundTripsBitExact) {
+  MRGI_SKIP_WITHOUT_SHARED(kOni);
   test::run_with_deadline(std::chrono::seconds(120), "recording the .oni", [] {
     test::TempDir dir("record");
     const std::string out = dir.file("kinect");
@@ -72,6 +73,7 @@ TEST(Record, OniToCaptureRoundTripsBitExact) {
 }
 
 TEST(Record, FailureMidStreamLeavesNothing) {
+  MRGI_SKIP_WITHOUT_SHARED(kOni);
   test::run_with_deadline(std::chrono::seconds(60), "recording a broken .oni", [] {
     test::TempDir dir("record-bad");
     // Depth frame 5's payload overwritten: playback either stalls (BadInput) or ends early;
@@ -99,6 +101,7 @@ TEST(Record, FailureMidStreamLeavesNothing) {
 }
 
 TEST(Record, ToolRecordsTheOni) {
+  MRGI_SKIP_WITHOUT_SHARED(kOni);
   if (!std::filesystem::exists(MRGI_TOOL)) GTEST_SKIP() << "mrgi tool not built at " << MRGI_TOOL;
   test::TempDir dir("record-tool");
   const std::string out = dir.file("cap");

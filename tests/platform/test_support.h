@@ -15,7 +15,9 @@
 
 namespace mrgi::test {
 
-inline std::string shared_data(const std::string& rel) { return std::string(MRGI_SHARED_DIR) + "/data/" + rel; }
+}  // namespace mrgi::test
+#include "common/shared_data.h"
+namespace mrgi::test {
 
 // A fresh folder under the system temp dir, removed when the object dies.
 struct TempDir {

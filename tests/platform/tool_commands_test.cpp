@@ -54,6 +54,7 @@ TEST_F(ToolCommands, DevicesReportsEveryAdapterAndExitsZero) {
 }
 
 TEST_F(ToolCommands, LiveRendersEveryFrameOfTheOniWithTheDefaultObject) {
+  MRGI_SKIP_WITHOUT_SHARED(kOni);
   test::TempDir dir("live");
   const std::string out = dir.file("out");
   const std::string cmd = std::string("LP_NUM_THREADS=2 timeout 300 ") + MRGI_TOOL + " live openni:" + kOni +
@@ -72,6 +73,7 @@ TEST_F(ToolCommands, LiveRendersEveryFrameOfTheOniWithTheDefaultObject) {
 // ssrt on a real Kinect recording: every frame has a finite light estimate from the frame it was
 // primed on, and stats.json says which frame was run twice for that.
 TEST_F(ToolCommands, LiveSsrtOnTheKinectRecordingEstimatesLightFromTheFirstFrame) {
+  MRGI_SKIP_WITHOUT_SHARED(kOni);
   test::TempDir dir("live-ssrt");
   const std::string out = dir.file("out");
   ASSERT_EQ(run(std::string("LP_NUM_THREADS=2 timeout 300 ") + MRGI_TOOL + " live openni:" + kOni +
@@ -92,6 +94,7 @@ TEST_F(ToolCommands, LiveSsrtOnTheKinectRecordingEstimatesLightFromTheFirstFrame
 }
 
 TEST_F(ToolCommands, RecordedCaptureReplays) {
+  MRGI_SKIP_WITHOUT_SHARED(kOni);
   test::TempDir dir("record-replay");
   const std::string cap = dir.file("cap"), out = dir.file("out");
   ASSERT_EQ(run(std::string("timeout 120 ") + MRGI_TOOL + " record openni:" + kOni + " --out " + cap + " -q > /dev/null 2> " +

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "common/shared_data.h"
 #include "mrgi/platform/capture.h"
 #include "mrgi/platform/capture_references.h"
 #include "mrgi/reference/description.h"
@@ -16,11 +17,14 @@ namespace fs = std::filesystem;
 namespace mrgi::reference {
 namespace {
 
-const std::string kShared = MRGI_SHARED_DIR;
+const std::string kShared = mrgi::test::shared_root();
 
 class SynthTest : public ::testing::Test {
  protected:
   void SetUp() override {
+    // Every description below names an environment map and a model from ../shared.
+    MRGI_SKIP_WITHOUT_SHARED(kShared + "/data/models/bunny.glb");
+    MRGI_SKIP_WITHOUT_SHARED(kShared + "/data/env/courtyard.exr");
     dir_ = fs::temp_directory_path() / ("mrgi_synth_test_" + std::to_string(::getpid()) + "_" +
                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);

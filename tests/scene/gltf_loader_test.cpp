@@ -10,6 +10,7 @@
 
 #include "capture/temp_dir.h"
 #include "mrgi/scene.h"
+#include "common/shared_data.h"
 
 namespace mrgi {
 namespace {
@@ -17,7 +18,7 @@ namespace {
 using testing::TempDir;
 using testing::write_text;
 
-const std::string kModels = std::string(MRGI_SHARED_DIR) + "/data/models/";
+const std::string kModels = mrgi::test::shared_data("models/");
 
 void expect_vec3_near(const glm::vec3& a, const glm::vec3& b, float tol) {
   EXPECT_NEAR(a.x, b.x, tol);
@@ -32,6 +33,7 @@ size_t vertex_count(const Model& m) {
 }
 
 TEST(GltfLoader, BunnyVerticesBoundsAndMaterial) {
+  MRGI_SKIP_WITHOUT_SHARED(kModels);
   auto model = load_gltf(kModels + "bunny.glb", Placement{});
   ASSERT_TRUE(model.ok()) << model.error().message;
   ASSERT_EQ(model->primitives.size(), 1u);
@@ -53,6 +55,7 @@ TEST(GltfLoader, BunnyVerticesBoundsAndMaterial) {
 }
 
 TEST(GltfLoader, DuckNodeTransformAndTexture) {
+  MRGI_SKIP_WITHOUT_SHARED(kModels);
   auto model = load_gltf(kModels + "duck.glb", Placement{});
   ASSERT_TRUE(model.ok()) << model.error().message;
   ASSERT_EQ(model->primitives.size(), 1u);  // the camera node carries no mesh
@@ -82,6 +85,7 @@ TEST(GltfLoader, DuckNodeTransformAndTexture) {
 }
 
 TEST(GltfLoader, PlacementIsAppliedOnTop) {
+  MRGI_SKIP_WITHOUT_SHARED(kModels);
   Placement p;
   p.position = {10, 0, 0};
   p.scale = glm::vec3(2.0f);
@@ -93,6 +97,7 @@ TEST(GltfLoader, PlacementIsAppliedOnTop) {
 }
 
 TEST(GltfLoader, CornellBoxMeshesAndIor) {
+  MRGI_SKIP_WITHOUT_SHARED(kModels);
   auto model = load_gltf(kModels + "cornell_box.glb", Placement{});
   ASSERT_TRUE(model.ok()) << model.error().message;
   EXPECT_EQ(model->primitives.size(), 8u);

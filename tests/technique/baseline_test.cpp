@@ -10,18 +10,13 @@
 #include <filesystem>
 #include <functional>
 
+#include "capture/temp_dir.h"
 #include "mrgi/runtime.h"
 #include "../../shaders/shared/mrgi_shared.h"
 #include "synthetic_scene.h"
 
 namespace mrgi::test {
 namespace {
-
-std::string temp_folder(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("mrgi_technique_" + name);
-  std::filesystem::create_directories(dir);
-  return dir.string();
-}
 
 RuntimeSettings settings_for(int level) {
   RuntimeSettings s;
@@ -103,7 +98,8 @@ Classified classify(const SyntheticScene& s, int margin) {
 
 class BaselineTest : public ::testing::Test {
  protected:
-  void SetUp() override { scene_ = SyntheticScene::create(temp_folder("baseline")); }
+  void SetUp() override { scene_ = SyntheticScene::create(dir_.str()); }
+  mrgi::testing::TempDir dir_;
   SyntheticScene scene_;
 };
 

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "capture/temp_dir.h"
 #include "mrgi/runtime.h"
 #include "runtime/influence.h"
 #include "synthetic_scene.h"
@@ -59,12 +60,6 @@ TEST(Influence, AVirtualLampAffectsEveryFrame) {
   EXPECT_TRUE(runtime::virtual_influence_in_view(q, {point_lamp({0.0f, 0.0f, 5.0f}, false)}));
 }
 
-std::string temp_folder(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("mrgi_skip_" + name);
-  std::filesystem::create_directories(dir);
-  return dir.string();
-}
-
 FrameOutput run_one(const SyntheticScene& s, const SceneDesc& scene, bool skips, bool profiled = false,
                     int output_width = 0, int output_height = 0) {
   RuntimeSettings rs;
@@ -98,7 +93,8 @@ bool reports_skip(const FrameOutput& o) {
 }
 
 TEST(FrameSkip, OutOfViewObjectSkipsTheTechniqueWithoutChangingTheOutput) {
-  const SyntheticScene s = SyntheticScene::create(temp_folder("out"));
+  const mrgi::testing::TempDir dir;
+  const SyntheticScene s = SyntheticScene::create(dir.str());
   SceneDesc far = s.scene;
   for (auto& v : far.virtual_objects) v.placement.position += glm::vec3(30.0f, 0.0f, 0.0f);
   const FrameOutput skipped = run_one(s, far, true);
@@ -120,7 +116,8 @@ TEST(FrameSkip, OutOfViewObjectSkipsTheTechniqueWithoutChangingTheOutput) {
 // its output is the camera frame byte for byte; at another output size compose's camera-copy
 // pipeline resamples it, and nothing else runs.
 TEST(FrameSkip, UnaffectedFrameIsTheCameraFrameWithoutAPass) {
-  const SyntheticScene s = SyntheticScene::create(temp_folder("lean"));
+  const mrgi::testing::TempDir dir;
+  const SyntheticScene s = SyntheticScene::create(dir.str());
   SceneDesc far = s.scene;
   for (auto& v : far.virtual_objects) v.placement.position += glm::vec3(30.0f, 0.0f, 0.0f);
   const FrameOutput o = run_one(s, far, true);
@@ -159,7 +156,8 @@ TEST(FrameSkip, UnaffectedFrameIsTheCameraFrameWithoutAPass) {
 
 // Profiling mode: every pass its own host-timed submission, and they add up to the frame.
 TEST(FrameSkip, ProfiledFramePassesAddUpAndMatchTheNormalOutput) {
-  const SyntheticScene s = SyntheticScene::create(temp_folder("profiled"));
+  const mrgi::testing::TempDir dir;
+  const SyntheticScene s = SyntheticScene::create(dir.str());
   const FrameOutput normal = run_one(s, s.scene, true, false);
   const FrameOutput profiled = run_one(s, s.scene, true, true);
   ASSERT_FALSE(profiled.image.empty());
@@ -177,7 +175,8 @@ TEST(FrameSkip, ProfiledFramePassesAddUpAndMatchTheNormalOutput) {
 }
 
 TEST(FrameSkip, ObjectInViewIsNotSkipped) {
-  const SyntheticScene s = SyntheticScene::create(temp_folder("in"));
+  const mrgi::testing::TempDir dir;
+  const SyntheticScene s = SyntheticScene::create(dir.str());
   const FrameOutput o = run_one(s, s.scene, true);
   ASSERT_FALSE(o.image.empty());
   EXPECT_FALSE(reports_skip(o));

@@ -8,6 +8,8 @@
 //   copy        a 16-byte-per-invocation buffer copy, 2 x 64 MiB touched (peak_copy.comp)
 //   image load  RGBA32F imageLoad at hashed positions within 64 px (peak_image_load.comp), the
 //               access pattern of a screen-space sampling pass
+//   buffer floor the floor pass's per-pixel load and store (4 bytes each) through storage
+//               buffers instead of images (peak_buffer_floor.comp): what the image path costs
 #pragma once
 #include <string>
 #include <vector>
