@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
-# The test command: installs what is needed, builds, and runs every test (unit, capture and scene
-# parsing with every refusal case, frame graph, Vulkan with validation layers on, golden runs
-# against the path-traced references, reference-renderer checks, platform adapters, bench subset).
+# The test command: installs what is needed, builds with -Werror, and runs every test (unit, capture
+# and scene parsing with every refusal case, frame graph, Vulkan with validation layers on, golden
+# runs against the path-traced references, reference-renderer checks, platform adapters, bench
+# subset, fuzz seed corpora); then the same tests under ASan + UBSan and a short run of every fuzz
+# target (scripts/sanitize.sh). SKIP_SANITIZERS=1 stops after the first pass.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
-bash scripts/build.sh
+bash scripts/build.sh -DMRGI_WERROR=ON
 export LP_NUM_THREADS="${LP_NUM_THREADS:-2}"
 ctest --test-dir build --output-on-failure --no-tests=error -j"$(nproc)" --timeout 900
+[ "${SKIP_SANITIZERS:-0}" = 1 ] || bash scripts/sanitize.sh

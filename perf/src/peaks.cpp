@@ -15,7 +15,7 @@
 namespace mrgi::perf {
 namespace {
 
-constexpr uint32_t kWidth = 640, kHeight = 480;
+constexpr uint32_t kPeakWidth = 640, kPeakHeight = 480;
 
 struct Kernel {
   const char* name;
@@ -84,13 +84,13 @@ Expected<Peaks> measure_peaks(const PeaksSettings& s) {
   out.driver = ctx.info().driver;
   if (const char* t = std::getenv("LP_NUM_THREADS")) out.lp_num_threads = std::atoi(t);
 
-  auto floor = gpu::measure_floor_pass(ctx, kWidth, kHeight, uint32_t(std::max(s.repeats, 5)));
+  auto floor = gpu::measure_floor_pass(ctx, kPeakWidth, kPeakHeight, uint32_t(std::max(s.repeats, 5)));
   if (!floor) return floor.error();
   out.floor_median_ms = floor->median_ms;
 
   gpu::FrameGraphSettings fs;
-  fs.max_output_width = kWidth;
-  fs.max_output_height = kHeight;
+  fs.max_output_width = kPeakWidth;
+  fs.max_output_height = kPeakHeight;
   fs.frames_in_flight = 1;
   fs.max_passes = 4;
   auto graph_or = gpu::FrameGraph::create(ctx, fs);
@@ -102,7 +102,7 @@ Expected<Peaks> measure_peaks(const PeaksSettings& s) {
   const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
   const VkDeviceSize copy_bytes = VkDeviceSize(s.copy_mib) << 20;
   const VkDeviceSize result_bytes =
-      std::max<VkDeviceSize>(VkDeviceSize(s.fma_invocations), kWidth * kHeight) * 16;
+      std::max<VkDeviceSize>(VkDeviceSize(s.fma_invocations), kPeakWidth * kPeakHeight) * 16;
   auto results = graph.create_buffer({"peaks_result", result_bytes}, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (!results) return results.error();
   auto src = graph.create_buffer({"peaks_copy_src", copy_bytes},
@@ -120,13 +120,13 @@ Expected<Peaks> measure_peaks(const PeaksSettings& s) {
   id.name = "peaks_image";
   id.format = VK_FORMAT_R32G32B32A32_SFLOAT;
   id.size_mode = gpu::SizeMode::Absolute;
-  id.width = kWidth;
-  id.height = kHeight;
+  id.width = kPeakWidth;
+  id.height = kPeakHeight;
   id.history = true;
   auto image = graph.create_image(id, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
   if (!image) return image.error();
   {
-    std::vector<float> texels(size_t(kWidth) * kHeight * 4);
+    std::vector<float> texels(size_t(kPeakWidth) * kPeakHeight * 4);
     for (size_t i = 0; i < texels.size(); ++i) texels[i] = float(i % 97) * 0.01f;
     MRGI_TRY(graph.upload_image(*image, texels.data(), texels.size() * sizeof(float)));
   }
@@ -187,7 +187,7 @@ Expected<Peaks> measure_peaks(const PeaksSettings& s) {
   }
   {
     const gpu::Pipeline& p = **load;
-    const glm::ivec4 pc(s.image_loads, int(kWidth), int(kHeight), 0);
+    const glm::ivec4 pc(s.image_loads, int(kPeakWidth), int(kPeakHeight), 0);
     auto ms = time_pass(
         graph, "peak_image_load", s.repeats,
         [&](gpu::PassBuilder& pb) {
@@ -201,15 +201,15 @@ Expected<Peaks> measure_peaks(const PeaksSettings& s) {
               .storage_image(0, pass.view(im))
               .storage_buffer(1, pass.buffer(res))
               .push(ctx, cmd, p);
-          gpu::dispatch_2d(cmd, p, &pc, sizeof(pc), kWidth, kHeight);
+          gpu::dispatch_2d(cmd, p, &pc, sizeof(pc), kPeakWidth, kPeakHeight);
         });
     if (!ms) return ms.error();
-    const double loads = double(kWidth) * kHeight * s.image_loads;
+    const double loads = double(kPeakWidth) * kPeakHeight * s.image_loads;
     out.results.push_back(result("image_load", *ms, loads, "Gload/s", 1e9));
   }
   {
     const gpu::Pipeline& p = **buffer_floor;
-    const glm::ivec4 pc(int(kWidth), int(kHeight), 0, 0);
+    const glm::ivec4 pc(int(kPeakWidth), int(kPeakHeight), 0, 0);
     auto ms = time_pass(
         graph, "peak_buffer_floor", s.repeats,
         [&](gpu::PassBuilder& pb) {
@@ -223,11 +223,11 @@ Expected<Peaks> measure_peaks(const PeaksSettings& s) {
               .storage_buffer(0, pass.buffer(a))
               .storage_buffer(1, pass.buffer(b))
               .push(ctx, cmd, p);
-          gpu::dispatch_2d(cmd, p, &pc, sizeof(pc), kWidth, kHeight);
+          gpu::dispatch_2d(cmd, p, &pc, sizeof(pc), kPeakWidth, kPeakHeight);
         });
     if (!ms) return ms.error();
     // Accesses (one load, one store per pixel), the unit the floor pass spends through images.
-    out.results.push_back(result("buffer_floor", *ms, 2.0 * kWidth * kHeight, "Gaccess/s", 1e9));
+    out.results.push_back(result("buffer_floor", *ms, 2.0 * kPeakWidth * kPeakHeight, "Gaccess/s", 1e9));
   }
   return out;
 }

@@ -148,7 +148,7 @@ TEST(CaptureRefuses, NulByteInAListedPathAndAFifoList) {
   std::filesystem::remove(f.file("depth.txt"));
   ASSERT_EQ(mkfifo(f.file("depth.txt").c_str(), 0600), 0);
   write_text(f.file("rgb.txt"), "1.0 rgb/0.png\n1.1 rgb/1.png\n");
-  EXPECT_ERROR(CaptureReader::open(f.folder()), NotFound, "depth.txt");  // refused, not opened
+  EXPECT_ERROR(CaptureReader::open(f.folder()), BadInput, "depth.txt", "regular file");  // refused, not opened
 }
 
 TEST(CaptureRefuses, NonNumericTimestamp) {

@@ -84,7 +84,9 @@ TEST(OutputDir, RootHomeAndCurrentFolderAreRefused) {
   fs::current_path(before);
   EXPECT_FALSE(cur.ok());
   EXPECT_FALSE(parent.ok());
-  if (const char* home = std::getenv("HOME"); home && *home) EXPECT_FALSE(OutputDir::begin(home).ok());
+  if (const char* home = std::getenv("HOME"); home && *home) {
+    EXPECT_FALSE(OutputDir::begin(home).ok());
+  }
 }
 
 TEST(OutputDir, AFailedRunRemovesOnlyItsOwnPartial) {

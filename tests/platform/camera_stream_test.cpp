@@ -330,7 +330,9 @@ TEST(UsbDiscovery, KnownIdsAndScanWithoutBusAccess) {
   EXPECT_EQ(match_usb_sensor(0x045e, 0x0001), nullptr);
   const UsbScan scan = scan_usb();  // must not fail or hang without /dev/bus/usb
   EXPECT_FALSE(scan.status.empty());
-  if (!scan.available) EXPECT_TRUE(scan.devices.empty());
+  if (!scan.available) {
+    EXPECT_TRUE(scan.devices.empty());
+  }
 }
 
 TEST(EnvCamera, FrameToRadianceDecodesSRGBAndExposure) {

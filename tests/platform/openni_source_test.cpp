@@ -170,6 +170,35 @@ TEST(OpenNISource, CorruptFilesAreNamedErrorsNotHangs) {
 }
 
 // Issue 12 case 9: a folder named like a recording gave std::bad_alloc; a FIFO would block.
+// Issue 12 case 2: one changed byte in a property name (the second node's
+// "xnSupportedMapOutputModesCount", so the driver never reads the count it then uses) passes the
+// record-structure check and segfaulted inside OpenNI2's Device::open. The probe process takes
+// the crash: a named BadInput, this process unharmed, nothing opened.
+TEST(OpenNISource, AFileThatCrashesTheDriverIsRefusedNotFatal) {
+  MRGI_SKIP_WITHOUT_SHARED(kOni);
+  test::run_with_deadline(std::chrono::seconds(90), "probing a driver-crashing .oni", [] {
+    test::TempDir dir("oni-crash");
+    auto bytes = read_all(kOni);
+    const std::string name = "xnSupportedMapOutputModesCount";
+    const std::string text(bytes.begin(), bytes.end());
+    const size_t first = text.find(name);
+    ASSERT_NE(first, std::string::npos);
+    const size_t second = text.find(name, first + 1);
+    ASSERT_NE(second, std::string::npos);
+    bytes[second + 22] = char(0xFA);
+    write_all(dir.file("renamed.oni"), bytes.data(), bytes.size());
+    ASSERT_TRUE(oni::inspect_oni_file(dir.file("renamed.oni")).ok()) << "the structure check must pass for this case";
+    auto src = open_openni_source(dir.file("renamed.oni"));
+    ASSERT_FALSE(src.ok());
+    EXPECT_EQ(src.error().kind, ErrorKind::BadInput);
+    EXPECT_NE(src.error().message.find("crashed"), std::string::npos) << src.error().message;
+    EXPECT_NE(src.error().message.find("renamed.oni"), std::string::npos) << src.error().message;
+    // The same process still opens the intact recording afterwards.
+    auto good = open_openni_source(kOni);
+    EXPECT_TRUE(good.ok()) << good.error().message;
+  });
+}
+
 TEST(OpenNISource, AFolderOrFifoNamedOniIsABadInputNotACrash) {
   test::TempDir dir("oni-not-a-file");
   std::filesystem::create_directories(dir.file("folder.oni"));

@@ -243,7 +243,10 @@ struct Driver {
     info.virtual_objects_present = !scene_gpu->virtual_objects.empty();
     const Status st = tech->record(info, skipped);
     EXPECT_TRUE(st.ok()) << st.error().message;
-    for (auto [img, buf] : {std::pair{shared.lit_r, readback_r}, std::pair{shared.lit_rv, readback_rv}}) {
+    for (const auto& image_and_buffer : {std::pair{shared.lit_r, readback_r}, std::pair{shared.lit_rv, readback_rv}}) {
+      // Named copies, not a structured binding: clang 14 (the sanitizer build) cannot capture one.
+      const auto img = image_and_buffer.first;
+      const auto buf = image_and_buffer.second;
       graph->add_pass(
           std::string("readback_") + graph->name(img), PassKind::Transfer,
           [img, buf](PassBuilder& b) {

@@ -140,8 +140,11 @@ class ReconFilterTest : public VulkanTest {
     std::memcpy(graph_->mapped(constants_, graph_->slot()), &fc, sizeof(fc));
     recon_->upload(*graph_, input);
     recon_->record(*graph_, constants_);
-    for (auto [img, buf] : {std::pair{recon_->normal(), normal_rb_},
-                            std::pair{recon_->filtered_depth(), depth_rb_}}) {
+    for (const auto& image_and_buffer : {std::pair{recon_->normal(), normal_rb_},
+                                         std::pair{recon_->filtered_depth(), depth_rb_}}) {
+      // Named copies, not a structured binding: clang 14 (the sanitizer build) cannot capture one.
+      const auto img = image_and_buffer.first;
+      const auto buf = image_and_buffer.second;
       graph_->add_pass(
           "readback_" + graph_->name(img), PassKind::Transfer,
           [img, buf](gpu::PassBuilder& b) {

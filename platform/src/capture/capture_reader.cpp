@@ -41,15 +41,39 @@ std::string resolve(const std::string& folder, const std::string& listed) {
   return (p.is_absolute() ? p : fs::path(folder) / p).lexically_normal().string();
 }
 
-// Resolves each line's path fields and checks the files exist.
+// Whether an optional file of the capture (capture.json, groundtruth.txt, scene.json, ...) is
+// there: false when nothing is at PATH, true for a regular file (or a link to one), and an error
+// for anything else: a folder, a FIFO or a dangling link named like the file would otherwise be
+// skipped without a word (a scene.json folder rendered no object).
+Expected<bool> optional_file(const std::string& path) {
+  std::error_code ec;
+  const fs::file_status link = fs::symlink_status(path, ec);
+  if (ec || link.type() == fs::file_type::not_found) return false;
+  const fs::file_status target = fs::status(path, ec);
+  if (target.type() == fs::file_type::regular) return true;
+  if (link.type() == fs::file_type::symlink && (ec || target.type() == fs::file_type::not_found))
+    return fail(ErrorKind::BadInput, path + ": a dangling symbolic link (it must be a regular file or absent)");
+  return fail(ErrorKind::BadInput, path + ": not a regular file (a " +
+                                       (target.type() == fs::file_type::directory ? "folder" : "special file") +
+                                       "); it must be a regular file or absent");
+}
+
+// Resolves each line's path fields and checks the files: relative paths inside the capture
+// folder (no absolute path, no '..' out of it: a list must not read other files of the
+// machine), each a regular file.
 Status check_listed_files(const std::string& list_path, const std::string& folder,
                           std::vector<capture::ListLine>* lines) {
   for (auto& line : *lines) {
     for (auto& field : line.fields) {
+      const std::string where = list_path + ":" + std::to_string(line.line) + ": listed file '" + field + "'";
+      const fs::path rel = fs::path(field).lexically_normal();
+      if (rel.is_absolute() || rel.empty() || *rel.begin() == "..")
+        return fail(ErrorKind::BadInput, where + " is not a relative path inside the capture folder");
       const std::string abs = resolve(folder, field);
-      if (!capture::file_exists(abs))
-        return fail(ErrorKind::NotFound, list_path + ":" + std::to_string(line.line) + ": listed file '" +
-                                             field + "' does not exist (looked for " + abs + ")");
+      std::error_code ec;
+      if (!fs::exists(abs, ec))
+        return fail(ErrorKind::NotFound, where + " does not exist (looked for " + abs + ")");
+      if (!capture::file_exists(abs)) return fail(ErrorKind::BadInput, where + " is not a regular file");
       field = abs;
     }
   }
@@ -169,17 +193,22 @@ Expected<CaptureReader> CaptureReader::open(const std::string& folder) {
   const fs::path dir(folder);
 
   const std::string capture_json = (dir / "capture.json").string();
-  if (capture::file_exists(capture_json)) {
+  auto has_capture_json = optional_file(capture_json);
+  if (!has_capture_json) return has_capture_json.error();
+  if (*has_capture_json) {
     auto info = load_capture_json(capture_json);
     if (!info) return info.error();
     reader.info_ = *info;
   }
 
-  for (const char* required : {"rgb.txt", "depth.txt"})
-    if (!capture::file_exists((dir / required).string()))
+  for (const char* required : {"rgb.txt", "depth.txt"}) {
+    auto present = optional_file((dir / required).string());
+    if (!present) return present.error();
+    if (!*present)
       return fail(ErrorKind::NotFound, (dir / required).string() +
                                            ": missing; a capture folder needs rgb.txt and depth.txt "
                                            "(TUM lists 'timestamp path')");
+  }
   auto color = read_image_list(folder, "rgb.txt", 1, "timestamp path");
   if (!color) return color.error();
   auto depth = read_image_list(folder, "depth.txt", 1, "timestamp path");
@@ -196,7 +225,9 @@ Expected<CaptureReader> CaptureReader::open(const std::string& folder) {
 
   std::vector<TimedPose> poses;
   const std::string gt_path = (dir / "groundtruth.txt").string();
-  if (capture::file_exists(gt_path)) {
+  auto has_gt = optional_file(gt_path);
+  if (!has_gt) return has_gt.error();
+  if (*has_gt) {
     auto gt = read_groundtruth(gt_path);
     if (!gt) return gt.error();
     poses = std::move(*gt);
@@ -204,7 +235,9 @@ Expected<CaptureReader> CaptureReader::open(const std::string& folder) {
 
   std::vector<double> env_times;
   std::vector<std::string> env_paths;
-  if (capture::file_exists((dir / "env.txt").string())) {
+  auto has_env = optional_file((dir / "env.txt").string());
+  if (!has_env) return has_env.error();
+  if (*has_env) {
     auto env = read_image_list(folder, "env.txt", 1, "timestamp path");
     if (!env) return env.error();
     for (const auto& line : *env) {
@@ -226,7 +259,9 @@ Expected<CaptureReader> CaptureReader::open(const std::string& folder) {
   }
 
   const std::string ref_list = (dir / "reference.txt").string();
-  if (capture::file_exists(ref_list)) {
+  auto has_refs = optional_file(ref_list);
+  if (!has_refs) return has_refs.error();
+  if (*has_refs) {
     auto refs = read_image_list(folder, "reference.txt", 2, "timestamp path [mask_path]");
     if (!refs) return refs.error();
     std::vector<double> all_color_times;
@@ -253,7 +288,9 @@ Expected<CaptureReader> CaptureReader::open(const std::string& folder) {
   }
 
   const std::string scene_json = (dir / "scene.json").string();
-  if (capture::file_exists(scene_json)) {
+  auto has_scene = optional_file(scene_json);
+  if (!has_scene) return has_scene.error();
+  if (*has_scene) {
     auto scene = load_scene_json(scene_json);
     if (!scene) return scene.error();
     reader.scene_ = std::move(*scene);

@@ -3,12 +3,17 @@
 
 #include <OpenNI.h>
 
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <mutex>
 #include <set>
+#include <thread>
 
 #include "openni/oni_file_inspector.h"
 
@@ -24,7 +29,7 @@ std::string openni_error_text() {
   return s.empty() ? std::string("no error text from OpenNI2") : s;
 }
 
-bool ends_with(const std::string& s, const std::string& suffix) {
+bool ends_with_ignoring_case(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && std::equal(suffix.rbegin(), suffix.rend(), s.rbegin(),
                                                  [](char a, char b) { return std::tolower(a) == b; });
 }
@@ -71,9 +76,67 @@ class OpenNISource final : public InputSource {
   }
 
   static Expected<std::unique_ptr<InputSource>> open(const std::string& uri, const OpenNISettings& settings) {
+    if (ends_with_ignoring_case(uri, ".oni")) MRGI_TRY(probe_file(uri, settings));
+    return open_unprobed(uri, settings);
+  }
+
+  static Expected<std::unique_ptr<InputSource>> open_unprobed(const std::string& uri,
+                                                              const OpenNISettings& settings) {
     auto src = std::unique_ptr<OpenNISource>(new OpenNISource());
     MRGI_TRY(src->open_device(uri, settings));
     return std::unique_ptr<InputSource>(std::move(src));
+  }
+
+  // OpenNI2's file driver trusts the recording: one changed property value (a mode count larger
+  // than its mode list, say) makes it read out of bounds and segfault inside Device::open, and
+  // mrgi's record-structure check (oni_file_inspector.h) cannot know the meaning of every driver
+  // property. So the driver first reads the whole file in a child process: the same open and
+  // every frame, as this process will read them. A child killed by a signal or past its time
+  // limit means the file is refused here, before this process hands it to the driver; a child
+  // that ends with an error (a refusal with a message) or with every frame read lets the normal
+  // open run, which gives that message itself. Cost: one extra read of the recording at open
+  // (0.2 s for the 12-frame Kinect file).
+  static Status probe_file(const std::string& uri, const OpenNISettings& settings) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(uri, ec)) return ok_status();  // the open names the problem
+    const auto bytes = std::filesystem::file_size(uri, ec);
+    // 20 s plus 1 s per 10 MB: the driver decodes ~100 MB/s here; a hang is a refusal, not a wait.
+    const auto limit = std::chrono::seconds(20 + (ec ? 0 : int64_t(bytes / 10000000)));
+    std::fflush(nullptr);
+    const pid_t pid = ::fork();
+    if (pid < 0) return ok_status();  // no probe possible (process limit): open as before
+    if (pid == 0) {
+      auto src = open_unprobed(uri, settings);
+      if (!src.ok()) ::_exit(3);
+      for (;;) {
+        auto f = (*src)->next(std::chrono::milliseconds(5000));
+        if (!f.ok()) ::_exit(f.error().kind == ErrorKind::EndOfStream ? 0 : 3);
+      }
+    }
+    const auto deadline = Clock::now() + limit;
+    int status = 0;
+    for (;;) {
+      const pid_t r = ::waitpid(pid, &status, WNOHANG);
+      if (r == pid) break;
+      if (r < 0) return ok_status();
+      if (Clock::now() > deadline) {
+        ::kill(pid, SIGKILL);
+        ::waitpid(pid, &status, 0);
+        return fail(ErrorKind::BadInput, uri + ": OpenNI2's file driver did not finish reading the recording within " +
+                                             std::to_string(limit.count()) +
+                                             " s in a probe process (it hangs on this file); refused");
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    if (WIFSIGNALED(status)) {
+      const int sig = WTERMSIG(status);
+      return fail(ErrorKind::BadInput, uri + ": OpenNI2's file driver crashed (signal " + std::to_string(sig) + ", " +
+                                           strsignal(sig) +
+                                           ") reading the recording in a probe process: the file is corrupt in a way "
+                                           "the record-structure check does not see (for example a property value "
+                                           "the driver trusts); refused");
+    }
+    return ok_status();
   }
 
   std::string name() const override { return name_; }
@@ -137,7 +200,7 @@ class OpenNISource final : public InputSource {
   Status open_device(const std::string& uri, const OpenNISettings& settings) {
     MRGI_TRY(openni_initialize());
     settings_ = settings;
-    const bool is_file = ends_with(uri, ".oni");
+    const bool is_file = ends_with_ignoring_case(uri, ".oni");
     report_.is_file = is_file;
     name_ = "openni:" + uri;
     oni::FileSummary summary;

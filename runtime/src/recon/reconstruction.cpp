@@ -10,7 +10,7 @@ namespace {
 // Shader buffers are read as 32-bit words: round byte sizes up to a multiple of 4.
 size_t words_bytes(size_t bytes) { return (bytes + 3) / 4 * 4; }
 
-Expected<gpu::ImageHandle> internal_image(gpu::FrameGraph& graph, const char* name, VkFormat format,
+Expected<gpu::ImageHandle> recon_image(gpu::FrameGraph& graph, const char* name, VkFormat format,
                                           VkImageUsageFlags usage, bool history = false) {
   gpu::ImageDesc d;
   d.name = name;
@@ -59,19 +59,19 @@ Expected<Reconstruction> Reconstruction::create(gpu::Context& context, gpu::Fram
   // Transfer source: tests and debug tools read the reconstruction back.
   const VkImageUsageFlags usage =
       VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
-  auto p = internal_image(graph, "real_position", VK_FORMAT_R32G32B32A32_SFLOAT, usage);
+  auto p = recon_image(graph, "real_position", VK_FORMAT_R32G32B32A32_SFLOAT, usage);
   if (!p) return p.error();
   r.position_ = *p;
-  auto n = internal_image(graph, "real_normal", VK_FORMAT_R16G16B16A16_SFLOAT, usage);
+  auto n = recon_image(graph, "real_normal", VK_FORMAT_R16G16B16A16_SFLOAT, usage);
   if (!n) return n.error();
   r.normal_ = *n;
-  auto a = internal_image(graph, "real_albedo", VK_FORMAT_R16G16B16A16_SFLOAT, usage);
+  auto a = recon_image(graph, "real_albedo", VK_FORMAT_R16G16B16A16_SFLOAT, usage);
   if (!a) return a.error();
   r.albedo_ = *a;
-  auto fd = internal_image(graph, "recon_filtered_depth", VK_FORMAT_R32G32_SFLOAT, usage, true);
+  auto fd = recon_image(graph, "recon_filtered_depth", VK_FORMAT_R32G32_SFLOAT, usage, true);
   if (!fd) return fd.error();
   r.filtered_depth_ = *fd;
-  auto wp = internal_image(graph, "recon_warped_depth", VK_FORMAT_R32_UINT,
+  auto wp = recon_image(graph, "recon_warped_depth", VK_FORMAT_R32_UINT,
                            VK_IMAGE_USAGE_STORAGE_BIT, true);
   if (!wp) return wp.error();
   r.warped_ = *wp;

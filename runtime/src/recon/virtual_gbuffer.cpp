@@ -10,7 +10,7 @@ constexpr VkFormat kNormalFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kAlbedoFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 
-Expected<gpu::ImageHandle> internal_image(gpu::FrameGraph& graph, const char* name, VkFormat format,
+Expected<gpu::ImageHandle> gbuffer_image(gpu::FrameGraph& graph, const char* name, VkFormat format,
                                           VkImageUsageFlags usage) {
   gpu::ImageDesc d;
   d.name = name;
@@ -29,16 +29,16 @@ Expected<VirtualGBuffer> VirtualGBuffer::create(gpu::Context& context, gpu::Fram
   // texelFetch).
   const VkImageUsageFlags color =
       VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT;
-  auto p = internal_image(graph, "virtual_position", kPositionFormat, color);
+  auto p = gbuffer_image(graph, "virtual_position", kPositionFormat, color);
   if (!p) return p.error();
   v.position_ = *p;
-  auto n = internal_image(graph, "virtual_normal", kNormalFormat, color);
+  auto n = gbuffer_image(graph, "virtual_normal", kNormalFormat, color);
   if (!n) return n.error();
   v.normal_ = *n;
-  auto a = internal_image(graph, "virtual_albedo", kAlbedoFormat, color);
+  auto a = gbuffer_image(graph, "virtual_albedo", kAlbedoFormat, color);
   if (!a) return a.error();
   v.albedo_ = *a;
-  auto d = internal_image(graph, "virtual_depth", kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
+  auto d = gbuffer_image(graph, "virtual_depth", kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
   if (!d) return d.error();
   v.depth_ = *d;
   v.color_layout_ =

@@ -20,10 +20,6 @@ Status check_range(bool ok, const char* field, const std::string& rule) {
               std::string("ssrt LightEstimatorSettings.") + field + ": " + rule);
 }
 
-double luminance(const glm::dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
-
-constexpr double kPi = 3.14159265358979323846;
-
 // The dominant normal of the frame's pixels: the principal axis of the band-1 block of T^T T
 // (T's band 1 is the visibility-weighted cosine lobe around the normal, so the block is a sum of
 // n n^T), signed so that the pixels are lit from its side (T^T I_c). Zero when undefined.

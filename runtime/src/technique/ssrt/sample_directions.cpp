@@ -13,8 +13,6 @@
 namespace mrgi::ssrt {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 uint64_t edge_key(uint32_t a, uint32_t b) { return (uint64_t(a) << 32) | b; }
 
 }  // namespace

@@ -10,11 +10,8 @@
 namespace mrgi::ssrt {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Clamped-cosine zonal factors A_l (Ramamoorthi & Hanrahan 2001) for l = 0..3.
 constexpr double kCosineLobe[kMaxShBands] = {kPi, 2.0 * kPi / 3.0, kPi / 4.0, 0.0};
-
-double luminance(const glm::dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
 
 }  // namespace
 
@@ -115,10 +112,9 @@ Rgb irradiance_at(const LightEstimate& estimate, const std::array<float, 3>& nor
   return out;
 }
 
-
 Expected<LightEstimate> light_from_environment(const ImageRGBF& image, const EnvCamera& camera,
                                                double intensity, int bands) {
-  constexpr double kPi = 3.14159265358979323846;
+  using ssrt::kPi;
   if (image.empty() || image.width < 1 || image.height < 1)
     return fail(ErrorKind::BadInput, "light_from_environment: empty environment image");
   const bool fisheye = camera.model == EnvModel::FisheyeEquidistant;

@@ -11,6 +11,11 @@
 
 namespace mrgi::ssrt {
 
+constexpr double kPi = 3.14159265358979323846;
+// Rec. 709 luminance of linear RGB, in double for the host-side solves (the shaders' float one is
+// mrgi_shared.h `luminance`).
+inline double luminance(const glm::dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
+
 constexpr int kMaxShBands = 4;
 constexpr int kMaxShCoeffs = kMaxShBands * kMaxShBands;  // 16
 

@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# The sanitizer build (part of the test command, scripts/test.sh): clang with AddressSanitizer +
+# UndefinedBehaviorSanitizer (a UB report aborts), -Werror, libFuzzer coverage, into
+# build-asan/; then every test again under it (tests/sanitizers: third-party leak suppressions
+# only) and a short run of every fuzz target (scripts/fuzz.sh, FUZZ_SECONDS each, default 10).
+# To fit the CI time (the test command builds the tree twice on 2 cores): -O0 with line tables
+# only, and the libraries as unity translation units (MRGI_UNITY_LIBS).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+command -v clang++ >/dev/null || { echo "sanitize.sh: clang++ not found (scripts/install-deps.sh installs it)" >&2; exit 1; }
+CC=clang CXX=clang++ cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O0 -gline-tables-only" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O0 -gline-tables-only" \
+  -DMRGI_SANITIZE=ON -DMRGI_WERROR=ON -DMRGI_FUZZ=ON -DMRGI_UNITY_LIBS=ON >/dev/null
+ninja -C build-asan -j"$(nproc)"
+export LP_NUM_THREADS="${LP_NUM_THREADS:-2}"
+ctest --test-dir build-asan --output-on-failure --no-tests=error -j"$(nproc)" --timeout 900
+MRGI_FUZZ_BUILD=build-asan bash scripts/fuzz.sh "${FUZZ_SECONDS:-10}"
