@@ -1,9 +1,10 @@
 // Reading the frame's raw camera uploads (RGB8 colour and u16 depth packed into uint words, as
 // the runtime copies them) and the nearest-sample gather from the internal image into either
-// camera. Shared by recon/depth_to_positions.comp and ssrt/depth_input.comp, which both start
-// from the raw frame. The including shader declares, before including this file:
+// camera. Shared by recon/depth_to_positions.comp and the ssrt passes, which start from the raw
+// frame. The including shader declares, before including this file:
 //   readonly buffer ... { uint color_words[]; };  readonly buffer ... { uint depth_words[]; };
-// and includes shared/mrgi_shared.h (project_pinhole).
+// and includes shared/mrgi_shared.h (project_pinhole); camera_at() also needs the frame
+// constants as `frame` (common/frame_constants.glsl).
 #ifndef MRGI_UPLOAD_GATHER_GLSL
 #define MRGI_UPLOAD_GATHER_GLSL
 
@@ -19,5 +20,27 @@ ivec2 nearest_pixel(vec3 ray, vec4 k, ivec2 size) {
   if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) return ivec2(-1);
   return q;
 }
+
+#ifdef MRGI_FRAME_CONSTANTS_GLSL
+// The camera's colour seen through internal pixel position p as linear reflectance, the value
+// recon/depth_to_positions.comp writes to real_albedo (sRGB-decoded, divided by the exposure,
+// clamped to [0, 1]; the DIR approximation explained there), in rgb; a = 1 where the depth
+// camera measured the same ray (its nearest sample is non-zero), else 0. For passes that need
+// the camera colour only at some pixels (ssrt: cell centres, shaded tiles) instead of a full
+// real G-buffer.
+vec4 camera_at(vec2 p) {
+  vec3 ray = unproject_pinhole(p, 1.0f, frame.internal_k);
+  ivec2 cp = nearest_pixel(ray, frame.color_k, frame.color_depth_size.xy);
+  ivec2 dp = nearest_pixel(ray, frame.depth_k, frame.color_depth_size.zw);
+  vec3 albedo = vec3(0.0f);
+  if (cp.x >= 0) {
+    uint base = uint(cp.y * frame.color_depth_size.x + cp.x) * 3u;
+    vec3 encoded = vec3(color_byte(base), color_byte(base + 1u), color_byte(base + 2u)) / 255.0f;
+    albedo = clamp(camera_to_radiance(encoded, frame.camera.y), vec3(0.0f), vec3(1.0f));
+  }
+  bool measured = dp.x >= 0 && depth_value(uint(dp.y * frame.color_depth_size.z + dp.x)) != 0u;
+  return vec4(albedo, measured ? 1.0f : 0.0f);
+}
+#endif
 
 #endif  // MRGI_UPLOAD_GATHER_GLSL

@@ -1,8 +1,9 @@
 #version 460
 // Virtual G-buffer: world position + coverage, normal + roughness, linear base colour +
-// metallic. A virtual fragment behind the real surface seen at its pixel (reconstructed depth)
-// is hidden, so real objects occlude virtual ones.
+// metallic. A virtual fragment behind the real surface seen at its pixel (the real geometry's
+// depth, technique::RealGeometry) is hidden, so real objects occlude virtual ones.
 #extension GL_GOOGLE_include_directive : require
+#include "shared/mrgi_shared.h"
 #include "common/frame_constants.glsl"
 #include "common/scene_materials.glsl"
 
@@ -10,7 +11,9 @@ layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
 layout(std430, set = 0, binding = 1) readonly buffer Materials { GpuMaterial materials[]; };
 layout(set = 0, binding = 2) uniform sampler2D real_position;         // xyz world, w depth
 layout(set = 0, binding = 3) uniform sampler2DArray base_color_maps;  // sRGB, decoded on fetch
-layout(push_constant) uniform Draw { int material; } draw;
+layout(set = 0, binding = 4) uniform sampler2D real_normal;           // xyz world (step > 1)
+// material: per draw; real_step: internal pixels per texel side of real_position.
+layout(push_constant) uniform Draw { int material; int real_step; } draw;
 
 layout(location = 0) in vec3 in_world;
 layout(location = 1) in vec3 in_normal;
@@ -21,7 +24,17 @@ layout(location = 1) out vec4 out_normal;    // xyz unit, w roughness
 layout(location = 2) out vec4 out_albedo;    // rgb linear base colour, w metallic
 
 void main() {
-  vec4 real = texelFetch(real_position, ivec2(gl_FragCoord.xy), 0);
+  ivec2 pixel = ivec2(gl_FragCoord.xy);
+  ivec2 texel = pixel / max(draw.real_step, 1);
+  vec4 real = texelFetch(real_position, texel, 0);
+  if (draw.real_step > 1 && real.w > 0.0f) {
+    // A coarse texel: the depth of its tangent plane on this pixel's ray (exact on planes, so a
+    // virtual object resting on a sloped real surface is not cut by the texel-centre depth).
+    vec3 ray = unproject_pinhole(vec2(pixel), 1.0f, frame.internal_k);
+    vec3 p = (frame.world_to_camera * vec4(real.xyz, 1.0f)).xyz;
+    vec3 n = mat3(frame.world_to_camera) * texelFetch(real_normal, texel, 0).xyz;
+    real.w = tangent_plane_depth(ray, p, n, MRGI_DEPTH_EDGE_RELATIVE);
+  }
   // Hidden when a valid real surface is in front by more than the tolerance (a fraction of
   // the depth: sensor noise grows with distance; objects resting on a real surface stay seen).
   if (real.w > 0.0f && real.w < in_view_z * (1.0f - frame.camera.z)) discard;
@@ -31,7 +44,8 @@ void main() {
   if (m.params.z >= 0.0f) base *= texture(base_color_maps, vec3(in_uv, m.params.z));
   vec3 n = normalize(in_normal);
   if (any(isnan(n))) n = vec3(0.0f, 1.0f, 0.0f);
-  // Single-sided glTF seen from behind, or a flipped normal: shade the side the camera sees.
+  // A double-sided material seen from behind (single-sided ones are culled), or a flipped
+  // normal: shade the side the camera sees.
   if (dot(n, frame.camera_world.xyz - in_world) < 0.0f) n = -n;
   out_position = vec4(in_world, 1.0f);
   out_normal = vec4(n, clamp(m.params.y, 0.02f, 1.0f));

@@ -77,6 +77,22 @@ MRGI_FN vec3 camera_to_radiance(vec3 encoded, float exposure) {
   return srgb_decode(encoded) / e;
 }
 
+// ---- coarse geometry lookups ----------------------------------------------------------------
+
+// Camera-space depth where the camera ray `ray` (any point on it with z = 1) meets the tangent
+// plane of a G-buffer texel (camera-space point `p`, unit normal `n`). A coarse G-buffer (one
+// texel per 4x4 pixels at ssrt's fast levels) holds the surface at the texel centre; a sample
+// that projects 2 px from it on a sloped floor would read that centre's depth, several per cent
+// off, and the 1 % occluder bias would find it blocked by its own surface. The plane keeps the
+// lookup exact on planar surfaces. Falls back to p.z where the ray grazes the plane or the plane
+// depth leaves p.z by more than `max_relative` of it (a depth edge, not a plane).
+MRGI_FN float tangent_plane_depth(vec3 ray, vec3 p, vec3 n, float max_relative) {
+  float denom = dot(n, ray);
+  float z = abs(denom) > 1e-4f ? dot(n, p) / denom : p.z;
+  bool ok = z > 0.0f && abs(z - p.z) <= max_relative * p.z;
+  return ok ? z : p.z;
+}
+
 // ---- normals --------------------------------------------------------------------------------
 
 // Octahedral mapping of a unit vector to [-1, 1]^2 (Cigolle et al. 2014, "A Survey of Efficient

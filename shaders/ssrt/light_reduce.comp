@@ -14,14 +14,19 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 #include "shared/mrgi_shared.h"
+#include "common/frame_constants.glsl"
 
 layout(local_size_x = 64) in;
 layout(set = 0, binding = 0, rgba32f) readonly uniform image2DArray coarse;
-layout(set = 0, binding = 1, rgba16f) readonly uniform image2D real_albedo;  // camera, linear
+// The camera frame as uploaded (upload_gather.glsl camera_at: linear colour).
+layout(std140, set = 0, binding = 3) uniform FrameUbo { FrameConstants frame; };
+layout(std430, set = 0, binding = 1) readonly buffer ColorWords { uint color_words[]; };  // RGB8
+layout(std430, set = 0, binding = 4) readonly buffer DepthWords { uint depth_words[]; };  // u16
+#include "common/upload_gather.glsl"
 layout(std430, set = 0, binding = 2) writeonly buffer Partials { float partials[]; };
 layout(push_constant) uniform Push {
   ivec4 grid;  // x, y cells; z step in pixels; w cells per strip
-  ivec4 size;  // xy used extent of real_albedo (internal resolution); z strips per row
+  ivec4 size;  // xy the internal extent (pixels); z strips per row
 } pc;
 
 void main() {
@@ -41,7 +46,7 @@ void main() {
     ivec2 q = min(cell, pc.grid.xy - ivec2(1));
     float ok = inside && imageLoad(coarse, ivec3(q, 4)).z > 0.5f ? 1.0f : 0.0f;
     ivec2 pixel = min(q * pc.grid.z + ivec2(pc.grid.z / 2), pc.size.xy - ivec2(1));
-    vec3 camera = imageLoad(real_albedo, pixel).rgb * ok;
+    vec3 camera = camera_at(vec2(pixel)).rgb * ok;
     float t[16];
     [[unroll]] for (int l = 0; l < 4; ++l) {
       vec4 v = imageLoad(coarse, ivec3(q, l)) * ok;

@@ -12,6 +12,7 @@
 // (bicubic overshoots).
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
+#include "common/frame_constants.glsl"
 #include "ssrt/ssrt_math.h"
 #include "ssrt/upsampled.glsl"
 
@@ -25,7 +26,12 @@ layout(constant_id = 1) const bool kTiled = false;
 // Storage images read with imageLoad: on lavapipe a sampled texelFetch costs 2-3x as much.
 layout(set = 0, binding = 0, rgba32f) readonly uniform image2DArray coarse;
 layout(set = 0, binding = 1, rgba32f) readonly uniform image2D real_position;
-layout(set = 0, binding = 2, rgba16f) readonly uniform image2D real_albedo;
+// The camera frame as uploaded: A = upload_gather.glsl camera_at (what recon's real_albedo
+// holds, read only at the pixels shaded).
+layout(std430, set = 0, binding = 2) readonly buffer ColorWords { uint color_words[]; };  // RGB8
+layout(std430, set = 0, binding = 9) readonly buffer DepthWords { uint depth_words[]; };  // u16
+layout(std140, set = 0, binding = 10) uniform FrameUbo { FrameConstants frame; };
+#include "common/upload_gather.glsl"
 layout(set = 0, binding = 3, rgba32f) readonly uniform image2D virtual_position;
 layout(set = 0, binding = 4, rgba16f) readonly uniform image2D virtual_albedo;
 layout(set = 0, binding = 5, rgba16f) writeonly uniform image2D lit_rv;
@@ -105,7 +111,7 @@ void main() {
   if (pixel.x >= used.x || pixel.y >= used.y) return;
   bool real_ok = imageLoad(real_position, pixel / pc.size.z).w > 0.0f;
   bool virt = imageLoad(virtual_position, pixel).w > 0.5f;
-  vec3 a = imageLoad(real_albedo, pixel).rgb;
+  vec3 a = camera_at(vec2(pixel)).rgb;
   bool inside = pixel.x >= pc.influence.x && pixel.x < pc.influence.z &&
                 pixel.y >= pc.influence.y && pixel.y < pc.influence.w;
   if (kPassThrough || (!inside && !virt)) {

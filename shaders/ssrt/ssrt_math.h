@@ -88,22 +88,6 @@ SSRT_FN vec3 ssrt_indirect_term(vec3 x, vec3 n_x, vec3 s, vec3 n_s, vec3 albedo_
   return (1.0f - clamp(k, 0.0f, 1.0f)) * g * MRGI_PI * f * sender_radiance;
 }
 
-// ---- coarse geometry lookups ------------------------------------------------------------------
-
-// Camera-space depth where the camera ray `ray` (any point on it with z = 1) meets the tangent
-// plane of a G-buffer texel (camera-space point `p`, unit normal `n`). A coarse G-buffer (one
-// texel per 4x4 pixels at ssrt's fast levels) holds the surface at the texel centre; a sample
-// that projects 2 px from it on a sloped floor would read that centre's depth, several per cent
-// off, and the 1 % occluder bias would find it blocked by its own surface. The plane keeps the
-// lookup exact on planar surfaces. Falls back to p.z where the ray grazes the plane or the plane
-// depth leaves p.z by more than `max_relative` of it (a depth edge, not a plane).
-SSRT_FN float ssrt_plane_depth(vec3 ray, vec3 p, vec3 n, float max_relative) {
-  float denom = dot(n, ray);
-  float z = abs(denom) > 1e-4f ? dot(n, p) / denom : p.z;
-  bool ok = z > 0.0f && abs(z - p.z) <= max_relative * p.z;
-  return ok ? z : p.z;
-}
-
 // ---- transfer and shading -------------------------------------------------------------------
 
 // Diffuse radiance transfer of one sample direction w at normal n (eq. 6 without the albedo):

@@ -36,19 +36,27 @@ layout(std430, set = 0, binding = 2) readonly buffer SampleBuffer { SsrtSample s
 // Storage images read with imageLoad: on lavapipe a sampled texelFetch costs 2-3x as much.
 layout(set = 0, binding = 3, rgba32f) readonly uniform image2D real_position;
 layout(set = 0, binding = 4, rgba16f) readonly uniform image2D real_normal;
-layout(set = 0, binding = 5, rgba16f) readonly uniform image2D real_albedo;
+// The receiver (the cell's centre pixel) is read from the full-resolution buffers 5-7 and 13
+// (the camera's colour and depth as uploaded, upload_gather.glsl); what a sample lands on from
+// the occluder G-buffer at the geometry grid's resolution (occluders.comp: 8 the virtual
+// surface, 12 the real and virtual albedo and the virtual normal).
+layout(std430, set = 0, binding = 5) readonly buffer ColorWords { uint color_words[]; };  // RGB8
+layout(std430, set = 0, binding = 13) readonly buffer DepthWords { uint depth_words[]; };  // u16
+#include "common/upload_gather.glsl"
 layout(set = 0, binding = 6, rgba32f) readonly uniform image2D virtual_position;
 layout(set = 0, binding = 7, rgba16f) readonly uniform image2D virtual_normal;
-layout(set = 0, binding = 8, rgba16f) readonly uniform image2D virtual_albedo;
+layout(set = 0, binding = 8, rgba32f) readonly uniform image2D occ_position;
 layout(set = 0, binding = 9, rgba32f) writeonly uniform image2DArray coarse;
 // The volume's auxiliary orthographic layers (left, right, top, light; aux_views.glsl): occluders
 // outside the camera frustum (paper Sec. 5.1).
 layout(set = 0, binding = 10, rgba32f) readonly uniform image2DArray aux_position;
 layout(std140, set = 0, binding = 11) uniform AuxUbo { SsrtAuxViews aux; };
+layout(set = 0, binding = 12, rgba32ui) readonly uniform uimage2D occ_attrs;
 layout(push_constant) uniform Push {
   ivec4 grid;     // x, y cells; z step in pixels; w directions N
   ivec4 config;   // x first sample of the level's sets, y SH bands, z geometry step (internal
-                  // pixels per texel of real_position / real_normal), w unused
+                  // pixels per texel of real_position / real_normal), w occluder step (of
+                  // occ_position / occ_attrs)
   vec4 sampling;  // x radius (m), y chi, z normal offset (m), w minimum sender distance (m)
   vec4 bounce;    // x sample area (m^2), y saturation threshold, z depth test bias (fraction),
                   // w occluder range (m)
@@ -83,16 +91,43 @@ bool aux_occluder(vec3 x, vec3 y, out vec3 s) {
 
 // The real surface seen through internal pixel position q (qi its nearest pixel): xyz world,
 // w camera depth; n its world normal. At geometry step 1 the texel itself; coarser, the point
-// of the texel's tangent plane on q's camera ray (ssrt_plane_depth).
+// of the texel's tangent plane on q's camera ray (tangent_plane_depth).
 vec4 real_surface(vec2 q, ivec2 qi, int gstep, out vec3 n) {
   ivec2 g = qi / gstep;
   vec4 o = imageLoad(real_position, g);
   n = imageLoad(real_normal, g).xyz;
   vec3 ray = unproject_pinhole(q, 1.0f, frame.internal_k);
   vec3 p = (frame.world_to_camera * vec4(o.xyz, 1.0f)).xyz;
-  float z = ssrt_plane_depth(ray, p, mat3(frame.world_to_camera) * n, MRGI_DEPTH_EDGE_RELATIVE);
+  float z = tangent_plane_depth(ray, p, mat3(frame.world_to_camera) * n, MRGI_DEPTH_EDGE_RELATIVE);
   vec4 plane = vec4((frame.camera_to_world * vec4(ray * z, 1.0f)).xyz, z);
   return gstep > 1 && o.w > 0.0f ? plane : o;
+}
+
+// The virtual surface seen through internal pixel position q (qi its nearest pixel), from the
+// occluder G-buffer: xyz world, w camera depth (all 0 where no virtual object covers the
+// texel); n its normal, albedo its base colour, real_albedo the camera's colour there. Coarser
+// than one texel per pixel, the point of the texel's tangent plane on q's camera ray, as for
+// the real surface (a virtual receiver's samples would otherwise find its own texel in front).
+vec4 virtual_surface(vec2 q, ivec2 qi, int ostep, out vec3 n, out vec3 albedo,
+                     out vec3 real_albedo) {
+  ivec2 g = qi / ostep;
+  vec4 o = imageLoad(occ_position, g);
+  uvec4 a = imageLoad(occ_attrs, g);
+  real_albedo = unpackUnorm4x8(a.x).rgb;
+  albedo = unpackUnorm4x8(a.y).rgb;
+  n = vec3(unpackHalf2x16(a.z), unpackHalf2x16(a.w).x);
+  vec3 p = (frame.world_to_camera * vec4(o.xyz, 1.0f)).xyz;
+  vec3 ray = unproject_pinhole(q, 1.0f, frame.internal_k);
+  float z = tangent_plane_depth(ray, p, mat3(frame.world_to_camera) * n, MRGI_DEPTH_EDGE_RELATIVE);
+  vec4 plane = vec4((frame.camera_to_world * vec4(ray * z, 1.0f)).xyz, z);
+  vec4 texel = ostep > 1 ? plane : vec4(o.xyz, p.z);
+  return o.w > 0.5f ? texel : vec4(0.0f);
+}
+
+// The camera's colour (linear) of the real surface at internal pixel qi, from the occluder
+// G-buffer.
+vec3 real_albedo_at(ivec2 qi, int ostep) {
+  return unpackUnorm4x8(imageLoad(occ_attrs, qi / ostep).x).rgb;
 }
 
 // Camera-space depth of a world point.
@@ -106,6 +141,7 @@ void main() {
   ivec2 pixel = min(cell * step + ivec2(step / 2), size - ivec2(1));
 
   int gstep = pc.config.z;
+  int ostep = pc.config.w;
   vec4 rp = imageLoad(real_position, pixel / gstep);
   vec4 vp = imageLoad(virtual_position, pixel);
   bool real_ok = rp.w > 0.0f;
@@ -162,17 +198,16 @@ void main() {
       ivec2 qi = ivec2(floor(q + 0.5f));
       bool in_view = yz > 0.0f && all(greaterThanEqual(qi, ivec2(0))) && all(lessThan(qi, size));
       qi = clamp(qi, ivec2(0), size - 1);
-      vec3 on;
+      vec3 on, vn, va, oa;
       vec4 o = real_surface(q, qi, gstep, on);
-      vec4 ov = imageLoad(virtual_position, qi);
-      vec3 oa = imageLoad(real_albedo, qi).rgb;
+      vec4 ov = virtual_surface(q, qi, ostep, vn, va, oa);
       // Real scene: the real surface in front of the sample within the range (see the general
       // path below for the rules); real + virtual: the virtual surface where the virtual
       // G-buffer holds one (it is in front of the real one there), else the real one.
       vec3 dr_r = o.xyz - xr;
       bool hit_r = in_view && o.w > 0.0f && o.w < yz * (1.0f - bias) && dot(dr_r, dr_r) <= range2;
-      bool use_virtual = in_view && influenced && ov.w > 0.5f;
-      float oz_v = view_depth(ov.xyz);
+      bool use_virtual = in_view && influenced && ov.w > 0.0f;
+      float oz_v = ov.w;
       vec3 dr_v = ov.xyz - xr;
       bool hit_vo = oz_v > 0.0f && oz_v < yz * (1.0f - bias) && dot(dr_v, dr_v) <= range2;
       bool hit_v = use_virtual ? hit_vo : hit_r;
@@ -196,8 +231,8 @@ void main() {
       t_rv[1] += tw_v * y_sh.c1;
       t_rv[2] += tw_v * y_sh.c2;
       t_rv[3] += tw_v * y_sh.c3;
-      vec3 sn_v = use_virtual ? imageLoad(virtual_normal, qi).xyz : on;
-      vec3 sa_v = use_virtual ? imageLoad(virtual_albedo, qi).rgb : oa;
+      vec3 sn_v = use_virtual ? vn : on;
+      vec3 sa_v = use_virtual ? va : oa;
       if (from_view)
         ri += ssrt_indirect_term(xr, nr, o.xyz, on, oa, k, l_dir, e_light, pc.bounce.x,
                                  pc.sampling.w);
@@ -239,7 +274,7 @@ void main() {
             if (o.w > 0.0f && o.w < yz * (1.0f - bias) && dot(dr, dr) <= pc.bounce.w * pc.bounce.w) {
               sp = o.xyz;
               sn = on;
-              sa = imageLoad(real_albedo, qi).rgb;
+              sa = real_albedo_at(qi, ostep);
               k = ssrt_visibility_k(xr, sp, w, chi);
             }
           }
@@ -271,18 +306,18 @@ void main() {
           vec2 q = project_pinhole((frame.world_to_camera * vec4(y, 1.0f)).xyz, frame.internal_k);
           ivec2 qi = ivec2(floor(q + 0.5f));
           if (all(greaterThanEqual(qi, ivec2(0))) && all(lessThan(qi, size))) {
-            vec4 ov = imageLoad(virtual_position, qi);
-            vec3 on;
+            vec3 on, vn, va, ra;
+            vec4 ov = virtual_surface(q, qi, ostep, vn, va, ra);
             vec4 o = real_surface(q, qi, gstep, on);
             // The virtual G-buffer only holds virtual surfaces in front of the real one.
-            bool use_virtual = ov.w > 0.5f;
-            float oz = use_virtual ? view_depth(ov.xyz) : o.w;
+            bool use_virtual = ov.w > 0.0f;
+            float oz = use_virtual ? ov.w : o.w;
             vec3 dv = (use_virtual ? ov.xyz : o.xyz) - xv;
             if ((use_virtual || o.w > 0.0f) && oz > 0.0f && oz < yz * (1.0f - bias) &&
                 dot(dv, dv) <= pc.bounce.w * pc.bounce.w) {
               sp = use_virtual ? ov.xyz : o.xyz;
-              sn = use_virtual ? imageLoad(virtual_normal, qi).xyz : on;
-              sa = use_virtual ? imageLoad(virtual_albedo, qi).rgb : imageLoad(real_albedo, qi).rgb;
+              sn = use_virtual ? vn : on;
+              sa = use_virtual ? va : ra;
               k = ssrt_visibility_k(xv, sp, w, chi);
             }
           }
@@ -328,7 +363,7 @@ void main() {
   // black surface: 500 such cells at env_fisheye's far floor pulled the estimate down), and the
   // green channel, 72 % of the luminance, is below clipping. A warm sun clips red first on a
   // bright grey ball; rejecting such pixels removed exactly the surfaces facing the light.
-  vec4 camera = imageLoad(real_albedo, pixel);
+  vec4 camera = camera_at(vec2(pixel));
   float usable = real_ok && camera.a > 0.5f && camera.g < pc.bounce.y ? 1.0f : 0.0f;
   for (int c = 0; c < 4; ++c) imageStore(coarse, ivec3(cell, c), real_ok ? t_real[c] : zero);
   imageStore(coarse, ivec3(cell, 4), vec4(max(rd, 0.0f), max(rd_v, 0.0f), usable, virt ? 2.0f : 1.0f));

@@ -235,23 +235,23 @@ TEST(SsrtSamples, PairLoopEqualsTheSumOverAllSamples) {
   }
 }
 
-// ssrt_plane_depth: a coarse G-buffer texel's tangent plane met by another pixel's ray.
+// tangent_plane_depth: a coarse G-buffer texel's tangent plane met by another pixel's ray.
 TEST(SsrtMath, PlaneDepthIsExactOnAPlaneAndFallsBackWhereItCannotBe) {
   // Plane z = 2 + 0.5 x (camera space), texel centre at x = 0.
   const vec3 n = glm::normalize(vec3(-0.5f, 0.0f, 1.0f));
   const vec3 p(0.0f, 0.0f, 2.0f);
   for (float u : {-0.02f, -0.01f, 0.0f, 0.01f, 0.02f}) {
     const vec3 ray(u, 0.0f, 1.0f);  // z = 1
-    const float z = shader::ssrt_plane_depth(ray, p, n, 0.05f);
+    const float z = shader::tangent_plane_depth(ray, p, n, 0.05f);
     // On the plane: z = 2 + 0.5 (u z)  =>  z = 2 / (1 - 0.5 u).
     EXPECT_NEAR(z, 2.0f / (1.0f - 0.5f * u), 1e-5f) << u;
   }
   // Farther than 5 % from the texel's depth: a depth edge, not the plane.
-  EXPECT_FLOAT_EQ(shader::ssrt_plane_depth(vec3(0.3f, 0.0f, 1.0f), p, n, 0.05f), 2.0f);
+  EXPECT_FLOAT_EQ(shader::tangent_plane_depth(vec3(0.3f, 0.0f, 1.0f), p, n, 0.05f), 2.0f);
   // A ray grazing the plane, a plane through the camera: the texel's depth, never NaN or inf.
   const vec3 side = glm::normalize(vec3(1.0f, 0.0f, 0.0f));
-  EXPECT_FLOAT_EQ(shader::ssrt_plane_depth(vec3(0.0f, 0.0f, 1.0f), p, side, 0.05f), 2.0f);
-  EXPECT_FLOAT_EQ(shader::ssrt_plane_depth(vec3(0.0f, 0.0f, 1.0f), vec3(0.0f), n, 0.05f), 0.0f);
+  EXPECT_FLOAT_EQ(shader::tangent_plane_depth(vec3(0.0f, 0.0f, 1.0f), p, side, 0.05f), 2.0f);
+  EXPECT_FLOAT_EQ(shader::tangent_plane_depth(vec3(0.0f, 0.0f, 1.0f), vec3(0.0f), n, 0.05f), 0.0f);
 }
 
 }  // namespace

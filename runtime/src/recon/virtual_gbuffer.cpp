@@ -57,8 +57,9 @@ Expected<VirtualGBuffer> VirtualGBuffer::create(gpu::Context& context, gpu::Fram
   desc.bindings = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
                    {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
                    {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
+                   {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
                    {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER}};
-  desc.push_constant_bytes = sizeof(int32_t);
+  desc.push_constant_bytes = 2 * sizeof(int32_t);  // material (per draw), real geometry step
   desc.vertex_strides = {sizeof(technique::GpuVertex)};
   desc.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(technique::GpuVertex, position)},
                      {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(technique::GpuVertex, normal)},
@@ -66,18 +67,28 @@ Expected<VirtualGBuffer> VirtualGBuffer::create(gpu::Context& context, gpu::Fram
   desc.color_formats = {kPositionFormat, kNormalFormat, kAlbedoFormat};
   desc.depth_format = kDepthFormat;
   desc.depth_compare = VK_COMPARE_OP_LESS;
-  // Both sides: glTF objects may be single-sided, and the y-down projection flips winding.
-  desc.cull_mode = VK_CULL_MODE_NONE;
+  // Single-sided materials (glTF's default) cull back faces; the loader keeps front faces
+  // counter-clockwise in world space (mirroring transforms swap the winding), and the camera's
+  // y-down projection keeps them counter-clockwise on screen in Vulkan's framebuffer
+  // convention (checked: culling the other side makes desk_spot's bunny show its inside, RDE
+  // 0.83 -> 0.98). Cost on lavapipe, desk_spot's 16k-triangle bunny: 7.7 -> 5.8 ms.
+  desc.cull_mode = VK_CULL_MODE_BACK_BIT;
+  desc.front_face = VK_FRONT_FACE_COUNTER_CLOCKWISE;
   auto pipe = gpu::create_graphics_pipeline(context, desc);
   if (!pipe) return pipe.error();
   v.pipeline_ = gpu::PipelineHandle(context, std::move(*pipe));
+  desc.name = "virtual_gbuffer_double_sided";
+  desc.cull_mode = VK_CULL_MODE_NONE;
+  auto two_sided = gpu::create_graphics_pipeline(context, desc);
+  if (!two_sided) return two_sided.error();
+  v.double_sided_pipeline_ = gpu::PipelineHandle(context, std::move(*two_sided));
   return v;
 }
 
 void VirtualGBuffer::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_constants,
-                            gpu::ImageHandle real_position) {
+                            const technique::RealGeometry& real) {
   frame_constants_ = frame_constants;
-  real_position_ = real_position;
+  real_ = real;
   graph.add_pass(
       "virtual_gbuffer", gpu::PassKind::Graphics,
       [this](gpu::PassBuilder& b) {
@@ -86,7 +97,8 @@ void VirtualGBuffer::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_cons
         b.read(scene_->base_color_maps, gpu::Access::Sampled);
         b.read(scene_->virtual_objects.vertices, gpu::Access::VertexBuffer);
         b.read(scene_->virtual_objects.indices, gpu::Access::IndexBuffer);
-        b.read(real_position_, gpu::Access::Sampled);
+        b.read(real_.position, gpu::Access::Sampled);
+        if (real_.normal != real_.position) b.read(real_.normal, gpu::Access::Sampled);
         b.write(position_, gpu::Access::ColorAttachmentWrite);
         b.write(normal_, gpu::Access::ColorAttachmentWrite);
         b.write(albedo_, gpu::Access::ColorAttachmentWrite);
@@ -130,10 +142,14 @@ void VirtualGBuffer::draw(VkCommandBuffer cmd, gpu::PassContext& pass) {
     gpu::DescriptorPush()
         .uniform_buffer(0, pass.buffer(frame_constants_))
         .storage_buffer(1, pass.buffer(scene_->materials))
-        .sampled_image(2, pass.view(real_position_), ctx.samplers().nearest_clamp)
+        .sampled_image(2, pass.view(real_.position), ctx.samplers().nearest_clamp)
         .sampled_image(3, scene_->base_color_array_view(), ctx.samplers().linear_repeat)
+        .sampled_image(4, pass.view(real_.normal), ctx.samplers().nearest_clamp)
         .push(ctx, cmd, *pipeline_);
-    scene_->virtual_objects.draw(cmd, pass, &*pipeline_);
+    const int32_t step = int32_t(real_.step);
+    vkCmdPushConstants(cmd, pipeline_->layout, pipeline_->stages, sizeof(int32_t), sizeof(step),
+                       &step);
+    scene_->virtual_objects.draw(cmd, pass, &*pipeline_, &*double_sided_pipeline_);
   }
   vkCmdEndRendering(cmd);
 }

@@ -1,6 +1,7 @@
 // The virtual G-buffer: the scene's glTF objects rasterised from the colour camera (OpenCV
 // intrinsics -> Vulkan projection with y down and depth 0..1, FrameConstants::world_to_clip) at
-// the internal resolution, hidden where the reconstructed real surface is in front.
+// the internal resolution, hidden where the real surface is in front (recon's positions, or the
+// technique's own real geometry: technique::RealGeometry).
 // Images: virtual_position (RGBA32F: xyz world, w 1 where a virtual object is seen = the
 // real/virtual mask), virtual_normal (RGBA16F: xyz, w roughness), virtual_albedo (RGBA16F:
 // linear base colour, w metallic), virtual_depth (D32, for the virtual objects among themselves).
@@ -8,6 +9,7 @@
 #include "gpu/frame_graph.h"
 #include "gpu/pipelines.h"
 #include "technique/scene_gpu.h"
+#include "technique/technique.h"
 
 namespace mrgi::recon {
 
@@ -17,7 +19,7 @@ class VirtualGBuffer {
                                          const technique::SceneGpu& scene);
   // Adds the pass "virtual_gbuffer" (always: with no object it clears the mask).
   void record(gpu::FrameGraph& graph, gpu::BufferHandle frame_constants,
-              gpu::ImageHandle real_position);
+              const technique::RealGeometry& real);
 
   gpu::ImageHandle position() const { return position_; }
   gpu::ImageHandle normal() const { return normal_; }
@@ -28,9 +30,9 @@ class VirtualGBuffer {
 
   const technique::SceneGpu* scene_ = nullptr;
   gpu::BufferHandle frame_constants_;
-  gpu::ImageHandle real_position_;
+  technique::RealGeometry real_;
   gpu::ImageHandle position_, normal_, albedo_, depth_;
-  gpu::PipelineHandle pipeline_;
+  gpu::PipelineHandle pipeline_, double_sided_pipeline_;  // back faces culled; both sides
   VkImageLayout color_layout_ = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
   VkImageLayout depth_layout_ = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
 };

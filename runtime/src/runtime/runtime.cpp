@@ -423,20 +423,30 @@ Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, 
   // A frame nothing virtual affects is the camera frame (the lean skeleton above): the
   // reconstruction is not needed for it; its temporal history restarts on the next affected
   // frame (one frame of unfiltered depth).
-  if (affected) {
+  const bool recon_used = technique_->uses_reconstruction();
+  if (affected && recon_used) {
     recon_->record(*graph_, frame_constants_);
   } else {
     recon_->skip_frame();
-    rec.skipped.push_back("recon: nothing virtual in view (its temporal history restarts when there is)");
+    rec.skipped.push_back(affected ? "recon: " + technique_->name() +
+                                         " builds its own real geometry and reads the camera frame itself"
+                                   : "recon: nothing virtual in view (its temporal history restarts when there is)");
   }
   if (affected) {
-    virtual_gbuffer_->record(*graph_, frame_constants_, recon_->position());
     technique::FrameInfo info;
     info.frame_index = frame.index;
     info.level = level_;
     info.virtual_objects_present = has_objects;
     info.camera_to_world = last_pose_;
     info.input = &frame;
+    MRGI_TRY(technique_->record_geometry(info, rec.skipped));
+    const std::optional<technique::RealGeometry> own = technique_->occlusion_geometry();
+    if (!own && !recon_used)
+      return fail(ErrorKind::Internal, technique_->name() +
+                                           ": skips the reconstruction but gives no real geometry "
+                                           "for the virtual objects' depth test");
+    virtual_gbuffer_->record(*graph_, frame_constants_,
+                             own ? *own : technique::RealGeometry{recon_->position(), recon_->position(), 1});
     MRGI_TRY(technique_->record(info, rec.skipped));
   } else {
     rec.skipped.push_back(has_objects ? "technique: no virtual object or its shadow in view"

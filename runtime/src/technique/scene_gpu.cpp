@@ -29,6 +29,8 @@ void append_model(const Model& model, int material_base, MeshData& out) {
     range.index_count = uint32_t(prim.indices.size());
     range.vertex_offset = int32_t(out.vertices.size());
     range.material = prim.material < 0 ? 0 : material_base + prim.material;
+    range.double_sided = prim.material >= 0 && size_t(prim.material) < model.materials.size() &&
+                         model.materials[size_t(prim.material)].double_sided;
     for (size_t i = 0; i < prim.positions.size(); ++i) {
       GpuVertex v;
       v.position = prim.positions[i];
@@ -74,13 +76,20 @@ Expected<MeshSet> upload_meshes(gpu::Context& ctx, gpu::FrameGraph& graph, const
 }  // namespace
 
 void MeshSet::draw(VkCommandBuffer cmd, const gpu::PassContext& pass,
-                   const gpu::Pipeline* material_pipeline) const {
+                   const gpu::Pipeline* material_pipeline,
+                   const gpu::Pipeline* double_sided_pipeline) const {
   if (draws.empty()) return;
   VkBuffer vb = pass.buffer(vertices);
   VkDeviceSize offset = 0;
   vkCmdBindVertexBuffers(cmd, 0, 1, &vb, &offset);
   vkCmdBindIndexBuffer(cmd, pass.buffer(indices), 0, VK_INDEX_TYPE_UINT32);
+  const gpu::Pipeline* bound = nullptr;
   for (const DrawRange& d : draws) {
+    if (double_sided_pipeline) {
+      const gpu::Pipeline* want = d.double_sided ? double_sided_pipeline : material_pipeline;
+      if (want != bound) vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, want->pipeline);
+      bound = want;
+    }
     if (material_pipeline)
       vkCmdPushConstants(cmd, material_pipeline->layout, material_pipeline->stages, 0,
                          sizeof(int32_t), &d.material);

@@ -31,6 +31,9 @@ struct DrawRange {
   uint32_t index_count = 0;
   int32_t vertex_offset = 0;
   int32_t material = 0;  // index into the material array (virtual set only)
+  // glTF doubleSided: both faces are surfaces; otherwise back faces are culled (glTF 2.0
+  // 3.9.4), which on lavapipe also halves the triangles its single-threaded setup handles.
+  bool double_sided = false;
 };
 
 struct MeshSet {
@@ -40,9 +43,12 @@ struct MeshSet {
   glm::vec3 bounds_min{0.0f}, bounds_max{0.0f};  // world AABB; meaningless when empty()
   bool empty() const { return draws.empty(); }
   // Binds the buffers and draws every range; with `material_pipeline` the range's material
-  // index is pushed as a 4-byte push constant at offset 0 before each draw.
+  // index is pushed as a 4-byte push constant at offset 0 before each draw. With
+  // `double_sided_pipeline` (same layout, no culling) the ranges of double-sided materials are
+  // drawn with it and the others with `material_pipeline`, each bound here when it changes.
   void draw(VkCommandBuffer cmd, const gpu::PassContext& pass,
-            const gpu::Pipeline* material_pipeline) const;
+            const gpu::Pipeline* material_pipeline,
+            const gpu::Pipeline* double_sided_pipeline = nullptr) const;
 };
 
 // Base-colour textures are resampled to one square size (the largest texture side, at most

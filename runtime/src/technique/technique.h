@@ -12,6 +12,7 @@
 //     FrameStats::skipped as "pass: reason".
 #pragma once
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -71,6 +72,16 @@ struct SharedResources {
   bool compose_honours_tiles = false;
 };
 
+// Real geometry as a G-buffer another stage reads (the virtual G-buffer's depth test: real
+// surfaces hide virtual ones): positions (xyz world, w camera depth in metres, all 0 = none)
+// with one texel per `step` x `step` internal pixels, and their normals (xyz world), which a
+// reader at step > 1 uses to take each pixel's depth on the texel's tangent plane
+// (tangent_plane_depth, shared/mrgi_shared.h). At step 1 `normal` may be the position image.
+struct RealGeometry {
+  gpu::ImageHandle position, normal;
+  uint32_t step = 1;
+};
+
 // What record() needs to know about the current frame.
 struct FrameInfo {
   int64_t frame_index = 0;
@@ -87,6 +98,17 @@ class Technique {
   virtual const std::vector<QualityLevel>& levels() const = 0;
   // Records this frame's passes for `info.level`; appends "pass: reason" for each pass left out.
   virtual Status record(const FrameInfo& info, std::vector<std::string>& skipped) = 0;
+  // Whether the runtime's reconstruction (recon/: real positions, normals, albedo) runs for
+  // this technique. One with its own geometry stage that reads the camera frame itself where
+  // it needs it (ssrt, paper Sec. 4) says no, and the runtime records neither recon pass.
+  virtual bool uses_reconstruction() const { return true; }
+  // Called before the virtual G-buffer is recorded, on frames that record(): a technique whose
+  // real geometry the virtual objects' depth test should use records the passes that make it
+  // here and returns it from occlusion_geometry() (nullopt, the default: recon's positions).
+  virtual Status record_geometry(const FrameInfo& /*info*/, std::vector<std::string>& /*skipped*/) {
+    return ok_status();
+  }
+  virtual std::optional<RealGeometry> occlusion_geometry() const { return std::nullopt; }
   // The real-world light a technique estimates (ssrt), or nullptr for techniques that take it
   // from the scene description.
   virtual const LightEstimate* light_estimate() const { return nullptr; }

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <optional>
 #include <string>
+#include <tuple>
 
 #include "common/frame_constants.glsl"
 #include "gpu/pipelines.h"
@@ -84,6 +85,16 @@ class Ssrt final : public Technique {
   const std::vector<QualityLevel>& levels() const override { return ladder_; }
   Status init();
   Status record(const FrameInfo& info, std::vector<std::string>& skipped) override;
+  // The paper's own geometry stage (Sec. 4) replaces the runtime's reconstruction: the
+  // transfer and the shading read the filtered G-buffer, the camera colour is read from the
+  // upload where it is used (cell centres, shaded tiles), and the virtual objects' depth test
+  // reads the filtered G-buffer too (G_r, Fig. 2: the paper's occlusion geometry). recon's two
+  // full-resolution passes cost 13-14 ms of desk_spot's fast frame on lavapipe.
+  bool uses_reconstruction() const override { return false; }
+  Status record_geometry(const FrameInfo& info, std::vector<std::string>& skipped) override;
+  std::optional<RealGeometry> occlusion_geometry() const override {
+    return RealGeometry{geo_position_, geo_normal_, geometry_step_};
+  }
   const LightEstimate& estimate() const { return estimator_->estimate(); }
   const LightEstimate* light_estimate() const override { return &estimator_->estimate(); }
   // Once, before the first estimate: the first frame is lit by its own estimate instead of the
@@ -97,8 +108,8 @@ class Ssrt final : public Technique {
   void consume_readback(uint32_t slot, std::vector<std::string>& notes);
   // The paper's geometry stage (Sec. 4): fuse the volume, ray-cast G_v and the aux layers, run
   // the depth filter chain into the G-buffer the transfer reads.
-  Status record_geometry(const FrameInfo& info, const QualityLevel& level,
-                         std::vector<std::string>& skipped);
+  Status record_real_geometry(const FrameInfo& info, const QualityLevel& level,
+                              std::vector<std::string>& skipped);
   void write_light();
   // Whether the virtual objects' influence region (bounds grown by the sampling radius) is in
   // view; `cells` gets its conservative screen rectangle in cells [x0, x1) x [y0, y1).
@@ -128,6 +139,8 @@ class Ssrt final : public Technique {
 
   // The real G-buffer the transfer uses: the filter chain's (paper Sec. 4), not recon's.
   gpu::ImageHandle geo_position_, geo_normal_;
+  // The occluder G-buffer at the same resolution (occluders.comp): virtual surface, albedos.
+  gpu::ImageHandle occ_position_, occ_attrs_;
   // The frame constants the geometry stage (volume ray cast, depth filters) reads: a copy of
   // the runtime's with internal_k / internal_output_size at the geometry resolution, so the same
   // shaders run at any geometry step. Images whose extent follows it: geo_images_.
@@ -139,7 +152,7 @@ class Ssrt final : public Technique {
   gpu::BufferHandle samples_, light_, partials_, result_;
   gpu::ImageHandle coarse_;
   gpu::ImageHandle upsampled_;  // RGBA32UI per cell, shaders/ssrt/upsampled.glsl
-  gpu::PipelineHandle transfer_, transfer_real_, reduce_, reduce_final_, blur_, shade_, shade_pass_,
+  gpu::PipelineHandle occluders_, transfer_, transfer_real_, reduce_, reduce_final_, blur_, shade_, shade_pass_,
       shade_tiled_, shade_tiles_;
   // Fast levels' shade tiles (shade_tiles.comp): indirect dispatch arguments and tile indices.
   gpu::BufferHandle tile_args_, tile_list_;
@@ -149,8 +162,11 @@ class Ssrt final : public Technique {
   bool primed_ = false;                // a priming run was asked for (only ever once)
   std::vector<std::string> deferred_notes_;  // from frames_completed, reported by the next record
   // This frame's knobs (set by record before the passes are added).
-  uint32_t step_ = 1, directions_ = 64, bands_ = 4, geometry_step_ = 1;
+  uint32_t step_ = 1, directions_ = 64, bands_ = 4, geometry_step_ = 1, occluder_step_ = 1;
   int level_ = 0;
+  // The frame record_geometry() last recorded (record() then adds the rest of it).
+  int64_t geometry_frame_ = -1;
+  bool geometry_frame_valid_ = false;
   glm::uvec2 grid_{1, 1};
   glm::ivec4 influence_cells_{0, 0, 0, 0};
   VkExtent2D used_{1, 1};
@@ -184,6 +200,16 @@ Status Ssrt::init() {
   filter_.emplace(std::move(*filt));
   geo_position_ = filter_->position();
   geo_normal_ = filter_->normal();
+  for (auto [handle, name, format] :
+       {std::tuple{&occ_position_, "ssrt_occluder_position", VK_FORMAT_R32G32B32A32_SFLOAT},
+        std::tuple{&occ_attrs_, "ssrt_occluder_attributes", VK_FORMAT_R32G32B32A32_UINT}}) {
+    gpu::ImageDesc od;
+    od.name = name;
+    od.format = format;
+    auto img = graph.create_image(od, VK_IMAGE_USAGE_STORAGE_BIT);
+    if (!img) return img.error();
+    *handle = *img;
+  }
   geo_images_ = {volume_->depth_volume(), volume_->normal_volume(), filter_->input(),
                  filter_->merged(), filter_->merged_intensity(), filter_->bilateral(),
                  filter_->final_depth(), filter_->position(), filter_->normal()};
@@ -249,14 +275,20 @@ Status Ssrt::init() {
   for (uint32_t real_receivers = 0; real_receivers < 2; ++real_receivers) {
     gpu::ComputePipelineDesc d{real_receivers ? "ssrt_transfer_real_receivers" : "ssrt_transfer",
                                *transfer_spv,
-                               {{ubo}, {ubo}, {ssbo}, {img}, {img}, {img}, {img}, {img}, {img},
-                                {img}, {img}, {ubo}},
+                               {{ubo}, {ubo}, {ssbo}, {img}, {img}, {ssbo}, {img}, {img}, {img},
+                                {img}, {img}, {ubo}, {img}, {ssbo}},
                                sizeof(TransferPush), {real_receivers}};
     auto tp = gpu::create_compute_pipeline(ctx, d);
     if (!tp) return tp.error();
     (real_receivers ? transfer_real_ : transfer_) = gpu::PipelineHandle(ctx, std::move(*tp));
   }
-  auto p = gpu::load_compute_pipeline(ctx, "ssrt/light_reduce.comp", {{img}, {img}, {ssbo}}, sizeof(ReducePush));
+  auto p = gpu::load_compute_pipeline(ctx, "ssrt/occluders.comp",
+                                      {{ubo}, {ssbo}, {ssbo}, {img}, {img}, {img}, {img}, {img}},
+                                      sizeof(glm::ivec4));
+  if (!p) return p.error();
+  occluders_ = std::move(*p);
+  p = gpu::load_compute_pipeline(ctx, "ssrt/light_reduce.comp",
+                                 {{img}, {ssbo}, {ssbo}, {ubo}, {ssbo}}, sizeof(ReducePush));
   if (!p) return p.error();
   reduce_ = std::move(*p);
   p = gpu::load_compute_pipeline(ctx, "ssrt/light_reduce_final.comp", {{ssbo}, {ssbo}}, sizeof(FinalPush));
@@ -276,7 +308,8 @@ Status Ssrt::init() {
                         {"ssrt_shade_tiled", 0, 1, &shade_tiled_}};
   for (const auto& v : shade_variants) {
     gpu::ComputePipelineDesc d{v.name, *shade_spv,
-                               {{img}, {img}, {img}, {img}, {img}, {img}, {img}, {img}, {ssbo}},
+                               {{img}, {img}, {ssbo}, {img}, {img}, {img}, {img}, {img}, {ssbo},
+                                {ssbo}, {ubo}},
                                sizeof(ShadePush), {v.pass_through, v.tiled}};
     auto sp = gpu::create_compute_pipeline(ctx, d);
     if (!sp) return sp.error();
@@ -315,11 +348,13 @@ Status Ssrt::write_geometry_constants() {
   fc.internal_output_size.y = (fc.internal_output_size.y + st - 1) / st;
   std::memcpy(graph.mapped(geo_constants_, graph.slot()), &fc, sizeof(fc));
   for (gpu::ImageHandle h : geo_images_) MRGI_TRY(graph.set_extent_divisor(h, geometry_step_));
+  for (gpu::ImageHandle h : {occ_position_, occ_attrs_})
+    MRGI_TRY(graph.set_extent_divisor(h, occluder_step_));
   return ok_status();
 }
 
-Status Ssrt::record_geometry(const FrameInfo& info, const QualityLevel& level,
-                             std::vector<std::string>& skipped) {
+Status Ssrt::record_real_geometry(const FrameInfo& info, const QualityLevel& level,
+                                  std::vector<std::string>& skipped) {
   MRGI_TRY(write_geometry_constants());
   if (!volume_center_) {
     // The workspace cube sits on the virtual objects (where occluders matter); a scene without
@@ -495,10 +530,11 @@ void Ssrt::add_shade_pass(const char* name, ShadeMode mode, bool run_transfer) {
         // so the bindings are always in the layout the graph gave them.
         b.read(coarse_, gpu::Access::StorageRead);
         b.read(upsampled_, gpu::Access::StorageRead);
-        for (gpu::ImageHandle h : {geo_position_, r.real_albedo, r.virtual_position,
-                                   r.virtual_albedo})
+        for (gpu::ImageHandle h : {geo_position_, r.virtual_position, r.virtual_albedo})
           b.read(h, gpu::Access::StorageRead);
-        b.read(tile_list_, gpu::Access::StorageRead);
+        for (gpu::BufferHandle h : {r.color_upload, r.depth_upload, tile_list_})
+          b.read(h, gpu::Access::StorageRead);
+        b.read(r.frame_constants, gpu::Access::UniformRead);
         // The tiled pass rewrites some tiles of what the pass-through one wrote.
         const gpu::Access out = mode == ShadeMode::Tiled ? gpu::Access::StorageReadWrite
                                                          : gpu::Access::StorageWrite;
@@ -516,13 +552,15 @@ void Ssrt::add_shade_pass(const char* name, ShadeMode mode, bool run_transfer) {
         gpu::DescriptorPush()
             .storage_image(0, pass.view(coarse_))
             .storage_image(1, pass.view(geo_position_))
-            .storage_image(2, pass.view(r.real_albedo))
+            .storage_buffer(2, pass.buffer(r.color_upload))
             .storage_image(3, pass.view(r.virtual_position))
             .storage_image(4, pass.view(r.virtual_albedo))
             .storage_image(5, pass.view(r.lit_rv))
             .storage_image(6, pass.view(r.lit_r))
             .storage_image(7, pass.view(upsampled_))
             .storage_buffer(8, pass.buffer(tile_list_))
+            .storage_buffer(9, pass.buffer(r.depth_upload))
+            .uniform_buffer(10, pass.buffer(r.frame_constants))
             .push(ctx, cmd, pipe);
         ShadePush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), run_transfer ? 0 : 1),
                      glm::ivec4(int(used_.width), int(used_.height), int(geometry_step_), 0),
@@ -537,7 +575,7 @@ void Ssrt::add_shade_pass(const char* name, ShadeMode mode, bool run_transfer) {
       });
 }
 
-Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
+Status Ssrt::record_geometry(const FrameInfo& info, std::vector<std::string>& skipped) {
   if (info.level < 0 || info.level >= int(ladder_.size()))
     return fail(ErrorKind::BadUsage, "ssrt: level " + std::to_string(info.level) + " outside 0.." +
                                          std::to_string(ladder_.size() - 1));
@@ -547,6 +585,7 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   directions_ = uint32_t(knob(level, "directions"));
   bands_ = uint32_t(knob(level, "sh_bands"));
   geometry_step_ = uint32_t(knob(level, "geometry_step"));
+  occluder_step_ = uint32_t(knob(level, "occluder_step"));
   gpu::FrameGraph& graph = *shared_.graph;
   used_ = graph.extent(shared_.lit_r);
   grid_ = glm::uvec2((used_.width + step_ - 1) / step_, (used_.height + step_ - 1) / step_);
@@ -555,7 +594,18 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   deferred_notes_.clear();
   consume_readback(graph.slot(), skipped);
   write_light();
-  MRGI_TRY(record_geometry(info, level, skipped));
+  MRGI_TRY(record_real_geometry(info, level, skipped));
+  geometry_frame_ = info.frame_index;
+  geometry_frame_valid_ = true;
+  return ok_status();
+}
+
+Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
+  // Callers that drive the technique directly (tests, tools) may skip record_geometry().
+  if (geometry_frame_ != info.frame_index || !geometry_frame_valid_)
+    MRGI_TRY(record_geometry(info, skipped));
+  geometry_frame_valid_ = false;
+  gpu::FrameGraph& graph = *shared_.graph;
 
   const bool run_transfer = info.virtual_objects_present && influence_in_view(influence_cells_);
   if (!run_transfer) {
@@ -567,14 +617,45 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
       skipped.push_back(std::string(pass) + ": " + why);
   } else {
     graph.add_pass(
+        "ssrt_occluders", gpu::PassKind::Compute,
+        [this](gpu::PassBuilder& b) {
+          const SharedResources& r = shared_;
+          b.read(r.frame_constants, gpu::Access::UniformRead);
+          b.read(r.color_upload, gpu::Access::StorageRead);
+          b.read(r.depth_upload, gpu::Access::StorageRead);
+          for (gpu::ImageHandle h : {r.virtual_position, r.virtual_normal, r.virtual_albedo})
+            b.read(h, gpu::Access::StorageRead);
+          b.write(occ_position_, gpu::Access::StorageWrite);
+          b.write(occ_attrs_, gpu::Access::StorageWrite);
+        },
+        [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
+          const SharedResources& r = shared_;
+          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, occluders_->pipeline);
+          gpu::DescriptorPush()
+              .uniform_buffer(0, pass.buffer(r.frame_constants))
+              .storage_buffer(1, pass.buffer(r.color_upload))
+              .storage_buffer(2, pass.buffer(r.depth_upload))
+              .storage_image(3, pass.view(r.virtual_position))
+              .storage_image(4, pass.view(r.virtual_normal))
+              .storage_image(5, pass.view(r.virtual_albedo))
+              .storage_image(6, pass.view(occ_position_))
+              .storage_image(7, pass.view(occ_attrs_))
+              .push(pass.context(), cmd, *occluders_);
+          const glm::ivec4 pc(int(occluder_step_), int(used_.width), int(used_.height), 0);
+          const VkExtent2D e = pass.extent(occ_position_);
+          gpu::dispatch_2d(cmd, *occluders_, &pc, sizeof(pc), e.width, e.height);
+        });
+    graph.add_pass(
         "ssrt_transfer", gpu::PassKind::Compute,
         [this](gpu::PassBuilder& b) {
           const SharedResources& r = shared_;
           b.read(r.frame_constants, gpu::Access::UniformRead);
           b.read(light_, gpu::Access::UniformRead);
           b.read(samples_, gpu::Access::StorageRead);
-          for (gpu::ImageHandle h : {geo_position_, geo_normal_, r.real_albedo,
-                                     r.virtual_position, r.virtual_normal, r.virtual_albedo,
+          b.read(r.color_upload, gpu::Access::StorageRead);
+          b.read(r.depth_upload, gpu::Access::StorageRead);
+          for (gpu::ImageHandle h : {geo_position_, geo_normal_, r.virtual_position,
+                                     r.virtual_normal, occ_position_, occ_attrs_,
                                      volume_->aux_position()})
             b.read(h, gpu::Access::StorageRead);
           b.read(volume_->aux_views(), gpu::Access::UniformRead);
@@ -590,17 +671,19 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
               .storage_buffer(2, pass.buffer(samples_))
               .storage_image(3, pass.view(geo_position_))
               .storage_image(4, pass.view(geo_normal_))
-              .storage_image(5, pass.view(r.real_albedo))
+              .storage_buffer(5, pass.buffer(r.color_upload))
               .storage_image(6, pass.view(r.virtual_position))
               .storage_image(7, pass.view(r.virtual_normal))
-              .storage_image(8, pass.view(r.virtual_albedo))
+              .storage_image(8, pass.view(occ_position_))
               .storage_image(9, pass.view(coarse_))
               .storage_image(10, pass.view(volume_->aux_position()))
-              .uniform_buffer(11, pass.buffer(volume_->aux_views()));
+              .uniform_buffer(11, pass.buffer(volume_->aux_views()))
+              .storage_image(12, pass.view(occ_attrs_))
+              .storage_buffer(13, pass.buffer(r.depth_upload));
           const float sample_area = 3.14159265f * kRadiusM * kRadiusM / float(directions_);
           TransferPush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), int(directions_)),
                           glm::ivec4(int(sample_base_[size_t(level_)]), int(bands_),
-                                     int(geometry_step_), 0),
+                                     int(geometry_step_), int(occluder_step_)),
                           glm::vec4(kRadiusM, chi_[size_t(level_)], kNormalOffsetM, kMinSenderDistM),
                           glm::vec4(sample_area, kSaturation, kDepthBias, kRangeM),
                           influence_cells_,
@@ -634,7 +717,9 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
         "ssrt_light_reduce", gpu::PassKind::Compute,
         [this](gpu::PassBuilder& b) {
           b.read(coarse_, gpu::Access::StorageRead);
-          b.read(shared_.real_albedo, gpu::Access::StorageRead);
+          b.read(shared_.frame_constants, gpu::Access::UniformRead);
+          b.read(shared_.color_upload, gpu::Access::StorageRead);
+          b.read(shared_.depth_upload, gpu::Access::StorageRead);
           b.write(partials_, gpu::Access::StorageWrite);
         },
         [this, strips_x, partial_count](VkCommandBuffer cmd, gpu::PassContext& pass) {
@@ -642,7 +727,9 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
           vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, reduce_->pipeline);
           gpu::DescriptorPush()
               .storage_image(0, pass.view(coarse_))
-              .storage_image(1, pass.view(shared_.real_albedo))
+              .storage_buffer(1, pass.buffer(shared_.color_upload))
+              .uniform_buffer(3, pass.buffer(shared_.frame_constants))
+              .storage_buffer(4, pass.buffer(shared_.depth_upload))
               .storage_buffer(2, pass.buffer(partials_))
               .push(ctx, cmd, *reduce_);
           ReducePush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), int(kStripCells)),
@@ -745,7 +832,8 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
 
 std::vector<QualityLevel> ssrt_ladder() {
   auto level = [](const char* name, double step, double n, double bands, double scale,
-                  double volume, double aux, double final_filter, double geometry_step) {
+                  double volume, double aux, double final_filter, double geometry_step,
+                  double occluder_step) {
     QualityLevel l;
     l.name = name;
     l.internal_scale = float(scale);
@@ -758,7 +846,10 @@ std::vector<QualityLevel> ssrt_ladder() {
                {"final_filter", final_filter, "1 = the third median pass (eq. 5) on, 0 = off"},
                {"geometry_step", geometry_step,
                 "internal pixels per texel side of the volume ray cast, depth filters and their "
-                "G-buffer"}};
+                "G-buffer"},
+               {"occluder_step", occluder_step,
+                "internal pixels per texel side of the occluder G-buffer the transfer's samples "
+                "read (virtual surface, albedos; occluders.comp)"}};
     return l;
   };
   // Full is the paper's desktop set-up (256^3, eq. 5 pass on); fast its mobile one (64^3, eq. 5
@@ -766,10 +857,10 @@ std::vector<QualityLevel> ssrt_ladder() {
   // (ray cast, filters, G-buffer) once per transfer cell: the transfer reads its receivers at
   // the cell centres, so a finer geometry only sharpens occluder lookups, and at 640x480 on
   // lavapipe it cost 69 ms of the fast level's 219 (ray cast) plus 18 ms (filters).
-  return {level("full", 1, 64, 4, 1.0, 256, 256, 1, 1),
-          level("half", 2, 32, 4, 1.0, 256, 256, 1, 1),
-          level("fast", 4, 32, 4, 1.0, 64, 64, 0, 4),
-          level("fastest", 4, 16, 4, 0.5, 64, 64, 0, 2)};
+  return {level("full", 1, 64, 4, 1.0, 256, 256, 1, 1, 1),
+          level("half", 2, 32, 4, 1.0, 256, 256, 1, 1, 1),
+          level("fast", 4, 32, 4, 1.0, 64, 64, 0, 4, 4),
+          level("fastest", 4, 16, 4, 0.5, 64, 64, 0, 2, 1)};
 }
 
 Expected<std::unique_ptr<Technique>> create_ssrt(const SharedResources& shared) {
