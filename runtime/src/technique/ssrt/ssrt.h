@@ -1,7 +1,10 @@
 // The `ssrt` technique: image-space radiance transfer with probeless SH light estimation
 // ("Image-Space Illumination for Augmented Reality in Dynamic Environments", Sec. 5).
 //
-// Per frame (passes in order):
+// Per frame (passes in order, after the geometry stage below and the virtual G-buffer):
+//   ssrt_occluders           what the transfer's samples read where they land (virtual
+//                            surface, real and virtual albedo) gathered once per texel of the
+//                            occluder grid (knob occluder_step; occluders.comp says why)
 //   ssrt_transfer            SSDO visibility of N jittered directions (2x2 sets) per cell of the
 //                            sub-sampled grid, projected to SH (eq. 6-9), real and real+virtual
 //                            in one pass, with one-bounce indirect light (eq. 10-12); cells
@@ -25,15 +28,18 @@
 // range check), and pixels outside it are written as pass-through.
 //
 // Quality ladder (best first), knobs with units:
-//   level  name     subsample  directions  sh_bands  internal_scale  geometry_step
-//   0      full     1          64          4         1.0             1  (paper "Ours")
-//   1      half     2          32          4         1.0             1
-//   2      fast     4          32          4         1.0             4  (paper "OursFast": 4x4)
-//   3      fastest  4          16          4         0.5             2
+//   level  name     subsample  directions  sh_bands  internal_scale  geometry_step  occluder_step
+//   0      full     1          64          4         1.0             1              1 ("Ours")
+//   1      half     2          32          4         1.0             1              1
+//   2      fast     4          32          4         1.0             4              4 ("OursFast")
+//   3      fastest  4          16          4         0.5             2              1
 // subsample: cells are step x step pixels; directions: N per jitter set; sh_bands: SH bands of
 // the transfer and of the estimated light; geometry_step: internal pixels per texel side of the
 // volume ray cast, the depth filters (windows shrunk to match) and their G-buffer, which the
-// transfer reads at its cell centres (occluder lookups through the texel's tangent plane).
+// transfer reads at its cell centres (occluder lookups through the texel's tangent plane);
+// occluder_step: internal pixels per texel side of the occluder G-buffer (at 320x240 internal
+// the fastest level keeps it per pixel: 2x2 texels lost thin virtual parts' contact shadows in
+// the 64x48 unit test, and its full-resolution images are small enough to stay in cache).
 //
 // Deviations from the paper, each explained where it is implemented: chi of eq. 9 read as a
 // one-minus-cosine threshold and G of eq. 12 on the sender's normal (ssrt_math.h); F of eq. 11
@@ -49,8 +55,10 @@
 // top, dominant light); ssrt::DepthFilterGpu (depth_filter_gpu.h) runs D', D'' and (full/half)
 // D''' and writes the G-buffer the transfer and shade read. A sample the view finds free is
 // also tested against the aux layers (visibility only: an aux occluder sends no indirect light,
-// its colour and normal are unknown). The runtime's recon G-buffer is used only for the camera
-// colour (I_c) and the virtual objects' depth test.
+// its colour and normal are unknown). The runtime's reconstruction (recon/) does not run for
+// ssrt: the camera colour (I_c) is read from the upload where it is used, and the virtual
+// objects' depth test reads this G-buffer (Technique::occlusion_geometry; at geometry step > 1
+// through each texel's tangent plane).
 //
 // Light estimate on the suite's environment-lit scene (perf/suite/env_fisheye, 8 frames, truth:
 // band 1 of each frame's environment image; test GoldenSsrt): direction error median / worst
