@@ -301,16 +301,16 @@ Status Ssrt::init() {
   if (!shade_spv) return shade_spv.error();
   const struct {
     const char* name;
-    uint32_t pass_through, tiled;
+    uint32_t pass_through, tiled, local_x, local_y;
     gpu::PipelineHandle* handle;
-  } shade_variants[] = {{"ssrt_shade", 0, 0, &shade_},
-                        {"ssrt_shade_pass_through", 1, 0, &shade_pass_},
-                        {"ssrt_shade_tiled", 0, 1, &shade_tiled_}};
+  } shade_variants[] = {{"ssrt_shade", 0, 0, 8, 8, &shade_},
+                        {"ssrt_shade_pass_through", 1, 0, 8, 8, &shade_pass_},
+                        {"ssrt_shade_tiled", 0, 1, 8, 1, &shade_tiled_}};
   for (const auto& v : shade_variants) {
     gpu::ComputePipelineDesc d{v.name, *shade_spv,
                                {{img}, {img}, {ssbo}, {img}, {img}, {img}, {img}, {img}, {ssbo},
                                 {ssbo}, {ubo}},
-                               sizeof(ShadePush), {v.pass_through, v.tiled}};
+                               sizeof(ShadePush), {v.pass_through, v.tiled, v.local_x, v.local_y}};
     auto sp = gpu::create_compute_pipeline(ctx, d);
     if (!sp) return sp.error();
     *v.handle = gpu::PipelineHandle(ctx, std::move(*sp));
