@@ -6,6 +6,7 @@ find_package(PkgConfig REQUIRED)
 find_package(Eigen3 3.4 REQUIRED NO_MODULE)
 find_package(nlohmann_json 3.10 REQUIRED)
 find_package(TinyGLTF REQUIRED)
+find_package(meshoptimizer REQUIRED)
 # Debian's package exports TinyGLTF::TinyGLTF (a shared library that holds the implementation);
 # the project links it under the upstream-style name.
 if(TARGET TinyGLTF::TinyGLTF AND NOT TARGET tinygltf::tinygltf)

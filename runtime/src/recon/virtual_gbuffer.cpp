@@ -1,5 +1,8 @@
 #include "recon/virtual_gbuffer.h"
 
+#include <cstring>
+
+#include "common/frame_constants.glsl"
 #include "gpu/shaders.h"
 
 namespace mrgi::recon {
@@ -86,9 +89,15 @@ Expected<VirtualGBuffer> VirtualGBuffer::create(gpu::Context& context, gpu::Fram
 }
 
 void VirtualGBuffer::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_constants,
-                            const technique::RealGeometry& real) {
+                            const technique::RealGeometry& real, float mesh_error_px) {
   frame_constants_ = frame_constants;
   real_ = real;
+  // Level of detail from this frame's camera (the constants the runtime just wrote).
+  shader::FrameConstants fc;
+  std::memcpy(&fc, graph.mapped(frame_constants, graph.slot()), sizeof(fc));
+  lod_.camera_world = glm::vec3(fc.camera_world);
+  lod_.focal_px = fc.internal_k.x;
+  lod_.max_error_px = mesh_error_px;
   graph.add_pass(
       "virtual_gbuffer", gpu::PassKind::Graphics,
       [this](gpu::PassBuilder& b) {
@@ -149,7 +158,7 @@ void VirtualGBuffer::draw(VkCommandBuffer cmd, gpu::PassContext& pass) {
     const int32_t step = int32_t(real_.step);
     vkCmdPushConstants(cmd, pipeline_->layout, pipeline_->stages, sizeof(int32_t), sizeof(step),
                        &step);
-    scene_->virtual_objects.draw(cmd, pass, &*pipeline_, &*double_sided_pipeline_);
+    scene_->virtual_objects.draw(cmd, pass, &*pipeline_, &*double_sided_pipeline_, &lod_);
   }
   vkCmdEndRendering(cmd);
 }

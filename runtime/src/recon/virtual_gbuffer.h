@@ -18,8 +18,10 @@ class VirtualGBuffer {
   static Expected<VirtualGBuffer> create(gpu::Context& context, gpu::FrameGraph& graph,
                                          const technique::SceneGpu& scene);
   // Adds the pass "virtual_gbuffer" (always: with no object it clears the mask).
+  // Mesh ranges are drawn at the coarsest level of detail within `mesh_error_px` projected
+  // internal pixels (QualityLevel::mesh_error_px; 0 = full detail).
   void record(gpu::FrameGraph& graph, gpu::BufferHandle frame_constants,
-              const technique::RealGeometry& real);
+              const technique::RealGeometry& real, float mesh_error_px);
 
   gpu::ImageHandle position() const { return position_; }
   gpu::ImageHandle normal() const { return normal_; }
@@ -31,6 +33,10 @@ class VirtualGBuffer {
   const technique::SceneGpu* scene_ = nullptr;
   gpu::BufferHandle frame_constants_;
   technique::RealGeometry real_;
+  // Why levels of detail: lavapipe sets triangles up on one thread (desk_spot's 16k-triangle
+  // bunny, a few pixels per triangle at 640x480, cost 8.5 ms of this pass's 10; a quarter of
+  // the triangles 1.7 ms).
+  technique::LodView lod_;
   gpu::ImageHandle position_, normal_, albedo_, depth_;
   gpu::PipelineHandle pipeline_, double_sided_pipeline_;  // back faces culled; both sides
   VkImageLayout color_layout_ = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;

@@ -446,7 +446,8 @@ Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, 
                                            ": skips the reconstruction but gives no real geometry "
                                            "for the virtual objects' depth test");
     virtual_gbuffer_->record(*graph_, frame_constants_,
-                             own ? *own : technique::RealGeometry{recon_->position(), recon_->position(), 1});
+                             own ? *own : technique::RealGeometry{recon_->position(), recon_->position(), 1},
+                             level.mesh_error_px);
     MRGI_TRY(technique_->record(info, rec.skipped));
   } else {
     rec.skipped.push_back(has_objects ? "technique: no virtual object or its shadow in view"

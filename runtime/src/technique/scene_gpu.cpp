@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstring>
 
+#include <meshoptimizer.h>
+
 #define STB_IMAGE_RESIZE_STATIC
 #define STB_IMAGE_RESIZE_IMPLEMENTATION
 #include <stb/stb_image_resize.h>
@@ -20,8 +22,38 @@ struct MeshData {
   glm::vec3 lo{1e30f}, hi{-1e30f};
 };
 
-// Appends a model's primitives; material indices are offset by `material_base`.
-void append_model(const Model& model, int material_base, MeshData& out) {
+// Levels of detail per virtual primitive: each halves the previous one's triangle count
+// (simplified from the original, not from the previous level), down to kMinLodTriangles, and
+// stops where meshoptimizer cannot reach 80 % of the previous count (the mesh is as coarse as
+// its topology allows) or the error would exceed kMaxLodRelativeError of the mesh's extent.
+constexpr int kMaxLods = 6;
+constexpr size_t kMinLodTriangles = 64;
+constexpr float kMaxLodRelativeError = 0.05f;
+
+void append_lods(const MeshPrimitive& prim, DrawRange& range, std::vector<uint32_t>& indices) {
+  range.lods.push_back({range.first_index, range.index_count, 0.0f});
+  const size_t n = prim.indices.size();
+  const float* positions = &prim.positions[0].x;
+  const float scale = meshopt_simplifyScale(positions, prim.positions.size(), sizeof(glm::vec3));
+  std::vector<uint32_t> lod(n);
+  size_t previous = n;
+  for (int k = 1; k < kMaxLods; ++k) {
+    const size_t target = previous / 6 * 3;  // half the triangles
+    if (target < 3 * kMinLodTriangles) break;
+    float error = 0.0f;
+    const size_t m = meshopt_simplify(lod.data(), prim.indices.data(), n, positions,
+                                      prim.positions.size(), sizeof(glm::vec3), target,
+                                      kMaxLodRelativeError, 0, &error);
+    if (m < 3 || m > previous * 8 / 10) break;
+    range.lods.push_back({uint32_t(indices.size()), uint32_t(m), error * scale});
+    indices.insert(indices.end(), lod.begin(), lod.begin() + std::ptrdiff_t(m));
+    previous = m;
+  }
+}
+
+// Appends a model's primitives; material indices are offset by `material_base`. With `lods`,
+// each primitive also gets its levels of detail (append_lods).
+void append_model(const Model& model, int material_base, MeshData& out, bool lods) {
   for (const MeshPrimitive& prim : model.primitives) {
     if (prim.indices.empty() || prim.positions.empty()) continue;
     DrawRange range;
@@ -31,6 +63,8 @@ void append_model(const Model& model, int material_base, MeshData& out) {
     range.material = prim.material < 0 ? 0 : material_base + prim.material;
     range.double_sided = prim.material >= 0 && size_t(prim.material) < model.materials.size() &&
                          model.materials[size_t(prim.material)].double_sided;
+    range.bounds_min = glm::vec3(1e30f);
+    range.bounds_max = glm::vec3(-1e30f);
     for (size_t i = 0; i < prim.positions.size(); ++i) {
       GpuVertex v;
       v.position = prim.positions[i];
@@ -38,9 +72,12 @@ void append_model(const Model& model, int material_base, MeshData& out) {
       v.uv = i < prim.uvs.size() ? prim.uvs[i] : glm::vec2(0.0f);
       out.lo = glm::min(out.lo, v.position);
       out.hi = glm::max(out.hi, v.position);
+      range.bounds_min = glm::min(range.bounds_min, v.position);
+      range.bounds_max = glm::max(range.bounds_max, v.position);
       out.vertices.push_back(v);
     }
     out.indices.insert(out.indices.end(), prim.indices.begin(), prim.indices.end());
+    if (lods) append_lods(prim, range, out.indices);
     out.draws.push_back(range);
   }
 }
@@ -75,9 +112,23 @@ Expected<MeshSet> upload_meshes(gpu::Context& ctx, gpu::FrameGraph& graph, const
 
 }  // namespace
 
+size_t MeshSet::select_lod(const DrawRange& range, const LodView& view) {
+  // Nearest point of the range's bounds: its error can be seen no larger anywhere.
+  const glm::vec3 nearest = glm::clamp(view.camera_world, range.bounds_min, range.bounds_max);
+  const float distance = glm::length(nearest - view.camera_world);
+  size_t chosen = 0;
+  if (!(view.max_error_px > 0.0f)) return chosen;  // full detail asked for
+  for (size_t i = 1; i < range.lods.size(); ++i) {
+    const float px = distance > 0.0f ? range.lods[i].error_m * view.focal_px / distance : 1e30f;
+    if (!(px <= view.max_error_px)) break;
+    chosen = i;
+  }
+  return chosen;
+}
+
 void MeshSet::draw(VkCommandBuffer cmd, const gpu::PassContext& pass,
                    const gpu::Pipeline* material_pipeline,
-                   const gpu::Pipeline* double_sided_pipeline) const {
+                   const gpu::Pipeline* double_sided_pipeline, const LodView* lod) const {
   if (draws.empty()) return;
   VkBuffer vb = pass.buffer(vertices);
   VkDeviceSize offset = 0;
@@ -93,7 +144,12 @@ void MeshSet::draw(VkCommandBuffer cmd, const gpu::PassContext& pass,
     if (material_pipeline)
       vkCmdPushConstants(cmd, material_pipeline->layout, material_pipeline->stages, 0,
                          sizeof(int32_t), &d.material);
-    vkCmdDrawIndexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0);
+    if (lod && !d.lods.empty()) {
+      const DrawRange::Lod& l = d.lods[select_lod(d, *lod)];
+      vkCmdDrawIndexed(cmd, l.index_count, 1, l.first_index, d.vertex_offset, 0);
+    } else {
+      vkCmdDrawIndexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0);
+    }
   }
 }
 
@@ -124,12 +180,12 @@ Expected<std::unique_ptr<SceneGpu>> SceneGpu::create(gpu::Context& context, gpu:
                            glm::vec4(mat.metallic, mat.roughness, layer, 0.0f)});
     }
     for (const Texture& t : m.textures) textures.push_back(&t.image);
-    append_model(m, material_base, virtual_data);
+    append_model(m, material_base, virtual_data, true);
   }
   for (const RealGeometryDesc& proxy : scene.real_geometry) {
     auto model = load_gltf(proxy.gltf, proxy.placement);
     if (!model) return model.error();
-    append_model(*model, 0, proxy_data);
+    append_model(*model, 0, proxy_data, false);
   }
 
   auto vset = upload_meshes(context, graph, virtual_data, "virtual_objects");

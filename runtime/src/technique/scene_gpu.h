@@ -34,6 +34,26 @@ struct DrawRange {
   // glTF doubleSided: both faces are surfaces; otherwise back faces are culled (glTF 2.0
   // 3.9.4), which on lavapipe also halves the triangles its single-threaded setup handles.
   bool double_sided = false;
+  // Levels of detail, finest first: lods[0] is the range itself (error 0), each later one a
+  // simplified index list of the same vertices, stored after the original indices in the same
+  // buffer, with its geometric error (metres: meshoptimizer's estimate of the largest distance
+  // of the simplified surface from the original). Virtual set only; empty for proxies.
+  struct Lod {
+    uint32_t first_index = 0;
+    uint32_t index_count = 0;
+    float error_m = 0.0f;
+  };
+  std::vector<Lod> lods;
+  glm::vec3 bounds_min{0.0f}, bounds_max{0.0f};  // world AABB of the range's vertices
+};
+
+// What a draw needs to choose a level of detail: the camera centre (world) and the focal
+// length in pixels of the image drawn; a range is drawn with the coarsest level whose error,
+// projected at the range's nearest distance from the camera, stays within `max_error_px`.
+struct LodView {
+  glm::vec3 camera_world{0.0f};
+  float focal_px = 0.0f;
+  float max_error_px = 0.5f;
 };
 
 struct MeshSet {
@@ -46,9 +66,13 @@ struct MeshSet {
   // index is pushed as a 4-byte push constant at offset 0 before each draw. With
   // `double_sided_pipeline` (same layout, no culling) the ranges of double-sided materials are
   // drawn with it and the others with `material_pipeline`, each bound here when it changes.
+  // With `lod` each range is drawn at the level select_lod() picks (else at full detail).
   void draw(VkCommandBuffer cmd, const gpu::PassContext& pass,
             const gpu::Pipeline* material_pipeline,
-            const gpu::Pipeline* double_sided_pipeline = nullptr) const;
+            const gpu::Pipeline* double_sided_pipeline = nullptr,
+            const LodView* lod = nullptr) const;
+  // The level of detail of `range` for `view` (index into range.lods; 0 without levels).
+  static size_t select_lod(const DrawRange& range, const LodView& view);
 };
 
 // Base-colour textures are resampled to one square size (the largest texture side, at most

@@ -41,6 +41,12 @@ struct QualityLevel {
   // Fraction of the output resolution the G-buffers and solutions use at this level, (0, 1].
   // Every technique has it: the runtime applies it as the frame graph's render scale.
   float internal_scale = 1.0f;
+  // Largest projected geometric error (internal pixels) of the level of detail the virtual
+  // G-buffer draws each mesh range at (scene_gpu.h DrawRange::lods); 0 = full detail. Applied
+  // by the runtime. Not free in accuracy: meshoptimizer 0.18 simplifies by position only, so
+  // the coarser triangles interpolate the normals over larger areas (baseline's 160x120 golden
+  // capture: virtual RDE 0.240 -> 0.249 at 0.1 px, 0.314 at 0.5 px); only fast levels use it.
+  float mesh_error_px = 0.0f;
 };
 
 // The shared start-up inputs of a technique (owned by the runtime, alive as long as it).
