@@ -1,8 +1,8 @@
 #version 460
 // ssrt_tsdf_raycast: the volume's view of this frame's camera at the internal resolution (the
-// paper's G_v: D_v and N_v, Fig. 2c). Per pixel the camera ray is marched through the TSDF to its
-// first front-facing zero crossing (tsdf_march.glsl); D_v = that point's depth along the camera
-// z in metres, N_v = the TSDF gradient there (world, unit, w = 1). No crossing: 0 and (0, 0, 0, 0).
+// paper's G_v, Fig. 2c: D_v here, N_v in tsdf_normals.comp). Per pixel the camera ray is marched
+// through the TSDF to its first front-facing zero crossing (tsdf_march.glsl); D_v = that
+// point's depth along the camera z in metres. No crossing: 0.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
 #include "common/frame_constants.glsl"
@@ -13,7 +13,6 @@ layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
 layout(std140, set = 0, binding = 1) uniform VolumeUbo { SsrtVolumeParams volume; };
 layout(std430, set = 0, binding = 2) readonly buffer Voxels { uint voxels[]; };
 layout(set = 0, binding = 3, r32f) writeonly uniform image2D depth_volume;
-layout(set = 0, binding = 4, rgba16f) writeonly uniform image2D normal_volume;
 
 #include "ssrt/tsdf_march.glsl"
 
@@ -25,14 +24,7 @@ void main() {
   vec3 d_unnormalised = mat3(volume.camera_to_world) * ray_camera;
   float len = length(d_unnormalised);
   vec3 d = d_unnormalised / len;
-  float depth = 0.0f;
-  vec4 normal = vec4(0.0f);
   float t = tsdf_march(o, d, 0.0f);
-  if (t > 0.0f) {
-    depth = t / len;  // the ray has camera z = 1 per `len` metres
-    vec3 n;
-    if (tsdf_normal(o + t * d, n)) normal = vec4(n, 1.0f);
-  }
+  float depth = t > 0.0f ? t / len : 0.0f;  // the ray has camera z = 1 per `len` metres
   imageStore(depth_volume, pixel, vec4(depth, 0.0f, 0.0f, 0.0f));
-  imageStore(normal_volume, pixel, normal);
 }

@@ -116,9 +116,12 @@ Expected<Volume> Volume::create(gpu::Context& ctx, gpu::FrameGraph& graph,
   auto p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_fuse.comp", {{ubo}, {ssbo}, {ssbo}});
   if (!p) return p.error();
   v.fuse_ = std::move(*p);
-  p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_raycast.comp", {{ubo}, {ubo}, {ssbo}, {img}, {img}});
+  p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_raycast.comp", {{ubo}, {ubo}, {ssbo}, {img}});
   if (!p) return p.error();
   v.raycast_ = std::move(*p);
+  p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_normals.comp", {{ubo}, {ubo}, {ssbo}, {img}, {img}});
+  if (!p) return p.error();
+  v.normals_ = std::move(*p);
   p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_aux.comp", {{ubo}, {ubo}, {ssbo}, {img}});
   if (!p) return p.error();
   v.aux_ = std::move(*p);
@@ -331,7 +334,6 @@ void Volume::add_passes(const VolumeFrame& frame, bool clear, bool fuse, bool vi
         b.read(params_, gpu::Access::UniformRead);
         b.read(voxels_, gpu::Access::StorageRead);
         b.write(depth_volume_, gpu::Access::StorageWrite);
-        b.write(normal_volume_, gpu::Access::StorageWrite);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
         const gpu::Context& ctx = pass.context();
@@ -341,10 +343,32 @@ void Volume::add_passes(const VolumeFrame& frame, bool clear, bool fuse, bool vi
             .uniform_buffer(1, pass.buffer(params_))
             .storage_buffer(2, pass.buffer(voxels_))
             .storage_image(3, pass.view(depth_volume_))
-            .storage_image(4, pass.view(normal_volume_))
             .push(ctx, cmd, *raycast_);
         const VkExtent2D e = pass.extent(depth_volume_);
         gpu::dispatch_2d(cmd, *raycast_, nullptr, 0, e.width, e.height);
+      });
+  // Culled by the graph unless something reads N_v (tsdf_normals.comp says why).
+  graph.add_pass(
+      "ssrt_tsdf_normals", gpu::PassKind::Compute,
+      [this](gpu::PassBuilder& b) {
+        b.read(shared_.frame_constants, gpu::Access::UniformRead);
+        b.read(params_, gpu::Access::UniformRead);
+        b.read(voxels_, gpu::Access::StorageRead);
+        b.read(depth_volume_, gpu::Access::StorageRead);
+        b.write(normal_volume_, gpu::Access::StorageWrite);
+      },
+      [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
+        const gpu::Context& ctx = pass.context();
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, normals_->pipeline);
+        gpu::DescriptorPush()
+            .uniform_buffer(0, pass.buffer(shared_.frame_constants))
+            .uniform_buffer(1, pass.buffer(params_))
+            .storage_buffer(2, pass.buffer(voxels_))
+            .storage_image(3, pass.view(depth_volume_))
+            .storage_image(4, pass.view(normal_volume_))
+            .push(ctx, cmd, *normals_);
+        const VkExtent2D e = pass.extent(normal_volume_);
+        gpu::dispatch_2d(cmd, *normals_, nullptr, 0, e.width, e.height);
       });
   graph.add_pass(
       "ssrt_tsdf_aux", gpu::PassKind::Compute,

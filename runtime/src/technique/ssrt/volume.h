@@ -67,7 +67,8 @@ class Volume {
   static Expected<Volume> create(gpu::Context& ctx, gpu::FrameGraph& graph,
                                  const technique::SharedResources& shared,
                                  const VolumeSettings& s = {});
-  // Adds ssrt_tsdf_clear (resets only), ssrt_tsdf_fuse, ssrt_tsdf_raycast, ssrt_tsdf_aux, or
+  // Adds ssrt_tsdf_clear (resets only), ssrt_tsdf_fuse, ssrt_tsdf_raycast, ssrt_tsdf_normals
+  // (the graph culls it unless normal_volume() is read), ssrt_tsdf_aux, or
   // appends "<pass>: <reason>" to `skipped` for each left out. Errors (BadUsage) name the field.
   Status record(const VolumeFrame& frame, std::vector<std::string>& skipped);
   gpu::ImageHandle depth_volume() const { return depth_volume_; }    // R32F: D_v, camera z m, 0 none
@@ -94,7 +95,7 @@ class Volume {
   gpu::FrameGraph* graph_ = nullptr;
   gpu::BufferHandle voxels_, params_, aux_views_;
   gpu::ImageHandle depth_volume_, normal_volume_, aux_position_;
-  gpu::PipelineHandle fuse_, raycast_, aux_;
+  gpu::PipelineHandle fuse_, raycast_, normals_, aux_;
   // Host state of the skip tests (allocated at create).
   ImageU16 last_depth_;
   bool has_fused_ = false, last_depth_valid_ = false, fused_last_frame_ = false;
