@@ -1,5 +1,6 @@
 #include "compose/compose.h"
 
+#include <algorithm>
 #include <cstring>
 
 #include <glm/glm.hpp>
@@ -22,6 +23,14 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
   c.settings_ = settings;
   c.width_ = width;
   c.height_ = height;
+  c.same_size_as_camera_ = same_size_as_camera;
+  c.max_tiles_ = ((width + 7) / 8) * ((height + 7) / 8);
+  auto tiles = graph.create_buffer({"compose_tile_readback", 16 + VkDeviceSize(c.max_tiles_) * 4,
+                                    gpu::MemoryUsage::Readback, true},
+                                   VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  if (!tiles) return tiles.error();
+  c.tile_readback_ = *tiles;
+  c.slot_host_camera_.assign(graph.frames_in_flight(), 0);
   const VkDeviceSize bytes = VkDeviceSize(width) * height * 4;
   auto out = graph.create_buffer({"output_rgba8", bytes, gpu::MemoryUsage::Readback, true},
                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
@@ -66,7 +75,9 @@ void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
   const VkExtent2D used = graph.extent(in_.lit_r);
   tiled_ = !in_.camera_only && in_.tile_args.valid() && in_.tile_list.valid() &&
            used.width == width_ && used.height == height_;
-  if (tiled_) {
+  const bool host_camera = tiled_ && same_size_as_camera_;
+  slot_host_camera_[graph.slot()] = host_camera ? 1 : 0;
+  if (tiled_ && !host_camera) {
     // The camera frame everywhere, then the composite over the technique's tiles.
     graph.add_pass(
         "compose_camera", gpu::PassKind::Compute,
@@ -96,13 +107,29 @@ void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
         } else {
           b.read(no_tiles_, gpu::Access::StorageRead);
         }
-        const gpu::Access out = tiled_ ? gpu::Access::StorageReadWrite : gpu::Access::StorageWrite;
+        const gpu::Access out = tiled_ && !same_size_as_camera_ ? gpu::Access::StorageReadWrite
+                                                                 : gpu::Access::StorageWrite;
         b.write(output_, out);
         b.write(mask_, out);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) { dispatch(cmd, pass, tiled_); });
   graph.mark_output(output_);
   graph.mark_output(mask_);
+  if (!host_camera) return;
+  graph.add_pass(
+      "compose_tile_readback", gpu::PassKind::Transfer,
+      [this](gpu::PassBuilder& b) {
+        b.read(in_.tile_args, gpu::Access::TransferSrc);
+        b.read(in_.tile_list, gpu::Access::TransferSrc);
+        b.write(tile_readback_, gpu::Access::TransferDst);
+      },
+      [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
+        const VkBufferCopy args{0, 0, 16};
+        vkCmdCopyBuffer(cmd, pass.buffer(in_.tile_args), pass.buffer(tile_readback_), 1, &args);
+        const VkBufferCopy list{0, 16, VkDeviceSize(max_tiles_) * 4};
+        vkCmdCopyBuffer(cmd, pass.buffer(in_.tile_list), pass.buffer(tile_readback_), 1, &list);
+      });
+  graph.mark_output(tile_readback_);
 }
 
 // tiled_pass: the composite over the listed tiles; otherwise the camera copy of a tiled frame
@@ -143,10 +170,40 @@ Status Compose::read(const gpu::FrameGraph& graph, uint32_t slot, ImageRGBA8& im
   MRGI_TRY(graph.context().invalidate(mb));
   image = ImageRGBA8(int(width_), int(height_));
   mask = Image<uint8_t, 1>(int(width_), int(height_));
-  // Packed with packUnorm4x8 (r in the low byte): on a little-endian host the bytes are RGBA.
-  std::memcpy(image.data.data(), graph.mapped(output_, slot), image.data.size());
+  const uint8_t* out = static_cast<const uint8_t*>(graph.mapped(output_, slot));
   const uint32_t* m = static_cast<const uint32_t*>(graph.mapped(mask_, slot));
-  for (size_t i = 0; i < mask.data.size(); ++i) mask.data[i] = m[i] != 0 ? 255 : 0;
+  if (!slot_host_camera_[slot]) {
+    // Packed with packUnorm4x8 (r in the low byte): on a little-endian host the bytes are RGBA.
+    std::memcpy(image.data.data(), out, image.data.size());
+    for (size_t i = 0; i < mask.data.size(); ++i) mask.data[i] = m[i] != 0 ? 255 : 0;
+    return ok_status();
+  }
+  // The camera frame (this slot's upload: RGB8 at the output size), then the composed tiles.
+  const gpu::GpuBuffer& tb = graph.gpu_buffer(tile_readback_, slot);
+  MRGI_TRY(graph.context().invalidate(tb));
+  const auto* rgb = static_cast<const uint8_t*>(graph.mapped(in_.color_upload, slot));
+  uint8_t* px = image.data.data();
+  const size_t n = size_t(width_) * height_;
+  for (size_t i = 0; i < n; ++i) {
+    px[4 * i + 0] = rgb[3 * i + 0];
+    px[4 * i + 1] = rgb[3 * i + 1];
+    px[4 * i + 2] = rgb[3 * i + 2];
+    px[4 * i + 3] = 255;
+  }
+  const auto* words = static_cast<const uint32_t*>(graph.mapped(tile_readback_, slot));
+  const uint32_t count = std::min(words[0], max_tiles_);
+  const uint32_t tiles_x = (width_ + 7) / 8;
+  for (uint32_t k = 0; k < count; ++k) {
+    const uint32_t t = words[4 + k];
+    const uint32_t x0 = (t % tiles_x) * 8, y0 = (t / tiles_x) * 8;
+    if (x0 >= width_ || y0 >= height_) continue;  // never written by the GPU either
+    const uint32_t w = std::min(8u, width_ - x0);
+    for (uint32_t y = y0; y < std::min(y0 + 8, height_); ++y) {
+      const size_t i = size_t(y) * width_ + x0;
+      std::memcpy(px + 4 * i, out + 4 * i, size_t(w) * 4);
+      for (uint32_t x = 0; x < w; ++x) mask.data[i + x] = m[i + x] != 0 ? 255 : 0;
+    }
+  }
   return ok_status();
 }
 

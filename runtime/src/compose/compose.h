@@ -2,8 +2,13 @@
 // adds their difference onto the camera frame per caustics-DIR eq. 1-2 (shaders/compose/
 // compose.comp says how and why in linear space), at the output resolution (the solutions are
 // upsampled bilinearly when the internal resolution is lower). Writes the RGBA8 sRGB frame and
-// the virtual-pixel mask straight into this slot's readback buffers.
+// the virtual-pixel mask straight into this slot's readback buffers. A tiled frame at the
+// camera's size writes only the listed tiles there, with a copy of the tile list: read() takes
+// the camera frame from the upload on the host and lays the tiles over it (0.3 ms of host time
+// against 2.4 ms for a full-frame camera copy pass on lavapipe at 640x480).
 #pragma once
+#include <vector>
+
 #include "gpu/frame_graph.h"
 #include "gpu/pipelines.h"
 #include "mrgi/image.h"
@@ -37,7 +42,8 @@ class Compose {
   static Expected<Compose> create(gpu::Context& context, gpu::FrameGraph& graph, uint32_t width,
                                   uint32_t height, bool same_size_as_camera,
                                   const ComposeSettings& settings = {});
-  // Adds the pass "compose" and marks both readback buffers as outputs.
+  // Adds the pass "compose" (tiled at the camera's size: and "compose_tile_readback"; tiled at
+  // another size: and "compose_camera" before it) and marks the readback buffers as outputs.
   void record(gpu::FrameGraph& graph, const ComposeInputs& inputs);
   // Copies slot `slot`'s results (after its frame completed) into `image` and `mask`
   // (resized to the output size; non-zero mask = virtual pixel).
@@ -55,6 +61,11 @@ class Compose {
   gpu::PipelineHandle pipeline_, same_internal_pipeline_, camera_pipeline_, tiled_pipeline_;
   gpu::BufferHandle no_tiles_;  // bound as the tile list when there is none (never read)
   bool tiled_ = false;          // this frame: camera copy + composite over the listed tiles
+  bool same_size_as_camera_ = false;
+  uint32_t max_tiles_ = 0;
+  // Per slot: args (16 bytes) then the tile indices of that slot's tiled frame.
+  gpu::BufferHandle tile_readback_;
+  std::vector<uint8_t> slot_host_camera_;  // per slot: the camera frame is laid on the host
 };
 
 }  // namespace mrgi::compose

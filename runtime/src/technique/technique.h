@@ -131,8 +131,9 @@ class Technique {
   // frame (L_rv == L_r and nothing virtual there), as an indirect-dispatch argument buffer
   // (VkDispatchIndirectCommand, x = tile count) and the tile indices (ty * ceil(w / 8) + tx),
   // both written by this frame's passes. The solutions are then defined only inside the tiles,
-  // and compose copies the camera frame elsewhere. Null handles (the default): compose every
-  // pixel from the solutions.
+  // and compose copies the camera frame elsewhere (both buffers need TRANSFER_SRC usage: the
+  // host reads the list back to lay the tiles over the camera frame). Null handles (the
+  // default): compose every pixel from the solutions.
   struct ComposeTiles {
     gpu::BufferHandle args, list;
   };

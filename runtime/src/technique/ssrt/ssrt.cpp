@@ -323,11 +323,13 @@ Status Ssrt::init() {
   auto args = graph.create_buffer({"ssrt_shade_tile_args", 16},
                                   VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
                                       VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
-                                      VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+                                      VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                                      VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
   if (!args) return args.error();
   tile_args_ = *args;
   auto list = graph.create_buffer({"ssrt_shade_tile_list", VkDeviceSize(max_tiles) * 4},
-                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                      VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
   if (!list) return list.error();
   tile_list_ = *list;
   return ok_status();
