@@ -36,27 +36,27 @@ layout(std430, set = 0, binding = 2) readonly buffer SampleBuffer { SsrtSample s
 // Storage images read with imageLoad: on lavapipe a sampled texelFetch costs 2-3x as much.
 layout(set = 0, binding = 3, rgba32f) readonly uniform image2D real_position;
 layout(set = 0, binding = 4, rgba16f) readonly uniform image2D real_normal;
-// The receiver (the cell's centre pixel) is read from the full-resolution buffers 5-7 and 13
-// (the camera's colour and depth as uploaded, upload_gather.glsl); what a sample lands on from
-// the occluder G-buffer at the geometry grid's resolution (occluders.comp: 8 the virtual
-// surface, 12 the real and virtual albedo and the virtual normal).
+// The receiver (the cell's centre pixel) is read from the real G-buffer (3, 4), the
+// full-resolution buffers 6-7 and 5, 13 (the camera's colour and depth as uploaded,
+// upload_gather.glsl); what a sample lands on from the packed occluder G-buffer
+// (occluders.comp: 8 and 12).
 layout(std430, set = 0, binding = 5) readonly buffer ColorWords { uint color_words[]; };  // RGB8
 layout(std430, set = 0, binding = 13) readonly buffer DepthWords { uint depth_words[]; };  // u16
 #include "common/upload_gather.glsl"
 layout(set = 0, binding = 6, rgba32f) readonly uniform image2D virtual_position;
 layout(set = 0, binding = 7, rgba16f) readonly uniform image2D virtual_normal;
-layout(set = 0, binding = 8, rgba32f) readonly uniform image2D occ_position;
+layout(set = 0, binding = 8, rgba32ui) readonly uniform uimage2D occ_a;
 layout(set = 0, binding = 9, rgba32f) writeonly uniform image2DArray coarse;
 // The volume's auxiliary orthographic layers (left, right, top, light; aux_views.glsl): occluders
 // outside the camera frustum (paper Sec. 5.1).
 layout(set = 0, binding = 10, rgba32f) readonly uniform image2DArray aux_position;
 layout(std140, set = 0, binding = 11) uniform AuxUbo { SsrtAuxViews aux; };
-layout(set = 0, binding = 12, rgba32ui) readonly uniform uimage2D occ_attrs;
+layout(set = 0, binding = 12, rg32ui) readonly uniform uimage2D occ_b;
 layout(push_constant) uniform Push {
   ivec4 grid;     // x, y cells; z step in pixels; w directions N
   ivec4 config;   // x first sample of the level's sets, y SH bands, z geometry step (internal
                   // pixels per texel of real_position / real_normal), w occluder step (of
-                  // occ_position / occ_attrs)
+                  // occ_a / occ_b)
   vec4 sampling;  // x radius (m), y chi, z normal offset (m), w minimum sender distance (m)
   vec4 bounce;    // x sample area (m^2), y saturation threshold, z depth test bias (fraction),
                   // w occluder range (m)
@@ -89,45 +89,41 @@ bool aux_occluder(vec3 x, vec3 y, out vec3 s) {
   return found;
 }
 
-// The real surface seen through internal pixel position q (qi its nearest pixel): xyz world,
-// w camera depth; n its world normal. At geometry step 1 the texel itself; coarser, the point
-// of the texel's tangent plane on q's camera ray (tangent_plane_depth).
-vec4 real_surface(vec2 q, ivec2 qi, int gstep, out vec3 n) {
-  ivec2 g = qi / gstep;
-  vec4 o = imageLoad(real_position, g);
-  n = imageLoad(real_normal, g).xyz;
-  vec3 ray = unproject_pinhole(q, 1.0f, frame.internal_k);
-  vec3 p = (frame.world_to_camera * vec4(o.xyz, 1.0f)).xyz;
-  float z = tangent_plane_depth(ray, p, mat3(frame.world_to_camera) * n, MRGI_DEPTH_EDGE_RELATIVE);
-  vec4 plane = vec4((frame.camera_to_world * vec4(ray * z, 1.0f)).xyz, z);
-  return gstep > 1 && o.w > 0.0f ? plane : o;
-}
-
-// The virtual surface seen through internal pixel position q (qi its nearest pixel), from the
-// occluder G-buffer: xyz world, w camera depth (all 0 where no virtual object covers the
-// texel); n its normal, albedo its base colour, real_albedo the camera's colour there. Coarser
-// than one texel per pixel, the point of the texel's tangent plane on q's camera ray, as for
-// the real surface (a virtual receiver's samples would otherwise find its own texel in front).
-vec4 virtual_surface(vec2 q, ivec2 qi, int ostep, out vec3 n, out vec3 albedo,
-                     out vec3 real_albedo) {
+// What a sample sees at internal pixel position q (qi its nearest pixel), from the packed
+// occluder G-buffer (occluders.comp): the real surface (xyz world, w camera depth; 0 = none), its
+// world normal rn and camera colour ra; the virtual surface in front of it (same form, all 0
+// where none), its normal vn and albedo va. Positions are rebuilt from the depths: the real one
+// at the centre of its geometry texel (gstep pixels a side), the virtual one at the occluder
+// texel's sample pixel. Coarser than a pixel, the point of the texel's tangent plane on q's
+// camera ray (tangent_plane_depth): a sample that projects 2 px from the texel centre on a sloped
+// floor would otherwise read the centre's depth, several per cent off, and the occluder bias
+// would find the receiver blocked by its own surface.
+void surfaces_at(vec2 q, ivec2 qi, int gstep, int ostep, out vec4 real, out vec3 rn,
+                 out vec3 ra, out vec4 virt, out vec3 vn, out vec3 va) {
   ivec2 g = qi / ostep;
-  vec4 o = imageLoad(occ_position, g);
-  uvec4 a = imageLoad(occ_attrs, g);
-  real_albedo = unpackUnorm4x8(a.x).rgb;
-  albedo = unpackUnorm4x8(a.y).rgb;
-  n = vec3(unpackHalf2x16(a.z), unpackHalf2x16(a.w).x);
-  vec3 p = (frame.world_to_camera * vec4(o.xyz, 1.0f)).xyz;
+  uvec4 a = imageLoad(occ_a, g);
+  uvec2 b = imageLoad(occ_b, g).xy;
+  ivec2 p = min(g * ostep + ivec2(ostep / 2), frame.internal_output_size.xy - 1);
   vec3 ray = unproject_pinhole(q, 1.0f, frame.internal_k);
-  float z = tangent_plane_depth(ray, p, mat3(frame.world_to_camera) * n, MRGI_DEPTH_EDGE_RELATIVE);
-  vec4 plane = vec4((frame.camera_to_world * vec4(ray * z, 1.0f)).xyz, z);
-  vec4 texel = ostep > 1 ? plane : vec4(o.xyz, p.z);
-  return o.w > 0.5f ? texel : vec4(0.0f);
-}
+  mat3 to_camera = mat3(frame.world_to_camera);
 
-// The camera's colour (linear) of the real surface at internal pixel qi, from the occluder
-// G-buffer.
-vec3 real_albedo_at(ivec2 qi, int ostep) {
-  return unpackUnorm4x8(imageLoad(occ_attrs, qi / ostep).x).rgb;
+  float zr = uintBitsToFloat(a.x);
+  rn = oct_decode(unpackSnorm2x16(a.y));
+  ra = unpackUnorm4x8(a.z).rgb;
+  ivec2 gt = p / gstep;
+  vec2 centre = vec2(gt * gstep) + 0.5f * float(gstep - 1);
+  vec3 pr = unproject_pinhole(centre, zr, frame.internal_k);
+  float z = gstep > 1 ? tangent_plane_depth(ray, pr, to_camera * rn, MRGI_DEPTH_EDGE_RELATIVE) : zr;
+  vec3 cr = gstep > 1 ? ray * z : pr;
+  real = zr > 0.0f ? vec4((frame.camera_to_world * vec4(cr, 1.0f)).xyz, z) : vec4(0.0f);
+
+  float zv = uintBitsToFloat(a.w);
+  vn = oct_decode(unpackSnorm2x16(b.x));
+  va = unpackUnorm4x8(b.y).rgb;
+  vec3 pv = unproject_pinhole(vec2(p), zv, frame.internal_k);
+  float z_v = ostep > 1 ? tangent_plane_depth(ray, pv, to_camera * vn, MRGI_DEPTH_EDGE_RELATIVE) : zv;
+  vec3 cv = ostep > 1 ? ray * z_v : pv;
+  virt = zv > 0.0f ? vec4((frame.camera_to_world * vec4(cv, 1.0f)).xyz, z_v) : vec4(0.0f);
 }
 
 // Camera-space depth of a world point.
@@ -199,8 +195,8 @@ void main() {
       bool in_view = yz > 0.0f && all(greaterThanEqual(qi, ivec2(0))) && all(lessThan(qi, size));
       qi = clamp(qi, ivec2(0), size - 1);
       vec3 on, vn, va, oa;
-      vec4 o = real_surface(q, qi, gstep, on);
-      vec4 ov = virtual_surface(q, qi, ostep, vn, va, oa);
+      vec4 o, ov;
+      surfaces_at(q, qi, gstep, ostep, o, on, oa, ov, vn, va);
       // Real scene: the real surface in front of the sample within the range (see the general
       // path below for the rules); real + virtual: the virtual surface where the virtual
       // G-buffer holds one (it is in front of the real one there), else the real one.
@@ -265,8 +261,9 @@ void main() {
           vec2 q = project_pinhole((frame.world_to_camera * vec4(y, 1.0f)).xyz, frame.internal_k);
           ivec2 qi = ivec2(floor(q + 0.5f));
           if (all(greaterThanEqual(qi, ivec2(0))) && all(lessThan(qi, size))) {
-            vec3 on;
-            vec4 o = real_surface(q, qi, gstep, on);
+            vec3 on, vn, va, ra;
+            vec4 o, ov;
+            surfaces_at(q, qi, gstep, ostep, o, on, ra, ov, vn, va);
             // Range check (standard SSDO/SSAO practice; the paper does not say): a surface
             // farther from x than the range (push: twice the sampling radius, since the surface
             // seen in front of y may lie well in front of it) is not what blocks this direction.
@@ -274,7 +271,7 @@ void main() {
             if (o.w > 0.0f && o.w < yz * (1.0f - bias) && dot(dr, dr) <= pc.bounce.w * pc.bounce.w) {
               sp = o.xyz;
               sn = on;
-              sa = real_albedo_at(qi, ostep);
+              sa = ra;
               k = ssrt_visibility_k(xr, sp, w, chi);
             }
           }
@@ -307,8 +304,8 @@ void main() {
           ivec2 qi = ivec2(floor(q + 0.5f));
           if (all(greaterThanEqual(qi, ivec2(0))) && all(lessThan(qi, size))) {
             vec3 on, vn, va, ra;
-            vec4 ov = virtual_surface(q, qi, ostep, vn, va, ra);
-            vec4 o = real_surface(q, qi, gstep, on);
+            vec4 o, ov;
+            surfaces_at(q, qi, gstep, ostep, o, on, ra, ov, vn, va);
             // The virtual G-buffer only holds virtual surfaces in front of the real one.
             bool use_virtual = ov.w > 0.0f;
             float oz = use_virtual ? ov.w : o.w;

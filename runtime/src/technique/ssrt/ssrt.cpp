@@ -139,8 +139,8 @@ class Ssrt final : public Technique {
 
   // The real G-buffer the transfer uses: the filter chain's (paper Sec. 4), not recon's.
   gpu::ImageHandle geo_position_, geo_normal_;
-  // The occluder G-buffer at the same resolution (occluders.comp): virtual surface, albedos.
-  gpu::ImageHandle occ_position_, occ_attrs_;
+  // The packed occluder G-buffer (occluders.comp: occ_a, occ_b) at the occluder step.
+  gpu::ImageHandle occ_a_, occ_b_;
   // The frame constants the geometry stage (volume ray cast, depth filters) reads: a copy of
   // the runtime's with internal_k / internal_output_size at the geometry resolution, so the same
   // shaders run at any geometry step. Images whose extent follows it: geo_images_.
@@ -201,8 +201,8 @@ Status Ssrt::init() {
   geo_position_ = filter_->position();
   geo_normal_ = filter_->normal();
   for (auto [handle, name, format] :
-       {std::tuple{&occ_position_, "ssrt_occluder_position", VK_FORMAT_R32G32B32A32_SFLOAT},
-        std::tuple{&occ_attrs_, "ssrt_occluder_attributes", VK_FORMAT_R32G32B32A32_UINT}}) {
+       {std::tuple{&occ_a_, "ssrt_occluders_a", VK_FORMAT_R32G32B32A32_UINT},
+        std::tuple{&occ_b_, "ssrt_occluders_b", VK_FORMAT_R32G32_UINT}}) {
     gpu::ImageDesc od;
     od.name = name;
     od.format = format;
@@ -283,7 +283,8 @@ Status Ssrt::init() {
     (real_receivers ? transfer_real_ : transfer_) = gpu::PipelineHandle(ctx, std::move(*tp));
   }
   auto p = gpu::load_compute_pipeline(ctx, "ssrt/occluders.comp",
-                                      {{ubo}, {ssbo}, {ssbo}, {img}, {img}, {img}, {img}, {img}},
+                                      {{ubo}, {ssbo}, {ssbo}, {img}, {img}, {img}, {img}, {img},
+                                       {img}, {img}},
                                       sizeof(glm::ivec4));
   if (!p) return p.error();
   occluders_ = std::move(*p);
@@ -350,7 +351,7 @@ Status Ssrt::write_geometry_constants() {
   fc.internal_output_size.y = (fc.internal_output_size.y + st - 1) / st;
   std::memcpy(graph.mapped(geo_constants_, graph.slot()), &fc, sizeof(fc));
   for (gpu::ImageHandle h : geo_images_) MRGI_TRY(graph.set_extent_divisor(h, geometry_step_));
-  for (gpu::ImageHandle h : {occ_position_, occ_attrs_})
+  for (gpu::ImageHandle h : {occ_a_, occ_b_})
     MRGI_TRY(graph.set_extent_divisor(h, occluder_step_));
   return ok_status();
 }
@@ -625,10 +626,11 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
           b.read(r.frame_constants, gpu::Access::UniformRead);
           b.read(r.color_upload, gpu::Access::StorageRead);
           b.read(r.depth_upload, gpu::Access::StorageRead);
-          for (gpu::ImageHandle h : {r.virtual_position, r.virtual_normal, r.virtual_albedo})
+          for (gpu::ImageHandle h : {r.virtual_position, r.virtual_normal, r.virtual_albedo,
+                                     geo_position_, geo_normal_})
             b.read(h, gpu::Access::StorageRead);
-          b.write(occ_position_, gpu::Access::StorageWrite);
-          b.write(occ_attrs_, gpu::Access::StorageWrite);
+          b.write(occ_a_, gpu::Access::StorageWrite);
+          b.write(occ_b_, gpu::Access::StorageWrite);
         },
         [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
           const SharedResources& r = shared_;
@@ -640,11 +642,14 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
               .storage_image(3, pass.view(r.virtual_position))
               .storage_image(4, pass.view(r.virtual_normal))
               .storage_image(5, pass.view(r.virtual_albedo))
-              .storage_image(6, pass.view(occ_position_))
-              .storage_image(7, pass.view(occ_attrs_))
+              .storage_image(6, pass.view(geo_position_))
+              .storage_image(7, pass.view(geo_normal_))
+              .storage_image(8, pass.view(occ_a_))
+              .storage_image(9, pass.view(occ_b_))
               .push(pass.context(), cmd, *occluders_);
-          const glm::ivec4 pc(int(occluder_step_), int(used_.width), int(used_.height), 0);
-          const VkExtent2D e = pass.extent(occ_position_);
+          const glm::ivec4 pc(int(occluder_step_), int(used_.width), int(used_.height),
+                              int(geometry_step_));
+          const VkExtent2D e = pass.extent(occ_a_);
           gpu::dispatch_2d(cmd, *occluders_, &pc, sizeof(pc), e.width, e.height);
         });
     graph.add_pass(
@@ -657,7 +662,7 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
           b.read(r.color_upload, gpu::Access::StorageRead);
           b.read(r.depth_upload, gpu::Access::StorageRead);
           for (gpu::ImageHandle h : {geo_position_, geo_normal_, r.virtual_position,
-                                     r.virtual_normal, occ_position_, occ_attrs_,
+                                     r.virtual_normal, occ_a_, occ_b_,
                                      volume_->aux_position()})
             b.read(h, gpu::Access::StorageRead);
           b.read(volume_->aux_views(), gpu::Access::UniformRead);
@@ -676,11 +681,11 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
               .storage_buffer(5, pass.buffer(r.color_upload))
               .storage_image(6, pass.view(r.virtual_position))
               .storage_image(7, pass.view(r.virtual_normal))
-              .storage_image(8, pass.view(occ_position_))
+              .storage_image(8, pass.view(occ_a_))
               .storage_image(9, pass.view(coarse_))
               .storage_image(10, pass.view(volume_->aux_position()))
               .uniform_buffer(11, pass.buffer(volume_->aux_views()))
-              .storage_image(12, pass.view(occ_attrs_))
+              .storage_image(12, pass.view(occ_b_))
               .storage_buffer(13, pass.buffer(r.depth_upload));
           const float sample_area = 3.14159265f * kRadiusM * kRadiusM / float(directions_);
           TransferPush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), int(directions_)),
