@@ -68,25 +68,43 @@ layout(push_constant) uniform Push {
 
 // Paper Fig. 5a: a sample the main buffer finds visible may lie behind a surface one of the
 // auxiliary buffers sees. Returns true with that surface's world position (the first layer
-// that occludes; its surface must lie within the occluder range of the receiver x).
-// Unrolled over the layers: with a constant layer index lavapipe reads world_to_aux once per
-// SIMD chunk, with a loop index it gathers the matrix per lane.
-bool aux_occluder(vec3 x, vec3 y, out vec3 s) {
+// that occludes, in layer order; its surface must lie within the occluder range of the
+// receiver x). `y_camera_x`: y's camera-space x.
+// The left and right layers share the image plane through the camera centre and look along
+// -x and +x (volume.cpp make_views): y lies in front of the left one exactly when its camera x
+// is negative, else of the right one (or of neither, on the plane), so one lookup with that
+// layer's matrix stands for both (on lavapipe every layer costs its whole test for every lane,
+// taken or not: three tests instead of four). The matrices are chosen per lane by selects of
+// uniform columns; with a constant layer index lavapipe reads a matrix once per SIMD chunk,
+// with a loop or lane index it gathers it per lane.
+bool aux_layer_hit(mat4 world_to_aux, int layer, float bias_m, vec3 x, vec3 y, out vec3 s) {
+  ivec2 texel;
+  float depth;
+  bool in_layer = layer < aux.info.x && ssrt_aux_texel(world_to_aux, aux.info.y, y, texel, depth);
+  vec4 o = imageLoad(aux_position, ivec3(texel, layer));
+  vec3 d = o.xyz - x;
+  s = o.xyz;
+  return in_layer && o.w > 0.0f && o.w < depth - bias_m && dot(d, d) <= pc.bounce.w * pc.bounce.w;
+}
+
+bool aux_occluder(vec3 x, vec3 y, float y_camera_x, out vec3 s) {
   s = vec3(0.0f);
   if (pc.aux_test.y < 0.5f) return false;
-  bool found = false;
-  [[unroll]] for (int i = 0; i < SSRT_AUX_LAYERS; ++i) {
-    ivec2 texel;
-    float depth;
-    bool in_layer = i < aux.info.x && ssrt_aux_texel(aux.world_to_aux[i], aux.info.y, y, texel, depth);
-    vec4 o = imageLoad(aux_position, ivec3(texel, i));
-    vec3 d = o.xyz - x;
-    bool hit = in_layer && o.w > 0.0f && o.w < depth - pc.aux_test.x * aux.extent[i].z &&
-               dot(d, d) <= pc.bounce.w * pc.bounce.w;
-    s = hit && !found ? o.xyz : s;
-    found = found || hit;
-  }
-  return found;
+  bool right = y_camera_x > 0.0f;
+  int side = right ? SSRT_AUX_RIGHT : SSRT_AUX_LEFT;
+  mat4 m = mat4(right ? aux.world_to_aux[SSRT_AUX_RIGHT][0] : aux.world_to_aux[SSRT_AUX_LEFT][0],
+                right ? aux.world_to_aux[SSRT_AUX_RIGHT][1] : aux.world_to_aux[SSRT_AUX_LEFT][1],
+                right ? aux.world_to_aux[SSRT_AUX_RIGHT][2] : aux.world_to_aux[SSRT_AUX_LEFT][2],
+                right ? aux.world_to_aux[SSRT_AUX_RIGHT][3] : aux.world_to_aux[SSRT_AUX_LEFT][3]);
+  float side_bias = pc.aux_test.x * (right ? aux.extent[SSRT_AUX_RIGHT].z : aux.extent[SSRT_AUX_LEFT].z);
+  vec3 s_side, s_top, s_light;
+  bool hit_side = aux_layer_hit(m, side, side_bias, x, y, s_side);
+  bool hit_top = aux_layer_hit(aux.world_to_aux[SSRT_AUX_TOP], SSRT_AUX_TOP,
+                               pc.aux_test.x * aux.extent[SSRT_AUX_TOP].z, x, y, s_top);
+  bool hit_light = aux_layer_hit(aux.world_to_aux[SSRT_AUX_LIGHT], SSRT_AUX_LIGHT,
+                                 pc.aux_test.x * aux.extent[SSRT_AUX_LIGHT].z, x, y, s_light);
+  s = hit_side ? s_side : (hit_top ? s_top : (hit_light ? s_light : s));
+  return hit_side || hit_top || hit_light;
 }
 
 // What a sample sees at internal pixel position q (qi its nearest pixel), from the packed
@@ -189,8 +207,9 @@ void main() {
       float r = (flip ? r_anti : dr.w) * pc.sampling.x;
       if (!(real_ok && dot(nr, w) > 0.0f)) continue;
       vec3 y = xr + nr * pc.sampling.z + w * r;
-      float yz = view_depth(y);
-      vec2 q = project_pinhole((frame.world_to_camera * vec4(y, 1.0f)).xyz, frame.internal_k);
+      vec3 yc = (frame.world_to_camera * vec4(y, 1.0f)).xyz;
+      float yz = yc.z;
+      vec2 q = project_pinhole(yc, frame.internal_k);
       ivec2 qi = ivec2(floor(q + 0.5f));
       bool in_view = yz > 0.0f && all(greaterThanEqual(qi, ivec2(0))) && all(lessThan(qi, size));
       qi = clamp(qi, ivec2(0), size - 1);
@@ -212,7 +231,7 @@ void main() {
       float k_v = hit_v ? ssrt_visibility_k(xr, sp_v, w, chi) : 1.0f;
       bool from_view = k < 1.0f, from_view_v = k_v < 1.0f;
       vec3 s_aux;
-      bool aux_hit = aux_occluder(xr, y, s_aux);
+      bool aux_hit = aux_occluder(xr, y, yc.x, s_aux);
       float k_aux = ssrt_visibility_k(xr, s_aux, w, chi);
       if (!from_view && aux_hit) k = k_aux;
       if (!from_view_v && aux_hit) k_v = k_aux;
@@ -256,9 +275,10 @@ void main() {
         vec3 y = xr + nr * pc.sampling.z + w * r_r;
         float k = 1.0f;
         vec3 sp = vec3(0.0f), sn = vec3(0.0f), sa = vec3(0.0f);
-        float yz = view_depth(y);
+        vec3 yc = (frame.world_to_camera * vec4(y, 1.0f)).xyz;
+        float yz = yc.z;
         if (yz > 0.0f) {
-          vec2 q = project_pinhole((frame.world_to_camera * vec4(y, 1.0f)).xyz, frame.internal_k);
+          vec2 q = project_pinhole(yc, frame.internal_k);
           ivec2 qi = ivec2(floor(q + 0.5f));
           if (all(greaterThanEqual(qi, ivec2(0))) && all(lessThan(qi, size))) {
             vec3 on, vn, va, ra;
@@ -280,7 +300,7 @@ void main() {
         // so they send no indirect light).
         vec3 s_aux;
         bool from_view = k < 1.0f;
-        if (!from_view && aux_occluder(xr, y, s_aux)) k = ssrt_visibility_k(xr, s_aux, w, chi);
+        if (!from_view && aux_occluder(xr, y, yc.x, s_aux)) k = ssrt_visibility_k(xr, s_aux, w, chi);
         float tw = ssrt_transfer_weight(nr, w, k, 1.0f);
         SH16 y_sh = sh_basis16(w);
         t_real[0] += tw * y_sh.c0;
@@ -298,9 +318,10 @@ void main() {
         vec3 y = xv + nv * pc.sampling.z + w * r_v;
         float k = 1.0f;
         vec3 sp = vec3(0.0f), sn = vec3(0.0f), sa = vec3(0.0f);
-        float yz = view_depth(y);
+        vec3 yc = (frame.world_to_camera * vec4(y, 1.0f)).xyz;
+        float yz = yc.z;
         if (yz > 0.0f) {
-          vec2 q = project_pinhole((frame.world_to_camera * vec4(y, 1.0f)).xyz, frame.internal_k);
+          vec2 q = project_pinhole(yc, frame.internal_k);
           ivec2 qi = ivec2(floor(q + 0.5f));
           if (all(greaterThanEqual(qi, ivec2(0))) && all(lessThan(qi, size))) {
             vec3 on, vn, va, ra;
@@ -321,7 +342,7 @@ void main() {
         }
         vec3 sv_aux;
         bool from_view_v = k < 1.0f;
-        if (!from_view_v && aux_occluder(xv, y, sv_aux)) k = ssrt_visibility_k(xv, sv_aux, w, chi);
+        if (!from_view_v && aux_occluder(xv, y, yc.x, sv_aux)) k = ssrt_visibility_k(xv, sv_aux, w, chi);
         float tw = ssrt_transfer_weight(nv, w, k, 1.0f);
         SH16 y_sh = sh_basis16(w);
         t_rv[0] += tw * y_sh.c0;
