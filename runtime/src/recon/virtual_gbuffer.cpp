@@ -1,5 +1,7 @@
 #include "recon/virtual_gbuffer.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include "common/frame_constants.glsl"
@@ -98,6 +100,7 @@ void VirtualGBuffer::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_cons
   lod_.camera_world = glm::vec3(fc.camera_world);
   lod_.focal_px = fc.internal_k.x;
   lod_.max_error_px = mesh_error_px;
+  area_ = projected_area(graph.extent(position_), fc);
   graph.add_pass(
       "virtual_gbuffer", gpu::PassKind::Graphics,
       [this](gpu::PassBuilder& b) {
@@ -114,6 +117,50 @@ void VirtualGBuffer::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_cons
         b.write(depth_, gpu::Access::DepthAttachmentWrite);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) { draw(cmd, pass); });
+}
+
+VkRect2D VirtualGBuffer::projected_area(VkExtent2D e, const shader::FrameConstants& fc) {
+  const VkRect2D full{{0, 0}, e};
+  const bool same_size = e.width == previous_extent_.width && e.height == previous_extent_.height;
+  previous_extent_ = e;
+  VkRect2D now{{0, 0}, {0, 0}};  // empty: no object
+  if (!scene_->virtual_objects.empty()) {
+    glm::vec2 lo(1e30f), hi(-1e30f);
+    const glm::vec3 b0 = scene_->virtual_objects.bounds_min, b1 = scene_->virtual_objects.bounds_max;
+    for (int k = 0; k < 8; ++k) {
+      const glm::vec4 c = fc.world_to_clip * glm::vec4(k & 1 ? b1.x : b0.x, k & 2 ? b1.y : b0.y,
+                                                      k & 4 ? b1.z : b0.z, 1.0f);
+      if (!(c.w > 1e-4f)) {  // a corner at or behind the camera plane: no bound from projection
+        lo = glm::vec2(-1e30f);
+        hi = glm::vec2(1e30f);
+        break;
+      }
+      const glm::vec2 px = (glm::vec2(c) / c.w * 0.5f + 0.5f) * glm::vec2(float(e.width), float(e.height));
+      lo = glm::min(lo, px);
+      hi = glm::max(hi, px);
+    }
+    // One pixel of margin for rasterisation rounding.
+    const int x0 = int(std::clamp(std::floor(lo.x) - 1.0f, 0.0f, float(e.width)));
+    const int y0 = int(std::clamp(std::floor(lo.y) - 1.0f, 0.0f, float(e.height)));
+    const int x1 = int(std::clamp(std::ceil(hi.x) + 1.0f, 0.0f, float(e.width)));
+    const int y1 = int(std::clamp(std::ceil(hi.y) + 1.0f, 0.0f, float(e.height)));
+    if (x1 > x0 && y1 > y0) now = {{x0, y0}, {uint32_t(x1 - x0), uint32_t(y1 - y0)}};
+  }
+  VkRect2D area = same_size ? previous_ : full;
+  if (same_size && now.extent.width > 0) {
+    if (area.extent.width == 0) {
+      area = now;
+    } else {
+      const int x0 = std::min(area.offset.x, now.offset.x), y0 = std::min(area.offset.y, now.offset.y);
+      const int x1 = std::max(area.offset.x + int(area.extent.width), now.offset.x + int(now.extent.width));
+      const int y1 = std::max(area.offset.y + int(area.extent.height), now.offset.y + int(now.extent.height));
+      area = {{x0, y0}, {uint32_t(x1 - x0), uint32_t(y1 - y0)}};
+    }
+  }
+  previous_ = now;
+  // Vulkan needs a non-empty render area; a 1x1 clear of texel (0, 0) keeps it cleared.
+  if (area.extent.width == 0 || area.extent.height == 0) area = {{0, 0}, {1, 1}};
+  return area;
 }
 
 void VirtualGBuffer::draw(VkCommandBuffer cmd, gpu::PassContext& pass) {
@@ -135,7 +182,7 @@ void VirtualGBuffer::draw(VkCommandBuffer cmd, gpu::PassContext& pass) {
   depth.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
   depth.clearValue.depthStencil = {1.0f, 0};
   VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-  ri.renderArea = {{0, 0}, e};
+  ri.renderArea = area_;
   ri.layerCount = 1;
   ri.colorAttachmentCount = 3;
   ri.pColorAttachments = colors;
@@ -143,7 +190,7 @@ void VirtualGBuffer::draw(VkCommandBuffer cmd, gpu::PassContext& pass) {
   vkCmdBeginRendering(cmd, &ri);
   if (!scene_->virtual_objects.empty()) {
     const VkViewport vp{0.0f, 0.0f, float(e.width), float(e.height), 0.0f, 1.0f};
-    const VkRect2D sc{{0, 0}, e};
+    const VkRect2D sc = area_;
     vkCmdSetViewport(cmd, 0, 1, &vp);
     vkCmdSetScissor(cmd, 0, 1, &sc);
     const gpu::Context& ctx = pass.context();
