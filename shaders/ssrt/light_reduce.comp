@@ -55,11 +55,12 @@ void main() {
       t[4 * l + 2] = v.z;
       t[4 * l + 3] = v.w;
     }
-    int k = 0;
+    // Constant trip counts (j from 0, not from i) so both loops unroll and every index is a
+    // constant: a loop starting at i kept its counter dynamic, which put ata[] in per-lane
+    // scratch memory on lavapipe. k = entry (i, j) of the row-major upper triangle.
     [[unroll]] for (int i = 0; i < 16; ++i) {
-      [[unroll]] for (int j = i; j < 16; ++j) {
-        ata[k] += t[i] * t[j];
-        ++k;
+      [[unroll]] for (int j = 0; j < 16; ++j) {
+        if (j >= i) ata[i * 16 - (i * (i - 1)) / 2 + (j - i)] += t[i] * t[j];
       }
     }
     [[unroll]] for (int i = 0; i < 16; ++i) {

@@ -367,14 +367,16 @@ void main() {
   // Bands above the level's count are dropped (their coefficients stay 0 in the light too).
   int n = pc.config.y * pc.config.y;
   float rd = 0.0f, rd_v = 0.0f;
-  for (int i = 0; i < 16; ++i) {
-    if (i >= n) break;
+  // A constant trip count with a select instead of `break`, so the loop unrolls and every index
+  // into t_real / t_rv is a constant: one dynamic index puts the whole array in per-lane scratch
+  // memory on lavapipe, including the accumulations of the sample loop (+0 leaves a sum as is).
+  [[unroll]] for (int i = 0; i < 16; ++i) {
     vec4 a = t_real[i / 4], b = t_rv[i / 4];
     int k = i - 4 * (i / 4);
     float ta = k == 0 ? a.x : (k == 1 ? a.y : (k == 2 ? a.z : a.w));
     float tb = k == 0 ? b.x : (k == 1 ? b.y : (k == 2 ? b.z : b.w));
-    rd += ta * light.sh[i].w;
-    rd_v += tb * light.sh[i].w;
+    rd += i < n ? ta * light.sh[i].w : 0.0f;
+    rd_v += i < n ? tb * light.sh[i].w : 0.0f;
   }
   // Usable for the light estimation: the camera measured this pixel (recon's alpha; the volume's
   // G-buffer also fills pixels the depth camera missed, whose recon colour is 0 and read as a
