@@ -96,6 +96,9 @@ Expected<Volume> Volume::create(gpu::Context& ctx, gpu::FrameGraph& graph,
   gpu::ImageDesc nd = dd;
   nd.name = "ssrt_normal_volume";
   nd.format = VK_FORMAT_R16G16B16A16_SFLOAT;
+  // Not persistent: a history image's last write is never culled, and nothing in the frame
+  // reads N_v (tsdf_normals.comp); a reader gets it on frames that ray-cast.
+  nd.history = false;
   auto normal = graph.create_image(nd, usage);
   if (!normal) return normal.error();
   v.normal_volume_ = *normal;
