@@ -72,15 +72,20 @@
 // fast level scores RDE 0.563, so the estimate costs about 0.02.
 //
 // Cost on lavapipe (LP_NUM_THREADS=2, 640x480, `mrgi bench --techniques ssrt --frames 4
-// --warmup 1`, perf/results/report-ssrt-640x480.md, floor 1.78 ms): suite mean sustained full
-// 1164 ms, half 603, fast 84.2 (46x floor), fastest 39.7 (22x); median over the five scenes
-// with a virtual object: fast 102, fastest 49. Fast level split (median over scenes): transfer
-// 27.8, recon 18.6, shade 11 (tiles), compose 7.8 (camera copy + tiles), ray cast 5.5, virtual
-// G-buffer 4.2, aux 3.8, light sums 4.2, fuse 3.1, filters 2.5, blur 1.6, host 2.6.
+// --warmup 1`, perf/results/report-ssrt-640x480.md, floor 1.51 ms): suite mean sustained full
+// 794 ms, half 472, fast 40.4 (26x floor), fastest 26.3 (17x); median over the five scenes
+// with a virtual object: fast 47.0, fastest 29.5. Fast level split (median over scenes):
+// transfer 15.9, shade 7.1 (tiles), ray cast 3.6, compose 3.4 (tiles), host 3.6, aux 2.5,
+// virtual G-buffer 1.8, fuse 1.4, filters 1.4, blur 1.2, light sums 1.0, occluders 0.9.
+// Measured gains behind them (fast level): no runtime reconstruction (-14 ms), constant
+// indices into the transfer's and the light sums' local arrays (a dynamic index had put them
+// in per-lane scratch memory: -5 and -3 ms), the occluder G-buffer (cache misses, then fewer
+// reads), mesh levels of detail and a bounded virtual G-buffer, the grouped bicubic in shade, N_v
+// culled, three aux lookups instead of four, the camera copy on the host.
 // Known defects: the grey-world albedo (paper Sec. 6.4) reads brighter objects as more light
 // from their side (env_fisheye's boxes and ball are 0.6-0.7, its floor 0.5); the fast level is
-// above 33 ms on lavapipe (perf/results/peaks-lavapipe-x2.md: at ~2 ns per image access the
-// full-resolution passes alone need ~28 ms); its coarse geometry costs corner 0.017 RDE (0.748
+// above 33 ms on lavapipe (its transfer is about 3x its image-read floor, ~2.2 M reads at ~2.3
+// ns, perf/results/peaks-lavapipe-x2.md); its coarse geometry costs corner 0.017 RDE (0.748
 // -> 0.765; geometry_step 2 gives 0.741 but ~24 ms more). The fastest level had 2 SH bands
 // until session 4; the transfer accumulates all 16 coefficients whatever the level, so 2 bands
 // saved nothing and cost the direction (46 degrees off; LightEstimatorSettings::
