@@ -9,6 +9,19 @@
 #define MRGI_UPLOAD_GATHER_GLSL
 
 uint color_byte(uint index) { return (color_words[index >> 2] >> ((index & 3u) * 8u)) & 0xffu; }
+// The three bytes of colour pixel `pixel` (row-major) from the two words they lie in: two reads
+// instead of three (every buffer read is a per-lane gather on lavapipe). The second word is
+// clamped to the buffer (the last pixel's bytes can end in the last word).
+uvec3 color_rgb8(uint pixel) {
+  uint base = pixel * 3u;
+  uint w = base >> 2;
+  uint shift = (base & 3u) * 8u;
+  uint lo = color_words[w];
+  uint hi = color_words[min(w + 1u, uint(color_words.length()) - 1u)];
+  // Bytes base .. base + 2 as the low 24 bits (for shift 0 the high word is not needed).
+  uint v = shift == 0u ? lo : (lo >> shift) | (hi << (32u - shift));
+  return uvec3(v & 0xffu, (v >> 8u) & 0xffu, (v >> 16u) & 0xffu);
+}
 uint depth_value(uint index) { return (depth_words[index >> 1] >> ((index & 1u) * 16u)) & 0xffffu; }
 
 // Nearest pixel of a camera with intrinsics k and size for a camera-space ray (any z > 0);
@@ -34,8 +47,7 @@ vec4 camera_at(vec2 p) {
   ivec2 dp = nearest_pixel(ray, frame.depth_k, frame.color_depth_size.zw);
   vec3 albedo = vec3(0.0f);
   if (cp.x >= 0) {
-    uint base = uint(cp.y * frame.color_depth_size.x + cp.x) * 3u;
-    vec3 encoded = vec3(color_byte(base), color_byte(base + 1u), color_byte(base + 2u)) / 255.0f;
+    vec3 encoded = vec3(color_rgb8(uint(cp.y * frame.color_depth_size.x + cp.x))) / 255.0f;
     albedo = clamp(camera_to_radiance(encoded, frame.camera.y), vec3(0.0f), vec3(1.0f));
   }
   bool measured = dp.x >= 0 && depth_value(uint(dp.y * frame.color_depth_size.z + dp.x)) != 0u;
