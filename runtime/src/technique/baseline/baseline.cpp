@@ -48,12 +48,6 @@ struct ShadePush {
   glm::vec4 shadow;
 };
 
-double knob(const QualityLevel& level, const std::string& name) {
-  for (const Knob& k : level.knobs)
-    if (k.name == name) return k.value;
-  return 0.0;
-}
-
 class Baseline final : public Technique {
  public:
   explicit Baseline(const SharedResources& shared) : shared_(shared), ladder_(baseline_ladder()) {}

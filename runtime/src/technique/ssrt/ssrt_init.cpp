@@ -1,0 +1,170 @@
+// Ssrt::init: everything the technique allocates at start-up, for its top level (technique.h).
+#include "technique/ssrt/ssrt_internal.h"
+
+namespace mrgi::technique::ssrt_detail {
+
+Status Ssrt::init() {
+  gpu::Context& ctx = *shared_.context;
+  gpu::FrameGraph& graph = *shared_.graph;
+  auto est = ssrt::LightEstimator::create({});
+  if (!est) return est.error();
+  estimator_.emplace(std::move(*est));
+  ssrt::VolumeSettings vs;
+  vs.max_resolution = 1;
+  vs.max_aux_resolution = 1;
+  for (const QualityLevel& l : ladder_) {
+    vs.max_resolution = std::max(vs.max_resolution, uint32_t(knob(l, "volume_resolution")));
+    vs.max_aux_resolution = std::max(vs.max_aux_resolution, uint32_t(knob(l, "aux_resolution")));
+  }
+  auto geo_constants = graph.create_buffer(
+      {"ssrt_geometry_constants", sizeof(shader::FrameConstants), gpu::MemoryUsage::Upload, true},
+      VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  if (!geo_constants) return geo_constants.error();
+  geo_constants_ = *geo_constants;
+  technique::SharedResources geo_shared = shared_;
+  geo_shared.frame_constants = geo_constants_;
+  auto vol = ssrt::Volume::create(ctx, graph, geo_shared, vs);
+  if (!vol) return vol.error();
+  volume_.emplace(std::move(*vol));
+  auto filt = ssrt::DepthFilterGpu::create(ctx, graph, geo_shared);
+  if (!filt) return filt.error();
+  filter_.emplace(std::move(*filt));
+  geo_position_ = filter_->position();
+  geo_normal_ = filter_->normal();
+  for (auto [handle, name, format] :
+       {std::tuple{&occ_a_, "ssrt_occluders_a", VK_FORMAT_R32G32B32A32_UINT},
+        std::tuple{&occ_b_, "ssrt_occluders_b", VK_FORMAT_R32G32_UINT}}) {
+    gpu::ImageDesc od;
+    od.name = name;
+    od.format = format;
+    auto img = graph.create_image(od, VK_IMAGE_USAGE_STORAGE_BIT);
+    if (!img) return img.error();
+    *handle = *img;
+  }
+  geo_images_ = {volume_->depth_volume(), volume_->normal_volume(), filter_->input(),
+                 filter_->merged(), filter_->merged_intensity(), filter_->bilateral(),
+                 filter_->final_depth(), filter_->position(), filter_->normal()};
+
+  // Sample sets of every level, one buffer.
+  std::vector<ssrt::GpuSample> all;
+  for (const QualityLevel& l : ladder_) {
+    auto sets = ssrt::make_sample_sets({uint32_t(knob(l, "directions")), kSampleSeed});
+    if (!sets) return sets.error();
+    sample_base_.push_back(uint32_t(all.size()));
+    chi_.push_back(sets->chi);
+    all.insert(all.end(), sets->samples.begin(), sets->samples.end());
+  }
+  const VkDeviceSize sample_bytes = all.size() * sizeof(ssrt::GpuSample);
+  auto samples = graph.create_buffer({"ssrt_samples", sample_bytes},
+                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  if (!samples) return samples.error();
+  samples_ = *samples;
+  MRGI_TRY(ctx.upload_buffer(graph.gpu_buffer(samples_, 0), all.data(), sample_bytes));
+
+  auto light = graph.create_buffer(
+      {"ssrt_light", sizeof(shader::SsrtLight), gpu::MemoryUsage::Upload, true},
+      VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  if (!light) return light.error();
+  light_ = *light;
+
+  // Everything sized for the top level: one cell per pixel of the largest internal image.
+  const VkExtent2D top = graph.allocated_extent(shared_.lit_r);
+  const uint32_t strips = ((top.width + kStripCells - 1) / kStripCells) * top.height;
+  auto partials = graph.create_buffer(
+      {"ssrt_light_partials", VkDeviceSize(strips) * kReduceEntries * sizeof(float)},
+      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  if (!partials) return partials.error();
+  partials_ = *partials;
+  auto result = graph.create_buffer(
+      {"ssrt_light_sums", kReduceEntries * sizeof(float), gpu::MemoryUsage::Readback, true},
+      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  if (!result) return result.error();
+  result_ = *result;
+  pending_.assign(graph.frames_in_flight(), -1);
+  pending_bands_.assign(graph.frames_in_flight(), 0);
+
+  gpu::ImageDesc cd;
+  cd.name = "ssrt_coarse";
+  cd.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+  cd.layers = kCoarseLayers;
+  auto coarse = graph.create_image(cd, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT);
+  if (!coarse) return coarse.error();
+  coarse_ = *coarse;
+  gpu::ImageDesc ud;
+  ud.name = "ssrt_upsampled";
+  ud.format = VK_FORMAT_R32G32B32A32_UINT;
+  auto upsampled = graph.create_image(ud, VK_IMAGE_USAGE_STORAGE_BIT);
+  if (!upsampled) return upsampled.error();
+  upsampled_ = *upsampled;
+
+  const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+  const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+  auto transfer_spv = gpu::shader_spirv("ssrt/transfer.comp");
+  if (!transfer_spv) return transfer_spv.error();
+  for (uint32_t real_receivers = 0; real_receivers < 2; ++real_receivers) {
+    gpu::ComputePipelineDesc d{real_receivers ? "ssrt_transfer_real_receivers" : "ssrt_transfer",
+                               *transfer_spv,
+                               {{ubo}, {ubo}, {ssbo}, {img}, {img}, {ssbo}, {img}, {img}, {img},
+                                {img}, {img}, {ubo}, {img}, {ssbo}},
+                               sizeof(TransferPush), {real_receivers}};
+    auto tp = gpu::create_compute_pipeline(ctx, d);
+    if (!tp) return tp.error();
+    (real_receivers ? transfer_real_ : transfer_) = gpu::PipelineHandle(ctx, std::move(*tp));
+  }
+  auto p = gpu::load_compute_pipeline(ctx, "ssrt/occluders.comp",
+                                      {{ubo}, {ssbo}, {ssbo}, {img}, {img}, {img}, {img}, {img},
+                                       {img}, {img}},
+                                      sizeof(glm::ivec4));
+  if (!p) return p.error();
+  occluders_ = std::move(*p);
+  p = gpu::load_compute_pipeline(ctx, "ssrt/light_reduce.comp",
+                                 {{img}, {ssbo}, {ssbo}, {ubo}, {ssbo}}, sizeof(ReducePush));
+  if (!p) return p.error();
+  reduce_ = std::move(*p);
+  p = gpu::load_compute_pipeline(ctx, "ssrt/light_reduce_final.comp", {{ssbo}, {ssbo}}, sizeof(FinalPush));
+  if (!p) return p.error();
+  reduce_final_ = std::move(*p);
+  p = gpu::load_compute_pipeline(ctx, "ssrt/upsample_blur.comp", {{img}, {img}}, sizeof(BlurPush));
+  if (!p) return p.error();
+  blur_ = std::move(*p);
+  auto shade_spv = gpu::shader_spirv("ssrt/shade.comp");
+  if (!shade_spv) return shade_spv.error();
+  const struct {
+    const char* name;
+    uint32_t pass_through, tiled, local_x, local_y;
+    gpu::PipelineHandle* handle;
+  } shade_variants[] = {{"ssrt_shade", 0, 0, 8, 8, &shade_},
+                        {"ssrt_shade_pass_through", 1, 0, 8, 8, &shade_pass_},
+                        {"ssrt_shade_tiled", 0, 1, 8, 1, &shade_tiled_}};
+  for (const auto& v : shade_variants) {
+    gpu::ComputePipelineDesc d{v.name, *shade_spv,
+                               {{img}, {img}, {ssbo}, {img}, {img}, {img}, {img}, {img}, {ssbo},
+                                {ssbo}, {ubo}},
+                               sizeof(ShadePush), {v.pass_through, v.tiled, v.local_x, v.local_y}};
+    auto sp = gpu::create_compute_pipeline(ctx, d);
+    if (!sp) return sp.error();
+    *v.handle = gpu::PipelineHandle(ctx, std::move(*sp));
+  }
+  p = gpu::load_compute_pipeline(ctx, "ssrt/shade_tiles.comp", {{img}, {ssbo}, {ssbo}},
+                                 sizeof(TilesPush));
+  if (!p) return p.error();
+  shade_tiles_ = std::move(*p);
+  const uint32_t max_tiles = ((top.width + 7) / 8) * ((top.height + 7) / 8);
+  auto args = graph.create_buffer({"ssrt_shade_tile_args", 16},
+                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                      VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
+                                      VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                                      VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  if (!args) return args.error();
+  tile_args_ = *args;
+  auto list = graph.create_buffer({"ssrt_shade_tile_list", VkDeviceSize(max_tiles) * 4},
+                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                      VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  if (!list) return list.error();
+  tile_list_ = *list;
+  return ok_status();
+}
+
+}  // namespace mrgi::technique::ssrt_detail

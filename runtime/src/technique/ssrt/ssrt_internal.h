@@ -1,0 +1,171 @@
+// Internal to the ssrt technique (ssrt.cpp, ssrt_init.cpp): its constants, push-constant
+// blocks and the technique class. Not part of the library's interface.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <optional>
+#include <string>
+#include <tuple>
+
+#include "common/frame_constants.glsl"
+#include "gpu/pipelines.h"
+#include "gpu/shaders.h"
+#include "ssrt/ssrt_math.h"
+#include "technique/scene_gpu.h"
+#include "technique/ssrt/depth_filter_gpu.h"
+#include "technique/ssrt/light_estimator.h"
+#include "technique/ssrt/sample_directions.h"
+#include "technique/ssrt/volume.h"
+
+#include "technique/ssrt/ssrt.h"
+
+namespace mrgi::technique::ssrt_detail {
+
+constexpr uint32_t kCoarseLayers = 7;
+constexpr uint32_t kReduceEntries = 192;       // per partial sum, see light_reduce.comp
+constexpr uint32_t kStripCells = 32;           // cells of a row per light_reduce invocation
+constexpr uint32_t kSampleSeed = 20140901;     // sample sets are a pure function of N and this
+
+// Settings shared by every level (units in the names).
+constexpr float kRadiusM = 0.5f;             // SSDO sampling radius
+constexpr float kRangeM = 2.0f * kRadiusM;   // occluders farther from the receiver do not count
+constexpr float kNormalOffsetM = 0.01f;      // start of the samples above the surface
+constexpr float kMinSenderDistM = 0.05f;     // 1/d^2 clamp of the form factor
+constexpr float kDepthBias = 0.01f;          // occluder must be 1 % closer than the sample
+constexpr float kSaturation = 0.98f;         // camera values at/above are clipped: not used
+constexpr float kIndirectTolerance = 1e-3f;  // eq. 14
+constexpr float kGaussRadiusPx = 8.0f;       // paper OursFast
+// An auxiliary-buffer surface occludes a sample only if it lies this many of the layer's texels
+// in front of it (the aux layers are ray-cast from a TSDF with voxels about one texel wide).
+constexpr float kAuxBiasTexels = 1.5f;
+// Without a virtual object the volume is centred this far in front of the first camera pose.
+constexpr double kVolumeAheadM = 1.0;
+
+struct TransferPush {
+  glm::ivec4 grid;
+  glm::ivec4 config;
+  glm::vec4 sampling;
+  glm::vec4 bounce;
+  glm::ivec4 influence;
+  glm::vec4 aux;  // x bias in texels of the aux layer, y 1 = test the aux layers, z solid angle
+  glm::ivec4 region;  // cells [x0, x1) x [y0, y1) of one dispatch
+};
+struct ReducePush {
+  glm::ivec4 grid;
+  glm::ivec4 size;
+};
+struct FinalPush {
+  glm::ivec4 counts;
+};
+struct BlurPush {
+  glm::ivec4 grid;
+  glm::vec4 filt;
+};
+struct TilesPush {
+  glm::ivec4 grid;
+  glm::ivec4 counts;
+  glm::ivec4 virt;
+};
+struct ShadePush {
+  glm::ivec4 grid;
+  glm::ivec4 size;
+  glm::ivec4 influence;
+  glm::vec4 opts;
+};
+
+class Ssrt final : public Technique {
+ public:
+  explicit Ssrt(const SharedResources& shared) : shared_(shared), ladder_(ssrt_ladder()) {}
+  const std::string& name() const override { return name_; }
+  const std::vector<QualityLevel>& levels() const override { return ladder_; }
+  Status init();
+  Status record(const FrameInfo& info, std::vector<std::string>& skipped) override;
+  // The paper's own geometry stage (Sec. 4) replaces the runtime's reconstruction: the
+  // transfer and the shading read the filtered G-buffer, the camera colour is read from the
+  // upload where it is used (cell centres, shaded tiles), and the virtual objects' depth test
+  // reads the filtered G-buffer too (G_r, Fig. 2: the paper's occlusion geometry). recon's two
+  // full-resolution passes cost 13-14 ms of desk_spot's fast frame on lavapipe.
+  bool uses_reconstruction() const override { return false; }
+  Status record_geometry(const FrameInfo& info, std::vector<std::string>& skipped) override;
+  std::optional<RealGeometry> occlusion_geometry() const override {
+    return RealGeometry{geo_position_, geo_normal_, geometry_step_};
+  }
+  const LightEstimate& estimate() const { return estimator_->estimate(); }
+  const LightEstimate* light_estimate() const override { return &estimator_->estimate(); }
+  // Once, before the first estimate: the first frame is lit by its own estimate instead of the
+  // prior (a uniform grey guess that made the first frames_in_flight frames' RDE about 1).
+  bool wants_priming_run() const override { return !primed_ && !estimator_->estimate().valid; }
+  void frames_completed() override;
+  ComposeTiles compose_tiles() const override { return compose_tiles_; }
+
+ private:
+  // Solves the sums the frame that last used `slot` read back (it must have completed).
+  void consume_readback(uint32_t slot, std::vector<std::string>& notes);
+  // The paper's geometry stage (Sec. 4): fuse the volume, ray-cast G_v and the aux layers, run
+  // the depth filter chain into the G-buffer the transfer reads.
+  Status record_real_geometry(const FrameInfo& info, const QualityLevel& level,
+                              std::vector<std::string>& skipped);
+  void write_light();
+  // Whether the virtual objects' influence region (bounds grown by the sampling radius) is in
+  // view; `cells` gets its conservative screen rectangle in cells [x0, x1) x [y0, y1).
+  bool influence_in_view(glm::ivec4& cells) const;
+  bool project_virtual_bounds(float grow_m, glm::vec2& pmin, glm::vec2& pmax, bool& behind) const;
+  glm::ivec4 virtual_pixels() const;
+  glm::ivec4 virtual_cells() const;
+  enum class ShadeMode { Full, PassThrough, Tiled };
+  void add_shade_pass(const char* name, ShadeMode mode, bool run_transfer);
+  glm::ivec4 influence_pixels() const {
+    const int st = int(step_);
+    const int grow = step_ > 1 ? int(kGaussRadiusPx) + 2 * st : 0;
+    return glm::ivec4(influence_cells_.x * st - grow, influence_cells_.y * st - grow,
+                      influence_cells_.z * st + grow, influence_cells_.w * st + grow);
+  }
+
+  std::string name_ = "ssrt";
+  SharedResources shared_;
+  std::vector<QualityLevel> ladder_;
+  std::optional<ssrt::LightEstimator> estimator_;
+  std::optional<ssrt::Volume> volume_;
+  std::optional<ssrt::DepthFilterGpu> filter_;
+  // Writes this frame's geometry constants: the frame constants with the internal intrinsics
+  // and size replaced by the geometry stage's (geometry_step_ internal pixels per texel), and
+  // sets the geometry images' extent divisor to match.
+  Status write_geometry_constants();
+
+  // The real G-buffer the transfer uses: the filter chain's (paper Sec. 4), not recon's.
+  gpu::ImageHandle geo_position_, geo_normal_;
+  // The packed occluder G-buffer (occluders.comp: occ_a, occ_b) at the occluder step.
+  gpu::ImageHandle occ_a_, occ_b_;
+  // The frame constants the geometry stage (volume ray cast, depth filters) reads: a copy of
+  // the runtime's with internal_k / internal_output_size at the geometry resolution, so the same
+  // shaders run at any geometry step. Images whose extent follows it: geo_images_.
+  gpu::BufferHandle geo_constants_;
+  std::vector<gpu::ImageHandle> geo_images_;
+  std::optional<glm::vec3> volume_center_;
+  std::vector<uint32_t> sample_base_;  // per level: first sample of its sets
+  std::vector<float> chi_;             // per level
+  gpu::BufferHandle samples_, light_, partials_, result_;
+  gpu::ImageHandle coarse_;
+  gpu::ImageHandle upsampled_;  // RGBA32UI per cell, shaders/ssrt/upsampled.glsl
+  gpu::PipelineHandle occluders_, transfer_, transfer_real_, reduce_, reduce_final_, blur_, shade_, shade_pass_,
+      shade_tiled_, shade_tiles_;
+  // Fast levels' shade tiles (shade_tiles.comp): indirect dispatch arguments and tile indices.
+  gpu::BufferHandle tile_args_, tile_list_;
+  ComposeTiles compose_tiles_;  // this frame's (set by record)
+  std::vector<int64_t> pending_;       // per frame slot: frame whose sums its readback holds
+  std::vector<int> pending_bands_;     // per frame slot: SH bands of that frame's transfer
+  bool primed_ = false;                // a priming run was asked for (only ever once)
+  std::vector<std::string> deferred_notes_;  // from frames_completed, reported by the next record
+  // This frame's knobs (set by record before the passes are added).
+  uint32_t step_ = 1, directions_ = 64, bands_ = 4, geometry_step_ = 1, occluder_step_ = 1;
+  int level_ = 0;
+  // The frame record_geometry() last recorded (record() then adds the rest of it).
+  int64_t geometry_frame_ = -1;
+  bool geometry_frame_valid_ = false;
+  glm::uvec2 grid_{1, 1};
+  glm::ivec4 influence_cells_{0, 0, 0, 0};
+  VkExtent2D used_{1, 1};
+};
+
+}  // namespace mrgi::technique::ssrt_detail
