@@ -116,6 +116,10 @@ void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
   graph.mark_output(output_);
   graph.mark_output(mask_);
   if (!host_camera) return;
+  // A technique's list may be smaller than this output's tile count (it lists only its used
+  // extent's tiles); the count in args never exceeds what it holds.
+  list_bytes_ = std::min<VkDeviceSize>(VkDeviceSize(max_tiles_) * 4,
+                                       graph.gpu_buffer(in_.tile_list, graph.slot()).size);
   graph.add_pass(
       "compose_tile_readback", gpu::PassKind::Transfer,
       [this](gpu::PassBuilder& b) {
@@ -126,7 +130,7 @@ void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
         const VkBufferCopy args{0, 0, 16};
         vkCmdCopyBuffer(cmd, pass.buffer(in_.tile_args), pass.buffer(tile_readback_), 1, &args);
-        const VkBufferCopy list{0, 16, VkDeviceSize(max_tiles_) * 4};
+        const VkBufferCopy list{0, 16, list_bytes_};
         vkCmdCopyBuffer(cmd, pass.buffer(in_.tile_list), pass.buffer(tile_readback_), 1, &list);
       });
   graph.mark_output(tile_readback_);
@@ -191,7 +195,7 @@ Status Compose::read(const gpu::FrameGraph& graph, uint32_t slot, ImageRGBA8& im
     px[4 * i + 3] = 255;
   }
   const auto* words = static_cast<const uint32_t*>(graph.mapped(tile_readback_, slot));
-  const uint32_t count = std::min(words[0], max_tiles_);
+  const uint32_t count = std::min(words[0], max_tiles_);  // (the list copy bounds it too)
   const uint32_t tiles_x = (width_ + 7) / 8;
   for (uint32_t k = 0; k < count; ++k) {
     const uint32_t t = words[4 + k];

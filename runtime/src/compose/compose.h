@@ -63,6 +63,7 @@ class Compose {
   bool tiled_ = false;          // this frame: camera copy + composite over the listed tiles
   bool same_size_as_camera_ = false;
   uint32_t max_tiles_ = 0;
+  VkDeviceSize list_bytes_ = 0;  // this frame's tile-list copy (at most the list's size)
   // Per slot: args (16 bytes) then the tile indices of that slot's tiled frame.
   gpu::BufferHandle tile_readback_;
   std::vector<uint8_t> slot_host_camera_;  // per slot: the camera frame is laid on the host
