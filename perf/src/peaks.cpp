@@ -92,7 +92,7 @@ Expected<Peaks> measure_peaks(const PeaksSettings& s) {
   fs.max_output_width = kPeakWidth;
   fs.max_output_height = kPeakHeight;
   fs.frames_in_flight = 1;
-  fs.max_passes = 4;
+  fs.max_passes = 5;
   auto graph_or = gpu::FrameGraph::create(ctx, fs);
   if (!graph_or) return graph_or.error();
   gpu::FrameGraph& graph = **graph_or;
@@ -139,6 +139,8 @@ Expected<Peaks> measure_peaks(const PeaksSettings& s) {
   if (!load) return load.error();
   auto buffer_floor = gpu::load_compute_pipeline(ctx, "perf/peak_buffer_floor.comp", {{ssbo}, {ssbo}}, 16);
   if (!buffer_floor) return buffer_floor.error();
+  auto gather = gpu::load_compute_pipeline(ctx, "perf/peak_buffer_gather.comp", {{ssbo}, {ssbo}}, 16);
+  if (!gather) return gather.error();
   const gpu::BufferHandle res = *results, a = *src, b = *dst;
   const gpu::ImageHandle im = *image;
 
@@ -211,6 +213,13 @@ Expected<Peaks> measure_peaks(const PeaksSettings& s) {
     out.results.push_back(result("image_load", *ms, loads, "Gload/s", 1e9));
   }
   {
+    const glm::ivec4 pc(s.image_loads, int(kPeakWidth), int(kPeakHeight), int(copy_bytes / 16));
+    auto ms = time_a_to_b("peak_buffer_gather", **gather, pc, kPeakWidth, kPeakHeight, 8, 8);
+    if (!ms) return ms.error();
+    const double loads = double(kPeakWidth) * kPeakHeight * s.image_loads;
+    out.results.push_back(result("buffer_gather", *ms, loads, "Gload/s", 1e9));
+  }
+  {
     auto ms = time_a_to_b("peak_buffer_floor", **buffer_floor, glm::ivec4(int(kPeakWidth), int(kPeakHeight), 0, 0),
                           kPeakWidth, kPeakHeight, 8, 8);
     if (!ms) return ms.error();
@@ -235,7 +244,7 @@ std::string peaks_markdown(const Peaks& p) {
       << (p.floor_median_ms > 0.0 ? r.median_ms / p.floor_median_ms : 0.0) << " |\n";
   }
   o << "\nA pass needing F FLOPs, B streamed bytes and L scattered loads takes at least "
-       "max(F / fma, B / copy, L / image_load).\n";
+       "max(F / fma, B / copy, L / image_load) (L / buffer_gather where it reads a buffer).\n";
   return o.str();
 }
 

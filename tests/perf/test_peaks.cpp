@@ -18,9 +18,9 @@ TEST(Peaks, SmallKernelsGiveFiniteRatesBesideTheFloorPass) {
   auto p = mrgi::perf::measure_peaks(s);
   ASSERT_TRUE(p.ok()) << p.error().message;
   EXPECT_GT(p->floor_median_ms, 0.0);
-  ASSERT_EQ(p->results.size(), 4u);
-  const char* names[] = {"fma", "copy", "image_load", "buffer_floor"};
-  for (size_t i = 0; i < 4; ++i) {
+  ASSERT_EQ(p->results.size(), 5u);
+  const char* names[] = {"fma", "copy", "image_load", "buffer_gather", "buffer_floor"};
+  for (size_t i = 0; i < 5; ++i) {
     const auto& r = p->results[i];
     EXPECT_EQ(r.name, names[i]);
     EXPECT_TRUE(std::isfinite(r.rate) && r.rate > 0.0) << r.name;

@@ -8,6 +8,8 @@
 //   copy        a 16-byte-per-invocation buffer copy, 2 x 64 MiB touched (peak_copy.comp)
 //   image load  RGBA32F imageLoad at hashed positions within 64 px (peak_image_load.comp), the
 //               access pattern of a screen-space sampling pass
+//   buffer gather the same access pattern from a storage buffer (peak_buffer_gather.comp): what a
+//               scattered read pays for the image path
 //   buffer floor the floor pass's per-pixel load and store (4 bytes each) through storage
 //               buffers instead of images (peak_buffer_floor.comp): what the image path costs
 #pragma once
@@ -41,7 +43,7 @@ struct Peaks {
   std::string device, driver;
   int lp_num_threads = 0;          // LP_NUM_THREADS when set (lavapipe's thread count), else 0
   double floor_median_ms = 0.0;    // the floor pass at 640 x 480, same process
-  std::vector<PeakResult> results; // fma, copy, image_load
+  std::vector<PeakResult> results; // fma, copy, image_load, buffer_gather, buffer_floor
 };
 
 Expected<Peaks> measure_peaks(const PeaksSettings& settings);
