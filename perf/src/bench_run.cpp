@@ -146,9 +146,10 @@ struct RunSamples {
   BenchEntry entry;
   std::vector<double> interval_ms;   // sustained phase: completion to completion
   double sustained_ms = 0.0;         // sustained phase: wall clock over the measured frames / frames
+  double cpu_ms = 0.0;               // sustained phase: process CPU time over the same interval / frames
   std::vector<double> profiled_ms;   // profiling phase: sum of the passes per frame
   std::vector<std::string> pass_order;
-  std::map<std::string, std::vector<double>> pass_ms;
+  std::map<std::string, std::vector<double>> pass_ms, pass_cpu_ms;
 };
 
 struct Progress {
@@ -224,13 +225,17 @@ Expected<RunSamples> run_one(const LoadedScene& l, const std::string& technique,
   std::vector<FrameOutput> kept;
   kept.reserve(measured);
   double start_s = -1.0, end_s = -1.0;
+  double start_cpu_ms = -1.0;
   auto keep = [&](std::vector<FrameOutput>& outs) -> Status {
     for (FrameOutput& out : outs) {
       const int64_t k = out.stats.frame_index;
       if (k < 0 || size_t(k) >= total)
         return fail(ErrorKind::Internal, what + ": runtime returned frame index " + std::to_string(k) +
                                              " outside 0.." + std::to_string(total - 1));
-      if (warmup > 0 && size_t(k) + 1 == warmup) start_s = out.stats.completed_s;
+      if (warmup > 0 && size_t(k) + 1 == warmup) {
+        start_s = out.stats.completed_s;
+        start_cpu_ms = gpu::process_cpu_ms();
+      }
       if (size_t(k) < warmup) continue;
       const double previous = kept.empty() ? start_s : kept.back().stats.completed_s;
       if (previous >= 0.0) r.interval_ms.push_back(1000.0 * (out.stats.completed_s - previous));
@@ -241,6 +246,7 @@ Expected<RunSamples> run_one(const LoadedScene& l, const std::string& technique,
     return ok_status();
   };
   const auto loop_start = std::chrono::steady_clock::now();
+  const double loop_start_cpu_ms = gpu::process_cpu_ms();
   for (size_t k = 0; k < total; ++k) {
     auto outs = rt->process(run_frames[k]);
     if (!outs.ok()) return fail(outs.error().kind, what + ", frame " + std::to_string(k) + ": " + outs.error().message);
@@ -249,12 +255,16 @@ Expected<RunSamples> run_one(const LoadedScene& l, const std::string& technique,
   auto rest = rt->flush();
   if (!rest.ok()) return fail(rest.error().kind, what + ", flush: " + rest.error().message);
   MRGI_TRY(keep(*rest));
+  const double end_cpu_ms = gpu::process_cpu_ms();
   if (kept.size() != measured)
     return fail(ErrorKind::Internal, what + ": " + std::to_string(kept.size()) + " of " + std::to_string(measured) +
                                          " measured frames came back");
   if (start_s < 0.0)  // no warm-up: from the first call (includes filling the pipeline)
     start_s = std::chrono::duration<double>(loop_start.time_since_epoch()).count();
   r.sustained_ms = 1000.0 * (end_s - start_s) / double(measured);
+  // The CPU clock is read when the host sees the completions (the first after the warm-up, the
+  // flush after the last), so it spans the same frames as the wall clock above.
+  r.cpu_ms = (end_cpu_ms - (start_cpu_ms >= 0.0 ? start_cpu_ms : loop_start_cpu_ms)) / double(measured);
 
   bool pooled_any = false;
   for (const FrameOutput& out : kept) {
@@ -292,13 +302,14 @@ Expected<RunSamples> run_one(const LoadedScene& l, const std::string& technique,
         // The frame = its passes + the host's own work on it (record, upload, readback), which
         // on a CPU device takes the same cores the passes run on.
         r.profiled_ms.push_back(out.stats.gpu_total_ms + out.stats.host_ms);
-        auto add = [&](const std::string& name, double ms) {
+        auto add = [&](const std::string& name, double ms, double cpu_ms) {
           auto [it, inserted] = r.pass_ms.try_emplace(name);
           if (inserted) r.pass_order.push_back(name);
           it->second.push_back(ms);
+          r.pass_cpu_ms[name].push_back(cpu_ms);
         };
-        for (const PassTiming& p : out.stats.passes) add(p.name, p.gpu_ms);
-        add(kHostPassName, out.stats.host_ms);
+        for (const PassTiming& p : out.stats.passes) add(p.name, p.gpu_ms, p.cpu_ms);
+        add(kHostPassName, out.stats.host_ms, out.stats.host_ms);  // the host thread's own
       }
     };
     for (size_t k = total; k < profiled_total; ++k) {
@@ -422,9 +433,11 @@ Expected<BenchResult> run_bench(const BenchSettings& s) {
       r.entry.frame = summarize(r.interval_ms, f.median_ms, f.min_ms);
       r.entry.sustained_ms = r.sustained_ms;
       r.entry.sustained_ratio = r.sustained_ms / f.median_ms;
+      r.entry.cpu_ms = r.cpu_ms;
       r.entry.profiled = summarize(r.profiled_ms, f.median_ms, f.min_ms);
       for (const std::string& name : r.pass_order)
-        r.entry.passes.push_back(PassSummary{name, summarize(r.pass_ms[name], f.median_ms, f.min_ms)});
+        r.entry.passes.push_back(PassSummary{name, summarize(r.pass_ms[name], f.median_ms, f.min_ms),
+                                             percentile(r.pass_cpu_ms[name], 50)});
       result.entries.push_back(std::move(r.entry));
     }
   }
@@ -446,6 +459,7 @@ std::vector<LevelAggregate> aggregate_levels(const BenchResult& result) {
     it->scenes += 1;
     it->mean_median_ms += e.sustained_ms;
     it->mean_median_ratio += e.sustained_ratio;
+    it->mean_cpu_ms += e.cpu_ms;
     it->max_memory_mib = std::max(it->max_memory_mib, e.memory_mib);
     if (e.has_reference) {
       if (!it->has_reference) {
@@ -461,6 +475,7 @@ std::vector<LevelAggregate> aggregate_levels(const BenchResult& result) {
   for (LevelAggregate& a : out) {
     a.mean_median_ms /= double(a.scenes);
     a.mean_median_ratio /= double(a.scenes);
+    a.mean_cpu_ms /= double(a.scenes);
   }
   return out;
 }

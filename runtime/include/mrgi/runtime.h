@@ -63,6 +63,10 @@ struct RuntimeSettings {
 struct PassTiming {
   std::string name;
   double gpu_ms = 0.0;
+  // Profiled frames: the process's CPU time (every thread: on a CPU device the driver's workers
+  // run the pass) over the pass's submission, ms; 0 otherwise. Over gpu_ms x the device's
+  // threads it says how well a pass keeps them busy, and it moves less with other tenants' load.
+  double cpu_ms = 0.0;
 };
 
 struct FrameStats {

@@ -4,12 +4,19 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <ctime>
 #include <string>
 
 #include "gpu/frame_graph.h"
 #include "gpu/vk_check.h"
 
 namespace mrgi::gpu {
+
+double process_cpu_ms() {
+  timespec ts{};
+  if (clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts) != 0) return 0.0;
+  return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
+}
 namespace {
 // A frame that has not finished after this long is treated as a hung device. Generous because
 // the CPU rasteriser (lavapipe, 2 threads) runs the best quality levels at seconds per frame.
@@ -42,6 +49,7 @@ struct FrameGraph::Slot {
   std::vector<std::string> culled;
   bool profiled = false;             // this slot's frame ran in profiling mode
   std::vector<double> host_ms;       // profiling mode: per pass, submit to fence
+  std::vector<double> cpu_ms;        // profiling mode: per pass, process CPU time meanwhile
 };
 
 // --- PassBuilder / PassContext -------------------------------------------------------------------
@@ -119,6 +127,7 @@ Status FrameGraph::init() {
     VK_CHECK(vkCreateQueryPool(dev, &qci, nullptr, &s.queries));
     s.pass_names.reserve(settings_.max_passes);
     s.host_ms.reserve(settings_.max_passes);
+    s.cpu_ms.reserve(settings_.max_passes);
   }
   if (settings_.allow_profiling) {
     profile_cmds_.resize(settings_.max_passes);
@@ -346,7 +355,7 @@ Expected<std::optional<FrameTimings>> FrameGraph::collect(uint32_t index) {
   t.profiled = s.profiled;
   if (s.profiled) {
     for (uint32_t i = 0; i < n; ++i) {
-      t.passes.push_back(PassTiming{s.pass_names[i], s.host_ms[i]});
+      t.passes.push_back(PassTiming{s.pass_names[i], s.host_ms[i], s.cpu_ms[i]});
       t.total_ms += s.host_ms[i];
     }
   } else if (n > 0) {
@@ -607,6 +616,7 @@ Status FrameGraph::submit_profiled() {
   VK_CHECK(vkQueueWaitIdle(context_.queue()));
   Slot& slot = slots_[slot_];
   slot.host_ms.assign(n, 0.0);
+  slot.cpu_ms.assign(n, 0.0);
   PassContext ctx(*this);
   VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -620,9 +630,11 @@ Status FrameGraph::submit_profiled() {
     if (i + 1 == n) record_barriers(cmd, compiled_.final_barriers);
     VK_CHECK(vkEndCommandBuffer(cmd));
     // Recording is not timed: the pass's time is what the queue spends on it.
+    const double cpu0 = process_cpu_ms();
     auto ms = submit_and_wait(cmd, &p.name);
     if (!ms) return ms.error();
     slot.host_ms[i] = std::max(0.0, *ms - submission_overhead_ms_);
+    slot.cpu_ms[i] = process_cpu_ms() - cpu0;
   }
   finish_execute(true);
   // The slot's fence marks the frame done, as in normal mode (an empty submission signals it).

@@ -28,6 +28,10 @@
 
 namespace mrgi::gpu {
 
+// CPU time of every thread of this process so far, ms (the profiling mode's and the bench's CPU
+// figures: on a CPU device the driver's worker threads do the GPU work).
+double process_cpu_ms();
+
 struct ImageHandle {
   uint32_t id = UINT32_MAX;
   bool valid() const { return id != UINT32_MAX; }

@@ -62,6 +62,7 @@ struct TimeSummary {
 struct PassSummary {
   std::string name;
   TimeSummary time;  // profiling phase: over the frames in which the pass ran (samples says how many)
+  double cpu_median_ms = 0.0;  // profiling phase: median process CPU time (PassTiming::cpu_ms)
 };
 
 struct BenchEntry {
@@ -71,6 +72,11 @@ struct BenchEntry {
   // The headline: wall-clock ms per frame sustained over the measured frames (phase 1), and
   // its ratio to the scene's floor.
   double sustained_ms = 0.0, sustained_ratio = 0.0;
+  // CPU time of the whole process (the host thread and the driver's worker threads) over the
+  // same interval, per measured frame. On a shared machine it moves less than wall time with
+  // other tenants' load (time the machine gives elsewhere is not counted), so it is the figure
+  // to compare two builds by; on lavapipe it approaches LP_NUM_THREADS x the work's wall time.
+  double cpu_ms = 0.0;
   TimeSummary frame;                     // phase 1: intervals between frame completions
   TimeSummary profiled;                  // phase 2: per frame, the sum of its passes
   std::vector<PassSummary> passes;       // in first-seen order
@@ -115,6 +121,7 @@ struct LevelAggregate {
   int level = 0;
   size_t scenes = 0;
   double mean_median_ms = 0.0, mean_median_ratio = 0.0;
+  double mean_cpu_ms = 0.0;  // mean over scenes of BenchEntry::cpu_ms
   double max_memory_mib = 0.0;
   bool has_reference = false;
   RdeReport error;
