@@ -30,6 +30,11 @@ layout(local_size_x = 8, local_size_y = 8) in;
 // halving the reads is the only way to save them). Same results as the general path, which
 // runs over the cells inside those bounds.
 layout(constant_id = 0) const bool kRealReceivers = false;
+// kRealOnly (with kRealReceivers): the dispatch covers only cells outside the influence region,
+// whose real + virtual solution is the real one bit for bit (see `influenced` in main): only the
+// real solution is computed, and nothing of the virtual G-buffer is read. Most of a frame lies
+// outside the region when the virtual objects are small on screen.
+layout(constant_id = 1) const bool kRealOnly = false;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
 layout(std140, set = 0, binding = 1) uniform LightUbo { SsrtLight light; };
 layout(std430, set = 0, binding = 2) readonly buffer SampleBuffer { SsrtSample samples[]; };
@@ -120,7 +125,7 @@ void surfaces_at(vec2 q, ivec2 qi, int gstep, int ostep, out vec4 real, out vec3
                  out vec3 ra, out vec4 virt, out vec3 vn, out vec3 va) {
   ivec2 g = qi / ostep;
   uvec4 a = imageLoad(occ_a, g);
-  uvec2 b = imageLoad(occ_b, g).xy;
+  uvec2 b = kRealOnly ? uvec2(0u) : imageLoad(occ_b, g).xy;
   ivec2 p = min(g * ostep + ivec2(ostep / 2), frame.internal_output_size.xy - 1);
   vec3 ray = unproject_pinhole(q, 1.0f, frame.internal_k);
   mat3 to_camera = mat3(frame.world_to_camera);
@@ -135,6 +140,10 @@ void surfaces_at(vec2 q, ivec2 qi, int gstep, int ostep, out vec4 real, out vec3
   vec3 cr = gstep > 1 ? ray * z : pr;
   real = zr > 0.0f ? vec4((frame.camera_to_world * vec4(cr, 1.0f)).xyz, z) : vec4(0.0f);
 
+  virt = vec4(0.0f);
+  vn = vec3(0.0f);
+  va = vec3(0.0f);
+  if (kRealOnly) return;
   float zv = uintBitsToFloat(a.w);
   vn = oct_decode(unpackSnorm2x16(b.x));
   va = unpackUnorm4x8(b.y).rgb;
@@ -184,8 +193,8 @@ void main() {
   // this surface, and the range check below makes sure only occluders within that range count,
   // so the real + virtual solution equals the real one bit for bit: it is copied, not computed
   // (DESIGN.md: tiles outside the influence region are not shaded).
-  bool influenced = virt || (cell.x >= pc.influence.x && cell.x < pc.influence.z &&
-                             cell.y >= pc.influence.y && cell.y < pc.influence.w);
+  bool influenced = !kRealOnly && (virt || (cell.x >= pc.influence.x && cell.x < pc.influence.z &&
+                             cell.y >= pc.influence.y && cell.y < pc.influence.w));
   int base = pc.config.x + set * pc.grid.w;
 
   // Each set holds antipodal pairs (sample j + N/2 = -sample j, sample_directions.h), so exactly
@@ -237,20 +246,21 @@ void main() {
       if (!from_view_v && aux_hit) k_v = k_aux;
       SH16 y_sh = sh_basis16(w);
       float tw = ssrt_transfer_weight(nr, w, k, 1.0f);
-      float tw_v = ssrt_transfer_weight(nr, w, k_v, 1.0f);
       t_real[0] += tw * y_sh.c0;
       t_real[1] += tw * y_sh.c1;
       t_real[2] += tw * y_sh.c2;
       t_real[3] += tw * y_sh.c3;
+      if (from_view)
+        ri += ssrt_indirect_term(xr, nr, o.xyz, on, oa, k, l_dir, e_light, pc.bounce.x,
+                                 pc.sampling.w);
+      if (kRealOnly) continue;
+      float tw_v = ssrt_transfer_weight(nr, w, k_v, 1.0f);
       t_rv[0] += tw_v * y_sh.c0;
       t_rv[1] += tw_v * y_sh.c1;
       t_rv[2] += tw_v * y_sh.c2;
       t_rv[3] += tw_v * y_sh.c3;
       vec3 sn_v = use_virtual ? vn : on;
       vec3 sa_v = use_virtual ? va : oa;
-      if (from_view)
-        ri += ssrt_indirect_term(xr, nr, o.xyz, on, oa, k, l_dir, e_light, pc.bounce.x,
-                                 pc.sampling.w);
       if (from_view_v)
         ri_v += ssrt_indirect_term(xr, nr, sp_v, sn_v, sa_v, k_v, l_dir, e_light, pc.bounce.x,
                                    pc.sampling.w);

@@ -1,4 +1,5 @@
 #include "technique/ssrt/ssrt_internal.h"
+#include <array>
 
 namespace mrgi::technique {
 namespace ssrt_detail {
@@ -144,6 +145,25 @@ bool Ssrt::project_virtual_bounds(float grow_m, glm::vec2& pmin, glm::vec2& pmax
     if (out_count[side] == 8) return false;
   behind = out_count[0] > 0;
   return true;
+}
+
+// The smallest rectangle holding both [x0, x1) x [y0, y1) rectangles (an empty one adds nothing).
+static glm::ivec4 cover(glm::ivec4 a, glm::ivec4 b) {
+  const bool a_empty = a.z <= a.x || a.w <= a.y, b_empty = b.z <= b.x || b.w <= b.y;
+  if (a_empty) return b;
+  if (b_empty) return a;
+  return glm::ivec4(glm::min(glm::ivec2(a), glm::ivec2(b)), glm::max(glm::ivec2(a.z, a.w), glm::ivec2(b.z, b.w)));
+}
+
+// `outer` less `inner` as up to four disjoint rectangles (above, below, left, right; empty ones
+// have x1 <= x0 or y1 <= y0). `inner` is clipped to `outer`; an empty one leaves `outer` whole.
+static std::array<glm::ivec4, 4> bands_around(glm::ivec4 outer, glm::ivec4 inner) {
+  inner = glm::ivec4(glm::clamp(glm::ivec2(inner), glm::ivec2(outer), glm::ivec2(outer.z, outer.w)),
+                     glm::clamp(glm::ivec2(inner.z, inner.w), glm::ivec2(outer), glm::ivec2(outer.z, outer.w)));
+  if (inner.z <= inner.x || inner.w <= inner.y)
+    return {outer, glm::ivec4(0), glm::ivec4(0), glm::ivec4(0)};
+  return {glm::ivec4(outer.x, outer.y, outer.z, inner.y), glm::ivec4(outer.x, inner.w, outer.z, outer.w),
+          glm::ivec4(outer.x, inner.y, inner.x, inner.w), glm::ivec4(inner.z, inner.y, outer.z, inner.w)};
 }
 
 // The region where the virtual objects can shadow or light a real surface: their bounds grown
@@ -365,19 +385,26 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
                                     0.0f),
                           glm::ivec4(0)};
           // Cells whose receiver may be virtual (centre pixel inside the virtual objects'
-          // projected bounds) take the general path; the rest, up to four bands around them,
-          // the real-receiver one.
+          // projected bounds) take the general path; the rest of the influence region, up to
+          // four bands around them, the real-receiver one; the cells outside the region, up to
+          // four bands around it, the real-only one (their real + virtual solution is the real
+          // one). Each variant's shader has the paths it does not take compiled out.
           const glm::ivec4 v = virtual_cells();
-          const int gx = int(grid_.x), gy = int(grid_.y);
-          const glm::ivec4 regions[5] = {v,                   // general path
-                                         {0, 0, gx, v.y},     // real receivers: above,
-                                         {0, v.w, gx, gy},    // below,
-                                         {0, v.y, v.x, v.w},  // left,
-                                         {v.z, v.y, gx, v.w}};  // right
-          for (int i = 0; i < 5; ++i) {
-            pc.region = regions[i];
+          const glm::ivec4 grid(0, 0, int(grid_.x), int(grid_.y));
+          const glm::ivec4 infl = cover(influence_cells_, v);
+          struct Dispatch { glm::ivec4 region; const gpu::Pipeline* pipe; };
+          std::array<Dispatch, 9> dispatches;
+          dispatches[0] = {v, &*transfer_};
+          const std::array<glm::ivec4, 4> near = bands_around(infl, v);
+          const std::array<glm::ivec4, 4> far = bands_around(grid, infl);
+          for (size_t i = 0; i < 4; ++i) {
+            dispatches[1 + i] = {near[i], &*transfer_real_};
+            dispatches[5 + i] = {far[i], &*transfer_real_only_};
+          }
+          for (const Dispatch& d : dispatches) {
+            pc.region = d.region;
             if (pc.region.z <= pc.region.x || pc.region.w <= pc.region.y) continue;
-            const gpu::Pipeline& pipe = i == 0 ? *transfer_ : *transfer_real_;
+            const gpu::Pipeline& pipe = *d.pipe;
             vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipe.pipeline);
             descriptors.push(ctx, cmd, pipe);
             gpu::dispatch_2d(cmd, pipe, &pc, sizeof(pc), uint32_t(pc.region.z - pc.region.x),

@@ -103,15 +103,23 @@ Status Ssrt::init() {
   const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
   auto transfer_spv = gpu::shader_spirv("ssrt/transfer.comp");
   if (!transfer_spv) return transfer_spv.error();
-  for (uint32_t real_receivers = 0; real_receivers < 2; ++real_receivers) {
-    gpu::ComputePipelineDesc d{real_receivers ? "ssrt_transfer_real_receivers" : "ssrt_transfer",
-                               *transfer_spv,
+  // Variants (transfer.comp's constants kRealReceivers, kRealOnly): the general path, real
+  // receivers inside the influence region, real receivers outside it.
+  const struct {
+    const char* name;
+    uint32_t real_receivers, real_only;
+    gpu::PipelineHandle* handle;
+  } transfer_variants[] = {{"ssrt_transfer", 0, 0, &transfer_},
+                           {"ssrt_transfer_real_receivers", 1, 0, &transfer_real_},
+                           {"ssrt_transfer_real_only", 1, 1, &transfer_real_only_}};
+  for (const auto& variant : transfer_variants) {
+    gpu::ComputePipelineDesc d{variant.name, *transfer_spv,
                                {{ubo}, {ubo}, {ssbo}, {img}, {img}, {ssbo}, {img}, {img}, {img},
                                 {img}, {img}, {ubo}, {img}, {ssbo}},
-                               sizeof(TransferPush), {real_receivers}};
+                               sizeof(TransferPush), {variant.real_receivers, variant.real_only}};
     auto tp = gpu::create_compute_pipeline(ctx, d);
     if (!tp) return tp.error();
-    (real_receivers ? transfer_real_ : transfer_) = gpu::PipelineHandle(ctx, std::move(*tp));
+    *variant.handle = gpu::PipelineHandle(ctx, std::move(*tp));
   }
   auto p = gpu::load_compute_pipeline(ctx, "ssrt/occluders.comp",
                                       {{ubo}, {ssbo}, {ssbo}, {img}, {img}, {img}, {img}, {img},

@@ -148,7 +148,7 @@ class Ssrt final : public Technique {
   gpu::BufferHandle samples_, light_, partials_, result_;
   gpu::ImageHandle coarse_;
   gpu::ImageHandle upsampled_;  // RGBA32UI per cell, shaders/ssrt/upsampled.glsl
-  gpu::PipelineHandle occluders_, transfer_, transfer_real_, reduce_, reduce_final_, blur_, shade_, shade_pass_,
+  gpu::PipelineHandle occluders_, transfer_, transfer_real_, transfer_real_only_, reduce_, reduce_final_, blur_, shade_, shade_pass_,
       shade_tiled_, shade_tiles_;
   // Fast levels' shade tiles (shade_tiles.comp): indirect dispatch arguments and tile indices.
   gpu::BufferHandle tile_args_, tile_list_;
