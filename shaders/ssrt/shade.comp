@@ -203,41 +203,47 @@ void shade_group(ivec2 origin) {
       const float f_x = px == 0 ? 0.5f : (px == 1 ? 0.75f : (px == 2 ? 0.0f : 0.25f));
       float f_y = f_y0 + 0.25f * float(py);
       vec4 wx = cubic_weights(f_x), wy = cubic_weights(f_y);
-      vec4 k4 = vec4(0.0f), k5 = vec4(0.0f), k6 = vec4(0.0f);
-      vec4 a4 = vec4(0.0f), a5 = vec4(0.0f), a6 = vec4(0.0f);
+      // sample_bicubic's two sums (same kind, any surface) differ only in which cells count,
+      // and only one of them is used: the weights decide which first (scalars), then one
+      // weighted sum runs over the taps with the other cells' weight 0. Adding 0 * value leaves
+      // a sum as it is, so the result is sample_bicubic's, term for term, with half the vector
+      // arithmetic (and only the components store_shaded reads: R_d, R'_d, R_i, R'_i).
+      float w16[16];
+      bool present16[16], same16[16];
       float kw = 0.0f, aw = 0.0f;
       [[unroll]] for (int j = 0; j < 4; ++j) {
         [[unroll]] for (int i = 0; i < 4; ++i) {
           int c = j * 5 + col0 + i;
           float kind_q = c_kind[c];
-          float present = kind_q > 0.5f ? 1.0f : 0.0f;
-          float same = present > 0.5f && abs(kind_q - kind) <= 0.5f ? 1.0f : 0.0f;
+          bool present = kind_q > 0.5f;
+          bool same = present && abs(kind_q - kind) <= 0.5f;
           float w = wx[i] * wy[j];
-          vec4 a = vec4(c_rd[c], c_rdv[c], 0.0f, kind_q);
-          vec4 t5 = vec4(c_ri[c], 1.0f);
-          vec4 t6 = vec4(c_riv[c], 1.0f);
-          // Same terms as sample_bicubic's `continue`s: absent cells add nothing.
-          if (present > 0.5f) {
-            a4 += w * a;
-            a5 += w * t5;
-            a6 += w * t6;
-            aw += w;
-          }
-          if (same > 0.5f) {
-            k4 += w * a;
-            k5 += w * t5;
-            k6 += w * t6;
-            kw += w;
-          }
+          w16[j * 4 + i] = w;
+          present16[j * 4 + i] = present;
+          same16[j * 4 + i] = same;
+          aw += present ? w : 0.0f;
+          kw += same ? w : 0.0f;
+        }
+      }
+      bool use_same = abs(kw) > 1e-4f;
+      float wsum = use_same ? kw : aw;
+      vec2 sd = vec2(0.0f);
+      vec3 si = vec3(0.0f), siv = vec3(0.0f);
+      [[unroll]] for (int j = 0; j < 4; ++j) {
+        [[unroll]] for (int i = 0; i < 4; ++i) {
+          int c = j * 5 + col0 + i;
+          bool counts = use_same ? same16[j * 4 + i] : present16[j * 4 + i];
+          float w = counts ? w16[j * 4 + i] : 0.0f;
+          sd += w * vec2(c_rd[c], c_rdv[c]);
+          si += w * c_ri[c];
+          siv += w * c_riv[c];
         }
       }
       vec4 s4 = vec4(0.0f), s5 = vec4(0.0f), s6 = vec4(0.0f);
-      bool use_same = abs(kw) > 1e-4f;
-      float wsum = use_same ? kw : aw;
       if (abs(wsum) > 1e-4f) {
-        s4 = max((use_same ? k4 : a4) / wsum, vec4(0.0f));
-        s5 = max((use_same ? k5 : a5) / wsum, vec4(0.0f));
-        s6 = max((use_same ? k6 : a6) / wsum, vec4(0.0f));
+        s4 = vec4(max(sd / wsum, vec2(0.0f)), 0.0f, 0.0f);
+        s5 = vec4(max(si / wsum, vec3(0.0f)), 0.0f);
+        s6 = vec4(max(siv / wsum, vec3(0.0f)), 0.0f);
       }
       if (pixel.x < pc.size.x && pixel.y < pc.size.y) {
         if (!p.inside && !p.virt) {
