@@ -54,11 +54,6 @@ uvec3 camera_bytes(ivec2 p) {
 
 vec3 camera_linear(ivec2 p) { return srgb_decode(vec3(camera_bytes(p)) / 255.0f); }
 
-vec3 finite(vec3 c) {
-  return vec3(isnan(c.x) || isinf(c.x) ? 0.0f : c.x, isnan(c.y) || isinf(c.y) ? 0.0f : c.y,
-              isnan(c.z) || isinf(c.z) ? 0.0f : c.z);
-}
-
 // Camera colour at an output pixel, linear; bilinear on linear values when the sizes differ.
 vec3 camera_at(vec2 rel, ivec2 pixel) {
   if (kSameSize) return camera_linear(pixel);
@@ -75,15 +70,15 @@ vec3 camera_at(vec2 rel, ivec2 pixel) {
 // (A macro: GLSL image parameters cannot carry the format qualifier imageLoad needs.)
 #define SOLUTION_AT(NAME, S)                                                                  \
   vec3 NAME(vec2 rel, ivec2 used, ivec2 pixel) {                                             \
-    if (kSameInternal) return finite(imageLoad(S, pixel).rgb);                               \
+    if (kSameInternal) return finite3(imageLoad(S, pixel).rgb);                               \
     vec2 ipos = rel * vec2(used) - 0.5f;                                                     \
     ivec2 i0 = ivec2(floor(ipos));                                                           \
     vec2 w = ipos - vec2(i0);                                                                \
     ivec2 a = clamp(i0, ivec2(0), used - 1), b = clamp(i0 + 1, ivec2(0), used - 1);          \
-    return mix(mix(finite(imageLoad(S, ivec2(a.x, a.y)).rgb),                                \
-                   finite(imageLoad(S, ivec2(b.x, a.y)).rgb), w.x),                          \
-               mix(finite(imageLoad(S, ivec2(a.x, b.y)).rgb),                                \
-                   finite(imageLoad(S, ivec2(b.x, b.y)).rgb), w.x), w.y);                    \
+    return mix(mix(finite3(imageLoad(S, ivec2(a.x, a.y)).rgb),                                \
+                   finite3(imageLoad(S, ivec2(b.x, a.y)).rgb), w.x),                          \
+               mix(finite3(imageLoad(S, ivec2(a.x, b.y)).rgb),                                \
+                   finite3(imageLoad(S, ivec2(b.x, b.y)).rgb), w.x), w.y);                    \
   }
 SOLUTION_AT(solution_rv, lit_rv)
 SOLUTION_AT(solution_r, lit_r)
@@ -114,12 +109,8 @@ void main() {
   vec3 r = solution_r(rel, used, pixel);
   ivec2 ip = kSameInternal ? pixel : min(ivec2(rel * vec2(used)), used - 1);
   float is_virtual = imageLoad(virtual_position, ip).w > 0.5f ? 1.0f : 0.0f;
-  float exposure = frame.camera.y;
-  vec3 tm_rv = clamp(rv * exposure, vec3(0.0f), vec3(1.0f));
-  vec3 tm_r = clamp(r * exposure, vec3(0.0f), vec3(1.0f));
-  vec3 out_linear = differential_compose(camera_at(rel, pixel), tm_r, tm_rv, is_virtual,
-                                         params.compose.x, params.compose.y);
-  vec3 encoded = srgb_encode(clamp(finite(out_linear), vec3(0.0f), vec3(1.0f)));
+  vec3 encoded = compose_encoded(camera_at(rel, pixel), r, rv, is_virtual, frame.camera.y,
+                                 params.compose.x, params.compose.y);
   out_rgba8[index] = packUnorm4x8(vec4(encoded, 1.0f));
   out_mask[index] = is_virtual > 0.5f ? 1u : 0u;
 }

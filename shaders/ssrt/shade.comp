@@ -27,6 +27,11 @@ layout(local_size_x_id = 2, local_size_y_id = 3) in;
 // ssrt_shade_tiles listed (workgroup i = tiles.list[i]); neither: every pixel.
 layout(constant_id = 0) const bool kPassThrough = false;
 layout(constant_id = 1) const bool kTiled = false;
+// kCompose (with kTiled, solutions at the camera's size): each shaded pixel is composed here
+// (mrgi_shared.h compose_encoded, the runtime's compose formula) and written to the runtime's
+// output and mask instead of lit_r / lit_rv (Technique::ComposeTiles::composed): the compose
+// pass would otherwise read both solutions, the coverage and the camera again per pixel.
+layout(constant_id = 4) const bool kCompose = false;
 // Storage images read with imageLoad: on lavapipe a sampled texelFetch costs 2-3x as much.
 layout(set = 0, binding = 0, rgba32f) readonly uniform image2DArray coarse;
 layout(set = 0, binding = 1, rgba32f) readonly uniform image2D real_position;
@@ -42,12 +47,15 @@ layout(set = 0, binding = 5, rgba16f) writeonly uniform image2D lit_rv;
 layout(set = 0, binding = 6, rgba16f) writeonly uniform image2D lit_r;
 layout(set = 0, binding = 7, rgba32ui) readonly uniform uimage2D upsampled;
 layout(std430, set = 0, binding = 8) readonly buffer Tiles { uint list[]; } tiles;
+layout(std430, set = 0, binding = 11) writeonly buffer Output { uint out_rgba8[]; };  // kCompose
+layout(std430, set = 0, binding = 12) writeonly buffer Mask { uint out_mask[]; };     // kCompose
 layout(push_constant) uniform Push {
   ivec4 grid;   // x, y cells; z step in pixels; w unused
   ivec4 size;   // xy used extent of the solutions (internal resolution), z geometry step
                 // (internal pixels per texel of real_position)
   ivec4 influence;  // pixels [x0, x1) x [y0, y1) the virtual objects' influence region covers
-  vec4 opts;    // x relative tolerance of eq. 14
+  vec4 opts;    // x relative tolerance of eq. 14; kCompose: y eps, z alpha_max of the
+                // composite (compose_encoded)
 } pc;
 
 vec4 cubic_weights(float t) {
@@ -114,6 +122,7 @@ vec2 cell_position(ivec2 pixel) {
 struct PixelInputs {
   bool real_ok, virt, inside;
   vec3 a;
+  vec3 camera;  // kCompose: the camera's linear value at the pixel (compose's CI)
 };
 
 PixelInputs pixel_inputs(ivec2 pixel) {
@@ -121,17 +130,33 @@ PixelInputs pixel_inputs(ivec2 pixel) {
   p.real_ok = imageLoad(real_position, pixel / pc.size.z).w > 0.0f;
   p.virt = imageLoad(virtual_position, pixel).w > 0.5f;
   p.a = camera_at(vec2(pixel)).rgb;
+  // Compose reads the camera pixel of the output pixel; kCompose runs at the camera's size.
+  p.camera = kCompose ? srgb_decode(vec3(color_rgb8(uint(pixel.y * frame.color_depth_size.x + pixel.x))) / 255.0f)
+                      : vec3(0.0f);
   p.inside = pixel.x >= pc.influence.x && pixel.x < pc.influence.z &&
              pixel.y >= pc.influence.y && pixel.y < pc.influence.w;
   return p;
 }
 
+// The pixel's two solutions, or under kCompose its composite (what compose.comp writes).
+void store_solutions(ivec2 pixel, PixelInputs p, vec3 l_r, vec3 l_rv) {
+  if (kCompose) {
+    uint index = uint(pixel.y * frame.internal_output_size.z + pixel.x);
+    vec3 encoded = compose_encoded(p.camera, l_r, l_rv, p.virt ? 1.0f : 0.0f, frame.camera.y,
+                                   pc.opts.y, pc.opts.z);
+    out_rgba8[index] = packUnorm4x8(vec4(encoded, 1.0f));
+    out_mask[index] = p.virt ? 1u : 0u;
+    return;
+  }
+  imageStore(lit_r, pixel, vec4(l_r, 1.0f));
+  imageStore(lit_rv, pixel, vec4(l_rv, 1.0f));
+}
+
 // Skipped transfer, or a pixel outside the influence region: nothing virtual changes it, so
 // L_rv = L_r and the compose returns the camera colour whatever their common value.
 void store_pass_through(ivec2 pixel, PixelInputs p) {
-  vec4 v = vec4(p.real_ok ? p.a : vec3(0.0f), 1.0f);
-  imageStore(lit_r, pixel, v);
-  imageStore(lit_rv, pixel, v);
+  vec3 v = p.real_ok ? p.a : vec3(0.0f);
+  store_solutions(pixel, p, v, v);
 }
 
 void store_shaded(ivec2 pixel, PixelInputs p, vec4 s4, vec4 s5, vec4 s6) {
@@ -147,8 +172,7 @@ void store_shaded(ivec2 pixel, PixelInputs p, vec4 s4, vec4 s5, vec4 s6) {
   } else {
     l_rv = real_ok ? a * rd_v + a * ssrt_indirect_select(ri, ri_v, pc.opts.x) / MRGI_PI : vec3(0.0f);
   }
-  imageStore(lit_r, pixel, vec4(l_r, 1.0f));
-  imageStore(lit_rv, pixel, vec4(l_rv, 1.0f));
+  store_solutions(pixel, p, l_r, l_rv);
 }
 
 // One pixel on its own (untiled pipelines, and tiled ones at steps other than 4).

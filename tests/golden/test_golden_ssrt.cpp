@@ -93,5 +93,65 @@ TEST(GoldenSsrt, FirstFrameIsPrimedOnceAndEveryFrameGivesOneOutput) {
   }
 }
 
+// The fast level at the camera's size composes its tiles in its shade pass (RuntimeSettings::
+// fuse_compose); the runtime's compose pass, with the same formula, must give the same frames
+// to 1/255 (the fused path keeps the solutions in 32-bit floats, compose reads them back from
+// RGBA16F), the same virtual mask, and frames that differ from the camera where virtual light
+// falls. Validation layers on.
+TEST(GoldenSsrt, FusedComposeMatchesTheComposePass) {
+  auto capture = CaptureReader::open(std::string(MRGI_SOURCE_DIR) + "/tests/data/golden_desk_160");
+  ASSERT_TRUE(capture.ok()) << capture.error().message;
+  const CaptureInfo& info = capture->info();
+  std::vector<FrameOutput> runs[2];
+  for (int fused = 0; fused < 2; ++fused) {
+    RuntimeSettings s;
+    s.device.validate = true;
+    s.technique = "ssrt";
+    s.level = 2;  // fast: 4x4 cells, tiled shade
+    s.fuse_compose = fused == 1;
+    auto rt = create_runtime(s, CameraSetup{info.color, info.depth, info.depth_scale, info.exposure},
+                             *capture->scene());
+    ASSERT_TRUE(rt.ok()) << rt.error().message;
+    for (size_t i = 0; i < capture->frame_count(); ++i) {
+      auto f = capture->read_frame(i);
+      ASSERT_TRUE(f.ok());
+      f->index = int64_t(i);
+      auto o = (*rt)->process(*f);
+      ASSERT_TRUE(o.ok()) << o.error().message;
+      for (auto& x : *o) runs[fused].push_back(std::move(x));
+    }
+    auto rest = (*rt)->flush();
+    ASSERT_TRUE(rest.ok()) << rest.error().message;
+    for (auto& x : *rest) runs[fused].push_back(std::move(x));
+    ASSERT_EQ(runs[fused].size(), capture->frame_count());
+  }
+  size_t differing = 0, changed = 0, total = 0, fused_frames = 0;
+  for (size_t i = 0; i < runs[0].size(); ++i) {
+    const FrameOutput& a = runs[0][i];
+    const FrameOutput& b = runs[1][i];
+    ASSERT_EQ(a.image.data.size(), b.image.data.size());
+    EXPECT_EQ(a.virtual_mask.data, b.virtual_mask.data) << "frame " << i;
+    auto camera = capture->read_frame(i);
+    ASSERT_TRUE(camera.ok());
+    for (size_t p = 0; p < a.image.data.size() / 4; ++p) {
+      int worst = 0;
+      for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(int(a.image.data[4 * p + c]) - int(b.image.data[4 * p + c])));
+      ASSERT_LE(worst, 1) << "frame " << i << " pixel " << p;
+      differing += worst > 0;
+      for (int c = 0; c < 3; ++c) changed += b.image.data[4 * p + c] != camera->color.data[3 * p + c] ? 1 : 0;
+      ++total;
+    }
+    bool compose_pass = false;
+    for (const PassTiming& t : a.stats.passes) compose_pass |= t.name == "compose";
+    EXPECT_TRUE(compose_pass) << "frame " << i << ": compose runs when fusing is off";
+    bool notes_fused = false;
+    for (const std::string& n : b.stats.skipped) notes_fused |= n.rfind("compose: ssrt_shade_tiled composes", 0) == 0;
+    fused_frames += notes_fused;
+  }
+  EXPECT_EQ(fused_frames, runs[1].size()) << "every fused frame says compose ran no pass";
+  EXPECT_LT(differing, total / 20) << "pixels 1/255 apart";
+  EXPECT_GT(changed, total / 100) << "the virtual objects change the frame";
+}
+
 }  // namespace
 }  // namespace mrgi

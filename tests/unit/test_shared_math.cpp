@@ -2,6 +2,8 @@
 // trips, and SH orthonormality by numeric integration over the sphere.
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <cmath>
 #include <random>
 
@@ -197,6 +199,32 @@ TEST(SharedMath, DifferentialCompose) {
   const float a2 = compose_alpha1(0.5f, eps * 1.001f, eps, amax);
   EXPECT_NEAR(a1, a2, 1e-2f);
   EXPECT_FLOAT_EQ(compose_alpha1(0.5f, 0.0f, eps, amax), 1.0f);
+}
+
+TEST(SharedMath, ComposeEncodedIsTheCameraModelAroundDifferentialCompose) {
+  const float eps = 1e-3f, amax = 10.0f, exposure = 0.5f;
+  // Equal solutions: the camera's own value back, encoded.
+  const vec3 cam(0.2f, 0.4f, 0.8f);
+  vec3 o = compose_encoded(cam, vec3(0.3f), vec3(0.3f), 0.0f, exposure, eps, amax);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(o[c], srgb_encode1(cam[c]), 1e-6f);
+  // The solutions are seen through the exposure and clipped at 1 before the ratio.
+  o = compose_encoded(cam, vec3(0.8f), vec3(0.4f), 0.0f, exposure, eps, amax);
+  const vec3 want = differential_compose(cam, vec3(0.4f), vec3(0.2f), 0.0f, eps, amax);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(o[c], srgb_encode1(want[c]), 1e-6f);
+  o = compose_encoded(cam, vec3(0.3f), vec3(10.0f), 1.0f, exposure, eps, amax);
+  EXPECT_NEAR(o.x, 1.0f, 1e-6f) << "virtual pixel: L_rv clipped at sensor saturation";
+  // Non-finite solutions never reach the frame.
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  for (const vec3 bad : {vec3(nan), vec3(inf), vec3(-inf, nan, inf)}) {
+    for (const float virt : {0.0f, 1.0f}) {
+      const vec3 a = compose_encoded(cam, bad, vec3(0.3f), virt, exposure, eps, amax);
+      const vec3 b = compose_encoded(cam, vec3(0.3f), bad, virt, exposure, eps, amax);
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_TRUE(std::isfinite(a[c]) && a[c] >= 0.0f && a[c] <= 1.0f);
+        EXPECT_TRUE(std::isfinite(b[c]) && b[c] >= 0.0f && b[c] <= 1.0f);
+      }
+    }
+  }
 }
 
 }  // namespace

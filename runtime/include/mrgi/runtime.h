@@ -53,6 +53,12 @@ struct RuntimeSettings {
   // Skip the virtual G-buffer and the technique on frames where no virtual object or its shadow
   // can be seen (the output is then the camera frame; FrameStats::skipped says so).
   bool skip_unaffected_frames = true;
+  // A technique that shades only some tiles of the output may write their composite itself
+  // (ssrt's fast levels at the camera's size: compose then runs no pass; 10 of desk_spot's 150
+  // CPU ms per frame on lavapipe). false: the runtime's compose pass composes every frame, with
+  // the same formula (mrgi_shared.h compose_encoded); the outputs agree to 1/255 (the fused
+  // path keeps the solutions in 32-bit floats, compose reads them from RGBA16F images).
+  bool fuse_compose = true;
   // Profiling mode (also Runtime::set_profiling): each pass of a frame submitted on its own and
   // waited for, timed by the host clock, so FrameStats::passes add up to the frame. Frames then
   // do not overlap: use it to see where the time goes (bench, scheduler cost model), not to run.

@@ -77,6 +77,7 @@ void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
            used.width == width_ && used.height == height_;
   const bool host_camera = tiled_ && same_size_as_camera_;
   slot_host_camera_[graph.slot()] = host_camera ? 1 : 0;
+  const bool composed = host_camera && in_.tiles_composed;
   if (tiled_ && !host_camera) {
     // The camera frame everywhere, then the composite over the technique's tiles.
     graph.add_pass(
@@ -93,7 +94,7 @@ void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
         },
         [this](VkCommandBuffer cmd, gpu::PassContext& pass) { dispatch(cmd, pass, false); });
   }
-  graph.add_pass(
+  if (!composed) graph.add_pass(
       "compose", gpu::PassKind::Compute,
       [this](gpu::PassBuilder& b) {
         b.read(in_.frame_constants, gpu::Access::UniformRead);

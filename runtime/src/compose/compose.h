@@ -5,7 +5,9 @@
 // the virtual-pixel mask straight into this slot's readback buffers. A tiled frame at the
 // camera's size writes only the listed tiles there, with a copy of the tile list: read() takes
 // the camera frame from the upload on the host and lays the tiles over it (0.3 ms of host time
-// against 2.4 ms for a full-frame camera copy pass on lavapipe at 640x480).
+// against 2.4 ms for a full-frame camera copy pass on lavapipe at 640x480). A technique may write
+// the composite of its tiles itself (ComposeInputs::tiles_composed, same formula: mrgi_shared.h
+// compose_encoded); compose then adds no pass, only the tile-list readback.
 #pragma once
 #include <vector>
 
@@ -33,6 +35,11 @@ struct ComposeInputs {
   // the output is the camera frame. Used when the solutions are at the output size; then
   // compose runs as a camera copy over the frame and the composite over the tiles.
   gpu::BufferHandle tile_args, tile_list;
+  // The technique wrote the composite of those tiles into output() and mask() itself
+  // (Technique::ComposeTiles::composed): compose adds no pass of its own, only the tile-list
+  // readback, and lays the tiles over the camera frame on the host. Honoured only for a frame
+  // at the camera's size whose solutions have the output's size (fusable()).
+  bool tiles_composed = false;
 };
 
 class Compose {
@@ -49,6 +56,14 @@ class Compose {
   // (resized to the output size; non-zero mask = virtual pixel).
   Status read(const gpu::FrameGraph& graph, uint32_t slot, ImageRGBA8& image,
               Image<uint8_t, 1>& mask) const;
+  // Where a technique composes its own tiles: the readback buffers (RGBA8 packed as
+  // packUnorm4x8 of the sRGB value, and a uint per pixel, non-zero = virtual), row-major at the
+  // output size, and the guards (mrgi_shared.h compose_encoded). fusable(): the output has the
+  // camera's size, the only case in which tiles_composed is honoured.
+  gpu::BufferHandle output() const { return output_; }
+  gpu::BufferHandle mask() const { return mask_; }
+  const ComposeSettings& settings() const { return settings_; }
+  bool fusable() const { return same_size_as_camera_; }
 
  private:
   void dispatch(VkCommandBuffer cmd, gpu::PassContext& pass, bool tiled_pass);

@@ -191,6 +191,11 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
     *h = *img;
   }
 
+  auto comp = compose::Compose::create(*context_, *graph_, uint32_t(output_w_), uint32_t(output_h_),
+                                       output_w_ == c.width && output_h_ == c.height);
+  if (!comp) return comp.error();
+  compose_.emplace(std::move(*comp));
+
   technique::SharedResources shared;
   shared.context = context_.get();
   shared.graph = graph_.get();
@@ -206,6 +211,12 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   shared.lit_rv = lit_rv_;
   shared.lit_r = lit_r_;
   shared.compose_honours_tiles = true;  // record(): compose uses Technique::compose_tiles()
+  if (settings.fuse_compose && compose_->fusable()) {
+    shared.composed_output = compose_->output();
+    shared.composed_mask = compose_->mask();
+  }
+  shared.compose_eps = compose_->settings().eps;
+  shared.compose_alpha_max = compose_->settings().alpha_max;
   shared.color_upload = recon_->color_upload();
   shared.depth_upload = recon_->depth_upload();
   shared.color_intrinsics = c;
@@ -216,10 +227,6 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   if (!tech) return tech.error();
   technique_ = std::move(*tech);
 
-  auto comp = compose::Compose::create(*context_, *graph_, uint32_t(output_w_), uint32_t(output_h_),
-                                       output_w_ == c.width && output_h_ == c.height);
-  if (!comp) return comp.error();
-  compose_.emplace(std::move(*comp));
 
   // Baseline's environment: a constant ambient from the mean radiance (no occlusion). An image
   // file is averaged once here; the env camera's frames are averaged per frame in process().
@@ -466,6 +473,7 @@ Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, 
       const technique::Technique::ComposeTiles tiles = technique_->compose_tiles();
       ci.tile_args = tiles.args;
       ci.tile_list = tiles.list;
+      ci.tiles_composed = tiles.composed;
     }
     compose_->record(*graph_, ci);
   }

@@ -226,16 +226,25 @@ void Ssrt::add_shade_pass(const char* name, ShadeMode mode, bool run_transfer) {
           b.read(h, gpu::Access::StorageRead);
         b.read(r.frame_constants, gpu::Access::UniformRead);
         // The tiled pass rewrites some tiles of what the pass-through one wrote.
-        const gpu::Access out = mode == ShadeMode::Tiled ? gpu::Access::StorageReadWrite
-                                                         : gpu::Access::StorageWrite;
-        if (mode == ShadeMode::Tiled) b.read(tile_args_, gpu::Access::IndirectRead);
+        const bool tiled = mode == ShadeMode::Tiled || mode == ShadeMode::TiledCompose;
+        const gpu::Access out = tiled ? gpu::Access::StorageReadWrite : gpu::Access::StorageWrite;
+        if (tiled) b.read(tile_args_, gpu::Access::IndirectRead);
+        // Bound by every variant, written by the composing one only.
         b.write(r.lit_rv, out);
         b.write(r.lit_r, out);
+        if (mode == ShadeMode::TiledCompose) {
+          b.write(r.composed_output, gpu::Access::StorageWrite);
+          b.write(r.composed_mask, gpu::Access::StorageWrite);
+        } else {
+          b.write(no_compose_, gpu::Access::StorageWrite);
+        }
       },
       [this, mode, run_transfer](VkCommandBuffer cmd, gpu::PassContext& pass) {
         const gpu::Context& ctx = pass.context();
         const SharedResources& r = shared_;
-        const gpu::Pipeline& pipe = mode == ShadeMode::Tiled        ? *shade_tiled_
+        const bool compose = mode == ShadeMode::TiledCompose;
+        const gpu::Pipeline& pipe = compose                          ? *shade_tiled_compose_
+                                    : mode == ShadeMode::Tiled       ? *shade_tiled_
                                     : mode == ShadeMode::PassThrough ? *shade_pass_
                                                                      : *shade_;
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipe.pipeline);
@@ -251,13 +260,16 @@ void Ssrt::add_shade_pass(const char* name, ShadeMode mode, bool run_transfer) {
             .storage_buffer(8, pass.buffer(tile_list_))
             .storage_buffer(9, pass.buffer(r.depth_upload))
             .uniform_buffer(10, pass.buffer(r.frame_constants))
+            .storage_buffer(11, pass.buffer(compose ? r.composed_output : no_compose_))
+            .storage_buffer(12, pass.buffer(compose ? r.composed_mask : no_compose_))
             .push(ctx, cmd, pipe);
         ShadePush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), run_transfer ? 0 : 1),
                      glm::ivec4(int(used_.width), int(used_.height), int(geometry_step_), 0),
                      // Cells -> pixels, grown by the up-sampling footprint (Gauss radius plus
                      // the bicubic's two cells) so every pixel the filters can reach is shaded.
-                     influence_pixels(), glm::vec4(kIndirectTolerance, 0.0f, 0.0f, 0.0f)};
-        if (mode == ShadeMode::Tiled) {
+                     influence_pixels(),
+                     glm::vec4(kIndirectTolerance, r.compose_eps, r.compose_alpha_max, 0.0f)};
+        if (mode == ShadeMode::Tiled || compose) {
           gpu::dispatch_indirect(cmd, pipe, &pc, sizeof(pc), pass.buffer(tile_args_));
         } else {
           gpu::dispatch_2d(cmd, pipe, &pc, sizeof(pc), used_.width, used_.height);
@@ -514,17 +526,23 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
           gpu::dispatch_2d(cmd, *shade_tiles_, &pc, sizeof(pc), tiles.x * tiles.y, 1, 64, 1);
         });
     // At the output size the tiles are the compose's too: it copies the camera frame outside
-    // them, so the pass-through solutions there would never be read.
+    // them, so the pass-through solutions there would never be read; at the camera's size the
+    // tiled shade composes its pixels itself (shade.comp kCompose), and compose runs no pass.
     const VkExtent2D out = graph.output_size();
-    if (shared_.compose_honours_tiles && used_.width == out.width &&
-        used_.height == out.height) {
-      compose_tiles_ = {tile_args_, tile_list_};
+    const bool at_output = shared_.compose_honours_tiles && used_.width == out.width &&
+                           used_.height == out.height;
+    const bool fused = at_output && shared_.composed_output.valid() && shared_.composed_mask.valid();
+    if (at_output) {
+      compose_tiles_ = {tile_args_, tile_list_, fused};
       skipped.push_back("ssrt_shade: pass-through left out, compose copies the camera frame "
                         "outside the shaded tiles");
+      if (fused)
+        skipped.push_back("compose: ssrt_shade_tiled composes its tiles (the camera frame is laid "
+                          "on the host)");
     } else {
       add_shade_pass("ssrt_shade", ShadeMode::PassThrough, true);
     }
-    add_shade_pass("ssrt_shade_tiled", ShadeMode::Tiled, true);
+    add_shade_pass("ssrt_shade_tiled", fused ? ShadeMode::TiledCompose : ShadeMode::Tiled, true);
   }
   return ok_status();
 }

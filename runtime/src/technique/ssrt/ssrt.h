@@ -19,7 +19,9 @@
 //                            at subsample > 1: ssrt_shade_tiles lists the 8x8 tiles whose result
 //                            can differ from the camera, ssrt_shade_tiled shades only those
 //                            (indirect dispatch) and hands them to compose (compose_tiles),
-//                            which copies the camera frame elsewhere
+//                            which copies the camera frame elsewhere; at the camera's size
+//                            ssrt_shade_tiled writes those tiles' composite itself (shade.comp
+//                            kCompose, the runtime's formula) and compose runs no pass
 // Skips: no virtual object in the scene, or its bounds grown by the occluder range (its
 // influence region, 2 x the 0.5 m sampling radius) outside the view: the transfer passes do not
 // run and L_rv = L_r = camera colour (compose then returns the camera image unchanged); the

@@ -141,16 +141,18 @@ Status Ssrt::init() {
   if (!shade_spv) return shade_spv.error();
   const struct {
     const char* name;
-    uint32_t pass_through, tiled, local_x, local_y;
+    uint32_t pass_through, tiled, local_x, local_y, compose;
     gpu::PipelineHandle* handle;
-  } shade_variants[] = {{"ssrt_shade", 0, 0, 8, 8, &shade_},
-                        {"ssrt_shade_pass_through", 1, 0, 8, 8, &shade_pass_},
-                        {"ssrt_shade_tiled", 0, 1, 8, 1, &shade_tiled_}};
+  } shade_variants[] = {{"ssrt_shade", 0, 0, 8, 8, 0, &shade_},
+                        {"ssrt_shade_pass_through", 1, 0, 8, 8, 0, &shade_pass_},
+                        {"ssrt_shade_tiled", 0, 1, 8, 1, 0, &shade_tiled_},
+                        {"ssrt_shade_tiled_compose", 0, 1, 8, 1, 1, &shade_tiled_compose_}};
   for (const auto& v : shade_variants) {
     gpu::ComputePipelineDesc d{v.name, *shade_spv,
                                {{img}, {img}, {ssbo}, {img}, {img}, {img}, {img}, {img}, {ssbo},
-                                {ssbo}, {ubo}},
-                               sizeof(ShadePush), {v.pass_through, v.tiled, v.local_x, v.local_y}};
+                                {ssbo}, {ubo}, {ssbo}, {ssbo}},
+                               sizeof(ShadePush),
+                               {v.pass_through, v.tiled, v.local_x, v.local_y, v.compose}};
     auto sp = gpu::create_compute_pipeline(ctx, d);
     if (!sp) return sp.error();
     *v.handle = gpu::PipelineHandle(ctx, std::move(*sp));
@@ -172,6 +174,11 @@ Status Ssrt::init() {
                                       VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
   if (!list) return list.error();
   tile_list_ = *list;
+  // Bound as shade.comp's composed output and mask by the variants that do not compose (the
+  // shader declares them; nothing is written there).
+  auto unused = graph.create_buffer({"ssrt_shade_no_compose", 16}, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  if (!unused) return unused.error();
+  no_compose_ = *unused;
   return ok_status();
 }
 

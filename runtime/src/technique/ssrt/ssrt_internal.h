@@ -113,7 +113,9 @@ class Ssrt final : public Technique {
   bool project_virtual_bounds(float grow_m, glm::vec2& pmin, glm::vec2& pmax, bool& behind) const;
   glm::ivec4 virtual_pixels() const;
   glm::ivec4 virtual_cells() const;
-  enum class ShadeMode { Full, PassThrough, Tiled };
+  // TiledCompose: Tiled, with the composite written to the runtime's output (shade.comp
+  // kCompose; SharedResources::composed_output).
+  enum class ShadeMode { Full, PassThrough, Tiled, TiledCompose };
   void add_shade_pass(const char* name, ShadeMode mode, bool run_transfer);
   glm::ivec4 influence_pixels() const {
     const int st = int(step_);
@@ -148,10 +150,11 @@ class Ssrt final : public Technique {
   gpu::BufferHandle samples_, light_, partials_, result_;
   gpu::ImageHandle coarse_;
   gpu::ImageHandle upsampled_;  // RGBA32UI per cell, shaders/ssrt/upsampled.glsl
-  gpu::PipelineHandle occluders_, transfer_, transfer_real_, transfer_real_only_, reduce_, reduce_final_, blur_, shade_, shade_pass_,
-      shade_tiled_, shade_tiles_;
+  gpu::PipelineHandle occluders_, transfer_, transfer_real_, transfer_real_only_, reduce_,
+      reduce_final_, blur_, shade_, shade_pass_, shade_tiled_, shade_tiled_compose_, shade_tiles_;
   // Fast levels' shade tiles (shade_tiles.comp): indirect dispatch arguments and tile indices.
   gpu::BufferHandle tile_args_, tile_list_;
+  gpu::BufferHandle no_compose_;  // shade.comp's output and mask for the variants without kCompose
   ComposeTiles compose_tiles_;  // this frame's (set by record)
   std::vector<int64_t> pending_;       // per frame slot: frame whose sums its readback holds
   std::vector<int> pending_bands_;     // per frame slot: SH bands of that frame's transfer
