@@ -33,16 +33,33 @@ SSRT_FN float ssrt_chi_from_median_angle(float median_angle_rad) {
   return max(1.0f - cos(0.5f * median_angle_rad), 1e-6f);
 }
 
+// A sender (occluder) point s seen from the receiver x: the unit direction t = (s - x)/|s - x|
+// and the squared distance, which eq. 7-8 and eq. 10-12 all start from. A pass evaluating both
+// for one point computes them once (ssrt_sender, then the *_from functions): each is a square
+// root and three divisions per lane, paid by every lane on a CPU device. len2 <= 1e-12
+// (s == x): degenerate, t is 0.
+struct SsrtSender {
+  vec3 t;
+  float len2;
+};
+SSRT_FN SsrtSender ssrt_sender(vec3 x, vec3 s) {
+  vec3 d = s - x;
+  SsrtSender r;
+  r.len2 = dot(d, d);
+  r.t = r.len2 > 1e-12f ? d / sqrt(r.len2) : vec3(0.0f);
+  return r;
+}
+
 // Eq. 7-8: visibility of direction w (unit) at x when the depth test found the surface point s
 // in front of the sample: t = (s - x)/|s - x|, K = min(chi, 1 - t.w)/chi. 0 = blocked (the
 // occluder lies along w), rising to 1 as the occluder's direction leaves w's cell. A degenerate
 // s == x cannot block anything and counts as visible.
+SSRT_FN float ssrt_visibility_k_from(SsrtSender s, vec3 w, float chi) {
+  if (!(s.len2 > 1e-12f)) return 1.0f;
+  return clamp(min(chi, 1.0f - dot(s.t, w)) / chi, 0.0f, 1.0f);
+}
 SSRT_FN float ssrt_visibility_k(vec3 x, vec3 s, vec3 w, float chi) {
-  vec3 d = s - x;
-  float len2 = dot(d, d);
-  if (!(len2 > 1e-12f)) return 1.0f;
-  vec3 t = d / sqrt(len2);
-  return clamp(min(chi, 1.0f - dot(t, w)) / chi, 0.0f, 1.0f);
+  return ssrt_visibility_k_from(ssrt_sender(x, s), w, chi);
 }
 
 // ---- one-bounce indirect, eq. 10-12 ---------------------------------------------------------
@@ -59,33 +76,37 @@ SSRT_FN float ssrt_facing_gate(vec3 n_s, vec3 t) { return dot(n_s, -t) > 0.0f ? 
 // `sample_area` = pi r_max^2 / N. The distance is clamped below at `min_dist` (metres) so a
 // sender next to the receiver cannot blow up (the 1/d^2 singularity of point-to-point transfer),
 // and F is limited to 1 (a patch cannot send more than it receives). Cosines are clamped at 0.
+SSRT_FN float ssrt_form_factor_from(SsrtSender s, vec3 n_x, vec3 n_s, float sample_area,
+                                    float min_dist) {
+  if (!(s.len2 > 1e-12f)) return 0.0f;
+  float cos_r = max(dot(n_x, s.t), 0.0f);
+  float cos_s = max(dot(n_s, -s.t), 0.0f);
+  float d2 = max(s.len2, min_dist * min_dist);
+  return min(cos_r * cos_s * sample_area / (MRGI_PI * d2), 1.0f);
+}
 SSRT_FN float ssrt_form_factor(vec3 x, vec3 n_x, vec3 s, vec3 n_s, float sample_area,
                                float min_dist) {
-  vec3 d = s - x;
-  float len2 = dot(d, d);
-  if (!(len2 > 1e-12f)) return 0.0f;
-  vec3 t = d / sqrt(len2);
-  float cos_r = max(dot(n_x, t), 0.0f);
-  float cos_s = max(dot(n_s, -t), 0.0f);
-  float d2 = max(len2, min_dist * min_dist);
-  return min(cos_r * cos_s * sample_area / (MRGI_PI * d2), 1.0f);
+  return ssrt_form_factor_from(ssrt_sender(x, s), n_x, n_s, sample_area, min_dist);
 }
 
 // One term of eq. 10: the sender s, lit by the dominant directional light (unit direction to
 // the light `l_dir`, irradiance `e_light`), reflects albedo_s * E / pi towards x, weighted by
 // occlusion (1 - K), the form factor and the facing gate. Returns the irradiance it adds at x
 // (linear RGB); the receiver's albedo is applied by the composite.
-SSRT_FN vec3 ssrt_indirect_term(vec3 x, vec3 n_x, vec3 s, vec3 n_s, vec3 albedo_s, float k,
-                                vec3 l_dir, vec3 e_light, float sample_area, float min_dist) {
-  vec3 d = s - x;
-  float len2 = dot(d, d);
-  if (!(len2 > 1e-12f)) return vec3(0.0f);
-  vec3 t = d / sqrt(len2);
-  float f = ssrt_form_factor(x, n_x, s, n_s, sample_area, min_dist);
-  float g = ssrt_facing_gate(n_s, t);
+SSRT_FN vec3 ssrt_indirect_term_from(SsrtSender s, vec3 n_x, vec3 n_s, vec3 albedo_s, float k,
+                                     vec3 l_dir, vec3 e_light, float sample_area,
+                                     float min_dist) {
+  if (!(s.len2 > 1e-12f)) return vec3(0.0f);
+  float f = ssrt_form_factor_from(s, n_x, n_s, sample_area, min_dist);
+  float g = ssrt_facing_gate(n_s, s.t);
   vec3 sender_radiance = albedo_s * e_light * (max(dot(n_s, l_dir), 0.0f) / MRGI_PI);
   // F already holds 1/pi of the Lambertian kernel; radiance * pi * F is the irradiance received.
   return (1.0f - clamp(k, 0.0f, 1.0f)) * g * MRGI_PI * f * sender_radiance;
+}
+SSRT_FN vec3 ssrt_indirect_term(vec3 x, vec3 n_x, vec3 s, vec3 n_s, vec3 albedo_s, float k,
+                                vec3 l_dir, vec3 e_light, float sample_area, float min_dist) {
+  return ssrt_indirect_term_from(ssrt_sender(x, s), n_x, n_s, albedo_s, k, l_dir, e_light,
+                                 sample_area, min_dist);
 }
 
 // ---- transfer and shading -------------------------------------------------------------------

@@ -228,16 +228,18 @@ void main() {
       // Real scene: the real surface in front of the sample within the range (see the general
       // path below for the rules); real + virtual: the virtual surface where the virtual
       // G-buffer holds one (it is in front of the real one there), else the real one.
-      vec3 dr_r = o.xyz - xr;
-      bool hit_r = in_view && o.w > 0.0f && o.w < yz * (1.0f - bias) && dot(dr_r, dr_r) <= range2;
+      // Each sender's direction and distance once (ssrt_sender): the range check, K and the
+      // bounce term all start from them.
+      SsrtSender sd_r = ssrt_sender(xr, o.xyz);
+      SsrtSender sd_vo = ssrt_sender(xr, ov.xyz);
+      bool hit_r = in_view && o.w > 0.0f && o.w < yz * (1.0f - bias) && sd_r.len2 <= range2;
       bool use_virtual = in_view && influenced && ov.w > 0.0f;
       float oz_v = ov.w;
-      vec3 dr_v = ov.xyz - xr;
-      bool hit_vo = oz_v > 0.0f && oz_v < yz * (1.0f - bias) && dot(dr_v, dr_v) <= range2;
+      bool hit_vo = oz_v > 0.0f && oz_v < yz * (1.0f - bias) && sd_vo.len2 <= range2;
       bool hit_v = use_virtual ? hit_vo : hit_r;
-      vec3 sp_v = use_virtual ? ov.xyz : o.xyz;
-      float k = hit_r ? ssrt_visibility_k(xr, o.xyz, w, chi) : 1.0f;
-      float k_v = hit_v ? ssrt_visibility_k(xr, sp_v, w, chi) : 1.0f;
+      SsrtSender sd_v = use_virtual ? sd_vo : sd_r;
+      float k = hit_r ? ssrt_visibility_k_from(sd_r, w, chi) : 1.0f;
+      float k_v = hit_v ? ssrt_visibility_k_from(sd_v, w, chi) : 1.0f;
       bool from_view = k < 1.0f, from_view_v = k_v < 1.0f;
       vec3 s_aux;
       bool aux_hit = aux_occluder(xr, y, yc.x, s_aux);
@@ -251,8 +253,8 @@ void main() {
       t_real[2] += tw * y_sh.c2;
       t_real[3] += tw * y_sh.c3;
       if (from_view)
-        ri += ssrt_indirect_term(xr, nr, o.xyz, on, oa, k, l_dir, e_light, pc.bounce.x,
-                                 pc.sampling.w);
+        ri += ssrt_indirect_term_from(sd_r, nr, on, oa, k, l_dir, e_light, pc.bounce.x,
+                                      pc.sampling.w);
       if (kRealOnly) continue;
       float tw_v = ssrt_transfer_weight(nr, w, k_v, 1.0f);
       t_rv[0] += tw_v * y_sh.c0;
@@ -262,8 +264,8 @@ void main() {
       vec3 sn_v = use_virtual ? vn : on;
       vec3 sa_v = use_virtual ? va : oa;
       if (from_view_v)
-        ri_v += ssrt_indirect_term(xr, nr, sp_v, sn_v, sa_v, k_v, l_dir, e_light, pc.bounce.x,
-                                   pc.sampling.w);
+        ri_v += ssrt_indirect_term_from(sd_v, nr, sn_v, sa_v, k_v, l_dir, e_light, pc.bounce.x,
+                                        pc.sampling.w);
     }
   } else {
     for (int j = 0; j < half_n; ++j) {
@@ -284,7 +286,8 @@ void main() {
         vec3 w = w_r;
         vec3 y = xr + nr * pc.sampling.z + w * r_r;
         float k = 1.0f;
-        vec3 sp = vec3(0.0f), sn = vec3(0.0f), sa = vec3(0.0f);
+        vec3 sn = vec3(0.0f), sa = vec3(0.0f);
+        SsrtSender sd = ssrt_sender(xr, xr);  // none yet (degenerate: sends nothing)
         vec3 yc = (frame.world_to_camera * vec4(y, 1.0f)).xyz;
         float yz = yc.z;
         if (yz > 0.0f) {
@@ -297,12 +300,12 @@ void main() {
             // Range check (standard SSDO/SSAO practice; the paper does not say): a surface
             // farther from x than the range (push: twice the sampling radius, since the surface
             // seen in front of y may lie well in front of it) is not what blocks this direction.
-            vec3 dr = o.xyz - xr;
-            if (o.w > 0.0f && o.w < yz * (1.0f - bias) && dot(dr, dr) <= pc.bounce.w * pc.bounce.w) {
-              sp = o.xyz;
+            SsrtSender so = ssrt_sender(xr, o.xyz);
+            if (o.w > 0.0f && o.w < yz * (1.0f - bias) && so.len2 <= pc.bounce.w * pc.bounce.w) {
+              sd = so;
               sn = on;
               sa = ra;
-              k = ssrt_visibility_k(xr, sp, w, chi);
+              k = ssrt_visibility_k_from(sd, w, chi);
             }
           }
         }
@@ -318,8 +321,8 @@ void main() {
         t_real[2] += tw * y_sh.c2;
         t_real[3] += tw * y_sh.c3;
         if (from_view) {
-          ri += ssrt_indirect_term(xr, nr, sp, sn, sa, k, l_dir, e_light, pc.bounce.x,
-                                   pc.sampling.w);
+          ri += ssrt_indirect_term_from(sd, nr, sn, sa, k, l_dir, e_light, pc.bounce.x,
+                                        pc.sampling.w);
         }
       }
       // Visible receiver against real + virtual occluders.
@@ -327,7 +330,8 @@ void main() {
         vec3 w = w_v;
         vec3 y = xv + nv * pc.sampling.z + w * r_v;
         float k = 1.0f;
-        vec3 sp = vec3(0.0f), sn = vec3(0.0f), sa = vec3(0.0f);
+        vec3 sn = vec3(0.0f), sa = vec3(0.0f);
+        SsrtSender sd = ssrt_sender(xv, xv);  // none yet (degenerate: sends nothing)
         vec3 yc = (frame.world_to_camera * vec4(y, 1.0f)).xyz;
         float yz = yc.z;
         if (yz > 0.0f) {
@@ -340,13 +344,13 @@ void main() {
             // The virtual G-buffer only holds virtual surfaces in front of the real one.
             bool use_virtual = ov.w > 0.0f;
             float oz = use_virtual ? ov.w : o.w;
-            vec3 dv = (use_virtual ? ov.xyz : o.xyz) - xv;
+            SsrtSender so = ssrt_sender(xv, use_virtual ? ov.xyz : o.xyz);
             if ((use_virtual || o.w > 0.0f) && oz > 0.0f && oz < yz * (1.0f - bias) &&
-                dot(dv, dv) <= pc.bounce.w * pc.bounce.w) {
-              sp = use_virtual ? ov.xyz : o.xyz;
+                so.len2 <= pc.bounce.w * pc.bounce.w) {
+              sd = so;
               sn = use_virtual ? vn : on;
               sa = use_virtual ? va : ra;
-              k = ssrt_visibility_k(xv, sp, w, chi);
+              k = ssrt_visibility_k_from(sd, w, chi);
             }
           }
         }
@@ -360,8 +364,8 @@ void main() {
         t_rv[2] += tw * y_sh.c2;
         t_rv[3] += tw * y_sh.c3;
         if (from_view_v) {
-          ri_v += ssrt_indirect_term(xv, nv, sp, sn, sa, k, l_dir, e_light, pc.bounce.x,
-                                     pc.sampling.w);
+          ri_v += ssrt_indirect_term_from(sd, nv, sn, sa, k, l_dir, e_light, pc.bounce.x,
+                                          pc.sampling.w);
         }
       }
     }
