@@ -129,10 +129,19 @@ PixelInputs pixel_inputs(ivec2 pixel) {
   PixelInputs p;
   p.real_ok = imageLoad(real_position, pixel / pc.size.z).w > 0.0f;
   p.virt = imageLoad(virtual_position, pixel).w > 0.5f;
-  p.a = camera_at(vec2(pixel)).rgb;
-  // Compose reads the camera pixel of the output pixel; kCompose runs at the camera's size.
-  p.camera = kCompose ? srgb_decode(vec3(color_rgb8(uint(pixel.y * frame.color_depth_size.x + pixel.x))) / 255.0f)
-                      : vec3(0.0f);
+  if (kCompose) {
+    // At the camera's size (kCompose's condition, with internal_k = color_k) the camera pixel
+    // of this pixel is the pixel itself: camera_at's nearest-pixel mapping returns it (a
+    // projection round trip is within an ulp of the integer), so its albedo, camera_at's
+    // camera_to_radiance clamped, comes from the one decode compose needs as well (three
+    // pow() per pixel fewer).
+    vec3 decoded = srgb_decode(vec3(color_rgb8(uint(pixel.y * frame.color_depth_size.x + pixel.x))) / 255.0f);
+    p.camera = decoded;
+    p.a = clamp(decoded / (frame.camera.y > 0.0f ? frame.camera.y : 1.0f), vec3(0.0f), vec3(1.0f));
+  } else {
+    p.a = camera_at(vec2(pixel)).rgb;
+    p.camera = vec3(0.0f);
+  }
   p.inside = pixel.x >= pc.influence.x && pixel.x < pc.influence.z &&
              pixel.y >= pc.influence.y && pixel.y < pc.influence.w;
   return p;
