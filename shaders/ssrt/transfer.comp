@@ -181,8 +181,26 @@ void main() {
   vec3 xv = virt ? vp.xyz : xr;
   vec3 nv = virt ? normalize(imageLoad(virtual_normal, pixel).xyz + vec3(1e-9f)) : nr;
 
+  // T_real, the 16 SH transfer coefficients the light estimation needs. R_d and R'_d are
+  // T . l, and T . l = sum over samples of weight x L(w), L(w) = l . Y(w) the current light's
+  // radiance from the sample's direction: each solution accumulates that one product per sample
+  // (rd_sum, rd_v_sum), so the real + virtual solution keeps no 16 coefficients of its own
+  // (16 accumulators per lane fewer: on a CPU device they spill; 16 multiply-adds become one).
+  // Both sums take the same terms in the same order where nothing virtual takes part, so R'_d
+  // equals R_d bit for bit there, as the up-sampling's tile test needs.
   vec4 t_real[4] = vec4[4](zero, zero, zero, zero);
-  vec4 t_rv[4] = vec4[4](zero, zero, zero, zero);
+  float rd_sum = 0.0f, rd_v_sum = 0.0f;
+  // Bands above the level's count are dropped (their coefficients stay 0 in the light too).
+  int n_sh = pc.config.y * pc.config.y;
+  SH16 l_sh;
+  l_sh.c0 = vec4(light.sh[0].w, n_sh > 1 ? light.sh[1].w : 0.0f, n_sh > 2 ? light.sh[2].w : 0.0f,
+                 n_sh > 3 ? light.sh[3].w : 0.0f);
+  l_sh.c1 = vec4(n_sh > 4 ? light.sh[4].w : 0.0f, n_sh > 5 ? light.sh[5].w : 0.0f,
+                 n_sh > 6 ? light.sh[6].w : 0.0f, n_sh > 7 ? light.sh[7].w : 0.0f);
+  l_sh.c2 = vec4(n_sh > 8 ? light.sh[8].w : 0.0f, n_sh > 9 ? light.sh[9].w : 0.0f,
+                 n_sh > 10 ? light.sh[10].w : 0.0f, n_sh > 11 ? light.sh[11].w : 0.0f);
+  l_sh.c3 = vec4(n_sh > 12 ? light.sh[12].w : 0.0f, n_sh > 13 ? light.sh[13].w : 0.0f,
+                 n_sh > 14 ? light.sh[14].w : 0.0f, n_sh > 15 ? light.sh[15].w : 0.0f);
   vec3 ri = vec3(0.0f), ri_v = vec3(0.0f);
   vec3 l_dir = light.dominant.xyz;
   vec3 e_light = light.dominant.w > 0.5f ? light.dominant_irradiance.rgb : vec3(0.0f);
@@ -247,20 +265,19 @@ void main() {
       if (!from_view && aux_hit) k = k_aux;
       if (!from_view_v && aux_hit) k_v = k_aux;
       SH16 y_sh = sh_basis16(w);
+      float l_w = sh_dot(y_sh, l_sh);
       float tw = ssrt_transfer_weight(nr, w, k, 1.0f);
       t_real[0] += tw * y_sh.c0;
       t_real[1] += tw * y_sh.c1;
       t_real[2] += tw * y_sh.c2;
       t_real[3] += tw * y_sh.c3;
+      rd_sum += tw * l_w;
       if (from_view)
         ri += ssrt_indirect_term_from(sd_r, nr, on, oa, k, l_dir, e_light, pc.bounce.x,
                                       pc.sampling.w);
       if (kRealOnly) continue;
       float tw_v = ssrt_transfer_weight(nr, w, k_v, 1.0f);
-      t_rv[0] += tw_v * y_sh.c0;
-      t_rv[1] += tw_v * y_sh.c1;
-      t_rv[2] += tw_v * y_sh.c2;
-      t_rv[3] += tw_v * y_sh.c3;
+      rd_v_sum += tw_v * l_w;
       vec3 sn_v = use_virtual ? vn : on;
       vec3 sa_v = use_virtual ? va : oa;
       if (from_view_v)
@@ -320,6 +337,7 @@ void main() {
         t_real[1] += tw * y_sh.c1;
         t_real[2] += tw * y_sh.c2;
         t_real[3] += tw * y_sh.c3;
+        rd_sum += tw * sh_dot(y_sh, l_sh);
         if (from_view) {
           ri += ssrt_indirect_term_from(sd, nr, sn, sa, k, l_dir, e_light, pc.bounce.x,
                                         pc.sampling.w);
@@ -358,11 +376,7 @@ void main() {
         bool from_view_v = k < 1.0f;
         if (!from_view_v && aux_occluder(xv, y, yc.x, sv_aux)) k = ssrt_visibility_k(xv, sv_aux, w, chi);
         float tw = ssrt_transfer_weight(nv, w, k, 1.0f);
-        SH16 y_sh = sh_basis16(w);
-        t_rv[0] += tw * y_sh.c0;
-        t_rv[1] += tw * y_sh.c1;
-        t_rv[2] += tw * y_sh.c2;
-        t_rv[3] += tw * y_sh.c3;
+        rd_v_sum += tw * sh_dot(sh_basis16(w), l_sh);
         if (from_view_v) {
           ri_v += ssrt_indirect_term_from(sd, nv, sn, sa, k, l_dir, e_light, pc.bounce.x,
                                           pc.sampling.w);
@@ -370,27 +384,11 @@ void main() {
       }
     }
   }
-  for (int c = 0; c < 4; ++c) {
-    t_real[c] *= pc.aux_test.z;  // the solid angle of one sample, 4 pi / N
-    t_rv[c] *= pc.aux_test.z;
-  }
+  for (int c = 0; c < 4; ++c) t_real[c] *= pc.aux_test.z;  // the solid angle of one sample, 4 pi / N
+  float rd = rd_sum * pc.aux_test.z, rd_v = rd_v_sum * pc.aux_test.z;
   if (!influenced) {
-    t_rv = t_real;
+    rd_v = rd;
     ri_v = ri;
-  }
-  // Bands above the level's count are dropped (their coefficients stay 0 in the light too).
-  int n = pc.config.y * pc.config.y;
-  float rd = 0.0f, rd_v = 0.0f;
-  // A constant trip count with a select instead of `break`, so the loop unrolls and every index
-  // into t_real / t_rv is a constant: one dynamic index puts the whole array in per-lane scratch
-  // memory on lavapipe, including the accumulations of the sample loop (+0 leaves a sum as is).
-  [[unroll]] for (int i = 0; i < 16; ++i) {
-    vec4 a = t_real[i / 4], b = t_rv[i / 4];
-    int k = i - 4 * (i / 4);
-    float ta = k == 0 ? a.x : (k == 1 ? a.y : (k == 2 ? a.z : a.w));
-    float tb = k == 0 ? b.x : (k == 1 ? b.y : (k == 2 ? b.z : b.w));
-    rd += i < n ? ta * light.sh[i].w : 0.0f;
-    rd_v += i < n ? tb * light.sh[i].w : 0.0f;
   }
   // Usable for the light estimation: the camera measured this pixel (recon's alpha; the volume's
   // G-buffer also fills pixels the depth camera missed, whose recon colour is 0 and read as a
