@@ -42,6 +42,17 @@ using uint = uint32_t;
 
 const float MRGI_PI = 3.14159265358979f;
 
+// ---- integer arithmetic ---------------------------------------------------------------------
+
+// a / b for 0 <= a < 2^20 and 1 <= b < 2^10 (per component), exactly the integer quotient,
+// through one float division: a CPU Vulkan device runs an integer division by a value it cannot
+// see at compile time as one scalar divide per SIMD lane (x86 has no vector integer divide;
+// ssrt's transfer made four per sample), a float division as one vector instruction. Exact:
+// a = k b + r gives a / b = k + r / b, at least 1 / b below k + 1, which is more than the
+// float's rounding step there; for r = 0 the quotient is representable.
+MRGI_FN ivec2 div_nonneg(ivec2 a, int b) { return ivec2(vec2(a) / float(b)); }
+MRGI_FN int div_nonneg1(int a, int b) { return int(float(a) / float(b)); }
+
 // ---- colour -------------------------------------------------------------------------------
 
 // sRGB transfer function (IEC 61966-2-1), per channel, input clamped to [0, 1].

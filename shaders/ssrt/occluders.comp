@@ -39,10 +39,10 @@ void main() {
   ivec2 g = ivec2(gl_GlobalInvocationID.xy);
   int s = pc.step.x;
   ivec2 size = pc.step.yz;
-  ivec2 grid = (size + s - 1) / s;
+  ivec2 grid = div_nonneg(size + s - 1, s);
   if (any(greaterThanEqual(g, grid))) return;
   ivec2 p = min(g * s + ivec2(s / 2), size - 1);
-  ivec2 gt = p / pc.step.w;
+  ivec2 gt = div_nonneg(p, pc.step.w);
   vec4 rp = imageLoad(real_position, gt);
   vec3 rn = imageLoad(real_normal, gt).xyz;
   vec4 ra = camera_at(vec2(p));

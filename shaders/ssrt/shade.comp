@@ -127,7 +127,7 @@ struct PixelInputs {
 
 PixelInputs pixel_inputs(ivec2 pixel) {
   PixelInputs p;
-  p.real_ok = imageLoad(real_position, pixel / pc.size.z).w > 0.0f;
+  p.real_ok = imageLoad(real_position, div_nonneg(pixel, pc.size.z)).w > 0.0f;
   p.virt = imageLoad(virtual_position, pixel).w > 0.5f;
   if (kCompose) {
     // At the camera's size (kCompose's condition, with internal_k = color_k) the camera pixel

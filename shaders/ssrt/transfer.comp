@@ -123,7 +123,7 @@ bool aux_occluder(vec3 x, vec3 y, float y_camera_x, out vec3 s) {
 // would find the receiver blocked by its own surface.
 void surfaces_at(vec2 q, ivec2 qi, int gstep, int ostep, out vec4 real, out vec3 rn,
                  out vec3 ra, out vec4 virt, out vec3 vn, out vec3 va) {
-  ivec2 g = qi / ostep;
+  ivec2 g = div_nonneg(qi, ostep);
   uvec4 a = imageLoad(occ_a, g);
   uvec2 b = kRealOnly ? uvec2(0u) : imageLoad(occ_b, g).xy;
   ivec2 p = min(g * ostep + ivec2(ostep / 2), frame.internal_output_size.xy - 1);
@@ -133,7 +133,7 @@ void surfaces_at(vec2 q, ivec2 qi, int gstep, int ostep, out vec4 real, out vec3
   float zr = uintBitsToFloat(a.x);
   rn = oct_decode(unpackSnorm2x16(a.y));
   ra = unpackUnorm4x8(a.z).rgb;
-  ivec2 gt = p / gstep;
+  ivec2 gt = div_nonneg(p, gstep);
   vec2 centre = vec2(gt * gstep) + 0.5f * float(gstep - 1);
   vec3 pr = unproject_pinhole(centre, zr, frame.internal_k);
   float z = gstep > 1 ? tangent_plane_depth(ray, pr, to_camera * rn, MRGI_DEPTH_EDGE_RELATIVE) : zr;
@@ -165,7 +165,7 @@ void main() {
 
   int gstep = pc.config.z;
   int ostep = pc.config.w;
-  vec4 rp = imageLoad(real_position, pixel / gstep);
+  vec4 rp = imageLoad(real_position, div_nonneg(pixel, gstep));
   vec4 vp = imageLoad(virtual_position, pixel);
   bool real_ok = rp.w > 0.0f;
   bool virt = vp.w > 0.5f;
@@ -175,7 +175,7 @@ void main() {
     return;
   }
   vec3 xr = rp.xyz;
-  vec3 nr = normalize(imageLoad(real_normal, pixel / gstep).xyz + vec3(1e-9f));
+  vec3 nr = normalize(imageLoad(real_normal, div_nonneg(pixel, gstep)).xyz + vec3(1e-9f));
   if (kRealReceivers) virt = false;  // the host's bounds say so; a stray coverage bit must not
                                      // change the solution between the two paths
   vec3 xv = virt ? vp.xyz : xr;

@@ -5,6 +5,7 @@
 // axis through the TSDF and stores the first front-facing surface: xyz world, w depth along the
 // axis (m); no surface: 0. The views and the occlusion rule are in ssrt/aux_views.glsl.
 #extension GL_GOOGLE_include_directive : require
+#include "shared/mrgi_shared.h"
 #include "ssrt/aux_views.glsl"
 #include "ssrt/tsdf_volume.glsl"
 
@@ -19,7 +20,7 @@ layout(set = 0, binding = 3, rgba32f) writeonly uniform image2DArray aux_positio
 void main() {
   int res = views.info.y;
   ivec2 id = ivec2(gl_GlobalInvocationID.xy);
-  int layer = id.y / res;
+  int layer = div_nonneg1(id.y, res);
   ivec2 texel = ivec2(id.x, id.y - layer * res);
   if (id.x >= res || layer >= views.info.x) return;
   vec2 uv = (vec2(texel) + 0.5f) / float(res);

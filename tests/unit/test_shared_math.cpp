@@ -201,6 +201,25 @@ TEST(SharedMath, DifferentialCompose) {
   EXPECT_FLOAT_EQ(compose_alpha1(0.5f, 0.0f, eps, amax), 1.0f);
 }
 
+TEST(SharedMath, DivNonnegIsTheIntegerQuotient) {
+  // Every pair the shaders can meet (pixels and cells up to 8192, steps and sizes up to 1024),
+  // sampled densely near multiples of b, where a rounding error would show.
+  for (int b = 1; b < 1024; b += (b < 64 ? 1 : 37)) {
+    for (int a = 0; a < (1 << 20); a += (a < 16384 ? 1 : 4093)) {
+      ASSERT_EQ(div_nonneg1(a, b), a / b) << a << " / " << b;
+      const int near = (a / b) * b;  // a multiple of b and its neighbours
+      for (int d : {-1, 0, 1}) {
+        const int x = near + d;
+        if (x < 0) continue;
+        ASSERT_EQ(div_nonneg1(x, b), x / b) << x << " / " << b;
+      }
+    }
+  }
+  const ivec2 q = div_nonneg(ivec2(639, 480), 4);
+  EXPECT_EQ(q.x, 159);
+  EXPECT_EQ(q.y, 120);
+}
+
 TEST(SharedMath, ComposeEncodedIsTheCameraModelAroundDifferentialCompose) {
   const float eps = 1e-3f, amax = 10.0f, exposure = 0.5f;
   // Equal solutions: the camera's own value back, encoded.
