@@ -18,7 +18,7 @@
 //     if p.xy outside [0, 1] or p.z <= 0: layer i says nothing about y
 //     texel = min(ivec2(p.xy * info.y), info.y - 1); w = texelFetch(layer i, texel).w
 //     if w > 0 and w < p.z - bias: y lies behind layer i's first surface -> occluded
-// (ssrt_aux_texel below does the first three lines.) The used square of every layer is the
+// (ssrt_aux_texel_at below does the second and third lines.) The used square of every layer is the
 // corner [0, info.y)^2 of an allocation of info.z texels per side: sampler coordinates, where
 // wanted, are p.xy * info.y / info.z.
 #ifndef MRGI_SSRT_AUX_VIEWS_GLSL
@@ -52,13 +52,14 @@ struct SsrtAuxViews {
 static_assert(sizeof(SsrtAuxViews) == 8 * 64 + 8 * 16 + 16, "std140 mirror");
 }  // namespace mrgi::shader
 #else
-// The texel of an aux layer (its world_to_aux matrix, `texels` used per side) for world point
-// `y`, and y's depth along that layer's axis; false when y projects outside the layer's square
-// or lies behind its image plane. Takes the one matrix, not the whole SsrtAuxViews: a struct
-// parameter indexed by a loop variable was copied into scratch memory on every call, which
-// made the aux test 55 % of ssrt_transfer on lavapipe.
-bool ssrt_aux_texel(mat4 world_to_aux, int texels, vec3 y, out ivec2 texel, out float depth) {
-  vec4 p = world_to_aux * vec4(y, 1.0f);
+// The texel of an aux layer (`texels` used per side) for a point whose layer coordinates are
+// p = world_to_aux * (y, 1) (u, v, depth along the axis), and that depth; false when y projects
+// outside the layer's square or lies behind its image plane. Takes the coordinates rather than
+// the layer's matrix, so a caller can derive one layer's from another's (ssrt_transfer mirrors
+// the left layer's into the right one's); never the whole SsrtAuxViews: a struct parameter
+// indexed by a loop variable was copied into scratch memory on every call (the aux test was
+// 55 % of ssrt_transfer on lavapipe).
+bool ssrt_aux_texel_at(vec3 p, int texels, out ivec2 texel, out float depth) {
   texel = ivec2(0);
   depth = p.z;
   if (any(lessThan(p.xy, vec2(0.0f))) || any(greaterThan(p.xy, vec2(1.0f))) || !(p.z > 0.0f))

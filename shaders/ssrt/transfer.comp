@@ -82,10 +82,10 @@ layout(push_constant) uniform Push {
 // taken or not: three tests instead of four). The matrices are chosen per lane by selects of
 // uniform columns; with a constant layer index lavapipe reads a matrix once per SIMD chunk,
 // with a loop or lane index it gathers it per lane.
-bool aux_layer_hit(mat4 world_to_aux, int layer, float bias_m, vec3 x, vec3 y, out vec3 s) {
+bool aux_layer_hit_at(vec3 p, int layer, float bias_m, vec3 x, out vec3 s) {
   ivec2 texel;
   float depth;
-  bool in_layer = layer < aux.info.x && ssrt_aux_texel(world_to_aux, aux.info.y, y, texel, depth);
+  bool in_layer = layer < aux.info.x && ssrt_aux_texel_at(p, aux.info.y, texel, depth);
   vec4 o = imageLoad(aux_position, ivec3(texel, layer));
   vec3 d = o.xyz - x;
   s = o.xyz;
@@ -97,17 +97,19 @@ bool aux_occluder(vec3 x, vec3 y, float y_camera_x, out vec3 s) {
   if (pc.aux_test.y < 0.5f) return false;
   bool right = y_camera_x > 0.0f;
   int side = right ? SSRT_AUX_RIGHT : SSRT_AUX_LEFT;
-  mat4 m = mat4(right ? aux.world_to_aux[SSRT_AUX_RIGHT][0] : aux.world_to_aux[SSRT_AUX_LEFT][0],
-                right ? aux.world_to_aux[SSRT_AUX_RIGHT][1] : aux.world_to_aux[SSRT_AUX_LEFT][1],
-                right ? aux.world_to_aux[SSRT_AUX_RIGHT][2] : aux.world_to_aux[SSRT_AUX_LEFT][2],
-                right ? aux.world_to_aux[SSRT_AUX_RIGHT][3] : aux.world_to_aux[SSRT_AUX_LEFT][3]);
+  // The right layer mirrors the left one (same image plane and down axis, opposite right and
+  // forward axes: volume.cpp make_views), so y's coordinates in it are (1 - u, v, -depth) of
+  // its left ones: one uniform matrix instead of a per-lane choice of two.
+  vec3 p_left = (aux.world_to_aux[SSRT_AUX_LEFT] * vec4(y, 1.0f)).xyz;
+  vec3 p_side = right ? vec3(1.0f - p_left.x, p_left.y, -p_left.z) : p_left;
   float side_bias = pc.aux_test.x * (right ? aux.extent[SSRT_AUX_RIGHT].z : aux.extent[SSRT_AUX_LEFT].z);
   vec3 s_side, s_top, s_light;
-  bool hit_side = aux_layer_hit(m, side, side_bias, x, y, s_side);
-  bool hit_top = aux_layer_hit(aux.world_to_aux[SSRT_AUX_TOP], SSRT_AUX_TOP,
-                               pc.aux_test.x * aux.extent[SSRT_AUX_TOP].z, x, y, s_top);
-  bool hit_light = aux_layer_hit(aux.world_to_aux[SSRT_AUX_LIGHT], SSRT_AUX_LIGHT,
-                                 pc.aux_test.x * aux.extent[SSRT_AUX_LIGHT].z, x, y, s_light);
+  bool hit_side = aux_layer_hit_at(p_side, side, side_bias, x, s_side);
+  bool hit_top = aux_layer_hit_at((aux.world_to_aux[SSRT_AUX_TOP] * vec4(y, 1.0f)).xyz, SSRT_AUX_TOP,
+                                  pc.aux_test.x * aux.extent[SSRT_AUX_TOP].z, x, s_top);
+  bool hit_light = aux_layer_hit_at((aux.world_to_aux[SSRT_AUX_LIGHT] * vec4(y, 1.0f)).xyz,
+                                    SSRT_AUX_LIGHT, pc.aux_test.x * aux.extent[SSRT_AUX_LIGHT].z,
+                                    x, s_light);
   s = hit_side ? s_side : (hit_top ? s_top : (hit_light ? s_light : s));
   return hit_side || hit_top || hit_light;
 }

@@ -417,6 +417,15 @@ TEST_F(VulkanTest, VolumeAuxLayersSeeTheBoxLeftOfTheViewAndTheTopFromTheLight) {
   // Every layer: the axes of the looking-down camera (left -x, right +x, top -z world, light
   // -y), aux_to_world inverting world_to_aux, and each stored surface projecting back onto its
   // own texel at its stored depth.
+  // ssrt_transfer reads the right layer through the left one's coordinates: same image plane and
+  // down axis, opposite right and forward axes, so right = (1 - u, v, -depth) of left.
+  for (const glm::vec3 pt : {glm::vec3(-0.85f, 0.15f, 0.05f), glm::vec3(0.4f, -0.2f, 0.9f), glm::vec3(1.3f, 0.7f, -0.6f)}) {
+    const glm::vec4 l = views.world_to_aux[SSRT_AUX_LEFT] * glm::vec4(pt, 1.0f);
+    const glm::vec4 rr = views.world_to_aux[SSRT_AUX_RIGHT] * glm::vec4(pt, 1.0f);
+    EXPECT_NEAR(rr.x, 1.0f - l.x, 1e-5f);
+    EXPECT_NEAR(rr.y, l.y, 1e-5f);
+    EXPECT_NEAR(rr.z, -l.z, 1e-5f);
+  }
   const glm::vec3 axes[4] = {{-1, 0, 0}, {1, 0, 0}, {0, 0, -1}, {0, -1, 0}};
   for (int layer = 0; layer < 4; ++layer) {
     EXPECT_LT(glm::length(glm::vec3(views.direction[layer]) - axes[layer]), 1e-5f) << layer;
