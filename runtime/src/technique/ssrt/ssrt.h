@@ -74,21 +74,32 @@
 // fast level scores RDE 0.563, so the estimate costs about 0.02.
 //
 // Cost on lavapipe (LP_NUM_THREADS=2, 640x480, `mrgi bench --techniques ssrt --frames 4
-// --warmup 1`, perf/results/report-ssrt-640x480.md, floor 1.51 ms): suite mean sustained full
-// 794 ms, half 472, fast 40.4 (26x floor), fastest 26.3 (17x); median over the five scenes
-// with a virtual object: fast 47.0, fastest 29.5. Fast level split (median over scenes):
-// transfer 15.9, shade 7.1 (tiles), ray cast 3.6, compose 3.4 (tiles), host 3.6, aux 2.5,
-// virtual G-buffer 1.8, fuse 1.4, filters 1.4, blur 1.2, light sums 1.0, occluders 0.9.
+// --warmup 1`, perf/results/report-ssrt-640x480.md, on a machine about 1.5x slower than the
+// one before: floor 2.4 ms against 1.5): suite mean sustained full 1182 ms, half 658, fast 65.8,
+// fastest 45.5. The same build against session 8's, interleaved on one machine (5 scenes with a
+// virtual object, 8 frames, two rounds): fast 86.3 -> 69.6 ms sustained (-19 %), process CPU
+// 128 -> 101 ms per frame (-21 %), RDE identical. Fast level split (profiling mode, median over
+// scenes, ratio to the floor): transfer 9.9 floors, shade (composing its tiles) 3.4, ray cast
+// 1.9, host 1.6, aux layers 1.5, virtual G-buffer 1.3, blur 1.1, occluders 0.7, fuse 0.6,
+// filters 1.1, light sums 0.5: about 24 floors, against about 22 for 33 ms on a 1.5 ms floor.
 // Measured gains behind them (fast level): no runtime reconstruction (-14 ms), constant
 // indices into the transfer's and the light sums' local arrays (a dynamic index had put them
 // in per-lane scratch memory: -5 and -3 ms), the occluder G-buffer (cache misses, then fewer
 // reads), mesh levels of detail and a bounded virtual G-buffer, the grouped bicubic in shade, N_v
-// culled, three aux lookups instead of four, the camera copy on the host.
+// culled, three aux lookups instead of four, the camera copy on the host; session 9: compose
+// fused into the tiled shade (its pass gone), one weighted bicubic sum, R'_d as weight x L(w)
+// (16 accumulators fewer), each sender normalised once, integer divisions through floats, the
+// right aux layer mirrored from the left one's matrix (transfer -17 %).
+// What the transfer's time is (knock-out runs, process CPU, desk_spot/corner): the real-receiver
+// path is 87 % of it; the aux test 35 % (each layer about 7 ms of CPU; without its image loads
+// only 10 % less, so it is the arithmetic and the registers it holds, not the reads); the SH
+// basis 5 %; T_real's 16 accumulators 13 %. On lavapipe a shader's live values decide its cost:
+// a per-lane choice between two uniform matrices cost 17 % of the pass.
 // Known defects: the grey-world albedo (paper Sec. 6.4) reads brighter objects as more light
 // from their side (env_fisheye's boxes and ball are 0.6-0.7, its floor 0.5); the fast level is
-// above 33 ms on lavapipe (its transfer is about 3x its image-read floor, ~2.2 M reads at ~2.3
-// ns, perf/results/peaks-lavapipe-x2.md); its coarse geometry costs corner 0.017 RDE (0.748
-// -> 0.765; geometry_step 2 gives 0.741 but ~24 ms more). The fastest level had 2 SH bands
+// above 33 ms on lavapipe (about 24 floor passes against 22; the transfer is the rest); its
+// coarse geometry costs corner 0.017 RDE (0.748 -> 0.765; geometry_step 2 gives 0.741 but ~24
+// ms more). The fastest level had 2 SH bands
 // until session 4; the transfer accumulates all 16 coefficients whatever the level, so 2 bands
 // saved nothing and cost the direction (46 degrees off; LightEstimatorSettings::
 // below_surface_penalty says why).
