@@ -25,6 +25,26 @@ double median(std::vector<double> v) {
   return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
+// Every frame of `capture` through a runtime made with `s` (validation layers as `s` says), the
+// outputs in frame order as they come back.
+void run_every_frame(CaptureReader& capture, const RuntimeSettings& s, std::vector<FrameOutput>& outs) {
+  const CaptureInfo& info = capture.info();
+  auto rt = create_runtime(s, CameraSetup{info.color, info.depth, info.depth_scale, info.exposure},
+                           *capture.scene());
+  ASSERT_TRUE(rt.ok()) << rt.error().message;
+  for (size_t i = 0; i < capture.frame_count(); ++i) {
+    auto f = capture.read_frame(i);
+    ASSERT_TRUE(f.ok());
+    f->index = int64_t(i);
+    auto o = (*rt)->process(*f);
+    ASSERT_TRUE(o.ok()) << o.error().message;
+    for (auto& x : *o) outs.push_back(std::move(x));
+  }
+  auto rest = (*rt)->flush();
+  ASSERT_TRUE(rest.ok()) << rest.error().message;
+  for (auto& x : *rest) outs.push_back(std::move(x));
+}
+
 TEST(GoldenSsrt, EnvFisheyeLightDirectionAndRdeBeatBaseline) {
   const test::ReplayResult base = test::replay_capture(kCapture, "baseline", 0);
   ASSERT_TRUE(base.any && base.pooled.all.rde_defined);
@@ -56,27 +76,14 @@ TEST(GoldenSsrt, EnvFisheyeLightDirectionAndRdeBeatBaseline) {
 TEST(GoldenSsrt, FirstFrameIsPrimedOnceAndEveryFrameGivesOneOutput) {
   auto capture = CaptureReader::open(std::string(MRGI_SOURCE_DIR) + "/tests/data/golden_desk_160");
   ASSERT_TRUE(capture.ok()) << capture.error().message;
-  const CaptureInfo& info = capture->info();
   for (const char* technique : {"ssrt", "baseline"}) {
     RuntimeSettings s;
     s.device.validate = true;
     s.technique = technique;
     s.level = 3;
-    auto rt = create_runtime(s, CameraSetup{info.color, info.depth, info.depth_scale, info.exposure},
-                             *capture->scene());
-    ASSERT_TRUE(rt.ok()) << rt.error().message;
     std::vector<FrameOutput> outs;
-    for (size_t i = 0; i < capture->frame_count(); ++i) {
-      auto f = capture->read_frame(i);
-      ASSERT_TRUE(f.ok());
-      f->index = int64_t(i);
-      auto o = (*rt)->process(*f);
-      ASSERT_TRUE(o.ok()) << o.error().message;
-      for (auto& x : *o) outs.push_back(std::move(x));
-    }
-    auto rest = (*rt)->flush();
-    ASSERT_TRUE(rest.ok()) << rest.error().message;
-    for (auto& x : *rest) outs.push_back(std::move(x));
+    run_every_frame(*capture, s, outs);
+    if (HasFatalFailure()) return;
     ASSERT_EQ(outs.size(), capture->frame_count()) << technique;
     int primed = 0;
     for (size_t i = 0; i < outs.size(); ++i) {
@@ -101,7 +108,6 @@ TEST(GoldenSsrt, FirstFrameIsPrimedOnceAndEveryFrameGivesOneOutput) {
 TEST(GoldenSsrt, FusedComposeMatchesTheComposePass) {
   auto capture = CaptureReader::open(std::string(MRGI_SOURCE_DIR) + "/tests/data/golden_desk_160");
   ASSERT_TRUE(capture.ok()) << capture.error().message;
-  const CaptureInfo& info = capture->info();
   std::vector<FrameOutput> runs[2];
   for (int fused = 0; fused < 2; ++fused) {
     RuntimeSettings s;
@@ -109,20 +115,8 @@ TEST(GoldenSsrt, FusedComposeMatchesTheComposePass) {
     s.technique = "ssrt";
     s.level = 2;  // fast: 4x4 cells, tiled shade
     s.fuse_compose = fused == 1;
-    auto rt = create_runtime(s, CameraSetup{info.color, info.depth, info.depth_scale, info.exposure},
-                             *capture->scene());
-    ASSERT_TRUE(rt.ok()) << rt.error().message;
-    for (size_t i = 0; i < capture->frame_count(); ++i) {
-      auto f = capture->read_frame(i);
-      ASSERT_TRUE(f.ok());
-      f->index = int64_t(i);
-      auto o = (*rt)->process(*f);
-      ASSERT_TRUE(o.ok()) << o.error().message;
-      for (auto& x : *o) runs[fused].push_back(std::move(x));
-    }
-    auto rest = (*rt)->flush();
-    ASSERT_TRUE(rest.ok()) << rest.error().message;
-    for (auto& x : *rest) runs[fused].push_back(std::move(x));
+    run_every_frame(*capture, s, runs[fused]);
+    if (HasFatalFailure()) return;
     ASSERT_EQ(runs[fused].size(), capture->frame_count());
   }
   size_t differing = 0, changed = 0, total = 0, fused_frames = 0;
