@@ -9,6 +9,11 @@
 #include "ssrt/upsampled.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
+// kRadiusCells > 0: the window's radius in cells is this constant (the level's radius / step,
+// rounded up, must equal it; ssrt.cpp picks the pipeline): the taps unroll, their in-window
+// tests fold away and their Gauss weights are computed once per distance instead of per tap.
+// 0: the radius comes from the push constants.
+layout(constant_id = 0) const int kRadiusCells = 0;
 layout(set = 0, binding = 0, rgba32f) readonly uniform image2DArray coarse;
 layout(set = 0, binding = 1, rgba32ui) writeonly uniform uimage2D upsampled;
 layout(push_constant) uniform Push {
@@ -20,7 +25,7 @@ void main() {
   ivec2 cell = ivec2(gl_GlobalInvocationID.xy);
   if (cell.x >= pc.grid.x || cell.y >= pc.grid.y) return;
   float radius_cells = pc.filt.x / float(pc.grid.z);
-  int r = int(ceil(radius_cells));
+  int r = kRadiusCells > 0 ? kRadiusCells : int(ceil(radius_cells));
   float sigma = max(radius_cells * 0.5f, 1e-3f);
   vec4 centre = imageLoad(coarse, ivec3(cell, 4));
   vec4 acc4 = vec4(0.0f), acc5 = vec4(0.0f), acc6 = vec4(0.0f);

@@ -478,14 +478,17 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
           },
           [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
             const gpu::Context& ctx = pass.context();
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, blur_->pipeline);
+            const gpu::Pipeline* blur = &*blur_;
+            for (const auto& [r, pipe] : blur_by_radius_)
+              if (r == blur_radius_cells(int(step_))) blur = &*pipe;
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, blur->pipeline);
             gpu::DescriptorPush()
                 .storage_image(0, pass.view(coarse_))
                 .storage_image(1, pass.view(upsampled_))
-                .push(ctx, cmd, *blur_);
+                .push(ctx, cmd, *blur);
             BlurPush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), 0),
                         glm::vec4(kGaussRadiusPx, 0.0f, 0.0f, 0.0f)};
-            gpu::dispatch_2d(cmd, *blur_, &pc, sizeof(pc), grid_.x, grid_.y);
+            gpu::dispatch_2d(cmd, *blur, &pc, sizeof(pc), grid_.x, grid_.y);
           });
     } else {
       skipped.push_back("ssrt_upsample_blur: level samples every pixel");

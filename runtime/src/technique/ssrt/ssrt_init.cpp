@@ -137,6 +137,22 @@ Status Ssrt::init() {
   p = gpu::load_compute_pipeline(ctx, "ssrt/upsample_blur.comp", {{img}, {img}}, sizeof(BlurPush));
   if (!p) return p.error();
   blur_ = std::move(*p);
+  // One blur per window radius the ladder uses, the radius a constant (upsample_blur.comp).
+  auto blur_spv = gpu::shader_spirv("ssrt/upsample_blur.comp");
+  if (!blur_spv) return blur_spv.error();
+  for (const QualityLevel& level : ladder_) {
+    const int step = int(knob(level, "subsample"));
+    if (step <= 1) continue;
+    const int r = blur_radius_cells(step);
+    if (std::any_of(blur_by_radius_.begin(), blur_by_radius_.end(),
+                    [r](const auto& e) { return e.first == r; }))
+      continue;
+    gpu::ComputePipelineDesc d{"ssrt_upsample_blur_r" + std::to_string(r), *blur_spv, {{img}, {img}},
+                               sizeof(BlurPush), {uint32_t(r)}};
+    auto bp = gpu::create_compute_pipeline(ctx, d);
+    if (!bp) return bp.error();
+    blur_by_radius_.emplace_back(r, gpu::PipelineHandle(ctx, std::move(*bp)));
+  }
   auto shade_spv = gpu::shader_spirv("ssrt/shade.comp");
   if (!shade_spv) return shade_spv.error();
   const struct {

@@ -7,6 +7,8 @@
 #include <optional>
 #include <string>
 #include <tuple>
+#include <utility>
+#include <vector>
 
 #include "common/frame_constants.glsl"
 #include "gpu/pipelines.h"
@@ -154,7 +156,12 @@ class Ssrt final : public Technique {
       reduce_final_, blur_, shade_, shade_pass_, shade_tiled_, shade_tiled_compose_, shade_tiles_;
   // Fast levels' shade tiles (shade_tiles.comp): indirect dispatch arguments and tile indices.
   gpu::BufferHandle tile_args_, tile_list_;
-  gpu::BufferHandle no_compose_;  // shade.comp's output and mask for the variants without kCompose
+  gpu::BufferHandle no_compose_;
+  // ssrt_upsample_blur with its window radius in cells as a constant, per radius the ladder uses
+  // (blur_ takes it from the push constants).
+  std::vector<std::pair<int, gpu::PipelineHandle>> blur_by_radius_;
+  // The blur window's radius in cells at `step` pixels per cell (upsample_blur.comp).
+  static int blur_radius_cells(int step) { return int(std::ceil(kGaussRadiusPx / float(step))); }  // shade.comp's output and mask for the variants without kCompose
   ComposeTiles compose_tiles_;  // this frame's (set by record)
   std::vector<int64_t> pending_;       // per frame slot: frame whose sums its readback holds
   std::vector<int> pending_bands_;     // per frame slot: SH bands of that frame's transfer
