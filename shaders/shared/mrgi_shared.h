@@ -235,13 +235,14 @@ MRGI_FN vec3 finite3(vec3 v) { return vec3(finite1(v.x), finite1(v.y), finite1(v
 // seen by the camera model without its sRGB step (times the exposure, clipped to [0, 1]) are
 // composed with the camera's linear value (differential_compose), and the result is encoded.
 // Differences of sRGB-encoded values would darken shadows by the curve's slope, so the whole
-// composite is linear (compose.comp says more). Non-finite solution channels count as 0, so no
-// NaN reaches a frame. compose.comp runs it per output pixel; a technique that composes its own
-// tiles (Technique::ComposeTiles::composed) runs the same function.
+// composite is linear (compose.comp says more). The solutions must be finite (callers
+// sanitise them with finite3 where they read them: compose.comp per texel, before its bilinear
+// mix); the result is, whatever they are. compose.comp runs it per output pixel; a technique
+// that composes its own tiles (Technique::ComposeTiles::composed) runs the same function.
 MRGI_FN vec3 compose_encoded(vec3 camera_linear, vec3 l_r, vec3 l_rv, float virtual_mask,
                              float exposure, float eps, float alpha_max) {
-  vec3 tm_rv = clamp(finite3(l_rv) * exposure, vec3(0.0f), vec3(1.0f));
-  vec3 tm_r = clamp(finite3(l_r) * exposure, vec3(0.0f), vec3(1.0f));
+  vec3 tm_rv = clamp(l_rv * exposure, vec3(0.0f), vec3(1.0f));
+  vec3 tm_r = clamp(l_r * exposure, vec3(0.0f), vec3(1.0f));
   vec3 out_linear = differential_compose(camera_linear, tm_r, tm_rv, virtual_mask, eps, alpha_max);
   return srgb_encode(clamp(finite3(out_linear), vec3(0.0f), vec3(1.0f)));
 }

@@ -151,8 +151,8 @@ PixelInputs pixel_inputs(ivec2 pixel) {
 void store_solutions(ivec2 pixel, PixelInputs p, vec3 l_r, vec3 l_rv) {
   if (kCompose) {
     uint index = uint(pixel.y * frame.internal_output_size.z + pixel.x);
-    vec3 encoded = compose_encoded(p.camera, l_r, l_rv, p.virt ? 1.0f : 0.0f, frame.camera.y,
-                                   pc.opts.y, pc.opts.z);
+    vec3 encoded = compose_encoded(p.camera, finite3(l_r), finite3(l_rv), p.virt ? 1.0f : 0.0f,
+                                   frame.camera.y, pc.opts.y, pc.opts.z);
     out_rgba8[index] = packUnorm4x8(vec4(encoded, 1.0f));
     out_mask[index] = p.virt ? 1u : 0u;
     return;

