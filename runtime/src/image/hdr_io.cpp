@@ -83,6 +83,49 @@ Expected<ImageRGBF> load_exr(const std::string& path) {
   }
 }
 
+// stb_image's Radiance decoder (Debian's 2.27+) never returns on a run-length-encoded scanline
+// whose data stops early or holds a literal run of length 0: it reads 0 past the end and loops
+// without advancing (found by fuzz_hdr: a 69-byte file hung it). This walks the RLE control
+// bytes as stbi__hdr_load does and refuses such a file first: a scanline's four channels must
+// each be filled by runs of 1 .. what is left, within the data. Scanlines stb reads flat (width
+// outside [8, 32768), or the first one without the 2, 2 marker, after which stb reads the rest
+// flat) are bounded by the image's size and not walked.
+Status check_hdr_runs(const std::vector<uint8_t>& data, int w, int h, const std::string& path) {
+  if (w < 8 || w >= 32768) return ok_status();
+  // Pixel data starts after the header's empty line and the resolution line.
+  size_t pos = 0;
+  const size_t n = data.size();
+  for (; pos + 1 < n && !(data[pos] == '\n' && data[pos + 1] == '\n'); ++pos) {
+  }
+  pos += 2;
+  while (pos < n && data[pos] != '\n') ++pos;
+  ++pos;
+  auto get8 = [&]() -> int { return pos < n ? data[pos++] : 0; };  // stb reads 0 past the end
+  for (int j = 0; j < h; ++j) {
+    const int c1 = get8(), c2 = get8(), len_hi = get8();
+    if (c1 != 2 || c2 != 2 || (len_hi & 0x80)) return ok_status();  // stb reads the rest flat
+    if (((len_hi << 8) | get8()) != w) return ok_status();          // stb refuses it itself
+    for (int k = 0; k < 4; ++k) {
+      for (int i = 0; i < w;) {
+        if (pos >= n)
+          return fail(ErrorKind::BadInput, path + ": Radiance HDR scanline " + std::to_string(j) +
+                                               " ends early (run-length data stops at byte " +
+                                               std::to_string(n) + ")");
+        int count = get8();
+        const bool run = count > 128;
+        if (run) count -= 128;
+        if (count == 0 || count > w - i)
+          return fail(ErrorKind::BadInput, path + ": Radiance HDR scanline " + std::to_string(j) +
+                                               ": run of length " + std::to_string(count) + " with " +
+                                               std::to_string(w - i) + " pixels left (corrupt run-length data)");
+        pos += run ? 1 : size_t(count);
+        i += count;
+      }
+    }
+  }
+  return ok_status();
+}
+
 Expected<ImageRGBF> load_radiance_hdr(const std::string& path) {
   auto bytes = read_file_bytes(path);
   if (!bytes) return bytes.error();
@@ -93,6 +136,7 @@ Expected<ImageRGBF> load_radiance_hdr(const std::string& path) {
   if (w <= 0 || h <= 0 || uint64_t(w) * uint64_t(h) > kMaxHdrPixels)
     return fail(ErrorKind::BadInput, path + ": Radiance HDR is " + std::to_string(w) + "x" + std::to_string(h) +
                                          ", over the limit of " + std::to_string(kMaxHdrPixels) + " pixels (or empty)");
+  MRGI_TRY(check_hdr_runs(*bytes, w, h, path));
   float* pixels = stbi_loadf_from_memory(bytes->data(), int(bytes->size()), &w, &h, &channels, 3);
   if (!pixels) {
     const char* why = stbi_failure_reason();  // may be null (stb built without failure strings)
