@@ -9,7 +9,8 @@
 //
 // Output layers of `coarse` (cell grid in the top-left corner):
 //   0..3  T_real: 16 SH transfer coefficients of the real surface (for the light estimation)
-//   4     x R_d = T_real . l, y R'_d = T_rv . l (luminance), z 1 real surface usable for the
+//   4     x R_d, y R'_d: T . l (luminance), summed per sample as weight x L(w) (see rd_sum),
+//         z 1 real surface usable for the
 //         light estimation (measured camera colour, green unclipped: see `usable`), w what the
 //         cell sees: 0 nothing, 1 a real surface, 2 a virtual one (the up-sampling filters do
 //         not mix the two)

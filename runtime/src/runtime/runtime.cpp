@@ -227,7 +227,6 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   if (!tech) return tech.error();
   technique_ = std::move(*tech);
 
-
   // Baseline's environment: a constant ambient from the mean radiance (no occlusion). An image
   // file is averaged once here; the env camera's frames are averaged per frame in process().
   const EnvironmentDesc& env = scene_.environment;

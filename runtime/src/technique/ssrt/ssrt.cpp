@@ -229,7 +229,8 @@ void Ssrt::add_shade_pass(const char* name, ShadeMode mode, bool run_transfer) {
         const bool tiled = mode == ShadeMode::Tiled || mode == ShadeMode::TiledCompose;
         const gpu::Access out = tiled ? gpu::Access::StorageReadWrite : gpu::Access::StorageWrite;
         if (tiled) b.read(tile_args_, gpu::Access::IndirectRead);
-        // Bound by every variant, written by the composing one only.
+        // The solutions: bound by every variant, written by all but the composing one (which
+        // writes the composite to the runtime's output instead; the rest get no_compose_).
         b.write(r.lit_rv, out);
         b.write(r.lit_r, out);
         if (mode == ShadeMode::TiledCompose) {
