@@ -21,6 +21,7 @@
 // composite behind a never-entered uniform `if`), so each path is compiled out of the other.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
+#include "common/workgroup_order.glsl"
 #include "common/frame_constants.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -84,10 +85,10 @@ SOLUTION_AT(solution_rv, lit_rv)
 SOLUTION_AT(solution_r, lit_r)
 
 void main() {
-  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 pixel = spread_invocation_id();
   ivec2 out_size = frame.internal_output_size.zw;
   if (kTiled) {
-    uint t = tiles.list[gl_WorkGroupID.x];
+    uint t = tiles.list[spread_workgroup_index_1d()];
     int tiles_x = (out_size.x + 7) / 8;
     pixel = ivec2(int(t) % tiles_x, int(t) / tiles_x) * 8 + ivec2(gl_LocalInvocationID.xy);
   }

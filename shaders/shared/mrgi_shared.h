@@ -44,14 +44,35 @@ const float MRGI_PI = 3.14159265358979f;
 
 // ---- integer arithmetic ---------------------------------------------------------------------
 
-// a / b for 0 <= a < 2^20 and 1 <= b < 2^10 (per component), exactly the integer quotient,
+// a / b for 0 <= a < 2^20 and 1 <= b < 2^20 (per component), exactly the integer quotient,
 // through one float division: a CPU Vulkan device runs an integer division by a value it cannot
 // see at compile time as one scalar divide per SIMD lane (x86 has no vector integer divide;
-// ssrt's transfer made four per sample), a float division as one vector instruction. Exact:
-// a = k b + r gives a / b = k + r / b, at least 1 / b below k + 1, which is more than the
-// float's rounding step there; for r = 0 the quotient is representable.
+// ssrt's transfer made four per sample), a float division as one vector instruction. Exact
+// where the division is IEEE (lavapipe's is: tests/vulkan/test_shader_math.cpp checks it on
+// the device): a = k b + r gives a / b = k + r / b, at least 1 / b below k + 1, which is more
+// than the float's rounding step there (1 / b > (k + 1) 2^-24 while b (k + 1) <= a + b < 2^24);
+// for r = 0 the quotient is representable.
 MRGI_FN ivec2 div_nonneg(ivec2 a, int b) { return ivec2(vec2(a) / float(b)); }
 MRGI_FN int div_nonneg1(int a, int b) { return int(float(a) / float(b)); }
+
+// Workgroup order for CPU Vulkan devices. Lavapipe (Mesa 22.3, lp_cs_tpool.c) splits a
+// dispatch's n workgroups statically: with T worker threads, thread i runs the contiguous run
+// [i n / T, (i + 1) n / T) of the linear workgroup index (x fastest), so with 2 threads one
+// runs the top half of the image and the other the bottom half. Where the cost differs
+// between the halves (sky against a floor full of samples, rays that miss against rays that
+// march) one thread idles while the other finishes: ssrt's fast level ran with one core idle
+// for 11 % of its frame. This maps the index a worker runs, k, to the tile the invocation
+// computes: the k of quarter q of the range (q = 0..3) take the tiles congruent to q mod 4,
+// so each half and each quarter of the range covers the whole grid in stripes (balanced for
+// 2 and 4 threads); the last n mod 4 keep their place. A bijection on [0, n); on a GPU the
+// order of workgroups does not matter.
+MRGI_FN int spread_workgroup_index(int k, int n) {
+  int bulk = n - n % 4;
+  if (k >= bulk) return k;
+  int quarter = bulk / 4;
+  int q = div_nonneg1(k, quarter);
+  return 4 * (k - q * quarter) + q;
+}
 
 // ---- colour -------------------------------------------------------------------------------
 

@@ -14,6 +14,7 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require  // depth_median.glsl
 #include "shared/mrgi_shared.h"
+#include "common/workgroup_order.glsl"
 #include "common/frame_constants.glsl"
 #include "ssrt/depth_median.glsl"
 
@@ -57,7 +58,7 @@ bool axis_difference(ivec2 p, ivec2 step, vec3 centre, float z0, out vec3 d) {
 
 void main() {
   g_size = frame.internal_output_size.xy;
-  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 pixel = spread_invocation_id();
   if (any(greaterThanEqual(pixel, g_size))) return;
   float z0 = imageLoad(depth, pixel).x;
   if (!depth_valid(z0)) {

@@ -18,6 +18,7 @@
 // sender's reflected light), normals to 16-bit octahedral (below 0.01 degrees).
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
+#include "common/workgroup_order.glsl"
 #include "common/frame_constants.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -36,7 +37,7 @@ layout(set = 0, binding = 9, rg32ui) writeonly uniform uimage2D occ_b;
 layout(push_constant) uniform Push { ivec4 step; } pc;
 
 void main() {
-  ivec2 g = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 g = spread_invocation_id();
   int s = pc.step.x;
   ivec2 size = pc.step.yz;
   ivec2 grid = div_nonneg(size + s - 1, s);

@@ -13,6 +13,7 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 #include "shared/mrgi_shared.h"
+#include "common/workgroup_order.glsl"
 #include "common/frame_constants.glsl"
 #include "ssrt/ssrt_math.h"
 #include "ssrt/upsampled.glsl"
@@ -291,7 +292,7 @@ void shade_group(ivec2 origin) {
 
 void main() {
   if (kTiled) {
-    uint t = tiles.list[gl_WorkGroupID.x];
+    uint t = tiles.list[spread_workgroup_index_1d()];
     int tiles_x = (pc.size.x + 7) / 8;
     ivec2 tile = ivec2(int(t) % tiles_x, int(t) / tiles_x) * 8;
     // local_size 8 x 1: lavapipe packs invocations into SIMD lanes along x only.
@@ -305,5 +306,5 @@ void main() {
     }
     return;
   }
-  shade_pixel(ivec2(gl_GlobalInvocationID.xy));
+  shade_pixel(spread_invocation_id());
 }

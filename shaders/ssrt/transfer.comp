@@ -22,6 +22,7 @@
 #include "common/frame_constants.glsl"
 #include "ssrt/ssrt_math.h"
 #include "ssrt/aux_views.glsl"
+#include "common/workgroup_order.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 // kRealReceivers: the dispatch covers only cells whose receiver is real (outside the virtual
@@ -160,7 +161,7 @@ void surfaces_at(vec2 q, ivec2 qi, int gstep, int ostep, out vec4 real, out vec3
 float view_depth(vec3 p) { return (frame.world_to_camera * vec4(p, 1.0f)).z; }
 
 void main() {
-  ivec2 cell = pc.region.xy + ivec2(gl_GlobalInvocationID.xy);
+  ivec2 cell = pc.region.xy + spread_invocation_id();
   if (cell.x >= pc.region.z || cell.y >= pc.region.w) return;
   ivec2 size = frame.internal_output_size.xy;
   int step = pc.grid.z;

@@ -6,6 +6,7 @@
 // axis (m); no surface: 0. The views and the occlusion rule are in ssrt/aux_views.glsl.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
+#include "common/workgroup_order.glsl"
 #include "ssrt/aux_views.glsl"
 #include "ssrt/tsdf_volume.glsl"
 
@@ -19,7 +20,7 @@ layout(set = 0, binding = 3, rgba32f) writeonly uniform image2DArray aux_positio
 
 void main() {
   int res = views.info.y;
-  ivec2 id = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 id = spread_invocation_id();
   int layer = div_nonneg1(id.y, res);
   ivec2 texel = ivec2(id.x, id.y - layer * res);
   if (id.x >= res || layer >= views.info.x) return;

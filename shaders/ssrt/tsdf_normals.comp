@@ -7,6 +7,7 @@
 // third of the ray cast's time on lavapipe.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
+#include "common/workgroup_order.glsl"
 #include "common/frame_constants.glsl"
 #include "ssrt/tsdf_volume.glsl"
 
@@ -20,7 +21,7 @@ layout(set = 0, binding = 4, rgba16f) writeonly uniform image2D normal_volume;
 #include "ssrt/tsdf_march.glsl"
 
 void main() {
-  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 pixel = spread_invocation_id();
   if (any(greaterThanEqual(pixel, frame.internal_output_size.xy))) return;
   float depth = imageLoad(depth_volume, pixel).x;
   vec4 normal = vec4(0.0f);

@@ -5,6 +5,7 @@
 // point's depth along the camera z in metres. No crossing: 0.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
+#include "common/workgroup_order.glsl"
 #include "common/frame_constants.glsl"
 #include "ssrt/tsdf_volume.glsl"
 
@@ -17,7 +18,7 @@ layout(set = 0, binding = 3, r32f) writeonly uniform image2D depth_volume;
 #include "ssrt/tsdf_march.glsl"
 
 void main() {
-  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 pixel = spread_invocation_id();
   if (any(greaterThanEqual(pixel, frame.internal_output_size.xy))) return;
   vec3 ray_camera = unproject_pinhole(vec2(pixel), 1.0f, frame.internal_k);  // z = 1
   vec3 o = volume.camera_to_world[3].xyz;

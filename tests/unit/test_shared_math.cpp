@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "../../shaders/shared/mrgi_shared.h"
 
@@ -215,9 +216,51 @@ TEST(SharedMath, DivNonnegIsTheIntegerQuotient) {
       }
     }
   }
+  // Large divisors (a quarter of a dispatch's workgroups: spread_workgroup_index).
+  for (int b = 1024; b < (1 << 20); b = b * 3 + 1) {
+    for (int k = 0; k * b < (1 << 20); ++k) {
+      for (int d : {-1, 0, 1}) {
+        const int x = k * b + d;
+        if (x < 0 || x >= (1 << 20)) continue;
+        ASSERT_EQ(div_nonneg1(x, b), x / b) << x << " / " << b;
+      }
+    }
+  }
   const ivec2 q = div_nonneg(ivec2(639, 480), 4);
   EXPECT_EQ(q.x, 159);
   EXPECT_EQ(q.y, 120);
+}
+
+TEST(SharedMath, SpreadWorkgroupIndexIsABijectionThatSpreadsEachQuarter) {
+  std::vector<int> seen;
+  for (int n = 1; n < 700; ++n) {
+    seen.assign(size_t(n), 0);
+    for (int k = 0; k < n; ++k) {
+      const int t = spread_workgroup_index(k, n);
+      ASSERT_GE(t, 0) << k << " of " << n;
+      ASSERT_LT(t, n) << k << " of " << n;
+      ++seen[size_t(t)];
+    }
+    for (int t = 0; t < n; ++t) ASSERT_EQ(seen[size_t(t)], 1) << "tile " << t << " of " << n;
+  }
+  // What lavapipe's two workers get: the first half of the index range takes the tiles 0 and
+  // 1 mod 4, the second 2 and 3, so each works on every row of a 20 x 15 grid (300 workgroups).
+  const int gx = 20, gy = 15, n = gx * gy;
+  std::vector<int> rows_first(gy, 0), rows_second(gy, 0);
+  for (int k = 0; k < n; ++k) {
+    const int t = spread_workgroup_index(k, n);
+    (k < n / 2 ? rows_first : rows_second)[size_t(t / gx)]++;
+  }
+  for (int y = 0; y < gy; ++y) {
+    EXPECT_EQ(rows_first[size_t(y)], gx / 2) << "row " << y;
+    EXPECT_EQ(rows_second[size_t(y)], gx / 2) << "row " << y;
+  }
+  // Large grids (1280 x 960 and 2560 x 1920 at 8 x 8, and odd counts) stay bijective.
+  for (int big : {19200, 19203, 76801}) {
+    seen.assign(size_t(big), 0);
+    for (int k = 0; k < big; ++k) ++seen[size_t(spread_workgroup_index(k, big))];
+    for (int t = 0; t < big; ++t) ASSERT_EQ(seen[size_t(t)], 1) << "tile " << t << " of " << big;
+  }
 }
 
 TEST(SharedMath, ComposeEncodedIsTheCameraModelAroundDifferentialCompose) {
