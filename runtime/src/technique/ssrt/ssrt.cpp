@@ -464,8 +464,7 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
               .storage_buffer(1, pass.buffer(result_))
               .push(ctx, cmd, *reduce_final_);
           FinalPush pc{glm::ivec4(int(partial_count), 0, 0, 0)};
-          gpu::dispatch_2d(cmd, *reduce_final_, &pc, sizeof(pc), kReduceEntries, 1,
-                           kReduceEntries, 1);
+          gpu::dispatch_2d(cmd, *reduce_final_, &pc, sizeof(pc), kReduceEntries, 1, 24, 1);
         });
     graph.mark_output(result_);
     pending_[graph.slot()] = info.frame_index;
