@@ -361,3 +361,95 @@ TEST(GltfHardening, TruncatedOrForeignGlbHeadersAreRefused) {
 
 }  // namespace
 }  // namespace mrgi
+
+namespace mrgi {
+namespace {
+
+// Issue 12 case 10: KHR_texture_transform on the base colour texture (offset, rotation, scale
+// and its texCoord override) is applied to the primitive's coordinates, as the extension's
+// T * R * S matrix; bad values are refused naming the field.
+std::string textured_triangle_gltf(const std::string& texture_info) {
+  return R"({
+  "asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+  "extensionsUsed": ["KHR_texture_transform"],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1, "TEXCOORD_1": 2}, "material": 0}]}],
+  "materials": [{"pbrMetallicRoughness": {"baseColorTexture": )" + texture_info + R"(}}],
+  "textures": [{"source": 0}],
+  "images": [{"uri": "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAIAAACQd1PeAAAADElEQVR4nGM4kWIEAANWAV/oF4RSAAAAAElFTkSuQmCC"}],
+  "buffers": [{"uri": "uv.bin", "byteLength": 84}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
+                  {"buffer": 0, "byteOffset": 36, "byteLength": 24},
+                  {"buffer": 0, "byteOffset": 60, "byteLength": 24}],
+  "accessors": [
+    {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+    {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"},
+    {"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC2"}]
+})";
+}
+
+void write_uv_bin(const std::string& path) {
+  const float data[21] = {0, 0, 0, 1, 0, 0, 0, 1, 0,  // positions
+                          0, 0, 1, 0, 0, 0.5f,        // TEXCOORD_0
+                          0.25f, 0.25f, 0.25f, 0.25f, 0.25f, 0.25f};  // TEXCOORD_1
+  std::ofstream out(path, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(data), sizeof(data));
+}
+
+TEST(GltfLoader, TextureTransformIsAppliedToTheBaseColourCoordinates) {
+  TempDir dir;
+  write_uv_bin(dir.file("uv.bin"));
+  // Scale (2, 1), then 90 degrees counter-clockwise ((u, v) -> (-v, u)), then offset (0.5, 0):
+  // (1, 0) -> (2, 0) -> (0, 2) -> (0.5, 2); (0, 0.5) -> (0, 0.5) -> (-0.5, 0) -> (0, 0).
+  write_text(dir.file("t.gltf"), textured_triangle_gltf(
+      R"({"index": 0, "extensions": {"KHR_texture_transform": {"offset": [0.5, 0], "rotation": 1.5707963267948966, "scale": [2, 1]}}})"));
+  auto model = load_gltf(dir.file("t.gltf"), Placement{});
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  const auto& uvs = model->primitives[0].uvs;
+  ASSERT_EQ(uvs.size(), 3u);
+  EXPECT_NEAR(uvs[0].x, 0.5f, 1e-6f);
+  EXPECT_NEAR(uvs[0].y, 0.0f, 1e-6f);
+  EXPECT_NEAR(uvs[1].x, 0.5f, 1e-6f);
+  EXPECT_NEAR(uvs[1].y, 2.0f, 1e-6f);
+  EXPECT_NEAR(uvs[2].x, 0.0f, 1e-6f);
+  EXPECT_NEAR(uvs[2].y, 0.0f, 1e-6f);
+
+  // The extension's texCoord overrides the texture info's: TEXCOORD_1 (all 0.25), offset only.
+  write_text(dir.file("set1.gltf"), textured_triangle_gltf(
+      R"({"index": 0, "texCoord": 0, "extensions": {"KHR_texture_transform": {"offset": [0.5, 0.25], "texCoord": 1}}})"));
+  auto set1 = load_gltf(dir.file("set1.gltf"), Placement{});
+  ASSERT_TRUE(set1.ok()) << set1.error().message;
+  for (const auto& uv : set1->primitives[0].uvs) {
+    EXPECT_NEAR(uv.x, 0.75f, 1e-6f);
+    EXPECT_NEAR(uv.y, 0.5f, 1e-6f);
+  }
+  // Without the extension the texture info's own texCoord picks the set.
+  write_text(dir.file("plain1.gltf"), textured_triangle_gltf(R"({"index": 0, "texCoord": 1})"));
+  auto plain1 = load_gltf(dir.file("plain1.gltf"), Placement{});
+  ASSERT_TRUE(plain1.ok()) << plain1.error().message;
+  EXPECT_NEAR(plain1->primitives[0].uvs[1].x, 0.25f, 1e-6f);
+}
+
+TEST(GltfHardening, BadTextureTransformsAreRefusedNamingTheField) {
+  TempDir dir;
+  write_uv_bin(dir.file("uv.bin"));
+  const std::pair<const char*, const char*> cases[] = {
+      {R"({"index": 0, "extensions": {"KHR_texture_transform": {"scale": [1]}}})", "scale"},
+      {R"({"index": 0, "extensions": {"KHR_texture_transform": {"offset": [1e39, 0]}}})", "offset"},
+      {R"({"index": 0, "extensions": {"KHR_texture_transform": {"rotation": "half"}}})", "rotation"},
+      {R"({"index": 0, "extensions": {"KHR_texture_transform": {"texCoord": -1}}})", "texCoord"},
+      {R"({"index": 0, "texCoord": 5})", "TEXCOORD_5"},
+  };
+  int i = 0;
+  for (const auto& [info, field] : cases) {
+    const std::string name = "bad" + std::to_string(i++) + ".gltf";
+    write_text(dir.file(name), textured_triangle_gltf(info));
+    auto r = load_gltf(dir.file(name), Placement{});
+    ASSERT_FALSE(r.ok()) << name;
+    EXPECT_EQ(r.error().kind, ErrorKind::BadInput) << r.error().message;
+    EXPECT_NE(r.error().message.find(name), std::string::npos) << r.error().message;
+    EXPECT_NE(r.error().message.find(field), std::string::npos) << r.error().message;
+  }
+}
+
+}  // namespace
+}  // namespace mrgi

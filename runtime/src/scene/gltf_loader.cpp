@@ -277,6 +277,64 @@ glm::dmat4 node_local_matrix(const tinygltf::Node& node) {
   return m;
 }
 
+// The base colour texture's coordinate set and KHR_texture_transform (offset, rotation, scale:
+// uv' = offset + R(rotation) (scale * uv), R counter-clockwise, the extension's matrix
+// T * R * S). The base colour is the only texture mrgi samples, so the transform is applied to
+// the primitive's coordinates once at load instead of per texel lookup.
+struct UvTransform {
+  int tex_coord = 0;
+  glm::dvec2 offset{0.0}, scale{1.0};
+  double rotation = 0.0;
+  bool identity() const { return offset == glm::dvec2(0.0) && scale == glm::dvec2(1.0) && rotation == 0.0; }
+  glm::vec2 apply(glm::vec2 uv) const {
+    const glm::dvec2 s = glm::dvec2(uv) * scale;
+    const double c = std::cos(rotation), n = std::sin(rotation);
+    return glm::vec2(offset + glm::dvec2(c * s.x - n * s.y, n * s.x + c * s.y));
+  }
+};
+
+Expected<UvTransform> base_color_uv_transform(const LoadContext& ctx, int material) {
+  UvTransform t;
+  if (material < 0 || size_t(material) >= ctx.gltf.materials.size()) return t;
+  const auto& info = ctx.gltf.materials[size_t(material)].pbrMetallicRoughness.baseColorTexture;
+  if (info.index < 0) return t;
+  const std::string where = ctx.path + ": materials[" + std::to_string(material) +
+                            "].pbrMetallicRoughness.baseColorTexture";
+  t.tex_coord = info.texCoord;
+  auto it = info.extensions.find("KHR_texture_transform");
+  if (it != info.extensions.end()) {
+    const tinygltf::Value& ext = it->second;
+    const std::string field = where + ".extensions.KHR_texture_transform.";
+    auto pair = [&](const char* key, glm::dvec2& out) -> Status {
+      if (!ext.Has(key)) return ok_status();
+      const auto& v = ext.Get(key);
+      if (!v.IsArray() || v.ArrayLen() != 2 || !v.Get(0).IsNumber() || !v.Get(1).IsNumber())
+        return fail(ErrorKind::BadInput, field + key + ": must be an array of 2 numbers");
+      out = glm::dvec2(v.Get(0).GetNumberAsDouble(), v.Get(1).GetNumberAsDouble());
+      if (!std::isfinite(out.x) || !std::isfinite(out.y) || std::abs(out.x) > 1e6 || std::abs(out.y) > 1e6)
+        return fail(ErrorKind::BadInput, field + key + ": must be finite and within +-1e6");
+      return ok_status();
+    };
+    MRGI_TRY(pair("offset", t.offset));
+    MRGI_TRY(pair("scale", t.scale));
+    if (ext.Has("rotation")) {
+      const auto& r = ext.Get("rotation");
+      if (!r.IsNumber() || !std::isfinite(r.GetNumberAsDouble()))
+        return fail(ErrorKind::BadInput, field + "rotation: must be a finite number (radians)");
+      t.rotation = r.GetNumberAsDouble();
+    }
+    if (ext.Has("texCoord")) {
+      const auto& c = ext.Get("texCoord");
+      if (!c.IsInt() || c.GetNumberAsInt() < 0)
+        return fail(ErrorKind::BadInput, field + "texCoord: must be a non-negative integer");
+      t.tex_coord = c.GetNumberAsInt();
+    }
+  }
+  if (t.tex_coord < 0)
+    return fail(ErrorKind::BadInput, where + ".texCoord: must be a non-negative integer");
+  return t;
+}
+
 Status add_primitive(LoadContext& ctx, int mesh_index, size_t prim_index, const glm::dmat4& world) {
   const auto& prim = ctx.gltf.meshes[size_t(mesh_index)].primitives[prim_index];
   const std::string what = mesh_label(ctx.gltf, mesh_index, prim_index);
@@ -295,11 +353,19 @@ Status add_primitive(LoadContext& ctx, int mesh_index, size_t prim_index, const 
     if (!n) return n.error();
     normals = std::move(*n);
   }
+  auto uv_transform = base_color_uv_transform(ctx, prim.material);
+  if (!uv_transform) return uv_transform.error();
   std::vector<glm::vec2> uvs;
-  if (auto it = prim.attributes.find("TEXCOORD_0"); it != prim.attributes.end()) {
-    auto t = read_vectors<2>(ctx, it->second, what + " TEXCOORD_0");
+  const std::string uv_name = "TEXCOORD_" + std::to_string(uv_transform->tex_coord);
+  if (auto it = prim.attributes.find(uv_name); it != prim.attributes.end()) {
+    auto t = read_vectors<2>(ctx, it->second, what + " " + uv_name);
     if (!t) return t.error();
     uvs = std::move(*t);
+    if (!uv_transform->identity())
+      for (glm::vec2& uv : uvs) uv = uv_transform->apply(uv);
+  } else if (uv_transform->tex_coord != 0) {
+    return fail(ErrorKind::BadInput, ctx.path + ": " + what + ": its material's base colour texture reads " +
+                                         uv_name + ", which the primitive does not have");
   }
   const size_t vcount = positions->size();
   if ((!normals.empty() && normals.size() != vcount) || (!uvs.empty() && uvs.size() != vcount))
