@@ -59,13 +59,6 @@ layout(push_constant) uniform Push {
                 // composite (compose_encoded)
 } pc;
 
-vec4 cubic_weights(float t) {
-  // Catmull-Rom.
-  float t2 = t * t, t3 = t2 * t;
-  return vec4(-0.5f * t3 + t2 - 0.5f * t, 1.5f * t3 - 2.5f * t2 + 1.0f,
-              -1.5f * t3 + 2.0f * t2 + 0.5f * t, 0.5f * t3 - 0.5f * t2);
-}
-
 // Bicubic over the cells that see the same kind of surface as the pixel (1 real, 2 virtual),
 // renormalised by the weights of the cells used; where the 4x4 neighbourhood holds no cell of
 // the pixel's kind (thin virtual parts at 4x4), over the cells of any surface.
@@ -76,7 +69,7 @@ vec4 cubic_weights(float t) {
 void sample_bicubic(vec2 c, float kind, out vec4 s4, out vec4 s5, out vec4 s6) {
   vec2 base = floor(c);
   vec2 f = c - base;
-  vec4 wx = cubic_weights(f.x), wy = cubic_weights(f.y);
+  vec4 wx = ssrt_catmull_rom(f.x), wy = ssrt_catmull_rom(f.y);
   vec4 k4 = vec4(0.0f), k5 = vec4(0.0f), k6 = vec4(0.0f);  // same kind
   vec4 a4 = vec4(0.0f), a5 = vec4(0.0f), a6 = vec4(0.0f);  // any surface
   float kw = 0.0f, aw = 0.0f;
@@ -236,7 +229,7 @@ void shade_group(ivec2 origin) {
       const int col0 = px < 2 ? 0 : 1;  // first of the 5 columns in this pixel's window
       const float f_x = px == 0 ? 0.5f : (px == 1 ? 0.75f : (px == 2 ? 0.0f : 0.25f));
       float f_y = f_y0 + 0.25f * float(py);
-      vec4 wx = cubic_weights(f_x), wy = cubic_weights(f_y);
+      vec4 wx = ssrt_catmull_rom(f_x), wy = ssrt_catmull_rom(f_y);
       // sample_bicubic's two sums (same kind, any surface) differ only in which cells count,
       // and only one of them is used: the weights decide which first (scalars), then one
       // weighted sum runs over the taps with the other cells' weight 0. Adding 0 * value leaves

@@ -163,6 +163,33 @@ SSRT_FN vec3 ssrt_compose_real(vec3 camera, float r_d, float r_d_virtual, vec3 r
   return max(direct + bounce, vec3(0.0f));
 }
 
+// ---- up-sampling (fast levels) ---------------------------------------------------------------
+
+// Catmull-Rom weights of the 4 taps around fraction t (shade.comp's bicubic, paper OursFast).
+SSRT_FN vec4 ssrt_catmull_rom(float t) {
+  float t2 = t * t, t3 = t2 * t;
+  return vec4(-0.5f * t3 + t2 - 0.5f * t, 1.5f * t3 - 2.5f * t2 + 1.0f,
+              -1.5f * t3 + 2.0f * t2 + 0.5f * t, 0.5f * t3 - 0.5f * t2);
+}
+
+// Whether shading a tile can move none of its pixels by a visible amount, so the camera frame
+// may stand (shade_tiles.comp), from its bicubic footprint's cells, all present and real (the
+// weights then sum to 1): d_max = max |R'_d - R_d|, i_max = max component of R'_i over the
+// cells where R'_i != R_i (0 where equal: eq. 14's select is 0 there), R_d in [lo, hi].
+// A real pixel's composite is camera + alpha (L_rv - L_r) with alpha <= camera / L_r
+// (mrgi_shared.h differential_compose; the exposure and the clip at 1 only shrink the
+// difference), L_r = A R_d and L_rv = A (R'_d + select(R_i, R'_i) / pi): shading moves the
+// linear camera value c by at most c r, r = |R'_d - R_d + select / pi| / R_d, and the 8-bit
+// sRGB value by at most 255 max(x srgb'(x)) r = 112.1 r (at x = 1: 1.055 / 2.4 x^(1 / 2.4)).
+// Catmull-Rom's two negative weights per axis sum to -t (1 - t) / 2 >= -1/8, so sum |w| <=
+// 1.25^2 = 1.5625 in 2D and the negative weights sum to at most 0.28125: a pixel's R_d is at
+// least lo - 0.28125 (hi - lo), its numerator at most 1.5625 (d_max + i_max / pi). With
+// tolerance 2^-7 no pixel moves by more than 0.88 of a level.
+SSRT_FN bool ssrt_tile_invisible(float d_max, float i_max, float lo, float hi, float tolerance) {
+  float r_d_lower = lo - 0.28125f * (hi - lo);
+  return r_d_lower > 0.0f && 1.5625f * (d_max + i_max / MRGI_PI) <= tolerance * r_d_lower;
+}
+
 // ---- GPU-side data -------------------------------------------------------------------------
 
 // The estimated light as the passes read it (std140 uniform; vec4 members only so GLM's layout

@@ -255,3 +255,77 @@ TEST(SsrtMath, PlaneDepthIsExactOnAPlaneAndFallsBackWhereItCannotBe) {
 }
 
 }  // namespace
+
+namespace {
+using mrgi::shader::vec4;
+
+// shade_tiles.comp skips a tile when ssrt_tile_invisible says shading it moves no pixel by a
+// visible amount. Random footprints of 4 x 4 real cells that it accepts are interpolated as
+// shade.comp does (Catmull-Rom, weights summing to 1, clamped at 0), shaded (L_r = A R_d,
+// L_rv = A (R'_d + eq. 14's select / pi)) and composed (mrgi_shared.h compose_encoded, random
+// camera values and exposures): the 8-bit result is never more than one level from the camera's
+// own, which the skipped tile keeps. The rule must also accept some footprints, or it saves
+// nothing.
+TEST(SsrtMath, SkippedTilesAreWithinOneLevelOfShadingThem) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const float tolerance = 1.0f / 128.0f, eps = 1e-3f, alpha_max = 10.0f;
+  int accepted = 0, checked = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const float base = 0.02f + 3.0f * u(rng), spread = base * 0.6f * u(rng);
+    const float scale_d = std::pow(10.0f, -4.0f + 3.5f * u(rng));  // |R'_d - R_d| / R_d scale
+    const bool bounce = u(rng) < 0.5f;
+    float rd[16], rdv[16];
+    vec3 ri[16], riv[16];
+    float d_max = 0.0f, i_max = 0.0f, lo = 1e30f, hi = 0.0f;
+    for (int k = 0; k < 16; ++k) {
+      rd[k] = base + spread * u(rng);
+      rdv[k] = std::max(0.0f, rd[k] * (1.0f + scale_d * (2.0f * u(rng) - 1.0f)));
+      ri[k] = vec3(0.05f * u(rng), 0.05f * u(rng), 0.05f * u(rng));
+      riv[k] = bounce ? ri[k] + vec3(scale_d * base * u(rng)) : ri[k];
+      d_max = std::max(d_max, std::abs(rdv[k] - rd[k]));
+      if (bounce) i_max = std::max({i_max, riv[k].x, riv[k].y, riv[k].z});
+      lo = std::min(lo, rd[k]);
+      hi = std::max(hi, rd[k]);
+    }
+    if (!shader::ssrt_tile_invisible(d_max, i_max, lo, hi, tolerance)) continue;
+    ++accepted;
+    for (int pixel = 0; pixel < 8; ++pixel) {
+      const vec4 wx = shader::ssrt_catmull_rom(u(rng)), wy = shader::ssrt_catmull_rom(u(rng));
+      float s_rd = 0.0f, s_rdv = 0.0f;
+      vec3 s_ri(0.0f), s_riv(0.0f);
+      for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) {
+          const float w = wx[i] * wy[j];
+          s_rd += w * rd[j * 4 + i];
+          s_rdv += w * rdv[j * 4 + i];
+          s_ri += w * ri[j * 4 + i];
+          s_riv += w * riv[j * 4 + i];
+        }
+      s_rd = std::max(s_rd, 0.0f);
+      s_rdv = std::max(s_rdv, 0.0f);
+      s_ri = glm::max(s_ri, vec3(0.0f));
+      s_riv = glm::max(s_riv, vec3(0.0f));
+      const float exposure = 0.5f + 1.5f * u(rng);
+      const vec3 camera(u(rng), u(rng), u(rng));
+      const vec3 a = glm::clamp(camera / exposure, vec3(0.0f), vec3(1.0f));
+      const vec3 l_r = a * s_rd;
+      const vec3 l_rv = a * s_rdv + a * shader::ssrt_indirect_select(s_ri, s_riv, 1e-3f) / float(kPi);
+      const vec3 out = shader::compose_encoded(camera, l_r, l_rv, 0.0f, exposure, eps, alpha_max);
+      for (int c = 0; c < 3; ++c) {
+        const int shaded = int(std::lround(out[c] * 255.0f));
+        const int kept = int(std::lround(shader::srgb_encode1(camera[c]) * 255.0f));
+        ASSERT_LE(std::abs(shaded - kept), 1) << "trial " << trial << " channel " << c;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(accepted, 1000) << "the rule should accept footprints whose solutions barely differ";
+  EXPECT_GT(checked, 0);
+  // And refuse: no light (R_d = 0), a difference above the tolerance.
+  EXPECT_FALSE(shader::ssrt_tile_invisible(0.0f, 0.0f, 0.0f, 1.0f, tolerance));
+  EXPECT_FALSE(shader::ssrt_tile_invisible(0.02f, 0.0f, 1.0f, 1.0f, tolerance));
+  EXPECT_TRUE(shader::ssrt_tile_invisible(0.002f, 0.0f, 1.0f, 1.0f, tolerance));
+}
+
+}  // namespace

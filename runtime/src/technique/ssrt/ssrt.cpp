@@ -525,7 +525,8 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
               .storage_buffer(2, pass.buffer(tile_list_))
               .push(ctx, cmd, *shade_tiles_);
           TilesPush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), 0),
-                       glm::ivec4(int(tiles.x), int(tiles.y), 0, 0), virtual_pixels()};
+                       glm::ivec4(int(tiles.x), int(tiles.y), 0, 0), virtual_pixels(),
+                       glm::vec4(kTileTolerance, 0.0f, 0.0f, 0.0f)};
           gpu::dispatch_2d(cmd, *shade_tiles_, &pc, sizeof(pc), tiles.x * tiles.y, 1, 64, 1);
         });
     // At the output size the tiles are the compose's too: it copies the camera frame outside

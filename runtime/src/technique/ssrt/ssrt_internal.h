@@ -37,6 +37,11 @@ constexpr float kMinSenderDistM = 0.05f;     // 1/d^2 clamp of the form factor
 constexpr float kDepthBias = 0.01f;          // occluder must be 1 % closer than the sample
 constexpr float kSaturation = 0.98f;         // camera values at/above are clipped: not used
 constexpr float kIndirectTolerance = 1e-3f;  // eq. 14
+// Fast levels: a tile whose footprint's solutions can change no pixel's composite by more than
+// this fraction keeps the camera frame: at most 0.88 of an 8-bit level, so no pixel moves by
+// more than one level (ssrt_math.h ssrt_tile_invisible). The suite's fast level, third frame
+// of the 5 scenes with a virtual object: 15380 -> 10870 tiles shaded of 24000, frames identical.
+constexpr float kTileTolerance = 1.0f / 128.0f;
 constexpr float kGaussRadiusPx = 8.0f;       // paper OursFast
 // An auxiliary-buffer surface occludes a sample only if it lies this many of the layer's texels
 // in front of it (the aux layers are ray-cast from a TSDF with voxels about one texel wide).
@@ -68,6 +73,7 @@ struct TilesPush {
   glm::ivec4 grid;
   glm::ivec4 counts;
   glm::ivec4 virt;
+  glm::vec4 tolerance;
 };
 struct ShadePush {
   glm::ivec4 grid;
