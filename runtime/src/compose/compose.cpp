@@ -1,6 +1,7 @@
 #include "compose/compose.h"
 
 #include <algorithm>
+#include <bit>
 #include <cstring>
 
 #include <glm/glm.hpp>
@@ -189,7 +190,19 @@ Status Compose::read(const gpu::FrameGraph& graph, uint32_t slot, ImageRGBA8& im
   const auto* rgb = static_cast<const uint8_t*>(graph.mapped(in_.color_upload, slot));
   uint8_t* px = image.data.data();
   const size_t n = size_t(width_) * height_;
-  for (size_t i = 0; i < n; ++i) {
+  // One 4-byte load per pixel (its RGB and the next pixel's R, replaced by alpha 255): the
+  // byte-wise loop was about a third of the host's time per frame at 640x480. The last pixel
+  // is copied byte-wise so nothing is read past the frame.
+  static_assert(std::endian::native == std::endian::little, "RGBA8 words are R | G << 8 | B << 16");
+  const uint32_t alpha = 0xffu << 24;
+  for (size_t i = 0; i + 1 < n; ++i) {
+    uint32_t v;
+    std::memcpy(&v, rgb + 3 * i, 4);
+    v = (v & 0x00ffffffu) | alpha;
+    std::memcpy(px + 4 * i, &v, 4);
+  }
+  if (n > 0) {
+    const size_t i = n - 1;
     px[4 * i + 0] = rgb[3 * i + 0];
     px[4 * i + 1] = rgb[3 * i + 1];
     px[4 * i + 2] = rgb[3 * i + 2];
