@@ -74,14 +74,13 @@
 // fast level scores RDE 0.563, so the estimate costs about 0.02.
 //
 // Cost on lavapipe (LP_NUM_THREADS=2, 640x480, `mrgi bench --techniques ssrt --frames 4
-// --warmup 1`, perf/results/report-ssrt-640x480.md, on a machine about 1.5x slower than the
-// one before: floor 2.4 ms against 1.5): suite mean sustained full 1182 ms, half 658, fast 65.8,
-// fastest 45.5. The same build against session 8's, interleaved on one machine (5 scenes with a
-// virtual object, 8 frames, two rounds): fast 86.3 -> 69.6 ms sustained (-19 %), process CPU
-// 128 -> 101 ms per frame (-21 %), RDE identical. Fast level split (profiling mode, median over
-// scenes, ratio to the floor): transfer 9.9 floors, shade (composing its tiles) 3.4, ray cast
-// 1.9, host 1.6, aux layers 1.5, virtual G-buffer 1.3, blur 1.1, occluders 0.7, fuse 0.6,
-// filters 1.1, light sums 0.5: about 24 floors, against about 22 for 33 ms on a 1.5 ms floor.
+// --warmup 1`, perf/results/report-ssrt-640x480.md, session 10's machine: floor 2.2-2.7 ms,
+// session 8's was 1.5): suite mean sustained full 1153 ms, half 759, fast 53.0, fastest 48.5;
+// fast over the scenes with a virtual object 20.8-23.6 floors (median 23.0). Fast level split
+// (profiling mode, median over scenes, ratio to the floor): transfer 9.5 floors, shade
+// (composing its tiles) 2.4 and its tile test 0.4, ray cast 1.9, virtual G-buffer 1.5, host
+// 1.2, blur 0.9, filters 0.9, occluders 0.8, fuse 0.6, G-buffer 0.6, light sums 0.5, aux layers
+// 0.5: about 22 floors profiled, 23 sustained, against about 22 for 33 ms on a 1.5 ms floor.
 // Measured gains behind them (fast level): no runtime reconstruction (-14 ms), constant
 // indices into the transfer's and the light sums' local arrays (a dynamic index had put them
 // in per-lane scratch memory: -5 and -3 ms), the occluder G-buffer (cache misses, then fewer
@@ -90,7 +89,10 @@
 // fused into the tiled shade (its pass gone), one weighted bicubic sum, R'_d as weight x L(w)
 // (16 accumulators fewer), each sender normalised once, integer divisions through floats, the
 // right aux layer mirrored from the left one's matrix (transfer -17 %), the blur's radius a
-// specialization constant (blur -14 %).
+// specialization constant (blur -14 %); session 10: workgroups in spread order for lavapipe's
+// static split of a dispatch between its workers, tiles that cannot move a pixel by one 8-bit
+// level left to the camera frame (ssrt_tile_invisible: shaded tiles -29 %), aux layers at 32
+// texels on the fast levels (their ray cast -75 %), the light sums' final pass on 8 workgroups.
 // What the transfer's time is (knock-out runs, process CPU, desk_spot/corner): the real-receiver
 // path is 87 % of it; the aux test 35 % (each layer about 7 ms of CPU; without its image loads
 // only 10 % less, so it is the arithmetic and the registers it holds, not the reads); the SH
@@ -98,7 +100,7 @@
 // a per-lane choice between two uniform matrices cost 17 % of the pass.
 // Known defects: the grey-world albedo (paper Sec. 6.4) reads brighter objects as more light
 // from their side (env_fisheye's boxes and ball are 0.6-0.7, its floor 0.5); the fast level is
-// above 33 ms on lavapipe (about 24 floor passes against 22; the transfer is the rest); its
+// above 33 ms on lavapipe (about 23 floor passes against 22; the transfer is the rest); its
 // coarse geometry costs corner 0.017 RDE (0.748 -> 0.765; geometry_step 2 gives 0.741 but ~24
 // ms more). The fastest level had 2 SH bands
 // until session 4; the transfer accumulates all 16 coefficients whatever the level, so 2 bands
