@@ -20,6 +20,7 @@ layout(set = 0, binding = 4) uniform sampler2D real_albedo;
 layout(set = 0, binding = 5) uniform sampler2D virtual_position;
 layout(set = 0, binding = 6) uniform sampler2D virtual_normal;
 layout(set = 0, binding = 7) uniform sampler2D virtual_albedo;
+layout(set = 0, binding = 12) uniform sampler2D virtual_emission;  // rgb emitted radiance
 layout(set = 0, binding = 8) uniform sampler2DArrayShadow shadow_primary;
 layout(set = 0, binding = 9) uniform sampler2DArrayShadow shadow_virtual;
 layout(set = 0, binding = 10, rgba16f) writeonly uniform image2D lit_rv;
@@ -116,7 +117,10 @@ void main() {
   float roughness = is_virtual ? nrm.w : 1.0f;
   float r_p = is_virtual ? 0.0f : 1.0f;
 
-  vec3 l_rv = alb.rgb * (frame.ambient_both.rgb + frame.ambient_virtual.rgb);
+  // A virtual surface's own emission (glTF emissive) is seen directly; it lights nothing else
+  // here (this technique has no indirect light).
+  vec3 l_rv = alb.rgb * (frame.ambient_both.rgb + frame.ambient_virtual.rgb) +
+              (is_virtual ? texelFetch(virtual_emission, pixel, 0).rgb : vec3(0.0f));
   vec3 l_r = r_p * alb.rgb * frame.ambient_both.rgb;
   int count = min(light_set.count.x, MRGI_MAX_LIGHTS);
   for (int i = 0; i < count; ++i) {

@@ -11,10 +11,12 @@ using glm::vec4;
 struct GpuMaterial {
   vec4 base_color_factor;  // linear RGBA (glTF baseColorFactor)
   vec4 params;             // x metallic, y roughness, z base-colour texture layer (-1 none), w unused
+  vec4 emission;           // rgb emitted radiance (glTF emissiveFactor x
+                           // KHR_materials_emissive_strength), w its texture's layer (-1 none)
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(GpuMaterial) == 32, "std430 mirror");
+static_assert(sizeof(GpuMaterial) == 48, "std430 mirror");
 }  // namespace mrgi::shader
 #endif
 #endif  // MRGI_SCENE_MATERIALS_GLSL

@@ -1,6 +1,6 @@
 #version 460
 // Virtual G-buffer: world position + coverage, normal + roughness, linear base colour +
-// metallic. A virtual fragment behind the real surface seen at its pixel (the real geometry's
+// metallic, emitted radiance. A virtual fragment behind the real surface seen at its pixel (the real geometry's
 // depth, technique::RealGeometry) is hidden, so real objects occlude virtual ones.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
@@ -11,6 +11,7 @@ layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
 layout(std430, set = 0, binding = 1) readonly buffer Materials { GpuMaterial materials[]; };
 layout(set = 0, binding = 2) uniform sampler2D real_position;         // xyz world, w depth
 layout(set = 0, binding = 3) uniform sampler2DArray base_color_maps;  // sRGB, decoded on fetch
+                                                                      // (emissive maps too)
 layout(set = 0, binding = 4) uniform sampler2D real_normal;           // xyz world (step > 1)
 // material: per draw; real_step: internal pixels per texel side of real_position.
 layout(push_constant) uniform Draw { int material; int real_step; } draw;
@@ -22,6 +23,7 @@ layout(location = 3) in float in_view_z;
 layout(location = 0) out vec4 out_position;  // xyz world, w = 1 (virtual coverage mask)
 layout(location = 1) out vec4 out_normal;    // xyz unit, w roughness
 layout(location = 2) out vec4 out_albedo;    // rgb linear base colour, w metallic
+layout(location = 3) out vec4 out_emission;  // rgb emitted radiance (glTF emissive), w 0
 
 void main() {
   ivec2 pixel = ivec2(gl_FragCoord.xy);
@@ -50,4 +52,8 @@ void main() {
   out_position = vec4(in_world, 1.0f);
   out_normal = vec4(n, clamp(m.params.y, 0.02f, 1.0f));
   out_albedo = vec4(clamp(base.rgb, vec3(0.0f), vec3(1.0f)), clamp(m.params.x, 0.0f, 1.0f));
+  // Half floats end at 65504 (a material's emission is finite and non-negative on upload).
+  vec3 emission = m.emission.rgb;
+  if (m.emission.w >= 0.0f) emission *= texture(base_color_maps, vec3(in_uv, m.emission.w)).rgb;
+  out_emission = vec4(min(emission, vec3(60000.0f)), 0.0f);
 }

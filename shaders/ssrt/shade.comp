@@ -50,6 +50,7 @@ layout(set = 0, binding = 7, rgba32ui) readonly uniform uimage2D upsampled;
 layout(std430, set = 0, binding = 8) readonly buffer Tiles { uint list[]; } tiles;
 layout(std430, set = 0, binding = 11) writeonly buffer Output { uint out_rgba8[]; };  // kCompose
 layout(std430, set = 0, binding = 12) writeonly buffer Mask { uint out_mask[]; };     // kCompose
+layout(set = 0, binding = 13, rgba16f) readonly uniform image2D virtual_emission;  // rgb radiance
 layout(push_constant) uniform Push {
   ivec4 grid;   // x, y cells; z step in pixels; w unused
   ivec4 size;   // xy used extent of the solutions (internal resolution), z geometry step
@@ -171,7 +172,9 @@ void store_shaded(ivec2 pixel, PixelInputs p, vec4 s4, vec4 s5, vec4 s6) {
   vec3 l_rv;
   if (virt) {
     vec3 av = imageLoad(virtual_albedo, pixel).rgb;
-    l_rv = av * (rd_v + ri_v / MRGI_PI);
+    // Plus the surface's own emission (glTF emissive), seen directly. It lights no other
+    // surface: the bounce term's senders are lit by the dominant light only (ssrt_math.h).
+    l_rv = av * (rd_v + ri_v / MRGI_PI) + imageLoad(virtual_emission, pixel).rgb;
   } else {
     l_rv = real_ok ? a * rd_v + a * ssrt_indirect_select(ri, ri_v, pc.opts.x) / MRGI_PI : vec3(0.0f);
   }

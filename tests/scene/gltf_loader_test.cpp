@@ -368,12 +368,12 @@ namespace {
 // Issue 12 case 10: KHR_texture_transform on the base colour texture (offset, rotation, scale
 // and its texCoord override) is applied to the primitive's coordinates, as the extension's
 // T * R * S matrix; bad values are refused naming the field.
-std::string textured_triangle_gltf(const std::string& texture_info) {
+std::string textured_triangle_gltf(const std::string& texture_info, const std::string& extra_material = "") {
   return R"({
   "asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
   "extensionsUsed": ["KHR_texture_transform"],
   "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1, "TEXCOORD_1": 2}, "material": 0}]}],
-  "materials": [{"pbrMetallicRoughness": {"baseColorTexture": )" + texture_info + R"(}}],
+  "materials": [{"pbrMetallicRoughness": {"baseColorTexture": )" + texture_info + R"(})" + extra_material + R"(}],
   "textures": [{"source": 0}],
   "images": [{"uri": "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAIAAACQd1PeAAAADElEQVR4nGM4kWIEAANWAV/oF4RSAAAAAElFTkSuQmCC"}],
   "buffers": [{"uri": "uv.bin", "byteLength": 84}],
@@ -449,6 +449,25 @@ TEST(GltfHardening, BadTextureTransformsAreRefusedNamingTheField) {
     EXPECT_NE(r.error().message.find(name), std::string::npos) << r.error().message;
     EXPECT_NE(r.error().message.find(field), std::string::npos) << r.error().message;
   }
+}
+
+TEST(GltfLoader, EmissiveTexturesShareTheBaseColoursCoordinatesOrAreRefused) {
+  TempDir dir;
+  write_uv_bin(dir.file("uv.bin"));
+  // Same coordinates (set 0, no transform): the emissive texture is loaded with the material.
+  write_text(dir.file("glow.gltf"), textured_triangle_gltf(
+      R"({"index": 0})", R"(, "emissiveFactor": [1, 0.5, 0], "emissiveTexture": {"index": 0})"));
+  auto glow = load_gltf(dir.file("glow.gltf"), Placement{});
+  ASSERT_TRUE(glow.ok()) << glow.error().message;
+  ASSERT_EQ(glow->materials.size(), 1u);
+  EXPECT_EQ(glow->materials[0].emissive_texture, 0);
+  EXPECT_FLOAT_EQ(glow->materials[0].emissive.y, 0.5f);
+  // Another set for the emissive texture than for the base colour: one set per vertex is kept,
+  // so this is refused by name.
+  write_text(dir.file("two_sets.gltf"), textured_triangle_gltf(
+      R"({"index": 0})", R"(, "emissiveTexture": {"index": 0, "texCoord": 1})"));
+  EXPECT_ERROR(load_gltf(dir.file("two_sets.gltf"), Placement{}), NotImplemented, "two_sets.gltf",
+               "emissive texture", "materials[0]");
 }
 
 }  // namespace

@@ -135,6 +135,7 @@ struct Driver {
     s.virtual_position = image("virtual_position", f32, true);
     s.virtual_normal = image("virtual_normal", f16, true);
     s.virtual_albedo = image("virtual_albedo", f16, true);
+    s.virtual_emission = image("virtual_emission", f16, true);
     s.lit_rv = image("lit_rv", f16, false);
     s.lit_r = image("lit_r", f16, false);
     auto fc = d.graph->create_buffer({"frame_constants", sizeof(shader::FrameConstants),
@@ -218,6 +219,8 @@ struct Driver {
     EXPECT_TRUE(graph->upload_image(s.virtual_position, vpos.data(), vpos.size() * 16).ok());
     EXPECT_TRUE(graph->upload_image(s.virtual_normal, vnrm.data(), vnrm.size() * 2).ok());
     EXPECT_TRUE(graph->upload_image(s.virtual_albedo, valb.data(), valb.size() * 2).ok());
+    const std::vector<uint16_t> no_emission(valb.size(), 0);  // the fixtures' objects emit nothing
+    EXPECT_TRUE(graph->upload_image(s.virtual_emission, no_emission.data(), no_emission.size() * 2).ok());
   }
 
   void write_constants() {

@@ -47,7 +47,8 @@ struct SyntheticScene {
   SceneDesc scene;                 // what the runtime gets (glTF + env files in `folder`)
 
   // Writes the glTF cube and the environment image into `folder`.
-  static SyntheticScene create(const std::string& folder);
+  // `emission`: the cubes' glTF emissiveFactor (radiance; 0 = none).
+  static SyntheticScene create(const std::string& folder, const glm::vec3& emission = glm::vec3(0.0f));
   CameraSetup cameras() const;
 
   // First surface a camera ray through pixel (u, v) hits; `with_virtual` includes the virtual boxes.

@@ -82,7 +82,8 @@ struct Material {
   float roughness = 1.0f;
   float transmission = 0.0f;     // KHR_materials_transmission
   float ior = 1.5f;              // KHR_materials_ior
-  glm::vec3 emissive{0.0f};
+  glm::vec3 emissive{0.0f};      // emitted radiance: emissiveFactor x KHR_materials_emissive_strength
+  int emissive_texture = -1;     // index into Model::textures (sRGB, multiplies `emissive`), -1 = none
   bool double_sided = false;
 };
 
@@ -96,7 +97,7 @@ struct MeshPrimitive {
 };
 
 struct Texture {
-  ImageRGBA8 image;  // sRGB-encoded base colour
+  ImageRGBA8 image;  // sRGB-encoded colour (a base colour or an emissive texture)
 };
 
 struct Model {

@@ -13,6 +13,7 @@ namespace {
 constexpr VkFormat kPositionFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 constexpr VkFormat kNormalFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kAlbedoFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+constexpr VkFormat kEmissionFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 
 Expected<gpu::ImageHandle> gbuffer_image(gpu::FrameGraph& graph, const char* name, VkFormat format,
@@ -43,6 +44,9 @@ Expected<VirtualGBuffer> VirtualGBuffer::create(gpu::Context& context, gpu::Fram
   auto a = gbuffer_image(graph, "virtual_albedo", kAlbedoFormat, color);
   if (!a) return a.error();
   v.albedo_ = *a;
+  auto em = gbuffer_image(graph, "virtual_emission", kEmissionFormat, color);
+  if (!em) return em.error();
+  v.emission_ = *em;
   auto d = gbuffer_image(graph, "virtual_depth", kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
   if (!d) return d.error();
   v.depth_ = *d;
@@ -69,7 +73,7 @@ Expected<VirtualGBuffer> VirtualGBuffer::create(gpu::Context& context, gpu::Fram
   desc.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(technique::GpuVertex, position)},
                      {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(technique::GpuVertex, normal)},
                      {2, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(technique::GpuVertex, uv)}};
-  desc.color_formats = {kPositionFormat, kNormalFormat, kAlbedoFormat};
+  desc.color_formats = {kPositionFormat, kNormalFormat, kAlbedoFormat, kEmissionFormat};
   desc.depth_format = kDepthFormat;
   desc.depth_compare = VK_COMPARE_OP_LESS;
   // Single-sided materials (glTF's default) cull back faces; the loader keeps front faces
@@ -114,6 +118,7 @@ void VirtualGBuffer::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_cons
         b.write(position_, gpu::Access::ColorAttachmentWrite);
         b.write(normal_, gpu::Access::ColorAttachmentWrite);
         b.write(albedo_, gpu::Access::ColorAttachmentWrite);
+        b.write(emission_, gpu::Access::ColorAttachmentWrite);
         b.write(depth_, gpu::Access::DepthAttachmentWrite);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) { draw(cmd, pass); });
@@ -165,9 +170,9 @@ VkRect2D VirtualGBuffer::projected_area(VkExtent2D e, const shader::FrameConstan
 
 void VirtualGBuffer::draw(VkCommandBuffer cmd, gpu::PassContext& pass) {
   const VkExtent2D e = pass.extent(position_);
-  VkRenderingAttachmentInfo colors[3];
-  const gpu::ImageHandle targets[3] = {position_, normal_, albedo_};
-  for (int i = 0; i < 3; ++i) {
+  VkRenderingAttachmentInfo colors[4];
+  const gpu::ImageHandle targets[4] = {position_, normal_, albedo_, emission_};
+  for (int i = 0; i < 4; ++i) {
     colors[i] = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
     colors[i].imageView = pass.view(targets[i]);
     colors[i].imageLayout = color_layout_;
@@ -184,7 +189,7 @@ void VirtualGBuffer::draw(VkCommandBuffer cmd, gpu::PassContext& pass) {
   VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
   ri.renderArea = area_;
   ri.layerCount = 1;
-  ri.colorAttachmentCount = 3;
+  ri.colorAttachmentCount = 4;
   ri.pColorAttachments = colors;
   ri.pDepthAttachment = &depth;
   vkCmdBeginRendering(cmd, &ri);

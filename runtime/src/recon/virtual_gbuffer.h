@@ -4,7 +4,8 @@
 // technique's own real geometry: technique::RealGeometry).
 // Images: virtual_position (RGBA32F: xyz world, w 1 where a virtual object is seen = the
 // real/virtual mask), virtual_normal (RGBA16F: xyz, w roughness), virtual_albedo (RGBA16F:
-// linear base colour, w metallic), virtual_depth (D32, for the virtual objects among themselves).
+// linear base colour, w metallic), virtual_emission (RGBA16F: emitted radiance, glTF emissive),
+// virtual_depth (D32, for the virtual objects among themselves).
 #pragma once
 #include "gpu/frame_graph.h"
 #include "gpu/pipelines.h"
@@ -27,6 +28,7 @@ class VirtualGBuffer {
   gpu::ImageHandle position() const { return position_; }
   gpu::ImageHandle normal() const { return normal_; }
   gpu::ImageHandle albedo() const { return albedo_; }
+  gpu::ImageHandle emission() const { return emission_; }
 
  private:
   void draw(VkCommandBuffer cmd, gpu::PassContext& pass);
@@ -47,7 +49,7 @@ class VirtualGBuffer {
   // four full-screen clears cost 1.4 ms of the pass on lavapipe at 640x480.
   VkRect2D area_{{0, 0}, {0, 0}}, previous_{{0, 0}, {0, 0}};
   VkExtent2D previous_extent_{0, 0};
-  gpu::ImageHandle position_, normal_, albedo_, depth_;
+  gpu::ImageHandle position_, normal_, albedo_, emission_, depth_;
   gpu::PipelineHandle pipeline_, double_sided_pipeline_;  // back faces culled; both sides
   VkImageLayout color_layout_ = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
   VkImageLayout depth_layout_ = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;

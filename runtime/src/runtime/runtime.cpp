@@ -208,6 +208,7 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   shared.virtual_position = virtual_gbuffer_->position();
   shared.virtual_normal = virtual_gbuffer_->normal();
   shared.virtual_albedo = virtual_gbuffer_->albedo();
+  shared.virtual_emission = virtual_gbuffer_->emission();
   shared.lit_rv = lit_rv_;
   shared.lit_r = lit_r_;
   shared.compose_honours_tiles = true;  // record(): compose uses Technique::compose_tiles()

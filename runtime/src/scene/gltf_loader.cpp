@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <optional>
 
 #include <glm/gtc/matrix_inverse.hpp>
 #include <glm/gtc/type_ptr.hpp>
@@ -251,6 +252,9 @@ Status convert_materials(LoadContext& ctx) {
         extension_number(g.extensions, "KHR_materials_emissive_strength", "emissiveStrength", 1.0);
     for (int c = 0; c < 3 && c < int(g.emissiveFactor.size()); ++c)
       mat.emissive[c] = float(g.emissiveFactor[size_t(c)] * emissive_strength);
+    auto emissive_tex = texture_for(ctx, g.emissiveTexture.index);
+    if (!emissive_tex) return emissive_tex.error();
+    mat.emissive_texture = *emissive_tex;
     mat.double_sided = g.doubleSided;
     mat.transmission = float(extension_number(g.extensions, "KHR_materials_transmission", "transmissionFactor", 0.0));
     mat.ior = float(extension_number(g.extensions, "KHR_materials_ior", "ior", 1.5));
@@ -277,15 +281,19 @@ glm::dmat4 node_local_matrix(const tinygltf::Node& node) {
   return m;
 }
 
-// The base colour texture's coordinate set and KHR_texture_transform (offset, rotation, scale:
-// uv' = offset + R(rotation) (scale * uv), R counter-clockwise, the extension's matrix
-// T * R * S). The base colour is the only texture mrgi samples, so the transform is applied to
-// the primitive's coordinates once at load instead of per texel lookup.
+// A texture's coordinate set and KHR_texture_transform (offset, rotation, scale: uv' = offset +
+// R(rotation) (scale * uv), R counter-clockwise, the extension's matrix T * R * S). The base
+// colour and the emissive texture are the ones mrgi samples, both through the primitive's one
+// set of coordinates, so the transform is applied to those coordinates once at load instead of
+// per texel lookup (and the two textures must agree on it: material_uv_transform).
 struct UvTransform {
   int tex_coord = 0;
   glm::dvec2 offset{0.0}, scale{1.0};
   double rotation = 0.0;
   bool identity() const { return offset == glm::dvec2(0.0) && scale == glm::dvec2(1.0) && rotation == 0.0; }
+  bool operator==(const UvTransform& o) const {
+    return tex_coord == o.tex_coord && offset == o.offset && scale == o.scale && rotation == o.rotation;
+  }
   glm::vec2 apply(glm::vec2 uv) const {
     const glm::dvec2 s = glm::dvec2(uv) * scale;
     const double c = std::cos(rotation), n = std::sin(rotation);
@@ -293,13 +301,8 @@ struct UvTransform {
   }
 };
 
-Expected<UvTransform> base_color_uv_transform(const LoadContext& ctx, int material) {
+Expected<UvTransform> texture_uv_transform(const tinygltf::TextureInfo& info, const std::string& where) {
   UvTransform t;
-  if (material < 0 || size_t(material) >= ctx.gltf.materials.size()) return t;
-  const auto& info = ctx.gltf.materials[size_t(material)].pbrMetallicRoughness.baseColorTexture;
-  if (info.index < 0) return t;
-  const std::string where = ctx.path + ": materials[" + std::to_string(material) +
-                            "].pbrMetallicRoughness.baseColorTexture";
   t.tex_coord = info.texCoord;
   auto it = info.extensions.find("KHR_texture_transform");
   if (it != info.extensions.end()) {
@@ -335,6 +338,34 @@ Expected<UvTransform> base_color_uv_transform(const LoadContext& ctx, int materi
   return t;
 }
 
+// The coordinates a primitive of `material` needs: its base colour texture's, else its emissive
+// texture's; both present with different sets or transforms is refused (one set of coordinates
+// per vertex is kept).
+Expected<UvTransform> material_uv_transform(const LoadContext& ctx, int material) {
+  if (material < 0 || size_t(material) >= ctx.gltf.materials.size()) return UvTransform{};
+  const auto& m = ctx.gltf.materials[size_t(material)];
+  const std::string where = ctx.path + ": materials[" + std::to_string(material) + "]";
+  const auto& base = m.pbrMetallicRoughness.baseColorTexture;
+  const auto& emissive = m.emissiveTexture;
+  std::optional<UvTransform> b, e;
+  if (base.index >= 0) {
+    auto t = texture_uv_transform(base, where + ".pbrMetallicRoughness.baseColorTexture");
+    if (!t) return t.error();
+    b = *t;
+  }
+  if (emissive.index >= 0) {
+    auto t = texture_uv_transform(emissive, where + ".emissiveTexture");
+    if (!t) return t.error();
+    e = *t;
+  }
+  if (b && e && !(*b == *e))
+    return fail(ErrorKind::NotImplemented,
+                where + ": the emissive texture reads other texture coordinates (texCoord or "
+                        "KHR_texture_transform) than the base colour texture; mrgi keeps one set per "
+                        "vertex");
+  return b ? *b : (e ? *e : UvTransform{});
+}
+
 Status add_primitive(LoadContext& ctx, int mesh_index, size_t prim_index, const glm::dmat4& world) {
   const auto& prim = ctx.gltf.meshes[size_t(mesh_index)].primitives[prim_index];
   const std::string what = mesh_label(ctx.gltf, mesh_index, prim_index);
@@ -353,7 +384,7 @@ Status add_primitive(LoadContext& ctx, int mesh_index, size_t prim_index, const 
     if (!n) return n.error();
     normals = std::move(*n);
   }
-  auto uv_transform = base_color_uv_transform(ctx, prim.material);
+  auto uv_transform = material_uv_transform(ctx, prim.material);
   if (!uv_transform) return uv_transform.error();
   std::vector<glm::vec2> uvs;
   const std::string uv_name = "TEXCOORD_" + std::to_string(uv_transform->tex_coord);
@@ -364,7 +395,7 @@ Status add_primitive(LoadContext& ctx, int mesh_index, size_t prim_index, const 
     if (!uv_transform->identity())
       for (glm::vec2& uv : uvs) uv = uv_transform->apply(uv);
   } else if (uv_transform->tex_coord != 0) {
-    return fail(ErrorKind::BadInput, ctx.path + ": " + what + ": its material's base colour texture reads " +
+    return fail(ErrorKind::BadInput, ctx.path + ": " + what + ": its material's texture reads " +
                                          uv_name + ", which the primitive does not have");
   }
   const size_t vcount = positions->size();

@@ -167,7 +167,7 @@ Expected<std::unique_ptr<SceneGpu>> SceneGpu::create(gpu::Context& context, gpu:
     models.push_back(std::move(*model));
   }
   // Material 0 is the glTF default material (white, metallic 1, roughness 1 per the spec).
-  materials.push_back({glm::vec4(1.0f), glm::vec4(1.0f, 1.0f, -1.0f, 0.0f)});
+  materials.push_back({glm::vec4(1.0f), glm::vec4(1.0f, 1.0f, -1.0f, 0.0f), glm::vec4(0.0f)});
   for (const Model& m : models) {
     const int material_base = int(materials.size());
     const int texture_base = int(textures.size());
@@ -176,8 +176,13 @@ Expected<std::unique_ptr<SceneGpu>> SceneGpu::create(gpu::Context& context, gpu:
                                   mat.base_color_texture < int(m.textures.size())
                               ? float(texture_base + mat.base_color_texture)
                               : -1.0f;
+      const float emissive_layer = mat.emissive_texture >= 0 &&
+                                           mat.emissive_texture < int(m.textures.size())
+                                       ? float(texture_base + mat.emissive_texture)
+                                       : -1.0f;
       materials.push_back({mat.base_color_factor,
-                           glm::vec4(mat.metallic, mat.roughness, layer, 0.0f)});
+                           glm::vec4(mat.metallic, mat.roughness, layer, 0.0f),
+                           glm::vec4(glm::max(mat.emissive, glm::vec3(0.0f)), emissive_layer)});
     }
     for (const Texture& t : m.textures) textures.push_back(&t.image);
     append_model(m, material_base, virtual_data, true);

@@ -69,8 +69,9 @@ struct SharedResources {
   // Real G-buffer (recon/): positions (xyz world, w depth; 0 invalid), normals, albedo.
   gpu::ImageHandle real_position, real_normal, real_albedo;
   // Virtual G-buffer (recon/virtual_gbuffer): xyz world + coverage, normal + roughness,
-  // base colour + metallic.
-  gpu::ImageHandle virtual_position, virtual_normal, virtual_albedo;
+  // base colour + metallic, emitted radiance (a technique adds it to L_rv where it shades a
+  // virtual pixel).
+  gpu::ImageHandle virtual_position, virtual_normal, virtual_albedo, virtual_emission;
   // The solutions the technique writes (RGBA16F, internal resolution, linear radiance).
   gpu::ImageHandle lit_rv, lit_r;
   // This frame's raw inputs as uploaded by recon/ (per-slot buffers): colour sRGB8 packed as

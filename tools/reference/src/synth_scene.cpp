@@ -21,6 +21,8 @@ RefMaterial from_gltf(const Material& m, int texture_offset) {
   r.roughness = glm::clamp(m.roughness, 0.0f, 1.0f);
   r.metallic = glm::clamp(m.metallic, 0.0f, 1.0f);
   r.ior = m.ior;
+  // An emissive texture is not rendered here: the reference's emitters have one radiance per
+  // mesh (sampled for next-event estimation by area), so a textured one emits its factor.
   r.emission = glm::max(m.emissive, glm::vec3(0.0f));
   if (m.transmission >= 0.5f) r.type = MaterialType::Glass;
   else if (r.metallic >= 0.99f && r.roughness <= 0.02f) r.type = MaterialType::Mirror;

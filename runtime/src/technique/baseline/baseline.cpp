@@ -192,7 +192,8 @@ Status Baseline::init() {
   const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
   const auto tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
   const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-  shade.bindings = {{ubo}, {ubo}, {tex}, {tex}, {tex}, {tex}, {tex}, {tex}, {tex}, {tex}, {img}, {img}};
+  shade.bindings = {{ubo}, {ubo}, {tex}, {tex}, {tex}, {tex}, {tex}, {tex}, {tex}, {tex}, {img}, {img},
+                    {tex}};
   shade.push_constant_bytes = sizeof(ShadePush);
   auto sp = gpu::create_compute_pipeline(ctx, shade);
   if (!sp) return sp.error();
@@ -278,6 +279,7 @@ Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped
         b.read(r.virtual_position, gpu::Access::Sampled);
         b.read(r.virtual_normal, gpu::Access::Sampled);
         b.read(r.virtual_albedo, gpu::Access::Sampled);
+        b.read(r.virtual_emission, gpu::Access::Sampled);
         b.read(shadow_primary_, gpu::Access::Sampled);
         b.read(shadow_virtual_, gpu::Access::Sampled);
         b.write(r.lit_rv, gpu::Access::StorageWrite);
@@ -352,6 +354,7 @@ void Baseline::shade(VkCommandBuffer cmd, gpu::PassContext& pass) {
       .sampled_image(9, virtual_array_view_, compare)
       .storage_image(10, pass.view(r.lit_rv))
       .storage_image(11, pass.view(r.lit_r))
+      .sampled_image(12, pass.view(r.virtual_emission), nearest)
       .push(ctx, cmd, *shade_pipeline_);
   ShadePush pc;
   pc.shadow = glm::vec4(float(shadow_size_) / float(kTopShadowSize), float(shadow_size_),

@@ -166,7 +166,7 @@ Status Ssrt::init() {
   for (const auto& v : shade_variants) {
     gpu::ComputePipelineDesc d{v.name, *shade_spv,
                                {{img}, {img}, {ssbo}, {img}, {img}, {img}, {img}, {img}, {ssbo},
-                                {ssbo}, {ubo}, {ssbo}, {ssbo}},
+                                {ssbo}, {ubo}, {ssbo}, {ssbo}, {img}},
                                sizeof(ShadePush),
                                {v.pass_through, v.tiled, v.local_x, v.local_y, v.compose}};
     auto sp = gpu::create_compute_pipeline(ctx, d);
