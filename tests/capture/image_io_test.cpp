@@ -170,6 +170,19 @@ TEST(HdrIo, RadianceHeaderBeyondTheSizeLimitIsRefused) {
 }
 
 // The shared maps are DWAB-compressed half floats (tinyexr cannot decode them).
+// fuzz_hdr (10-minute run): a 38-byte file named .hdr that stb's generic loader read as a TGA
+// header kept it busy for minutes; only a file with the Radiance signature reaches stb now.
+TEST(HdrIo, FilesWithoutTheRadianceSignatureAreRefusedBeforeStb) {
+  testing::TempDir dir;
+  std::string tga("\xf5\x00\x0b\xdf\xdf\x00\x00\x61\x00\x00\x61\x30\x00\x04\x8b\x80"
+                  "\x20\x38\x0a\x02\x02\x5f\x68\xa3\x5c\x31\x56\x00\x00\x00\x08\x88"
+                  "\xdf\xdf\xdf\xdf\xdf\x41", 38);
+  testing::write_text(dir.file("tga.hdr"), tga);
+  EXPECT_ERROR(load_hdr_image(dir.file("tga.hdr")), BadInput, "tga.hdr", "#?RADIANCE");
+  testing::write_text(dir.file("png_bytes.hdr"), std::string("\x89PNG\r\n\x1a\n", 8));
+  EXPECT_ERROR(load_hdr_image(dir.file("png_bytes.hdr")), BadInput, "png_bytes.hdr", "signature");
+}
+
 TEST(HdrIo, RealDwabEnvironmentMapsLoadFinite) {
   MRGI_SKIP_WITHOUT_SHARED(mrgi::test::shared_data("env"));
   for (const char* name : {"interior.exr", "courtyard.exr"}) {

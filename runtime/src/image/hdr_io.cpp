@@ -130,6 +130,11 @@ Expected<ImageRGBF> load_radiance_hdr(const std::string& path) {
   auto bytes = read_file_bytes(path);
   if (!bytes) return bytes.error();
   int w = 0, h = 0, channels = 0;
+  // Only a Radiance file goes to stb: its generic entry points try every format it knows, and
+  // a 38-byte file read as a TGA header kept its decoder busy for minutes (fuzz_hdr).
+  if (!stbi_is_hdr_from_memory(bytes->data(), int(bytes->size())))
+    return fail(ErrorKind::BadInput, path + ": not a Radiance HDR image (the file does not start "
+                                            "with the #?RADIANCE or #?RGBE signature)");
   // The header's size is checked before stb allocates it (a 2 KB file can ask for 120 GB).
   if (!stbi_info_from_memory(bytes->data(), int(bytes->size()), &w, &h, &channels))
     return fail(ErrorKind::BadInput, path + ": not a Radiance HDR image (header unreadable)");
