@@ -120,7 +120,7 @@ void main() {
   // A virtual surface's own emission (glTF emissive) is seen directly; it lights nothing else
   // here (this technique has no indirect light).
   vec3 l_rv = alb.rgb * (frame.ambient_both.rgb + frame.ambient_virtual.rgb) +
-              (is_virtual ? texelFetch(virtual_emission, pixel, 0).rgb : vec3(0.0f));
+              (is_virtual && frame.flags.y != 0 ? texelFetch(virtual_emission, pixel, 0).rgb : vec3(0.0f));
   vec3 l_r = r_p * alb.rgb * frame.ambient_both.rgb;
   int count = min(light_set.count.x, MRGI_MAX_LIGHTS);
   for (int i = 0; i < count; ++i) {

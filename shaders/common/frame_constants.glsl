@@ -34,7 +34,8 @@ struct FrameConstants {
                           // z virtual-behind-real tolerance (fraction of the real depth), w unused
   vec4 ambient_both;      // rgb radiance of a real environment's mean: added to L_r and L_rv
   vec4 ambient_virtual;   // rgb radiance of a virtual environment's mean: added to L_rv only
-  ivec4 flags;            // x: 1 depth registered to colour (same intrinsics), 0 resampled
+  ivec4 flags;            // x: 1 depth registered to colour (same intrinsics), 0 resampled;
+                          // y: 1 the virtual G-buffer holds emission (virtual_emission), 0 none
 };
 
 #ifdef __cplusplus

@@ -174,7 +174,8 @@ void store_shaded(ivec2 pixel, PixelInputs p, vec4 s4, vec4 s5, vec4 s6) {
     vec3 av = imageLoad(virtual_albedo, pixel).rgb;
     // Plus the surface's own emission (glTF emissive), seen directly. It lights no other
     // surface: the bounce term's senders are lit by the dominant light only (ssrt_math.h).
-    l_rv = av * (rd_v + ri_v / MRGI_PI) + imageLoad(virtual_emission, pixel).rgb;
+    vec3 emission = frame.flags.y != 0 ? imageLoad(virtual_emission, pixel).rgb : vec3(0.0f);
+    l_rv = av * (rd_v + ri_v / MRGI_PI) + emission;
   } else {
     l_rv = real_ok ? a * rd_v + a * ssrt_indirect_select(ri, ri_v, pc.opts.x) / MRGI_PI : vec3(0.0f);
   }

@@ -28,6 +28,7 @@ class VirtualGBuffer {
   gpu::ImageHandle position() const { return position_; }
   gpu::ImageHandle normal() const { return normal_; }
   gpu::ImageHandle albedo() const { return albedo_; }
+  // Invalid when no virtual material emits (the target is then not allocated or drawn).
   gpu::ImageHandle emission() const { return emission_; }
 
  private:

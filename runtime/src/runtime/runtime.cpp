@@ -298,7 +298,8 @@ void RuntimeImpl::write_constants(const InputFrame& frame, const glm::dmat4& cam
                        kVirtualDepthTolerance, 0.0f);
   f.ambient_both = glm::vec4(ambient_both, 0.0f);
   f.ambient_virtual = glm::vec4(ambient_virtual, 0.0f);
-  f.flags = glm::ivec4(same_intrinsics(cameras_.color, cameras_.depth) ? 1 : 0, 0, 0, 0);
+  f.flags = glm::ivec4(same_intrinsics(cameras_.color, cameras_.depth) ? 1 : 0,
+                       virtual_gbuffer_->emission().valid() ? 1 : 0, 0, 0);
   *fc = f;
 }
 

@@ -183,6 +183,8 @@ Expected<std::unique_ptr<SceneGpu>> SceneGpu::create(gpu::Context& context, gpu:
       materials.push_back({mat.base_color_factor,
                            glm::vec4(mat.metallic, mat.roughness, layer, 0.0f),
                            glm::vec4(glm::max(mat.emissive, glm::vec3(0.0f)), emissive_layer)});
+      const glm::vec3 e = materials.back().emission;
+      out->emissive = out->emissive || e.x > 0.0f || e.y > 0.0f || e.z > 0.0f;
     }
     for (const Texture& t : m.textures) textures.push_back(&t.image);
     append_model(m, material_base, virtual_data, true);

@@ -91,6 +91,7 @@ class SceneGpu {
   MeshSet virtual_objects;
   MeshSet real_proxies;
   gpu::BufferHandle materials;        // shader::GpuMaterial[] (at least one entry)
+  bool emissive = false;              // some virtual material emits (GpuMaterial::emission)
   gpu::ImageHandle base_color_maps;   // R8G8B8A8_SRGB array (at least one white layer)
   VkImageView base_color_array_view() const { return array_view_; }  // 2D_ARRAY over all layers
 

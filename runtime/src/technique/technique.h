@@ -70,7 +70,7 @@ struct SharedResources {
   gpu::ImageHandle real_position, real_normal, real_albedo;
   // Virtual G-buffer (recon/virtual_gbuffer): xyz world + coverage, normal + roughness,
   // base colour + metallic, emitted radiance (a technique adds it to L_rv where it shades a
-  // virtual pixel).
+  // virtual pixel; invalid when no material emits, FrameConstants::flags.y 0).
   gpu::ImageHandle virtual_position, virtual_normal, virtual_albedo, virtual_emission;
   // The solutions the technique writes (RGBA16F, internal resolution, linear radiance).
   gpu::ImageHandle lit_rv, lit_r;

@@ -279,7 +279,7 @@ Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped
         b.read(r.virtual_position, gpu::Access::Sampled);
         b.read(r.virtual_normal, gpu::Access::Sampled);
         b.read(r.virtual_albedo, gpu::Access::Sampled);
-        b.read(r.virtual_emission, gpu::Access::Sampled);
+        if (r.virtual_emission.valid()) b.read(r.virtual_emission, gpu::Access::Sampled);
         b.read(shadow_primary_, gpu::Access::Sampled);
         b.read(shadow_virtual_, gpu::Access::Sampled);
         b.write(r.lit_rv, gpu::Access::StorageWrite);
@@ -354,7 +354,8 @@ void Baseline::shade(VkCommandBuffer cmd, gpu::PassContext& pass) {
       .sampled_image(9, virtual_array_view_, compare)
       .storage_image(10, pass.view(r.lit_rv))
       .storage_image(11, pass.view(r.lit_r))
-      .sampled_image(12, pass.view(r.virtual_emission), nearest)
+      // Without emission the albedo stands in (bound, never read: flags.y is 0).
+      .sampled_image(12, pass.view(r.virtual_emission.valid() ? r.virtual_emission : r.virtual_albedo), nearest)
       .push(ctx, cmd, *shade_pipeline_);
   ShadePush pc;
   pc.shadow = glm::vec4(float(shadow_size_) / float(kTopShadowSize), float(shadow_size_),

@@ -220,9 +220,9 @@ void Ssrt::add_shade_pass(const char* name, ShadeMode mode, bool run_transfer) {
         // so the bindings are always in the layout the graph gave them.
         b.read(coarse_, gpu::Access::StorageRead);
         b.read(upsampled_, gpu::Access::StorageRead);
-        for (gpu::ImageHandle h : {geo_position_, r.virtual_position, r.virtual_albedo,
-                                   r.virtual_emission})
+        for (gpu::ImageHandle h : {geo_position_, r.virtual_position, r.virtual_albedo})
           b.read(h, gpu::Access::StorageRead);
+        if (r.virtual_emission.valid()) b.read(r.virtual_emission, gpu::Access::StorageRead);
         for (gpu::BufferHandle h : {r.color_upload, r.depth_upload, tile_list_})
           b.read(h, gpu::Access::StorageRead);
         b.read(r.frame_constants, gpu::Access::UniformRead);
@@ -261,7 +261,9 @@ void Ssrt::add_shade_pass(const char* name, ShadeMode mode, bool run_transfer) {
             .storage_image(7, pass.view(upsampled_))
             .storage_buffer(8, pass.buffer(tile_list_))
             .storage_buffer(9, pass.buffer(r.depth_upload))
-            .storage_image(13, pass.view(r.virtual_emission))
+            // Without emission the albedo stands in (bound, never read: flags.y is 0).
+            .storage_image(13, pass.view(r.virtual_emission.valid() ? r.virtual_emission
+                                                                     : r.virtual_albedo))
             .uniform_buffer(10, pass.buffer(r.frame_constants))
             .storage_buffer(11, pass.buffer(compose ? r.composed_output : no_compose_))
             .storage_buffer(12, pass.buffer(compose ? r.composed_mask : no_compose_))
