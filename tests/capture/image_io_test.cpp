@@ -125,6 +125,18 @@ TEST(HdrIo, ExrRoundTripsFloatsExactly) {
   EXPECT_EQ(back->data, img.data);
 }
 
+// fuzz_hdr (10-minute run): an OpenEXR header asking for a 4980740 x 2 strip was read whole.
+// Every side is bounded now, as the Radiance loader's size, before any pixel is read.
+TEST(HdrIo, ExrStripsWiderThanTheLimitAreRefused) {
+  TempDir dir;
+  ImageRGBF strip(16385, 1, 0.25f);
+  ASSERT_TRUE(write_exr(dir.file("strip.exr"), strip).ok());
+  EXPECT_ERROR(load_hdr_image(dir.file("strip.exr")), BadInput, "strip.exr", "16385x1", "16384 a side");
+  ImageRGBF widest(16384, 1, 0.25f);
+  ASSERT_TRUE(write_exr(dir.file("widest.exr"), widest).ok());
+  EXPECT_TRUE(load_hdr_image(dir.file("widest.exr")).ok());
+}
+
 TEST(HdrIo, NonFiniteRadianceIsRefusedNamingFileAndPixel) {
   TempDir dir;
   ImageRGBF img(4, 2, 0.5f);

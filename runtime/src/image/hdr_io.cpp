@@ -30,8 +30,19 @@
 namespace mrgi {
 namespace {
 
-// Environment images up to 16384 x 8192 (a 16k equirectangular map, 1.5 GiB as RGB float).
+// Environment images up to 16384 x 8192 (a 16k equirectangular map, 1.5 GiB as RGB float), and
+// no side over 16384: a 5-million-pixel-wide strip is no environment (fuzz_hdr's 10-minute run
+// found an OpenEXR header asking for one; reading it took the fuzzer's whole time budget).
 constexpr uint64_t kMaxHdrPixels = 16384ull * 8192ull;
+constexpr int kMaxHdrSide = 16384;
+
+Status check_hdr_size(int w, int h, const std::string& path, const char* format) {
+  if (w <= 0 || h <= 0 || w > kMaxHdrSide || h > kMaxHdrSide || uint64_t(w) * uint64_t(h) > kMaxHdrPixels)
+    return fail(ErrorKind::BadInput, path + ": " + format + " image is " + std::to_string(w) + "x" +
+                                         std::to_string(h) + ", over the limit of 16384x8192 pixels (at "
+                                         "most 16384 a side), or empty");
+  return ok_status();
+}
 
 std::string lower_extension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
@@ -61,7 +72,7 @@ Expected<ImageRGBF> load_exr(const std::string& path) {
     Imf::InputFile file(path.c_str());
     const Imath::Box2i window = file.header().dataWindow();
     const int w = window.max.x - window.min.x + 1, h = window.max.y - window.min.y + 1;
-    if (w <= 0 || h <= 0) return fail(ErrorKind::BadInput, path + ": OpenEXR image has no pixels");
+    MRGI_TRY(check_hdr_size(w, h, path, "OpenEXR"));
     const Imf::ChannelList& channels = file.header().channels();
     // RGB, or a single luminance channel Y repeated into all three.
     const bool rgb = channels.findChannel("R") && channels.findChannel("G") && channels.findChannel("B");
@@ -138,9 +149,7 @@ Expected<ImageRGBF> load_radiance_hdr(const std::string& path) {
   // The header's size is checked before stb allocates it (a 2 KB file can ask for 120 GB).
   if (!stbi_info_from_memory(bytes->data(), int(bytes->size()), &w, &h, &channels))
     return fail(ErrorKind::BadInput, path + ": not a Radiance HDR image (header unreadable)");
-  if (w <= 0 || h <= 0 || uint64_t(w) * uint64_t(h) > kMaxHdrPixels)
-    return fail(ErrorKind::BadInput, path + ": Radiance HDR is " + std::to_string(w) + "x" + std::to_string(h) +
-                                         ", over the limit of " + std::to_string(kMaxHdrPixels) + " pixels (or empty)");
+  MRGI_TRY(check_hdr_size(w, h, path, "Radiance HDR"));
   MRGI_TRY(check_hdr_runs(*bytes, w, h, path));
   float* pixels = stbi_loadf_from_memory(bytes->data(), int(bytes->size()), &w, &h, &channels, 3);
   if (!pixels) {
