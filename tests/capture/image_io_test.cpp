@@ -125,6 +125,18 @@ TEST(HdrIo, ExrRoundTripsFloatsExactly) {
   EXPECT_EQ(back->data, img.data);
 }
 
+// fuzz_hdr (10-minute run): a header line of NUL bytes ends stb's header (it reads the line as
+// empty), so the run-length check must start where stb does; this 68-byte file hung stb.
+TEST(HdrIo, RunLengthCheckStartsWhereStbReadsThePixels) {
+  TempDir dir;
+  std::string hdr = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n";
+  hdr += std::string("\0\0\n", 3);
+  hdr += "-Y 2 +X 8\n";
+  hdr += std::string("\x02\x02\x00\x08\x88\x64\x88\x49\x00\x00\x00\x00\x00\x00\x00\x08\x09\x00\x00\x00\x6d", 21);
+  testing::write_text(dir.file("nul.hdr"), hdr);
+  EXPECT_ERROR(load_hdr_image(dir.file("nul.hdr")), BadInput, "nul.hdr", "scanline");
+}
+
 // fuzz_hdr (10-minute run): an OpenEXR header asking for a 4980740 x 2 strip was read whole.
 // Every side is bounded now, as the Radiance loader's size, before any pixel is read.
 TEST(HdrIo, ExrStripsWiderThanTheLimitAreRefused) {

@@ -103,15 +103,32 @@ Expected<ImageRGBF> load_exr(const std::string& path) {
 // flat) are bounded by the image's size and not walked.
 Status check_hdr_runs(const std::vector<uint8_t>& data, int w, int h, const std::string& path) {
   if (w < 8 || w >= 32768) return ok_status();
-  // Pixel data starts after the header's empty line and the resolution line.
   size_t pos = 0;
   const size_t n = data.size();
-  for (; pos + 1 < n && !(data[pos] == '\n' && data[pos + 1] == '\n'); ++pos) {
-  }
-  pos += 2;
-  while (pos < n && data[pos] != '\n') ++pos;
-  ++pos;
   auto get8 = [&]() -> int { return pos < n ? data[pos++] : 0; };  // stb reads 0 past the end
+  // Pixel data starts where stb's header reader stops, found the way it reads
+  // (stbi__hdr_gettoken): a line is the bytes up to '\n' (at most 1023, the rest skipped), and
+  // the header ends at the first line after the signature that is empty or starts with a NUL
+  // byte; the resolution line follows. Looking for "\n\n" instead found the wrong start on a
+  // header line of NUL bytes, and stb hung on data this walk never saw (fuzz_hdr).
+  auto line_first_byte = [&]() -> int {
+    int len = 0, first = 0;
+    int c = get8();
+    while (pos < n && c != '\n') {
+      if (len == 0) first = c;
+      if (++len == 1023) {
+        while (pos < n && get8() != '\n') {
+        }
+        break;
+      }
+      c = get8();
+    }
+    return len == 0 ? 0 : first;
+  };
+  line_first_byte();  // the signature
+  while (line_first_byte() != 0) {
+  }
+  line_first_byte();  // the resolution
   for (int j = 0; j < h; ++j) {
     const int c1 = get8(), c2 = get8(), len_hi = get8();
     if (c1 != 2 || c2 != 2 || (len_hi & 0x80)) return ok_status();  // stb reads the rest flat
