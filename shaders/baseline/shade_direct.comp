@@ -12,7 +12,8 @@
 #include "common/light_set.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
+layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
+FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(std140, set = 0, binding = 1) uniform LightUbo { LightSet light_set; };
 layout(set = 0, binding = 2) uniform sampler2D real_position;
 layout(set = 0, binding = 3) uniform sampler2D real_normal;
@@ -25,10 +26,12 @@ layout(set = 0, binding = 8) uniform sampler2DArrayShadow shadow_primary;
 layout(set = 0, binding = 9) uniform sampler2DArrayShadow shadow_virtual;
 layout(set = 0, binding = 10, rgba16f) writeonly uniform image2D lit_rv;
 layout(set = 0, binding = 11, rgba16f) writeonly uniform image2D lit_r;
-layout(push_constant) uniform Level {
+struct LevelConstants {
   vec4 shadow;  // x used map size / allocated size, y used size (texels), z allocated size,
                 // w PCF radius (taps each side of the centre)
-} level;
+};
+layout(push_constant) uniform Level { LevelConstants level_block; };
+LevelConstants level;
 
 const float kNormalOffsetTexels = 1.5f;  // shadow lookup moved along the normal, in texels
 
@@ -92,6 +95,7 @@ vec3 sanitize(vec3 c) {
 }
 
 void main() {
+  frame = frame_ubo; level = level_block;  // MRGI_UNIFORM_COPIES
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
   if (any(greaterThanEqual(pixel, frame.internal_output_size.xy))) return;
   vec4 vpos = texelFetch(virtual_position, pixel, 0);

@@ -13,9 +13,11 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0) uniform sampler2D real_position;  // xyz world, w depth (0 invalid)
 layout(std430, set = 0, binding = 1) writeonly buffer Indices { uint indices[]; };
-layout(push_constant) uniform Grid {
+struct GridConstants {
   ivec4 grid;  // x, y: grid points per row / column; z: G-buffer pixels between points
-} params;
+};
+layout(push_constant) uniform Grid { GridConstants params_block; };
+GridConstants params;
 
 bool continuous(float a, float b, float c) {
   float zmin = min(a, min(b, c));
@@ -24,6 +26,7 @@ bool continuous(float a, float b, float c) {
 }
 
 void main() {
+  params = params_block;  // MRGI_UNIFORM_COPIES
   ivec2 q = ivec2(gl_GlobalInvocationID.xy);
   ivec2 cells = params.grid.xy - 1;
   if (any(greaterThanEqual(q, cells))) return;

@@ -13,6 +13,19 @@ using glm::mat4;
 using glm::vec4;
 #endif
 
+// MRGI_UNIFORM_COPIES: every compute pass reads its uniform blocks (this one, the others whose
+// structs hold no arrays, its push constants) through private copies made on main's first line:
+//   layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
+//   FrameConstants frame;
+//   void main() { frame = frame_ubo; ... }
+// Why: lavapipe (Mesa 22.3's gallivm) loads a uniform value with one scalar load only where no
+// lane can be inactive, i.e. at the top level of main before any branch, loop or early return
+// (lp_bld_nir_soa.c invocation_0_must_be_active); anywhere else it gathers the value lane by
+// lane with a bounds check per lane. ssrt_transfer's sample loop held 32 such eight-lane gathers
+// per sample, 2/3 of its instructions (found by reading its JIT code): 32 -> 18 ms, frames bit
+// for bit the same. Blocks whose structs hold arrays are copied member by member instead (a
+// private copy of an array went to per-lane scratch memory). Other drivers see plain copies.
+
 // Depth discontinuity rule used by normals and the real caster mesh: two neighbouring depths
 // belong to one surface when |z_a - z_b| <= MRGI_DEPTH_EDGE_RELATIVE * min(z_a, z_b).
 #define MRGI_DEPTH_EDGE_RELATIVE 0.05

@@ -31,7 +31,8 @@ layout(constant_id = 2) const bool kSameInternal = false; // solutions' used siz
 // kTiled (with kSameInternal): only the 8 x 8 tiles the technique listed (Technique::
 // compose_tiles), workgroup i = tiles.list[i]; the camera-only pipeline wrote every pixel first.
 layout(constant_id = 3) const bool kTiled = false;
-layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
+layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
+FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(std430, set = 0, binding = 1) readonly buffer ColorWords { uint color_words[]; };  // RGB8
 // Storage images read with imageLoad: on lavapipe a sampled texelFetch costs 2-3x as much.
 layout(set = 0, binding = 2, rgba16f) readonly uniform image2D lit_rv;
@@ -40,9 +41,11 @@ layout(set = 0, binding = 4, rgba32f) readonly uniform image2D virtual_position;
 layout(std430, set = 0, binding = 5) writeonly buffer Output { uint out_rgba8[]; };
 layout(std430, set = 0, binding = 6) writeonly buffer Mask { uint out_mask[]; };
 layout(std430, set = 0, binding = 7) readonly buffer Tiles { uint list[]; } tiles;
-layout(push_constant) uniform Params {
+struct ParamsConstants {
   vec4 compose;      // x eps (linear camera units), y alpha_max
-} params;
+};
+layout(push_constant) uniform Params { ParamsConstants params_block; };
+ParamsConstants params;
 
 uint color_byte(uint index) { return (color_words[index >> 2] >> ((index & 3u) * 8u)) & 0xffu; }
 
@@ -85,6 +88,7 @@ SOLUTION_AT(solution_rv, lit_rv)
 SOLUTION_AT(solution_r, lit_r)
 
 void main() {
+  frame = frame_ubo; params = params_block;  // MRGI_UNIFORM_COPIES
   ivec2 pixel = spread_invocation_id();
   ivec2 out_size = frame.internal_output_size.zw;
   if (kTiled) {

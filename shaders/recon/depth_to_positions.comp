@@ -11,7 +11,8 @@
 #include "recon/depth_filter.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
+layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
+FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(std430, set = 0, binding = 1) readonly buffer ColorWords { uint color_words[]; };  // RGB8
 layout(std430, set = 0, binding = 2) readonly buffer DepthWords { uint depth_words[]; };  // u16
 #include "common/upload_gather.glsl"
@@ -21,7 +22,9 @@ layout(set = 0, binding = 5, r32ui) uniform uimage2D warped;                    
 layout(set = 0, binding = 6, rg32f) writeonly uniform image2D filtered_depth;   // z m, weight
 // x: 1 when `warped` holds the previous frame, y: weight cap (frames), z/w: same-surface rule
 // |z_new - z_warped| <= max(z * z_new, w metres); options.x: 1 = median on the raw depth.
-layout(push_constant) uniform Push { vec4 merge; ivec4 options; } pc;
+struct PushConstants { vec4 merge; ivec4 options; };
+layout(push_constant) uniform Push { PushConstants pc_block; };
+PushConstants pc;
 
 // Spatial step before the temporal merge: the median of the valid raw depths in the 3x3
 // neighbourhood of a valid pixel. Why: the sample's Kinect-like depth has single-pixel
@@ -81,6 +84,7 @@ uint median_depth(ivec2 c, ivec2 size) {
 }
 
 void main() {
+  frame = frame_ubo; pc = pc_block;  // MRGI_UNIFORM_COPIES
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
   ivec2 internal_size = frame.internal_output_size.xy;
   if (any(greaterThanEqual(pixel, internal_size))) return;

@@ -13,10 +13,13 @@
 #include "common/frame_constants.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
+layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
+FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(set = 0, binding = 1, rgba32f) readonly uniform image2D real_position;
 layout(set = 0, binding = 2, rgba16f) writeonly uniform image2D real_normal;  // xyz, w valid
-layout(push_constant) uniform Push { ivec4 stencil; } pc;  // x: central-difference radius >= 1
+struct PushConstants { ivec4 stencil; };
+layout(push_constant) uniform Push { PushConstants pc_block; };
+PushConstants pc;  // x: central-difference radius >= 1
 
 ivec2 g_size;
 
@@ -48,6 +51,7 @@ bool axis_difference(ivec2 pixel, ivec2 step, vec4 centre, out vec3 d) {
 }
 
 void main() {
+  frame = frame_ubo; pc = pc_block;  // MRGI_UNIFORM_COPIES
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
   g_size = frame.internal_output_size.xy;
   if (any(greaterThanEqual(pixel, g_size))) return;

@@ -19,10 +19,13 @@
 #include "recon/depth_filter.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
+layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
+FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(set = 0, binding = 1, rg32f) readonly uniform image2D previous_depth;  // x z m, y weight
 layout(set = 0, binding = 2, r32ui) uniform uimage2D warped;                  // packed, cleared
-layout(push_constant) uniform Push { mat4 previous_to_current; } pc;
+struct PushConstants { mat4 previous_to_current; };
+layout(push_constant) uniform Push { PushConstants pc_block; };
+PushConstants pc;
 
 vec3 warp_point(ivec2 pixel, float z) {
   vec3 p = unproject_pinhole(vec2(pixel), z, frame.internal_k);
@@ -43,6 +46,7 @@ bool warped_neighbour(ivec2 pixel, ivec2 size, float z0, out vec3 s) {
 }
 
 void main() {
+  frame = frame_ubo; pc = pc_block;  // MRGI_UNIFORM_COPIES
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
   ivec2 size = frame.internal_output_size.xy;
   if (any(greaterThanEqual(pixel, size))) return;

@@ -10,14 +10,18 @@
 #include "ssrt/depth_median.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
+layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
+FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(set = 0, binding = 1, rg32f) readonly uniform image2D merged_intensity;  // D', I_c
 layout(set = 0, binding = 2, r32f) writeonly uniform image2D bilateral;         // D''
 // window: x tap reach (pixels), y tap stride, z taps per side (<= 5, odd);
 // thresholds: x lambda_I (grey levels).
-layout(push_constant) uniform Push { ivec4 window; vec4 thresholds; } pc;
+struct PushConstants { ivec4 window; vec4 thresholds; };
+layout(push_constant) uniform Push { PushConstants pc_block; };
+PushConstants pc;
 
 void main() {
+  frame = frame_ubo; pc = pc_block;  // MRGI_UNIFORM_COPIES
   ivec2 size = frame.internal_output_size.xy;
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
   if (any(greaterThanEqual(pixel, size))) return;

@@ -9,10 +9,13 @@
 #include "ssrt/depth_median.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
+layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
+FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(set = 0, binding = 1, r32f) readonly uniform image2D bilateral;    // D''
 layout(set = 0, binding = 2, r32f) writeonly uniform image2D final_depth; // D'''
-layout(push_constant) uniform Push { ivec4 window; } pc;  // x: radius (0..2 pixels)
+struct PushConstants { ivec4 window; };
+layout(push_constant) uniform Push { PushConstants pc_block; };
+PushConstants pc;  // x: radius (0..2 pixels)
 
 ivec2 g_size;
 
@@ -25,6 +28,7 @@ float tap(ivec2 pixel, ivec2 offset) {
 }
 
 void main() {
+  frame = frame_ubo; pc = pc_block;  // MRGI_UNIFORM_COPIES
   g_size = frame.internal_output_size.xy;
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
   if (any(greaterThanEqual(pixel, g_size))) return;

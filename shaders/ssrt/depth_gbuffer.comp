@@ -20,10 +20,13 @@
 
 // x: tangent radius in texels (recon's default normal_radius, 2 px, shrunk with the texel size
 // so the tangents span the same part of the scene: a crease blends normals over the radius).
-layout(push_constant) uniform Push { ivec4 normal; } pc;
+struct PushConstants { ivec4 normal; };
+layout(push_constant) uniform Push { PushConstants pc_block; };
+PushConstants pc;
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
+layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
+FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(set = 0, binding = 1, r32f) readonly uniform image2D depth;       // metres, 0 = none
 layout(set = 0, binding = 2, rgba32f) writeonly uniform image2D position;
 layout(set = 0, binding = 3, rgba16f) writeonly uniform image2D normal;
@@ -57,6 +60,7 @@ bool axis_difference(ivec2 p, ivec2 step, vec3 centre, float z0, out vec3 d) {
 }
 
 void main() {
+  frame = frame_ubo; pc = pc_block;  // MRGI_UNIFORM_COPIES
   g_size = frame.internal_output_size.xy;
   ivec2 pixel = spread_invocation_id();
   if (any(greaterThanEqual(pixel, g_size))) return;

@@ -15,7 +15,8 @@
 #include "ssrt/depth_median.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
+layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
+FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(std430, set = 0, binding = 1) readonly buffer ColorWords { uint color_words[]; };  // RGB8
 layout(std430, set = 0, binding = 2) readonly buffer DepthWords { uint depth_words[]; };  // u16
 #include "common/upload_gather.glsl"
@@ -24,9 +25,12 @@ layout(set = 0, binding = 3, r32f) readonly uniform image2D depth_volume;  // D_
 layout(set = 0, binding = 4, rg32f) writeonly uniform image2D depth_input;
 // window.w: 1 when depth_volume holds D_v (else a placeholder: every D_v is missing);
 // thresholds.y: lambda_D (metres). (The merge's push block; the other fields are unused here.)
-layout(push_constant) uniform Push { ivec4 window; vec4 thresholds; } pc;
+struct PushConstants { ivec4 window; vec4 thresholds; };
+layout(push_constant) uniform Push { PushConstants pc_block; };
+PushConstants pc;
 
 void main() {
+  frame = frame_ubo; pc = pc_block;  // MRGI_UNIFORM_COPIES
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
   if (any(greaterThanEqual(pixel, frame.internal_output_size.xy))) return;
   ivec2 color_size = frame.color_depth_size.xy;

@@ -19,17 +19,21 @@
 layout(local_size_x = 64) in;
 layout(set = 0, binding = 0, rgba32f) readonly uniform image2DArray coarse;
 // The camera frame as uploaded (upload_gather.glsl camera_at: linear colour).
-layout(std140, set = 0, binding = 3) uniform FrameUbo { FrameConstants frame; };
+layout(std140, set = 0, binding = 3) uniform FrameUbo { FrameConstants frame_ubo; };
+FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(std430, set = 0, binding = 1) readonly buffer ColorWords { uint color_words[]; };  // RGB8
 layout(std430, set = 0, binding = 4) readonly buffer DepthWords { uint depth_words[]; };  // u16
 #include "common/upload_gather.glsl"
 layout(std430, set = 0, binding = 2) writeonly buffer Partials { float partials[]; };
-layout(push_constant) uniform Push {
+struct PushConstants {
   ivec4 grid;  // x, y cells; z step in pixels; w cells per strip
   ivec4 size;  // xy the internal extent (pixels); z strips per row
-} pc;
+};
+layout(push_constant) uniform Push { PushConstants pc_block; };
+PushConstants pc;
 
 void main() {
+  frame = frame_ubo; pc = pc_block;  // MRGI_UNIFORM_COPIES
   int id = int(gl_GlobalInvocationID.x);
   int strips = pc.size.z;
   int row = id / strips;

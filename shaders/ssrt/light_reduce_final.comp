@@ -7,11 +7,14 @@
 layout(local_size_x = 24) in;
 layout(std430, set = 0, binding = 0) readonly buffer Partials { float partials[]; };
 layout(std430, set = 0, binding = 1) writeonly buffer Result { float result[]; };
-layout(push_constant) uniform Push {
+struct PushConstants {
   ivec4 counts;  // x number of partials (light_reduce.comp invocations)
-} pc;
+};
+layout(push_constant) uniform Push { PushConstants pc_block; };
+PushConstants pc;
 
 void main() {
+  pc = pc_block;  // MRGI_UNIFORM_COPIES
   int k = int(gl_GlobalInvocationID.x);
   // Kahan-compensated float sum: thousands of tiles stay accurate to float precision.
   float sum = 0.0f, comp = 0.0f;

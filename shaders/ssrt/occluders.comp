@@ -22,7 +22,8 @@
 #include "common/frame_constants.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };  // internal
+layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
+FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)  // internal
 layout(std430, set = 0, binding = 1) readonly buffer ColorWords { uint color_words[]; };  // RGB8
 layout(std430, set = 0, binding = 2) readonly buffer DepthWords { uint depth_words[]; };  // u16
 #include "common/upload_gather.glsl"
@@ -34,9 +35,12 @@ layout(set = 0, binding = 7, rgba16f) readonly uniform image2D real_normal;
 layout(set = 0, binding = 8, rgba32ui) writeonly uniform uimage2D occ_a;
 layout(set = 0, binding = 9, rg32ui) writeonly uniform uimage2D occ_b;
 // x occluder step s; y, z the internal extent (pixels); w geometry step.
-layout(push_constant) uniform Push { ivec4 step; } pc;
+struct PushConstants { ivec4 step; };
+layout(push_constant) uniform Push { PushConstants pc_block; };
+PushConstants pc;
 
 void main() {
+  frame = frame_ubo; pc = pc_block;  // MRGI_UNIFORM_COPIES
   ivec2 g = spread_invocation_id();
   int s = pc.step.x;
   ivec2 size = pc.step.yz;

@@ -40,7 +40,8 @@ layout(set = 0, binding = 1, rgba32f) readonly uniform image2D real_position;
 // holds, read only at the pixels shaded).
 layout(std430, set = 0, binding = 2) readonly buffer ColorWords { uint color_words[]; };  // RGB8
 layout(std430, set = 0, binding = 9) readonly buffer DepthWords { uint depth_words[]; };  // u16
-layout(std140, set = 0, binding = 10) uniform FrameUbo { FrameConstants frame; };
+layout(std140, set = 0, binding = 10) uniform FrameUbo { FrameConstants frame_ubo; };
+FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 #include "common/upload_gather.glsl"
 layout(set = 0, binding = 3, rgba32f) readonly uniform image2D virtual_position;
 layout(set = 0, binding = 4, rgba16f) readonly uniform image2D virtual_albedo;
@@ -51,14 +52,16 @@ layout(std430, set = 0, binding = 8) readonly buffer Tiles { uint list[]; } tile
 layout(std430, set = 0, binding = 11) writeonly buffer Output { uint out_rgba8[]; };  // kCompose
 layout(std430, set = 0, binding = 12) writeonly buffer Mask { uint out_mask[]; };     // kCompose
 layout(set = 0, binding = 13, rgba16f) readonly uniform image2D virtual_emission;  // rgb radiance
-layout(push_constant) uniform Push {
+struct PushConstants {
   ivec4 grid;   // x, y cells; z step in pixels; w unused
   ivec4 size;   // xy used extent of the solutions (internal resolution), z geometry step
                 // (internal pixels per texel of real_position)
   ivec4 influence;  // pixels [x0, x1) x [y0, y1) the virtual objects' influence region covers
   vec4 opts;    // x relative tolerance of eq. 14; kCompose: y eps, z alpha_max of the
                 // composite (compose_encoded)
-} pc;
+};
+layout(push_constant) uniform Push { PushConstants pc_block; };
+PushConstants pc;
 
 // Bicubic over the cells that see the same kind of surface as the pixel (1 real, 2 virtual),
 // renormalised by the weights of the cells used; where the 4x4 neighbourhood holds no cell of
@@ -288,6 +291,7 @@ void shade_group(ivec2 origin) {
 }
 
 void main() {
+  frame = frame_ubo; pc = pc_block;  // MRGI_UNIFORM_COPIES
   if (kTiled) {
     uint t = tiles.list[spread_workgroup_index_1d()];
     int tiles_x = (pc.size.x + 7) / 8;

@@ -21,14 +21,17 @@ layout(local_size_x = 64) in;
 layout(set = 0, binding = 0, rgba32ui) readonly uniform uimage2D upsampled;
 layout(std430, set = 0, binding = 1) buffer Args { uint args[4]; };  // x, y, z groups, pad
 layout(std430, set = 0, binding = 2) writeonly buffer Tiles { uint list[]; };
-layout(push_constant) uniform Push {
+struct PushConstants {
   ivec4 grid;     // x, y cells; z step in pixels
   ivec4 counts;   // x, y tiles
   ivec4 virt;     // pixels [x0, x1) x [y0, y1) of the virtual objects' projected bounds
   vec4 tolerance; // x relative change of L_rv / L_r below which a tile is not shaded
-} pc;
+};
+layout(push_constant) uniform Push { PushConstants pc_block; };
+PushConstants pc;
 
 void main() {
+  pc = pc_block;  // MRGI_UNIFORM_COPIES
   int id = int(gl_GlobalInvocationID.x);
   if (id >= pc.counts.x * pc.counts.y) return;
   ivec2 tile = ivec2(id % pc.counts.x, id / pc.counts.x);

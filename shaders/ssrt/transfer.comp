@@ -37,7 +37,8 @@ layout(constant_id = 0) const bool kRealReceivers = false;
 // real solution is computed, and nothing of the virtual G-buffer is read. Most of a frame lies
 // outside the region when the virtual objects are small on screen.
 layout(constant_id = 1) const bool kRealOnly = false;
-layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
+layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
+FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(std140, set = 0, binding = 1) uniform LightUbo { SsrtLight light; };
 layout(std430, set = 0, binding = 2) readonly buffer SampleBuffer { SsrtSample samples[]; };
 // Storage images read with imageLoad: on lavapipe a sampled texelFetch costs 2-3x as much.
@@ -59,7 +60,7 @@ layout(set = 0, binding = 9, rgba32f) writeonly uniform image2DArray coarse;
 layout(set = 0, binding = 10, rgba32f) readonly uniform image2DArray aux_position;
 layout(std140, set = 0, binding = 11) uniform AuxUbo { SsrtAuxViews aux; };
 layout(set = 0, binding = 12, rg32ui) readonly uniform uimage2D occ_b;
-layout(push_constant) uniform Push {
+struct PushConstants {
   ivec4 grid;     // x, y cells; z step in pixels; w directions N
   ivec4 config;   // x first sample of the level's sets, y SH bands, z geometry step (internal
                   // pixels per texel of real_position / real_normal), w occluder step (of
@@ -71,7 +72,16 @@ layout(push_constant) uniform Push {
   vec4 aux_test;    // x depth bias in texels of each aux layer, y 1 = test the aux layers,
                     // z solid angle of one sample (4 pi / N)
   ivec4 region;     // cells [x0, x1) x [y0, y1) of this dispatch
-} pc;
+};
+layout(push_constant) uniform Push { PushConstants pc_block; };
+PushConstants pc;
+// The aux layers' values the sample loop reads, copied on main's first line like the blocks
+// above (SsrtAuxViews holds arrays: a private copy of the whole struct went to per-lane scratch
+// memory, allocated and cleared on every dispatch). g_aux_bias: the depth bias (m) of the left,
+// right, top and light layer.
+mat4 g_aux_left, g_aux_top, g_aux_light;
+vec4 g_aux_bias;
+int g_aux_layers, g_aux_texels;
 
 // Paper Fig. 5a: a sample the main buffer finds visible may lie behind a surface one of the
 // auxiliary buffers sees. Returns true with that surface's world position (the first layer
@@ -87,7 +97,7 @@ layout(push_constant) uniform Push {
 bool aux_layer_hit_at(vec3 p, int layer, float bias_m, vec3 x, out vec3 s) {
   ivec2 texel;
   float depth;
-  bool in_layer = layer < aux.info.x && ssrt_aux_texel_at(p, aux.info.y, texel, depth);
+  bool in_layer = layer < g_aux_layers && ssrt_aux_texel_at(p, g_aux_texels, texel, depth);
   vec4 o = imageLoad(aux_position, ivec3(texel, layer));
   vec3 d = o.xyz - x;
   s = o.xyz;
@@ -102,16 +112,15 @@ bool aux_occluder(vec3 x, vec3 y, float y_camera_x, out vec3 s) {
   // The right layer mirrors the left one (same image plane and down axis, opposite right and
   // forward axes: volume.cpp make_views), so y's coordinates in it are (1 - u, v, -depth) of
   // its left ones: one uniform matrix instead of a per-lane choice of two.
-  vec3 p_left = (aux.world_to_aux[SSRT_AUX_LEFT] * vec4(y, 1.0f)).xyz;
+  vec3 p_left = (g_aux_left * vec4(y, 1.0f)).xyz;
   vec3 p_side = right ? vec3(1.0f - p_left.x, p_left.y, -p_left.z) : p_left;
-  float side_bias = pc.aux_test.x * (right ? aux.extent[SSRT_AUX_RIGHT].z : aux.extent[SSRT_AUX_LEFT].z);
+  float side_bias = right ? g_aux_bias.y : g_aux_bias.x;
   vec3 s_side, s_top, s_light;
   bool hit_side = aux_layer_hit_at(p_side, side, side_bias, x, s_side);
-  bool hit_top = aux_layer_hit_at((aux.world_to_aux[SSRT_AUX_TOP] * vec4(y, 1.0f)).xyz, SSRT_AUX_TOP,
-                                  pc.aux_test.x * aux.extent[SSRT_AUX_TOP].z, x, s_top);
-  bool hit_light = aux_layer_hit_at((aux.world_to_aux[SSRT_AUX_LIGHT] * vec4(y, 1.0f)).xyz,
-                                    SSRT_AUX_LIGHT, pc.aux_test.x * aux.extent[SSRT_AUX_LIGHT].z,
-                                    x, s_light);
+  bool hit_top = aux_layer_hit_at((g_aux_top * vec4(y, 1.0f)).xyz, SSRT_AUX_TOP, g_aux_bias.z, x,
+                                  s_top);
+  bool hit_light = aux_layer_hit_at((g_aux_light * vec4(y, 1.0f)).xyz, SSRT_AUX_LIGHT,
+                                    g_aux_bias.w, x, s_light);
   s = hit_side ? s_side : (hit_top ? s_top : (hit_light ? s_light : s));
   return hit_side || hit_top || hit_light;
 }
@@ -161,6 +170,27 @@ void surfaces_at(vec2 q, ivec2 qi, int gstep, int ostep, out vec4 real, out vec3
 float view_depth(vec3 p) { return (frame.world_to_camera * vec4(p, 1.0f)).z; }
 
 void main() {
+  frame = frame_ubo; pc = pc_block;  // MRGI_UNIFORM_COPIES
+  g_aux_left = aux.world_to_aux[SSRT_AUX_LEFT];
+  g_aux_top = aux.world_to_aux[SSRT_AUX_TOP];
+  g_aux_light = aux.world_to_aux[SSRT_AUX_LIGHT];
+  g_aux_bias = pc.aux_test.x * vec4(aux.extent[SSRT_AUX_LEFT].z, aux.extent[SSRT_AUX_RIGHT].z,
+                                    aux.extent[SSRT_AUX_TOP].z, aux.extent[SSRT_AUX_LIGHT].z);
+  g_aux_layers = aux.info.x;
+  g_aux_texels = aux.info.y;
+  // Bands above the level's count are dropped (their coefficients stay 0 in the light too).
+  int n_sh = pc.config.y * pc.config.y;
+  SH16 l_sh;
+  l_sh.c0 = vec4(light.sh[0].w, n_sh > 1 ? light.sh[1].w : 0.0f, n_sh > 2 ? light.sh[2].w : 0.0f,
+                 n_sh > 3 ? light.sh[3].w : 0.0f);
+  l_sh.c1 = vec4(n_sh > 4 ? light.sh[4].w : 0.0f, n_sh > 5 ? light.sh[5].w : 0.0f,
+                 n_sh > 6 ? light.sh[6].w : 0.0f, n_sh > 7 ? light.sh[7].w : 0.0f);
+  l_sh.c2 = vec4(n_sh > 8 ? light.sh[8].w : 0.0f, n_sh > 9 ? light.sh[9].w : 0.0f,
+                 n_sh > 10 ? light.sh[10].w : 0.0f, n_sh > 11 ? light.sh[11].w : 0.0f);
+  l_sh.c3 = vec4(n_sh > 12 ? light.sh[12].w : 0.0f, n_sh > 13 ? light.sh[13].w : 0.0f,
+                 n_sh > 14 ? light.sh[14].w : 0.0f, n_sh > 15 ? light.sh[15].w : 0.0f);
+  vec3 l_dir = light.dominant.xyz;
+  vec3 e_light = light.dominant.w > 0.5f ? light.dominant_irradiance.rgb : vec3(0.0f);
   ivec2 cell = pc.region.xy + spread_invocation_id();
   if (cell.x >= pc.region.z || cell.y >= pc.region.w) return;
   ivec2 size = frame.internal_output_size.xy;
@@ -194,20 +224,7 @@ void main() {
   // equals R_d bit for bit there, as the up-sampling's tile test needs.
   vec4 t_real[4] = vec4[4](zero, zero, zero, zero);
   float rd_sum = 0.0f, rd_v_sum = 0.0f;
-  // Bands above the level's count are dropped (their coefficients stay 0 in the light too).
-  int n_sh = pc.config.y * pc.config.y;
-  SH16 l_sh;
-  l_sh.c0 = vec4(light.sh[0].w, n_sh > 1 ? light.sh[1].w : 0.0f, n_sh > 2 ? light.sh[2].w : 0.0f,
-                 n_sh > 3 ? light.sh[3].w : 0.0f);
-  l_sh.c1 = vec4(n_sh > 4 ? light.sh[4].w : 0.0f, n_sh > 5 ? light.sh[5].w : 0.0f,
-                 n_sh > 6 ? light.sh[6].w : 0.0f, n_sh > 7 ? light.sh[7].w : 0.0f);
-  l_sh.c2 = vec4(n_sh > 8 ? light.sh[8].w : 0.0f, n_sh > 9 ? light.sh[9].w : 0.0f,
-                 n_sh > 10 ? light.sh[10].w : 0.0f, n_sh > 11 ? light.sh[11].w : 0.0f);
-  l_sh.c3 = vec4(n_sh > 12 ? light.sh[12].w : 0.0f, n_sh > 13 ? light.sh[13].w : 0.0f,
-                 n_sh > 14 ? light.sh[14].w : 0.0f, n_sh > 15 ? light.sh[15].w : 0.0f);
   vec3 ri = vec3(0.0f), ri_v = vec3(0.0f);
-  vec3 l_dir = light.dominant.xyz;
-  vec3 e_light = light.dominant.w > 0.5f ? light.dominant_irradiance.rgb : vec3(0.0f);
   float chi = pc.sampling.y;
   float bias = pc.bounce.z;
   int set = (cell.x & 1) + 2 * (cell.y & 1);

@@ -11,7 +11,8 @@
 #include "ssrt/tsdf_volume.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(std140, set = 0, binding = 0) uniform VolumeUbo { SsrtVolumeParams volume; };
+layout(std140, set = 0, binding = 0) uniform VolumeUbo { SsrtVolumeParams volume_ubo; };
+SsrtVolumeParams volume;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(std140, set = 0, binding = 1) uniform AuxUbo { SsrtAuxViews views; };
 layout(std430, set = 0, binding = 2) readonly buffer Voxels { uint voxels[]; };
 layout(set = 0, binding = 3, rgba32f) writeonly uniform image2DArray aux_position;
@@ -19,6 +20,7 @@ layout(set = 0, binding = 3, rgba32f) writeonly uniform image2DArray aux_positio
 #include "ssrt/tsdf_march.glsl"
 
 void main() {
+  volume = volume_ubo;  // MRGI_UNIFORM_COPIES
   int res = views.info.y;
   ivec2 id = spread_invocation_id();
   int layer = div_nonneg1(id.y, res);

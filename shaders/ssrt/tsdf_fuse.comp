@@ -11,13 +11,15 @@
 #include "common/opaque_uniform.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(std140, set = 0, binding = 0) uniform VolumeUbo { SsrtVolumeParams volume; };
+layout(std140, set = 0, binding = 0) uniform VolumeUbo { SsrtVolumeParams volume_ubo; };
+SsrtVolumeParams volume;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(std430, set = 0, binding = 1) readonly buffer DepthWords { uint depth_words[]; };  // u16
 layout(std430, set = 0, binding = 2) buffer Voxels { uint voxels[]; };
 
 uint depth_value(uint index) { return (depth_words[index >> 1] >> ((index & 1u) * 16u)) & 0xffffu; }
 
 void main() {
+  volume = volume_ubo;  // MRGI_UNIFORM_COPIES
   int r = MRGI_OPAQUE_INT(volume.grid.x);  // the loop bound (common/opaque_uniform.glsl)
   ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
   if (any(greaterThanEqual(xy, ivec2(r)))) return;

@@ -10,14 +10,17 @@
 #include "ssrt/tsdf_volume.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
-layout(std140, set = 0, binding = 1) uniform VolumeUbo { SsrtVolumeParams volume; };
+layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
+FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
+layout(std140, set = 0, binding = 1) uniform VolumeUbo { SsrtVolumeParams volume_ubo; };
+SsrtVolumeParams volume;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(std430, set = 0, binding = 2) readonly buffer Voxels { uint voxels[]; };
 layout(set = 0, binding = 3, r32f) writeonly uniform image2D depth_volume;
 
 #include "ssrt/tsdf_march.glsl"
 
 void main() {
+  frame = frame_ubo; volume = volume_ubo;  // MRGI_UNIFORM_COPIES
   ivec2 pixel = spread_invocation_id();
   if (any(greaterThanEqual(pixel, frame.internal_output_size.xy))) return;
   vec3 ray_camera = unproject_pinhole(vec2(pixel), 1.0f, frame.internal_k);  // z = 1

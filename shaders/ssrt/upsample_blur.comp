@@ -16,12 +16,15 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(constant_id = 0) const int kRadiusCells = 0;
 layout(set = 0, binding = 0, rgba32f) readonly uniform image2DArray coarse;
 layout(set = 0, binding = 1, rgba32ui) writeonly uniform uimage2D upsampled;
-layout(push_constant) uniform Push {
+struct PushConstants {
   ivec4 grid;   // x, y cells; z step in pixels
   vec4 filt;    // x radius in output pixels
-} pc;
+};
+layout(push_constant) uniform Push { PushConstants pc_block; };
+PushConstants pc;
 
 void main() {
+  pc = pc_block;  // MRGI_UNIFORM_COPIES
   ivec2 cell = ivec2(gl_GlobalInvocationID.xy);
   if (cell.x >= pc.grid.x || cell.y >= pc.grid.y) return;
   float radius_cells = pc.filt.x / float(pc.grid.z);
