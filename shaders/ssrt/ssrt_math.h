@@ -202,6 +202,10 @@ struct SsrtLight {
   vec4 dominant_irradiance;
 };
 
+// Sample directions the transfer's uniform buffer holds, all levels together (16 KiB, the
+// smallest maxUniformBufferRange Vulkan allows).
+#define SSRT_MAX_SAMPLE_DIRECTIONS 1024
+
 // One visibility sample (std430; see runtime/src/technique/ssrt/sample_directions.h).
 struct SsrtSample {
   vec4 direction_and_radius;  // xyz unit direction (world), w displacement / radius in (0, 1]

@@ -40,7 +40,11 @@ layout(constant_id = 1) const bool kRealOnly = false;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
 FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(std140, set = 0, binding = 1) uniform LightUbo { SsrtLight light; };
-layout(std430, set = 0, binding = 2) readonly buffer SampleBuffer { SsrtSample samples[]; };
+// Every level's jitter sets, set-major (xyz unit direction, w displacement / radius; ssrt_init.cpp
+// says why a uniform buffer).
+layout(std140, set = 0, binding = 2) uniform SampleDirections {
+  vec4 sample_directions[SSRT_MAX_SAMPLE_DIRECTIONS];
+};
 // Storage images read with imageLoad: on lavapipe a sampled texelFetch costs 2-3x as much.
 layout(set = 0, binding = 3, rgba32f) readonly uniform image2D real_position;
 layout(set = 0, binding = 4, rgba16f) readonly uniform image2D real_normal;
@@ -248,8 +252,8 @@ void main() {
   if (kRealReceivers) {
     float range2 = pc.bounce.w * pc.bounce.w;
     for (int j = 0; j < half_n; ++j) {
-      vec4 dr = samples[base + j].direction_and_radius;
-      float r_anti = samples[base + j + half_n].direction_and_radius.w;
+      vec4 dr = sample_directions[base + j];
+      float r_anti = sample_directions[base + j + half_n].w;
       bool flip = dot(nr, dr.xyz) < 0.0f;
       vec3 w = flip ? -dr.xyz : dr.xyz;
       float r = (flip ? r_anti : dr.w) * pc.sampling.x;
@@ -307,8 +311,8 @@ void main() {
     }
   } else {
     for (int j = 0; j < half_n; ++j) {
-      vec4 dr = samples[base + j].direction_and_radius;
-      float r_anti = samples[base + j + half_n].direction_and_radius.w;
+      vec4 dr = sample_directions[base + j];
+      float r_anti = sample_directions[base + j + half_n].w;
       vec3 w0 = dr.xyz;
       bool flip_r = dot(nr, w0) < 0.0f;
       bool flip_v = dot(nv, w0) < 0.0f;

@@ -362,7 +362,7 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
           const SharedResources& r = shared_;
           b.read(r.frame_constants, gpu::Access::UniformRead);
           b.read(light_, gpu::Access::UniformRead);
-          b.read(samples_, gpu::Access::StorageRead);
+          b.read(samples_, gpu::Access::UniformRead);
           b.read(r.color_upload, gpu::Access::StorageRead);
           b.read(r.depth_upload, gpu::Access::StorageRead);
           for (gpu::ImageHandle h : {geo_position_, geo_normal_, r.virtual_position,
@@ -379,7 +379,7 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
           descriptors
               .uniform_buffer(0, pass.buffer(r.frame_constants))
               .uniform_buffer(1, pass.buffer(light_))
-              .storage_buffer(2, pass.buffer(samples_))
+              .uniform_buffer(2, pass.buffer(samples_))
               .storage_image(3, pass.view(geo_position_))
               .storage_image(4, pass.view(geo_normal_))
               .storage_buffer(5, pass.buffer(r.color_upload))

@@ -45,22 +45,32 @@ Status Ssrt::init() {
                  filter_->merged(), filter_->merged_intensity(), filter_->bilateral(),
                  filter_->final_depth(), filter_->position(), filter_->normal()};
 
-  // Sample sets of every level, one buffer.
-  std::vector<ssrt::GpuSample> all;
+  // Sample directions of every level, one uniform buffer (transfer.comp SampleDirections): the
+  // transfer reads them at per-lane indices (the jitter set is the cell's), and lavapipe gathers
+  // a uniform buffer with vector inserts but a storage buffer lane by lane in a branchy loop
+  // (14 % of the transfer's sample loop).
+  std::vector<glm::vec4> directions;
   for (const QualityLevel& l : ladder_) {
     auto sets = ssrt::make_sample_sets({uint32_t(knob(l, "directions")), kSampleSeed});
     if (!sets) return sets.error();
-    sample_base_.push_back(uint32_t(all.size()));
+    sample_base_.push_back(uint32_t(directions.size()));
     chi_.push_back(sets->chi);
-    all.insert(all.end(), sets->samples.begin(), sets->samples.end());
+    for (const ssrt::GpuSample& g : sets->samples) directions.push_back(g.direction_and_radius);
   }
-  const VkDeviceSize sample_bytes = all.size() * sizeof(ssrt::GpuSample);
-  auto samples = graph.create_buffer({"ssrt_samples", sample_bytes},
-                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+  if (directions.size() > SSRT_MAX_SAMPLE_DIRECTIONS)
+    return fail(ErrorKind::BadUsage,
+                "ssrt: the levels' sample directions (4 jitter sets x N each) add up to " +
+                    std::to_string(directions.size()) + ", more than the " +
+                    std::to_string(SSRT_MAX_SAMPLE_DIRECTIONS) +
+                    " one uniform buffer holds (SSRT_MAX_SAMPLE_DIRECTIONS, ssrt_math.h)");
+  directions.resize(SSRT_MAX_SAMPLE_DIRECTIONS, glm::vec4(0.0f));
+  const VkDeviceSize sample_bytes = directions.size() * sizeof(glm::vec4);
+  auto samples = graph.create_buffer({"ssrt_sample_directions", sample_bytes},
+                                     VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT |
                                          VK_BUFFER_USAGE_TRANSFER_DST_BIT);
   if (!samples) return samples.error();
   samples_ = *samples;
-  MRGI_TRY(ctx.upload_buffer(graph.gpu_buffer(samples_, 0), all.data(), sample_bytes));
+  MRGI_TRY(ctx.upload_buffer(graph.gpu_buffer(samples_, 0), directions.data(), sample_bytes));
 
   auto light = graph.create_buffer(
       {"ssrt_light", sizeof(shader::SsrtLight), gpu::MemoryUsage::Upload, true},
@@ -114,7 +124,7 @@ Status Ssrt::init() {
                            {"ssrt_transfer_real_only", 1, 1, &transfer_real_only_}};
   for (const auto& variant : transfer_variants) {
     gpu::ComputePipelineDesc d{variant.name, *transfer_spv,
-                               {{ubo}, {ubo}, {ssbo}, {img}, {img}, {ssbo}, {img}, {img}, {img},
+                               {{ubo}, {ubo}, {ubo}, {img}, {img}, {ssbo}, {img}, {img}, {img},
                                 {img}, {img}, {ubo}, {img}, {ssbo}},
                                sizeof(TransferPush), {variant.real_receivers, variant.real_only}};
     auto tp = gpu::create_compute_pipeline(ctx, d);
