@@ -2,13 +2,17 @@
 // the runtime copies them) and the nearest-sample gather from the internal image into either
 // camera. Shared by recon/depth_to_positions.comp and the ssrt passes, which start from the raw
 // frame. The including shader declares, before including this file:
-//   readonly buffer ... { uint color_words[]; };  readonly buffer ... { uint depth_words[]; };
+//   layout(..., r32ui) readonly uniform uimageBuffer color_words;  (and depth_words)
+// Storage texel buffers over the upload buffers (gpu::BufferDesc::texel_format), not storage
+// buffers: lavapipe reads a storage buffer at per-lane indices lane by lane in a loop with a
+// branch per lane, a texel buffer with vector inserts (ssrt's shade, occluders and fuse took
+// 10-25 % less).
 // and includes shared/mrgi_shared.h (project_pinhole); camera_at() also needs the frame
 // constants as `frame` (common/frame_constants.glsl).
 #ifndef MRGI_UPLOAD_GATHER_GLSL
 #define MRGI_UPLOAD_GATHER_GLSL
 
-uint color_byte(uint index) { return (color_words[index >> 2] >> ((index & 3u) * 8u)) & 0xffu; }
+uint color_byte(uint index) { return (imageLoad(color_words, int(index >> 2)).x >> ((index & 3u) * 8u)) & 0xffu; }
 // The three bytes of colour pixel `pixel` (row-major) from the two words they lie in: two reads
 // instead of three (every buffer read is a per-lane gather on lavapipe). The second word is
 // clamped to the buffer (the last pixel's bytes can end in the last word).
@@ -16,13 +20,13 @@ uvec3 color_rgb8(uint pixel) {
   uint base = pixel * 3u;
   uint w = base >> 2;
   uint shift = (base & 3u) * 8u;
-  uint lo = color_words[w];
-  uint hi = color_words[min(w + 1u, uint(color_words.length()) - 1u)];
+  uint lo = imageLoad(color_words, int(w)).x;
+  uint hi = imageLoad(color_words, int(min(w + 1u, uint(imageSize(color_words)) - 1u))).x;
   // Bytes base .. base + 2 as the low 24 bits (for shift 0 the high word is not needed).
   uint v = shift == 0u ? lo : (lo >> shift) | (hi << (32u - shift));
   return uvec3(v & 0xffu, (v >> 8u) & 0xffu, (v >> 16u) & 0xffu);
 }
-uint depth_value(uint index) { return (depth_words[index >> 1] >> ((index & 1u) * 16u)) & 0xffffu; }
+uint depth_value(uint index) { return (imageLoad(depth_words, int(index >> 1)).x >> ((index & 1u) * 16u)) & 0xffffu; }
 
 // Nearest pixel of a camera with intrinsics k and size for a camera-space ray (any z > 0);
 // (-1, -1) outside the image. Never interpolated: between a foreground and a background surface

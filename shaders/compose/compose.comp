@@ -33,7 +33,7 @@ layout(constant_id = 2) const bool kSameInternal = false; // solutions' used siz
 layout(constant_id = 3) const bool kTiled = false;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
 FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
-layout(std430, set = 0, binding = 1) readonly buffer ColorWords { uint color_words[]; };  // RGB8
+layout(set = 0, binding = 1, r32ui) readonly uniform uimageBuffer color_words;  // RGB8 words
 // Storage images read with imageLoad: on lavapipe a sampled texelFetch costs 2-3x as much.
 layout(set = 0, binding = 2, rgba16f) readonly uniform image2D lit_rv;
 layout(set = 0, binding = 3, rgba16f) readonly uniform image2D lit_r;
@@ -47,7 +47,7 @@ struct ParamsConstants {
 layout(push_constant) uniform Params { ParamsConstants params_block; };
 ParamsConstants params;
 
-uint color_byte(uint index) { return (color_words[index >> 2] >> ((index & 3u) * 8u)) & 0xffu; }
+uint color_byte(uint index) { return (imageLoad(color_words, int(index >> 2)).x >> ((index & 3u) * 8u)) & 0xffu; }
 
 uvec3 camera_bytes(ivec2 p) {
   ivec2 size = frame.color_depth_size.xy;

@@ -24,8 +24,8 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
 FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)  // internal
-layout(std430, set = 0, binding = 1) readonly buffer ColorWords { uint color_words[]; };  // RGB8
-layout(std430, set = 0, binding = 2) readonly buffer DepthWords { uint depth_words[]; };  // u16
+layout(set = 0, binding = 1, r32ui) readonly uniform uimageBuffer color_words;  // RGB8 words
+layout(set = 0, binding = 2, r32ui) readonly uniform uimageBuffer depth_words;  // u16 pairs
 #include "common/upload_gather.glsl"
 layout(set = 0, binding = 3, rgba32f) readonly uniform image2D virtual_position;
 layout(set = 0, binding = 4, rgba16f) readonly uniform image2D virtual_normal;

@@ -38,8 +38,8 @@ layout(set = 0, binding = 0, rgba32f) readonly uniform image2DArray coarse;
 layout(set = 0, binding = 1, rgba32f) readonly uniform image2D real_position;
 // The camera frame as uploaded: A = upload_gather.glsl camera_at (what recon's real_albedo
 // holds, read only at the pixels shaded).
-layout(std430, set = 0, binding = 2) readonly buffer ColorWords { uint color_words[]; };  // RGB8
-layout(std430, set = 0, binding = 9) readonly buffer DepthWords { uint depth_words[]; };  // u16
+layout(set = 0, binding = 2, r32ui) readonly uniform uimageBuffer color_words;  // RGB8 words
+layout(set = 0, binding = 9, r32ui) readonly uniform uimageBuffer depth_words;  // u16 pairs
 layout(std140, set = 0, binding = 10) uniform FrameUbo { FrameConstants frame_ubo; };
 FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 #include "common/upload_gather.glsl"

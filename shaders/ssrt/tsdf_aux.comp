@@ -14,7 +14,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, set = 0, binding = 0) uniform VolumeUbo { SsrtVolumeParams volume_ubo; };
 SsrtVolumeParams volume;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(std140, set = 0, binding = 1) uniform AuxUbo { SsrtAuxViews views; };
-layout(set = 0, binding = 2, r32ui) readonly uniform uimage2DArray voxels;  // tsdf_volume.glsl
+layout(set = 0, binding = 2, r32ui) readonly uniform uimageBuffer voxels;  // tsdf_volume.glsl
 layout(set = 0, binding = 3, rgba32f) writeonly uniform image2DArray aux_position;
 
 #include "ssrt/tsdf_march.glsl"

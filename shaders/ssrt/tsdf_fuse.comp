@@ -13,10 +13,10 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, set = 0, binding = 0) uniform VolumeUbo { SsrtVolumeParams volume_ubo; };
 SsrtVolumeParams volume;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
-layout(std430, set = 0, binding = 1) readonly buffer DepthWords { uint depth_words[]; };  // u16
-layout(set = 0, binding = 2, r32ui) uniform uimage2DArray voxels;  // tsdf_volume.glsl
+layout(set = 0, binding = 1, r32ui) readonly uniform uimageBuffer depth_words;  // u16 pairs
+layout(std430, set = 0, binding = 2) buffer Voxels { uint voxels[]; };
 
-uint depth_value(uint index) { return (depth_words[index >> 1] >> ((index & 1u) * 16u)) & 0xffffu; }
+uint depth_value(uint index) { return (imageLoad(depth_words, int(index >> 1)).x >> ((index & 1u) * 16u)) & 0xffffu; }
 
 void main() {
   volume = volume_ubo;  // MRGI_UNIFORM_COPIES
@@ -31,7 +31,9 @@ void main() {
   vec3 first = volume.origin.xyz + (vec3(xy, 0.0f) + 0.5f) * h;
   vec3 p0 = (volume.world_to_camera * vec4(first, 1.0f)).xyz;
   vec3 dz = mat3(volume.world_to_camera) * vec3(0.0f, 0.0f, h);
-  for (int z = 0; z < r; ++z) {
+  uint index = uint(xy.x + r * xy.y);
+  uint slice = uint(r * r);
+  for (int z = 0; z < r; ++z, index += slice) {
     vec3 p = p0 + float(z) * dz;
     if (!(p.z > 1e-3f)) continue;
     vec2 uv = vec2(k.x * p.x / p.z + k.z, k.y * p.y / p.z + k.w);
@@ -42,9 +44,9 @@ void main() {
     float sdf = float(raw) / units - p.z;
     if (sdf < -mu) continue;
     float tsdf = min(1.0f, sdf / mu);
-    vec2 old = unpackHalf2x16(imageLoad(voxels, ivec3(xy, z)).x);
+    vec2 old = unpackHalf2x16(voxels[index]);
     float w = old.y;
     float fused = (old.x * w + tsdf) / (w + 1.0f);
-    imageStore(voxels, ivec3(xy, z), uvec4(packHalf2x16(vec2(fused, min(w + 1.0f, max_weight)))));
+    voxels[index] = packHalf2x16(vec2(fused, min(w + 1.0f, max_weight)));
   }
 }

@@ -2,7 +2,7 @@
 // 2011 Sec. 3.4): shared by ssrt_tsdf_raycast (perspective view) and ssrt_tsdf_aux (orthographic
 // layers). The including shader declares, before including this file:
 //   layout(std140, ...) uniform VolumeUbo { SsrtVolumeParams volume; };
-//   layout(set = 0, binding = N, r32ui) readonly uniform uimage2DArray voxels;
+//   layout(set = 0, binding = N, r32ui) readonly uniform uimageBuffer voxels;
 #ifndef MRGI_SSRT_TSDF_MARCH_GLSL
 #define MRGI_SSRT_TSDF_MARCH_GLSL
 
@@ -16,14 +16,16 @@ bool tsdf_sample(vec3 p, out float value) {
   if (any(lessThan(g, vec3(0.0f))) || any(greaterThanEqual(g, vec3(float(r - 1))))) return false;
   ivec3 b = ivec3(floor(g));
   vec3 f = g - vec3(b);
-  vec2 c000 = unpackHalf2x16(imageLoad(voxels, b).x);
-  vec2 c100 = unpackHalf2x16(imageLoad(voxels, b + ivec3(1, 0, 0)).x);
-  vec2 c010 = unpackHalf2x16(imageLoad(voxels, b + ivec3(0, 1, 0)).x);
-  vec2 c110 = unpackHalf2x16(imageLoad(voxels, b + ivec3(1, 1, 0)).x);
-  vec2 c001 = unpackHalf2x16(imageLoad(voxels, b + ivec3(0, 0, 1)).x);
-  vec2 c101 = unpackHalf2x16(imageLoad(voxels, b + ivec3(1, 0, 1)).x);
-  vec2 c011 = unpackHalf2x16(imageLoad(voxels, b + ivec3(0, 1, 1)).x);
-  vec2 c111 = unpackHalf2x16(imageLoad(voxels, b + ivec3(1, 1, 1)).x);
+  int base = b.x + r * (b.y + r * b.z);
+  int row = r, slice = r * r;
+  vec2 c000 = unpackHalf2x16(imageLoad(voxels, base).x);
+  vec2 c100 = unpackHalf2x16(imageLoad(voxels, base + 1).x);
+  vec2 c010 = unpackHalf2x16(imageLoad(voxels, base + row).x);
+  vec2 c110 = unpackHalf2x16(imageLoad(voxels, base + row + 1).x);
+  vec2 c001 = unpackHalf2x16(imageLoad(voxels, base + slice).x);
+  vec2 c101 = unpackHalf2x16(imageLoad(voxels, base + slice + 1).x);
+  vec2 c011 = unpackHalf2x16(imageLoad(voxels, base + slice + row).x);
+  vec2 c111 = unpackHalf2x16(imageLoad(voxels, base + slice + row + 1).x);
   float wmin = min(min(min(c000.y, c100.y), min(c010.y, c110.y)),
                    min(min(c001.y, c101.y), min(c011.y, c111.y)));
   if (!(wmin > 0.0f)) return false;

@@ -16,7 +16,7 @@ layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo
 FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(std140, set = 0, binding = 1) uniform VolumeUbo { SsrtVolumeParams volume_ubo; };
 SsrtVolumeParams volume;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
-layout(set = 0, binding = 2, r32ui) readonly uniform uimage2DArray voxels;  // tsdf_volume.glsl
+layout(set = 0, binding = 2, r32ui) readonly uniform uimageBuffer voxels;  // tsdf_volume.glsl
 layout(set = 0, binding = 3, r32f) readonly uniform image2D depth_volume;
 layout(set = 0, binding = 4, rgba16f) writeonly uniform image2D normal_volume;
 

@@ -13,6 +13,7 @@
 #include <optional>
 #include <random>
 
+#include "recon/reconstruction.h"
 #include "../../shaders/common/frame_constants.glsl"
 #include "../../shaders/shared/mrgi_shared.h"
 #include "gpu/floor_pass.h"
@@ -110,8 +111,14 @@ struct Rig {
     technique::SharedResources& s = r->shared;
     s.frame_constants = buffer("frame_constants", sizeof(shader::FrameConstants),
                                VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
-    s.color_upload = buffer("color_upload", in.rgb.size(), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    s.depth_upload = buffer("depth_upload", in.raw.size() * 2, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    auto upload = [&](const char* name, size_t bytes) {
+      auto b = r->graph->create_buffer(recon::camera_upload_desc(name, bytes),
+                                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+      EXPECT_TRUE(b.ok()) << b.error().message;
+      return *b;
+    };
+    s.color_upload = upload("color_upload", in.rgb.size());
+    s.depth_upload = upload("depth_upload", in.raw.size() * 2);
     s.depth_scale = kDepthScale;
     s.context = &ctx;
     s.graph = r->graph.get();
@@ -536,8 +543,8 @@ TEST_F(VulkanTest, SsrtDepthFilterGpuRefusesWindowsBeyondItsLimits) {
   ASSERT_TRUE(g.ok());
   technique::SharedResources s;
   auto fc = (*g)->create_buffer({"fc", 512, MemoryUsage::Upload, true}, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
-  auto cu = (*g)->create_buffer({"cu", 4096, MemoryUsage::Upload, true}, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-  auto du = (*g)->create_buffer({"du", 4096, MemoryUsage::Upload, true}, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  auto cu = (*g)->create_buffer(recon::camera_upload_desc("cu", 4096), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  auto du = (*g)->create_buffer(recon::camera_upload_desc("du", 4096), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   ASSERT_TRUE(fc.ok() && cu.ok() && du.ok());
   s.frame_constants = *fc, s.color_upload = *cu, s.depth_upload = *du;
   auto expect_refused = [&](DepthFilterSettings st, const char* field) {
@@ -559,6 +566,28 @@ TEST_F(VulkanTest, SsrtDepthFilterGpuRefusesWindowsBeyondItsLimits) {
   bad.intensity_threshold = -1.0f;
   expect_refused(bad, "intensity_threshold");
   EXPECT_TRUE(DepthFilterGpu::create(ctx(), **g, s, {}).ok());  // the paper's parameters fit
+}
+
+// The passes read the camera uploads through their texel views: an upload made as a plain
+// storage buffer is refused at creation, naming it, instead of binding nothing at record time.
+TEST_F(VulkanTest, SsrtDepthFilterGpuRefusesAnUploadWithoutItsTexelView) {
+  FrameGraphSettings fs;
+  fs.max_output_width = 32;
+  fs.max_output_height = 24;
+  auto g = FrameGraph::create(ctx(), fs);
+  ASSERT_TRUE(g.ok());
+  technique::SharedResources s;
+  auto fc = (*g)->create_buffer({"fc", 512, MemoryUsage::Upload, true}, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  auto cu = (*g)->create_buffer(recon::camera_upload_desc("cu", 4096), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  auto plain = (*g)->create_buffer({"plain_depth", 4096, MemoryUsage::Upload, true},
+                                   VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  ASSERT_TRUE(fc.ok() && cu.ok() && plain.ok());
+  s.frame_constants = *fc, s.color_upload = *cu, s.depth_upload = *plain;
+  auto f = DepthFilterGpu::create(ctx(), **g, s, {});
+  ASSERT_FALSE(f.ok());
+  EXPECT_EQ(f.error().kind, ErrorKind::BadUsage);
+  EXPECT_NE(f.error().message.find("plain_depth"), std::string::npos) << f.error().message;
+  EXPECT_NE(f.error().message.find("texel view"), std::string::npos) << f.error().message;
 }
 
 // Per-pass GPU times at 640 x 480 (the synthetic frame scaled up); a measurement, not a check.

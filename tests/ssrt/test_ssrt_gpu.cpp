@@ -11,6 +11,7 @@
 #include <functional>
 #include <map>
 
+#include "recon/reconstruction.h"
 #include "../../shaders/common/frame_constants.glsl"
 #include "../../shaders/shared/mrgi_shared.h"
 #include "gpu/floor_pass.h"
@@ -143,10 +144,9 @@ struct Driver {
                                      VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
     EXPECT_TRUE(fc.ok());
     s.frame_constants = *fc;
-    auto words = [](size_t bytes) { return VkDeviceSize((bytes + 3) / 4 * 4); };
-    auto cu = d.graph->create_buffer({"color_upload", words(W * H * 3), MemoryUsage::Upload, true},
+    auto cu = d.graph->create_buffer(recon::camera_upload_desc("color_upload", W * H * 3),
                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    auto du = d.graph->create_buffer({"depth_upload", words(W * H * 2), MemoryUsage::Upload, true},
+    auto du = d.graph->create_buffer(recon::camera_upload_desc("depth_upload", W * H * 2),
                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     EXPECT_TRUE(cu.ok() && du.ok());
     s.color_upload = *cu;

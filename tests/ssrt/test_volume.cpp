@@ -16,6 +16,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/packing.hpp>
 
+#include "recon/reconstruction.h"
 #include "../../shaders/common/frame_constants.glsl"
 #include "../../shaders/shared/mrgi_shared.h"
 #include "gpu/frame_graph.h"
@@ -124,8 +125,7 @@ struct Rig {
                                     MemoryUsage::Upload, true},
                                    VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
     EXPECT_TRUE(fc.ok());
-    auto du = graph->create_buffer({"depth_upload", VkDeviceSize((w * h * 2 + 3) / 4 * 4),
-                                    MemoryUsage::Upload, true},
+    auto du = graph->create_buffer(recon::camera_upload_desc("depth_upload", size_t(w) * h * 2),
                                    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     EXPECT_TRUE(du.ok());
     auto rb = [&](const char* name, VkDeviceSize bytes) {

@@ -242,6 +242,40 @@ TEST_F(VulkanTest, ProfilingModeNeedsItsCommandBuffersAllocated) {
   EXPECT_TRUE((*g)->set_profiling(false).ok());
 }
 
+// A buffer with a texel format gets a view per frame copy; a format without a known texel
+// size, or more texels than the device's maxTexelBufferElements, is refused by name.
+TEST_F(VulkanTest, TexelBufferViewsPerCopyAndTheirLimits) {
+  FrameGraphSettings fs;
+  fs.max_output_width = W;
+  fs.max_output_height = H;
+  auto g = FrameGraph::create(ctx(), fs);
+  ASSERT_TRUE(g.ok()) << g.error().message;
+  BufferDesc d{"words", 1024, MemoryUsage::Upload, true};
+  d.texel_format = VK_FORMAT_R32_UINT;
+  auto b = (*g)->create_buffer(d, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  ASSERT_TRUE(b.ok()) << b.error().message;
+  EXPECT_EQ((*g)->texel_format(*b), VK_FORMAT_R32_UINT);
+  for (uint32_t slot = 0; slot < fs.frames_in_flight; ++slot)
+    EXPECT_NE((*g)->gpu_buffer(*b, slot).texel_view, VkBufferView(VK_NULL_HANDLE));
+  EXPECT_NE((*g)->gpu_buffer(*b, 0).texel_view, (*g)->gpu_buffer(*b, 1).texel_view);
+
+  BufferDesc odd{"odd_format", 1024};
+  odd.texel_format = VK_FORMAT_R8G8B8A8_UNORM;
+  auto o = (*g)->create_buffer(odd, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  ASSERT_FALSE(o.ok());
+  EXPECT_EQ(o.error().kind, ErrorKind::NotImplemented);
+  EXPECT_NE(o.error().message.find("odd_format"), std::string::npos) << o.error().message;
+
+  const VkDeviceSize limit = ctx().properties().limits.maxTexelBufferElements;
+  BufferDesc huge{"too_many_texels", (limit + 1) * 4};
+  huge.texel_format = VK_FORMAT_R32_UINT;
+  auto h = (*g)->create_buffer(huge, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  ASSERT_FALSE(h.ok());
+  EXPECT_EQ(h.error().kind, ErrorKind::Device);
+  EXPECT_NE(h.error().message.find("maxTexelBufferElements"), std::string::npos)
+      << h.error().message;
+}
+
 TEST_F(VulkanTest, NoAllocationAfterStartUp) {
   InvertGraph t = InvertGraph::make(ctx());
   auto floor = FloorPass::create(*t.graph);

@@ -46,6 +46,7 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
   const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
   const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+  const auto texel = VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER;  // the camera uploads (upload_gather.glsl)
   // compose.comp: kSameSize, kCameraOnly, kSameInternal; each path compiled out of the others'.
   const struct {
     const char* name;
@@ -60,7 +61,7 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
   c.no_tiles_ = *no_tiles;
   for (const auto& v : variants) {
     gpu::ComputePipelineDesc d{v.name, *spv,
-                               {{ubo}, {ssbo}, {img}, {img}, {img}, {ssbo}, {ssbo}, {ssbo}},
+                               {{ubo}, {texel}, {img}, {img}, {img}, {ssbo}, {ssbo}, {ssbo}},
                                sizeof(ComposePush),
                                {same_size_as_camera ? 1u : 0u, v.camera_only, v.same_internal,
                                 v.tiled}};
@@ -151,7 +152,7 @@ void Compose::dispatch(VkCommandBuffer cmd, gpu::PassContext& pass, bool tiled_p
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline);
   gpu::DescriptorPush()
       .uniform_buffer(0, pass.buffer(in_.frame_constants))
-      .storage_buffer(1, pass.buffer(in_.color_upload))
+      .storage_texel_buffer(1, pass.texel_view(in_.color_upload))
       .storage_image(2, pass.view(in_.lit_rv))
       .storage_image(3, pass.view(in_.lit_r))
       .storage_image(4, pass.view(in_.virtual_position))

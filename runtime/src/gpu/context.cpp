@@ -567,6 +567,7 @@ Expected<GpuImage> Context::create_image(const ImageCreateDesc& desc) {
 }
 
 void Context::destroy(GpuBuffer& b) {
+  if (b.texel_view) vkDestroyBufferView(device_, b.texel_view, nullptr);
   if (b.buffer) vkDestroyBuffer(device_, b.buffer, nullptr);
   if (b.memory) {
     if (b.mapped) vkUnmapMemory(device_, b.memory);

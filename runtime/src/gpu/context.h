@@ -36,6 +36,7 @@ struct GpuBuffer {
   MemoryUsage memory_usage = MemoryUsage::DeviceLocal;
   bool coherent = true;           // false: call Context::invalidate before host reads
   void* mapped = nullptr;
+  VkBufferView texel_view = VK_NULL_HANDLE;  // BufferDesc::texel_format's view; destroyed with it
 };
 
 // A 2D image (optionally layered / mipmapped) with one view over all levels and layers.

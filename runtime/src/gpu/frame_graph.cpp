@@ -73,6 +73,9 @@ VkImageView PassContext::view(ImageHandle h) const { return graph_.gpu_image(h).
 VkFormat PassContext::format(ImageHandle h) const { return graph_.gpu_image(h).format; }
 VkExtent2D PassContext::extent(ImageHandle h) const { return graph_.extent(h); }
 VkBuffer PassContext::buffer(BufferHandle h) const { return graph_.gpu_buffer(h, graph_.slot_).buffer; }
+VkBufferView PassContext::texel_view(BufferHandle h) const {
+  return graph_.gpu_buffer(h, graph_.slot_).texel_view;
+}
 VkDeviceSize PassContext::buffer_size(BufferHandle h) const { return graph_.gpu_buffer(h, graph_.slot_).size; }
 void* PassContext::mapped(BufferHandle h) const { return graph_.mapped(h, graph_.slot_); }
 VkExtent2D PassContext::output_size() const { return graph_.output_size_; }
@@ -216,10 +219,40 @@ Expected<BufferHandle> FrameGraph::create_buffer(const BufferDesc& desc, VkBuffe
     if (e.desc.name == desc.name) return fail(ErrorKind::BadUsage, what + ": name already used");
   BufferEntry e;
   e.desc = desc;
+  const bool texel = desc.texel_format != VK_FORMAT_UNDEFINED;
+  if (texel) {
+    // Texel sizes of the formats used so far; others are refused by name.
+    const VkDeviceSize texel_bytes = desc.texel_format == VK_FORMAT_R32_UINT ? 4 : 0;
+    if (texel_bytes == 0)
+      return fail(ErrorKind::NotImplemented, what + ": texel_format " +
+                                                 std::to_string(int(desc.texel_format)) +
+                                                 " (only R32_UINT views are implemented)");
+    const VkDeviceSize texels = desc.size / texel_bytes;
+    const uint32_t limit = context_.properties().limits.maxTexelBufferElements;
+    if (desc.size % texel_bytes != 0 || texels > limit)
+      return fail(ErrorKind::Device, what + ": " + std::to_string(desc.size) +
+                                         " bytes as a texel buffer: a whole number of texels, at "
+                                         "most " + std::to_string(limit) +
+                                         " (this device's maxTexelBufferElements)");
+    usage |= VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT;
+  }
   const uint32_t copies = desc.per_frame_copies ? settings_.frames_in_flight : 1;
   for (uint32_t i = 0; i < copies; ++i) {
     auto b = context_.create_buffer(desc.size, usage | desc.extra_usage, desc.memory,
                                     copies > 1 ? desc.name + "#" + std::to_string(i) : desc.name);
+    if (b && texel) {
+      VkBufferViewCreateInfo vi{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
+      vi.buffer = b->buffer;
+      vi.format = desc.texel_format;
+      vi.offset = 0;
+      vi.range = desc.size;
+      const VkResult r = vkCreateBufferView(context_.device(), &vi, nullptr, &b->texel_view);
+      if (r != VK_SUCCESS) {
+        context_.destroy(*b);
+        b = fail(ErrorKind::Device, what + ": vkCreateBufferView failed (VkResult " +
+                                        std::to_string(int(r)) + ")");
+      }
+    }
     if (!b) {
       for (GpuBuffer& made : e.copies) context_.destroy(made);
       return b.error();
@@ -331,6 +364,9 @@ const GpuBuffer& FrameGraph::gpu_buffer(BufferHandle buffer, uint32_t slot) cons
 }
 const std::string& FrameGraph::name(ImageHandle image) const { return images_.at(image.id).desc.name; }
 const std::string& FrameGraph::name(BufferHandle buffer) const { return buffers_.at(buffer.id).desc.name; }
+VkFormat FrameGraph::texel_format(BufferHandle buffer) const {
+  return buffers_.at(buffer.id).desc.texel_format;
+}
 void* FrameGraph::mapped(BufferHandle buffer, uint32_t slot) const { return gpu_buffer(buffer, slot).mapped; }
 
 // --- frames --------------------------------------------------------------------------------------

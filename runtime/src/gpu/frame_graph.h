@@ -73,6 +73,11 @@ struct BufferDesc {
   bool per_frame_copies = false;
   bool history = false;   // as ImageDesc::history
   VkBufferUsageFlags extra_usage = 0;
+  // Not VK_FORMAT_UNDEFINED: the buffer is also a storage texel buffer of this format, with a
+  // view over all of it (PassContext::texel_view; GLSL imageBuffer / uimageBuffer). Lavapipe
+  // reads such a view at per-lane indices with vector inserts, a storage buffer lane by lane in
+  // a branchy loop (shaders/common/upload_gather.glsl has the figures).
+  VkFormat texel_format = VK_FORMAT_UNDEFINED;
 };
 
 // How a pass touches a resource. Stages come from this and the pass kind.
@@ -211,6 +216,7 @@ class PassContext {
   VkFormat format(ImageHandle h) const;
   VkExtent2D extent(ImageHandle h) const;   // the used extent this frame (<= allocated)
   VkBuffer buffer(BufferHandle h) const;    // the current slot's copy
+  VkBufferView texel_view(BufferHandle h) const;  // its BufferDesc::texel_format view
   VkDeviceSize buffer_size(BufferHandle h) const;
   void* mapped(BufferHandle h) const;       // current slot's mapping (Upload/Readback)
   VkExtent2D output_size() const;
@@ -293,6 +299,7 @@ class FrameGraph {
   const GpuBuffer& gpu_buffer(BufferHandle buffer, uint32_t slot) const;
   const std::string& name(ImageHandle image) const;
   const std::string& name(BufferHandle buffer) const;
+  VkFormat texel_format(BufferHandle buffer) const;  // BufferDesc::texel_format
 
   // Frame loop.
   // Waits for the slot's previous frame (if any), reads its timestamps, resets the slot, clears

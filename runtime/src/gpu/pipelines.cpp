@@ -253,6 +253,19 @@ DescriptorPush& DescriptorPush::storage_buffer(uint32_t binding, VkBuffer buffer
   return *this;
 }
 
+DescriptorPush& DescriptorPush::storage_texel_buffer(uint32_t binding, VkBufferView view) {
+  if (count_ >= kMaxWrites) { overflow_ = true; return *this; }
+  texel_views_[count_] = view;
+  VkWriteDescriptorSet& w = writes_[count_];
+  w = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+  w.dstBinding = binding;
+  w.descriptorCount = 1;
+  w.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER;
+  w.pTexelBufferView = &texel_views_[count_];
+  ++count_;
+  return *this;
+}
+
 DescriptorPush& DescriptorPush::uniform_buffer(uint32_t binding, VkBuffer buffer, VkDeviceSize offset,
                                                VkDeviceSize range) {
   storage_buffer(binding, buffer, offset, range);

@@ -107,6 +107,7 @@ class DescriptorPush {
                                  VkDeviceSize range = VK_WHOLE_SIZE);
   DescriptorPush& uniform_buffer(uint32_t binding, VkBuffer buffer, VkDeviceSize offset = 0,
                                  VkDeviceSize range = VK_WHOLE_SIZE);
+  DescriptorPush& storage_texel_buffer(uint32_t binding, VkBufferView view);
   // Binds nothing else: call after vkCmdBindPipeline.
   void push(const Context& ctx, VkCommandBuffer cmd, const Pipeline& pipeline);
 
@@ -114,6 +115,7 @@ class DescriptorPush {
   std::array<VkWriteDescriptorSet, kMaxWrites> writes_{};
   std::array<VkDescriptorImageInfo, kMaxWrites> images_{};
   std::array<VkDescriptorBufferInfo, kMaxWrites> buffers_{};
+  std::array<VkBufferView, kMaxWrites> texel_views_{};
   uint32_t count_ = 0;
   bool overflow_ = false;
 };

@@ -1,5 +1,6 @@
 #include "recon/reconstruction.h"
 
+#include <algorithm>
 #include <cstring>
 
 #include "gpu/shaders.h"
@@ -39,6 +40,22 @@ Status check_settings(const ReconstructionSettings& s) {
 
 }  // namespace
 
+gpu::BufferDesc camera_upload_desc(const std::string& name, size_t bytes) {
+  gpu::BufferDesc d{name, words_bytes(std::max<size_t>(bytes, 4)), gpu::MemoryUsage::Upload, true};
+  d.texel_format = VK_FORMAT_R32_UINT;
+  return d;
+}
+
+Status check_camera_upload(const gpu::FrameGraph& graph, gpu::BufferHandle upload,
+                           const std::string& who) {
+  if (!upload.valid() || graph.texel_format(upload) != VK_FORMAT_R32_UINT)
+    return fail(ErrorKind::BadUsage,
+                who + ": camera upload '" + (upload.valid() ? graph.name(upload) : "(none)") +
+                    "' lacks the R32_UINT texel view its shaders read (create it with "
+                    "recon::camera_upload_desc)");
+  return ok_status();
+}
+
 Expected<Reconstruction> Reconstruction::create(gpu::Context& context, gpu::FrameGraph& graph,
                                                 const Intrinsics& color, const Intrinsics& depth,
                                                 const ReconstructionSettings& settings) {
@@ -47,11 +64,11 @@ Expected<Reconstruction> Reconstruction::create(gpu::Context& context, gpu::Fram
   r.settings_ = settings;
   r.color_bytes_ = size_t(color.width) * color.height * 3;
   r.depth_bytes_ = size_t(depth.width) * depth.height * 2;
-  gpu::BufferDesc cb{"color_upload", words_bytes(r.color_bytes_), gpu::MemoryUsage::Upload, true};
+  const gpu::BufferDesc cb = camera_upload_desc("color_upload", r.color_bytes_);
   auto c = graph.create_buffer(cb, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (!c) return c.error();
   r.color_upload_ = *c;
-  gpu::BufferDesc db{"depth_upload", words_bytes(r.depth_bytes_), gpu::MemoryUsage::Upload, true};
+  const gpu::BufferDesc db = camera_upload_desc("depth_upload", r.depth_bytes_);
   auto d = graph.create_buffer(db, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (!d) return d.error();
   r.depth_upload_ = *d;
@@ -77,12 +94,12 @@ Expected<Reconstruction> Reconstruction::create(gpu::Context& context, gpu::Fram
   r.warped_ = *wp;
 
   const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-  const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+  const auto texel = VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER;  // the camera uploads (upload_gather.glsl)
   auto pos_spv = gpu::shader_spirv("recon/depth_to_positions.comp");
   if (!pos_spv) return pos_spv.error();
   auto pp = gpu::create_compute_pipeline(
-      context, {"recon_positions", *pos_spv, {{ubo}, {ssbo}, {ssbo}, {img}, {img}, {img}, {img}},
+      context, {"recon_positions", *pos_spv, {{ubo}, {texel}, {texel}, {img}, {img}, {img}, {img}},
                 sizeof(MergePush)});
   if (!pp) return pp.error();
   r.positions_pipeline_ = gpu::PipelineHandle(context, std::move(*pp));
@@ -165,8 +182,8 @@ void Reconstruction::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_cons
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, positions_pipeline_->pipeline);
         gpu::DescriptorPush()
             .uniform_buffer(0, pass.buffer(frame_constants_))
-            .storage_buffer(1, pass.buffer(color_upload_))
-            .storage_buffer(2, pass.buffer(depth_upload_))
+            .storage_texel_buffer(1, pass.texel_view(color_upload_))
+            .storage_texel_buffer(2, pass.texel_view(depth_upload_))
             .storage_image(3, pass.view(position_))
             .storage_image(4, pass.view(albedo_))
             .storage_image(5, pass.view(warped_))

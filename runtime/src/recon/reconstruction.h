@@ -36,6 +36,14 @@ struct ReconstructionSettings {
   int normal_radius = 2;            // pixels: central-difference half-width for normals, [1, 8]
 };
 
+// How a camera upload buffer (RGB8 colour or u16 depth packed into uint words, host-written each
+// frame) is created, as every pass that reads one expects it: one copy per frame slot, rounded
+// to whole words, with the R32_UINT texel view shaders/common/upload_gather.glsl reads.
+gpu::BufferDesc camera_upload_desc(const std::string& name, size_t bytes);
+// BadUsage naming `who` unless `upload` was created that way (has the texel view).
+Status check_camera_upload(const gpu::FrameGraph& graph, gpu::BufferHandle upload,
+                           const std::string& who);
+
 class Reconstruction {
  public:
   // Buffers sized for the colour and depth images; images allocated at the output size.

@@ -1,4 +1,5 @@
 #include "technique/ssrt/depth_filter_gpu.h"
+#include "recon/reconstruction.h"
 
 #include <algorithm>
 #include <cmath>
@@ -77,6 +78,8 @@ Expected<DepthFilterGpu> DepthFilterGpu::create(gpu::Context& ctx, gpu::FrameGra
     return fail(ErrorKind::BadUsage,
                 "technique/ssrt/depth_filter_gpu.cpp: SharedResources needs frame_constants, "
                 "color_upload and depth_upload");
+  MRGI_TRY(recon::check_camera_upload(graph, shared.color_upload, "ssrt depth filter"));
+  MRGI_TRY(recon::check_camera_upload(graph, shared.depth_upload, "ssrt depth filter"));
 
   DepthFilterGpu f;
   f.graph_ = &graph;
@@ -115,9 +118,9 @@ Expected<DepthFilterGpu> DepthFilterGpu::create(gpu::Context& ctx, gpu::FrameGra
   MRGI_TRY(graph.upload_image(f.no_volume_, &zero, sizeof(zero)));
 
   const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-  const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  const auto texel = VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER;  // the camera uploads (upload_gather.glsl)
   const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-  auto p = gpu::load_compute_pipeline(ctx, "ssrt/depth_input.comp", {{ubo}, {ssbo}, {ssbo}, {img}, {img}},
+  auto p = gpu::load_compute_pipeline(ctx, "ssrt/depth_input.comp", {{ubo}, {texel}, {texel}, {img}, {img}},
                     sizeof(WindowPush));
   if (!p) return p.error();
   f.input_pipe_ = std::move(*p);
@@ -192,8 +195,8 @@ Status DepthFilterGpu::record(gpu::ImageHandle depth_volume, bool final_pass,
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, input_pipe_->pipeline);
         gpu::DescriptorPush()
             .uniform_buffer(0, pass.buffer(frame_constants_))
-            .storage_buffer(1, pass.buffer(color_upload_))
-            .storage_buffer(2, pass.buffer(depth_upload_))
+            .storage_texel_buffer(1, pass.texel_view(color_upload_))
+            .storage_texel_buffer(2, pass.texel_view(depth_upload_))
             .storage_image(3, pass.view(volume_))
             .storage_image(4, pass.view(input_))
             .push(pass.context(), cmd, *input_pipe_);

@@ -253,14 +253,14 @@ void Ssrt::add_shade_pass(const char* name, ShadeMode mode, bool run_transfer) {
         gpu::DescriptorPush()
             .storage_image(0, pass.view(coarse_))
             .storage_image(1, pass.view(geo_position_))
-            .storage_buffer(2, pass.buffer(r.color_upload))
+            .storage_texel_buffer(2, pass.texel_view(r.color_upload))
             .storage_image(3, pass.view(r.virtual_position))
             .storage_image(4, pass.view(r.virtual_albedo))
             .storage_image(5, pass.view(r.lit_rv))
             .storage_image(6, pass.view(r.lit_r))
             .storage_image(7, pass.view(upsampled_))
             .storage_buffer(8, pass.buffer(tile_list_))
-            .storage_buffer(9, pass.buffer(r.depth_upload))
+            .storage_texel_buffer(9, pass.texel_view(r.depth_upload))
             // Without emission the albedo stands in (bound, never read: flags.y is 0).
             .storage_image(13, pass.view(r.virtual_emission.valid() ? r.virtual_emission
                                                                      : r.virtual_albedo))
@@ -341,8 +341,8 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
           vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, occluders_->pipeline);
           gpu::DescriptorPush()
               .uniform_buffer(0, pass.buffer(r.frame_constants))
-              .storage_buffer(1, pass.buffer(r.color_upload))
-              .storage_buffer(2, pass.buffer(r.depth_upload))
+              .storage_texel_buffer(1, pass.texel_view(r.color_upload))
+              .storage_texel_buffer(2, pass.texel_view(r.depth_upload))
               .storage_image(3, pass.view(r.virtual_position))
               .storage_image(4, pass.view(r.virtual_normal))
               .storage_image(5, pass.view(r.virtual_albedo))
@@ -382,7 +382,7 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
               .uniform_buffer(2, pass.buffer(samples_))
               .storage_image(3, pass.view(geo_position_))
               .storage_image(4, pass.view(geo_normal_))
-              .storage_buffer(5, pass.buffer(r.color_upload))
+              .storage_texel_buffer(5, pass.texel_view(r.color_upload))
               .storage_image(6, pass.view(r.virtual_position))
               .storage_image(7, pass.view(r.virtual_normal))
               .storage_image(8, pass.view(occ_a_))
@@ -390,7 +390,7 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
               .storage_image(10, pass.view(volume_->aux_position()))
               .uniform_buffer(11, pass.buffer(volume_->aux_views()))
               .storage_image(12, pass.view(occ_b_))
-              .storage_buffer(13, pass.buffer(r.depth_upload));
+              .storage_texel_buffer(13, pass.texel_view(r.depth_upload));
           const float sample_area = 3.14159265f * kRadiusM * kRadiusM / float(directions_);
           TransferPush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), int(directions_)),
                           glm::ivec4(int(sample_base_[size_t(level_)]), int(bands_),
@@ -445,9 +445,9 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
           vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, reduce_->pipeline);
           gpu::DescriptorPush()
               .storage_image(0, pass.view(coarse_))
-              .storage_buffer(1, pass.buffer(shared_.color_upload))
+              .storage_texel_buffer(1, pass.texel_view(shared_.color_upload))
               .uniform_buffer(3, pass.buffer(shared_.frame_constants))
-              .storage_buffer(4, pass.buffer(shared_.depth_upload))
+              .storage_texel_buffer(4, pass.texel_view(shared_.depth_upload))
               .storage_buffer(2, pass.buffer(partials_))
               .push(ctx, cmd, *reduce_);
           ReducePush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), int(kStripCells)),

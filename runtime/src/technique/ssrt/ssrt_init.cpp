@@ -110,6 +110,7 @@ Status Ssrt::init() {
 
   const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
   const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  const auto texel = VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER;  // the camera uploads (upload_gather.glsl)
   const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
   auto transfer_spv = gpu::shader_spirv("ssrt/transfer.comp");
   if (!transfer_spv) return transfer_spv.error();
@@ -124,21 +125,21 @@ Status Ssrt::init() {
                            {"ssrt_transfer_real_only", 1, 1, &transfer_real_only_}};
   for (const auto& variant : transfer_variants) {
     gpu::ComputePipelineDesc d{variant.name, *transfer_spv,
-                               {{ubo}, {ubo}, {ubo}, {img}, {img}, {ssbo}, {img}, {img}, {img},
-                                {img}, {img}, {ubo}, {img}, {ssbo}},
+                               {{ubo}, {ubo}, {ubo}, {img}, {img}, {texel}, {img}, {img}, {img},
+                                {img}, {img}, {ubo}, {img}, {texel}},
                                sizeof(TransferPush), {variant.real_receivers, variant.real_only}};
     auto tp = gpu::create_compute_pipeline(ctx, d);
     if (!tp) return tp.error();
     *variant.handle = gpu::PipelineHandle(ctx, std::move(*tp));
   }
   auto p = gpu::load_compute_pipeline(ctx, "ssrt/occluders.comp",
-                                      {{ubo}, {ssbo}, {ssbo}, {img}, {img}, {img}, {img}, {img},
+                                      {{ubo}, {texel}, {texel}, {img}, {img}, {img}, {img}, {img},
                                        {img}, {img}},
                                       sizeof(glm::ivec4));
   if (!p) return p.error();
   occluders_ = std::move(*p);
   p = gpu::load_compute_pipeline(ctx, "ssrt/light_reduce.comp",
-                                 {{img}, {ssbo}, {ssbo}, {ubo}, {ssbo}}, sizeof(ReducePush));
+                                 {{img}, {texel}, {ssbo}, {ubo}, {texel}}, sizeof(ReducePush));
   if (!p) return p.error();
   reduce_ = std::move(*p);
   p = gpu::load_compute_pipeline(ctx, "ssrt/light_reduce_final.comp", {{ssbo}, {ssbo}}, sizeof(FinalPush));
@@ -175,8 +176,8 @@ Status Ssrt::init() {
                         {"ssrt_shade_tiled_compose", 0, 1, 8, 1, 1, &shade_tiled_compose_}};
   for (const auto& v : shade_variants) {
     gpu::ComputePipelineDesc d{v.name, *shade_spv,
-                               {{img}, {img}, {ssbo}, {img}, {img}, {img}, {img}, {img}, {ssbo},
-                                {ssbo}, {ubo}, {ssbo}, {ssbo}, {img}},
+                               {{img}, {img}, {texel}, {img}, {img}, {img}, {img}, {img}, {ssbo},
+                                {texel}, {ubo}, {ssbo}, {ssbo}, {img}},
                                sizeof(ShadePush),
                                {v.pass_through, v.tiled, v.local_x, v.local_y, v.compose}};
     auto sp = gpu::create_compute_pipeline(ctx, d);

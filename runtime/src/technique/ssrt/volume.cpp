@@ -6,6 +6,7 @@
 
 #include "common/frame_constants.glsl"
 #include "ssrt/tsdf_volume.glsl"
+#include "recon/reconstruction.h"
 
 namespace mrgi::ssrt {
 namespace {
@@ -38,13 +39,6 @@ Expected<Volume> Volume::create(gpu::Context& ctx, gpu::FrameGraph& graph,
   if (s.max_resolution < 2 || s.max_resolution > kMaxResolution)
     return fail(ErrorKind::BadUsage, where + "max_resolution " + std::to_string(s.max_resolution) +
                                          " outside 2.." + std::to_string(kMaxResolution));
-  const VkPhysicalDeviceLimits& limits = ctx.properties().limits;
-  if (s.max_resolution > limits.maxImageArrayLayers || s.max_resolution > limits.maxImageDimension2D)
-    return fail(ErrorKind::Device,
-                where + "max_resolution " + std::to_string(s.max_resolution) +
-                    " exceeds this device's image limits (the voxels are a 2D array image: " +
-                    std::to_string(limits.maxImageArrayLayers) + " layers, " +
-                    std::to_string(limits.maxImageDimension2D) + " texels a side)");
   if (s.max_aux_resolution < 1 || s.max_aux_resolution > kMaxAuxResolution)
     return fail(ErrorKind::BadUsage, where + "max_aux_resolution " +
                                          std::to_string(s.max_aux_resolution) + " outside 1.." +
@@ -61,6 +55,7 @@ Expected<Volume> Volume::create(gpu::Context& ctx, gpu::FrameGraph& graph,
   if (!shared.depth_upload.valid() || !shared.frame_constants.valid())
     return fail(ErrorKind::BadUsage,
                 "ssrt volume: shared resources lack depth_upload or frame_constants");
+  MRGI_TRY(recon::check_camera_upload(graph, shared.depth_upload, "ssrt volume"));
   const Intrinsics& dk = shared.depth_intrinsics;
   if (dk.width <= 0 || dk.height <= 0 || !(dk.fx > 0.0) || !(dk.fy > 0.0) ||
       !(shared.depth_scale > 0.0))
@@ -71,15 +66,15 @@ Expected<Volume> Volume::create(gpu::Context& ctx, gpu::FrameGraph& graph,
   v.settings_ = s;
   v.shared_ = shared;
   v.graph_ = &graph;
-  // A 2D array image (tsdf_volume.glsl says why not a storage buffer: on lavapipe the ray cast
-  // 6.0 -> 3.6 ms, its aux layers 1.4 -> 0.9 at the fast level on desk_spot).
-  gpu::ImageDesc vd;
-  vd.name = "ssrt_tsdf_voxels";
-  vd.format = VK_FORMAT_R32_UINT;
-  vd.size_mode = gpu::SizeMode::Absolute;
-  vd.width = vd.height = vd.layers = s.max_resolution;
-  vd.history = true;
-  auto voxels = graph.create_image(vd, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
+  // A storage buffer the fuse pass writes, read through an R32_UINT texel view (tsdf_volume.glsl
+  // says why: on lavapipe the ray cast 6.5 -> 3.0 ms at the fast level on desk_spot).
+  gpu::BufferDesc vd{"ssrt_tsdf_voxels",
+                     VkDeviceSize(s.max_resolution) * s.max_resolution * s.max_resolution *
+                         sizeof(uint32_t),
+                     gpu::MemoryUsage::DeviceLocal, false, /*history=*/true};
+  vd.texel_format = VK_FORMAT_R32_UINT;
+  auto voxels = graph.create_buffer(vd, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                            VK_BUFFER_USAGE_TRANSFER_DST_BIT);
   if (!voxels) return voxels.error();
   v.voxels_ = *voxels;
   auto params = graph.create_buffer(
@@ -124,18 +119,19 @@ Expected<Volume> Volume::create(gpu::Context& ctx, gpu::FrameGraph& graph,
   v.aux_position_ = *aux;
 
   const VkDescriptorType ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-  const VkDescriptorType ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   const VkDescriptorType img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-  auto p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_fuse.comp", {{ubo}, {ssbo}, {img}});
+  const VkDescriptorType ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  const VkDescriptorType texel = VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER;  // uploads, voxels
+  auto p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_fuse.comp", {{ubo}, {texel}, {ssbo}});
   if (!p) return p.error();
   v.fuse_ = std::move(*p);
-  p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_raycast.comp", {{ubo}, {ubo}, {img}, {img}});
+  p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_raycast.comp", {{ubo}, {ubo}, {texel}, {img}});
   if (!p) return p.error();
   v.raycast_ = std::move(*p);
-  p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_normals.comp", {{ubo}, {ubo}, {img}, {img}, {img}});
+  p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_normals.comp", {{ubo}, {ubo}, {texel}, {img}, {img}});
   if (!p) return p.error();
   v.normals_ = std::move(*p);
-  p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_aux.comp", {{ubo}, {ubo}, {img}, {img}});
+  p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_aux.comp", {{ubo}, {ubo}, {texel}, {img}});
   if (!p) return p.error();
   v.aux_ = std::move(*p);
 
@@ -315,11 +311,9 @@ void Volume::add_passes(const VolumeFrame& frame, bool clear, bool fuse, bool vi
         "ssrt_tsdf_clear", gpu::PassKind::Transfer,
         [this](gpu::PassBuilder& b) { b.write(voxels_, gpu::Access::TransferDst); },
         [this, res](VkCommandBuffer cmd, gpu::PassContext& pass) {
-          // 0 = packHalf2x16(tsdf 0, weight 0): never observed. The level's first res layers.
-          const VkClearColorValue zero{};
-          const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, res};
-          vkCmdClearColorImage(cmd, pass.image(voxels_), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                               &zero, 1, &range);
+          // 0 = packHalf2x16(tsdf 0, weight 0): never observed.
+          vkCmdFillBuffer(cmd, pass.buffer(voxels_), 0,
+                          VkDeviceSize(res) * res * res * sizeof(uint32_t), 0u);
         });
   }
   if (fuse) {
@@ -335,8 +329,8 @@ void Volume::add_passes(const VolumeFrame& frame, bool clear, bool fuse, bool vi
           vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, fuse_->pipeline);
           gpu::DescriptorPush()
               .uniform_buffer(0, pass.buffer(params_))
-              .storage_buffer(1, pass.buffer(shared_.depth_upload))
-              .storage_image(2, pass.view(voxels_))
+              .storage_texel_buffer(1, pass.texel_view(shared_.depth_upload))
+              .storage_buffer(2, pass.buffer(voxels_))
               .push(ctx, cmd, *fuse_);
           gpu::dispatch_2d(cmd, *fuse_, nullptr, 0, res, res);
         });
@@ -356,7 +350,7 @@ void Volume::add_passes(const VolumeFrame& frame, bool clear, bool fuse, bool vi
         gpu::DescriptorPush()
             .uniform_buffer(0, pass.buffer(shared_.frame_constants))
             .uniform_buffer(1, pass.buffer(params_))
-            .storage_image(2, pass.view(voxels_))
+            .storage_texel_buffer(2, pass.texel_view(voxels_))
             .storage_image(3, pass.view(depth_volume_))
             .push(ctx, cmd, *raycast_);
         const VkExtent2D e = pass.extent(depth_volume_);
@@ -378,7 +372,7 @@ void Volume::add_passes(const VolumeFrame& frame, bool clear, bool fuse, bool vi
         gpu::DescriptorPush()
             .uniform_buffer(0, pass.buffer(shared_.frame_constants))
             .uniform_buffer(1, pass.buffer(params_))
-            .storage_image(2, pass.view(voxels_))
+            .storage_texel_buffer(2, pass.texel_view(voxels_))
             .storage_image(3, pass.view(depth_volume_))
             .storage_image(4, pass.view(normal_volume_))
             .push(ctx, cmd, *normals_);
@@ -399,7 +393,7 @@ void Volume::add_passes(const VolumeFrame& frame, bool clear, bool fuse, bool vi
         gpu::DescriptorPush()
             .uniform_buffer(0, pass.buffer(params_))
             .uniform_buffer(1, pass.buffer(aux_views_))
-            .storage_image(2, pass.view(voxels_))
+            .storage_texel_buffer(2, pass.texel_view(voxels_))
             .storage_image(3, pass.view(aux_position_))
             .push(ctx, cmd, *aux_);
         // The layers stacked along y: rows [i aux_res, (i + 1) aux_res) are layer i.

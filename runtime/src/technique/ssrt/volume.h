@@ -77,7 +77,7 @@ class Volume {
   // surface, w its depth along the view axis in metres (0 = no surface).
   gpu::ImageHandle aux_position() const { return aux_position_; }
   gpu::BufferHandle aux_views() const { return aux_views_; }        // uniform: shader::SsrtAuxViews
-  gpu::ImageHandle voxels() const { return voxels_; }               // storage: tsdf_volume.glsl
+  gpu::BufferHandle voxels() const { return voxels_; }              // storage: tsdf_volume.glsl
   bool fused_last_frame() const { return fused_last_frame_; }
   const VolumeSettings& settings() const { return settings_; }
 
@@ -93,8 +93,7 @@ class Volume {
   VolumeSettings settings_;
   technique::SharedResources shared_;
   gpu::FrameGraph* graph_ = nullptr;
-  gpu::ImageHandle voxels_;
-  gpu::BufferHandle params_, aux_views_;
+  gpu::BufferHandle voxels_, params_, aux_views_;
   gpu::ImageHandle depth_volume_, normal_volume_, aux_position_;
   gpu::PipelineHandle fuse_, raycast_, normals_, aux_;
   // Host state of the skip tests (allocated at create).
