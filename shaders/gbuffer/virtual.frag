@@ -5,21 +5,24 @@
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
 #include "common/frame_constants.glsl"
-#include "common/scene_materials.glsl"
 
-layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
-layout(std430, set = 0, binding = 1) readonly buffer Materials { GpuMaterial materials[]; };
 layout(set = 0, binding = 2) uniform sampler2D real_position;         // xyz world, w depth
 layout(set = 0, binding = 3) uniform sampler2DArray base_color_maps;  // sRGB, decoded on fetch
                                                                       // (emissive maps too)
 layout(set = 0, binding = 4) uniform sampler2D real_normal;           // xyz world (step > 1)
-// material: per draw; real_step: internal pixels per texel side of real_position.
-layout(push_constant) uniform Draw { int material; int real_step; } draw;
-
+// Bindings 0 (frame constants), 1 (materials) and the push constants are read by virtual.vert,
+// which says why, and arrive as the flat inputs below.
 layout(location = 0) in vec3 in_world;
 layout(location = 1) in vec3 in_normal;
 layout(location = 2) in vec2 in_uv;
 layout(location = 3) in float in_view_z;
+layout(location = 4) flat in vec4 in_base_color;
+layout(location = 5) flat in vec4 in_material;  // x metallic, y roughness, z base-colour layer,
+                                                // w real_step
+layout(location = 6) flat in vec4 in_emission;
+layout(location = 7) flat in vec4 in_k;
+layout(location = 8) flat in vec4 in_camera;    // xyz camera centre (world), w behind-real tolerance
+layout(location = 9) flat in mat3x4 in_to_camera;
 layout(location = 0) out vec4 out_position;  // xyz world, w = 1 (virtual coverage mask)
 layout(location = 1) out vec4 out_normal;    // xyz unit, w roughness
 layout(location = 2) out vec4 out_albedo;    // rgb linear base colour, w metallic
@@ -27,33 +30,35 @@ layout(location = 3) out vec4 out_emission;  // rgb emitted radiance (glTF emiss
 
 void main() {
   ivec2 pixel = ivec2(gl_FragCoord.xy);
-  ivec2 texel = pixel / max(draw.real_step, 1);
+  int real_step = int(in_material.w);
+  ivec2 texel = pixel / real_step;
   vec4 real = texelFetch(real_position, texel, 0);
-  if (draw.real_step > 1 && real.w > 0.0f) {
+  if (real_step > 1 && real.w > 0.0f) {
     // A coarse texel: the depth of its tangent plane on this pixel's ray (exact on planes, so a
     // virtual object resting on a sloped real surface is not cut by the texel-centre depth).
-    vec3 ray = unproject_pinhole(vec2(pixel), 1.0f, frame.internal_k);
-    vec3 p = (frame.world_to_camera * vec4(real.xyz, 1.0f)).xyz;
-    vec3 n = mat3(frame.world_to_camera) * texelFetch(real_normal, texel, 0).xyz;
+    mat4 world_to_camera = mat4(transpose(in_to_camera));
+    world_to_camera[3][3] = 1.0f;
+    vec3 ray = unproject_pinhole(vec2(pixel), 1.0f, in_k);
+    vec3 p = (world_to_camera * vec4(real.xyz, 1.0f)).xyz;
+    vec3 n = mat3(world_to_camera) * texelFetch(real_normal, texel, 0).xyz;
     real.w = tangent_plane_depth(ray, p, n, MRGI_DEPTH_EDGE_RELATIVE);
   }
   // Hidden when a valid real surface is in front by more than the tolerance (a fraction of
   // the depth: sensor noise grows with distance; objects resting on a real surface stay seen).
-  if (real.w > 0.0f && real.w < in_view_z * (1.0f - frame.camera.z)) discard;
+  if (real.w > 0.0f && real.w < in_view_z * (1.0f - in_camera.w)) discard;
 
-  GpuMaterial m = materials[max(draw.material, 0)];
-  vec4 base = m.base_color_factor;
-  if (m.params.z >= 0.0f) base *= texture(base_color_maps, vec3(in_uv, m.params.z));
+  vec4 base = in_base_color;
+  if (in_material.z >= 0.0f) base *= texture(base_color_maps, vec3(in_uv, in_material.z));
   vec3 n = normalize(in_normal);
   if (any(isnan(n))) n = vec3(0.0f, 1.0f, 0.0f);
   // A double-sided material seen from behind (single-sided ones are culled), or a flipped
   // normal: shade the side the camera sees.
-  if (dot(n, frame.camera_world.xyz - in_world) < 0.0f) n = -n;
+  if (dot(n, in_camera.xyz - in_world) < 0.0f) n = -n;
   out_position = vec4(in_world, 1.0f);
-  out_normal = vec4(n, clamp(m.params.y, 0.02f, 1.0f));
-  out_albedo = vec4(clamp(base.rgb, vec3(0.0f), vec3(1.0f)), clamp(m.params.x, 0.0f, 1.0f));
+  out_normal = vec4(n, clamp(in_material.y, 0.02f, 1.0f));
+  out_albedo = vec4(clamp(base.rgb, vec3(0.0f), vec3(1.0f)), clamp(in_material.x, 0.0f, 1.0f));
   // Half floats end at 65504 (a material's emission is finite and non-negative on upload).
-  vec3 emission = m.emission.rgb;
-  if (m.emission.w >= 0.0f) emission *= texture(base_color_maps, vec3(in_uv, m.emission.w)).rgb;
+  vec3 emission = in_emission.rgb;
+  if (in_emission.w >= 0.0f) emission *= texture(base_color_maps, vec3(in_uv, in_emission.w)).rgb;
   out_emission = vec4(min(emission, vec3(60000.0f)), 0.0f);
 }
