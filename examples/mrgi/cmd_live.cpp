@@ -211,11 +211,13 @@ void run_live(const LiveOptions& o) {
     ImageRGB8 camera;
   };
   BoundedQueue<Finished> finished(2);
+  ReturnQueue<FrameOutput> encoded;  // outputs written, for Runtime::recycle
   StageThread encode(
       [&] {
         while (auto f = finished.pop()) {
           auto st = output.add(f->output, f->camera, nullptr, nullptr);
           if (!st.ok()) fail_with(st.error());
+          encoded.put(std::move(f->output));
           ++written;
           if (!o.quiet)
             progress("live " + o.technique, written, o.frames > 0 ? size_t(o.frames) : written,
@@ -260,6 +262,7 @@ void run_live(const LiveOptions& o) {
     else frame.pose = last_pose;  // without tracking the camera pose stays where it was
     frame.index = int64_t(submitted++);
     cameras_by_frame[frame.index] = resize_bilinear(frame.color, out_w, out_h);
+    for (FrameOutput& done : encoded.take_all()) runtime->recycle(std::move(done));
     consume(take(runtime->process(frame)));
   }
   consume(take(runtime->flush()));

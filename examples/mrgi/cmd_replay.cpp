@@ -66,6 +66,7 @@ void run_replay(const ReplayOptions& o) {
   };
   BoundedQueue<Decoded> decoded(kQueued);
   BoundedQueue<Finished> finished(kQueued);
+  ReturnQueue<FrameOutput> encoded;  // outputs written, for Runtime::recycle
   const double env_intensity = scene.environment.present ? scene.environment.intensity : 1.0;
   size_t written = 0;
   const auto t0 = std::chrono::steady_clock::now();
@@ -100,6 +101,7 @@ void run_replay(const ReplayOptions& o) {
           const LightEstimate* truth = f->truth ? &*f->truth : nullptr;
           auto st = output.add(f->output, f->camera, ref ? &*ref : nullptr, mask ? &*mask : nullptr, truth);
           if (!st.ok()) fail_with(st.error());
+          encoded.put(std::move(f->output));
           ++written;
           if (!o.quiet)
             progress("replay " + o.technique, written, frames,
@@ -128,6 +130,7 @@ void run_replay(const ReplayOptions& o) {
       auto d = decoded.pop();
       if (!d) break;
       const size_t i = size_t(d->frame.index);
+      for (FrameOutput& done : encoded.take_all()) runtime->recycle(std::move(done));
       auto outs = runtime->process(d->frame);
       in_flight[i] = std::move(d);
       in_flight[i]->frame = InputFrame{};

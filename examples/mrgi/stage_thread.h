@@ -81,4 +81,26 @@ class StageThread {
   std::thread thread_;
 };
 
+// Items a later stage is done with, handed back to the thread that owns their source: the
+// encoder returns frame outputs to the runtime's thread, which recycles them
+// (Runtime::recycle is not thread-safe); never blocks the encoder.
+template <class T>
+class ReturnQueue {
+ public:
+  void put(T&& item) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    items_.push_back(std::move(item));
+  }
+  std::deque<T> take_all() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::deque<T> out;
+    out.swap(items_);
+    return out;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::deque<T> items_;
+};
+
 }  // namespace mrgi::tool

@@ -5,6 +5,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <set>
 
 #include "capture/temp_dir.h"
 #include "mrgi/runtime.h"
@@ -183,6 +184,66 @@ TEST(FrameSkip, ObjectInViewIsNotSkipped) {
   int virtual_pixels = 0;
   for (uint8_t m : o.virtual_mask.data) virtual_pixels += m != 0;
   EXPECT_GT(virtual_pixels, 0);
+}
+
+}  // namespace
+}  // namespace mrgi::test
+
+namespace mrgi::test {
+namespace {
+
+// Runtime::recycle: a frame handed back is filled again (its storage reused: no fresh memory per
+// frame) and every output equals a runtime's that never recycles, for composed frames and for
+// camera copies (object out of view). Frames of another size are not reused.
+TEST(Runtime, RecycledOutputsAreRefilledAndUnchanged) {
+  const mrgi::testing::TempDir dir;
+  const SyntheticScene s = SyntheticScene::create(dir.str());
+  for (const bool in_view : {true, false}) {
+    SceneDesc scene = s.scene;
+    if (!in_view)
+      for (auto& v : scene.virtual_objects) v.placement.position += glm::vec3(30.0f, 0.0f, 0.0f);
+    RuntimeSettings rs;
+    rs.device.validate = true;
+    rs.technique = "baseline";
+    rs.level = 3;
+    auto recycling = create_runtime(rs, s.cameras(), scene);
+    auto plain = create_runtime(rs, s.cameras(), scene);
+    ASSERT_TRUE(recycling.ok() && plain.ok());
+    std::vector<FrameOutput> got, want;
+    std::set<const uint8_t*> storage;
+    size_t reused = 0;
+    for (int64_t k = 0; k < 6; ++k) {
+      auto a = (*recycling)->process(s.frame(k));
+      auto b = (*plain)->process(s.frame(k));
+      ASSERT_TRUE(a.ok() && b.ok());
+      for (FrameOutput& o : *a) {
+        reused += storage.count(o.image.data.data());
+        storage.insert(o.image.data.data());
+        got.push_back(o);                     // a copy for the comparison below
+        (*recycling)->recycle(std::move(o));  // the storage goes back
+      }
+      for (FrameOutput& o : *b) want.push_back(std::move(o));
+    }
+    auto a = (*recycling)->flush();
+    auto b = (*plain)->flush();
+    ASSERT_TRUE(a.ok() && b.ok());
+    for (FrameOutput& o : *a) got.push_back(std::move(o));
+    for (FrameOutput& o : *b) want.push_back(std::move(o));
+    ASSERT_EQ(got.size(), want.size());
+    EXPECT_GE(reused, 3u) << "recycled images were not filled again";
+    for (size_t i = 0; i < got.size(); ++i) {
+      EXPECT_EQ(got[i].stats.frame_index, want[i].stats.frame_index);
+      EXPECT_TRUE(got[i].image.data == want[i].image.data) << "frame " << i << ", in view " << in_view;
+      EXPECT_TRUE(got[i].virtual_mask.data == want[i].virtual_mask.data) << "frame " << i;
+    }
+    FrameOutput other;
+    other.image = ImageRGBA8(8, 8);
+    (*recycling)->recycle(std::move(other));  // another size: dropped, not reused
+    auto c = (*recycling)->process(s.frame(7));
+    auto d = (*recycling)->flush();
+    ASSERT_TRUE(c.ok() && d.ok());
+    for (const FrameOutput& o : *d) EXPECT_EQ(o.image.width, got[0].image.width);
+  }
 }
 
 }  // namespace

@@ -175,8 +175,8 @@ Status Compose::read(const gpu::FrameGraph& graph, uint32_t slot, ImageRGBA8& im
   const gpu::GpuBuffer& mb = graph.gpu_buffer(mask_, slot);
   MRGI_TRY(graph.context().invalidate(ob));
   MRGI_TRY(graph.context().invalidate(mb));
-  image = ImageRGBA8(int(width_), int(height_));
-  mask = Image<uint8_t, 1>(int(width_), int(height_));
+  reuse_or_allocate(image, int(width_), int(height_), false);  // every pixel written below
+  reuse_or_allocate(mask, int(width_), int(height_));   // zero, tiles written below
   const uint8_t* out = static_cast<const uint8_t*>(graph.mapped(output_, slot));
   const uint32_t* m = static_cast<const uint32_t*>(graph.mapped(mask_, slot));
   if (!slot_host_camera_[slot]) {

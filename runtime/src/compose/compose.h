@@ -9,6 +9,7 @@
 // the composite of its tiles itself (ComposeInputs::tiles_composed, same formula: mrgi_shared.h
 // compose_encoded); compose then adds no pass, only the tile-list readback.
 #pragma once
+#include <algorithm>
 #include <vector>
 
 #include "gpu/frame_graph.h"
@@ -41,6 +42,18 @@ struct ComposeInputs {
   // at the camera's size whose solutions have the output's size (fusable()).
   bool tiles_composed = false;
 };
+
+// `image` at w x h, reusing its storage when it already has that size (Runtime::recycle: no
+// fresh pages for the OS to zero each frame); every value zero, or, with `zeroed` false, left as
+// it was where reused (the caller writes every value).
+template <class T, int C>
+void reuse_or_allocate(Image<T, C>& image, int w, int h, bool zeroed = true) {
+  if (image.width == w && image.height == h && image.data.size() == size_t(w) * h * C) {
+    if (zeroed) std::fill(image.data.begin(), image.data.end(), T{});
+    return;
+  }
+  image = Image<T, C>(w, h);
+}
 
 class Compose {
  public:

@@ -60,6 +60,7 @@ class RuntimeImpl final : public Runtime {
 
   Expected<std::vector<FrameOutput>> process(const InputFrame& frame) override;
   Expected<std::vector<FrameOutput>> flush() override;
+  void recycle(FrameOutput&& done) override;
   const DeviceInfo& device() const override { return context_->info(); }
   double memory_mib() const override { return context_->memory_mib(); }
   int level_count() const override { return int(technique_->levels().size()); }
@@ -99,6 +100,7 @@ class RuntimeImpl final : public Runtime {
   std::unique_ptr<technique::Technique> technique_;
   std::optional<compose::Compose> compose_;
   std::vector<SlotRecord> slots_;
+  std::vector<FrameOutput> spare_outputs_;  // recycle(): images and masks to fill again
   glm::dmat4 last_pose_{1.0};
   bool have_pose_ = false;
   glm::vec3 env_mean_{0.0f};  // environment from a file: mean radiance x intensity
@@ -483,14 +485,26 @@ Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, 
   return check_validation();
 }
 
+void RuntimeImpl::recycle(FrameOutput&& done) {
+  if (done.image.width != output_w_ || done.image.height != output_h_ ||
+      spare_outputs_.size() > size_t(settings_.frames_in_flight))
+    return;
+  spare_outputs_.push_back(std::move(done));
+}
+
 Expected<FrameOutput> RuntimeImpl::collect(const gpu::FrameTimings& timings) {
   SlotRecord& rec = slots_[timings.slot];
   FrameOutput out;
+  if (!spare_outputs_.empty()) {  // recycle(): its image and mask are filled below
+    out.image = std::move(spare_outputs_.back().image);
+    out.virtual_mask = std::move(spare_outputs_.back().virtual_mask);
+    spare_outputs_.pop_back();
+  }
   const auto read_start = std::chrono::steady_clock::now();
   if (rec.camera_copy) {
     const auto* rgb = static_cast<const uint8_t*>(graph_->mapped(recon_->color_upload(), timings.slot));
-    out.image = ImageRGBA8(output_w_, output_h_);
-    out.virtual_mask = Image<uint8_t, 1>(output_w_, output_h_);  // zero: no virtual pixel
+    compose::reuse_or_allocate(out.image, output_w_, output_h_, false);  // all written
+    compose::reuse_or_allocate(out.virtual_mask, output_w_, output_h_);  // zero: no virtual pixel
     uint8_t* px = out.image.data.data();
     const size_t n = size_t(output_w_) * size_t(output_h_);
     for (size_t i = 0; i < n; ++i) {
