@@ -143,7 +143,7 @@ def main():
         if not os.path.exists(args.mrgi):
             fail(f"{args.mrgi} not found (build it, or pass --mrgi)")
         env = dict(os.environ, LP_NUM_THREADS=os.environ.get("LP_NUM_THREADS", "2"))
-        cmd = [args.mrgi, "bench", "--frames", "2000", "--warmup", "2", "--profile-frames", "0",
+        cmd = [args.mrgi, "bench", "--frames", "400", "--warmup", "2", "--profile-frames", "0",
                "-q", "-o", os.path.join(args.out, "bench")] + args.bench_args
         proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL,
                                 stderr=subprocess.DEVNULL)
