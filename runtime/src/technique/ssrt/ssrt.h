@@ -73,14 +73,15 @@
 // (Technique::wants_priming_run). With the environment's true SH in place of the estimate the
 // fast level scores RDE 0.563, so the estimate costs about 0.02.
 //
-// Cost on lavapipe (LP_NUM_THREADS=2, 640x480, `mrgi bench --techniques ssrt --frames 4
-// --warmup 1`, perf/results/report-ssrt-640x480.md, session 10's machine: floor 2.2-2.7 ms,
-// session 8's was 1.5): suite mean sustained full 1153 ms, half 759, fast 53.0, fastest 48.5;
-// fast over the scenes with a virtual object 20.8-23.6 floors (median 23.0). Fast level split
-// (profiling mode, median over scenes, ratio to the floor): transfer 9.5 floors, shade
-// (composing its tiles) 2.4 and its tile test 0.4, ray cast 1.9, virtual G-buffer 1.5, host
-// 1.2, blur 0.9, filters 0.9, occluders 0.8, fuse 0.6, G-buffer 0.6, light sums 0.5, aux layers
-// 0.5: about 22 floors profiled, 23 sustained, against about 22 for 33 ms on a 1.5 ms floor.
+// Cost on lavapipe (LP_NUM_THREADS=2, 640x480, `mrgi bench --techniques ssrt`, session 11:
+// perf/results/report-ssrt-640x480.md (4 frames after 1), report-ssrt-fast-16frames.md and
+// ab-ssrt-fast-session11.md; floor 1.6-2.8 ms, session 8's was 1.5): suite mean sustained full
+// 823 ms, half 480, fast 42.8, fastest 40.0; fast over the scenes with a virtual object 20.0
+// floors (median; 17.3-21.9) on a loaded machine, 21.3 in a quieter hour, against about 22 for
+// 33 ms on a 1.5 ms floor. Fast level split (profiling mode, ratio to the floor): transfer 5.9
+// floors, shade (composing its tiles) 2.1 and its tile test 0.45, host 1.3, ray cast 1.3, blur
+// 0.95, filters 0.9, virtual G-buffer 0.8, occluders 0.75, fuse 0.7, G-buffer 0.5, light sums
+// 0.5, aux layers 0.3: about 17.5 floors profiled, 20 sustained.
 // Measured gains behind them (fast level): no runtime reconstruction (-14 ms), constant
 // indices into the transfer's and the light sums' local arrays (a dynamic index had put them
 // in per-lane scratch memory: -5 and -3 ms), the occluder G-buffer (cache misses, then fewer
@@ -92,15 +93,20 @@
 // specialization constant (blur -14 %); session 10: workgroups in spread order for lavapipe's
 // static split of a dispatch between its workers, tiles that cannot move a pixel by one 8-bit
 // level left to the camera frame (ssrt_tile_invisible: shaded tiles -29 %), aux layers at 32
-// texels on the fast levels (their ray cast -75 %), the light sums' final pass on 8 workgroups.
+// texels on the fast levels (their ray cast -75 %), the light sums' final pass on 8 workgroups;
+// session 11 (read from lavapipe's JIT code, perf/tools/jit_probe.py): uniform blocks copied on
+// each pass's first line (a uniform read after any branch is a per-lane gather on lavapipe:
+// transfer 32 -> 18 ms), the sample directions in a uniform buffer and the camera uploads and
+// voxels through texel buffers (a per-lane storage-buffer load is a branchy loop over the lanes:
+// transfer -22 %, ray cast -45 %, shade -20 %).
 // What the transfer's time is (knock-out runs, process CPU, desk_spot/corner): the real-receiver
 // path is 87 % of it; the aux test 35 % (each layer about 7 ms of CPU; without its image loads
 // only 10 % less, so it is the arithmetic and the registers it holds, not the reads); the SH
 // basis 5 %; T_real's 16 accumulators 13 %. On lavapipe a shader's live values decide its cost:
 // a per-lane choice between two uniform matrices cost 17 % of the pass.
 // Known defects: the grey-world albedo (paper Sec. 6.4) reads brighter objects as more light
-// from their side (env_fisheye's boxes and ball are 0.6-0.7, its floor 0.5); the fast level is
-// above 33 ms on lavapipe (about 23 floor passes against 22; the transfer is the rest); its
+// from their side (env_fisheye's boxes and ball are 0.6-0.7, its floor 0.5); the fast level
+// meets the 33 ms bar on lavapipe without margin (20-22 floor passes against about 22); its
 // coarse geometry costs corner 0.017 RDE (0.748 -> 0.765; geometry_step 2 gives 0.741 but ~24
 // ms more). The fastest level had 2 SH bands
 // until session 4; the transfer accumulates all 16 coefficients whatever the level, so 2 bands
