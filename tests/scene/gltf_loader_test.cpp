@@ -429,6 +429,24 @@ TEST(GltfLoader, TextureTransformIsAppliedToTheBaseColourCoordinates) {
   EXPECT_NEAR(plain1->primitives[0].uvs[1].x, 0.25f, 1e-6f);
 }
 
+// Issue 12 case 9: a texture image that is not there is refused naming the file (not only the
+// image's index), and nothing is loaded.
+TEST(GltfHardening, AMissingTextureFileIsNamed) {
+  TempDir dir;
+  write_uv_bin(dir.file("uv.bin"));
+  std::string text = textured_triangle_gltf(R"({"index": 0})");
+  const std::string data_uri = R"("uri": "data:image/png;base64,)";
+  const size_t at = text.find(data_uri);
+  ASSERT_NE(at, std::string::npos);
+  const size_t end = text.find('"', at + data_uri.size());
+  text.replace(at, end + 1 - at, R"("uri": "textures/not_here.png")");
+  write_text(dir.file("t.gltf"), text);
+  auto model = load_gltf(dir.file("t.gltf"), Placement{});
+  ASSERT_FALSE(model.ok());
+  EXPECT_EQ(model.error().kind, ErrorKind::BadInput) << model.error().message;
+  EXPECT_NE(model.error().message.find("not_here.png"), std::string::npos) << model.error().message;
+}
+
 TEST(GltfHardening, BadTextureTransformsAreRefusedNamingTheField) {
   TempDir dir;
   write_uv_bin(dir.file("uv.bin"));

@@ -185,6 +185,12 @@ Expected<std::vector<uint32_t>> read_indices(const LoadContext& ctx, int index, 
 // Any decoded glTF image (1-4 channels, 8 or 16 bits) to sRGB-encoded RGBA8.
 Expected<ImageRGBA8> to_rgba8(const LoadContext& ctx, const tinygltf::Image& img, int image_index) {
   const int n = img.component, bytes = img.bits / 8;
+  // tinygltf leaves an image it could not read empty (with only a warning): name its file.
+  if (img.image.empty() && !img.uri.empty() && img.uri.rfind("data:", 0) != 0)
+    return fail(ErrorKind::BadInput, ctx.path + ": image " + std::to_string(image_index) + " ('" +
+                                         img.uri + "', images[" + std::to_string(image_index) +
+                                         "].uri): the file is missing or unreadable (looked for "
+                                         "next to the model, inside its folder)");
   if (img.width <= 0 || img.height <= 0 || n < 1 || n > 4 || (bytes != 1 && bytes != 2) ||
       img.image.size() != size_t(img.width) * size_t(img.height) * size_t(n) * size_t(bytes))
     return fail(ErrorKind::BadInput, ctx.path + ": image " + std::to_string(image_index) +
