@@ -33,6 +33,9 @@ layout(constant_id = 1) const bool kTiled = false;
 // output and mask instead of lit_r / lit_rv (Technique::ComposeTiles::composed): the compose
 // pass would otherwise read both solutions, the coverage and the camera again per pixel.
 layout(constant_id = 4) const bool kCompose = false;
+// kEmission: some virtual material emits (virtual_emission holds it; ssrt_init.cpp says why a
+// constant).
+layout(constant_id = 5) const bool kEmission = false;
 // Storage images read with imageLoad: on lavapipe a sampled texelFetch costs 2-3x as much.
 layout(set = 0, binding = 0, rgba32f) readonly uniform image2DArray coarse;
 layout(set = 0, binding = 1, rgba32f) readonly uniform image2D real_position;
@@ -177,7 +180,7 @@ void store_shaded(ivec2 pixel, PixelInputs p, vec4 s4, vec4 s5, vec4 s6) {
     vec3 av = imageLoad(virtual_albedo, pixel).rgb;
     // Plus the surface's own emission (glTF emissive), seen directly. It lights no other
     // surface: the bounce term's senders are lit by the dominant light only (ssrt_math.h).
-    vec3 emission = frame.flags.y != 0 ? imageLoad(virtual_emission, pixel).rgb : vec3(0.0f);
+    vec3 emission = kEmission ? imageLoad(virtual_emission, pixel).rgb : vec3(0.0f);
     l_rv = av * (rd_v + ri_v / MRGI_PI) + emission;
   } else {
     l_rv = real_ok ? a * rd_v + a * ssrt_indirect_select(ri, ri_v, pc.opts.x) / MRGI_PI : vec3(0.0f);

@@ -261,7 +261,7 @@ void Ssrt::add_shade_pass(const char* name, ShadeMode mode, bool run_transfer) {
             .storage_image(7, pass.view(upsampled_))
             .storage_buffer(8, pass.buffer(tile_list_))
             .storage_texel_buffer(9, pass.texel_view(r.depth_upload))
-            // Without emission the albedo stands in (bound, never read: flags.y is 0).
+            // Without emission the albedo stands in (bound, never read: kEmission is false).
             .storage_image(13, pass.view(r.virtual_emission.valid() ? r.virtual_emission
                                                                      : r.virtual_albedo))
             .uniform_buffer(10, pass.buffer(r.frame_constants))

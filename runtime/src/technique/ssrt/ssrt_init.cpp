@@ -174,12 +174,16 @@ Status Ssrt::init() {
                         {"ssrt_shade_pass_through", 1, 0, 8, 8, 0, &shade_pass_},
                         {"ssrt_shade_tiled", 0, 1, 8, 1, 0, &shade_tiled_},
                         {"ssrt_shade_tiled_compose", 0, 1, 8, 1, 1, &shade_tiled_compose_}};
+  // kEmission: some material emits (the virtual G-buffer has its emission target). A constant,
+  // not FrameConstants::flags.y: lavapipe runs both sides of a select, so every shaded pixel
+  // fetched the emission (no measurable change on the suite, but work for nothing).
+  const uint32_t emission = shared_.virtual_emission.valid() ? 1u : 0u;
   for (const auto& v : shade_variants) {
     gpu::ComputePipelineDesc d{v.name, *shade_spv,
                                {{img}, {img}, {texel}, {img}, {img}, {img}, {img}, {img}, {ssbo},
                                 {texel}, {ubo}, {ssbo}, {ssbo}, {img}},
                                sizeof(ShadePush),
-                               {v.pass_through, v.tiled, v.local_x, v.local_y, v.compose}};
+                               {v.pass_through, v.tiled, v.local_x, v.local_y, v.compose, emission}};
     auto sp = gpu::create_compute_pipeline(ctx, d);
     if (!sp) return sp.error();
     *v.handle = gpu::PipelineHandle(ctx, std::move(*sp));
