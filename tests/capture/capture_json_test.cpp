@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <cctype>
+#include <ostream>
+
 #include "capture/temp_dir.h"
 #include "mrgi/platform/capture.h"
 
@@ -64,6 +67,9 @@ struct BadCaptureJson {
   const char* rule;
 };
 
+// What gtest prints for a case (not its bytes, which hold pointers).
+void PrintTo(const BadCaptureJson& c, std::ostream* os) { *os << c.key << ": " << c.json; }
+
 class CaptureJsonRefuses : public ::testing::TestWithParam<BadCaptureJson> {};
 
 TEST_P(CaptureJsonRefuses, NamingFileKeyAndRule) {
@@ -107,7 +113,15 @@ INSTANTIATE_TEST_SUITE_P(
                                                          {"id": 1, "position": [0,0,0], "rotation": [0,0,0,1]}]}})",
                        "apriltag.tags[1].id", "listed twice"},
         BadCaptureJson{R"({"version": 1, "apriltag": {"tags": [{"id": 1, "position": [0,0], "rotation": [0,0,0,1]}]}})",
-                       "apriltag.tags[0].position", "array of 3 numbers"}));
+                       "apriltag.tags[0].position", "array of 3 numbers"}),
+    // Names from the case's index and the key it names: stable across builds (the default
+    // printed the struct's bytes, pointers included).
+    [](const ::testing::TestParamInfo<BadCaptureJson>& info) {
+      std::string name = std::to_string(info.index) + "_";
+      for (const char* c = info.param.key; *c; ++c)
+        name += std::isalnum(static_cast<unsigned char>(*c)) ? *c : '_';
+      return name;
+    });
 
 }  // namespace
 }  // namespace mrgi

@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <cctype>
+#include <ostream>
+
 #include <filesystem>
 
 #include "capture/temp_dir.h"
@@ -117,6 +120,9 @@ struct BadScene {
   const char* rule;  // words of the rule the message must give
 };
 
+// What gtest prints for a case (not its bytes, which hold pointers).
+void PrintTo(const BadScene& c, std::ostream* os) { *os << c.key << ": " << c.json; }
+
 class SceneJsonRefuses : public ::testing::TestWithParam<BadScene> {};
 
 TEST_P(SceneJsonRefuses, NamingFileKeyAndRule) {
@@ -200,7 +206,15 @@ INSTANTIATE_TEST_SUITE_P(
         BadScene{R"({"version": 1, "virtual_objects": [{"gltf": "models/box.glb", "scale": 1e39}]})",
                  ErrorKind::BadInput, "virtual_objects[0].scale", "32-bit float"},
         BadScene{R"({"version": 1, "virtual_objects": [{"gltf": "models/box.glb", "position": [0, -1e39, 0]}]})",
-                 ErrorKind::BadInput, "virtual_objects[0].position[1]", "32-bit float"}));
+                 ErrorKind::BadInput, "virtual_objects[0].position[1]", "32-bit float"}),
+    // Names from the case's index and the key it names: stable across builds (the default
+    // printed the struct's bytes, pointers included).
+    [](const ::testing::TestParamInfo<BadScene>& info) {
+      std::string name = std::to_string(info.index) + "_";
+      for (const char* c = info.param.key; *c; ++c)
+        name += std::isalnum(static_cast<unsigned char>(*c)) ? *c : '_';
+      return name;
+    });
 
 // The same key in different objects is fine.
 TEST(SceneJson, SameKeyInDifferentObjectsIsAccepted) {
