@@ -3,9 +3,10 @@
 # UndefinedBehaviorSanitizer (a UB report aborts), -Werror, libFuzzer coverage, into
 # build-asan/; then the tests again under it (tools/sanitizers: third-party leak suppressions
 # only) and a short run of every fuzz target (scripts/fuzz.sh, FUZZ_SECONDS each, default 10).
-# In the test command it runs the areas that read outside input (unit, capture, scene and the
-# fuzz corpora) to keep the command near 15 minutes on 2 cores; MRGI_SANITIZE_ALL=1 builds and
-# runs every test (about 12 minutes more).
+# In the test command it runs the areas that read outside input (unit, capture, scene, the .oni
+# reader and the fuzz corpora) to keep the command near 15 minutes on 2 cores;
+# MRGI_SANITIZE_ALL=1 builds and runs every test (about 12 minutes more; session 11: 376 tests,
+# no report in mrgi's code after the .oni probe fix).
 # To fit the CI time (the test command builds the tree twice on 2 cores): -O0 with line tables
 # only, and the libraries as unity translation units (MRGI_UNITY_LIBS).
 set -euo pipefail
@@ -19,8 +20,12 @@ if [ "${MRGI_SANITIZE_ALL:-0}" = 1 ]; then
   ninja -C build-asan -j"$(nproc)"
   ctest --test-dir build-asan --output-on-failure --no-tests=error -j"$(nproc)" --timeout 900
 else
-  ninja -C build-asan -j"$(nproc)" test_unit test_capture test_scene \
+  ninja -C build-asan -j"$(nproc)" test_unit test_capture test_scene test_platform \
     fuzz_capture_json fuzz_capture_list fuzz_tum_poses fuzz_scene_json fuzz_gltf fuzz_texture fuzz_png fuzz_hdr fuzz_oni
   ctest --test-dir build-asan --output-on-failure --no-tests=error -j"$(nproc)" --timeout 900 -L '^(unit|capture|scene|fuzz)$'
+  # The .oni reader's tests too (a file that crashes the driver must be refused under ASan's
+  # crash handler as well: the full run found it was not); the rest of `platform` (2.5 minutes
+  # under ASan, mostly AprilTag photos) runs with MRGI_SANITIZE_ALL=1.
+  ctest --test-dir build-asan --output-on-failure --no-tests=error -j"$(nproc)" --timeout 900 -R '^OpenNI'
 fi
 MRGI_FUZZ_BUILD=build-asan bash scripts/fuzz.sh "${FUZZ_SECONDS:-10}"

@@ -136,6 +136,14 @@ class OpenNISource final : public InputSource {
                                            "the record-structure check does not see (for example a property value "
                                            "the driver trusts); refused");
     }
+    // The probe ends with 0 (read to the end) or 3 (an error the open in this process reports by
+    // name); anything else is a death the driver caused that did not show as a signal (a crash
+    // handler that exits, e.g. a sanitizer's): refused too, never retried in this process.
+    if (WIFEXITED(status) && WEXITSTATUS(status) != 0 && WEXITSTATUS(status) != 3)
+      return fail(ErrorKind::BadInput, uri + ": OpenNI2's file driver crashed the probe process (it exited with "
+                                           "status " + std::to_string(WEXITSTATUS(status)) +
+                                           " through a crash handler) reading the recording: the file is "
+                                           "corrupt in a way the record-structure check does not see; refused");
     return ok_status();
   }
 
