@@ -213,56 +213,49 @@ void PipelineHandle::reset() {
   p_ = {};
 }
 
-DescriptorPush& DescriptorPush::storage_image(uint32_t binding, VkImageView view) {
-  if (count_ >= kMaxWrites) { overflow_ = true; return *this; }
-  images_[count_] = {VK_NULL_HANDLE, view, VK_IMAGE_LAYOUT_GENERAL};
+VkWriteDescriptorSet* DescriptorPush::next_write(uint32_t binding, VkDescriptorType type) {
+  if (count_ >= kMaxWrites) {
+    overflow_ = true;
+    return nullptr;
+  }
   VkWriteDescriptorSet& w = writes_[count_];
   w = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
   w.dstBinding = binding;
   w.descriptorCount = 1;
-  w.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-  w.pImageInfo = &images_[count_];
-  ++count_;
+  w.descriptorType = type;
+  return &w;
+}
+
+DescriptorPush& DescriptorPush::storage_image(uint32_t binding, VkImageView view) {
+  if (VkWriteDescriptorSet* w = next_write(binding, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE)) {
+    images_[count_] = {VK_NULL_HANDLE, view, VK_IMAGE_LAYOUT_GENERAL};
+    w->pImageInfo = &images_[count_++];
+  }
   return *this;
 }
 
 DescriptorPush& DescriptorPush::sampled_image(uint32_t binding, VkImageView view, VkSampler sampler) {
-  if (count_ >= kMaxWrites) { overflow_ = true; return *this; }
-  images_[count_] = {sampler, view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-  VkWriteDescriptorSet& w = writes_[count_];
-  w = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-  w.dstBinding = binding;
-  w.descriptorCount = 1;
-  w.descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-  w.pImageInfo = &images_[count_];
-  ++count_;
+  if (VkWriteDescriptorSet* w = next_write(binding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER)) {
+    images_[count_] = {sampler, view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    w->pImageInfo = &images_[count_++];
+  }
   return *this;
 }
 
 DescriptorPush& DescriptorPush::storage_buffer(uint32_t binding, VkBuffer buffer, VkDeviceSize offset,
                                                VkDeviceSize range) {
-  if (count_ >= kMaxWrites) { overflow_ = true; return *this; }
-  buffers_[count_] = {buffer, offset, range};
-  VkWriteDescriptorSet& w = writes_[count_];
-  w = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-  w.dstBinding = binding;
-  w.descriptorCount = 1;
-  w.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-  w.pBufferInfo = &buffers_[count_];
-  ++count_;
+  if (VkWriteDescriptorSet* w = next_write(binding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER)) {
+    buffers_[count_] = {buffer, offset, range};
+    w->pBufferInfo = &buffers_[count_++];
+  }
   return *this;
 }
 
 DescriptorPush& DescriptorPush::storage_texel_buffer(uint32_t binding, VkBufferView view) {
-  if (count_ >= kMaxWrites) { overflow_ = true; return *this; }
-  texel_views_[count_] = view;
-  VkWriteDescriptorSet& w = writes_[count_];
-  w = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-  w.dstBinding = binding;
-  w.descriptorCount = 1;
-  w.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER;
-  w.pTexelBufferView = &texel_views_[count_];
-  ++count_;
+  if (VkWriteDescriptorSet* w = next_write(binding, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER)) {
+    texel_views_[count_] = view;
+    w->pTexelBufferView = &texel_views_[count_++];
+  }
   return *this;
 }
 

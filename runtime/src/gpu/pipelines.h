@@ -112,6 +112,8 @@ class DescriptorPush {
   void push(const Context& ctx, VkCommandBuffer cmd, const Pipeline& pipeline);
 
  private:
+  // The next write with its common fields set; nullptr (and overflow_) when all are used.
+  VkWriteDescriptorSet* next_write(uint32_t binding, VkDescriptorType type);
   std::array<VkWriteDescriptorSet, kMaxWrites> writes_{};
   std::array<VkDescriptorImageInfo, kMaxWrites> images_{};
   std::array<VkDescriptorBufferInfo, kMaxWrites> buffers_{};
