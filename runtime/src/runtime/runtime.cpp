@@ -243,6 +243,7 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
     s.skipped.reserve(16);
     s.notes.reserve(4);
   }
+  spare_outputs_.reserve(size_t(settings.frames_in_flight) + 1);  // recycle() never reallocates
   return check_validation();
 }
 
