@@ -191,7 +191,7 @@ void run_live(const LiveOptions& o) {
   settings.technique = o.technique;
   settings.level = level;
   settings.exposure = info.exposure;
-  CameraSetup cameras{info.color, info.depth, info.depth_scale, info.exposure};
+  CameraSetup cameras{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera};
   auto runtime = take(create_runtime(settings, cameras, scene));
   const int out_w = info.color.width, out_h = info.color.height;
   ReplayMeta meta{source->name(), o.technique, level, runtime->level_names()[size_t(level)], runtime->device().name,

@@ -35,7 +35,7 @@ void run_replay(const ReplayOptions& o) {
   settings.output_width = o.width;
   settings.output_height = o.height;
   settings.exposure = info.exposure;
-  CameraSetup cameras{info.color, info.depth, info.depth_scale, info.exposure};
+  CameraSetup cameras{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera};
   const SceneDesc scene = capture.scene() ? *capture.scene() : SceneDesc{};
   auto runtime = take(create_runtime(settings, cameras, scene));
 

@@ -194,7 +194,7 @@ Expected<RunSamples> run_one(const LoadedScene& l, const std::string& technique,
   rs.exposure = l.info.exposure;
   rs.output_width = s.width;
   rs.output_height = s.height;
-  const CameraSetup cameras{l.info.color, l.info.depth, l.info.depth_scale, l.info.exposure};
+  const CameraSetup cameras{l.info.color, l.info.depth, l.info.depth_scale, l.info.exposure, l.info.env_camera};
   auto created = create_runtime(rs, cameras, l.scene);
   const std::string what = "scene '" + l.suite.name + "', technique '" + technique + "', level " + std::to_string(level);
   if (!created.ok()) return fail(created.error().kind, what + ": " + created.error().message);

@@ -4,8 +4,11 @@
 //   L_r  += L_o * r(lamp) * r(p) * st_r    (only real lamps on real points, real casters)
 // L_o: Lambert for real surfaces (albedo from the camera, recon/depth_to_positions.comp);
 // Lambert + GGX (metallic/roughness) for virtual ones; inverse-square distance, spot cone.
-// A constant ambient from the environment's mean radiance (no occlusion) is added: a real
-// environment to both solutions, a virtual one to L_rv only.
+// The lights are the light stage's (light/light_stage.h): declared lamps, an environment's
+// strongest median-cut regions or the probeless dominant light, each with its shadow maps, so
+// a virtual object occludes the sky's bright part for the real surface below it. The rest of
+// the light is an ambient irradiance in SH (bands 0..2), unshadowed: the real part lights both
+// solutions, a virtual environment L_rv only.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
 #include "common/frame_constants.glsl"
@@ -15,6 +18,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
 FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(std140, set = 0, binding = 1) uniform LightUbo { LightSet light_set; };
+AmbientIrradiance ambient_rv, ambient_r;  // private copies of light_set's (MRGI_UNIFORM_COPIES)
 layout(set = 0, binding = 2) uniform sampler2D real_position;
 layout(set = 0, binding = 3) uniform sampler2D real_normal;
 layout(set = 0, binding = 4) uniform sampler2D real_albedo;
@@ -90,12 +94,20 @@ vec3 brdf(vec3 n, vec3 v, vec3 l, vec3 base, float metallic, float roughness, bo
   return (1.0f - f) * diffuse + d * vis * f;
 }
 
+// E(n) of an ambient, linear RGB, >= 0 (SH bands 0..2 can dip below 0 away from the light).
+vec3 ambient_irradiance(AmbientIrradiance a, vec3 n) {
+  vec4 n4 = vec4(n, 1.0f);
+  return max(vec3(dot(n4, a.r * n4), dot(n4, a.g * n4), dot(n4, a.b * n4)), vec3(0.0f));
+}
+
 vec3 sanitize(vec3 c) {
   return vec3(isnan(c.x) ? 0.0f : c.x, isnan(c.y) ? 0.0f : c.y, isnan(c.z) ? 0.0f : c.z);
 }
 
 void main() {
   frame = frame_ubo; level = level_block;  // MRGI_UNIFORM_COPIES
+  ambient_rv = light_set.ambient_rv;
+  ambient_r = light_set.ambient_r;
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
   if (any(greaterThanEqual(pixel, frame.internal_output_size.xy))) return;
   vec4 vpos = texelFetch(virtual_position, pixel, 0);
@@ -123,9 +135,9 @@ void main() {
 
   // A virtual surface's own emission (glTF emissive) is seen directly; it lights nothing else
   // here (this technique has no indirect light).
-  vec3 l_rv = alb.rgb * (frame.ambient_both.rgb + frame.ambient_virtual.rgb) +
+  vec3 l_rv = alb.rgb * ambient_irradiance(ambient_rv, n) * (1.0f / MRGI_PI) +
               (is_virtual && frame.flags.y != 0 ? texelFetch(virtual_emission, pixel, 0).rgb : vec3(0.0f));
-  vec3 l_r = r_p * alb.rgb * frame.ambient_both.rgb;
+  vec3 l_r = r_p * alb.rgb * ambient_irradiance(ambient_r, n) * (1.0f / MRGI_PI);
   int count = min(light_set.count.x, MRGI_MAX_LIGHTS);
   for (int i = 0; i < count; ++i) {
     ShadowLight L = light_set.lights[i];

@@ -45,14 +45,12 @@ struct FrameConstants {
   ivec4 color_depth_size;      // colour w, h; depth w, h
   vec4 camera;            // x depth units per metre, y exposure (radiance -> linear camera value),
                           // z virtual-behind-real tolerance (fraction of the real depth), w unused
-  vec4 ambient_both;      // rgb radiance of a real environment's mean: added to L_r and L_rv
-  vec4 ambient_virtual;   // rgb radiance of a virtual environment's mean: added to L_rv only
   ivec4 flags;            // x: 1 depth registered to colour (same intrinsics), 0 resampled;
                           // y: 1 the virtual G-buffer holds emission (virtual_emission), 0 none
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(FrameConstants) == 3 * 64 + 11 * 16, "std140 mirror");
+static_assert(sizeof(FrameConstants) == 3 * 64 + 9 * 16, "std140 mirror");
 }  // namespace mrgi::shader
 #endif
 

@@ -1,6 +1,6 @@
-// Scene lamps with their shadow-map layers, as the shading passes see them (one uniform buffer
-// written at start-up: lamps are static in scene.json v1). Shared by C++ and GLSL like
-// frame_constants.glsl.
+// The light stage's lights with their shadow-map layers and its ambient, as the shading passes
+// see them (one uniform buffer per frame slot, written each frame: environment regions and the
+// probeless dominant light move). Shared by C++ and GLSL like frame_constants.glsl.
 #ifndef MRGI_LIGHT_SET_GLSL
 #define MRGI_LIGHT_SET_GLSL
 #ifdef __cplusplus
@@ -28,12 +28,22 @@ struct ShadowLight {
                         // casters of a real lamp) or -1; z faces (1, or 6 for a point lamp cube)
 };
 
+// Ambient irradiance (the light not in `lights`, bands 0..2 of its SH, light/light_stage.h
+// irradiance_matrices): E_c(n) = dot(vec4(n, 1), M_c * vec4(n, 1)) per channel. Three mat4s, not
+// an array of nine SH coefficients, so a pass copies them whole on main's first line
+// (MRGI_UNIFORM_COPIES) and evaluates them with two dot products each.
+struct AmbientIrradiance {
+  mat4 r, g, b;
+};
+
 // Point lamps use a cube of 6 perspective faces: +X, -X, +Y, -Y, +Z, -Z (major axis of the
 // light-to-point vector picks the face), each a 90 degree frustum.
 struct LightSet {
   ivec4 count;                                   // x number of lamps
   ShadowLight lights[MRGI_MAX_LIGHTS];
   mat4 face_view_proj[MRGI_MAX_LIGHTS * 6];      // lamp i face f at i * 6 + f; Vulkan clip
+  AmbientIrradiance ambient_rv;                  // real + virtual ambient: lights L_rv
+  AmbientIrradiance ambient_r;                   // real ambient: lights L_r (real surfaces)
 };
 
 #ifdef __cplusplus

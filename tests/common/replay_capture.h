@@ -22,23 +22,31 @@ struct ReplayResult {
   std::vector<double> light_error_deg;  // per frame with an estimate and an environment image
 };
 
-inline ReplayResult replay_capture(const std::string& path, const std::string& technique, int level) {
+// `undeclared_light`: scene.json's lamps and environment are dropped, so the runtime lights the
+// scene from what it estimates (the light stage's probeless source), as an app that declares
+// nothing; the environment frames still serve as the truth for the direction error.
+inline ReplayResult replay_capture(const std::string& path, const std::string& technique, int level,
+                                   bool undeclared_light = false) {
   ReplayResult g;
   auto capture = CaptureReader::open(path);
   EXPECT_TRUE(capture.ok()) << (capture.ok() ? "" : capture.error().message);
   if (!capture.ok()) return g;
   const CaptureInfo& info = capture->info();
-  const SceneDesc& scene = *capture->scene();
+  SceneDesc scene = *capture->scene();
+  const double env_intensity = scene.environment.present ? scene.environment.intensity : 1.0;
+  if (undeclared_light) {
+    scene.lights.clear();
+    scene.environment = EnvironmentDesc{};
+  }
   RuntimeSettings s;
   s.device.validate = true;
   s.technique = technique;
   s.level = level;
   s.exposure = info.exposure;
-  auto rt = create_runtime(s, CameraSetup{info.color, info.depth, info.depth_scale, info.exposure},
+  auto rt = create_runtime(s, CameraSetup{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera},
                            scene);
   EXPECT_TRUE(rt.ok()) << (rt.ok() ? "" : rt.error().message);
   if (!rt.ok()) return g;
-  const double env_intensity = scene.environment.present ? scene.environment.intensity : 1.0;
   std::vector<ImageRGB8> cameras(capture->frame_count());
   std::vector<std::optional<LightEstimate>> truth(capture->frame_count());
   auto consume = [&](Expected<std::vector<FrameOutput>>&& outs) {

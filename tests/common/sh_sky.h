@@ -6,19 +6,18 @@
 
 #include <glm/glm.hpp>
 
-#include "technique/ssrt/sample_directions.h"
-#include "technique/ssrt/sh_tools.h"
+#include "light/sh_tools.h"
 
 namespace mrgi::test {
 
-inline void add_sh_sky(ssrt::ShRgb& l, double radiance, const glm::dvec3& up = {0.0, 1.0, 0.0}) {
+inline void add_sh_sky(light::ShRgb& l, double radiance, const glm::dvec3& up = {0.0, 1.0, 0.0}) {
   constexpr int kDirections = 4000;
   constexpr double kPi = 3.14159265358979323846;
   for (int k = 0; k < kDirections; ++k) {
-    const glm::dvec3 w = ssrt::fibonacci_direction(k, kDirections);
+    const glm::dvec3 w = light::fibonacci_direction(k, kDirections);
     if (glm::dot(w, up) <= 0.0) continue;
-    const ssrt::ShVector b = ssrt::sh_basis(glm::vec3(w));
-    for (int i = 0; i < ssrt::kMaxShCoeffs; ++i)
+    const light::ShVector b = light::sh_basis(glm::vec3(w));
+    for (int i = 0; i < light::kMaxShCoeffs; ++i)
       l[i] += glm::dvec3(radiance * b[i] * 4.0 * kPi / kDirections);
   }
 }

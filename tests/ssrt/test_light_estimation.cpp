@@ -9,12 +9,13 @@
 
 #include "../../shaders/ssrt/ssrt_math.h"
 #include "common/sh_sky.h"
-#include "technique/ssrt/light_estimator.h"
+#include "light/sh_estimator.h"
 #include "technique/ssrt/sample_directions.h"
 
 namespace {
 using namespace mrgi;
 using namespace mrgi::ssrt;
+using namespace mrgi::light;
 
 constexpr double kPi = 3.14159265358979323846;
 

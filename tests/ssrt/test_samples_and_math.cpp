@@ -8,7 +8,7 @@
 
 #include "../../shaders/ssrt/ssrt_math.h"
 #include "technique/ssrt/sample_directions.h"
-#include "technique/ssrt/sh_tools.h"
+#include "light/sh_tools.h"
 
 namespace {
 using namespace mrgi;

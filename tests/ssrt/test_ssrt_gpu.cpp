@@ -18,7 +18,8 @@
 #include "gpu/frame_graph.h"
 #include "technique/scene_gpu.h"
 #include "technique/ssrt/ssrt.h"
-#include "technique/ssrt/sh_tools.h"
+#include "light/light_stage.h"
+#include "light/sh_tools.h"
 #include "vulkan/vk_test_util.h"
 #include "common/look_at.h"
 #include "common/frame_constants_for.h"
@@ -86,6 +87,7 @@ struct Driver {
   std::unique_ptr<technique::SceneGpu> scene_gpu;
   SceneDesc scene;
   technique::SharedResources shared;
+  std::unique_ptr<light::LightStage> light_stage;
   std::unique_ptr<technique::Technique> tech;
   BufferHandle readback_r, readback_rv;
   std::vector<std::string> skipped;
@@ -170,6 +172,10 @@ struct Driver {
     s.graph = d.graph.get();
     s.scene = &d.scene;
     s.scene_gpu = d.scene_gpu.get();
+    auto stage = light::LightStage::create({}, d.scene, CameraSetup{k, k, 5000.0, 1.0, std::nullopt});
+    EXPECT_TRUE(stage.ok()) << stage.error().message;
+    d.light_stage = std::move(*stage);
+    s.light_stage = d.light_stage.get();
     auto t = technique::create_ssrt(s);
     EXPECT_TRUE(t.ok()) << t.error().message;
     d.tech = std::move(*t);
@@ -470,10 +476,10 @@ TEST_F(VulkanTest, SsrtEstimatedDominantDirectionOfARealSphereScene) {
                                    glm::dvec3(0.2, 0.7, -0.7)}) {
     g_camera_to_world = camera;
     const glm::dvec3 sun_dir = glm::normalize(sun_raw);
-    ssrt::ShRgb light = ssrt::sh_directional_light(sun_dir, glm::dvec3(2.0));
+    light::ShRgb light = light::sh_directional_light(sun_dir, glm::dvec3(2.0));
     test::add_sh_sky(light, 0.2);
     glm::dvec3 sun(0.0);  // the truth: band 1 of sun and sky together
-    ASSERT_TRUE(ssrt::sh_dominant_direction(light, sun));
+    ASSERT_TRUE(light::sh_dominant_direction(light, sun));
     const Driver::Tweak real_sphere = [&](auto& pos, auto& nrm, auto& alb) {
       const glm::mat4 c2w = camera_to_world();
       const glm::vec3 o(c2w[3]);
@@ -491,7 +497,7 @@ TEST_F(VulkanTest, SsrtEstimatedDominantDirectionOfARealSphereScene) {
             const glm::vec3 cam = glm::vec3(glm::inverse(c2w) * glm::vec4(p, 1.0f));
             pos[i] = glm::vec4(p, cam.z);
           }
-          const double e = ssrt::sh_irradiance(light, n).y;
+          const double e = light::sh_irradiance(light, n).y;
           const float value = float(0.5 * e / 3.14159265358979);
           for (int c = 0; c < 3; ++c) {
             nrm[i * 4 + c] = uint16_t(glm::packHalf1x16(n[c]));

@@ -141,6 +141,9 @@ struct CameraSetup {
   Intrinsics depth;
   double depth_scale = 5000.0;
   double exposure = 1.0;
+  // The environment camera's model (capture.json `env_camera`), for frames that carry env
+  // images (InputFrame::env); without it those images cannot be mapped to directions.
+  std::optional<EnvCamera> env_camera;
 };
 
 Expected<std::unique_ptr<Runtime>> create_runtime(const RuntimeSettings& settings,

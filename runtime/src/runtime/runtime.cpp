@@ -14,6 +14,7 @@
 #include "compose/compose.h"
 #include "gpu/context.h"
 #include "gpu/frame_graph.h"
+#include "light/light_stage.h"
 #include "mrgi/runtime.h"
 #include "recon/reconstruction.h"
 #include "recon/virtual_gbuffer.h"
@@ -25,7 +26,6 @@
 namespace mrgi {
 namespace {
 
-using runtime_detail::environment_mean;
 using runtime_detail::opencv_projection;
 
 // A virtual surface is hidden behind a real one closer by more than this fraction of its depth.
@@ -71,8 +71,7 @@ class RuntimeImpl final : public Runtime {
  private:
   Status check_validation() const;
   Status check_frame(const InputFrame& frame) const;
-  void write_constants(const InputFrame& frame, const glm::dmat4& camera_to_world,
-                       const glm::vec3& ambient_both, const glm::vec3& ambient_virtual);
+  void write_constants(const glm::dmat4& camera_to_world);
   Expected<FrameOutput> collect(const gpu::FrameTimings& timings);
   // Waits for the frame that last used the next slot (its output joins `outputs`) and starts
   // that slot's record for `frame`.
@@ -93,6 +92,7 @@ class RuntimeImpl final : public Runtime {
   std::unique_ptr<gpu::Context> context_;
   std::unique_ptr<gpu::FrameGraph> graph_;
   std::unique_ptr<technique::SceneGpu> scene_gpu_;
+  std::unique_ptr<light::LightStage> light_stage_;
   std::optional<recon::Reconstruction> recon_;
   std::optional<recon::VirtualGBuffer> virtual_gbuffer_;
   gpu::BufferHandle frame_constants_;
@@ -103,13 +103,13 @@ class RuntimeImpl final : public Runtime {
   std::vector<FrameOutput> spare_outputs_;  // recycle(): images and masks to fill again
   glm::dmat4 last_pose_{1.0};
   bool have_pose_ = false;
-  glm::vec3 env_mean_{0.0f};  // environment from a file: mean radiance x intensity
 };
 
 RuntimeImpl::~RuntimeImpl() {
   if (context_ && context_->device() != VK_NULL_HANDLE) vkDeviceWaitIdle(context_->device());
   compose_.reset();
   technique_.reset();
+  light_stage_.reset();
   virtual_gbuffer_.reset();
   recon_.reset();
   scene_gpu_.reset();
@@ -172,6 +172,12 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   auto sg = technique::SceneGpu::create(*context_, *graph_, scene_);
   if (!sg) return sg.error();
   scene_gpu_ = std::move(*sg);
+  light::LightStageSettings ls;
+  if (!scene_gpu_->virtual_objects.empty())
+    ls.focus = 0.5f * (scene_gpu_->virtual_objects.bounds_min + scene_gpu_->virtual_objects.bounds_max);
+  auto stage = light::LightStage::create(ls, scene_, cameras_);
+  if (!stage) return stage.error();
+  light_stage_ = std::move(*stage);
   auto rc = recon::Reconstruction::create(*context_, *graph_, c, d);
   if (!rc) return rc.error();
   recon_.emplace(std::move(*rc));
@@ -203,6 +209,7 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   shared.graph = graph_.get();
   shared.scene = &scene_;
   shared.scene_gpu = scene_gpu_.get();
+  shared.light_stage = light_stage_.get();
   shared.frame_constants = frame_constants_;
   shared.real_position = recon_->position();
   shared.real_normal = recon_->normal();
@@ -230,14 +237,6 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   if (!tech) return tech.error();
   technique_ = std::move(*tech);
 
-  // Baseline's environment: a constant ambient from the mean radiance (no occlusion). An image
-  // file is averaged once here; the env camera's frames are averaged per frame in process().
-  const EnvironmentDesc& env = scene_.environment;
-  if (env.present && !env.from_env_camera) {
-    auto img = load_hdr_image(env.image);
-    if (!img) return img.error();
-    env_mean_ = environment_mean(*img, true) * env.intensity;
-  }
   slots_.resize(size_t(settings.frames_in_flight));
   for (SlotRecord& s : slots_) {
     s.skipped.reserve(16);
@@ -275,9 +274,7 @@ Status RuntimeImpl::check_frame(const InputFrame& frame) const {
   return ok_status();
 }
 
-void RuntimeImpl::write_constants(const InputFrame& frame, const glm::dmat4& camera_to_world,
-                                  const glm::vec3& ambient_both, const glm::vec3& ambient_virtual) {
-  (void)frame;
+void RuntimeImpl::write_constants(const glm::dmat4& camera_to_world) {
   auto* fc = static_cast<shader::FrameConstants*>(graph_->mapped(frame_constants_, graph_->slot()));
   const VkExtent2D internal = graph_->extent(lit_rv_);
   const Intrinsics ik = cameras_.color.scaled_to(int(internal.width), int(internal.height));
@@ -299,8 +296,6 @@ void RuntimeImpl::write_constants(const InputFrame& frame, const glm::dmat4& cam
                                   cameras_.depth.width, cameras_.depth.height);
   f.camera = glm::vec4(float(cameras_.depth_scale), float(cameras_.exposure),
                        kVirtualDepthTolerance, 0.0f);
-  f.ambient_both = glm::vec4(ambient_both, 0.0f);
-  f.ambient_virtual = glm::vec4(ambient_virtual, 0.0f);
   f.flags = glm::ivec4(same_intrinsics(cameras_.color, cameras_.depth) ? 1 : 0,
                        virtual_gbuffer_->emission().valid() ? 1 : 0, 0, 0);
   *fc = f;
@@ -412,22 +407,9 @@ Status RuntimeImpl::prime(const InputFrame& frame, SlotRecord& rec,
 // upload and a host conversion of the camera frame (below 1 floor pass); at another size
 // compose's camera-copy pipeline resamples it (2-3 ms). Recon and the technique are not added.
 Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, bool affected) {
-  glm::vec3 env = env_mean_;
-  const EnvironmentDesc& e = scene_.environment;
-  if (e.present && e.from_env_camera) {
-    if (frame.env) {
-      env = environment_mean(*frame.env, false) * e.intensity;
-      env_mean_ = env;  // kept for frames without an env image
-    } else {
-      rec.notes.push_back("environment: no env image in this frame, the last mean used");
-    }
-  }
-  const glm::vec3 ambient_both = e.present && e.real ? env : glm::vec3(0.0f);
-  const glm::vec3 ambient_virtual = e.present && !e.real ? env : glm::vec3(0.0f);
-
   const technique::QualityLevel& level = technique_->levels()[size_t(level_)];
   MRGI_TRY(graph_->set_render_scale(level.internal_scale));
-  write_constants(frame, last_pose_, ambient_both, ambient_virtual);
+  write_constants(last_pose_);
   recon_->upload(*graph_, frame);
 
   const bool has_objects = !scene_gpu_->virtual_objects.empty();
@@ -444,6 +426,8 @@ Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, 
                                    : "recon: nothing virtual in view (its temporal history restarts when there is)");
   }
   if (affected) {
+    // The light stage runs only where something is lit with its answer.
+    MRGI_TRY(light_stage_->update(frame, last_pose_, rec.notes));
     technique::FrameInfo info;
     info.frame_index = frame.index;
     info.level = level_;
@@ -530,7 +514,7 @@ Expected<FrameOutput> RuntimeImpl::collect(const gpu::FrameTimings& timings) {
   out.stats.skipped = rec.skipped;
   for (const std::string& c : timings.culled) out.stats.skipped.push_back(c + ": culled (nothing reads it)");
   out.stats.notes = rec.notes;
-  if (const LightEstimate* e = technique_->light_estimate()) out.light = *e;
+  if (light_stage_->lighting().estimate.valid) out.light = light_stage_->lighting().estimate;
   rec.used = false;
   return out;
 }

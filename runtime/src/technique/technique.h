@@ -26,6 +26,9 @@
 namespace mrgi::gpu {
 class Context;
 }
+namespace mrgi::light {
+class LightStage;
+}
 
 namespace mrgi::technique {
 
@@ -64,6 +67,9 @@ struct SharedResources {
   gpu::FrameGraph* graph = nullptr;
   const SceneDesc* scene = nullptr;
   const SceneGpu* scene_gpu = nullptr;     // uploaded virtual meshes and real proxies
+  // The light stage (light/light_stage.h): its lighting() is this frame's light when record()
+  // runs. A technique that sums its own probeless system hands it in (submit_system).
+  light::LightStage* light_stage = nullptr;
   // Per frame, written by the runtime: FrameConstants (shaders/common/frame_constants.glsl).
   gpu::BufferHandle frame_constants;
   // Real G-buffer (recon/): positions (xyz world, w depth; 0 invalid), normals, albedo.

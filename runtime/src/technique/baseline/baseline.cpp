@@ -7,6 +7,7 @@
 #include "gpu/pipelines.h"
 #include "gpu/shaders.h"
 #include "gpu/vk_check.h"
+#include "light/light_stage.h"
 #include "technique/baseline/shadow_plan.h"
 #include "technique/image_views.h"
 #include "technique/scene_gpu.h"
@@ -64,8 +65,13 @@ class Baseline final : public Technique {
   std::string name_ = "baseline";
   SharedResources shared_;
   std::vector<QualityLevel> ladder_;
+  // Re-plans the shadow maps when the light stage's lights changed; writes this slot's lights.
+  Status update_lights();
+
   ShadowPlan plan_;
-  gpu::BufferHandle lights_;
+  Bounds bounds_;
+  uint64_t planned_revision_ = ~uint64_t(0);
+  gpu::BufferHandle lights_;  // shader::LightSet, one per frame slot
   gpu::ImageHandle shadow_primary_, shadow_virtual_;
   ImageViews views_;
   std::vector<VkImageView> primary_layer_views_, virtual_layer_views_;
@@ -85,24 +91,29 @@ Status Baseline::init() {
   gpu::FrameGraph& graph = *shared_.graph;
   const SceneGpu& sg = *shared_.scene_gpu;
 
-  Bounds bounds;
-  if (!sg.virtual_objects.empty()) bounds.add(sg.virtual_objects.bounds_min, sg.virtual_objects.bounds_max);
-  if (!sg.real_proxies.empty()) bounds.add(sg.real_proxies.bounds_min, sg.real_proxies.bounds_max);
-  auto plan = plan_shadow_maps(*shared_.scene, bounds);
-  if (!plan) return plan.error();
-  plan_ = std::move(*plan);
-  if (sg.virtual_objects.empty()) {
-    // Nothing virtual casts: the virtual-caster maps would stay empty (all lit), so none is
-    // made and the shader treats st_v as 1.
-    plan_.virtual_only.clear();
-    for (int i = 0; i < plan_.light_set.count.x; ++i) plan_.light_set.lights[i].layers.y = -1;
+  if (!shared_.light_stage) return fail(ErrorKind::Internal, "baseline: no light stage");
+  if (!sg.virtual_objects.empty()) bounds_.add(sg.virtual_objects.bounds_min, sg.virtual_objects.bounds_max);
+  if (!sg.real_proxies.empty()) bounds_.add(sg.real_proxies.bounds_min, sg.real_proxies.bounds_max);
+  // Shadow map layers for the most lights the stage can give: its declared lamps as they are,
+  // the rest as real directional lights (one layer in each map).
+  const light::LightStage& stage = *shared_.light_stage;
+  std::vector<LightDesc> largest = shared_.scene->lights;
+  while (int(largest.size()) < stage.max_lights()) {
+    LightDesc d;
+    d.type = LightType::Directional;
+    largest.push_back(d);
   }
+  MRGI_TRY(plan_shadow_maps(largest, bounds_, shared_.scene->path + ": lights", plan_));
+  const size_t primary_layers = plan_.primary.size();
+  // Nothing virtual: no virtual-caster map is ever drawn (update_lights).
+  const size_t virtual_layers = sg.virtual_objects.empty() ? 0 : plan_.virtual_only.size();
+  plan_.primary.reserve(primary_layers);
+  plan_.virtual_only.reserve(virtual_layers);
 
-  auto lights = graph.create_buffer({"baseline_lights", sizeof(shader::LightSet)},
-                                    VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  auto lights = graph.create_buffer({"baseline_lights", sizeof(shader::LightSet), gpu::MemoryUsage::Upload, true},
+                                    VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   if (!lights) return lights.error();
   lights_ = *lights;
-  MRGI_TRY(ctx.upload_buffer(graph.gpu_buffer(lights_, 0), &plan_.light_set, sizeof(shader::LightSet)));
 
   auto make_map = [&](const char* name, size_t layers) -> Expected<gpu::ImageHandle> {
     gpu::ImageDesc d;
@@ -113,10 +124,10 @@ Status Baseline::init() {
     d.layers = uint32_t(std::max<size_t>(1, layers));
     return graph.create_image(d, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT);
   };
-  auto primary = make_map("shadow_primary", plan_.primary.size());
+  auto primary = make_map("shadow_primary", primary_layers);
   if (!primary) return primary.error();
   shadow_primary_ = *primary;
-  auto virt = make_map("shadow_virtual", plan_.virtual_only.size());
+  auto virt = make_map("shadow_virtual", virtual_layers);
   if (!virt) return virt.error();
   shadow_virtual_ = *virt;
 
@@ -134,8 +145,8 @@ Status Baseline::init() {
     array = *a;
     return ok_status();
   };
-  MRGI_TRY(make_views(shadow_primary_, plan_.primary.size(), primary_layer_views_, primary_array_view_));
-  MRGI_TRY(make_views(shadow_virtual_, plan_.virtual_only.size(), virtual_layer_views_, virtual_array_view_));
+  MRGI_TRY(make_views(shadow_primary_, primary_layers, primary_layer_views_, primary_array_view_));
+  MRGI_TRY(make_views(shadow_virtual_, virtual_layers, virtual_layer_views_, virtual_array_view_));
   depth_write_layout_ =
       gpu::access_info(gpu::PassKind::Graphics, gpu::Access::DepthAttachmentWrite, true, true).layout;
 
@@ -166,7 +177,6 @@ Status Baseline::init() {
                                         sizeof(glm::ivec4));
   if (!cip) return cip.error();
   caster_indices_pipeline_ = std::move(*cip);
-  for (const ShadowFace& f : plan_.primary) real_caster_faces_ = real_caster_faces_ || f.real_casters;
 
   auto mesh_vs = gpu::shader_spirv("baseline/shadow_mesh.vert");
   if (!mesh_vs) return mesh_vs.error();
@@ -212,6 +222,7 @@ Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped
   grid_ = caster_grid(graph.extent(shared_.real_position), shadow_size_, knob(level, "caster_cell_shadow_texels"));
   const SceneGpu& sg = *shared_.scene_gpu;
   const SharedResources& s = shared_;
+  MRGI_TRY(update_lights());
 
   if (plan_.primary.empty()) {
     skipped.push_back("shadow_primary: no lamp in the scene");
@@ -286,6 +297,31 @@ Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped
         b.write(r.lit_r, gpu::Access::StorageWrite);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) { shade(cmd, pass); });
+  return ok_status();
+}
+
+Status Baseline::update_lights() {
+  const light::Lighting& lighting = shared_.light_stage->lighting();
+  if (lighting.revision != planned_revision_) {
+    MRGI_TRY(plan_shadow_maps(lighting.lights, bounds_, "light stage lights", plan_));
+    if (shared_.scene_gpu->virtual_objects.empty()) {
+      // Nothing virtual casts: the virtual-caster maps would stay empty (all lit), so none is
+      // made and the shader treats st_v as 1.
+      plan_.virtual_only.clear();
+      for (int i = 0; i < plan_.light_set.count.x; ++i) plan_.light_set.lights[i].layers.y = -1;
+    }
+    real_caster_faces_ = false;
+    for (const ShadowFace& f : plan_.primary) real_caster_faces_ = real_caster_faces_ || f.real_casters;
+    planned_revision_ = lighting.revision;
+  }
+  auto* set = static_cast<shader::LightSet*>(shared_.graph->mapped(lights_, shared_.graph->slot()));
+  *set = plan_.light_set;
+  light::ShRgb both = lighting.ambient_real;
+  for (int i = 0; i < light::kMaxShCoeffs; ++i) both[size_t(i)] += lighting.ambient_virtual[size_t(i)];
+  const auto rv = light::irradiance_matrices(both);
+  const auto r = light::irradiance_matrices(lighting.ambient_real);
+  set->ambient_rv = {rv[0], rv[1], rv[2]};
+  set->ambient_r = {r[0], r[1], r[2]};
   return ok_status();
 }
 

@@ -44,20 +44,30 @@ int cube_face_of(const glm::vec3& d) {
 
 Expected<ShadowPlan> plan_shadow_maps(const SceneDesc& scene, const Bounds& bounds) {
   ShadowPlan plan;
-  if (scene.lights.size() > MRGI_MAX_LIGHTS)
+  MRGI_TRY(plan_shadow_maps(scene.lights, bounds, scene.path + ": lights", plan));
+  return plan;
+}
+
+Status plan_shadow_maps(const std::vector<LightDesc>& lights, const Bounds& bounds,
+                        const std::string& where, ShadowPlan& plan) {
+  plan.primary.clear();
+  plan.virtual_only.clear();
+  plan.real_lamps = plan.virtual_lamps = 0;
+  plan.light_set = shader::LightSet{};
+  if (lights.size() > MRGI_MAX_LIGHTS)
     return fail(ErrorKind::BadInput,
-                scene.path + ": lights: " + std::to_string(scene.lights.size()) +
+                where + ": " + std::to_string(lights.size()) +
                     " lamps, the baseline technique supports at most " +
                     std::to_string(MRGI_MAX_LIGHTS));
-  plan.light_set.count = glm::ivec4(int(scene.lights.size()), 0, 0, 0);
-  for (size_t i = 0; i < scene.lights.size(); ++i) {
-    const LightDesc& l = scene.lights[i];
+  plan.light_set.count = glm::ivec4(int(lights.size()), 0, 0, 0);
+  for (size_t i = 0; i < lights.size(); ++i) {
+    const LightDesc& l = lights[i];
     const int li = int(i);
     shader::ShadowLight& g = plan.light_set.lights[i];
     glm::vec3 dir = l.direction;
     const float len = glm::length(dir);
     if (l.type != LightType::Point && !(len > 1e-6f))
-      return fail(ErrorKind::BadInput, scene.path + ": lights[" + std::to_string(i) +
+      return fail(ErrorKind::BadInput, where + "[" + std::to_string(i) +
                                            "].direction: must not be zero for a spot or "
                                            "directional lamp");
     dir = l.type == LightType::Point ? glm::vec3(0.0f, -1.0f, 0.0f) : dir / len;
@@ -125,7 +135,7 @@ Expected<ShadowPlan> plan_shadow_maps(const SceneDesc& scene, const Bounds& boun
       ++plan.virtual_lamps;
     }
   }
-  return plan;
+  return ok_status();
 }
 
 }  // namespace mrgi::technique

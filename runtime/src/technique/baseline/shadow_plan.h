@@ -1,6 +1,7 @@
 // Which shadow maps the scene's lamps need and the light-space matrices that render and read
 // them (DIR section 3.3: a real lamp gets two maps, one with real and one with virtual casters;
-// a virtual lamp one map with every caster). Pure CPU, computed once at start-up.
+// a virtual lamp one map with every caster). Pure CPU: at start-up for declared lamps, again
+// whenever the light stage's lights move (environment regions, the probeless dominant light).
 //
 // Map shapes: spot lamp -> one perspective map (field of view = twice the outer cone angle,
 // at most kMaxSpotFovDeg); point lamp -> a cube of 6 perspective 90-degree faces (not
@@ -9,6 +10,7 @@
 // kMinOrthoHalfWidth), since the shadows that change the output are near the virtual objects;
 // outside that box the lamp is unshadowed in both solutions, so the differential is unaffected.
 #pragma once
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -56,6 +58,10 @@ struct Bounds {
 // BadInput (naming scene.json and the lamp index) for more than MRGI_MAX_LIGHTS lamps or a
 // zero-length direction.
 Expected<ShadowPlan> plan_shadow_maps(const SceneDesc& scene, const Bounds& bounds);
+// The same for any list of lights (the light stage's, per frame), into `plan`, whose vectors
+// keep their capacity (reserve once, re-plan without allocating). `where` prefixes messages.
+Status plan_shadow_maps(const std::vector<LightDesc>& lights, const Bounds& bounds,
+                        const std::string& where, ShadowPlan& plan);
 
 // Cube face f (0..5 = +X, -X, +Y, -Y, +Z, -Z) as the shaders pick it from a light-to-point vector.
 int cube_face_of(const glm::vec3& d);

@@ -8,21 +8,17 @@
 #include <unordered_set>
 
 #include "ssrt/ssrt_math.h"
-#include "technique/ssrt/sh_tools.h"
+#include "light/sh_tools.h"
 
 namespace mrgi::ssrt {
+using light::kPi;
+using light::ShVector;
+using light::sh_basis;
 namespace {
 
 uint64_t edge_key(uint32_t a, uint32_t b) { return (uint64_t(a) << 32) | b; }
 
 }  // namespace
-
-glm::dvec3 fibonacci_direction(int k, int count) {
-  const double y = 1.0 - 2.0 * (k + 0.5) / count;
-  const double r = std::sqrt(std::max(0.0, 1.0 - y * y));
-  const double phi = kPi * (3.0 - std::sqrt(5.0)) * k;
-  return glm::dvec3(r * std::cos(phi), y, r * std::sin(phi));
-}
 
 Expected<std::vector<std::array<uint32_t, 3>>> spherical_delaunay(
     const std::vector<glm::dvec3>& points) {

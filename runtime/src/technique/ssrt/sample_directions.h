@@ -43,10 +43,6 @@ struct SampleSets {
 // sphere evenly and the four sets of a 2x2 block interleave. BadUsage when `directions` is out of range.
 Expected<SampleSets> make_sample_sets(const SampleSetsDesc& desc);
 
-// The k-th of `count` directions spread evenly over the unit sphere (a spherical Fibonacci
-// spiral, y from +1 to -1, no jitter): quadrature over the sphere with weight 4 pi / count each.
-glm::dvec3 fibonacci_direction(int k, int count);
-
 // Spherical Delaunay triangulation of unit vectors = their convex hull (every point lies on the
 // sphere). Returns the triangles (indices, outward counter-clockwise). BadInput when fewer than
 // 4 points or all points coplanar.

@@ -44,7 +44,7 @@ Status Ssrt::record_real_geometry(const FrameInfo& info, const QualityLevel& lev
   vf.center = *volume_center_;
   vf.camera_to_world = info.camera_to_world;
   vf.depth = info.input ? &info.input->depth : nullptr;
-  const LightEstimate& e = estimator_->estimate();
+  const LightEstimate& e = estimator().estimate();
   vf.direction_to_light = glm::vec3(e.direction_to_light[0], e.direction_to_light[1], e.direction_to_light[2]);
   MRGI_TRY(volume_->record(vf, skipped));
   return filter_->record(volume_->depth_volume(), knob(level, "final_filter") > 0.5, skipped,
@@ -76,27 +76,27 @@ void Ssrt::consume_readback(uint32_t slot, std::vector<std::string>& notes) {
     return;
   }
   const float* sums = static_cast<const float*>(graph.mapped(result_, slot));
-  ssrt::LightSystem sys;
+  light::LightSystem sys;
   int k = 0;
-  for (int i = 0; i < ssrt::kMaxShCoeffs; ++i) {
-    for (int j = i; j < ssrt::kMaxShCoeffs; ++j, ++k) {
-      sys.ata[i * ssrt::kMaxShCoeffs + j] = sums[k];
-      sys.ata[j * ssrt::kMaxShCoeffs + i] = sums[k];
+  for (int i = 0; i < light::kMaxShCoeffs; ++i) {
+    for (int j = i; j < light::kMaxShCoeffs; ++j, ++k) {
+      sys.ata[i * light::kMaxShCoeffs + j] = sums[k];
+      sys.ata[j * light::kMaxShCoeffs + i] = sums[k];
     }
   }
-  for (int e = 0; e < ssrt::kMaxShCoeffs * 3; ++e) sys.atb[e] = sums[136 + e];
+  for (int e = 0; e < light::kMaxShCoeffs * 3; ++e) sys.atb[e] = sums[136 + e];
   sys.samples = sums[184];
   // The frame clock is not in FrameInfo: frames are spaced by the estimator's nominal step.
-  auto r = estimator_->update(sys, frame, double(frame) * estimator_->settings().nominal_frame_s,
-                              pending_bands_[slot]);
+  const Status r = shared_.light_stage->submit_system(
+      sys, frame, double(frame) * estimator().settings().nominal_frame_s, pending_bands_[slot], notes);
   if (!r) notes.push_back("ssrt_light_estimation: " + r.error().message);
 }
 
 void Ssrt::write_light() {
   gpu::FrameGraph& graph = *shared_.graph;
   shader::SsrtLight l{};
-  const LightEstimate& e = estimator_->estimate();
-  const ssrt::ShRgb& f = estimator_->filtered();
+  const LightEstimate& e = estimator().estimate();
+  const light::ShRgb& f = estimator().filtered();
   for (int i = 0; i < 16; ++i) {
     const glm::dvec3 c = i < int(bands_ * bands_) ? f[i] : glm::dvec3(0.0);
     const double y = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;

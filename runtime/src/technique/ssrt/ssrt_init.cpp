@@ -6,9 +6,8 @@ namespace mrgi::technique::ssrt_detail {
 Status Ssrt::init() {
   gpu::Context& ctx = *shared_.context;
   gpu::FrameGraph& graph = *shared_.graph;
-  auto est = ssrt::LightEstimator::create({});
-  if (!est) return est.error();
-  estimator_.emplace(std::move(*est));
+  if (!shared_.light_stage) return fail(ErrorKind::Internal, "ssrt: no light stage");
+  shared_.light_stage->use_external_system();  // its transfer pass sums the system (Sec. 5.2)
   ssrt::VolumeSettings vs;
   vs.max_resolution = 1;
   vs.max_aux_resolution = 1;

@@ -16,7 +16,8 @@
 #include "ssrt/ssrt_math.h"
 #include "technique/scene_gpu.h"
 #include "technique/ssrt/depth_filter_gpu.h"
-#include "technique/ssrt/light_estimator.h"
+#include "light/light_stage.h"
+#include "light/sh_estimator.h"
 #include "technique/ssrt/sample_directions.h"
 #include "technique/ssrt/volume.h"
 
@@ -99,11 +100,11 @@ class Ssrt final : public Technique {
   std::optional<RealGeometry> occlusion_geometry() const override {
     return RealGeometry{geo_position_, geo_normal_, geometry_step_};
   }
-  const LightEstimate& estimate() const { return estimator_->estimate(); }
-  const LightEstimate* light_estimate() const override { return &estimator_->estimate(); }
+  const LightEstimate& estimate() const { return estimator().estimate(); }
+  const LightEstimate* light_estimate() const override { return &estimator().estimate(); }
   // Once, before the first estimate: the first frame is lit by its own estimate instead of the
   // prior (a uniform grey guess that made the first frames_in_flight frames' RDE about 1).
-  bool wants_priming_run() const override { return !primed_ && !estimator_->estimate().valid; }
+  bool wants_priming_run() const override { return !primed_ && !estimator().estimate().valid; }
   void frames_completed() override;
   ComposeTiles compose_tiles() const override { return compose_tiles_; }
 
@@ -135,7 +136,8 @@ class Ssrt final : public Technique {
   std::string name_ = "ssrt";
   SharedResources shared_;
   std::vector<QualityLevel> ladder_;
-  std::optional<ssrt::LightEstimator> estimator_;
+  // The light stage's estimator, which this technique's sums feed.
+  const light::LightEstimator& estimator() const { return shared_.light_stage->estimator(); }
   std::optional<ssrt::Volume> volume_;
   std::optional<ssrt::DepthFilterGpu> filter_;
   // Writes this frame's geometry constants: the frame constants with the internal intrinsics

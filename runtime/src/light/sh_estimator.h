@@ -20,9 +20,9 @@
 
 #include "mrgi/expected.h"
 #include "mrgi/light_estimate.h"
-#include "technique/ssrt/sh_tools.h"
+#include "light/sh_tools.h"
 
-namespace mrgi::ssrt {
+namespace mrgi::light {
 
 // The frame's normal equations. `ata` is the full symmetric 16x16 matrix (row-major), `atb` is
 // 16 x 3 (row-major: coefficient, then R G B). `samples` counts the rows (pixels) summed.
@@ -122,4 +122,4 @@ class LightEstimator {
   double last_timestamp_ = 0.0;
 };
 
-}  // namespace mrgi::ssrt
+}  // namespace mrgi::light

@@ -1,4 +1,5 @@
-// Spherical-harmonics helpers of the ssrt technique on the CPU side, on the basis of
+// Spherical-harmonics helpers of the light stage (and of every technique that projects or reads
+// SH light) on the CPU side, on the basis of
 // shaders/shared/mrgi_shared.h (sh_basis16: real, orthonormal, Sloan order) so that what the
 // shaders project and what the CPU solves and exports agree coefficient for coefficient.
 #pragma once
@@ -9,7 +10,7 @@
 
 #include "mrgi/light_estimate.h"
 
-namespace mrgi::ssrt {
+namespace mrgi::light {
 
 constexpr double kPi = 3.14159265358979323846;
 // Rec. 709 luminance of linear RGB, in double for the host-side solves (the shaders' float one is
@@ -55,4 +56,8 @@ void fill_light_estimate(const ShRgb& l, int bands, LightEstimate& out);
 
 bool is_finite(const ShRgb& l);
 
-}  // namespace mrgi::ssrt
+// The k-th of `count` directions spread evenly over the unit sphere (a spherical Fibonacci
+// spiral, y from +1 to -1, no jitter): quadrature over the sphere with weight 4 pi / count each.
+glm::dvec3 fibonacci_direction(int k, int count);
+
+}  // namespace mrgi::light

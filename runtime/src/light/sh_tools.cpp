@@ -1,4 +1,4 @@
-#include "technique/ssrt/sh_tools.h"
+#include "light/sh_tools.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 
 #include "shared/mrgi_shared.h"
 
-namespace mrgi::ssrt {
+namespace mrgi::light {
 namespace {
 
 // Clamped-cosine zonal factors A_l (Ramamoorthi & Hanrahan 2001) for l = 0..3.
@@ -99,13 +99,20 @@ bool is_finite(const ShRgb& l) {
   return true;
 }
 
-}  // namespace mrgi::ssrt
+glm::dvec3 fibonacci_direction(int k, int count) {
+  const double y = 1.0 - 2.0 * (k + 0.5) / count;
+  const double r = std::sqrt(std::max(0.0, 1.0 - y * y));
+  const double phi = kPi * (3.0 - std::sqrt(5.0)) * k;
+  return glm::dvec3(r * std::cos(phi), y, r * std::sin(phi));
+}
+
+}  // namespace mrgi::light
 
 namespace mrgi {
 
 Rgb irradiance_at(const LightEstimate& estimate, const std::array<float, 3>& normal) {
   const glm::vec3 n(normal[0], normal[1], normal[2]);
-  const ssrt::ShVector y = ssrt::sh_basis(n);
+  const light::ShVector y = light::sh_basis(n);
   Rgb out{0.0f, 0.0f, 0.0f};
   for (int i = 0; i < 9; ++i)
     for (int c = 0; c < 3; ++c) out[c] += estimate.irradiance_sh9[i][c] * y[i];
@@ -114,17 +121,17 @@ Rgb irradiance_at(const LightEstimate& estimate, const std::array<float, 3>& nor
 
 Expected<LightEstimate> light_from_environment(const ImageRGBF& image, const EnvCamera& camera,
                                                double intensity, int bands) {
-  using ssrt::kPi;
+  using light::kPi;
   if (image.empty() || image.width < 1 || image.height < 1)
     return fail(ErrorKind::BadInput, "light_from_environment: empty environment image");
   const bool fisheye = camera.model == EnvModel::FisheyeEquidistant;
   if (fisheye && !(camera.f > 0.0))
     return fail(ErrorKind::BadInput, "light_from_environment: fisheye env camera needs f > 0 (pixels)");
-  if (bands < 1 || bands > ssrt::kMaxShBands)
+  if (bands < 1 || bands > light::kMaxShBands)
     return fail(ErrorKind::BadUsage, "light_from_environment: bands must be 1..4");
   const glm::dmat3 rot = glm::mat3_cast(camera.rotation);
   const double half_fov = 0.5 * camera.fov_deg * kPi / 180.0;
-  ssrt::ShRgb sh{};
+  light::ShRgb sh{};
   for (int v = 0; v < image.height; ++v) {
     for (int u = 0; u < image.width; ++u) {
       glm::dvec3 d;
@@ -147,13 +154,13 @@ Expected<LightEstimate> light_from_environment(const ImageRGBF& image, const Env
       glm::dvec3 c(t[0], t[1], t[2]);
       for (int i = 0; i < 3; ++i)
         if (!(c[i] >= 0.0) || std::isinf(c[i])) c[i] = 0.0;
-      const ssrt::ShVector y = ssrt::sh_basis(glm::vec3(rot * d));
+      const light::ShVector y = light::sh_basis(glm::vec3(rot * d));
       for (int i = 0; i < bands * bands; ++i)
         sh[size_t(i)] += c * (intensity * solid_angle * double(y[size_t(i)]));
     }
   }
   LightEstimate out;
-  ssrt::fill_light_estimate(sh, bands, out);
+  light::fill_light_estimate(sh, bands, out);
   out.valid = true;
   out.confidence = 1.0f;
   out.frame_index = -1;

@@ -1,4 +1,4 @@
-#include "technique/ssrt/light_estimator.h"
+#include "light/sh_estimator.h"
 
 #include <Eigen/Dense>
 
@@ -6,9 +6,8 @@
 #include <cmath>
 #include <string>
 
-#include "technique/ssrt/sample_directions.h"
 
-namespace mrgi::ssrt {
+namespace mrgi::light {
 namespace {
 
 using Mat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor, 16, 16>;
@@ -207,4 +206,4 @@ Expected<LightEstimate> LightEstimator::update(const LightSystem& system, int64_
   return estimate_;
 }
 
-}  // namespace mrgi::ssrt
+}  // namespace mrgi::light

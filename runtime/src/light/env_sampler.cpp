@@ -1,0 +1,245 @@
+#include "light/env_sampler.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <glm/gtc/quaternion.hpp>
+
+namespace mrgi::light {
+namespace {
+
+Status check_range(bool ok, const char* field, const std::string& rule) {
+  if (ok) return ok_status();
+  return fail(ErrorKind::BadUsage, std::string("EnvSamplerSettings.") + field + ": " + rule);
+}
+
+bool is_power_of_two(int n) { return n > 0 && (n & (n - 1)) == 0; }
+
+}  // namespace
+
+Expected<EnvSampler> EnvSampler::create(const EnvSamplerSettings& s) {
+  MRGI_TRY(check_range(s.grid_width >= 8 && s.grid_width <= 1024 && s.grid_width % 2 == 0,
+                       "grid_width", "must be even, 8..1024 cells"));
+  MRGI_TRY(check_range(is_power_of_two(s.samples) && s.samples <= 256, "samples",
+                       "must be a power of two, 1..256"));
+  MRGI_TRY(check_range(s.filter_frames >= 0.0 && std::isfinite(s.filter_frames), "filter_frames",
+                       "must be finite and >= 0 frames"));
+  EnvSampler e(s);
+  const int w = s.grid_width, h = w / 2;
+  const size_t cells = size_t(w) * size_t(h);
+  e.cell_solid_angle_.resize(cells);
+  e.cell_sh_.resize(cells);
+  for (int y = 0; y < h; ++y) {
+    // Exact solid angle of a latitude band cell: (cos theta0 - cos theta1) * 2 pi / w.
+    const double t0 = kPi * y / h, t1 = kPi * (y + 1) / h;
+    const double dw = (std::cos(t0) - std::cos(t1)) * 2.0 * kPi / w;
+    for (int x = 0; x < w; ++x) {
+      e.cell_solid_angle_[size_t(y) * w + x] = dw;
+      ShVector b = sh_basis(glm::vec3(e.cell_direction(x + 0.5, y + 0.5)));
+      for (float& v : b) v *= float(dw);
+      e.cell_sh_[size_t(y) * w + x] = b;
+    }
+  }
+  e.cell_sum_.assign(cells, glm::dvec3(0.0));
+  e.cell_seen_.assign(cells, 0.0);
+  e.radiance_.assign(cells, glm::dvec3(0.0));
+  e.moment_.assign(cells, glm::dvec3(0.0));
+  e.frame_moment_.assign(cells, glm::dvec3(0.0));
+  e.energy_sat_.assign(size_t(w + 1) * size_t(h + 1), 0.0);
+  e.lights_.reserve(size_t(s.samples));
+  e.regions_.reserve(size_t(s.samples) * 2);
+  e.next_regions_.reserve(size_t(s.samples) * 2);
+  return e;
+}
+
+glm::dvec3 EnvSampler::cell_direction(double x, double y) const {
+  const double theta = kPi * y / grid_height();
+  const double phi = (x / settings_.grid_width - 0.5) * 2.0 * kPi;
+  return glm::dvec3(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
+}
+
+Status EnvSampler::build_map(const ImageRGBF& image, const EnvCamera& camera,
+                             const glm::dquat& env_to_world) {
+  const glm::dquat rotation = env_to_world * camera.rotation;
+  const bool fisheye = camera.model == EnvModel::FisheyeEquidistant;
+  MapKey key{image.width, image.height, camera.model, fisheye ? camera.f : 0.0,
+             fisheye ? camera.cx : 0.0, fisheye ? camera.cy : 0.0, fisheye ? camera.fov_deg : 0.0,
+             rotation};
+  if (have_map_ && key == map_key_) return ok_status();
+  const glm::dmat3 rot = glm::mat3_cast(rotation);
+  const double half_fov = 0.5 * camera.fov_deg * kPi / 180.0;
+  const int w = settings_.grid_width, h = grid_height();
+  // A pixel wider than a cell is split into s x s sub-pixels (s from the angle a pixel spans
+  // against a cell's), so an image coarser than the grid leaves no cell empty.
+  const double cell_angle = 2.0 * kPi / w;
+  const double pixel_angle = fisheye ? 1.0 / camera.f : 2.0 * kPi / image.width;
+  const int s = std::clamp(int(std::ceil(2.0 * pixel_angle / cell_angle)), 1, 64);
+  entries_.clear();
+  entries_.reserve(image.pixel_count() * size_t(s) * size_t(s));
+  for (int v = 0; v < image.height; ++v) {
+    for (int u = 0; u < image.width; ++u) {
+      for (int j = 0; j < s; ++j) {
+        for (int i = 0; i < s; ++i) {
+          glm::dvec3 d;
+          double solid_angle = 0.0;
+          if (fisheye) {  // the pixel geometry of light_from_environment (sh_tools.cpp)
+            const double dx = u - 0.5 + (i + 0.5) / s - camera.cx, dy = v - 0.5 + (j + 0.5) / s - camera.cy;
+            const double r = std::sqrt(dx * dx + dy * dy), theta = r / camera.f;
+            if (theta > half_fov) continue;
+            const double sn = std::sin(theta);
+            d = r > 0.0 ? glm::dvec3(sn * dx / r, sn * dy / r, std::cos(theta)) : glm::dvec3(0, 0, 1);
+            // Equidistant: r dr dphi = f^2 theta dtheta dphi and dOmega = sin(theta) dtheta dphi.
+            solid_angle = (theta > 1e-9 ? sn / (theta * camera.f * camera.f) : 1.0 / (camera.f * camera.f)) / (s * s);
+          } else {
+            const double pu = (u + (i + 0.5) / s) / image.width, pv = (v + (j + 0.5) / s) / image.height;
+            const double theta = pv * kPi, phi = (pu - 0.5) * 2.0 * kPi;
+            d = glm::dvec3(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
+            solid_angle = std::sin(theta) * (kPi / image.height / s) * (2.0 * kPi / image.width / s);
+          }
+          const glm::dvec3 world = rot * d;
+          const double gu = 0.5 + std::atan2(world.x, -world.z) / (2.0 * kPi);
+          const double gv = std::acos(std::clamp(world.y, -1.0, 1.0)) / kPi;
+          const int cx = std::clamp(int(gu * w), 0, w - 1), cy = std::clamp(int(gv * h), 0, h - 1);
+          entries_.push_back({uint32_t(size_t(v) * size_t(image.width) + size_t(u)), cy * w + cx,
+                              float(solid_angle), glm::vec3(world)});
+        }
+      }
+    }
+  }
+  map_key_ = key;
+  have_map_ = true;
+  have_history_ = false;  // another geometry: the old grid is no history of this one
+  return ok_status();
+}
+
+Status EnvSampler::update(const ImageRGBF& image, const EnvCamera& camera,
+                          const glm::dquat& env_to_world, double intensity) {
+  if (image.empty() || image.data.size() != image.pixel_count() * 3)
+    return fail(ErrorKind::BadInput, "environment sampling: empty or malformed environment image");
+  if (camera.model == EnvModel::FisheyeEquidistant && !(camera.f > 0.0))
+    return fail(ErrorKind::BadInput, "environment sampling: fisheye env camera needs f > 0 (pixels)");
+  if (!(intensity >= 0.0) || !std::isfinite(intensity))
+    return fail(ErrorKind::BadInput, "environment sampling: intensity must be finite and >= 0");
+  MRGI_TRY(build_map(image, camera, env_to_world));
+
+  std::fill(cell_sum_.begin(), cell_sum_.end(), glm::dvec3(0.0));
+  std::fill(cell_seen_.begin(), cell_seen_.end(), 0.0);
+  std::fill(frame_moment_.begin(), frame_moment_.end(), glm::dvec3(0.0));
+  const float* px = image.data.data();
+  for (const MapEntry& e : entries_) {
+    const float* t = px + 3 * size_t(e.pixel);
+    glm::dvec3 l(t[0], t[1], t[2]);
+    for (int i = 0; i < 3; ++i)
+      if (!(l[i] >= 0.0) || std::isinf(l[i])) l[i] = 0.0;
+    const double dw = e.solid_angle;
+    const size_t c = size_t(e.cell);
+    cell_sum_[c] += l * (intensity * dw);
+    cell_seen_[c] += dw;
+    // The energy-weighted direction of what falls into the cell: a light then sits where its
+    // light is, not at its cells' centres.
+    frame_moment_[c] += (luminance(l) * intensity * dw) * glm::dvec3(e.direction);
+  }
+  const int w = settings_.grid_width, h = grid_height();
+  const double alpha = have_history_ && settings_.filter_frames > 0.0
+                           ? 1.0 - std::exp(-1.0 / settings_.filter_frames)
+                           : 1.0;
+  for (size_t c = 0; c < size_t(w) * size_t(h); ++c) {
+    const glm::dvec3 l = cell_seen_[c] > 0.0 ? cell_sum_[c] / cell_seen_[c] : glm::dvec3(0.0);
+    radiance_[c] += alpha * (l - radiance_[c]);
+    // The moment scales with the cell's coverage; normalised to a full cell like the radiance.
+    const glm::dvec3 m = cell_seen_[c] > 0.0 ? frame_moment_[c] * (cell_solid_angle_[c] / cell_seen_[c])
+                                             : glm::dvec3(0.0);
+    moment_[c] += alpha * (m - moment_[c]);
+  }
+  have_history_ = true;
+
+  sh_ = ShRgb{};
+  for (size_t c = 0; c < size_t(w) * size_t(h); ++c) {
+    if (radiance_[c] == glm::dvec3(0.0)) continue;
+    for (int i = 0; i < kMaxShCoeffs; ++i) sh_[size_t(i)] += radiance_[c] * double(cell_sh_[c][size_t(i)]);
+  }
+  cut();
+  return ok_status();
+}
+
+void EnvSampler::cut() {
+  const int w = settings_.grid_width, h = grid_height();
+  // Summed-area table of the energy (luminance x solid angle) for O(1) region sums.
+  auto sat = [&](int x, int y) -> double& { return energy_sat_[size_t(y) * size_t(w + 1) + size_t(x)]; };
+  for (int y = 0; y < h; ++y) {
+    double row = 0.0;
+    for (int x = 0; x < w; ++x) {
+      const size_t c = size_t(y) * w + x;
+      row += luminance(radiance_[c]) * cell_solid_angle_[c];
+      sat(x + 1, y + 1) = sat(x + 1, y) + row;
+    }
+  }
+  auto energy = [&](int x0, int x1, int y0, int y1) {
+    return sat(x1, y1) - sat(x0, y1) - sat(x1, y0) + sat(x0, y0);
+  };
+  regions_.clear();
+  regions_.push_back({0, w, 0, h});
+  for (int level = 1; level < settings_.samples; level *= 2) {
+    next_regions_.clear();
+    for (const RegionRect& r : regions_) {
+      const int nx = r.x1 - r.x0, ny = r.y1 - r.y0;
+      if (nx == 1 && ny == 1) {
+        next_regions_.push_back(r);
+        continue;
+      }
+      // Angular extents: a row of cells narrows with sin(theta) towards the poles (Debevec's
+      // cos(latitude) scaling of the width).
+      const double mid_theta = kPi * 0.5 * (r.y0 + r.y1) / h;
+      const double width = nx * (2.0 * kPi / w) * std::sin(mid_theta), height = ny * (kPi / h);
+      const bool split_x = ny == 1 || (nx > 1 && width >= height);
+      const int lo = split_x ? r.x0 : r.y0, hi = split_x ? r.x1 : r.y1;
+      const double total = energy(r.x0, r.x1, r.y0, r.y1);
+      int at = (lo + hi) / 2;
+      if (total > 0.0) {
+        double best = 1e300;
+        for (int k = lo + 1; k < hi; ++k) {
+          const double part = split_x ? energy(r.x0, k, r.y0, r.y1) : energy(r.x0, r.x1, r.y0, k);
+          const double diff = std::abs(part - 0.5 * total);
+          if (diff < best) {
+            best = diff;
+            at = k;
+          }
+        }
+      }
+      if (split_x) {
+        next_regions_.push_back({r.x0, at, r.y0, r.y1});
+        next_regions_.push_back({at, r.x1, r.y0, r.y1});
+      } else {
+        next_regions_.push_back({r.x0, r.x1, r.y0, at});
+        next_regions_.push_back({r.x0, r.x1, at, r.y1});
+      }
+    }
+    std::swap(regions_, next_regions_);
+  }
+  lights_.clear();
+  for (const RegionRect& r : regions_) {
+    EnvLight l;
+    glm::dvec3 moment(0.0);
+    for (int y = r.y0; y < r.y1; ++y) {
+      for (int x = r.x0; x < r.x1; ++x) {
+        const size_t c = size_t(y) * w + x;
+        l.irradiance += radiance_[c] * cell_solid_angle_[c];
+        l.solid_angle_sr += cell_solid_angle_[c];
+        moment += moment_[c];
+        for (int i = 0; i < kMaxShCoeffs; ++i)
+          l.region_sh[size_t(i)] += radiance_[c] * double(cell_sh_[c][size_t(i)]);
+      }
+    }
+    const double len = glm::length(moment);
+    l.direction = len > 0.0 && std::isfinite(len)
+                      ? moment / len
+                      : cell_direction(0.5 * (r.x0 + r.x1), 0.5 * (r.y0 + r.y1));
+    lights_.push_back(l);
+  }
+  std::stable_sort(lights_.begin(), lights_.end(), [](const EnvLight& a, const EnvLight& b) {
+    return luminance(a.irradiance) > luminance(b.irradiance);
+  });
+}
+
+}  // namespace mrgi::light

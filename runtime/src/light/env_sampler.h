@@ -1,0 +1,124 @@
+// Importance sampling of an environment image into N directional lights by median cut
+// (Debevec 2005, "A Median Cut Algorithm for Light Probe Sampling"; the DIR and DLPV papers
+// sample their environment maps into lights the same way: regions of equal energy, one light
+// each), plus the SH projection of the whole image for what the lights leave out.
+//
+// The image (equirectangular or equidistant fisheye, EnvCamera) is first gathered into a fixed
+// world-space equirectangular grid: every image pixel adds its radiance times its solid angle to
+// the grid cell its direction falls in, so a small bright sun is kept however coarse the grid is
+// (point sampling the image at the cells' centres misses it); a pixel wider than a cell is split
+// into sub-pixels, so a small image fills every cell. The pixel -> cell map is computed once per
+// image size, model and rotation and reused, so a frame costs a few multiply-adds per pixel.
+// Directions no pixel covers (below a fisheye's horizon) hold no light.
+//
+// Stability over frames (an env camera's frames differ by noise even in a still scene): the grid
+// is filtered over frames with an exponential moving average (`filter_frames`), and each light
+// sits at the energy-weighted mean direction of its region, which moves continuously with the
+// image; only a cut moving by a cell can move a light, by a fraction of its region.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "light/sh_tools.h"
+#include "mrgi/expected.h"
+#include "mrgi/frame.h"
+#include "mrgi/image.h"
+
+namespace mrgi::light {
+
+struct EnvSamplerSettings {
+  // Width of the world-space grid in cells (height = width / 2); 8..1024, even. 64: cells of
+  // 5.6 degrees, finer than any region of a 16-light cut of a real environment.
+  int grid_width = 64;
+  // Lights the median cut makes: a power of two, 1..256. Fewer when regions cannot be split
+  // further (a single cell).
+  int samples = 16;
+  // Exponential moving average of the grid over frames: the time constant in frames (a step
+  // moves 1 - exp(-1 / filter_frames) of the way). 0 = no filtering. The lag of a change is about
+  // this many frames.
+  double filter_frames = 2.0;
+};
+
+// One light of the cut: a region of the sphere collapsed to a directional light.
+struct EnvLight {
+  glm::dvec3 direction{0.0, 1.0, 0.0};  // unit, world, towards the light
+  glm::dvec3 irradiance{0.0};           // W/m^2 per linear RGB channel at normal incidence
+  double solid_angle_sr = 0.0;          // of its region
+  // Radiance SH (4 bands) of the region's own cells: what the environment's SH loses when this
+  // region is drawn as a light instead (radiance_sh() minus it is >= 0 everywhere the SH of
+  // the other regions is, unlike subtracting a delta light's SH, which rings).
+  ShRgb region_sh{};
+};
+
+class EnvSampler {
+ public:
+  // BadUsage naming the field when a setting is out of range.
+  static Expected<EnvSampler> create(const EnvSamplerSettings& settings);
+
+  // Gathers `image` (linear radiance times `intensity`; camera.rotation and `env_to_world` map
+  // its directions to the world) into the grid, filters it with the previous frames, cuts it.
+  // BadInput for an empty image or a fisheye without a focal length. NaN, Inf and negative
+  // texels count as 0.
+  Status update(const ImageRGBF& image, const EnvCamera& camera, const glm::dquat& env_to_world,
+                double intensity = 1.0);
+  // Forgets the history (the next update is not blended with earlier frames).
+  void reset() { have_history_ = false; }
+
+  bool valid() const { return have_history_; }
+  // The lights, strongest (luminance of the irradiance) first.
+  const std::vector<EnvLight>& lights() const { return lights_; }
+  // Radiance SH (4 bands) of the whole filtered grid.
+  const ShRgb& radiance_sh() const { return sh_; }
+  const EnvSamplerSettings& settings() const { return settings_; }
+  int grid_height() const { return settings_.grid_width / 2; }
+  // Filtered radiance of grid cell (x, y), linear RGB (for tests and plots).
+  glm::dvec3 cell_radiance(int x, int y) const { return radiance_[size_t(y) * settings_.grid_width + x]; }
+  // Unit world direction of the centre of grid cell (x, y) (the equirectangular convention of
+  // light_from_environment: u = 0.5 + atan2(x, -z) / 2 pi, v = acos(y) / pi).
+  glm::dvec3 cell_direction(double x, double y) const;
+
+ private:
+  explicit EnvSampler(const EnvSamplerSettings& s) : settings_(s) {}
+  Status build_map(const ImageRGBF& image, const EnvCamera& camera, const glm::dquat& env_to_world);
+  void cut();
+
+  EnvSamplerSettings settings_;
+  // The image geometry the map was built for.
+  struct MapKey {
+    int width = 0, height = 0;
+    EnvModel model = EnvModel::Equirectangular;
+    double f = 0, cx = 0, cy = 0, fov = 0;
+    glm::dquat rotation{1, 0, 0, 0};
+    bool operator==(const MapKey&) const = default;
+  } map_key_;
+  bool have_map_ = false;
+  // One (sub-)pixel of the image: the cell its direction falls in, its solid angle, its world
+  // direction.
+  struct MapEntry {
+    uint32_t pixel;
+    int32_t cell;
+    float solid_angle;
+    glm::vec3 direction;
+  };
+  std::vector<MapEntry> entries_;
+  // A rectangle of grid cells [x0, x1) x [y0, y1).
+  struct RegionRect {
+    int x0, x1, y0, y1;
+  };
+  std::vector<RegionRect> regions_, next_regions_;
+  std::vector<double> cell_solid_angle_;       // grid geometry
+  std::vector<glm::dvec3> cell_sum_;           // this frame: sum of L dw per cell
+  std::vector<double> cell_seen_;              // this frame: sum of dw per cell
+  std::vector<glm::dvec3> radiance_;           // filtered radiance per cell
+  std::vector<glm::dvec3> frame_moment_;       // this frame: sum of luminance(L) dw d per cell
+  std::vector<glm::dvec3> moment_;             // filtered, scaled to a fully seen cell
+  std::vector<double> energy_sat_;             // summed-area table of luminance * cell dw
+  bool have_history_ = false;
+  std::vector<EnvLight> lights_;
+  ShRgb sh_{};
+  std::vector<ShVector> cell_sh_;              // Y_i(cell centre) * cell dw
+};
+
+}  // namespace mrgi::light

@@ -1,0 +1,293 @@
+#include "light/light_stage.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "light/sh_tools.h"
+#include "shared/mrgi_shared.h"
+
+namespace mrgi::light {
+namespace {
+
+// The lights' colour and intensity in scene.json's convention: colour times intensity per
+// channel, the colour's largest channel 1.
+void set_rgb(LightDesc& l, const glm::dvec3& rgb) {
+  const double peak = std::max({rgb.x, rgb.y, rgb.z, 0.0});
+  l.intensity = float(peak);
+  l.color = peak > 0.0 ? glm::vec3(rgb / peak) : glm::vec3(1.0f);
+}
+
+glm::dvec3 light_rgb(const LightDesc& l) { return glm::dvec3(l.color) * double(l.intensity); }
+
+// Irradiance a declared lamp sends to `p` (W/m^2 per channel at normal incidence) and the
+// direction towards it, for the exported estimate.
+glm::dvec3 lamp_at(const LightDesc& l, const glm::dvec3& p, glm::dvec3& to_light) {
+  if (l.type == LightType::Directional) {
+    to_light = -glm::normalize(glm::dvec3(l.direction));
+    return light_rgb(l);
+  }
+  const glm::dvec3 d = glm::dvec3(l.position) - p;
+  const double d2 = std::max(glm::dot(d, d), 1e-6);
+  to_light = d / std::sqrt(d2);
+  double cone = 1.0;
+  if (l.type == LightType::Spot)
+    cone = shader::spot_falloff(float(glm::dot(glm::normalize(glm::dvec3(l.direction)), -to_light)),
+                                std::cos(glm::radians(l.outer_angle_deg)),
+                                std::cos(glm::radians(l.inner_angle_deg)));
+  return light_rgb(l) * (cone / d2);
+}
+
+}  // namespace
+
+const char* source_name(LightSourceKind kind) {
+  switch (kind) {
+    case LightSourceKind::Declared: return "declared lamps";
+    case LightSourceKind::Environment: return "environment image";
+    case LightSourceKind::Probeless: return "probeless estimate";
+    case LightSourceKind::None: break;
+  }
+  return "none";
+}
+
+std::array<glm::mat4, 3> irradiance_matrices(const ShRgb& l) {
+  // Basis polynomials of shaders/shared/mrgi_shared.h sh_basis16 (bands 0..2).
+  constexpr double c0 = 0.282094791773878, c1 = 0.488602511902920, c2 = 1.092548430592079,
+                   c3 = 0.315391565252520, c4 = 0.546274215296040;
+  constexpr double a0 = kPi, a1 = 2.0 * kPi / 3.0, a2 = kPi / 4.0;
+  std::array<glm::mat4, 3> out{};
+  for (int c = 0; c < 3; ++c) {
+    double e[9];
+    for (int i = 0; i < 9; ++i) e[i] = (i == 0 ? a0 : i < 4 ? a1 : a2) * l[size_t(i)][c];
+    glm::dmat4 m(0.0);  // m[col][row], symmetric; rows/cols x y z 1
+    m[0][0] = c4 * e[8];
+    m[1][1] = -c4 * e[8];
+    m[2][2] = 3.0 * c3 * e[6];
+    m[3][3] = c0 * e[0] - c3 * e[6];
+    m[0][1] = m[1][0] = 0.5 * c2 * e[4];
+    m[1][2] = m[2][1] = -0.5 * c2 * e[5];
+    m[0][2] = m[2][0] = -0.5 * c2 * e[7];
+    m[0][3] = m[3][0] = -0.5 * c1 * e[3];
+    m[1][3] = m[3][1] = -0.5 * c1 * e[1];
+    m[2][3] = m[3][2] = 0.5 * c1 * e[2];
+    out[size_t(c)] = glm::mat4(m);
+  }
+  return out;
+}
+
+Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSettings& settings,
+                                                         const SceneDesc& scene, const CameraSetup& cameras) {
+  if (settings.shadowed_environment_lights < 0 || settings.shadowed_environment_lights > kMaxStageLights)
+    return fail(ErrorKind::BadUsage, "LightStageSettings.shadowed_environment_lights: must be 0..8");
+  auto stage = std::unique_ptr<LightStage>(new LightStage());
+  LightStage& s = *stage;
+  s.settings_ = settings;
+  s.scene_ = scene;
+  s.cameras_ = cameras;
+  s.declared_ = int(scene.lights.size());
+  if (s.declared_ > kMaxStageLights)
+    return fail(ErrorKind::BadInput, scene.path + ": lights: " + std::to_string(s.declared_) +
+                                         " lamps, at most " + std::to_string(kMaxStageLights));
+  auto estimator = LightEstimator::create(settings.estimator);
+  if (!estimator) return estimator.error();
+  s.estimator_.emplace(std::move(*estimator));
+  const EnvironmentDesc& env = scene.environment;
+  if (env.present) {
+    auto sampler = EnvSampler::create(settings.environment);
+    if (!sampler) return sampler.error();
+    s.env_.emplace(std::move(*sampler));
+    s.env_lights_ = std::min(settings.shadowed_environment_lights, kMaxStageLights - s.declared_);
+    if (!env.from_env_camera) {  // a file: sampled once, here
+      auto img = load_hdr_image(env.image);
+      if (!img) return img.error();
+      MRGI_TRY(s.env_->update(*img, EnvCamera{}, glm::dquat(env.rotation), env.intensity));
+      s.env_from_file_ = true;
+    }
+  }
+  s.planned_ = env.present ? LightSourceKind::Environment
+                           : (s.declared_ > 0 ? LightSourceKind::Declared : LightSourceKind::Probeless);
+  if (s.planned_ == LightSourceKind::Probeless) {
+    auto b = ProbelessBuilder::create(settings.probeless, cameras.color, cameras.depth, cameras.depth_scale);
+    if (!b) return b.error();
+    s.probeless_.emplace(std::move(*b));
+  }
+  s.max_lights_ = s.declared_ + s.env_lights_ + (s.planned_ == LightSourceKind::Probeless ? 1 : 0);
+  s.lighting_.lights.reserve(kMaxStageLights);
+  s.last_env_directions_.reserve(kMaxStageLights);
+  for (const LightDesc& l : scene.lights) s.lighting_.lights.push_back(l);
+  // The declared real lamps seen from the focus, for the exported estimate.
+  for (const LightDesc& l : scene.lights) {
+    if (!l.real) continue;
+    glm::dvec3 to_light;
+    const glm::dvec3 e = lamp_at(l, glm::dvec3(settings.focus), to_light);
+    const ShRgb sh = sh_directional_light(to_light, e);
+    for (int i = 0; i < kMaxShCoeffs; ++i) s.declared_sh_[size_t(i)] += sh[size_t(i)];
+  }
+  s.lighting_.source = s.planned_;
+  s.lighting_.environment = env.present;
+  if (s.planned_ == LightSourceKind::Probeless) s.set_probeless_lighting();
+  else if (s.env_from_file_) s.set_environment_lighting(env.real);
+  else s.finish_declared();
+  return stage;
+}
+
+void LightStage::finish_declared() {
+  ShRgb all = declared_sh_;
+  if (lighting_.environment && scene_.environment.real && env_ && env_->valid())
+    for (int i = 0; i < kMaxShCoeffs; ++i) all[size_t(i)] += env_->radiance_sh()[size_t(i)];
+  LightEstimate& e = lighting_.estimate;
+  const int64_t frame = e.frame_index;
+  const double t = e.timestamp;
+  e = LightEstimate{};
+  fill_light_estimate(all, kMaxShBands, e);
+  e.valid = declared_ > 0 || (env_ && env_->valid());
+  e.confidence = 1.0f;
+  e.frame_index = frame;
+  e.timestamp = t;
+}
+
+void LightStage::set_environment_lighting(bool real) {
+  // Lamps first (unchanged), then the strongest regions as shadowed directional lights; the SH
+  // of the other regions is the ambient.
+  lighting_.lights.resize(size_t(declared_));
+  ShRgb ambient = env_->radiance_sh();
+  const auto& regions = env_->lights();
+  bool changed = last_env_directions_.size() != size_t(std::min<size_t>(regions.size(), size_t(env_lights_)));
+  last_env_directions_.resize(std::min<size_t>(regions.size(), size_t(env_lights_)));
+  for (size_t k = 0; k < regions.size() && int(k) < env_lights_; ++k) {
+    const EnvLight& r = regions[k];
+    LightDesc l;
+    l.type = LightType::Directional;
+    l.real = real;
+    l.direction = glm::vec3(-r.direction);
+    set_rgb(l, r.irradiance);
+    lighting_.lights.push_back(l);
+    for (int i = 0; i < kMaxShCoeffs; ++i) ambient[size_t(i)] -= r.region_sh[size_t(i)];
+    changed = changed || last_env_directions_[k] != r.direction;
+    last_env_directions_[k] = r.direction;
+  }
+  lighting_.ambient_real = real ? ambient : ShRgb{};
+  lighting_.ambient_virtual = real ? ShRgb{} : ambient;
+  if (changed) ++lighting_.revision;
+  finish_declared();
+}
+
+void LightStage::set_probeless_lighting() {
+  const LightEstimate& est = estimator_->estimate();
+  const ShRgb& l = estimator_->filtered();
+  lighting_.lights.clear();
+  ShRgb ambient = l;
+  glm::dvec3 dir;
+  if (est.valid && sh_dominant_direction(l, dir)) {
+    const glm::dvec3 e = sh_dominant_intensity(l, dir);
+    if (luminance(e) > 0.0) {
+      LightDesc d;
+      d.type = LightType::Directional;
+      d.real = true;
+      d.direction = glm::vec3(-dir);
+      set_rgb(d, e);
+      lighting_.lights.push_back(d);
+      const ShRgb sh = sh_directional_light(dir, e);
+      for (int i = 0; i < kMaxShCoeffs; ++i) ambient[size_t(i)] -= sh[size_t(i)];
+    }
+  }
+  lighting_.ambient_real = ambient;
+  lighting_.ambient_virtual = ShRgb{};
+  lighting_.estimate = est;
+  ++lighting_.revision;
+}
+
+void LightStage::use_external_system() {
+  external_system_ = true;
+  planned_ = LightSourceKind::Probeless;
+  lighting_.source = planned_;
+  lighting_.environment = false;
+  max_lights_ = 1;
+  probeless_.reset();
+  set_probeless_lighting();
+}
+
+Status LightStage::submit_system(const LightSystem& system, int64_t frame_index, double timestamp_s,
+                                 int solve_bands, std::vector<std::string>& notes) {
+  auto r = estimator_->update(system, frame_index, timestamp_s, solve_bands);
+  if (!r) {
+    notes.push_back("light: " + r.error().message);
+    return ok_status();  // the estimate keeps its last value: a broken frame is not fatal
+  }
+  if (planned_ == LightSourceKind::Probeless) set_probeless_lighting();
+  return ok_status();
+}
+
+Status LightStage::update(const InputFrame& frame, const glm::dmat4& camera_to_world,
+                          std::vector<std::string>& notes) {
+  char text[200];
+  const EnvironmentDesc& env = scene_.environment;
+  if (planned_ == LightSourceKind::Environment && env.from_env_camera) {
+    if (frame.env && cameras_.env_camera) {
+      MRGI_TRY(env_->update(*frame.env, *cameras_.env_camera, glm::dquat(env.rotation), env.intensity));
+    } else if (frame.env) {
+      notes.push_back("light: this frame's env image came without an env camera model (capture.json "
+                      "env_camera): not used");
+    } else if (env_->valid()) {
+      notes.push_back("light: no env image in this frame, the last one's light kept");
+    }
+    if (env_->valid()) {
+      set_environment_lighting(env.real);
+      lighting_.source = LightSourceKind::Environment;
+    } else {
+      // No environment image yet: the lamps alone (or nothing).
+      lighting_.lights.resize(size_t(declared_));
+      lighting_.ambient_real = lighting_.ambient_virtual = ShRgb{};
+      lighting_.source = declared_ > 0 ? LightSourceKind::Declared : LightSourceKind::None;
+      finish_declared();
+    }
+  }
+  if (planned_ == LightSourceKind::Probeless && !external_system_) {
+    // Rows interleaved over `parts` frames; until the first estimate exists the whole system is
+    // built at once, so no frame is lit by the prior.
+    const int parts = probeless_->settings().parts;
+    const bool first = !estimator_->estimate().valid;
+    for (int p = first ? 0 : next_part_; p < (first ? parts : next_part_ + 1); ++p)
+      MRGI_TRY(probeless_->add_part(frame, camera_to_world, cameras_.exposure, p, pending_));
+    next_part_ = first ? 0 : (next_part_ + 1) % parts;
+    if (next_part_ == 0) {
+      auto r = estimator_->update(pending_, frame.index, frame.timestamp);
+      if (!r) notes.push_back("light: " + r.error().message);
+      pending_.clear();
+      set_probeless_lighting();
+    }
+  }
+  lighting_.estimate.frame_index = planned_ == LightSourceKind::Probeless ? lighting_.estimate.frame_index : frame.index;
+  lighting_.estimate.timestamp = planned_ == LightSourceKind::Probeless ? lighting_.estimate.timestamp : frame.timestamp;
+
+  switch (lighting_.source) {
+    case LightSourceKind::Probeless: {
+      const LightEstimate& e = lighting_.estimate;
+      std::snprintf(text, sizeof text,
+                    "light: probeless estimate from %s (frame %lld, confidence %.2f)%s",
+                    external_system_ ? "the technique's transfer" : "colour and depth",
+                    static_cast<long long>(e.frame_index), double(e.confidence),
+                    e.valid ? "" : "; none solved yet: lit by the prior (uniform grey light)");
+      break;
+    }
+    case LightSourceKind::Environment:
+      std::snprintf(text, sizeof text, "light: environment image (%s, %zu median-cut regions, %d shadowed)%s",
+                    env.from_env_camera ? "env camera" : "file", env_->lights().size(),
+                    int(lighting_.lights.size()) - declared_,
+                    declared_ > 0 ? " and declared lamps" : "");
+      break;
+    case LightSourceKind::Declared:
+      std::snprintf(text, sizeof text, "light: %d declared lamp(s) (scene.json)", declared_);
+      break;
+    case LightSourceKind::None:
+      std::snprintf(text, sizeof text, "light: NONE: no lamp, no environment image yet and no estimate: "
+                                       "the virtual objects are unlit");
+      break;
+  }
+  notes.push_back(text);
+  return ok_status();
+}
+
+}  // namespace mrgi::light

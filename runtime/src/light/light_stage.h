@@ -1,0 +1,128 @@
+// The light stage (DESIGN.md "estimate light"): between reconstruction and the technique, once
+// per frame, it decides from what the capture or sensor gives where the real light comes from
+// and hands every technique the same answer:
+//   - declared lamps (scene.json `lights`, real and virtual, as tracked lamps are);
+//   - an environment image (scene.json `environment`: a file, or the env camera's frames):
+//     median-cut importance sampling (env_sampler.h); the strongest regions become shadowed
+//     directional lights, the rest stays as SH ambient;
+//   - neither: the probeless estimate from colour and depth (light::LightEstimator, fed by the
+//     stage's own ProbelessBuilder or by a technique's GPU sums, ssrt's), as one shadowed
+//     dominant directional light plus the rest of the estimate as SH ambient.
+// Declared lamps and an environment add up (a desk lamp in a sunlit room). Each frame's stats
+// carry a note naming the source; a frame lit by nothing says so.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "light/env_sampler.h"
+#include "light/probeless.h"
+#include "light/sh_estimator.h"
+#include "light/sh_tools.h"
+#include "mrgi/light_estimate.h"
+#include "mrgi/runtime.h"
+#include "mrgi/scene.h"
+
+namespace mrgi::light {
+
+// The most lights a frame's Lighting holds (MRGI_MAX_LIGHTS of shaders/common/light_set.glsl).
+inline constexpr int kMaxStageLights = 8;
+
+enum class LightSourceKind { None, Declared, Environment, Probeless };
+const char* source_name(LightSourceKind kind);
+
+struct LightStageSettings {
+  EnvSamplerSettings environment;
+  // Regions of the environment's cut that become shadowed directional lights (the strongest;
+  // the others' light stays in the ambient SH, unshadowed). 0..8, at most 8 minus the lamps.
+  int shadowed_environment_lights = 4;
+  ProbelessSettings probeless;
+  // The estimator of the probeless source. RGB by default (white_light false): the paper's
+  // white-light assumption gives a grey estimate under a blue sky.
+  LightEstimatorSettings estimator = [] {
+    LightEstimatorSettings s;
+    s.white_light = false;
+    return s;
+  }();
+  // Where declared lamps are seen from for the exported estimate (LightEstimate: SH and
+  // dominant light of the lamps at this point, world metres): the virtual objects' centre.
+  glm::vec3 focus{0.0f};
+};
+
+// One frame's light, as every technique reads it.
+struct Lighting {
+  LightSourceKind source = LightSourceKind::None;
+  bool environment = false;          // an environment contributes (with lamps or alone)
+  // Lights with shadows: declared lamps, then environment regions or the probeless dominant
+  // light (directional, `real`). Capacity kMaxStageLights, reserved at start-up.
+  std::vector<LightDesc> lights;
+  // Radiance SH (4 bands) of the light not in `lights`: real (lights real and virtual surfaces)
+  // and virtual (a virtual environment: lights virtual surfaces only).
+  ShRgb ambient_real{}, ambient_virtual{};
+  // Every real light as an estimate (SH, dominant light, confidence), the public form.
+  LightEstimate estimate;
+  // Bumped whenever `lights` changed (shadow maps are re-planned on a change only).
+  uint64_t revision = 0;
+};
+
+class LightStage {
+ public:
+  // BadUsage for settings out of range; BadInput (naming the file) for an environment image
+  // that cannot be read.
+  static Expected<std::unique_ptr<LightStage>> create(const LightStageSettings& settings,
+                                                      const SceneDesc& scene, const CameraSetup& cameras);
+
+  // A technique that sums its own probeless system on the GPU (ssrt) calls this at start-up:
+  // the stage then never runs its own builder, submit_system() feeds the estimator, and the
+  // source is the probeless estimate whatever the scene declares (ssrt's paper estimates the
+  // light from the frames; it has no use for lamps or an environment image).
+  void use_external_system();
+  bool external_system() const { return external_system_; }
+
+  // This frame's light. `notes` gets one line naming the source (and any problem).
+  Status update(const InputFrame& frame, const glm::dmat4& camera_to_world, std::vector<std::string>& notes);
+  // A technique's GPU-summed system (use_external_system), solved into the probeless estimate.
+  Status submit_system(const LightSystem& system, int64_t frame_index, double timestamp_s,
+                       int solve_bands, std::vector<std::string>& notes);
+
+  const Lighting& lighting() const { return lighting_; }
+  const LightEstimator& estimator() const { return *estimator_; }
+  // The largest number of shadowed lights any frame can have (for shadow map allocation).
+  int max_lights() const { return max_lights_; }
+  LightSourceKind planned_source() const { return planned_; }
+
+ private:
+  LightStage() = default;
+  void set_probeless_lighting();
+  void set_environment_lighting(bool real);
+  void finish_declared();
+
+  LightStageSettings settings_;
+  SceneDesc scene_;
+  CameraSetup cameras_;
+  LightSourceKind planned_ = LightSourceKind::None;
+  int declared_ = 0;                // lamps from scene.json (the first entries of lights)
+  int env_lights_ = 0;              // shadowed environment regions
+  int max_lights_ = 0;
+  bool external_system_ = false;
+  std::optional<EnvSampler> env_;
+  bool env_from_file_ = false;
+  std::optional<ProbelessBuilder> probeless_;
+  std::optional<LightEstimator> estimator_;
+  LightSystem pending_;             // the parts of the probeless system summed so far
+  int next_part_ = 0;
+  Lighting lighting_;
+  ShRgb declared_sh_{};             // the declared real lamps seen from the focus (radiance SH)
+  std::vector<glm::dvec3> last_env_directions_;
+};
+
+// The irradiance of radiance SH `l` (bands 0..2) as one 4x4 matrix per channel, so that
+// E_c(n) = (n, 1)^T M_c (n, 1) (Ramamoorthi & Hanrahan 2001, eq. 12): three mat4s a shader
+// copies whole and evaluates with two dot products, instead of an array of nine coefficients.
+std::array<glm::mat4, 3> irradiance_matrices(const ShRgb& l);
+
+}  // namespace mrgi::light

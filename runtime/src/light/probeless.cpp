@@ -1,0 +1,188 @@
+#include "light/probeless.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "common/frame_constants.glsl"
+#include "image/srgb.h"
+#include "ssrt/ssrt_math.h"
+
+namespace mrgi::light {
+namespace {
+
+Status check_range(bool ok, const char* field, const std::string& rule) {
+  if (ok) return ok_status();
+  return fail(ErrorKind::BadUsage, std::string("ProbelessSettings.") + field + ": " + rule);
+}
+
+constexpr int kSaturated = 250;            // 8-bit colour at or above: clipped, not a measurement
+constexpr float kSameSurface = float(MRGI_DEPTH_EDGE_RELATIVE);
+
+}  // namespace
+
+Expected<ProbelessBuilder> ProbelessBuilder::create(const ProbelessSettings& s, const Intrinsics& color,
+                                                    const Intrinsics& depth, double depth_scale) {
+  MRGI_TRY(check_range(s.stride >= 2 && s.stride <= 64, "stride", "must be 2..64 pixels"));
+  MRGI_TRY(check_range(s.directions >= 16 && s.directions <= 1024, "directions", "must be 16..1024"));
+  MRGI_TRY(check_range(s.march_steps >= 1 && s.march_steps <= 64, "march_steps", "must be 1..64"));
+  MRGI_TRY(check_range(s.radius_m > 0.0 && std::isfinite(s.radius_m), "radius_m", "must be > 0 metres"));
+  MRGI_TRY(check_range(s.parts >= 1 && s.parts <= 16, "parts", "must be 1..16 frames"));
+  if (color.width < 1 || color.height < 1 || depth.width < s.stride || depth.height < s.stride ||
+      !(color.fx > 0) || !(color.fy > 0) || !(depth.fx > 0) || !(depth.fy > 0) || !(depth_scale > 0))
+    return fail(ErrorKind::BadInput, "probeless light estimation: camera intrinsics need sizes of at "
+                                     "least one sample block, focal lengths and depth_scale > 0");
+  ProbelessBuilder b;
+  b.settings_ = s;
+  b.color_ = color;
+  b.depth_ = depth;
+  b.depth_scale_ = depth_scale;
+  b.grid_w_ = depth.width / s.stride;
+  b.grid_h_ = depth.height / s.stride;
+  b.position_.assign(size_t(b.grid_w_) * size_t(b.grid_h_), glm::vec3(0.0f));
+  b.directions_.reserve(size_t(s.directions));
+  b.direction_sh_.reserve(size_t(s.directions));
+  for (int k = 0; k < s.directions; ++k) {
+    const glm::vec3 w(fibonacci_direction(k, s.directions));
+    b.directions_.push_back(w);
+    b.direction_sh_.push_back(sh_basis(w));
+  }
+  // Neighbouring directions of a Fibonacci sphere are about sqrt(4 pi / N) apart: the median
+  // angle eq. 9 takes from a Delaunay triangulation, without building one.
+  b.chi_ = shader::ssrt_chi_from_median_angle(float(std::sqrt(4.0 * kPi / s.directions)));
+  return b;
+}
+
+void ProbelessBuilder::build_positions(const InputFrame& frame) {
+  const int s = settings_.stride;
+  const glm::vec4 k(float(depth_.fx), float(depth_.fy), float(depth_.cx), float(depth_.cy));
+  const float to_m = float(1.0 / depth_scale_);
+  for (int gy = 0; gy < grid_h_; ++gy) {
+    for (int gx = 0; gx < grid_w_; ++gx) {
+      // The block's centre depth picks the surface; the block's depths on that surface are
+      // averaged (Kinect noise grows with distance squared; 64 samples take most of it out).
+      const int x0 = gx * s, y0 = gy * s;
+      const uint16_t centre = frame.depth.data[size_t(y0 + s / 2) * size_t(frame.depth.width) + size_t(x0 + s / 2)];
+      glm::vec3& out = position_[size_t(gy) * grid_w_ + gx];
+      out = glm::vec3(0.0f);
+      if (centre == 0) continue;
+      const float zc = float(centre) * to_m;
+      double sum_z = 0.0, sum_u = 0.0, sum_v = 0.0;
+      int count = 0;
+      for (int y = y0; y < y0 + s; ++y) {
+        const uint16_t* row = frame.depth.data.data() + size_t(y) * size_t(frame.depth.width);
+        for (int x = x0; x < x0 + s; ++x) {
+          const float z = float(row[x]) * to_m;
+          if (row[x] == 0 || std::abs(z - zc) > kSameSurface * zc) continue;
+          sum_z += z;
+          sum_u += x;
+          sum_v += y;
+          ++count;
+        }
+      }
+      const float z = float(sum_z / count);
+      out = shader::unproject_pinhole(glm::vec2(float(sum_u / count), float(sum_v / count)), z, k);
+    }
+  }
+}
+
+Status ProbelessBuilder::add_part(const InputFrame& frame, const glm::dmat4& camera_to_world,
+                                  double exposure, int part, LightSystem& system) {
+  if (frame.depth.width != depth_.width || frame.depth.height != depth_.height ||
+      frame.color.width != color_.width || frame.color.height != color_.height)
+    return fail(ErrorKind::BadInput, "probeless light estimation: frame " + std::to_string(frame.index) +
+                                         " does not have the cameras' sizes");
+  if (part < 0 || part >= settings_.parts)
+    return fail(ErrorKind::BadUsage, "probeless light estimation: part " + std::to_string(part) +
+                                         " outside 0.." + std::to_string(settings_.parts - 1));
+  if (!(exposure > 0.0)) exposure = 1.0;
+  build_positions(frame);
+  const glm::mat3 rot = glm::mat3(camera_to_world);
+  const glm::mat3 rot_t = glm::transpose(rot);
+  const glm::vec4 kd(float(depth_.fx), float(depth_.fy), float(depth_.cx), float(depth_.cy));
+  const glm::vec4 kc(float(color_.fx), float(color_.fy), float(color_.cx), float(color_.cy));
+  const auto& lut = srgb8_to_linear_table();
+  const int s = settings_.stride;
+  const float radius = float(settings_.radius_m);
+  const float solid_angle = float(4.0 * kPi / settings_.directions);
+  const float inv_stride = 1.0f / float(s);
+  auto cell = [&](int gx, int gy) -> const glm::vec3& { return position_[size_t(gy) * grid_w_ + gx]; };
+  auto same_surface = [](const glm::vec3& a, const glm::vec3& b) {
+    return a.z > 0.0f && b.z > 0.0f && std::abs(a.z - b.z) <= kSameSurface * std::min(a.z, b.z);
+  };
+  for (int gy = part; gy < grid_h_; gy += settings_.parts) {
+    for (int gx = 0; gx < grid_w_; ++gx) {
+      const glm::vec3 p = cell(gx, gy);
+      if (!(p.z > 0.0f)) continue;
+      // Normal from the neighbouring cells on the same surface (central where both sides are,
+      // else one-sided), facing the camera.
+      glm::vec3 dx(0.0f), dy(0.0f);
+      const glm::vec3 l = gx > 0 ? cell(gx - 1, gy) : glm::vec3(0.0f);
+      const glm::vec3 r = gx + 1 < grid_w_ ? cell(gx + 1, gy) : glm::vec3(0.0f);
+      const glm::vec3 u = gy > 0 ? cell(gx, gy - 1) : glm::vec3(0.0f);
+      const glm::vec3 d = gy + 1 < grid_h_ ? cell(gx, gy + 1) : glm::vec3(0.0f);
+      const bool hl = same_surface(p, l), hr = same_surface(p, r), hu = same_surface(p, u), hd = same_surface(p, d);
+      if (hl && hr) dx = r - l; else if (hr) dx = r - p; else if (hl) dx = p - l;
+      if (hu && hd) dy = d - u; else if (hd) dy = d - p; else if (hu) dy = p - u;
+      glm::vec3 n_cam = glm::cross(dy, dx);
+      const float len = glm::length(n_cam);
+      if (!(len > 1e-12f)) continue;
+      n_cam /= len;
+      if (glm::dot(n_cam, p) > 0.0f) n_cam = -n_cam;
+
+      // Colour: the linear mean of the block's pixels where the depth camera's sample lands in
+      // the colour camera (same centre; intrinsics may differ).
+      const glm::vec2 c = shader::project_pinhole(p, kc);
+      const int half = std::max(1, int(std::lround(0.5 * s * color_.fx / depth_.fx)));
+      const int cx0 = std::max(0, int(c.x) - half), cx1 = std::min(color_.width, int(c.x) + half);
+      const int cy0 = std::max(0, int(c.y) - half), cy1 = std::min(color_.height, int(c.y) + half);
+      glm::dvec3 colour(0.0);
+      int count = 0;
+      bool saturated = false;
+      for (int y = cy0; y < cy1 && !saturated; ++y) {
+        const uint8_t* row = frame.color.data.data() + (size_t(y) * size_t(color_.width)) * 3;
+        for (int x = cx0; x < cx1; ++x) {
+          const uint8_t* px = row + size_t(x) * 3;
+          if (px[0] >= kSaturated || px[1] >= kSaturated || px[2] >= kSaturated) {
+            saturated = true;
+            break;
+          }
+          colour += glm::dvec3(lut[px[0]], lut[px[1]], lut[px[2]]);
+          ++count;
+        }
+      }
+      if (saturated || count == 0) continue;
+      colour /= double(count) * exposure;
+
+      // Transfer with visibility: each direction in front of the surface is marched through the
+      // depth grid; a grid surface in front of a step (within twice the radius: a range check,
+      // as the ssrt transfer) occludes it by eq. 7-8's continuous K.
+      const glm::vec3 n = rot * n_cam;
+      ShVector t{};
+      for (size_t j = 0; j < directions_.size(); ++j) {
+        const glm::vec3& w = directions_[j];
+        const float nw = glm::dot(n, w);
+        if (nw <= 0.0f) continue;
+        const glm::vec3 w_cam = rot_t * w;
+        float k = 1.0f;
+        for (int step = 1; step <= settings_.march_steps && k > 0.0f; ++step) {
+          const glm::vec3 q = p + w_cam * (radius * float(step) / float(settings_.march_steps));
+          if (!(q.z > 0.0f)) break;
+          const glm::vec2 px = shader::project_pinhole(q, kd) * inv_stride;
+          const int qx = int(std::floor(px.x)), qy = int(std::floor(px.y));
+          if (qx < 0 || qy < 0 || qx >= grid_w_ || qy >= grid_h_) break;  // left the view: unknown
+          const glm::vec3& sp = cell(qx, qy);
+          if (!(sp.z > 0.0f) || sp.z >= q.z - 0.02f * q.z || q.z - sp.z > 2.0f * radius) continue;
+          k = std::min(k, shader::ssrt_visibility_k(p, sp, w_cam, chi_));
+        }
+        const float weight = shader::ssrt_transfer_weight(n, w, k, solid_angle);
+        if (weight <= 0.0f) continue;
+        for (int i = 0; i < kMaxShCoeffs; ++i) t[size_t(i)] += weight * direction_sh_[j][size_t(i)];
+      }
+      system.add(t, colour);
+    }
+  }
+  return ok_status();
+}
+
+}  // namespace mrgi::light

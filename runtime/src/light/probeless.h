@@ -1,0 +1,70 @@
+// The light stage's own probeless input (image-space-illumination-dynamic-ar.md Sec. 5.1-5.2, on
+// the CPU): per sample of the depth image, the diffuse radiance transfer vector T(x) in SH with
+// screen-space visibility (the continuous K of eq. 7-9, shaders/ssrt/ssrt_math.h, the same
+// functions the ssrt technique's transfer pass runs) and the camera's linear colour I_c(x), summed
+// into the normal equations T^T T l = T^T I_c that light::LightEstimator solves.
+//
+// Why on the CPU and coarse: the estimate is a 16-coefficient least-squares fit whose error is
+// ruled by what the view shows (which normals, which shadows), not by how many pixels vote, so a
+// grid of one sample per `stride` x `stride` depth pixels (80 x 60 at 640 x 480) carries the same
+// information as every pixel. Each sample's depth and colour are averages over its block, which
+// also takes out most of the sensor noise. At that size the work is a few ms of one core, and it
+// is spread over `parts` frames (rows interleaved) so no frame pays it all: every technique gets
+// the estimate for a constant, small cost instead of a GPU pass (ssrt, whose transfer pass
+// computes T at every pixel anyway, hands its own sums to the same estimator instead).
+//
+// Deviation from the paper: visibility is searched in the current depth image only (no TSDF
+// auxiliary views): an occluder outside the view does not shadow. Saturated colour (any channel
+// at 250 or more of 255) is left out: it is not a linear measurement of the light.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "light/sh_estimator.h"
+#include "mrgi/expected.h"
+#include "mrgi/frame.h"
+
+namespace mrgi::light {
+
+struct ProbelessSettings {
+  int stride = 8;             // depth pixels per sample, each side (2..64)
+  int directions = 64;        // visibility directions over the sphere (Fibonacci), 16..1024
+  int march_steps = 6;        // depth-image steps per direction (1..64)
+  double radius_m = 0.6;      // how far an occluder is searched, metres (> 0)
+  int parts = 4;              // frames a full system is spread over (rows interleaved), 1..16
+};
+
+class ProbelessBuilder {
+ public:
+  // BadUsage naming the field for settings out of range; BadInput for intrinsics without size
+  // or focal length.
+  static Expected<ProbelessBuilder> create(const ProbelessSettings& settings, const Intrinsics& color,
+                                           const Intrinsics& depth, double depth_scale);
+
+  // Adds the sample rows of part `part` (0..parts-1) of `frame` to `system`: I_c is the linear
+  // camera value divided by `exposure` (radiance units, the estimator divides by the albedo).
+  // Frames whose images do not have the intrinsics' sizes are refused (BadInput).
+  Status add_part(const InputFrame& frame, const glm::dmat4& camera_to_world, double exposure,
+                  int part, LightSystem& system);
+  const ProbelessSettings& settings() const { return settings_; }
+  int grid_width() const { return grid_w_; }
+  int grid_height() const { return grid_h_; }
+
+ private:
+  ProbelessBuilder() = default;
+  // Camera-space positions of every grid cell from its block's depth (z 0 = none).
+  void build_positions(const InputFrame& frame);
+
+  ProbelessSettings settings_;
+  Intrinsics color_, depth_;
+  double depth_scale_ = 5000.0;
+  int grid_w_ = 0, grid_h_ = 0;
+  float chi_ = 0.0f;
+  std::vector<glm::vec3> directions_;   // unit, world
+  std::vector<ShVector> direction_sh_;  // Y_i(w) for each direction
+  std::vector<glm::vec3> position_;     // camera space, per grid cell; z 0 = none
+};
+
+}  // namespace mrgi::light

@@ -1,0 +1,268 @@
+// The light stage's parts on the CPU: median-cut environment sampling (energy, the sun's
+// direction and irradiance, stability under sensor noise, fisheye input), the ambient as
+// irradiance matrices, the stage's split of an environment into shadowed lights and ambient,
+// and the probeless estimate of a rendered room corner (direction and colour of its sun).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "light/env_sampler.h"
+#include "light/light_stage.h"
+#include "light/probeless.h"
+#include "light/sh_tools.h"
+
+namespace {
+using namespace mrgi;
+using namespace mrgi::light;
+
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+double angle_deg(const glm::dvec3& a, const glm::dvec3& b) {
+  return std::acos(std::clamp(glm::dot(glm::normalize(a), glm::normalize(b)), -1.0, 1.0)) / kDeg;
+}
+
+// Equirectangular direction of pixel (u, v) of a w x h image (light_from_environment's mapping).
+glm::dvec3 equirect_direction(int u, int v, int w, int h) {
+  const double theta = (v + 0.5) / h * kPi, phi = ((u + 0.5) / w - 0.5) * 2.0 * kPi;
+  return {std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi)};
+}
+
+// A sky of radiance `sky` over the upper hemisphere (a floor's worth of nothing below) and a sun
+// disc of `sun_radius_deg` towards `sun` whose irradiance at normal incidence is `sun_e`.
+struct Sky {
+  glm::dvec3 sun = glm::normalize(glm::dvec3(0.4, 0.7, -0.3));
+  glm::dvec3 sky{0.10, 0.15, 0.25};
+  glm::dvec3 sun_e{3.0, 2.7, 2.2};
+  double sun_radius_deg = 3.0;
+  ImageRGBF image(int w = 256, int h = 128) const {
+    ImageRGBF img(w, h);
+    const double cos_r = std::cos(sun_radius_deg * kDeg);
+    const double sun_solid_angle = 2.0 * kPi * (1.0 - cos_r);
+    for (int v = 0; v < h; ++v)
+      for (int u = 0; u < w; ++u) {
+        const glm::dvec3 d = equirect_direction(u, v, w, h);
+        glm::dvec3 l = d.y > 0.0 ? sky : glm::dvec3(0.0);
+        if (glm::dot(d, sun) >= cos_r) l += sun_e / sun_solid_angle * disc_scale(w, h);
+        float* t = img.at(u, v);
+        t[0] = float(l.x), t[1] = float(l.y), t[2] = float(l.z);
+      }
+    return img;
+  }
+  // The disc's pixels (by pixel centre) cover another solid angle than the analytic disc:
+  // their radiance is scaled so they carry exactly sun_e.
+  double disc_scale(int w, int h) const {
+    const double cos_r = std::cos(sun_radius_deg * kDeg);
+    double covered = 0.0;
+    for (int v = 0; v < h; ++v)
+      for (int u = 0; u < w; ++u)
+        if (glm::dot(equirect_direction(u, v, w, h), sun) >= cos_r)
+          covered += std::sin((v + 0.5) / h * kPi) * (kPi / h) * (2.0 * kPi / w);
+    return covered > 0.0 ? 2.0 * kPi * (1.0 - cos_r) / covered : 1.0;
+  }
+  // Total irradiance the image's pixels carry (sum L dw), which the cut must conserve.
+  static glm::dvec3 energy(const ImageRGBF& img) {
+    glm::dvec3 sum(0.0);
+    for (int v = 0; v < img.height; ++v)
+      for (int u = 0; u < img.width; ++u) {
+        const double theta = (v + 0.5) / img.height * kPi;
+        const double dw = std::sin(theta) * (kPi / img.height) * (2.0 * kPi / img.width);
+        const float* t = img.at(u, v);
+        sum += glm::dvec3(t[0], t[1], t[2]) * dw;
+      }
+    return sum;
+  }
+};
+
+TEST(EnvSampler, MedianCutConservesEnergyAndFindsTheSun) {
+  const Sky sky;
+  const ImageRGBF img = sky.image();
+  auto s = EnvSampler::create({});
+  ASSERT_TRUE(s.ok()) << s.error().message;
+  ASSERT_TRUE(s->update(img, EnvCamera{}, glm::dquat(1, 0, 0, 0)).ok());
+  ASSERT_EQ(s->lights().size(), 16u);
+  glm::dvec3 total(0.0);
+  double solid = 0.0;
+  for (const EnvLight& l : s->lights()) {
+    total += l.irradiance;
+    solid += l.solid_angle_sr;
+  }
+  const glm::dvec3 expected = Sky::energy(img);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(total[c], expected[c], 1e-3 * expected[c]);
+  EXPECT_NEAR(solid, 4.0 * kPi, 1e-6);
+  // The strongest light is (part of) the sun: the cut divides the sun itself, whose energy
+  // outweighs the sky's, so the lights within a few degrees of it hold its irradiance plus the
+  // little sky their regions hold.
+  const EnvLight& top = s->lights()[0];
+  EXPECT_LT(angle_deg(top.direction, sky.sun), 2.0);
+  glm::dvec3 near_sun(0.0);
+  for (const EnvLight& l : s->lights())
+    if (angle_deg(l.direction, sky.sun) < 5.0) near_sun += l.irradiance;
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_GE(near_sun[c], 0.98 * sky.sun_e[c]);
+    EXPECT_LE(near_sun[c], 1.15 * sky.sun_e[c]);
+  }
+  // Every region holds about the same energy (the median cut's invariant), up to the sun's
+  // indivisible cells.
+  for (size_t k = 1; k < s->lights().size(); ++k)
+    EXPECT_LE(luminance(s->lights()[k].irradiance), luminance(top.irradiance) + 1e-9);
+}
+
+TEST(EnvSampler, LightsStayPutUnderFrameNoise) {
+  const Sky sky;
+  const ImageRGBF clean = sky.image();
+  auto s = EnvSampler::create({});
+  ASSERT_TRUE(s.ok());
+  std::mt19937 rng(7);
+  std::normal_distribution<float> noise(0.0f, 0.03f);  // 3 % per pixel, a noisy HDR camera
+  std::vector<glm::dvec3> first;
+  double worst = 0.0;
+  for (int frame = 0; frame < 30; ++frame) {
+    ImageRGBF img = clean;
+    for (float& v : img.data) v *= std::max(0.0f, 1.0f + noise(rng));
+    ASSERT_TRUE(s->update(img, EnvCamera{}, glm::dquat(1, 0, 0, 0)).ok());
+    if (frame == 0) {
+      for (int k = 0; k < 4; ++k) first.push_back(s->lights()[size_t(k)].direction);
+      continue;
+    }
+    for (int k = 0; k < 4; ++k) {
+      // Match each of the first frame's strongest lights to its nearest light now.
+      double best = 180.0;
+      for (const EnvLight& l : s->lights()) best = std::min(best, angle_deg(l.direction, first[size_t(k)]));
+      worst = std::max(worst, best);
+    }
+  }
+  EXPECT_LT(worst, 2.0) << "a strong light moved by " << worst << " degrees under 3 % noise";
+  EXPECT_LT(angle_deg(s->lights()[0].direction, sky.sun), 1.0);
+}
+
+TEST(EnvSampler, FisheyeLookingUpSeesTheSunWhereItIs) {
+  // An equidistant fisheye of 180 degrees looking straight up (+y), its image x along world +x.
+  const Sky sky;
+  const int size = 128;
+  EnvCamera cam;
+  cam.model = EnvModel::FisheyeEquidistant;
+  cam.fov_deg = 180.0;
+  cam.cx = cam.cy = 0.5 * (size - 1);
+  cam.f = 0.5 * size / (0.5 * kPi);
+  // Camera axes (OpenCV: x right, y down, z forward) -> world: x -> +x, y -> -z, z -> +y.
+  const glm::dmat3 m(glm::dvec3(1, 0, 0), glm::dvec3(0, 0, -1), glm::dvec3(0, 1, 0));
+  cam.rotation = glm::quat_cast(m);
+  ImageRGBF img(size, size);
+  const double cos_r = std::cos(sky.sun_radius_deg * kDeg);
+  const double sun_solid_angle = 2.0 * kPi * (1.0 - cos_r);
+  for (int v = 0; v < size; ++v)
+    for (int u = 0; u < size; ++u) {
+      const double dx = u - cam.cx, dy = v - cam.cy, r = std::sqrt(dx * dx + dy * dy);
+      const double theta = r / cam.f;
+      if (theta > 0.5 * kPi) continue;
+      const glm::dvec3 d_cam = r > 0 ? glm::dvec3(std::sin(theta) * dx / r, std::sin(theta) * dy / r, std::cos(theta))
+                                     : glm::dvec3(0, 0, 1);
+      const glm::dvec3 d = m * d_cam;
+      glm::dvec3 l = sky.sky;
+      if (glm::dot(d, sky.sun) >= cos_r) l += sky.sun_e / sun_solid_angle;
+      float* t = img.at(u, v);
+      t[0] = float(l.x), t[1] = float(l.y), t[2] = float(l.z);
+    }
+  auto s = EnvSampler::create({});
+  ASSERT_TRUE(s.ok());
+  ASSERT_TRUE(s->update(img, cam, glm::dquat(1, 0, 0, 0)).ok());
+  EXPECT_LT(angle_deg(s->lights()[0].direction, sky.sun), 2.0);
+  // Nothing below the horizon: the fisheye does not see it.
+  for (const EnvLight& l : s->lights()) {
+    if (luminance(l.irradiance) > 1e-6) {
+      EXPECT_GT(l.direction.y, -0.05);
+    }
+  }
+}
+
+TEST(EnvSampler, RefusesBadSettingsAndImages) {
+  EXPECT_FALSE(EnvSampler::create({63, 16, 2.0}).ok());
+  EXPECT_FALSE(EnvSampler::create({64, 12, 2.0}).ok());
+  EXPECT_FALSE(EnvSampler::create({64, 16, -1.0}).ok());
+  auto s = EnvSampler::create({});
+  ASSERT_TRUE(s.ok());
+  EXPECT_FALSE(s->update(ImageRGBF{}, EnvCamera{}, glm::dquat(1, 0, 0, 0)).ok());
+  EnvCamera fisheye;
+  fisheye.model = EnvModel::FisheyeEquidistant;
+  EXPECT_FALSE(s->update(ImageRGBF(8, 8), fisheye, glm::dquat(1, 0, 0, 0)).ok());
+  // NaN and negative texels count as nothing.
+  ImageRGBF img(16, 8, 0.5f);
+  img.data[0] = std::nanf("");
+  img.data[5] = -3.0f;
+  ASSERT_TRUE(s->update(img, EnvCamera{}, glm::dquat(1, 0, 0, 0)).ok());
+  for (const EnvLight& l : s->lights()) EXPECT_TRUE(std::isfinite(l.irradiance.x));
+}
+
+TEST(IrradianceMatrices, AgreeWithTheShIrradiance) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    ShRgb l{};
+    for (auto& c : l) c = glm::dvec3(u(rng), u(rng), u(rng));
+    const auto m = irradiance_matrices(l);
+    for (int k = 0; k < 50; ++k) {
+      const glm::vec3 n = glm::normalize(glm::vec3(float(u(rng)), float(u(rng)), float(u(rng))));
+      const glm::dvec3 e = sh_irradiance(l, n);
+      const glm::vec4 n4(n, 1.0f);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(glm::dot(n4, m[size_t(c)] * n4), e[c], 1e-4);
+    }
+  }
+}
+
+// The stage's lights plus its ambient must reproduce the environment's irradiance for any
+// normal: the lights as deltas (what shading sees, unshadowed here), the ambient as SH.
+glm::dvec3 stage_irradiance(const Lighting& lit, const glm::dvec3& n) {
+  glm::dvec3 e = sh_irradiance(lit.ambient_real, glm::vec3(n));
+  e = glm::max(e, glm::dvec3(0.0));
+  for (const LightDesc& l : lit.lights)
+    e += glm::dvec3(l.color) * double(l.intensity) * std::max(0.0, glm::dot(n, -glm::dvec3(l.direction)));
+  return e;
+}
+
+TEST(LightStage, EnvironmentSplitsIntoShadowedLightsAndAmbientThatKeepTheIrradiance) {
+  const Sky sky;
+  const std::string path = ::testing::TempDir() + "light_stage_sky.exr";
+  ASSERT_TRUE(write_exr(path, sky.image()).ok());
+  SceneDesc scene;
+  scene.environment.present = true;
+  scene.environment.image = path;
+  auto stage = LightStage::create({}, scene, CameraSetup{});
+  ASSERT_TRUE(stage.ok()) << stage.error().message;
+  const Lighting& lit = (*stage)->lighting();
+  EXPECT_EQ(lit.source, LightSourceKind::Environment);
+  ASSERT_EQ(lit.lights.size(), 4u);
+  EXPECT_LT(angle_deg(-glm::dvec3(lit.lights[0].direction), sky.sun), 1.0);
+  // Truth: the sun's cosine plus the sky's (upper hemisphere, radiance L: pi L (1 + n.y) / 2).
+  for (const glm::dvec3 n : {glm::dvec3(0, 1, 0), glm::normalize(glm::dvec3(1, 1, 0)),
+                             glm::dvec3(0, 0, -1), glm::normalize(glm::dvec3(-0.3, 0.8, 0.5))}) {
+    const glm::dvec3 truth = sky.sun_e * std::max(0.0, glm::dot(n, sky.sun)) + kPi * sky.sky * 0.5 * (1.0 + n.y);
+    const glm::dvec3 got = stage_irradiance(lit, n);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], truth[c], 0.06 * luminance(truth) + 0.01) << n.x << " " << n.y << " " << n.z;
+  }
+  // The exported estimate: the sun's direction, and the light's colour (the sky's blue and
+  // the sun's warm white together).
+  EXPECT_LT(angle_deg(glm::dvec3(lit.estimate.direction_to_light[0], lit.estimate.direction_to_light[1],
+                                 lit.estimate.direction_to_light[2]), sky.sun), 10.0);
+  EXPECT_TRUE(lit.estimate.valid);
+}
+
+TEST(LightStage, UniformEnvironmentLightsAnUpFacingSurfaceLikeTheMean) {
+  // The baseline test scene's case: radiance L all round; every surface gets pi L. The four
+  // shadowed regions are a quarter of the sphere each drawn as one direction: within 8 %.
+  const std::string path = ::testing::TempDir() + "light_stage_uniform.exr";
+  ASSERT_TRUE(write_exr(path, ImageRGBF(64, 32, 0.05f)).ok());
+  SceneDesc scene;
+  scene.environment.present = true;
+  scene.environment.image = path;
+  auto stage = LightStage::create({}, scene, CameraSetup{});
+  ASSERT_TRUE(stage.ok()) << stage.error().message;
+  for (const glm::dvec3 n : {glm::dvec3(0, 1, 0), glm::dvec3(1, 0, 0), glm::dvec3(0, -1, 0)}) {
+    const glm::dvec3 e = stage_irradiance((*stage)->lighting(), n);
+    EXPECT_NEAR(e.y, kPi * 0.05, 0.08 * kPi * 0.05) << n.x << " " << n.y << " " << n.z;
+  }
+}
+
+}  // namespace
