@@ -14,7 +14,7 @@ namespace mrgi::tool {
 namespace {
 
 struct ReplayOptions {
-  std::string capture, technique = "baseline", out, level = "0", device;
+  std::string capture, technique = "baseline", out, level = "0", device, light = "declared";
   int frames = 0, width = 0, height = 0;
   bool validate = false, quiet = false;
 };
@@ -36,7 +36,13 @@ void run_replay(const ReplayOptions& o) {
   settings.output_height = o.height;
   settings.exposure = info.exposure;
   CameraSetup cameras{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera};
-  const SceneDesc scene = capture.scene() ? *capture.scene() : SceneDesc{};
+  SceneDesc scene = capture.scene() ? *capture.scene() : SceneDesc{};
+  // The env intensity stays known for the truth of the direction error (env frames).
+  const double env_intensity = scene.environment.present ? scene.environment.intensity : 1.0;
+  if (o.light == "estimate") {  // what an app that declares nothing sees: the runtime's estimate
+    scene.lights.clear();
+    scene.environment = EnvironmentDesc{};
+  }
   auto runtime = take(create_runtime(settings, cameras, scene));
 
   const int out_w = o.width ? o.width : info.color.width, out_h = o.height ? o.height : info.color.height;
@@ -67,7 +73,6 @@ void run_replay(const ReplayOptions& o) {
   BoundedQueue<Decoded> decoded(kQueued);
   BoundedQueue<Finished> finished(kQueued);
   ReturnQueue<FrameOutput> encoded;  // outputs written, for Runtime::recycle
-  const double env_intensity = scene.environment.present ? scene.environment.intensity : 1.0;
   size_t written = 0;
   const auto t0 = std::chrono::steady_clock::now();
   StageThread decode(
@@ -173,6 +178,10 @@ void setup(CLI::App& app) {
   cmd->add_option("--frames,-n", opts->frames, "replay at most N frames (0 = all)")->check(CLI::NonNegativeNumber);
   cmd->add_option("--width", opts->width, "output width in pixels (default: the colour camera's)")->check(CLI::Range(16, 8192));
   cmd->add_option("--height", opts->height, "output height in pixels")->check(CLI::Range(16, 8192));
+  cmd->add_option("--light", opts->light,
+                  "declared: scene.json's lamps and environment light the scene (default); estimate: they are "
+                  "ignored and the runtime estimates the light from the frames, as for an app that declares none")
+      ->check(CLI::IsMember({"declared", "estimate"}));
   cmd->add_option("--device", opts->device, "Vulkan device: index or name part (default $MRGI_DEVICE, else lavapipe)");
   cmd->add_flag("--validate", opts->validate, "enable Vulkan validation layers");
   cmd->add_flag("--quiet,-q", opts->quiet, "no progress on stderr");

@@ -58,8 +58,9 @@ TEST(GoldenSsrt, EnvFisheyeLightDirectionAndRdeBeatBaseline) {
               lit.pooled.real.rde, lit.pooled.virtual_.rde);
   const test::ReplayResult base = test::replay_capture(kCapture, "baseline", 0, true);
   ASSERT_TRUE(base.any && base.pooled.all.rde_defined);
-  std::printf("baseline high, probeless estimate: RDE all %.3f real %.3f virtual %.3f\n", base.pooled.all.rde,
-              base.pooled.real.rde, base.pooled.virtual_.rde);
+  std::printf("baseline high, probeless estimate: RDE all %.3f real %.3f virtual %.3f, direction error "
+              "median %.1f deg\n", base.pooled.all.rde, base.pooled.real.rde, base.pooled.virtual_.rde,
+              median(base.light_error_deg));
   struct Case {
     const char* level;
     int index;

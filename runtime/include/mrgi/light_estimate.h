@@ -1,7 +1,8 @@
-// The real-world light estimated from the camera image (probeless: image-space radiance transfer,
-// technique `ssrt`), in the two forms AR apps consume: spherical-harmonics environment radiance
-// (like ARCore's ambient SH / Filament's IndirectLight::irradiance) and one dominant directional
-// light (like ARCore's main light direction + intensity / a Filament sun).
+// The real-world light as the runtime's light stage knows it (declared lamps, an environment
+// image, or the probeless estimate from the camera frames), in the forms AR apps consume:
+// spherical-harmonics environment radiance and one dominant directional light, as LightEstimate;
+// ARCore Environmental HDR's shape (EnvironmentalHdr: main light, 27 SH coefficients, a small
+// HDR cubemap); and Filament's pre-scaled irradiance SH (to_filament_irradiance).
 //
 // Conventions (DESIGN.md): world space, right-handed, metres, +y up; linear RGB.
 // SH: real orthonormal basis of shaders/shared/mrgi_shared.h (Sloan 2008 sign convention and
@@ -51,6 +52,41 @@ struct LightEstimate {
 // 1, frame_index -1. BadInput for an empty image or a fisheye without a focal length.
 Expected<LightEstimate> light_from_environment(const ImageRGBF& image, const EnvCamera& camera,
                                                double intensity = 1.0, int bands = 4);
+
+// ARCore Environmental HDR's shape (ArLightEstimate_getEnvironmentalHdr*): what an app written
+// against ARCore's light estimation reads, filled from a LightEstimate.
+struct EnvironmentalHdr {
+  // Unit vector towards the main light, world space (ARCore's main light direction; Filament's
+  // LightManager::setDirection wants its negation: the direction light travels).
+  std::array<float, 3> main_light_direction{0.0f, 1.0f, 0.0f};
+  // Its irradiance at normal incidence, linear RGB (ARCore's main light intensity).
+  std::array<float, 3> main_light_intensity{0.0f, 0.0f, 0.0f};
+  // Ambient radiance SH, 9 RGB triplets (27 floats: coefficient-major, R G B), bands 0..2 of
+  // LightEstimate::sh_radiance: the real orthonormal basis with the Condon-Shortley sign, the
+  // same coefficients ARCore's getEnvironmentalHdrAmbientSphericalHarmonics returns (not
+  // convolved: multiply by to_filament_irradiance's factors for Filament).
+  std::array<float, 27> ambient_sh{};
+  // The HDR cubemap (when asked for; else empty): 6 faces of face_size^2 linear RGB texels in
+  // OpenGL's order +X, -X, +Y, -Y, +Z, -Z and orientation (ARCore's 16 x 16 cubemap), the SH
+  // radiance evaluated at each texel's direction (so blurred to 4 bands), clamped at 0.
+  int face_size = 0;
+  std::array<ImageRGBF, 6> cubemap;
+  bool valid = false;
+};
+
+// BadUsage for face_size outside 0..256 (0 = no cubemap).
+Expected<EnvironmentalHdr> to_environmental_hdr(const LightEstimate& estimate, int face_size = 16);
+
+// Filament's irradiance SH (IndirectLight::Builder::irradiance(3, sh)): 9 RGB coefficients
+// pre-scaled by the cosine lobe A_l / pi and the basis constants, so that Filament's shader
+//   max(sh[0] + sh[1] y + sh[2] z + sh[3] x + sh[4] y x + sh[5] y z + sh[6] (3 z^2 - 1)
+//       + sh[7] z x + sh[8] (x^2 - y^2), 0)
+// gives E(n) / pi, the Lambertian radiance of a white surface (Filament then multiplies by the
+// diffuse colour). The factors per coefficient are (A_l / pi) * K_lm * (Condon-Shortley sign):
+// 0.282095, -0.325735, 0.325735, -0.325735, 0.273137, -0.273137, 0.078848, -0.273137, 0.136569,
+// the same as Sceneform applies to ARCore's coefficients. Both use +y up, right-handed world
+// axes, so no rotation is needed.
+std::array<Rgb, 9> to_filament_irradiance(const LightEstimate& estimate);
 
 // Angle in degrees between the dominant directions of two estimates.
 double direction_error_deg(const LightEstimate& a, const LightEstimate& b);

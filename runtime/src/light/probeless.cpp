@@ -23,12 +23,13 @@ constexpr float kSameSurface = float(MRGI_DEPTH_EDGE_RELATIVE);
 
 Expected<ProbelessBuilder> ProbelessBuilder::create(const ProbelessSettings& s, const Intrinsics& color,
                                                     const Intrinsics& depth, double depth_scale) {
-  MRGI_TRY(check_range(s.stride >= 2 && s.stride <= 64, "stride", "must be 2..64 pixels"));
+  MRGI_TRY(check_range(s.grid_width >= 16 && s.grid_width <= 512, "grid_width", "must be 16..512 samples"));
   MRGI_TRY(check_range(s.directions >= 16 && s.directions <= 1024, "directions", "must be 16..1024"));
   MRGI_TRY(check_range(s.march_steps >= 1 && s.march_steps <= 64, "march_steps", "must be 1..64"));
   MRGI_TRY(check_range(s.radius_m > 0.0 && std::isfinite(s.radius_m), "radius_m", "must be > 0 metres"));
   MRGI_TRY(check_range(s.parts >= 1 && s.parts <= 16, "parts", "must be 1..16 frames"));
-  if (color.width < 1 || color.height < 1 || depth.width < s.stride || depth.height < s.stride ||
+  const int stride = std::max(2, depth.width / s.grid_width);
+  if (color.width < 1 || color.height < 1 || depth.width < stride || depth.height < stride ||
       !(color.fx > 0) || !(color.fy > 0) || !(depth.fx > 0) || !(depth.fy > 0) || !(depth_scale > 0))
     return fail(ErrorKind::BadInput, "probeless light estimation: camera intrinsics need sizes of at "
                                      "least one sample block, focal lengths and depth_scale > 0");
@@ -37,8 +38,9 @@ Expected<ProbelessBuilder> ProbelessBuilder::create(const ProbelessSettings& s, 
   b.color_ = color;
   b.depth_ = depth;
   b.depth_scale_ = depth_scale;
-  b.grid_w_ = depth.width / s.stride;
-  b.grid_h_ = depth.height / s.stride;
+  b.stride_ = stride;
+  b.grid_w_ = depth.width / stride;
+  b.grid_h_ = depth.height / stride;
   b.position_.assign(size_t(b.grid_w_) * size_t(b.grid_h_), glm::vec3(0.0f));
   b.directions_.reserve(size_t(s.directions));
   b.direction_sh_.reserve(size_t(s.directions));
@@ -54,7 +56,7 @@ Expected<ProbelessBuilder> ProbelessBuilder::create(const ProbelessSettings& s, 
 }
 
 void ProbelessBuilder::build_positions(const InputFrame& frame) {
-  const int s = settings_.stride;
+  const int s = stride_;
   const glm::vec4 k(float(depth_.fx), float(depth_.fy), float(depth_.cx), float(depth_.cy));
   const float to_m = float(1.0 / depth_scale_);
   for (int gy = 0; gy < grid_h_; ++gy) {
@@ -102,7 +104,7 @@ Status ProbelessBuilder::add_part(const InputFrame& frame, const glm::dmat4& cam
   const glm::vec4 kd(float(depth_.fx), float(depth_.fy), float(depth_.cx), float(depth_.cy));
   const glm::vec4 kc(float(color_.fx), float(color_.fy), float(color_.cx), float(color_.cy));
   const auto& lut = srgb8_to_linear_table();
-  const int s = settings_.stride;
+  const int s = stride_;
   const float radius = float(settings_.radius_m);
   const float solid_angle = float(4.0 * kPi / settings_.directions);
   const float inv_stride = 1.0f / float(s);

@@ -6,8 +6,9 @@
 //
 // Why on the CPU and coarse: the estimate is a 16-coefficient least-squares fit whose error is
 // ruled by what the view shows (which normals, which shadows), not by how many pixels vote, so a
-// grid of one sample per `stride` x `stride` depth pixels (80 x 60 at 640 x 480) carries the same
-// information as every pixel. Each sample's depth and colour are averages over its block, which
+// grid of about 80 samples across the depth image (one per 8 x 8 pixels at 640 x 480, per 4 x 4
+// at 320 x 240: relative to the input, so a small capture is not sampled more coarsely) carries
+// the same information as every pixel. Each sample's depth and colour are averages over its block, which
 // also takes out most of the sensor noise. At that size the work is a few ms of one core, and it
 // is spread over `parts` frames (rows interleaved) so no frame pays it all: every technique gets
 // the estimate for a constant, small cost instead of a GPU pass (ssrt, whose transfer pass
@@ -29,7 +30,9 @@
 namespace mrgi::light {
 
 struct ProbelessSettings {
-  int stride = 8;             // depth pixels per sample, each side (2..64)
+  // Samples across the depth image's width (16..512); each stands for a square block of
+  // width / grid_width pixels (at least 2).
+  int grid_width = 80;
   int directions = 64;        // visibility directions over the sphere (Fibonacci), 16..1024
   int march_steps = 6;        // depth-image steps per direction (1..64)
   double radius_m = 0.6;      // how far an occluder is searched, metres (> 0)
@@ -60,6 +63,7 @@ class ProbelessBuilder {
   ProbelessSettings settings_;
   Intrinsics color_, depth_;
   double depth_scale_ = 5000.0;
+  int stride_ = 8;                      // depth pixels per sample, each side
   int grid_w_ = 0, grid_h_ = 0;
   float chi_ = 0.0f;
   std::vector<glm::vec3> directions_;   // unit, world

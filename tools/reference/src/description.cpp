@@ -313,7 +313,7 @@ Expected<SceneDescription> load_scene_description(const std::string& path) {
   auto root = JsonObject::from(*json, path, "");
   if (!root) return root.error();
   MRGI_TRY(root->only_keys({"version", "frames", "fps", "camera", "camera_path", "render", "real_objects", "lights",
-                            "environment", "virtual_objects", "depth_sensor", "env_camera"}));
+                            "environment", "virtual_objects", "depth_sensor", "env_camera", "light_probe"}));
   const fs::path base = fs::path(path).parent_path();
   SceneDescription d;
   d.path = path;
@@ -382,9 +382,38 @@ Expected<SceneDescription> load_scene_description(const std::string& path) {
   if (root->has("environment")) {
     auto e = root->object("environment");
     if (!e) return e.error();
-    MRGI_TRY(e->only_keys({"image", "intensity", "rotation", "capture_width"}));
-    auto img = existing_file(*e, "image", base);
-    if (!img) return img.error();
+    MRGI_TRY(e->only_keys({"image", "sky", "intensity", "rotation", "capture_width"}));
+    if (e->has("image") == e->has("sky")) return e->error("image", "give exactly one of \"image\" and \"sky\"");
+    std::string img_path;
+    std::optional<ProceduralSky> sky;
+    if (e->has("image")) {
+      auto img = existing_file(*e, "image", base);
+      if (!img) return img.error();
+      img_path = *img;
+    } else {
+      auto so = e->object("sky");
+      if (!so) return so.error();
+      MRGI_TRY(so->only_keys({"sun_direction", "sun_irradiance", "sun_radius_deg", "zenith", "horizon", "ground", "width"}));
+      ProceduralSky k;
+      auto dir = unit_direction(*so, "sun_direction", k.sun_direction);
+      if (!dir) return dir.error();
+      auto irr = colour(*so, "sun_irradiance", k.sun_irradiance);
+      if (!irr) return irr.error();
+      auto rad = so->number("sun_radius_deg", k.sun_radius_deg);
+      if (!rad) return rad.error();
+      if (!(*rad >= 0.3 && *rad <= 10.0)) return so->error("sun_radius_deg", "must be in [0.3, 10] degrees");
+      auto zen = colour(*so, "zenith", k.zenith);
+      if (!zen) return zen.error();
+      auto hor = colour(*so, "horizon", k.horizon);
+      if (!hor) return hor.error();
+      auto gro = colour(*so, "ground", k.ground);
+      if (!gro) return gro.error();
+      auto w = so->integer("width", k.width);
+      if (!w) return w.error();
+      if (*w < 64 || *w > 4096 || *w % 2 != 0) return so->error("width", "must be an even number in [64, 4096]");
+      k = {*dir, *irr, *rad, *zen, *hor, *gro, int(*w)};
+      sky = k;
+    }
     auto in = non_negative(*e, "intensity", 1.0);
     if (!in) return in.error();
     auto rot = e->quat_xyzw("rotation", glm::dquat(1.0, 0.0, 0.0, 0.0));
@@ -392,7 +421,7 @@ Expected<SceneDescription> load_scene_description(const std::string& path) {
     auto cw = e->integer("capture_width", 256);
     if (!cw) return cw.error();
     if (*cw < 0 || *cw > 8192 || *cw % 2 != 0) return e->error("capture_width", "must be an even number in [0, 8192]");
-    d.environment = {true, *img, *in, *rot, *cw};
+    d.environment = {true, img_path, sky, *in, *rot, *cw};
   }
   if (root->has("virtual_objects")) {
     auto objs = root->objects("virtual_objects");
@@ -442,6 +471,19 @@ Expected<SceneDescription> load_scene_description(const std::string& path) {
       return e->error("up", "must not be parallel to the viewing direction (and look_at must differ from position)");
     d.env_camera = c;
   }
+  if (root->has("light_probe")) {
+    auto lp = root->object("light_probe");
+    if (!lp) return lp.error();
+    MRGI_TRY(lp->only_keys({"width", "spp"}));
+    auto w = lp->integer("width", 64);
+    if (!w) return w.error();
+    if (*w < 8 || *w > 1024 || *w % 2 != 0) return lp->error("width", "must be an even number in [8, 1024]");
+    auto spp = lp->integer("spp", 256);
+    if (!spp) return spp.error();
+    if (*spp < 1 || *spp > (1 << 20)) return lp->error("spp", "must be in [1, 1048576]");
+    if (d.virtual_objects.empty()) return lp->error("width", "a light probe needs a virtual object (it sits at their centre)");
+    d.light_probe = LightProbeDesc{int(*w), int(*spp)};
+  }
   if (d.environment.present && d.environment.capture_width == 0 && !d.env_camera)
     return root->error("environment", "capture_width 0 needs an env_camera, else the capture has no environment");
   return d;
@@ -480,6 +522,51 @@ Pose camera_pose_at(const SceneDescription& d, double t) {
   pose.translation = k.position;
   pose.rotation = look_rotation(k.position, k.look_at, k.up);
   return pose;
+}
+
+}  // namespace mrgi::reference
+
+namespace mrgi::reference {
+
+ImageRGBF render_sky(const ProceduralSky& sky) {
+  constexpr double kPi = 3.14159265358979323846;
+  const int w = sky.width, h = sky.width / 2;
+  ImageRGBF img(w, h);
+  const glm::dvec3 sun = glm::normalize(sky.sun_direction);
+  const double cos_r = std::cos(sky.sun_radius_deg * kPi / 180.0);
+  auto direction = [&](int u, int v) {
+    const double theta = (v + 0.5) / h * kPi, phi = ((u + 0.5) / w - 0.5) * 2.0 * kPi;
+    return glm::dvec3(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
+  };
+  // The disc's pixels cover another solid angle than the analytic disc: their radiance is set so
+  // they carry the sun's irradiance exactly (a disc smaller than a pixel still gets its pixel).
+  double covered = 0.0;
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u)
+      if (glm::dot(direction(u, v), sun) >= cos_r)
+        covered += std::sin((v + 0.5) / h * kPi) * (kPi / h) * (2.0 * kPi / w);
+  int nearest_u = 0, nearest_v = 0;
+  double nearest = -2.0;
+  if (covered == 0.0) {  // no pixel centre inside: the nearest pixel carries the sun
+    for (int v = 0; v < h; ++v)
+      for (int u = 0; u < w; ++u)
+        if (const double c = glm::dot(direction(u, v), sun); c > nearest) {
+          nearest = c;
+          nearest_u = u;
+          nearest_v = v;
+        }
+    covered = std::sin((nearest_v + 0.5) / h * kPi) * (kPi / h) * (2.0 * kPi / w);
+  }
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      const glm::dvec3 d = direction(u, v);
+      glm::dvec3 l = d.y > 0.0 ? sky.horizon + (sky.zenith - sky.horizon) * std::sqrt(d.y) : sky.ground;
+      const bool in_disc = nearest > -2.0 ? (u == nearest_u && v == nearest_v) : glm::dot(d, sun) >= cos_r;
+      if (in_disc) l += sky.sun_irradiance / covered;
+      float* t = img.at(u, v);
+      t[0] = float(l.x), t[1] = float(l.y), t[2] = float(l.z);
+    }
+  return img;
 }
 
 }  // namespace mrgi::reference

@@ -45,6 +45,10 @@ bool Integrator::camera_ray(double px, double py, glm::vec3* origin, glm::vec3* 
   if (camera_.model == RefCamera::Model::Pinhole) {
     const Intrinsics& k = camera_.pinhole;
     dc = glm::normalize(glm::dvec3((px - k.cx) / k.fx, (py - k.cy) / k.fy, 1.0));
+  } else if (camera_.model == RefCamera::Model::Equirectangular) {
+    constexpr double kPi = 3.14159265358979323846;
+    const double theta = (py + 0.5) / camera_.height * kPi, phi = ((px + 0.5) / camera_.width - 0.5) * 2.0 * kPi;
+    dc = glm::dvec3(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
   } else {
     const double dx = px - camera_.fisheye_cx, dy = py - camera_.fisheye_cy;
     const double r = std::sqrt(dx * dx + dy * dy);

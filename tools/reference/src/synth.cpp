@@ -1,9 +1,14 @@
 // `mrgi synth`: scene description -> capture v1 folder (see mrgi/reference/synth.h).
 #include "mrgi/reference/synth.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
+
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "mrgi/platform/capture.h"
 #include "mrgi/reference/path_tracer.h"
@@ -44,6 +49,62 @@ Status copy_file(const std::string& from, const fs::path& to) {
   fs::copy_file(from, to, fs::copy_options::overwrite_existing, ec);
   if (ec) return fail(ErrorKind::BadInput, "copying '" + from + "' to '" + to.string() + "': " + ec.message());
   return ok_status();
+}
+
+// Whether the segment from `o` along unit `d` up to `tmax` hits a real triangle (brute force:
+// a light probe's few shadow rays over a synthetic scene's few thousand triangles).
+bool real_occluded(const RefScene& scene, const glm::vec3& o, const glm::vec3& d, float tmax) {
+  for (const RefMesh& m : scene.meshes) {
+    if (m.is_virtual) continue;
+    for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
+      const glm::vec3 a = m.positions[m.indices[t]], b = m.positions[m.indices[t + 1]], c = m.positions[m.indices[t + 2]];
+      const glm::vec3 e1 = b - a, e2 = c - a, p = glm::cross(d, e2);
+      const float det = glm::dot(e1, p);
+      if (std::abs(det) < 1e-12f) continue;
+      const float inv = 1.0f / det;
+      const glm::vec3 s = o - a;
+      const float u = glm::dot(s, p) * inv;
+      if (u < 0.0f || u > 1.0f) continue;
+      const glm::vec3 q = glm::cross(s, e1);
+      const float v = glm::dot(d, q) * inv;
+      if (v < 0.0f || u + v > 1.0f) continue;
+      const float dist = glm::dot(e2, q) * inv;
+      if (dist > 1e-4f && dist < tmax) return true;
+    }
+  }
+  return false;
+}
+
+// A camera never sees a delta lamp (point, spot, directional): their direct light at the probe
+// is added to the pixel each one's direction falls in, as radiance = irradiance / the pixel's
+// solid angle, where no real surface blocks it. Virtual lamps are not part of the real scene.
+void add_delta_lamps(const RefScene& scene, const glm::vec3& p, ImageRGBF& probe) {
+  constexpr double kPi = 3.14159265358979323846;
+  for (const RefLight& l : scene.lights) {
+    if (l.is_virtual) continue;
+    glm::vec3 wi, e;
+    float dist = 1e30f;
+    if (l.type == RefLightType::Directional) {
+      wi = -glm::normalize(l.direction);
+      e = l.intensity;
+    } else {
+      const glm::vec3 to = l.position - p;
+      const float d2 = glm::dot(to, to);
+      if (!(d2 > 0.0f)) continue;
+      dist = std::sqrt(d2);
+      wi = to / dist;
+      e = l.intensity / d2;
+      if (l.type == RefLightType::Spot)
+        e *= shader::spot_falloff(glm::dot(-wi, glm::normalize(l.direction)), l.cos_outer, l.cos_inner);
+    }
+    if (glm::all(glm::equal(e, glm::vec3(0.0f))) || real_occluded(scene, p, wi, dist)) continue;
+    const double u = 0.5 + std::atan2(double(wi.x), -double(wi.z)) / (2.0 * kPi);
+    const double v = std::acos(std::clamp(double(wi.y), -1.0, 1.0)) / kPi;
+    const int x = std::clamp(int(u * probe.width), 0, probe.width - 1), y = std::clamp(int(v * probe.height), 0, probe.height - 1);
+    const double dw = std::sin((y + 0.5) / probe.height * kPi) * (kPi / probe.height) * (2.0 * kPi / probe.width);
+    float* t = probe.at(x, y);
+    for (int c = 0; c < 3; ++c) t[c] += float(e[c] / dw);
+  }
 }
 
 RefCamera env_camera_model(const EnvCameraDesc& e, EnvCamera* info) {
@@ -296,6 +357,46 @@ Expected<SynthReport> synthesize_capture(const SceneDescription& description, co
     report.frame_seconds += r.seconds;
   }
   if (!state.frames.empty()) report.noise_floor = state.frames[0].noise_floor;
+  if (report.finished && d.light_probe && !fs::exists(staging / "light_probe" / "probe.exr")) {
+    // The probe: the real scene's incident radiance at the virtual objects' frame-0 centre.
+    const RefScene at0 = scene->at_time(0.0);
+    glm::dvec3 lo(1e30), hi(-1e30);
+    for (const RefMesh& m : at0.meshes)
+      if (m.is_virtual)
+        for (const glm::vec3& p : m.positions) {
+          lo = glm::min(lo, glm::dvec3(p));
+          hi = glm::max(hi, glm::dvec3(p));
+        }
+    const glm::dvec3 centre = 0.5 * (lo + hi);
+    auto tracer = PathTracer::create(at0);
+    if (!tracer) return tracer.error();
+    RefCamera probe;
+    probe.model = RefCamera::Model::Equirectangular;
+    probe.width = d.light_probe->width;
+    probe.height = d.light_probe->width / 2;
+    probe.camera_to_world = glm::translate(glm::dmat4(1.0), centre);
+    RenderSettings ps;
+    ps.spp = d.light_probe->spp;
+    ps.max_depth = d.max_depth;
+    ps.rr_depth = d.rr_depth;
+    ps.seed = d.seed;
+    ps.threads = options.threads;
+    ps.real_only = true;
+    auto img = (*tracer)->render(probe, ps);
+    if (!img) return img.error();
+    add_delta_lamps(at0, glm::vec3(centre), img->real);
+    fs::create_directories(staging / "light_probe", ec);
+    MRGI_TRY(write_exr((staging / "light_probe" / "probe.exr").string(), img->real));
+    std::ofstream j(staging / "light_probe" / "probe.json");
+    char text[512];
+    std::snprintf(text, sizeof text,
+                  "{\n \"about\": \"incident radiance of the real scene (lamps, environment, bounce light, occlusion) at the "
+                  "virtual objects' frame-0 centre, path-traced, equirectangular in world axes (u = 0.5 + atan2(x, -z) / 2pi, "
+                  "v = acos(y) / pi), linear radiance\",\n \"position\": [%.6f, %.6f, %.6f],\n \"spp\": %d\n}\n",
+                  centre.x, centre.y, centre.z, ps.spp);
+    j << text;
+    if (!j) return fail(ErrorKind::Device, (staging / "light_probe" / "probe.json").string() + ": cannot write");
+  }
   if (report.finished) {
     fs::remove(resume_path, ec);
     if (ec) return fail(ErrorKind::Device, resume_path + ": cannot remove: " + ec.message());

@@ -59,7 +59,8 @@ Expected<SynthResumeState> synth_resume_identity(const SceneDescription& d, cons
   for (const auto& o : d.real_objects)
     if (!o.gltf.empty()) MRGI_TRY(add_file(&hash, o.gltf, "a real object's glTF"));
   for (const auto& v : d.virtual_objects) MRGI_TRY(add_file(&hash, v.gltf, "a virtual object's glTF"));
-  if (d.environment.present) MRGI_TRY(add_file(&hash, d.environment.image, "the environment image"));
+  if (d.environment.present && !d.environment.sky)
+    MRGI_TRY(add_file(&hash, d.environment.image, "the environment image"));
   char hex[17];
   std::snprintf(hex, sizeof(hex), "%016llx", static_cast<unsigned long long>(hash.h));
   s.fingerprint = hex;

@@ -130,9 +130,13 @@ Expected<SynthScene> SynthScene::load(const SceneDescription& d) {
     scene.lights.push_back(r);
   }
   if (d.environment.present) {
-    auto img = load_hdr_image(d.environment.image);
-    if (!img) return fail(img.error().kind, d.path + ": environment.image: " + img.error().message);
-    scene.environment.image = std::move(*img);
+    if (d.environment.sky) {
+      scene.environment.image = render_sky(*d.environment.sky);
+    } else {
+      auto img = load_hdr_image(d.environment.image);
+      if (!img) return fail(img.error().kind, d.path + ": environment.image: " + img.error().message);
+      scene.environment.image = std::move(*img);
+    }
     scene.environment.intensity = float(d.environment.intensity);
     scene.environment.rotation = glm::mat3(glm::mat3_cast(glm::quat(d.environment.rotation)));
   }

@@ -42,7 +42,17 @@
 //     ],
 //     "environment": {                    optional real surroundings (equirectangular, linear HDR;
 //                                         mapping in mrgi/reference/path_tracer.h)
-//       "image": "file.exr", "intensity": 1, "rotation": [0,0,0,1] (environment-to-world),
+//       "image": "file.exr"               an image file, or
+//       "sky": {                          a procedural sun and sky (render_sky below), env axes:
+//         "sun_direction": [x,y,z],       towards the sun (normalised; below the horizon allowed)
+//         "sun_irradiance": [r,g,b],      W/m^2 at normal incidence (default 3 3 3)
+//         "sun_radius_deg": 2,            angular radius of the disc, 0.3..10
+//         "zenith": [r,g,b], "horizon": [r,g,b],   sky radiance overhead and at the horizon,
+//                                         blended by sqrt(elevation sine) (defaults blue, paler)
+//         "ground": [r,g,b],              radiance below the horizon (default 0.03 grey)
+//         "width": 512                    image width (height width / 2), 64..4096, even
+//       },                                exactly one of "image" and "sky";
+//       "intensity": 1, "rotation": [0,0,0,1] (environment-to-world),
 //       "capture_width": 256              width of the copy written into the capture (height =
 //                                         width / 2, box-filtered); 0 = not copied (then an env
 //                                         camera must be given)
@@ -103,9 +113,24 @@ struct LampDesc {
   glm::dvec2 size{0.2, 0.2};       // area lamp edge lengths
 };
 
+// A procedural sun and sky (description "environment.sky").
+struct ProceduralSky {
+  glm::dvec3 sun_direction{0.0, 1.0, 0.0};  // unit, towards the sun, environment axes
+  glm::dvec3 sun_irradiance{3.0};           // W/m^2 at normal incidence
+  double sun_radius_deg = 2.0;
+  glm::dvec3 zenith{0.05, 0.09, 0.20}, horizon{0.12, 0.15, 0.20}, ground{0.03};
+  int width = 512;
+};
+
+// The equirectangular image of a procedural sky (mapping of path_tracer.h): sky radiance
+// horizon + (zenith - horizon) sqrt(y) above the horizon, `ground` below, plus the sun disc,
+// whose pixels (by pixel centre) are scaled so they carry exactly sun_irradiance.
+ImageRGBF render_sky(const ProceduralSky& sky);
+
 struct EnvironmentSourceDesc {
   bool present = false;
-  std::string image;               // absolute path
+  std::string image;               // absolute path; empty when `sky` is given
+  std::optional<ProceduralSky> sky;
   double intensity = 1.0;
   glm::dquat rotation{1.0, 0.0, 0.0, 0.0};
   int capture_width = 256;
@@ -127,6 +152,11 @@ struct EnvCameraDesc {
   int spp = 16;
 };
 
+struct LightProbeDesc {
+  int width = 64;   // equirectangular width (height = width / 2), 8..1024, even
+  int spp = 256;
+};
+
 struct SceneDescription {
   std::string path;                // the file it came from
   int frames = 8;
@@ -143,6 +173,7 @@ struct SceneDescription {
   std::vector<VirtualObjectMotionDesc> virtual_objects;
   DepthSensorSettings depth;
   std::optional<EnvCameraDesc> env_camera;
+  std::optional<LightProbeDesc> light_probe;
 };
 
 Expected<SceneDescription> load_scene_description(const std::string& path);

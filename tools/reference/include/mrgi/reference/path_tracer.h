@@ -95,9 +95,11 @@ struct RefScene {
 // The camera the image is rendered through. Pose is camera-to-world in the OpenCV/TUM convention
 // (x right, y down, looking along +z).
 struct RefCamera {
-  enum class Model { Pinhole, FisheyeEquidistant } model = Model::Pinhole;
+  // Equirectangular: the whole sphere around the camera's position in the environment mapping
+  // above (width x height, camera_to_world's rotation applied), e.g. a light probe.
+  enum class Model { Pinhole, FisheyeEquidistant, Equirectangular } model = Model::Pinhole;
   Intrinsics pinhole;                   // Pinhole: pixel intrinsics (width and height used)
-  int width = 256, height = 256;        // Fisheye: image size
+  int width = 256, height = 256;        // Fisheye, Equirectangular: image size
   double fisheye_f = 0.0, fisheye_cx = 0.0, fisheye_cy = 0.0;  // Fisheye: r = f * theta
   double fisheye_fov_deg = 180.0;       // Fisheye: full field of view; outside it is black
   glm::dmat4 camera_to_world{1.0};

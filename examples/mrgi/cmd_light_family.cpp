@@ -1,0 +1,69 @@
+// mrgi light-family: the light-estimation family (perf/suite/light/family.json) replayed lit by
+// its true light and by the runtime's estimate; a Markdown table of direction, irradiance,
+// colour and RDE figures per scene and per half (tuning / held out), and JSON beside it.
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include "commands.h"
+#include "mrgi/perf/bench.h"
+#include "mrgi/perf/light_family.h"
+
+namespace mrgi::tool {
+namespace {
+
+struct Options {
+  perf::LightFamilySettings settings;
+  std::string level = "0";
+  std::string out;
+};
+
+void write_file(const std::string& path, const std::string& text) {
+  const std::string partial = path + ".partial";
+  {
+    std::ofstream f(partial);
+    f << text;
+    if (!f) throw CommandFailure(1, partial + ": cannot write");
+  }
+  if (std::rename(partial.c_str(), path.c_str()) != 0)
+    throw CommandFailure(1, path + ": cannot move the finished file into place");
+}
+
+void run(Options o) {
+  perf::ensure_lp_num_threads();
+  o.settings.level = resolve_level(o.settings.technique, o.level);
+  const auto results = take(perf::run_light_family(o.settings, [](const std::string& what, size_t done, size_t total) {
+    progress(what, done, total, 0.0);
+  }));
+  const std::string md = perf::light_family_markdown(results, o.settings);
+  std::cout << md;
+  if (!o.out.empty()) {
+    std::filesystem::create_directories(o.out);
+    write_file(o.out + "/light-family.md", md);
+    write_file(o.out + "/light-family.json", perf::light_family_json(results));
+  }
+}
+
+void setup(CLI::App& app) {
+  auto o = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "light-family", "Replay the light-estimation family lit by the true light and by the runtime's "
+                      "estimate; direction, irradiance, colour and RDE figures per scene and per half");
+  cmd->add_option("--manifest", o->settings.manifest, "family manifest (default perf/suite/light/family.json)");
+  cmd->add_option("--technique", o->settings.technique, "technique to light (default baseline)");
+  cmd->add_option("--level", o->level, "level: number, name or 'last' (default 0)");
+  cmd->add_option("--root", o->settings.root, "folder the manifest's capture paths are relative to (default .)");
+  cmd->add_option("--half", o->settings.half,
+                  "all (default), tuning (the scenes a parameter may be chosen on) or held-out")
+      ->check(CLI::IsMember({"all", "tuning", "held-out"}));
+  cmd->add_flag("--validate", o->settings.validate, "Vulkan validation layers on (a message fails the run)");
+  cmd->add_option("-o,--out", o->out, "write light-family.md and light-family.json into this folder");
+  cmd->callback([o] { run(*o); });
+}
+
+}  // namespace
+
+MRGI_COMMAND(light_family, setup);
+
+}  // namespace mrgi::tool

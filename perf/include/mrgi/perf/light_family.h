@@ -1,0 +1,65 @@
+// The light-estimation family (perf/suite/light/family.json, issue 13): every capture replayed
+// twice through one technique, once lit by what its scene.json declares (lamps, environment
+// image: the true light) and once with nothing declared (the runtime's probeless estimate), and
+// the estimate compared with the truth, the capture's path-traced light probe at the virtual
+// objects' centre (light_probe/probe.exr, `mrgi synth`: lamps, sky, bounce light and occlusion
+// as the object receives them):
+//   direction error   degrees between the dominant directions (band 1 of the SH)
+//   irradiance error  RMS over 64 normals spread over the sphere of |E_est(n) - E_true(n)|
+//                     (luminance) over the RMS of E_true(n): 0 = the same shading of a diffuse
+//                     surface of any orientation
+//   colour error      the largest relative difference of a channel of band 0 (the mean light),
+//                     each normalised by its luminance: 0.1 = within 10 % per channel
+//   RDE ratio         pooled RDE lit by the estimate over pooled RDE lit by the truth
+// Figures are taken from the last frame's estimate (the filter has seen every frame).
+#pragma once
+#include <string>
+#include <vector>
+
+#include "mrgi/expected.h"
+
+namespace mrgi::perf {
+
+struct LightFamilyScene {
+  std::string name, capture, varies;
+  bool held_out = false;
+};
+
+// BadInput naming the file and field for a manifest that breaks its format.
+Expected<std::vector<LightFamilyScene>> load_light_family(const std::string& manifest_path);
+
+struct LightFamilyResult {
+  LightFamilyScene scene;
+  std::string estimate_source;   // the note the estimate-lit run gave for its light
+  double direction_error_deg = 0.0;
+  double irradiance_error = 0.0;
+  double colour_error = 0.0;
+  double confidence = 0.0;
+  double rde_true = 0.0, rde_estimate = 0.0;  // pooled over the frames, all pixels
+  double rde_ratio() const { return rde_true > 0.0 ? rde_estimate / rde_true : 0.0; }
+  bool sky = false;              // lit by a procedural sun and sky (colour target applies)
+};
+
+struct LightFamilySettings {
+  std::string manifest = "perf/suite/light/family.json";
+  std::string technique = "baseline";
+  int level = 0;
+  std::string root = ".";        // captures' paths are relative to this
+  bool validate = false;
+  // Which scenes run: "all", "tuning" (the half a parameter may be chosen on) or "held-out".
+  std::string half = "all";
+};
+
+// Runs every scene (progress through `progress(name, done, total)` when given).
+Expected<std::vector<LightFamilyResult>> run_light_family(
+    const LightFamilySettings& settings,
+    void (*progress)(const std::string&, size_t, size_t) = nullptr);
+
+// Markdown: one row per scene, then the summary of each half (median and worst direction
+// error, median irradiance error, worst colour error on the sky scenes, median and worst RDE
+// ratio) against the issue's targets.
+std::string light_family_markdown(const std::vector<LightFamilyResult>& results,
+                                  const LightFamilySettings& settings);
+std::string light_family_json(const std::vector<LightFamilyResult>& results);
+
+}  // namespace mrgi::perf

@@ -1,0 +1,222 @@
+// The light stage's probeless source end to end on the CPU: a room corner (floor, two walls, a
+// box) ray-traced under a coloured sun and a blue sky, seen by an RGB-D camera, estimated from
+// colour and depth alone. Checks the dominant direction, the sun's colour, that the stage turns
+// the estimate into one shadowed light plus ambient, and that bad frames are refused.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "common/look_at.h"
+#include "image/srgb.h"
+#include "light/light_stage.h"
+#include "light/probeless.h"
+
+namespace {
+using namespace mrgi;
+using namespace mrgi::light;
+
+struct Hit {
+  double t = 1e30;
+  glm::dvec3 n{0.0};
+  glm::dvec3 albedo{0.0};
+};
+
+// Axis-aligned rectangles and a box: enough for a corner with shadows.
+struct Room {
+  glm::dvec3 sun = glm::normalize(glm::dvec3(0.5, 0.8, 0.35));  // towards the sun
+  glm::dvec3 sun_e{2.4, 2.0, 1.5};                               // warm, W/m^2
+  glm::dvec3 sky{0.06, 0.09, 0.16};                              // blue radiance, upper hemisphere
+  glm::dvec3 box_lo{0.1, 0.0, 0.6}, box_hi{0.45, 0.35, 0.95};
+
+  static void plane(const glm::dvec3& o, const glm::dvec3& d, int axis, double at, const glm::dvec3& lo,
+                    const glm::dvec3& hi, const glm::dvec3& n, const glm::dvec3& albedo, Hit& h) {
+    if (std::abs(d[axis]) < 1e-12) return;
+    const double t = (at - o[axis]) / d[axis];
+    if (t <= 1e-6 || t >= h.t) return;
+    const glm::dvec3 p = o + t * d;
+    for (int a = 0; a < 3; ++a)
+      if (a != axis && (p[a] < lo[a] || p[a] > hi[a])) return;
+    h.t = t;
+    h.n = n;
+    h.albedo = albedo;
+  }
+  Hit trace(const glm::dvec3& o, const glm::dvec3& d) const {
+    Hit h;
+    plane(o, d, 1, 0.0, {-1, 0, -3}, {3, 0, 2}, {0, 1, 0}, {0.5, 0.5, 0.5}, h);       // floor
+    plane(o, d, 2, 2.0, {-1, 0, 2}, {3, 1.5, 2}, {0, 0, -1}, {0.6, 0.6, 0.6}, h);    // back wall
+    plane(o, d, 0, -1.0, {-1, 0, -3}, {-1, 1.5, 2}, {1, 0, 0}, {0.55, 0.55, 0.55}, h);  // left wall
+    const glm::dvec3 box_albedo(0.45, 0.45, 0.45);
+    plane(o, d, 1, box_hi.y, {box_lo.x, 0, box_lo.z}, {box_hi.x, 0, box_hi.z}, {0, 1, 0}, box_albedo, h);
+    plane(o, d, 0, box_lo.x, {0, box_lo.y, box_lo.z}, {0, box_hi.y, box_hi.z}, {-1, 0, 0}, box_albedo, h);
+    plane(o, d, 0, box_hi.x, {0, box_lo.y, box_lo.z}, {0, box_hi.y, box_hi.z}, {1, 0, 0}, box_albedo, h);
+    plane(o, d, 2, box_lo.z, {box_lo.x, box_lo.y, 0}, {box_hi.x, box_hi.y, 0}, {0, 0, -1}, box_albedo, h);
+    plane(o, d, 2, box_hi.z, {box_lo.x, box_lo.y, 0}, {box_hi.x, box_hi.y, 0}, {0, 0, 1}, box_albedo, h);
+    return h;
+  }
+  // Lambertian radiance at p: the sun and the sky, both shadowed by the room (the sky by
+  // quadrature over a Fibonacci sphere), as the estimator's transfer models them.
+  glm::dvec3 radiance(const glm::dvec3& p, const Hit& h) const {
+    const double c = glm::dot(h.n, sun);
+    const glm::dvec3 o = p + h.n * 1e-4;
+    const bool lit = c > 0.0 && trace(o, sun).t > 1e20;
+    constexpr int kSky = 96;
+    double sky_cos = 0.0;
+    for (int k = 0; k < kSky; ++k) {
+      const glm::dvec3 w = fibonacci_direction(k, kSky);
+      const double cw = glm::dot(h.n, w);
+      if (w.y > 0.0 && cw > 0.0 && trace(o, w).t > 1e20) sky_cos += cw;
+    }
+    const glm::dvec3 e = (lit ? sun_e * c : glm::dvec3(0.0)) + sky * (sky_cos * 4.0 * kPi / kSky);
+    return h.albedo / kPi * e;
+  }
+};
+
+struct RenderedFrame {
+  InputFrame frame;
+  glm::dmat4 pose;
+  Intrinsics k;
+};
+
+RenderedFrame render(const Room& room, const glm::dvec3& eye, const glm::dvec3& target, int w, int h) {
+  RenderedFrame r;
+  r.k = Intrinsics{w, h, 0.82 * w, 0.82 * w, 0.5 * (w - 1), 0.5 * (h - 1)};
+  r.pose = test::opencv_look_at(eye, target, {0, 1, 0});
+  r.frame.color = ImageRGB8(w, h);
+  r.frame.depth = ImageU16(w, h);
+  const glm::dmat3 rot(r.pose);
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      const glm::dvec3 dc((u - r.k.cx) / r.k.fx, (v - r.k.cy) / r.k.fy, 1.0);
+      const glm::dvec3 d = glm::normalize(rot * dc);
+      const Hit hit = room.trace(eye, d);
+      if (hit.t > 1e20) continue;
+      const glm::dvec3 p = eye + hit.t * d;
+      const double z = glm::dot(p - eye, glm::dvec3(r.pose[2]));
+      r.frame.depth.at(u, v)[0] = uint16_t(std::lround(z * 5000.0));
+      const glm::dvec3 l = room.radiance(p, hit);
+      for (int c = 0; c < 3; ++c) r.frame.color.at(u, v)[c] = linear_to_srgb8(float(l[c]));
+    }
+  return r;
+}
+
+TEST(Probeless, EstimatesTheSunsDirectionAndColourInARoomCorner) {
+  const Room room;
+  const RenderedFrame f = render(room, {1.6, 1.3, -0.9}, {0.1, 0.25, 1.0}, 320, 240);
+  SceneDesc nothing;  // no lamp, no environment: the probeless source
+  CameraSetup cams{f.k, f.k, 5000.0, 1.0, std::nullopt};
+  LightStageSettings settings;
+  auto stage = LightStage::create(settings, nothing, cams);
+  ASSERT_TRUE(stage.ok()) << stage.error().message;
+  EXPECT_EQ((*stage)->planned_source(), LightSourceKind::Probeless);
+  std::vector<std::string> notes;
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_TRUE((*stage)->update(f.frame, f.pose, notes).ok());
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  const Lighting& lit = (*stage)->lighting();
+  ASSERT_TRUE(lit.estimate.valid);
+  const glm::dvec3 dir(lit.estimate.direction_to_light[0], lit.estimate.direction_to_light[1],
+                       lit.estimate.direction_to_light[2]);
+  // The truth's dominant direction: band 1 of sun + sky (the sky pulls it towards +y).
+  ShRgb truth = sh_directional_light(room.sun, room.sun_e);
+  for (int k = 0; k < 4000; ++k) {
+    const glm::dvec3 w = fibonacci_direction(k, 4000);
+    if (w.y <= 0.0) continue;
+    const ShVector y = sh_basis(glm::vec3(w));
+    for (int i = 0; i < kMaxShCoeffs; ++i) truth[size_t(i)] += room.sky * double(y[size_t(i)]) * (4.0 * kPi / 4000);
+  }
+  glm::dvec3 truth_dir;
+  ASSERT_TRUE(sh_dominant_direction(truth, truth_dir));
+  const double err = std::acos(std::clamp(glm::dot(dir, truth_dir), -1.0, 1.0)) * 180.0 / kPi;
+  std::printf("probeless: direction error %.1f deg, confidence %.2f, %.1f ms for the whole system (%d x %d samples)\n",
+              err, double(lit.estimate.confidence), ms, 80, 60);
+  EXPECT_LT(err, 15.0);
+  // The light's colour (band 0 and the dominant light) within 10 % per channel of the truth's,
+  // each normalised by its luminance: the estimate is RGB, not grey.
+  const glm::dvec3 t0c = truth[0] / luminance(truth[0]), e0c = glm::dvec3(
+      lit.estimate.sh_radiance[0][0], lit.estimate.sh_radiance[0][1], lit.estimate.sh_radiance[0][2]);
+  const glm::dvec3 e0 = e0c / luminance(e0c);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(e0[c], t0c[c], 0.1 * t0c[c]) << "channel " << c;
+  // One shadowed dominant light, pointing from the light (scene.json's direction convention).
+  ASSERT_EQ(lit.lights.size(), 1u);
+  EXPECT_EQ(lit.lights[0].type, LightType::Directional);
+  EXPECT_TRUE(lit.lights[0].real);
+  EXPECT_GT(glm::dot(-glm::dvec3(lit.lights[0].direction), dir), 0.999);
+  ASSERT_FALSE(notes.empty());
+  EXPECT_NE(notes.back().find("probeless"), std::string::npos) << notes.back();
+}
+
+TEST(Probeless, RefusesFramesOfAnotherSizeAndBadSettings) {
+  Intrinsics k{64, 48, 50, 50, 32, 24};
+  EXPECT_FALSE(ProbelessBuilder::create({8, 64, 6, 0.6, 4}, k, k, 5000).ok());
+  EXPECT_FALSE(ProbelessBuilder::create({80, 8, 6, 0.6, 4}, k, k, 5000).ok());
+  EXPECT_FALSE(ProbelessBuilder::create({80, 64, 6, 0.0, 4}, k, k, 5000).ok());
+  EXPECT_FALSE(ProbelessBuilder::create({80, 64, 6, 0.6, 0}, k, k, 5000).ok());
+  auto b = ProbelessBuilder::create({}, k, k, 5000);
+  ASSERT_TRUE(b.ok()) << b.error().message;
+  InputFrame f;
+  f.color = ImageRGB8(32, 24);
+  f.depth = ImageU16(32, 24);
+  LightSystem sys;
+  EXPECT_FALSE(b->add_part(f, glm::dmat4(1.0), 1.0, 0, sys).ok());
+  f.color = ImageRGB8(64, 48);
+  f.depth = ImageU16(64, 48);
+  EXPECT_FALSE(b->add_part(f, glm::dmat4(1.0), 1.0, 9, sys).ok());
+  // An empty depth image: no sample, nothing added, no NaN.
+  ASSERT_TRUE(b->add_part(f, glm::dmat4(1.0), 1.0, 0, sys).ok());
+  EXPECT_EQ(sys.samples, 0.0);
+}
+
+}  // namespace
+namespace {
+TEST(ProbelessExperiment, Sweep) {
+  if (!getenv("MRGI_SWEEP")) GTEST_SKIP();
+  const Room room;
+  const RenderedFrame f = render(room, {1.6, 1.3, -0.9}, {0.1, 0.25, 1.0}, 320, 240);
+  ShRgb truth = sh_directional_light(room.sun, room.sun_e);
+  for (int k = 0; k < 4000; ++k) {
+    const glm::dvec3 w = fibonacci_direction(k, 4000);
+    if (w.y <= 0.0) continue;
+    const ShVector y = sh_basis(glm::vec3(w));
+    for (int i = 0; i < kMaxShCoeffs; ++i) truth[size_t(i)] += room.sky * double(y[size_t(i)]) * (4.0 * kPi / 4000);
+  }
+  glm::dvec3 truth_dir;
+  sh_dominant_direction(truth, truth_dir);
+  for (double reg : {1e-2, 1e-3, 1e-4})
+    for (double below : {0.3, 0.0})
+      for (int dirs : {64, 256})
+        for (double radius : {0.6, 1.5}) {
+          LightStageSettings s;
+          s.probeless.directions = dirs;
+          s.probeless.radius_m = radius;
+          s.probeless.march_steps = 12;
+          s.estimator.relative_regularisation = reg;
+          s.estimator.below_surface_penalty = below;
+          auto stage = LightStage::create(s, SceneDesc{}, CameraSetup{f.k, f.k, 5000.0, 1.0, std::nullopt});
+          std::vector<std::string> notes;
+          ASSERT_TRUE((*stage)->update(f.frame, f.pose, notes).ok());
+          const auto& e = (*stage)->lighting().estimate;
+          const glm::dvec3 dir(e.direction_to_light[0], e.direction_to_light[1], e.direction_to_light[2]);
+          std::printf("reg %g below %g dirs %d radius %g: err %.1f conf %.2f dir %.2f %.2f %.2f truth %.2f %.2f %.2f n %.2f %.2f %.2f\n", reg, below, dirs, radius,
+                      std::acos(std::clamp(glm::dot(dir, truth_dir), -1.0, 1.0)) * 180.0 / kPi, double(e.confidence),
+                      dir.x, dir.y, dir.z, truth_dir.x, truth_dir.y, truth_dir.z, (*stage)->estimator().dominant_normal().x,
+                      (*stage)->estimator().dominant_normal().y, (*stage)->estimator().dominant_normal().z);
+        }
+}
+}  // namespace
+namespace {
+TEST(ProbelessExperiment, EnvMeans) {
+  if (!getenv("MRGI_SWEEP")) GTEST_SKIP();
+  for (const char* n : {"courtyard.exr", "interior.exr"}) {
+    auto img = load_hdr_image(std::string(MRGI_SHARED_DIR) + "/data/env/" + n);
+    ASSERT_TRUE(img.ok());
+    auto e = light_from_environment(*img, EnvCamera{});
+    ASSERT_TRUE(e.ok());
+    const auto up = irradiance_at(*e, {0, 1, 0});
+    std::printf("%s %dx%d: band0 %.3f %.3f %.3f  E(up) %.3f %.3f %.3f dominant %.2f %.2f %.2f I %.3f\n", n, img->width, img->height,
+                e->sh_radiance[0][0], e->sh_radiance[0][1], e->sh_radiance[0][2], up[0], up[1], up[2],
+                e->direction_to_light[0], e->direction_to_light[1], e->direction_to_light[2], e->dominant_intensity[1]);
+  }
+}
+}  // namespace
