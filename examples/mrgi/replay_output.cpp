@@ -89,6 +89,7 @@ Status ReplayOutput::add(const FrameOutput& out, const ImageRGB8& camera, const 
   s["level"] = out.stats.level;
   s["gpu_total_ms"] = out.stats.gpu_total_ms;
   s["record_ms"] = out.stats.record_ms;
+  s["light_ms"] = out.stats.light_ms;
   nlohmann::json passes = nlohmann::json::object();
   for (const auto& p : out.stats.passes) passes[p.name] = p.gpu_ms;
   s["passes_ms"] = passes;

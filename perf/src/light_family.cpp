@@ -162,19 +162,31 @@ Expected<std::vector<LightFamilyResult>> run_light_family(const LightFamilySetti
     auto est = replay(*capture, undeclared, s);
     if (!est) return fail(est.error().kind, sc.name + " (estimate): " + est.error().message);
     if (!est->light) return fail(ErrorKind::Internal, sc.name + ": the estimate-lit run gave no light estimate");
-    // The truth: the path-traced probe at the virtual objects' centre (mrgi synth's light_probe).
-    const std::string probe_path = (fs::path(s.root) / sc.capture / "light_probe" / "probe.exr").string();
+    // The truth: the light sources as the virtual objects' centre sees them (mrgi synth's
+    // light_probe/probe_direct.exr: environment and lamps where no real surface is in the way).
+    const std::string probe_path = (fs::path(s.root) / sc.capture / "light_probe" / "probe_direct.exr").string();
     auto probe = load_hdr_image(probe_path);
     if (!probe) return fail(probe.error().kind, sc.name + ": the light probe: " + probe.error().message);
     auto probe_light = light_from_environment(*probe, EnvCamera{});
     if (!probe_light) return fail(probe_light.error().kind, probe_path + ": " + probe_light.error().message);
+    // The irradiance's truth is everything that reaches the object, bounce light included
+    // (probe.exr, path-traced): that is what lights it.
+    const std::string full_path = (fs::path(s.root) / sc.capture / "light_probe" / "probe.exr").string();
+    auto full = load_hdr_image(full_path);
+    if (!full) return fail(full.error().kind, sc.name + ": the light probe: " + full.error().message);
+    auto full_light = light_from_environment(*full, EnvCamera{});
+    if (!full_light) return fail(full_light.error().kind, full_path + ": " + full_light.error().message);
     LightFamilyResult r;
     r.scene = sc;
     r.estimate_source = est->light_note;
     r.direction_error_deg = direction_error_deg(*est->light, *probe_light);
-    r.irradiance_error = irradiance_error(*est->light, *probe_light);
+    r.irradiance_error = irradiance_error(*est->light, *full_light);
     r.colour_error = colour_error(*est->light, *probe_light);
     r.confidence = est->light->confidence;
+    r.estimate_direction = est->light->direction_to_light;
+    r.truth_direction = probe_light->direction_to_light;
+    r.estimate_mean = est->light->sh_radiance[0];
+    r.truth_mean = probe_light->sh_radiance[0];
     r.rde_true = truth->pooled.all.rde;
     r.rde_estimate = est->pooled.all.rde;
     r.sky = sc.name.rfind("sky", 0) == 0;
@@ -228,7 +240,9 @@ std::string light_family_json(const std::vector<LightFamilyResult>& results) {
     j.push_back({{"scene", r.scene.name}, {"held_out", r.scene.held_out}, {"source", r.estimate_source},
                  {"direction_error_deg", r.direction_error_deg}, {"irradiance_error", r.irradiance_error},
                  {"colour_error", r.colour_error}, {"confidence", r.confidence}, {"rde_true", r.rde_true},
-                 {"rde_estimate", r.rde_estimate}, {"rde_ratio", r.rde_ratio()}});
+                 {"rde_estimate", r.rde_estimate}, {"rde_ratio", r.rde_ratio()},
+                 {"estimate_direction", r.estimate_direction}, {"truth_direction", r.truth_direction},
+                 {"estimate_band0", r.estimate_mean}, {"truth_band0", r.truth_mean}});
   return j.dump(1) + "\n";
 }
 

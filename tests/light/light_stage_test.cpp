@@ -13,6 +13,7 @@
 #include "light/light_stage.h"
 #include "light/probeless.h"
 #include "light/sh_tools.h"
+#include "mrgi/platform/capture.h"
 
 namespace {
 using namespace mrgi;
@@ -265,4 +266,48 @@ TEST(LightStage, UniformEnvironmentLightsAnUpFacingSurfaceLikeTheMean) {
   }
 }
 
+}  // namespace
+
+namespace {
+// The env camera source end to end: the suite's fisheye capture (capture.json env_camera, env/
+// frames) gives the stage its lights per frame, named in the note, the sun among them.
+TEST(LightStage, EnvCameraFramesLightTheScene) {
+  auto cap = mrgi::CaptureReader::open(std::string(MRGI_SOURCE_DIR) + "/perf/suite/env_fisheye");
+  ASSERT_TRUE(cap.ok()) << cap.error().message;
+  const mrgi::CaptureInfo& info = cap->info();
+  ASSERT_TRUE(cap->scene() && cap->scene()->environment.from_env_camera);
+  auto stage = LightStage::create({}, *cap->scene(),
+                                  CameraSetup{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera});
+  ASSERT_TRUE(stage.ok()) << stage.error().message;
+  auto f = cap->read_frame(0);
+  ASSERT_TRUE(f.ok() && f->env && f->pose);
+  std::vector<std::string> notes;
+  ASSERT_TRUE((*stage)->update(*f, f->pose->matrix(), notes).ok());
+  ASSERT_FALSE(notes.empty());
+  EXPECT_EQ(notes.back(), "light: environment image (env camera, 16 median-cut regions, 4 shadowed)");
+  const Lighting& lit = (*stage)->lighting();
+  EXPECT_EQ(lit.source, LightSourceKind::Environment);
+  ASSERT_EQ(lit.lights.size(), 4u);
+  // One of the shadowed lights sits at the sun: the env image's brightest pixel, through the
+  // equidistant model (r = f theta) and the env camera's rotation, within 10 degrees. (The
+  // courtyard's low sun carries about as much light as a sixteenth of its sky, so its region is
+  // one of the strongest, not necessarily the first.)
+  const ImageRGBF& env = *f->env;
+  int bu = 0, bv = 0;
+  float best = -1.0f;
+  for (int v = 0; v < env.height; ++v)
+    for (int u = 0; u < env.width; ++u)
+      if (const float l = env.at(u, v)[1]; l > best) {
+        best = l;
+        bu = u;
+        bv = v;
+      }
+  const EnvCamera& cam = *info.env_camera;
+  const double dx = bu - cam.cx, dy = bv - cam.cy, r = std::sqrt(dx * dx + dy * dy), theta = r / cam.f;
+  const glm::dvec3 d_cam(std::sin(theta) * dx / r, std::sin(theta) * dy / r, std::cos(theta));
+  const glm::dvec3 sun = glm::mat3_cast(cam.rotation) * d_cam;
+  double closest = -1.0;
+  for (const LightDesc& l : lit.lights) closest = std::max(closest, glm::dot(-glm::dvec3(l.direction), sun));
+  EXPECT_GT(closest, std::cos(10.0 * kDeg));  // 6.7: the centroid of a region holding sky too
+}
 }  // namespace

@@ -293,28 +293,33 @@ TEST(SsrtLightEstimation, NonFiniteSystemIsRefusedAndTheEstimateKept) {
   for (int i = 0; i < 16; ++i) EXPECT_EQ(est->filtered()[i].x, before[i].x);
 }
 
-TEST(SsrtLightEstimation, TemporalFilterConvergesWithItsTimeConstant) {
+TEST(SsrtLightEstimation, TemporalFilterConvergesWithItsLagInFrames) {
   const SampleSets sets = samples(32);
   const ShRgb first = sh_directional_light(glm::dvec3(0, 1, 0), glm::dvec3(1.0));
   const ShRgb second = sh_directional_light(glm::dvec3(1, 0, 0), glm::dvec3(3.0));
   LightEstimatorSettings s;
   s.relative_regularisation = 1e-9;
-  s.time_constant_s = 0.5;
+  s.lag_frames = 15.0;
   auto est = LightEstimator::create(s);
   ASSERT_TRUE(est.ok());
   ASSERT_TRUE(est->update(synthetic_frame(sets, first, 0.5, 1500, 1), 0, 0.0).ok());
   const double start = est->filtered()[3].y;  // band 1, x
   const LightSystem sys2 = synthetic_frame(sets, second, 0.5, 1500, 1);
-  ASSERT_TRUE(est->update(sys2, 1, 0.0 + 1.0 / 30.0).ok());  // one step to measure the target
+  ASSERT_TRUE(est->update(sys2, 1, 1.0 / 30.0).ok());  // one step to measure the target
   const double target = est->frame_solution()[3].y;
   auto remaining = [&] { return (est->filtered()[3].y - target) / (start - target); };
-  // After one step of 1/30 s: exp(-1/15).
+  // After one frame: exp(-1/15).
   EXPECT_NEAR(remaining(), std::exp(-1.0 / 15.0), 1e-6);
   for (int f = 2; f <= 15; ++f) ASSERT_TRUE(est->update(sys2, f, f / 30.0).ok());
-  EXPECT_NEAR(remaining(), std::exp(-1.0), 1e-6);  // one time constant
+  EXPECT_NEAR(remaining(), std::exp(-1.0), 1e-6);  // one lag: 15 frames
   for (int f = 16; f <= 160; ++f) ASSERT_TRUE(est->update(sys2, f, f / 30.0).ok());
   EXPECT_LT(std::abs(remaining()), 1e-4);
-  // Timestamps that do not advance use the nominal step instead of freezing the filter.
+  // Solves 4 frames apart (the light stage's interleaved system): the same lag in frames.
+  auto est3 = LightEstimator::create(s);
+  ASSERT_TRUE(est3->update(synthetic_frame(sets, first, 0.5, 1500, 1), 0, 0.0).ok());
+  for (int f = 4; f <= 16; f += 4) ASSERT_TRUE(est3->update(sys2, f, 99.0).ok());
+  EXPECT_NEAR((est3->filtered()[3].y - target) / (start - target), std::exp(-16.0 / 15.0), 1e-6);
+  // Timestamps that do not advance do not freeze the filter: it steps by frame index.
   auto est2 = LightEstimator::create(s);
   ASSERT_TRUE(est2->update(synthetic_frame(sets, first, 0.5, 1500, 1), 0, 5.0).ok());
   for (int f = 1; f <= 300; ++f) ASSERT_TRUE(est2->update(sys2, f, 5.0).ok());

@@ -64,6 +64,10 @@ struct RuntimeSettings {
   // do not overlap: use it to see where the time goes (bench, scheduler cost model), not to run.
   // Needed on lavapipe, whose timestamps misattribute work between passes.
   bool profile_passes = false;
+  // The light stage's temporal filter (light estimate and environment samples): a change of the
+  // real light is followed with a time constant of this many frames (15: half a second at
+  // 30 fps), so noise between frames does not flicker the light. 0 = no filtering. 0..1e6.
+  double light_lag_frames = 15.0;
 };
 
 struct PassTiming {
@@ -93,6 +97,9 @@ struct FrameStats {
   // On a CPU device this competes with the passes for the same cores, so a frame's sustained
   // wall clock is about its passes plus this.
   double host_ms = 0.0;
+  // CPU time of the light stage this frame (light/light_stage.h: environment sampling or the
+  // probeless system's part and solve) on the calling thread, ms; inside record_ms and host_ms.
+  double light_ms = 0.0;
   int level = 0;
   std::vector<std::string> skipped;    // passes culled or skipped this frame, with reason
   // Conditions worth knowing about this frame, e.g. "pose: none given, previous pose used".

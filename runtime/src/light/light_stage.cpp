@@ -81,6 +81,7 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
                                                          const SceneDesc& scene, const CameraSetup& cameras) {
   if (settings.shadowed_environment_lights < 0 || settings.shadowed_environment_lights > kMaxStageLights)
     return fail(ErrorKind::BadUsage, "LightStageSettings.shadowed_environment_lights: must be 0..8");
+  if (auto check = LightEstimator::create(settings.external_estimator); !check) return check.error();
   auto stage = std::unique_ptr<LightStage>(new LightStage());
   LightStage& s = *stage;
   s.settings_ = settings;
@@ -201,6 +202,8 @@ void LightStage::set_probeless_lighting() {
 
 void LightStage::use_external_system() {
   external_system_ = true;
+  // Checked in create(): cannot fail here.
+  estimator_.emplace(std::move(*LightEstimator::create(settings_.external_estimator)));
   planned_ = LightSourceKind::Probeless;
   lighting_.source = planned_;
   lighting_.environment = false;

@@ -41,7 +41,13 @@ Expected<ProbelessBuilder> ProbelessBuilder::create(const ProbelessSettings& s, 
   b.stride_ = stride;
   b.grid_w_ = depth.width / stride;
   b.grid_h_ = depth.height / stride;
-  b.position_.assign(size_t(b.grid_w_) * size_t(b.grid_h_), glm::vec3(0.0f));
+  const size_t cells = size_t(b.grid_w_) * size_t(b.grid_h_);
+  b.position_.assign(cells, glm::vec3(0.0f));
+  b.normal_.assign(cells, glm::vec3(0.0f));
+  b.bin_.assign(cells, -1);
+  b.balance_.assign(cells, 0.0f);
+  b.bin_count_.assign(kNormalBins, 0);
+  for (int k = 0; k < kNormalBins; ++k) b.bin_direction_.push_back(glm::vec3(fibonacci_direction(k, kNormalBins)));
   b.directions_.reserve(size_t(s.directions));
   b.direction_sh_.reserve(size_t(s.directions));
   for (int k = 0; k < s.directions; ++k) {
@@ -59,10 +65,13 @@ void ProbelessBuilder::build_positions(const InputFrame& frame) {
   const int s = stride_;
   const glm::vec4 k(float(depth_.fx), float(depth_.fy), float(depth_.cx), float(depth_.cy));
   const float to_m = float(1.0 / depth_scale_);
+  // At most 4 x 4 depths a block: enough to average the noise out, and every frame rebuilds the
+  // whole grid (the visibility search reads any cell), so this is most of a frame's cost.
+  const int step = std::max(1, s / 4);
   for (int gy = 0; gy < grid_h_; ++gy) {
     for (int gx = 0; gx < grid_w_; ++gx) {
       // The block's centre depth picks the surface; the block's depths on that surface are
-      // averaged (Kinect noise grows with distance squared; 64 samples take most of it out).
+      // averaged (Kinect noise grows with distance squared; 16 samples take most of it out).
       const int x0 = gx * s, y0 = gy * s;
       const uint16_t centre = frame.depth.data[size_t(y0 + s / 2) * size_t(frame.depth.width) + size_t(x0 + s / 2)];
       glm::vec3& out = position_[size_t(gy) * grid_w_ + gx];
@@ -71,9 +80,9 @@ void ProbelessBuilder::build_positions(const InputFrame& frame) {
       const float zc = float(centre) * to_m;
       double sum_z = 0.0, sum_u = 0.0, sum_v = 0.0;
       int count = 0;
-      for (int y = y0; y < y0 + s; ++y) {
+      for (int y = y0; y < y0 + s; y += step) {
         const uint16_t* row = frame.depth.data.data() + size_t(y) * size_t(frame.depth.width);
-        for (int x = x0; x < x0 + s; ++x) {
+        for (int x = x0; x < x0 + s; x += step) {
           const float z = float(row[x]) * to_m;
           if (row[x] == 0 || std::abs(z - zc) > kSameSurface * zc) continue;
           sum_z += z;
@@ -88,32 +97,17 @@ void ProbelessBuilder::build_positions(const InputFrame& frame) {
   }
 }
 
-Status ProbelessBuilder::add_part(const InputFrame& frame, const glm::dmat4& camera_to_world,
-                                  double exposure, int part, LightSystem& system) {
-  if (frame.depth.width != depth_.width || frame.depth.height != depth_.height ||
-      frame.color.width != color_.width || frame.color.height != color_.height)
-    return fail(ErrorKind::BadInput, "probeless light estimation: frame " + std::to_string(frame.index) +
-                                         " does not have the cameras' sizes");
-  if (part < 0 || part >= settings_.parts)
-    return fail(ErrorKind::BadUsage, "probeless light estimation: part " + std::to_string(part) +
-                                         " outside 0.." + std::to_string(settings_.parts - 1));
-  if (!(exposure > 0.0)) exposure = 1.0;
-  build_positions(frame);
-  const glm::mat3 rot = glm::mat3(camera_to_world);
-  const glm::mat3 rot_t = glm::transpose(rot);
-  const glm::vec4 kd(float(depth_.fx), float(depth_.fy), float(depth_.cx), float(depth_.cy));
-  const glm::vec4 kc(float(color_.fx), float(color_.fy), float(color_.cx), float(color_.cy));
-  const auto& lut = srgb8_to_linear_table();
-  const int s = stride_;
-  const float radius = float(settings_.radius_m);
-  const float solid_angle = float(4.0 * kPi / settings_.directions);
-  const float inv_stride = 1.0f / float(s);
+void ProbelessBuilder::build_normals(const glm::mat3& rot) {
   auto cell = [&](int gx, int gy) -> const glm::vec3& { return position_[size_t(gy) * grid_w_ + gx]; };
   auto same_surface = [](const glm::vec3& a, const glm::vec3& b) {
     return a.z > 0.0f && b.z > 0.0f && std::abs(a.z - b.z) <= kSameSurface * std::min(a.z, b.z);
   };
-  for (int gy = part; gy < grid_h_; gy += settings_.parts) {
+  std::fill(bin_count_.begin(), bin_count_.end(), 0);
+  for (int gy = 0; gy < grid_h_; ++gy) {
     for (int gx = 0; gx < grid_w_; ++gx) {
+      glm::vec3& out = normal_[size_t(gy) * grid_w_ + gx];
+      out = glm::vec3(0.0f);
+      bin_[size_t(gy) * grid_w_ + gx] = -1;
       const glm::vec3 p = cell(gx, gy);
       if (!(p.z > 0.0f)) continue;
       // Normal from the neighbouring cells on the same surface (central where both sides are,
@@ -131,6 +125,62 @@ Status ProbelessBuilder::add_part(const InputFrame& frame, const glm::dmat4& cam
       if (!(len > 1e-12f)) continue;
       n_cam /= len;
       if (glm::dot(n_cam, p) > 0.0f) n_cam = -n_cam;
+      out = n_cam;
+      // The orientation's bin (the nearest of kNormalBins directions, world space).
+      const glm::vec3 nw = rot * n_cam;
+      int best = 0;
+      float best_dot = -2.0f;
+      for (int b = 0; b < kNormalBins; ++b)
+        if (const float d = glm::dot(nw, bin_direction_[size_t(b)]); d > best_dot) {
+          best_dot = d;
+          best = b;
+        }
+      bin_[size_t(gy) * grid_w_ + gx] = best;
+      ++bin_count_[size_t(best)];
+    }
+  }
+  int used = 0, total = 0;
+  for (int c : bin_count_) {
+    used += c > 0 ? 1 : 0;
+    total += c;
+  }
+  for (size_t i = 0; i < balance_.size(); ++i) {
+    const int b = bin_[i];
+    balance_[i] = b < 0 ? 0.0f
+                  : settings_.balance_normals ? float(total) / float(used * bin_count_[size_t(b)])
+                                              : 1.0f;
+  }
+}
+
+Status ProbelessBuilder::add_part(const InputFrame& frame, const glm::dmat4& camera_to_world,
+                                  double exposure, int part, LightSystem& system) {
+  if (frame.depth.width != depth_.width || frame.depth.height != depth_.height ||
+      frame.color.width != color_.width || frame.color.height != color_.height)
+    return fail(ErrorKind::BadInput, "probeless light estimation: frame " + std::to_string(frame.index) +
+                                         " does not have the cameras' sizes");
+  if (part < 0 || part >= settings_.parts)
+    return fail(ErrorKind::BadUsage, "probeless light estimation: part " + std::to_string(part) +
+                                         " outside 0.." + std::to_string(settings_.parts - 1));
+  if (!(exposure > 0.0)) exposure = 1.0;
+  build_positions(frame);
+  const glm::mat3 rot = glm::mat3(camera_to_world);
+  build_normals(rot);
+  const glm::mat3 rot_t = glm::transpose(rot);
+  const glm::vec4 kd(float(depth_.fx), float(depth_.fy), float(depth_.cx), float(depth_.cy));
+  const glm::vec4 kc(float(color_.fx), float(color_.fy), float(color_.cx), float(color_.cy));
+  const auto& lut = srgb8_to_linear_table();
+  const int s = stride_;
+  const float radius = float(settings_.radius_m);
+  const float solid_angle = float(4.0 * kPi / settings_.directions);
+  const float inv_stride = 1.0f / float(s);
+  auto cell = [&](int gx, int gy) -> const glm::vec3& { return position_[size_t(gy) * grid_w_ + gx]; };
+  for (int gy = part; gy < grid_h_; gy += settings_.parts) {
+    for (int gx = 0; gx < grid_w_; ++gx) {
+      const glm::vec3 p = cell(gx, gy);
+      if (!(p.z > 0.0f)) continue;
+      const glm::vec3 n_cam = normal_[size_t(gy) * grid_w_ + gx];
+      if (n_cam == glm::vec3(0.0f)) continue;
+      const float weight_row = balance_[size_t(gy) * grid_w_ + gx];
 
       // Colour: the linear mean of the block's pixels where the depth camera's sample lands in
       // the colour camera (same centre; intrinsics may differ).
@@ -181,7 +231,10 @@ Status ProbelessBuilder::add_part(const InputFrame& frame, const glm::dmat4& cam
         if (weight <= 0.0f) continue;
         for (int i = 0; i < kMaxShCoeffs; ++i) t[size_t(i)] += weight * direction_sh_[j][size_t(i)];
       }
-      system.add(t, colour);
+      // Rows weighted so that every orientation of surface counts alike (balance_normals).
+      const float sw = std::sqrt(weight_row);
+      for (float& v : t) v *= sw;
+      system.add(t, colour * double(sw));
     }
   }
   return ok_status();

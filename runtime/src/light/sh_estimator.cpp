@@ -74,10 +74,12 @@ Expected<LightEstimator> LightEstimator::create(const LightEstimatorSettings& s)
                        "must be finite and >= 0"));
   MRGI_TRY(check_range(s.below_surface_penalty >= 0.0 && std::isfinite(s.below_surface_penalty),
                        "below_surface_penalty", "must be finite and >= 0"));
-  MRGI_TRY(check_range(s.time_constant_s >= 0.0 && std::isfinite(s.time_constant_s),
-                       "time_constant_s", "must be finite and >= 0 seconds"));
-  MRGI_TRY(check_range(s.nominal_frame_s > 0.0 && s.nominal_frame_s <= 1.0, "nominal_frame_s",
-                       "must be in (0, 1] seconds"));
+  MRGI_TRY(check_range(s.lag_frames >= 0.0 && s.lag_frames <= 1e6, "lag_frames",
+                       "must be 0..1e6 frames"));
+  MRGI_TRY(check_range(s.nonnegative_penalty >= 0.0 && std::isfinite(s.nonnegative_penalty),
+                       "nonnegative_penalty", "must be finite and >= 0"));
+  MRGI_TRY(check_range(s.nonnegative_rounds >= 0 && s.nonnegative_rounds <= 16, "nonnegative_rounds",
+                       "must be 0..16"));
   MRGI_TRY(check_range(s.prior_radiance >= 0.0 && std::isfinite(s.prior_radiance),
                        "prior_radiance", "must be finite and >= 0"));
   MRGI_TRY(check_range(s.confidence_eigen_fraction > 0.0 && s.confidence_eigen_fraction < 1.0,
@@ -96,7 +98,7 @@ void LightEstimator::reset() {
   estimate_.bands = settings_.bands;
   fill_light_estimate(filtered_, settings_.bands, estimate_);
   have_previous_ = false;
-  last_timestamp_ = 0.0;
+  last_frame_ = 0;
 }
 
 Expected<LightEstimate> LightEstimator::update(const LightSystem& system, int64_t frame_index,
@@ -174,7 +176,34 @@ Expected<LightEstimate> LightEstimator::update(const LightSystem& system, int64_
   }
   // lhs is symmetric positive definite (T^T T is PSD, the added diagonal > 0): LDLT is exact
   // and stable; a robust fallback is not needed, but a non-finite result is still refused.
-  const Rhs x = lhs.ldlt().solve(rhs);
+  Rhs x = lhs.ldlt().solve(rhs);
+  // Radiance cannot be negative: where the solution's luminance is below 0 in some direction,
+  // a penalty on the radiance there is added and the system solved again (an active set,
+  // a few rounds). Least squares otherwise buys a better fit of the visible surfaces with
+  // negative light from directions nothing constrains, which turns the dominant direction.
+  const double nu = settings_.nonnegative_penalty;
+  if (nu > 0.0 && n >= 4) {
+    constexpr int kDirections = 256;
+    Mat added = Mat::Zero(n, n);
+    for (int round = 0; round < settings_.nonnegative_rounds; ++round) {
+      Mat extra = Mat::Zero(n, n);
+      int negative = 0;
+      for (int k = 0; k < kDirections; ++k) {
+        const glm::dvec3 w = fibonacci_direction(k, kDirections);
+        const ShVector y = sh_basis(glm::vec3(w));
+        double lum = 0.0;
+        for (int i = 0; i < n; ++i)
+          lum += double(y[size_t(i)]) * (0.2126 * x(i, 0) + 0.7152 * x(i, 1) + 0.0722 * x(i, 2));
+        if (lum >= 0.0) continue;
+        ++negative;
+        for (int i = 0; i < n; ++i)
+          for (int j = 0; j < n; ++j) extra(i, j) += double(y[size_t(i)]) * double(y[size_t(j)]);
+      }
+      if (negative == 0) break;
+      added += extra * (nu * std::max(mean_diag, 0.0) * 4.0 * kPi / kDirections);
+      x = (lhs + added).ldlt().solve(rhs);
+    }
+  }
   if (!x.allFinite()) {
     return fail(ErrorKind::Internal, "ssrt light estimation: frame " +
                                          std::to_string(frame_index) +
@@ -185,18 +214,18 @@ Expected<LightEstimate> LightEstimator::update(const LightSystem& system, int64_
 
   // Temporal filter. The first real frame replaces the prior outright.
   double alpha = 1.0;
-  if (have_previous_ && settings_.time_constant_s > 0.0) {
-    double dt = timestamp_s - last_timestamp_;
-    if (!std::isfinite(dt) || dt <= 0.0) dt = settings_.nominal_frame_s;
-    dt = std::min(dt, 10.0 * settings_.time_constant_s);
-    alpha = 1.0 - std::exp(-dt / settings_.time_constant_s);
+  if (have_previous_ && settings_.lag_frames > 0.0) {
+    // At least one frame (a frame solved twice, indices going back after a reset of the
+    // source), at most ten time constants (a long gap: the old estimate is worthless).
+    const double step = std::clamp(double(frame_index - last_frame_), 1.0, 10.0 * settings_.lag_frames);
+    alpha = 1.0 - std::exp(-step / settings_.lag_frames);
   }
   const bool informative = constrained > 0;
   if (informative) {
     for (int i = 0; i < kMaxShCoeffs; ++i)
       filtered_[i] += alpha * (frame_solution_[i] - filtered_[i]);
     have_previous_ = true;
-    last_timestamp_ = timestamp_s;
+    last_frame_ = frame_index;
   }
   estimate_.valid = estimate_.valid || informative;
   estimate_.frame_index = frame_index;

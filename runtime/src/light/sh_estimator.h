@@ -69,11 +69,13 @@ struct LightEstimatorSettings {
   // direction error: 0.3 -> 0.707, 7 degrees; 0.02 -> 0.611, 45; 0 -> 0.602, 76): a 2-band
   // level would want about 0.02.
   double below_surface_penalty = 0.3;
-  // Exponential temporal filter: after a step of dt seconds the estimate moves a fraction
-  // 1 - exp(-dt / time_constant_s) towards the frame's solution. 0 disables filtering.
-  double time_constant_s = 0.5;
-  // Step used when timestamps do not advance (replays of stills, broken clocks), seconds.
-  double nominal_frame_s = 1.0 / 30.0;
+  // Exponential temporal filter in frames: a solve covering the frames since the previous one
+  // (a step of k frames by frame index) moves the estimate a fraction 1 - exp(-k / lag_frames)
+  // towards its solution, so a step change of the light is followed with a time constant of
+  // lag_frames frames (15: half a second at 30 fps), whatever the solves' spacing. Frame
+  // indices, not timestamps: replays of stills and broken clocks cannot freeze or jump it.
+  // 0 disables filtering.
+  double lag_frames = 15.0;
   // The paper assumes white light (Sec. 5): the three channels are solved as one (luminance)
   // and exported grey. false: each channel is solved on its own (same T^T T).
   bool white_light = true;
@@ -83,6 +85,12 @@ struct LightEstimatorSettings {
   // frame's overall brightness is not pushed into directional bands the data does not constrain
   // (a floor darker than the prior otherwise reads as light from below). false: plain Tikhonov.
   bool refit_prior_ambient = true;
+  // Weight (relative to the mean diagonal of T^T T) of the penalty on negative radiance: after
+  // the solve, the directions where the estimate's luminance is below 0 get the penalty
+  // mu * integral over them of (sum_i l_i Y_i(w))^2 dw and the system is solved again, up to
+  // `nonnegative_rounds` times. 0 disables.
+  double nonnegative_penalty = 0.0;
+  int nonnegative_rounds = 3;
   // Eigenvalues of T^T T above this fraction of the largest count as constrained (confidence).
   double confidence_eigen_fraction = 1e-2;
 };
@@ -119,7 +127,7 @@ class LightEstimator {
   LightEstimate estimate_;
   glm::dvec3 dominant_normal_{0.0};
   bool have_previous_ = false;
-  double last_timestamp_ = 0.0;
+  int64_t last_frame_ = 0;
 };
 
 }  // namespace mrgi::light

@@ -4,6 +4,7 @@
 // that completed (pipelined over frames_in_flight slots).
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -38,6 +39,12 @@ bool same_intrinsics(const Intrinsics& a, const Intrinsics& b) {
 
 std::string size_text(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
 
+double thread_cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
+}
+
 // What a submitted frame needs to become a FrameOutput once its slot completes.
 struct SlotRecord {
   bool used = false;
@@ -48,6 +55,7 @@ struct SlotRecord {
   // Nothing virtual in view and the output has the camera's size: the output is the camera
   // frame, converted on the host from this slot's colour upload when the frame completes.
   bool camera_copy = false;
+  double light_ms = 0.0;
   std::vector<std::string> skipped;
   std::vector<std::string> notes;
 };
@@ -172,7 +180,11 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   auto sg = technique::SceneGpu::create(*context_, *graph_, scene_);
   if (!sg) return sg.error();
   scene_gpu_ = std::move(*sg);
+  if (!(settings.light_lag_frames >= 0.0 && settings.light_lag_frames <= 1e6))
+    return fail(ErrorKind::BadUsage, "RuntimeSettings.light_lag_frames must be 0..1e6 frames");
   light::LightStageSettings ls;
+  ls.estimator.lag_frames = settings.light_lag_frames;
+  ls.environment.filter_frames = settings.light_lag_frames;
   if (!scene_gpu_->virtual_objects.empty())
     ls.focus = 0.5f * (scene_gpu_->virtual_objects.bounds_min + scene_gpu_->virtual_objects.bounds_max);
   auto stage = light::LightStage::create(ls, scene_, cameras_);
@@ -318,6 +330,7 @@ Expected<SlotRecord*> RuntimeImpl::begin_slot(const InputFrame& frame,
   rec.level = level_;
   rec.skipped.clear();
   rec.notes.clear();
+  rec.light_ms = 0.0;
   return &rec;
 }
 
@@ -427,7 +440,11 @@ Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, 
   }
   if (affected) {
     // The light stage runs only where something is lit with its answer.
+    // Its cost as this thread's CPU time: wall time here would count the driver's workers
+    // preempting it on a CPU device; the CPU time is the work it adds to the frame.
+    const double light_start = thread_cpu_ms();
     MRGI_TRY(light_stage_->update(frame, last_pose_, rec.notes));
+    rec.light_ms = thread_cpu_ms() - light_start;
     technique::FrameInfo info;
     info.frame_index = frame.index;
     info.level = level_;
@@ -511,6 +528,7 @@ Expected<FrameOutput> RuntimeImpl::collect(const gpu::FrameTimings& timings) {
   out.stats.completed_s = timings.completed_s;
   out.stats.host_ms = std::max(0.0, rec.record_ms - (timings.profiled ? timings.total_ms : 0.0)) + readback_ms;
   out.stats.level = rec.level;
+  out.stats.light_ms = rec.light_ms;
   out.stats.skipped = rec.skipped;
   for (const std::string& c : timings.culled) out.stats.skipped.push_back(c + ": culled (nothing reads it)");
   out.stats.notes = rec.notes;

@@ -14,6 +14,7 @@
 #include "mrgi/reference/path_tracer.h"
 #include "mrgi/reference/sensors.h"
 #include "shared/mrgi_shared.h"
+#include "environment_sampler.h"
 #include "synth_resume.h"
 #include "synth_scene.h"
 
@@ -105,6 +106,37 @@ void add_delta_lamps(const RefScene& scene, const glm::vec3& p, ImageRGBF& probe
     float* t = probe.at(x, y);
     for (int c = 0; c < 3; ++c) t[c] += float(e[c] / dw);
   }
+}
+
+// The light sources alone as the probe point sees them: the environment where no real surface
+// is in the way (8 x 8 directions a pixel, so a small sun is not missed) and the delta lamps;
+// surfaces themselves are black (no bounce light). What an estimate of the real lights is
+// compared with.
+ImageRGBF direct_probe(const RefScene& scene, const glm::vec3& p, int width, int height) {
+  constexpr double kPi = 3.14159265358979323846;
+  constexpr int kSub = 8;
+  const EnvironmentSampler env(scene.environment);
+  ImageRGBF out(width, height);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      glm::dvec3 sum(0.0);
+      double weight = 0.0;
+      for (int j = 0; j < kSub; ++j)
+        for (int i = 0; i < kSub; ++i) {
+          const double theta = (y + (j + 0.5) / kSub) / height * kPi;
+          const double phi = ((x + (i + 0.5) / kSub) / width - 0.5) * 2.0 * kPi;
+          const glm::vec3 d(float(std::sin(theta) * std::sin(phi)), float(std::cos(theta)),
+                            float(-std::sin(theta) * std::cos(phi)));
+          const double w = std::sin(theta);
+          weight += w;
+          if (env.present() && !real_occluded(scene, p, d, 1e30f)) sum += w * glm::dvec3(env.radiance(d));
+        }
+      float* t = out.at(x, y);
+      const glm::dvec3 l = weight > 0.0 ? sum / weight : glm::dvec3(0.0);
+      t[0] = float(l.x), t[1] = float(l.y), t[2] = float(l.z);
+    }
+  add_delta_lamps(scene, p, out);
+  return out;
 }
 
 RefCamera env_camera_model(const EnvCameraDesc& e, EnvCamera* info) {
@@ -357,7 +389,7 @@ Expected<SynthReport> synthesize_capture(const SceneDescription& description, co
     report.frame_seconds += r.seconds;
   }
   if (!state.frames.empty()) report.noise_floor = state.frames[0].noise_floor;
-  if (report.finished && d.light_probe && !fs::exists(staging / "light_probe" / "probe.exr")) {
+  if (report.finished && d.light_probe && !fs::exists(staging / "light_probe" / "probe_direct.exr")) {
     // The probe: the real scene's incident radiance at the virtual objects' frame-0 centre.
     const RefScene at0 = scene->at_time(0.0);
     glm::dvec3 lo(1e30), hi(-1e30);
@@ -387,12 +419,15 @@ Expected<SynthReport> synthesize_capture(const SceneDescription& description, co
     add_delta_lamps(at0, glm::vec3(centre), img->real);
     fs::create_directories(staging / "light_probe", ec);
     MRGI_TRY(write_exr((staging / "light_probe" / "probe.exr").string(), img->real));
+    MRGI_TRY(write_exr((staging / "light_probe" / "probe_direct.exr").string(),
+                       direct_probe(at0, glm::vec3(centre), probe.width, probe.height)));
     std::ofstream j(staging / "light_probe" / "probe.json");
     char text[512];
     std::snprintf(text, sizeof text,
-                  "{\n \"about\": \"incident radiance of the real scene (lamps, environment, bounce light, occlusion) at the "
-                  "virtual objects' frame-0 centre, path-traced, equirectangular in world axes (u = 0.5 + atan2(x, -z) / 2pi, "
-                  "v = acos(y) / pi), linear radiance\",\n \"position\": [%.6f, %.6f, %.6f],\n \"spp\": %d\n}\n",
+                  "{\n \"about\": \"incident radiance of the real scene at the virtual objects' frame-0 centre, "
+                  "equirectangular in world axes (u = 0.5 + atan2(x, -z) / 2pi, v = acos(y) / pi), linear radiance: "
+                  "probe.exr path-traced (lamps, environment, bounce light, occlusion), probe_direct.exr the light "
+                  "sources alone (environment and lamps where no real surface blocks them, surfaces black)\",\n \"position\": [%.6f, %.6f, %.6f],\n \"spp\": %d\n}\n",
                   centre.x, centre.y, centre.z, ps.spp);
     j << text;
     if (!j) return fail(ErrorKind::Device, (staging / "light_probe" / "probe.json").string() + ": cannot write");

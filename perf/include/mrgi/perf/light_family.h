@@ -1,18 +1,20 @@
 // The light-estimation family (perf/suite/light/family.json, issue 13): every capture replayed
 // twice through one technique, once lit by what its scene.json declares (lamps, environment
 // image: the true light) and once with nothing declared (the runtime's probeless estimate), and
-// the estimate compared with the truth, the capture's path-traced light probe at the virtual
-// objects' centre (light_probe/probe.exr, `mrgi synth`: lamps, sky, bounce light and occlusion
-// as the object receives them):
+// the estimate compared with the truth, the light sources as the virtual objects' centre sees
+// them (light_probe/probe_direct.exr, `mrgi synth`: environment and lamps where no real surface
+// blocks them; the estimate is of the real lights, so bounce light is not part of the truth):
 //   direction error   degrees between the dominant directions (band 1 of the SH)
 //   irradiance error  RMS over 64 normals spread over the sphere of |E_est(n) - E_true(n)|
-//                     (luminance) over the RMS of E_true(n): 0 = the same shading of a diffuse
-//                     surface of any orientation
+//                     (luminance) over the RMS of E_true(n), against the path-traced probe
+//                     (probe.exr: bounce light included, as it lights the object): 0 = the same
+//                     shading of a diffuse surface of any orientation
 //   colour error      the largest relative difference of a channel of band 0 (the mean light),
 //                     each normalised by its luminance: 0.1 = within 10 % per channel
 //   RDE ratio         pooled RDE lit by the estimate over pooled RDE lit by the truth
 // Figures are taken from the last frame's estimate (the filter has seen every frame).
 #pragma once
+#include <array>
 #include <string>
 #include <vector>
 
@@ -35,6 +37,8 @@ struct LightFamilyResult {
   double irradiance_error = 0.0;
   double colour_error = 0.0;
   double confidence = 0.0;
+  std::array<float, 3> estimate_direction{}, truth_direction{};  // towards the dominant light
+  std::array<float, 3> estimate_mean{}, truth_mean{};            // band-0 radiance, linear RGB
   double rde_true = 0.0, rde_estimate = 0.0;  // pooled over the frames, all pixels
   double rde_ratio() const { return rde_true > 0.0 ? rde_estimate / rde_true : 0.0; }
   bool sky = false;              // lit by a procedural sun and sky (colour target applies)

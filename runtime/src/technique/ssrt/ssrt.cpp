@@ -86,9 +86,9 @@ void Ssrt::consume_readback(uint32_t slot, std::vector<std::string>& notes) {
   }
   for (int e = 0; e < light::kMaxShCoeffs * 3; ++e) sys.atb[e] = sums[136 + e];
   sys.samples = sums[184];
-  // The frame clock is not in FrameInfo: frames are spaced by the estimator's nominal step.
-  const Status r = shared_.light_stage->submit_system(
-      sys, frame, double(frame) * estimator().settings().nominal_frame_s, pending_bands_[slot], notes);
+  // The frame clock is not in FrameInfo: the filter steps by frame index; the timestamp
+  // reported is the frame's index at 30 frames a second.
+  const Status r = shared_.light_stage->submit_system(sys, frame, double(frame) / 30.0, pending_bands_[slot], notes);
   if (!r) notes.push_back("ssrt_light_estimation: " + r.error().message);
 }
 
