@@ -19,7 +19,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Run {
+struct FamilyRun {
   RdeReport pooled;
   bool any = false;
   std::optional<LightEstimate> light;  // the last frame's
@@ -27,7 +27,7 @@ struct Run {
 };
 
 // Replays every frame of `capture` with `scene` (its lights as given) and pools the error.
-Expected<Run> replay(const CaptureReader& capture, const SceneDesc& scene, const LightFamilySettings& s) {
+Expected<FamilyRun> replay_family_capture(const CaptureReader& capture, const SceneDesc& scene, const LightFamilySettings& s) {
   const CaptureInfo& info = capture.info();
   RuntimeSettings rs;
   rs.technique = s.technique;
@@ -36,7 +36,7 @@ Expected<Run> replay(const CaptureReader& capture, const SceneDesc& scene, const
   auto rt = create_runtime(rs, CameraSetup{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera},
                            scene);
   if (!rt) return rt.error();
-  Run run;
+  FamilyRun run;
   std::vector<ImageRGB8> cameras(capture.frame_count());
   auto consume = [&](std::vector<FrameOutput>& outs) -> Status {
     for (FrameOutput& o : outs) {
@@ -76,7 +76,7 @@ Expected<Run> replay(const CaptureReader& capture, const SceneDesc& scene, const
   return run;
 }
 
-double irradiance_error(const LightEstimate& est, const LightEstimate& truth) {
+double family_irradiance_error(const LightEstimate& est, const LightEstimate& truth) {
   constexpr int kNormals = 64;
   double err2 = 0.0, ref2 = 0.0;
   for (int k = 0; k < kNormals; ++k) {
@@ -84,7 +84,7 @@ double irradiance_error(const LightEstimate& est, const LightEstimate& truth) {
     const double y = 1.0 - 2.0 * (k + 0.5) / kNormals, r = std::sqrt(std::max(0.0, 1.0 - y * y));
     const double phi = 3.14159265358979323846 * (3.0 - std::sqrt(5.0)) * k;
     const std::array<float, 3> n{float(r * std::cos(phi)), float(y), float(r * std::sin(phi))};
-    auto lum = [](const Rgb& c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; };
+    auto lum = [](const mrgi::Rgb& c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; };
     const double e = std::max(0.0, lum(irradiance_at(est, n))), t = std::max(0.0, lum(irradiance_at(truth, n)));
     err2 += (e - t) * (e - t);
     ref2 += t * t;
@@ -92,8 +92,8 @@ double irradiance_error(const LightEstimate& est, const LightEstimate& truth) {
   return ref2 > 0.0 ? std::sqrt(err2 / ref2) : 0.0;
 }
 
-double colour_error(const LightEstimate& est, const LightEstimate& truth) {
-  auto norm = [](const Rgb& c) {
+double family_colour_error(const LightEstimate& est, const LightEstimate& truth) {
+  auto norm = [](const mrgi::Rgb& c) {
     const double l = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
     return l > 0.0 ? std::array<double, 3>{c[0] / l, c[1] / l, c[2] / l} : std::array<double, 3>{1, 1, 1};
   };
@@ -103,7 +103,7 @@ double colour_error(const LightEstimate& est, const LightEstimate& truth) {
   return worst;
 }
 
-double median(std::vector<double> v) {
+double family_median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
   const size_t n = v.size();
@@ -157,9 +157,9 @@ Expected<std::vector<LightFamilyResult>> run_light_family(const LightFamilySetti
     SceneDesc undeclared = truth_scene;
     undeclared.lights.clear();
     undeclared.environment = EnvironmentDesc{};
-    auto truth = replay(*capture, truth_scene, s);
+    auto truth = replay_family_capture(*capture, truth_scene, s);
     if (!truth) return fail(truth.error().kind, sc.name + " (true light): " + truth.error().message);
-    auto est = replay(*capture, undeclared, s);
+    auto est = replay_family_capture(*capture, undeclared, s);
     if (!est) return fail(est.error().kind, sc.name + " (estimate): " + est.error().message);
     if (!est->light) return fail(ErrorKind::Internal, sc.name + ": the estimate-lit run gave no light estimate");
     // The truth: the light sources as the virtual objects' centre sees them (mrgi synth's
@@ -180,8 +180,8 @@ Expected<std::vector<LightFamilyResult>> run_light_family(const LightFamilySetti
     r.scene = sc;
     r.estimate_source = est->light_note;
     r.direction_error_deg = direction_error_deg(*est->light, *probe_light);
-    r.irradiance_error = irradiance_error(*est->light, *full_light);
-    r.colour_error = colour_error(*est->light, *probe_light);
+    r.irradiance_error = family_irradiance_error(*est->light, *full_light);
+    r.colour_error = family_colour_error(*est->light, *probe_light);
     r.confidence = est->light->confidence;
     r.estimate_direction = est->light->direction_to_light;
     r.truth_direction = probe_light->direction_to_light;
@@ -227,8 +227,8 @@ std::string light_family_markdown(const std::vector<LightFamilyResult>& results,
     }
     if (dir.empty()) continue;
     std::snprintf(line, sizeof line, "| %s | %zu | %.1f / %.1f | %.2f | %.2f | %.2f / %.2f |\n",
-                  held ? "held out" : "tuning", dir.size(), median(dir), *std::max_element(dir.begin(), dir.end()),
-                  median(irr), colour, median(ratio), *std::max_element(ratio.begin(), ratio.end()));
+                  held ? "held out" : "tuning", dir.size(), family_median(dir), *std::max_element(dir.begin(), dir.end()),
+                  family_median(irr), colour, family_median(ratio), *std::max_element(ratio.begin(), ratio.end()));
     md += line;
   }
   return md;

@@ -308,3 +308,61 @@ TEST(TechniqueRegistry, NamesAndLevels) {
 
 }  // namespace
 }  // namespace mrgi::test
+
+namespace mrgi::test {
+namespace {
+
+// Issue 13, item 5: under an environment (no lamp), the virtual box shadows the sky for the real
+// floor at its foot: the light stage's strongest environment regions are drawn with shadow maps.
+// A sky bright above and dark below; floor pixels just outside the box's footprint get darker,
+// floor pixels far from every object keep the camera's value.
+TEST_F(BaselineTest, AVirtualObjectUnderASkyCastsAContactShadow) {
+  scene_.scene.lights.clear();
+  ImageRGB8 sky(32, 16);
+  for (int v = 0; v < 16; ++v)
+    for (int u = 0; u < 32; ++u)
+      for (int c = 0; c < 3; ++c) sky.at(u, v)[c] = uint8_t(v < 8 ? 200 : 20);  // the upper half bright
+  ASSERT_TRUE(write_png(scene_.scene.environment.image, sky).ok());
+  auto rt = create_runtime(settings_for(0), scene_.cameras(), scene_.scene);
+  ASSERT_TRUE(rt.ok()) << rt.error().message;
+  const InputFrame input = scene_.frame(0);
+  const auto outs = run(**rt, {input});
+  ASSERT_EQ(outs.size(), 1u);
+  const FrameOutput& out = outs[0];
+  bool noted = false;
+  for (const std::string& n : out.stats.notes) noted = noted || n.find("light: environment image") == 0;
+  EXPECT_TRUE(noted);
+  const Box& box = scene_.virtual_boxes[0];  // on the floor
+  double near_ratio = 0.0, far_ratio = 0.0;
+  int near = 0, far = 0;
+  for (int v = 0; v < 48; ++v) {
+    for (int u = 0; u < 64; ++u) {
+      const SurfaceHit h = scene_.trace(u, v, true);
+      if (h.kind != SurfaceKind::Floor) continue;
+      const float dx = std::max({box.lo.x - h.point.x, h.point.x - box.hi.x, 0.0f});
+      const float dz = std::max({box.lo.z - h.point.z, h.point.z - box.hi.z, 0.0f});
+      const float gap = std::sqrt(dx * dx + dz * dz);
+      const uint8_t* o = out.image.at(u, v);
+      const uint8_t* c = input.color.at(u, v);
+      const double ratio = (double(o[0]) + 1.0) / (double(c[0]) + 1.0);
+      if (gap > 0.03f && gap < 0.12f) {
+        near_ratio += ratio;
+        ++near;
+      } else if (std::abs(h.point.x) > 0.7f && h.point.z < -0.2f) {  // away from both boxes
+        far_ratio += ratio;
+        ++far;
+      }
+    }
+  }
+  ASSERT_GT(near, 5);
+  ASSERT_GT(far, 5);
+  near_ratio /= near;
+  far_ratio /= far;
+  // Measured 0.91 (session 12): four of the sixteen median-cut regions are shadowed, and the
+  // sky's share they carry is half the light; without the shadowed regions it is 1.
+  EXPECT_LT(near_ratio, 0.95) << "no contact shadow at the box's foot";
+  EXPECT_NEAR(far_ratio, 1.0, 0.03) << "open floor changed";
+}
+
+}  // namespace
+}  // namespace mrgi::test

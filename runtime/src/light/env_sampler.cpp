@@ -9,7 +9,7 @@
 namespace mrgi::light {
 namespace {
 
-Status check_range(bool ok, const char* field, const std::string& rule) {
+Status check_env_setting(bool ok, const char* field, const std::string& rule) {
   if (ok) return ok_status();
   return fail(ErrorKind::BadUsage, std::string("EnvSamplerSettings.") + field + ": " + rule);
 }
@@ -19,11 +19,11 @@ bool is_power_of_two(int n) { return n > 0 && (n & (n - 1)) == 0; }
 }  // namespace
 
 Expected<EnvSampler> EnvSampler::create(const EnvSamplerSettings& s) {
-  MRGI_TRY(check_range(s.grid_width >= 8 && s.grid_width <= 1024 && s.grid_width % 2 == 0,
+  MRGI_TRY(check_env_setting(s.grid_width >= 8 && s.grid_width <= 1024 && s.grid_width % 2 == 0,
                        "grid_width", "must be even, 8..1024 cells"));
-  MRGI_TRY(check_range(is_power_of_two(s.samples) && s.samples <= 256, "samples",
+  MRGI_TRY(check_env_setting(is_power_of_two(s.samples) && s.samples <= 256, "samples",
                        "must be a power of two, 1..256"));
-  MRGI_TRY(check_range(s.filter_frames >= 0.0 && std::isfinite(s.filter_frames), "filter_frames",
+  MRGI_TRY(check_env_setting(s.filter_frames >= 0.0 && std::isfinite(s.filter_frames), "filter_frames",
                        "must be finite and >= 0 frames"));
   EnvSampler e(s);
   const int w = s.grid_width, h = w / 2;

@@ -11,7 +11,7 @@
 namespace mrgi::light {
 namespace {
 
-Status check_range(bool ok, const char* field, const std::string& rule) {
+Status check_probeless_setting(bool ok, const char* field, const std::string& rule) {
   if (ok) return ok_status();
   return fail(ErrorKind::BadUsage, std::string("ProbelessSettings.") + field + ": " + rule);
 }
@@ -23,11 +23,11 @@ constexpr float kSameSurface = float(MRGI_DEPTH_EDGE_RELATIVE);
 
 Expected<ProbelessBuilder> ProbelessBuilder::create(const ProbelessSettings& s, const Intrinsics& color,
                                                     const Intrinsics& depth, double depth_scale) {
-  MRGI_TRY(check_range(s.grid_width >= 16 && s.grid_width <= 512, "grid_width", "must be 16..512 samples"));
-  MRGI_TRY(check_range(s.directions >= 16 && s.directions <= 1024, "directions", "must be 16..1024"));
-  MRGI_TRY(check_range(s.march_steps >= 1 && s.march_steps <= 64, "march_steps", "must be 1..64"));
-  MRGI_TRY(check_range(s.radius_m > 0.0 && std::isfinite(s.radius_m), "radius_m", "must be > 0 metres"));
-  MRGI_TRY(check_range(s.parts >= 1 && s.parts <= 16, "parts", "must be 1..16 frames"));
+  MRGI_TRY(check_probeless_setting(s.grid_width >= 16 && s.grid_width <= 512, "grid_width", "must be 16..512 samples"));
+  MRGI_TRY(check_probeless_setting(s.directions >= 16 && s.directions <= 1024, "directions", "must be 16..1024"));
+  MRGI_TRY(check_probeless_setting(s.march_steps >= 1 && s.march_steps <= 64, "march_steps", "must be 1..64"));
+  MRGI_TRY(check_probeless_setting(s.radius_m > 0.0 && std::isfinite(s.radius_m), "radius_m", "must be > 0 metres"));
+  MRGI_TRY(check_probeless_setting(s.parts >= 1 && s.parts <= 16, "parts", "must be 1..16 frames"));
   const int stride = std::max(2, depth.width / s.grid_width);
   if (color.width < 1 || color.height < 1 || depth.width < stride || depth.height < stride ||
       !(color.fx > 0) || !(color.fy > 0) || !(depth.fx > 0) || !(depth.fy > 0) || !(depth_scale > 0))

@@ -13,7 +13,7 @@ namespace {
 using Mat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor, 16, 16>;
 using Rhs = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor, 16, 3>;
 
-Status check_range(bool ok, const char* field, const std::string& rule) {
+Status check_estimator_setting(bool ok, const char* field, const std::string& rule) {
   if (ok) return ok_status();
   return fail(ErrorKind::BadUsage,
               std::string("ssrt LightEstimatorSettings.") + field + ": " + rule);
@@ -63,26 +63,26 @@ void LightSystem::add(const ShVector& transfer, const glm::dvec3& intensity) {
 }
 
 Expected<LightEstimator> LightEstimator::create(const LightEstimatorSettings& s) {
-  MRGI_TRY(check_range(s.bands >= 1 && s.bands <= kMaxShBands, "bands", "must be 1..4"));
-  MRGI_TRY(check_range(s.gray_albedo > 0.0 && s.gray_albedo <= 1.0, "gray_albedo",
+  MRGI_TRY(check_estimator_setting(s.bands >= 1 && s.bands <= kMaxShBands, "bands", "must be 1..4"));
+  MRGI_TRY(check_estimator_setting(s.gray_albedo > 0.0 && s.gray_albedo <= 1.0, "gray_albedo",
                        "must be in (0, 1]"));
-  MRGI_TRY(check_range(s.relative_regularisation >= 0.0 && std::isfinite(s.relative_regularisation),
+  MRGI_TRY(check_estimator_setting(s.relative_regularisation >= 0.0 && std::isfinite(s.relative_regularisation),
                        "relative_regularisation", "must be finite and >= 0"));
-  MRGI_TRY(check_range(s.min_regularisation > 0.0 && std::isfinite(s.min_regularisation),
+  MRGI_TRY(check_estimator_setting(s.min_regularisation > 0.0 && std::isfinite(s.min_regularisation),
                        "min_regularisation", "must be finite and > 0"));
-  MRGI_TRY(check_range(s.band_penalty >= 0.0 && std::isfinite(s.band_penalty), "band_penalty",
+  MRGI_TRY(check_estimator_setting(s.band_penalty >= 0.0 && std::isfinite(s.band_penalty), "band_penalty",
                        "must be finite and >= 0"));
-  MRGI_TRY(check_range(s.below_surface_penalty >= 0.0 && std::isfinite(s.below_surface_penalty),
+  MRGI_TRY(check_estimator_setting(s.below_surface_penalty >= 0.0 && std::isfinite(s.below_surface_penalty),
                        "below_surface_penalty", "must be finite and >= 0"));
-  MRGI_TRY(check_range(s.lag_frames >= 0.0 && s.lag_frames <= 1e6, "lag_frames",
+  MRGI_TRY(check_estimator_setting(s.lag_frames >= 0.0 && s.lag_frames <= 1e6, "lag_frames",
                        "must be 0..1e6 frames"));
-  MRGI_TRY(check_range(s.nonnegative_penalty >= 0.0 && std::isfinite(s.nonnegative_penalty),
+  MRGI_TRY(check_estimator_setting(s.nonnegative_penalty >= 0.0 && std::isfinite(s.nonnegative_penalty),
                        "nonnegative_penalty", "must be finite and >= 0"));
-  MRGI_TRY(check_range(s.nonnegative_rounds >= 0 && s.nonnegative_rounds <= 16, "nonnegative_rounds",
+  MRGI_TRY(check_estimator_setting(s.nonnegative_rounds >= 0 && s.nonnegative_rounds <= 16, "nonnegative_rounds",
                        "must be 0..16"));
-  MRGI_TRY(check_range(s.prior_radiance >= 0.0 && std::isfinite(s.prior_radiance),
+  MRGI_TRY(check_estimator_setting(s.prior_radiance >= 0.0 && std::isfinite(s.prior_radiance),
                        "prior_radiance", "must be finite and >= 0"));
-  MRGI_TRY(check_range(s.confidence_eigen_fraction > 0.0 && s.confidence_eigen_fraction < 1.0,
+  MRGI_TRY(check_estimator_setting(s.confidence_eigen_fraction > 0.0 && s.confidence_eigen_fraction < 1.0,
                        "confidence_eigen_fraction", "must be in (0, 1)"));
   LightEstimator e(s);
   e.reset();
