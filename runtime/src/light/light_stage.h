@@ -48,6 +48,8 @@ struct LightStageSettings {
   //   as ssrt's (regularisation 1e-2, no non-negativity)              20.6 / 37.8 degrees
   //   + non-negative radiance (nonnegative_penalty 10)                18.4 / 38.0
   //   + regularisation 1e-3                                           17.4 / 40.5 (chosen)
+  //   (+ the light's colour by vote, ProbelessSettings::grey_vote: 12.3 / 39.6, but worse on
+  //   the held-out half, so off: see there)
   //   (3 bands: 15.0 / 49.5; 128 directions: 19.2 / 35.5 at twice the cost; balancing the
   //   samples' orientations (ProbelessSettings::balance_normals): 24.0 / 46.6; below-surface
   //   weight 1: 15.8 / 42.5)

@@ -39,6 +39,8 @@ Expected<ProbelessBuilder> ProbelessBuilder::create(const ProbelessSettings& s, 
   b.depth_ = depth;
   b.depth_scale_ = depth_scale;
   b.stride_ = stride;
+  b.chroma_hist_.assign(size_t(kChromaBins) * size_t(kChromaBins), 0);
+  b.samples_.reserve(size_t(depth.width / stride) * size_t(depth.height / stride / s.parts + 1));
   b.grid_w_ = depth.width / stride;
   b.grid_h_ = depth.height / stride;
   const size_t cells = size_t(b.grid_w_) * size_t(b.grid_h_);
@@ -174,14 +176,13 @@ Status ProbelessBuilder::add_part(const InputFrame& frame, const glm::dmat4& cam
   const float solid_angle = float(4.0 * kPi / settings_.directions);
   const float inv_stride = 1.0f / float(s);
   auto cell = [&](int gx, int gy) -> const glm::vec3& { return position_[size_t(gy) * grid_w_ + gx]; };
+  // First the part's samples and their colours, so the light's colour can be voted on before
+  // any row is added.
+  samples_.clear();
   for (int gy = part; gy < grid_h_; gy += settings_.parts) {
     for (int gx = 0; gx < grid_w_; ++gx) {
       const glm::vec3 p = cell(gx, gy);
-      if (!(p.z > 0.0f)) continue;
-      const glm::vec3 n_cam = normal_[size_t(gy) * grid_w_ + gx];
-      if (n_cam == glm::vec3(0.0f)) continue;
-      const float weight_row = balance_[size_t(gy) * grid_w_ + gx];
-
+      if (!(p.z > 0.0f) || normal_[size_t(gy) * grid_w_ + gx] == glm::vec3(0.0f)) continue;
       // Colour: the linear mean of the block's pixels where the depth camera's sample lands in
       // the colour camera (same centre; intrinsics may differ).
       const glm::vec2 c = shader::project_pinhole(p, kc);
@@ -204,8 +205,17 @@ Status ProbelessBuilder::add_part(const InputFrame& frame, const glm::dmat4& cam
         }
       }
       if (saturated || count == 0) continue;
-      colour /= double(count) * exposure;
-
+      samples_.push_back({gy * grid_w_ + gx, colour / (double(count) * exposure)});
+    }
+  }
+  if (settings_.grey_vote) vote_light_colour();
+  for (const Sample& sample : samples_) {
+    const int gx = sample.cell % grid_w_, gy = sample.cell / grid_w_;
+    const glm::vec3 p = cell(gx, gy);
+    const glm::vec3 n_cam = normal_[size_t(sample.cell)];
+    const float weight_row = balance_[size_t(sample.cell)];
+    const glm::dvec3 colour = sample.colour;
+    {
       // Transfer with visibility: each direction in front of the surface is marched through the
       // depth grid; a grid surface in front of a step (within twice the radius: a range check,
       // as the ssrt transfer) occludes it by eq. 7-8's continuous K.
@@ -238,6 +248,52 @@ Status ProbelessBuilder::add_part(const InputFrame& frame, const glm::dmat4& cam
     }
   }
   return ok_status();
+}
+
+namespace {
+// Chromaticity (r, g, b) / (r + g + b) of linear RGB; grey for black.
+glm::dvec3 chroma_of(const glm::dvec3& c) {
+  const double sum = c.x + c.y + c.z;
+  return sum > 0.0 ? c / sum : glm::dvec3(1.0 / 3.0);
+}
+}  // namespace
+
+void ProbelessBuilder::vote_light_colour() {
+  // Every sample votes for the light's colour being its own (as if its surface were grey); the
+  // colour with the most votes within about 0.02 in (r, g) chromaticity wins (a mode, not
+  // gray-world's mean: a red wall or a wooden table beside a grey floor does not tint the light).
+  // Samples farther than kChromaOutlier from it keep their luminance but take the winner's
+  // colour: their surface is taken as coloured, and their brightness still tells the light's
+  // shape. Samples near it keep their own colour, which carries the light's colour by direction
+  // (a blue sky and a warm sun). Votes are counted on a 100 x 100 histogram of (r, g), each
+  // sample's votes the histogram's sum over the 5 x 5 bins around it: linear in the samples.
+  constexpr double kChromaOutlier = 0.04;
+  constexpr int kBins = kChromaBins, kReach = 2;
+  if (samples_.size() < 2) return;
+  std::fill(chroma_hist_.begin(), chroma_hist_.end(), 0);
+  auto bin = [](double v) { return std::clamp(int(v * kBins), 0, kBins - 1); };
+  for (const Sample& sm : samples_) {
+    const glm::dvec3 c = chroma_of(sm.colour);
+    ++chroma_hist_[size_t(bin(c.y)) * kBins + size_t(bin(c.x))];
+  }
+  int best_votes = -1;
+  glm::dvec3 winner(1.0 / 3.0);
+  for (const Sample& sm : samples_) {
+    const glm::dvec3 c = chroma_of(sm.colour);
+    const int bx = bin(c.x), by = bin(c.y);
+    int votes = 0;
+    for (int y = std::max(0, by - kReach); y <= std::min(kBins - 1, by + kReach); ++y)
+      for (int x = std::max(0, bx - kReach); x <= std::min(kBins - 1, bx + kReach); ++x)
+        votes += chroma_hist_[size_t(y) * kBins + size_t(x)];
+    if (votes > best_votes) {
+      best_votes = votes;
+      winner = c;
+    }
+  }
+  for (Sample& sm : samples_) {
+    if (glm::length(chroma_of(sm.colour) - winner) <= kChromaOutlier) continue;
+    sm.colour = winner * (sm.colour.x + sm.colour.y + sm.colour.z);
+  }
 }
 
 }  // namespace mrgi::light
