@@ -113,9 +113,7 @@ Status ReplayOutput::add(const FrameOutput& out, const ImageRGB8& camera, const 
     if (!pooled_) {
       pooled_ = *r;
     } else {
-      pooled_->all = pool(pooled_->all, r->all);
-      pooled_->real = pool(pooled_->real, r->real);
-      pooled_->virtual_ = pool(pooled_->virtual_, r->virtual_);
+      *pooled_ = pool(*pooled_, *r);
     }
     last_reference_ = *reference;
   }

@@ -304,9 +304,7 @@ Expected<RunSamples> run_one(const LoadedScene& l, const std::string& technique,
     if (!pooled_any) {
       e.error = *err;
     } else {
-      e.error.all = pool(e.error.all, err->all);
-      e.error.real = pool(e.error.real, err->real);
-      e.error.virtual_ = pool(e.error.virtual_, err->virtual_);
+      e.error = pool(e.error, *err);
     }
     pooled_any = true;
   }
@@ -487,9 +485,7 @@ std::vector<LevelAggregate> aggregate_levels(const BenchResult& result) {
       if (!it->has_reference) {
         it->error = e.error;
       } else {
-        it->error.all = pool(it->error.all, e.error.all);
-        it->error.real = pool(it->error.real, e.error.real);
-        it->error.virtual_ = pool(it->error.virtual_, e.error.virtual_);
+        it->error = pool(it->error, e.error);
       }
       it->has_reference = true;
     }

@@ -11,6 +11,7 @@
 
 #include "mrgi/light_estimate.h"
 #include "mrgi/metrics.h"
+#include "mrgi/perf/stats.h"
 #include "mrgi/platform/capture.h"
 #include "mrgi/runtime.h"
 
@@ -51,9 +52,7 @@ Expected<FamilyRun> replay_family_capture(const CaptureReader& capture, const Sc
         run.pooled = *r;
         run.any = true;
       } else {
-        run.pooled.all = pool(run.pooled.all, r->all);
-        run.pooled.real = pool(run.pooled.real, r->real);
-        run.pooled.virtual_ = pool(run.pooled.virtual_, r->virtual_);
+        run.pooled = pool(run.pooled, *r);
       }
       run.light = o.light;
       for (const std::string& n : o.stats.notes)
@@ -101,13 +100,6 @@ double family_colour_error(const LightEstimate& est, const LightEstimate& truth)
   double worst = 0.0;
   for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(e[c] - t[c]) / std::max(t[c], 1e-9));
   return worst;
-}
-
-double family_median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 }  // namespace
@@ -227,8 +219,8 @@ std::string light_family_markdown(const std::vector<LightFamilyResult>& results,
     }
     if (dir.empty()) continue;
     std::snprintf(line, sizeof line, "| %s | %zu | %.1f / %.1f | %.2f | %.2f | %.2f / %.2f |\n",
-                  held ? "held out" : "tuning", dir.size(), family_median(dir), *std::max_element(dir.begin(), dir.end()),
-                  family_median(irr), colour, family_median(ratio), *std::max_element(ratio.begin(), ratio.end()));
+                  held ? "held out" : "tuning", dir.size(), median(dir), *std::max_element(dir.begin(), dir.end()),
+                  median(irr), colour, median(ratio), *std::max_element(ratio.begin(), ratio.end()));
     md += line;
   }
   return md;

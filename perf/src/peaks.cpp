@@ -11,6 +11,7 @@
 #include "gpu/floor_pass.h"
 #include "gpu/frame_graph.h"
 #include "gpu/pipelines.h"
+#include "mrgi/perf/stats.h"
 
 namespace mrgi::perf {
 namespace {
@@ -23,12 +24,6 @@ struct Kernel {
   std::vector<gpu::DescriptorBinding> bindings;
   uint32_t push_bytes;
 };
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 // Times `record` as one profiled pass `repeats` times in a graph of its own.
 Expected<std::vector<double>> time_pass(gpu::FrameGraph& graph, const std::string& pass_name,

@@ -10,6 +10,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "mrgi/perf/stats.h"
+
 namespace mrgi::perf {
 namespace {
 
@@ -52,13 +54,6 @@ Status read_string(const nlohmann::json& obj, const char* key, const std::string
     return fail(ErrorKind::BadInput, where + ": \"" + key + "\" must be a string");
   out = obj[key].get<std::string>();
   return ok_status();
-}
-
-double median_of(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 }  // namespace
@@ -287,12 +282,12 @@ CheckReport check_against(const BenchResult& result, const Baseline& b) {
   if (!pass_changes.empty()) {
     std::vector<double> all;
     for (const auto& [pass, changes] : pass_changes) all.insert(all.end(), changes.begin(), changes.end());
-    const double run_change = median_of(all);
+    const double run_change = median(all);
     for (const auto& [pass, changes] : pass_changes) {
-      const double relative = median_of(changes) / run_change;
+      const double relative = median(changes) / run_change;
       if (!(relative <= 1.0 + tol.pass_ratio_relative))
         rep.violations.push_back("pass " + pass + ": median change over its " + std::to_string(changes.size()) +
-                                 " entries x" + num(median_of(changes)) + " against x" + num(run_change) +
+                                 " entries x" + num(median(changes)) + " against x" + num(run_change) +
                                  " for every checked pass: relative x" + num(relative) + " > x" +
                                  num(1.0 + tol.pass_ratio_relative));
     }

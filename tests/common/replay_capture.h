@@ -62,9 +62,7 @@ inline ReplayResult replay_capture(const std::string& path, const std::string& t
         g.pooled = *r;
         g.any = true;
       } else {
-        g.pooled.all = pool(g.pooled.all, r->all);
-        g.pooled.real = pool(g.pooled.real, r->real);
-        g.pooled.virtual_ = pool(g.pooled.virtual_, r->virtual_);
+        g.pooled = pool(g.pooled, *r);
       }
       if (o.light && o.light->valid && truth[i])
         g.light_error_deg.push_back(direction_error_deg(*o.light, *truth[i]));

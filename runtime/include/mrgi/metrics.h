@@ -37,6 +37,8 @@ Expected<RdeReport> measure_error(const ImageRGBA8& output, const ImageRGB8& cam
 
 // Pools figures of several frames (pixel-weighted means for rmse8/ssim, sums for rde).
 ErrorFigures pool(const ErrorFigures& a, const ErrorFigures& b);
+// The same for each of a report's three pixel sets.
+RdeReport pool(const RdeReport& a, const RdeReport& b);
 
 // sRGB transfer (IEC 61966-2-1), 8-bit code to linear [0,1]; a 256-entry table.
 float srgb8_to_linear(uint8_t v);

@@ -141,6 +141,10 @@ ErrorFigures pool(const ErrorFigures& a, const ErrorFigures& b) {
   return acc.finish();
 }
 
+RdeReport pool(const RdeReport& a, const RdeReport& b) {
+  return {pool(a.all, b.all), pool(a.real, b.real), pool(a.virtual_, b.virtual_)};
+}
+
 Expected<RdeReport> measure_error(const ImageRGB8& output, const ImageRGB8& camera,
                                   const ImageRGB8& reference, const ImageU8* virtual_mask) {
   return measure(output, camera, reference, virtual_mask);
