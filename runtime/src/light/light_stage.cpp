@@ -117,7 +117,13 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
   s.max_lights_ = s.declared_ + s.env_lights_ + (s.planned_ == LightSourceKind::Probeless ? 1 : 0);
   s.lighting_.lights.reserve(kMaxStageLights);
   s.last_env_directions_.reserve(kMaxStageLights);
-  for (const LightDesc& l : scene.lights) s.lighting_.lights.push_back(l);
+  s.lighting_.light_sh.reserve(kMaxStageLights);
+  s.lighting_.foldable.reserve(kMaxStageLights);
+  for (const LightDesc& l : scene.lights) {
+    s.lighting_.lights.push_back(l);
+    s.lighting_.light_sh.push_back(ShRgb{});
+    s.lighting_.foldable.push_back(0);
+  }
   // The declared real lamps seen from the focus, for the exported estimate.
   for (const LightDesc& l : scene.lights) {
     if (!l.real) continue;
@@ -153,6 +159,8 @@ void LightStage::set_environment_lighting(bool real) {
   // Lamps first (unchanged), then the strongest regions as shadowed directional lights; the SH
   // of the other regions is the ambient.
   lighting_.lights.resize(size_t(declared_));
+  lighting_.light_sh.resize(size_t(declared_));
+  lighting_.foldable.resize(size_t(declared_));
   ShRgb ambient = env_->radiance_sh();
   const auto& regions = env_->lights();
   bool changed = last_env_directions_.size() != size_t(std::min<size_t>(regions.size(), size_t(env_lights_)));
@@ -165,6 +173,8 @@ void LightStage::set_environment_lighting(bool real) {
     l.direction = glm::vec3(-r.direction);
     set_rgb(l, r.irradiance);
     lighting_.lights.push_back(l);
+    lighting_.light_sh.push_back(r.region_sh);
+    lighting_.foldable.push_back(1);
     for (int i = 0; i < kMaxShCoeffs; ++i) ambient[size_t(i)] -= r.region_sh[size_t(i)];
     changed = changed || last_env_directions_[k] != r.direction;
     last_env_directions_[k] = r.direction;
@@ -179,6 +189,8 @@ void LightStage::set_probeless_lighting() {
   const LightEstimate& est = estimator_->estimate();
   const ShRgb& l = estimator_->filtered();
   lighting_.lights.clear();
+  lighting_.light_sh.clear();
+  lighting_.foldable.clear();
   ShRgb ambient = l;
   glm::dvec3 dir;
   if (est.valid && sh_dominant_direction(l, dir)) {
@@ -191,6 +203,8 @@ void LightStage::set_probeless_lighting() {
       set_rgb(d, e);
       lighting_.lights.push_back(d);
       const ShRgb sh = sh_directional_light(dir, e);
+      lighting_.light_sh.push_back(sh);
+      lighting_.foldable.push_back(1);
       for (int i = 0; i < kMaxShCoeffs; ++i) ambient[size_t(i)] -= sh[size_t(i)];
     }
   }
@@ -242,6 +256,8 @@ Status LightStage::update(const InputFrame& frame, const glm::dmat4& camera_to_w
     } else {
       // No environment image yet: the lamps alone (or nothing).
       lighting_.lights.resize(size_t(declared_));
+      lighting_.light_sh.resize(size_t(declared_));
+      lighting_.foldable.resize(size_t(declared_));
       lighting_.ambient_real = lighting_.ambient_virtual = ShRgb{};
       lighting_.source = declared_ > 0 ? LightSourceKind::Declared : LightSourceKind::None;
       finish_declared();

@@ -79,6 +79,13 @@ struct Lighting {
   // Lights with shadows: declared lamps, then environment regions or the probeless dominant
   // light (directional, `real`). Capacity kMaxStageLights, reserved at start-up.
   std::vector<LightDesc> lights;
+  // Per light: the radiance SH of the light it stands for (an environment region's own cells,
+  // the probeless dominant light's delta) and whether it may be folded back into the ambient:
+  // a technique that shades fewer shadowed lights (a cheaper level) adds the SH of those it
+  // drops to ambient_real (or ambient_virtual for a virtual environment). Declared lamps are
+  // not foldable (a point lamp is no distant light).
+  std::vector<ShRgb> light_sh;
+  std::vector<uint8_t> foldable;
   // Radiance SH (4 bands) of the light not in `lights`: real (lights real and virtual surfaces)
   // and virtual (a virtual environment: lights virtual surfaces only).
   ShRgb ambient_real{}, ambient_virtual{};
