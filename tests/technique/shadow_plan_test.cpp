@@ -125,17 +125,5 @@ TEST(CameraProjection, OpenCvIntrinsicsMapPixelCentresAndDepth) {
   EXPECT_LT(ndc(p, {0, 0, 1.0f}).z, ndc(p, {0, 0, 2.0f}).z);
 }
 
-TEST(CameraProjection, EnvironmentMeanWeighsEquirectangularRowsBySolidAngle) {
-  ImageRGBF img(8, 4, 0.0f);
-  for (int x = 0; x < 8; ++x) img.at(x, 0)[0] = 1.0f;  // only the top row (near the pole) is lit
-  const glm::vec3 eq = runtime_detail::environment_mean(img, true);
-  const glm::vec3 plain = runtime_detail::environment_mean(img, false);
-  EXPECT_LT(eq.x, 0.25f);  // the polar row covers less than a quarter of the sphere
-  EXPECT_GT(eq.x, 0.0f);
-  EXPECT_FLOAT_EQ(plain.x, 1.0f);  // fisheye mean ignores black (outside-the-circle) pixels
-  img.at(0, 1)[1] = std::nanf("");
-  EXPECT_FALSE(std::isnan(runtime_detail::environment_mean(img, true).y));
-}
-
 }  // namespace
 }  // namespace mrgi::technique

@@ -1,5 +1,4 @@
-// Camera matrices for the runtime: the colour camera's OpenCV intrinsics as a Vulkan projection
-// and the environment's mean radiance for the baseline's constant ambient term.
+// Camera matrices for the runtime: the colour camera's OpenCV intrinsics as a Vulkan projection.
 #pragma once
 #include <glm/glm.hpp>
 
@@ -16,11 +15,5 @@ inline constexpr float kCameraFar = 100.0f;  // metres
 // integers, as OpenCV), y likewise (Vulkan's y is down too), depth 0 at kCameraNear and 1 at
 // kCameraFar.
 glm::mat4 opencv_projection(const Intrinsics& k, float near_m = kCameraNear, float far_m = kCameraFar);
-
-// Mean radiance of an environment image. equirectangular = true weights rows by the solid angle
-// they cover (sin of the polar angle); otherwise (fisheye frames) the plain mean over pixels
-// that are not black, since a fisheye's corners outside the image circle are black. NaN and
-// negative texels count as 0.
-glm::vec3 environment_mean(const ImageRGBF& image, bool equirectangular);
 
 }  // namespace mrgi::runtime_detail

@@ -138,9 +138,6 @@ class Technique {
     return ok_status();
   }
   virtual std::optional<RealGeometry> occlusion_geometry() const { return std::nullopt; }
-  // The real-world light a technique estimates (ssrt), or nullptr for techniques that take it
-  // from the scene description.
-  virtual const LightEstimate* light_estimate() const { return nullptr; }
   // Whether the next frame should be run twice: a technique whose output needs an estimate it
   // derives from the frames themselves (ssrt's light, read back a few frames late so nothing
   // stalls) and that has none yet asks once, so its first visible frame is not lit by a guess.

@@ -101,7 +101,6 @@ class Ssrt final : public Technique {
     return RealGeometry{geo_position_, geo_normal_, geometry_step_};
   }
   const LightEstimate& estimate() const { return estimator().estimate(); }
-  const LightEstimate* light_estimate() const override { return &estimator().estimate(); }
   // Once, before the first estimate: the first frame is lit by its own estimate instead of the
   // prior (a uniform grey guess that made the first frames_in_flight frames' RDE about 1).
   bool wants_priming_run() const override { return !primed_ && !estimator().estimate().valid; }
