@@ -250,4 +250,137 @@ TEST(FrameGraphValidation, BadDeclarationsAreErrorsNamingPassAndResource) {
   expect_bad({pass("xfer", PassKind::Transfer, {img(0, Access::StorageWrite)})}, "xfer");
 }
 
+// --- mip levels: state per level, so a mip chain reads level i - 1 while writing level i -------
+
+ResourceInfo mipped(const std::string& name, uint32_t levels, bool output = false) {
+  ResourceInfo r = image(name, output);
+  r.mip_levels = levels;
+  return r;
+}
+ResourceUse img_mips(uint32_t id, Access a, uint32_t base, uint32_t count) {
+  return {ResourceRef{true, id}, a, base, count};
+}
+
+TEST(FrameGraphMips, MipChainBarriersArePerLevel) {
+  std::vector<ResourceInfo> res = {mipped("volume", 4), image("out", true)};
+  std::vector<PassDecl> passes = {
+      pass("inject", PassKind::Compute, {img_mips(0, Access::StorageWrite, 0, 1)}),
+      pass("down1", PassKind::Compute, {img_mips(0, Access::StorageRead, 0, 1), img_mips(0, Access::StorageWrite, 1, 1)}),
+      pass("down2", PassKind::Compute, {img_mips(0, Access::StorageRead, 1, 1), img_mips(0, Access::StorageWrite, 2, 1)}),
+      pass("down3", PassKind::Compute, {img_mips(0, Access::StorageRead, 2, 1), img_mips(0, Access::StorageWrite, 3, 1)}),
+      pass("trace", PassKind::Compute, {img(0, Access::Sampled), img(1, Access::StorageWrite)}),
+  };
+  CompiledGraph g = compile_ok(passes, res);
+  EXPECT_TRUE(g.culled.empty());
+  // down1: level 0 read after inject's write (storage -> storage, no layout change), level 1
+  // made GENERAL from UNDEFINED (discarded: a first write-only touch).
+  const auto& d1 = g.passes[1].barriers;
+  ASSERT_EQ(d1.size(), 2u);
+  EXPECT_EQ(d1[0].base_mip, 0u);
+  EXPECT_EQ(d1[0].mip_count, 1u);
+  EXPECT_EQ(d1[0].src_access, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+  EXPECT_EQ(d1[0].dst_access, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+  EXPECT_EQ(d1[0].new_layout, VK_IMAGE_LAYOUT_GENERAL);
+  EXPECT_EQ(d1[1].base_mip, 1u);
+  EXPECT_EQ(d1[1].old_layout, VK_IMAGE_LAYOUT_UNDEFINED);
+  EXPECT_EQ(d1[1].new_layout, VK_IMAGE_LAYOUT_GENERAL);
+  // trace samples every level: each level exactly once in its barriers, all to SHADER_READ_ONLY,
+  // and level 3 (written, never read) waits for down3's write.
+  std::vector<int> covered(4, 0);
+  for (const Barrier& b : g.passes[4].barriers) {
+    if (b.resource_name != "volume") continue;
+    EXPECT_EQ(b.new_layout, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    EXPECT_EQ(b.old_layout, VK_IMAGE_LAYOUT_GENERAL);
+    for (uint32_t m = b.base_mip; m < b.base_mip + b.mip_count; ++m) ++covered[m];
+    if (b.base_mip + b.mip_count == 4) {
+      EXPECT_NE(b.src_access & VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, 0u);
+    }
+  }
+  EXPECT_EQ(covered, (std::vector<int>{1, 1, 1, 1}));
+  ASSERT_EQ(g.final_mip_states[0].size(), 4u);
+  for (const ResourceState& s : g.final_mip_states[0]) EXPECT_EQ(s.layout, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  EXPECT_TRUE(g.final_mip_states[1].empty());  // one level: final_states only
+}
+
+TEST(FrameGraphMips, NeighbouringLevelsShareOneBarrier) {
+  // Levels 1..3 were last touched alike (one clear of every level): one barrier covers them;
+  // level 0, sampled in between (another layout), gets its own.
+  std::vector<ResourceInfo> res = {mipped("volume", 4, true)};
+  std::vector<PassDecl> passes = {
+      pass("clear", PassKind::Compute, {img(0, Access::StorageWrite)}),
+      pass("look", PassKind::Compute, {img_mips(0, Access::Sampled, 0, 1)}, true),
+      pass("read all", PassKind::Compute, {img(0, Access::StorageReadWrite)}),
+  };
+  CompiledGraph g = compile_ok(passes, res);
+  const auto& b = g.passes[2].barriers;
+  ASSERT_EQ(b.size(), 2u);
+  EXPECT_EQ(b[0].base_mip, 0u);
+  EXPECT_EQ(b[0].mip_count, 1u);
+  EXPECT_EQ(b[1].base_mip, 1u);
+  EXPECT_EQ(b[1].mip_count, 3u);
+  EXPECT_EQ(g.passes[0].barriers.size(), 1u);  // clear: one barrier for all four levels
+  EXPECT_EQ(g.passes[0].barriers[0].mip_count, 4u);
+}
+
+TEST(FrameGraphMips, CullingFollowsLevels) {
+  // Only level 0 is read by the output's pass: the pass writing level 1 alone is culled.
+  std::vector<ResourceInfo> res = {mipped("pyramid", 3), image("out", true)};
+  std::vector<PassDecl> passes = {
+      pass("base", PassKind::Compute, {img_mips(0, Access::StorageWrite, 0, 1)}),
+      pass("level1", PassKind::Compute, {img_mips(0, Access::StorageRead, 0, 1), img_mips(0, Access::StorageWrite, 1, 1)}),
+      pass("use", PassKind::Compute, {img_mips(0, Access::Sampled, 0, 1), img(1, Access::StorageWrite)}),
+  };
+  CompiledGraph g = compile_ok(passes, res);
+  EXPECT_TRUE(g.runs("base"));
+  EXPECT_TRUE(g.runs("use"));
+  EXPECT_FALSE(g.runs("level1"));
+}
+
+TEST(FrameGraphMips, OverlappingOrOutOfRangeLevelsAreRefused) {
+  std::vector<ResourceInfo> res = {mipped("volume", 3), image("flat", true)};
+  auto overlap = compile_graph(std::vector<PassDecl>{pass("bad", PassKind::Compute,
+                                                          {img_mips(0, Access::StorageRead, 0, 2),
+                                                           img_mips(0, Access::StorageWrite, 1, 1)})},
+                               res);
+  ASSERT_FALSE(overlap.ok());
+  EXPECT_EQ(overlap.error().kind, ErrorKind::BadUsage);
+  EXPECT_NE(overlap.error().message.find("declared twice"), std::string::npos) << overlap.error().message;
+  auto beyond = compile_graph(std::vector<PassDecl>{pass("bad", PassKind::Compute,
+                                                         {img_mips(0, Access::StorageWrite, 2, 2)})},
+                              res);
+  ASSERT_FALSE(beyond.ok());
+  EXPECT_NE(beyond.error().message.find("mip levels 2..4 outside the resource's 3"), std::string::npos)
+      << beyond.error().message;
+  auto flat = compile_graph(std::vector<PassDecl>{pass("bad", PassKind::Compute,
+                                                       {img_mips(1, Access::StorageWrite, 1, 1)})},
+                            res);
+  ASSERT_FALSE(flat.ok());
+  EXPECT_NE(flat.error().message.find("'flat'"), std::string::npos) << flat.error().message;
+}
+
+TEST(FrameGraphMips, PerLevelInitialStatesCarryAcrossFrames) {
+  // Frame 1 leaves level 0 SHADER_READ_ONLY and level 1 GENERAL; frame 2 starts from that.
+  std::vector<ResourceInfo> res = {mipped("history", 2, true)};
+  res[0].history = true;
+  std::vector<PassDecl> frame1 = {
+      pass("write1", PassKind::Compute, {img_mips(0, Access::StorageWrite, 1, 1)}),
+      pass("read0", PassKind::Compute, {img_mips(0, Access::Sampled, 0, 1)}, true),
+  };
+  CompiledGraph g1 = compile_ok(frame1, res);
+  ASSERT_EQ(g1.final_mip_states[0].size(), 2u);
+  EXPECT_EQ(g1.final_mip_states[0][0].layout, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  EXPECT_EQ(g1.final_mip_states[0][1].layout, VK_IMAGE_LAYOUT_GENERAL);
+  res[0].initial = g1.final_states[0];
+  res[0].initial_mips = g1.final_mip_states[0];
+  std::vector<PassDecl> frame2 = {pass("read both", PassKind::Compute, {img(0, Access::StorageRead)}, true)};
+  CompiledGraph g2 = compile_ok(frame2, res);
+  const auto& b = g2.passes[0].barriers;
+  ASSERT_EQ(b.size(), 2u);  // level 0 changes layout; level 1 waits for frame 1's write
+  EXPECT_EQ(b[0].base_mip, 0u);
+  EXPECT_EQ(b[0].old_layout, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  EXPECT_EQ(b[1].base_mip, 1u);
+  EXPECT_EQ(b[1].old_layout, VK_IMAGE_LAYOUT_GENERAL);
+  EXPECT_EQ(b[1].src_access, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+}
+
 }  // namespace

@@ -334,7 +334,7 @@ TEST_F(VulkanTest, RelativeImagesFollowOutputSizeAndRenderScaleWithoutReallocati
   dup.name = "half";
   EXPECT_EQ((*g)->create_image(dup, VK_IMAGE_USAGE_STORAGE_BIT).error().kind, ErrorKind::BadUsage);
   // An extent divisor (a stage at a fraction of the internal size): ceil(extent / d), no
-  // reallocation, relative images only, 1..64.
+  // reallocation, 1..64.
   ASSERT_TRUE((*g)->set_output_size(640, 480).ok());
   ASSERT_TRUE((*g)->set_render_scale(1.0f).ok());
   ASSERT_TRUE((*g)->set_extent_divisor(*fr, 4).ok());
@@ -347,7 +347,14 @@ TEST_F(VulkanTest, RelativeImagesFollowOutputSizeAndRenderScaleWithoutReallocati
   ASSERT_TRUE((*g)->set_extent_divisor(*fr, 1).ok());
   EXPECT_EQ((*g)->extent(*fr).width, 638u);
   EXPECT_EQ(ctx().allocated_bytes(), bytes);
-  EXPECT_EQ((*g)->set_extent_divisor(*f, 2).error().kind, ErrorKind::BadUsage);   // absolute
+  // Absolute images (a volume's cheaper levels): each dimension of the allocation / divisor.
+  ASSERT_TRUE((*g)->set_extent_divisor(*f, 3).ok());
+  EXPECT_EQ((*g)->extent(*f).width, 86u);  // ceil(256 / 3)
+  EXPECT_EQ((*g)->extent3d(*f, 1).height, 43u);
+  EXPECT_EQ((*g)->extent3d(*f).depth, 1u);
+  ASSERT_TRUE((*g)->set_extent_divisor(*f, 1).ok());
+  EXPECT_EQ((*g)->extent(*f).width, 256u);
+  EXPECT_EQ(ctx().allocated_bytes(), bytes);
   EXPECT_EQ((*g)->set_extent_divisor(*fr, 0).error().kind, ErrorKind::BadUsage);
   EXPECT_EQ((*g)->set_extent_divisor(*fr, 65).error().kind, ErrorKind::BadUsage);
   EXPECT_EQ((*g)->set_extent_divisor(ImageHandle{}, 2).error().kind, ErrorKind::BadUsage);

@@ -503,17 +503,27 @@ Expected<GpuBuffer> Context::create_buffer(VkDeviceSize size, VkBufferUsageFlags
 }
 
 Expected<GpuImage> Context::create_image(const ImageCreateDesc& desc) {
-  if (desc.width == 0 || desc.height == 0 || desc.mip_levels == 0 || desc.layers == 0)
-    return fail(ErrorKind::BadUsage, "image '" + desc.name + "': width, height, mip_levels and layers must be > 0");
+  if (desc.width == 0 || desc.height == 0 || desc.depth == 0 || desc.mip_levels == 0 || desc.layers == 0)
+    return fail(ErrorKind::BadUsage, "image '" + desc.name + "': width, height, depth, mip_levels and layers must be > 0");
   if (desc.usage == 0) return fail(ErrorKind::BadUsage, "image '" + desc.name + "': no usage flags");
-  const uint32_t max_dim = properties_.limits.maxImageDimension2D;
-  if (desc.width > max_dim || desc.height > max_dim)
+  const bool is_3d = desc.depth > 1;
+  if (is_3d && desc.layers != 1)
+    return fail(ErrorKind::BadUsage, "image '" + desc.name + "': a 3D image (depth > 1) has one layer");
+  const uint32_t max_dim = is_3d ? properties_.limits.maxImageDimension3D : properties_.limits.maxImageDimension2D;
+  if (desc.width > max_dim || desc.height > max_dim || desc.depth > max_dim)
     return fail(ErrorKind::BadUsage, "image '" + desc.name + "': " + std::to_string(desc.width) + "x" +
-                                         std::to_string(desc.height) + " exceeds the device limit " +
-                                         std::to_string(max_dim));
+                                         std::to_string(desc.height) + "x" + std::to_string(desc.depth) +
+                                         " exceeds the device limit " + std::to_string(max_dim));
+  const uint32_t largest = std::max({desc.width, desc.height, desc.depth});
+  uint32_t full_chain = 1;
+  while ((largest >> full_chain) > 0) ++full_chain;
+  if (desc.mip_levels > full_chain)
+    return fail(ErrorKind::BadUsage, "image '" + desc.name + "': " + std::to_string(desc.mip_levels) +
+                                         " mip levels, more than the " + std::to_string(full_chain) +
+                                         " its size has");
   VkImageFormatProperties fp{};
   const VkResult support = vkGetPhysicalDeviceImageFormatProperties(
-      physical_, desc.format, VK_IMAGE_TYPE_2D, VK_IMAGE_TILING_OPTIMAL, desc.usage, 0, &fp);
+      physical_, desc.format, is_3d ? VK_IMAGE_TYPE_3D : VK_IMAGE_TYPE_2D, VK_IMAGE_TILING_OPTIMAL, desc.usage, 0, &fp);
   if (support != VK_SUCCESS)
     return fail(ErrorKind::Device, "image '" + desc.name + "': format " + std::to_string(int(desc.format)) +
                                        " with usage 0x" + std::to_string(desc.usage) +
@@ -521,14 +531,15 @@ Expected<GpuImage> Context::create_image(const ImageCreateDesc& desc) {
   GpuImage img;
   img.format = desc.format;
   img.extent = {desc.width, desc.height};
+  img.depth = desc.depth;
   img.mip_levels = desc.mip_levels;
   img.layers = desc.layers;
   img.aspect = aspect_of(desc.format);
   img.usage = desc.usage;
   VkImageCreateInfo ici{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
-  ici.imageType = VK_IMAGE_TYPE_2D;
+  ici.imageType = is_3d ? VK_IMAGE_TYPE_3D : VK_IMAGE_TYPE_2D;
   ici.format = desc.format;
-  ici.extent = {desc.width, desc.height, 1};
+  ici.extent = {desc.width, desc.height, desc.depth};
   ici.mipLevels = desc.mip_levels;
   ici.arrayLayers = desc.layers;
   ici.samples = VK_SAMPLE_COUNT_1_BIT;
@@ -553,13 +564,24 @@ Expected<GpuImage> Context::create_image(const ImageCreateDesc& desc) {
   }
   VkImageViewCreateInfo vci{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
   vci.image = img.image;
-  vci.viewType = desc.layers > 1 ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_2D;
+  vci.viewType = is_3d ? VK_IMAGE_VIEW_TYPE_3D : desc.layers > 1 ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_2D;
   vci.format = desc.format;
   vci.subresourceRange = {img.aspect, 0, desc.mip_levels, 0, desc.layers};
   const VkResult view = vkCreateImageView(device_, &vci, nullptr, &img.view);
   if (view != VK_SUCCESS) {
     destroy(img);
     return vk_error(view, "vkCreateImageView", __FILE__, __LINE__);
+  }
+  for (uint32_t m = 0; m < desc.mip_levels && desc.mip_levels > 1; ++m) {
+    vci.subresourceRange = {img.aspect, m, 1, 0, desc.layers};
+    VkImageView v = VK_NULL_HANDLE;
+    const VkResult mv = vkCreateImageView(device_, &vci, nullptr, &v);
+    if (mv != VK_SUCCESS) {
+      destroy(img);
+      return vk_error(mv, "vkCreateImageView (mip level)", __FILE__, __LINE__);
+    }
+    img.mip_views.push_back(v);
+    set_name(VK_OBJECT_TYPE_IMAGE_VIEW, uint64_t(v), desc.name + " mip " + std::to_string(m));
   }
   set_name(VK_OBJECT_TYPE_IMAGE, uint64_t(img.image), desc.name);
   set_name(VK_OBJECT_TYPE_IMAGE_VIEW, uint64_t(img.view), desc.name);
@@ -579,6 +601,7 @@ void Context::destroy(GpuBuffer& b) {
 }
 
 void Context::destroy(GpuImage& img) {
+  for (VkImageView v : img.mip_views) vkDestroyImageView(device_, v, nullptr);
   if (img.view) vkDestroyImageView(device_, img.view, nullptr);
   if (img.image) vkDestroyImage(device_, img.image, nullptr);
   if (img.memory) {
@@ -660,12 +683,13 @@ Status Context::upload_buffer(const GpuBuffer& dst, const void* data, VkDeviceSi
 
 Status Context::upload_image(const GpuImage& dst, const void* texels, VkDeviceSize size, VkImageLayout final_layout) {
   const uint32_t bpt = bytes_per_texel(dst.format);
-  const VkDeviceSize expected = VkDeviceSize(dst.extent.width) * dst.extent.height * bpt * dst.layers;
+  const VkDeviceSize expected = VkDeviceSize(dst.extent.width) * dst.extent.height * dst.depth * bpt * dst.layers;
   if (bpt == 0 || size != expected)
     return fail(ErrorKind::BadUsage, "image upload: " + std::to_string(size) + " bytes given, " +
                                          std::to_string(expected) + " expected for " +
                                          std::to_string(dst.extent.width) + "x" + std::to_string(dst.extent.height) + "x" +
-                                         std::to_string(dst.layers) + " layers (tightly packed mip 0)");
+                                         std::to_string(dst.depth) + " x " + std::to_string(dst.layers) +
+                                         " layers (tightly packed mip 0)");
   auto staging = create_buffer(size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUsage::Upload, "staging");
   if (!staging) return staging.error();
   std::memcpy(staging->mapped, texels, size);
@@ -685,7 +709,7 @@ Status Context::upload_image(const GpuImage& dst, const void* texels, VkDeviceSi
     fn_.cmd_pipeline_barrier2(cmd, &di);
     VkBufferImageCopy region{};
     region.imageSubresource = {dst.aspect, 0, 0, dst.layers};
-    region.imageExtent = {dst.extent.width, dst.extent.height, 1};
+    region.imageExtent = {dst.extent.width, dst.extent.height, dst.depth};
     vkCmdCopyBufferToImage(cmd, staging->buffer, dst.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
     b.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
     b.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;

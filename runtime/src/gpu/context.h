@@ -39,10 +39,13 @@ struct GpuBuffer {
   VkBufferView texel_view = VK_NULL_HANDLE;  // BufferDesc::texel_format's view; destroyed with it
 };
 
-// A 2D image (optionally layered / mipmapped) with one view over all levels and layers.
+// A 2D image (optionally layered / mipmapped) or a 3D image (depth > 1, one layer), with one
+// view over all levels and layers and, when mipmapped, one view per level (storage writes of a
+// mip chain bind a single level).
 struct ImageCreateDesc {
   VkFormat format = VK_FORMAT_R8G8B8A8_UNORM;
   uint32_t width = 1, height = 1;
+  uint32_t depth = 1;
   uint32_t mip_levels = 1;
   uint32_t layers = 1;            // > 1: a 2D array view
   VkImageUsageFlags usage = 0;
@@ -54,7 +57,9 @@ struct GpuImage {
   VkDeviceMemory memory = VK_NULL_HANDLE;
   VkFormat format = VK_FORMAT_UNDEFINED;
   VkExtent2D extent{0, 0};
+  uint32_t depth = 1;             // > 1: a 3D image
   uint32_t mip_levels = 1, layers = 1;
+  std::vector<VkImageView> mip_views;  // one per level when mip_levels > 1
   VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT;
   VkImageUsageFlags usage = 0;
   VkDeviceSize allocated = 0;

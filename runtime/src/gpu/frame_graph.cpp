@@ -29,7 +29,12 @@ struct FrameGraph::ImageEntry {
   GpuImage gpu;
   bool owned = true;
   uint32_t divisor = 1;  // set_extent_divisor: used extent = ceil(relative extent / divisor)
-  ResourceState state;
+  ResourceState state;                    // level 0's (every level's when there is one)
+  std::vector<ResourceState> mip_states;  // every level's, when there are more
+  void set_all_levels(const ResourceState& s) {
+    state = s;
+    if (gpu.mip_levels > 1) mip_states.assign(gpu.mip_levels, s);
+  }
 };
 
 struct FrameGraph::BufferEntry {
@@ -60,6 +65,12 @@ void PassBuilder::read(ImageHandle image, Access access) {
 void PassBuilder::write(ImageHandle image, Access access) {
   decl_.uses.push_back({ResourceRef{true, image.id}, access});
 }
+void PassBuilder::read(ImageHandle image, Access access, uint32_t base_mip, uint32_t mip_count) {
+  decl_.uses.push_back({ResourceRef{true, image.id}, access, base_mip, mip_count});
+}
+void PassBuilder::write(ImageHandle image, Access access, uint32_t base_mip, uint32_t mip_count) {
+  decl_.uses.push_back({ResourceRef{true, image.id}, access, base_mip, mip_count});
+}
 void PassBuilder::read(BufferHandle buffer, Access access) {
   decl_.uses.push_back({ResourceRef{false, uint32_t(graph_.images_.size()) + buffer.id}, access});
 }
@@ -70,6 +81,11 @@ void PassBuilder::side_effect() { decl_.side_effect = true; }
 
 VkImage PassContext::image(ImageHandle h) const { return graph_.gpu_image(h).image; }
 VkImageView PassContext::view(ImageHandle h) const { return graph_.gpu_image(h).view; }
+VkImageView PassContext::view(ImageHandle h, uint32_t mip) const {
+  const GpuImage& img = graph_.gpu_image(h);
+  return img.mip_levels == 1 && mip == 0 ? img.view : img.mip_views.at(mip);
+}
+VkExtent3D PassContext::extent3d(ImageHandle h, uint32_t mip) const { return graph_.extent3d(h, mip); }
 VkFormat PassContext::format(ImageHandle h) const { return graph_.gpu_image(h).format; }
 VkExtent2D PassContext::extent(ImageHandle h) const { return graph_.extent(h); }
 VkBuffer PassContext::buffer(BufferHandle h) const { return graph_.gpu_buffer(h, graph_.slot_).buffer; }
@@ -183,6 +199,9 @@ Expected<ImageHandle> FrameGraph::create_image(const ImageDesc& desc, VkImageUsa
   if (desc.name.empty()) return fail(ErrorKind::BadUsage, "frame graph image: name must not be empty");
   for (const ImageEntry& e : images_)
     if (e.desc.name == desc.name) return fail(ErrorKind::BadUsage, what + ": name already used");
+  if (desc.depth == 0) return fail(ErrorKind::BadUsage, what + ": depth must be >= 1");
+  if (desc.depth > 1 && (desc.size_mode != SizeMode::Absolute || desc.layers != 1))
+    return fail(ErrorKind::BadUsage, what + ": a 3D image (depth > 1) has an absolute size and one layer");
   VkExtent2D ext;
   if (desc.size_mode == SizeMode::Absolute) {
     if (desc.width == 0 || desc.height == 0)
@@ -198,6 +217,7 @@ Expected<ImageHandle> FrameGraph::create_image(const ImageDesc& desc, VkImageUsa
   cd.format = desc.format;
   cd.width = ext.width;
   cd.height = ext.height;
+  cd.depth = desc.depth;
   cd.mip_levels = desc.mip_levels;
   cd.layers = desc.layers;
   cd.usage = usage | desc.extra_usage;
@@ -207,6 +227,7 @@ Expected<ImageHandle> FrameGraph::create_image(const ImageDesc& desc, VkImageUsa
   ImageEntry e;
   e.desc = desc;
   e.gpu = *img;
+  e.set_all_levels(ResourceState{});
   images_.push_back(std::move(e));
   return ImageHandle{uint32_t(images_.size() - 1)};
 }
@@ -272,12 +293,15 @@ ImageHandle FrameGraph::import_image(const std::string& name, const GpuImage& im
   e.desc.size_mode = SizeMode::Absolute;
   e.desc.width = image.extent.width;
   e.desc.height = image.extent.height;
+  e.desc.depth = image.depth;
   e.desc.mip_levels = image.mip_levels;
   e.desc.layers = image.layers;
   e.desc.history = history;
   e.gpu = image;
   e.owned = false;
-  e.state.layout = layout;
+  ResourceState st;
+  st.layout = layout;
+  e.set_all_levels(st);
   images_.push_back(std::move(e));
   return ImageHandle{uint32_t(images_.size() - 1)};
 }
@@ -307,8 +331,9 @@ Status FrameGraph::upload_image(ImageHandle image, const void* texels, VkDeviceS
                                : (e.gpu.usage & VK_IMAGE_USAGE_STORAGE_BIT) ? VK_IMAGE_LAYOUT_GENERAL
                                                                             : VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
   MRGI_TRY(context_.upload_image(e.gpu, texels, size, layout));
-  e.state = ResourceState{};
-  e.state.layout = layout;
+  ResourceState st;
+  st.layout = layout;
+  e.set_all_levels(st);
   return ok_status();
 }
 
@@ -334,7 +359,10 @@ Status FrameGraph::set_render_scale(float scale) {
 
 VkExtent2D FrameGraph::extent(ImageHandle image) const {
   const ImageEntry& e = images_.at(image.id);
-  if (e.desc.size_mode == SizeMode::Absolute) return e.gpu.extent;
+  if (e.desc.size_mode == SizeMode::Absolute) {
+    const uint32_t d = e.divisor;
+    return {(e.gpu.extent.width + d - 1) / d, (e.gpu.extent.height + d - 1) / d};
+  }
   const float s = e.desc.scale * (e.desc.follows_render_scale ? render_scale_ : 1.0f);
   const VkExtent2D r = relative_extent(output_size_.width, output_size_.height, s);
   const uint32_t d = e.divisor;
@@ -342,13 +370,17 @@ VkExtent2D FrameGraph::extent(ImageHandle image) const {
           std::min((r.height + d - 1) / d, e.gpu.extent.height)};
 }
 
+VkExtent3D FrameGraph::extent3d(ImageHandle image, uint32_t mip) const {
+  const ImageEntry& e = images_.at(image.id);
+  const VkExtent2D xy = extent(image);
+  const uint32_t d = e.desc.size_mode == SizeMode::Absolute ? (e.gpu.depth + e.divisor - 1) / e.divisor : e.gpu.depth;
+  return {std::max(1u, xy.width >> mip), std::max(1u, xy.height >> mip), std::max(1u, d >> mip)};
+}
+
 Status FrameGraph::set_extent_divisor(ImageHandle image, uint32_t divisor) {
   if (image.id >= images_.size())
     return fail(ErrorKind::BadUsage, "set_extent_divisor: invalid image handle");
   ImageEntry& e = images_[image.id];
-  if (e.desc.size_mode != SizeMode::OutputRelative)
-    return fail(ErrorKind::BadUsage, "set_extent_divisor: image '" + e.desc.name +
-                                         "' is not OutputRelative (its size is absolute)");
   if (divisor < 1 || divisor > 64)
     return fail(ErrorKind::BadUsage, "set_extent_divisor: image '" + e.desc.name + "': divisor " +
                                          std::to_string(divisor) + " must be in 1..64");
@@ -459,7 +491,9 @@ void FrameGraph::update_resource_infos() {
     r.is_output = false;
     r.history = e.desc.history;
     r.host_read = false;
+    r.mip_levels = e.gpu.mip_levels;
     r.initial = e.state;
+    r.initial_mips = e.mip_states;
   }
   for (size_t i = 0; i < buffers_.size(); ++i) {
     ResourceInfo& r = infos_[images_.size() + i];
@@ -526,7 +560,7 @@ void FrameGraph::record_barriers(VkCommandBuffer cmd, const std::vector<Barrier>
       ib.newLayout = b.new_layout;
       ib.srcQueueFamilyIndex = ib.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
       ib.image = img.image;
-      ib.subresourceRange = {img.aspect, 0, img.mip_levels, 0, img.layers};
+      ib.subresourceRange = {img.aspect, b.base_mip, b.mip_count, 0, img.layers};
       image_barriers.push_back(ib);
     } else {
       const uint32_t id = b.resource.id - uint32_t(images_.size());
@@ -556,6 +590,7 @@ void FrameGraph::finish_execute(bool profiled) {
   for (size_t r = 0; r < compiled_.final_states.size(); ++r) {
     if (r < images_.size()) {
       images_[r].state = compiled_.final_states[r];
+      if (images_[r].gpu.mip_levels > 1) images_[r].mip_states = compiled_.final_mip_states[r];
     } else {
       BufferEntry& e = buffers_[r - images_.size()];
       (e.states.size() > 1 ? e.states[slot_] : e.states[0]) = compiled_.final_states[r];

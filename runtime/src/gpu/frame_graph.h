@@ -53,6 +53,7 @@ struct ImageDesc {
   VkFormat format = VK_FORMAT_R8G8B8A8_UNORM;
   SizeMode size_mode = SizeMode::OutputRelative;
   uint32_t width = 0, height = 0;  // Absolute only
+  uint32_t depth = 1;              // > 1: a 3D image (Absolute only; layers must be 1)
   float scale = 1.0f;              // OutputRelative only: fraction of the output size (0, 4]
   // OutputRelative only: also scaled by the per-frame render scale (internal resolution knob).
   bool follows_render_scale = true;
@@ -114,9 +115,14 @@ struct ResourceRef {
   bool operator==(const ResourceRef&) const = default;
 };
 
+// A pass's use of a resource: of an image, the mip levels [base_mip, base_mip + mip_count)
+// (mip_count 0: every level from base_mip), so a mip chain's pass may read level i - 1 and write
+// level i of one image; a buffer has one level.
 struct ResourceUse {
   ResourceRef resource;
   Access access = Access::Sampled;
+  uint32_t base_mip = 0;
+  uint32_t mip_count = 0;
   bool operator==(const ResourceUse&) const = default;
 };
 
@@ -145,13 +151,17 @@ struct ResourceInfo {
   bool is_output = false;     // marked output or history: its final writer is kept
   bool history = false;       // contents must be preserved across frames (no discard on write)
   bool host_read = false;     // a Readback buffer: the frame ends with a barrier to HOST_READ
-  ResourceState initial;      // state at the start of the frame
+  uint32_t mip_levels = 1;    // images: state is tracked per level; buffers: 1
+  ResourceState initial;      // state at the start of the frame (of every level, unless...)
+  std::vector<ResourceState> initial_mips;  // ...this has one per level (levels that differ)
   bool operator==(const ResourceInfo&) const = default;
 };
 
 struct Barrier {
   ResourceRef resource;
   std::string resource_name;
+  uint32_t base_mip = 0;   // images: the levels it covers (resolved, never 0 levels)
+  uint32_t mip_count = 1;
   VkPipelineStageFlags2 src_stages = 0;
   VkAccessFlags2 src_access = 0;
   VkImageLayout old_layout = VK_IMAGE_LAYOUT_UNDEFINED;  // images only
@@ -170,14 +180,17 @@ struct CompiledGraph {
   std::vector<CompiledPass> passes;       // the passes that run, in declaration order
   std::vector<std::string> culled;        // names of the passes culled
   std::vector<Barrier> final_barriers;    // after the last pass (host reads of readback buffers)
-  std::vector<ResourceState> final_states;  // per resource, the state at the end of the frame
+  std::vector<ResourceState> final_states;  // per resource, the state at the end of the frame (level 0)
+  // Per resource with more than one level: every level's state (empty for the others).
+  std::vector<std::vector<ResourceState>> final_mip_states;
   // Barriers naming this resource (by name), in order; for tests.
   std::vector<Barrier> barriers_for(const std::string& resource_name) const;
   bool runs(const std::string& pass_name) const;
 };
 
-// Culls and derives barriers. Errors (BadUsage) name the pass and resource: a resource used twice
-// by one pass, an image access on a buffer or the reverse, an unknown resource id.
+// Culls and derives barriers, per mip level of an image. Errors (BadUsage) name the pass and
+// resource: a resource used twice by one pass (for an image: on overlapping levels), levels
+// beyond the image's, an image access on a buffer or the reverse, an unknown resource id.
 Expected<CompiledGraph> compile_graph(std::span<const PassDecl> passes,
                                       std::span<const ResourceInfo> resources);
 
@@ -199,6 +212,10 @@ class PassBuilder {
   void write(ImageHandle image, Access access = Access::StorageWrite);
   void read(BufferHandle buffer, Access access = Access::StorageRead);
   void write(BufferHandle buffer, Access access = Access::StorageWrite);
+  // Mip levels [base_mip, base_mip + mip_count) of an image only (PassContext::view(h, mip)
+  // gives one level's view): a mip chain's pass reads level i - 1 and writes level i.
+  void read(ImageHandle image, Access access, uint32_t base_mip, uint32_t mip_count = 1);
+  void write(ImageHandle image, Access access, uint32_t base_mip, uint32_t mip_count = 1);
   void side_effect();  // keep this pass even if nothing reads what it writes
 
  private:
@@ -212,9 +229,11 @@ class PassBuilder {
 class PassContext {
  public:
   VkImage image(ImageHandle h) const;
-  VkImageView view(ImageHandle h) const;
+  VkImageView view(ImageHandle h) const;              // every level
+  VkImageView view(ImageHandle h, uint32_t mip) const;  // one level
   VkFormat format(ImageHandle h) const;
   VkExtent2D extent(ImageHandle h) const;   // the used extent this frame (<= allocated)
+  VkExtent3D extent3d(ImageHandle h, uint32_t mip = 0) const;  // with depth, of one level
   VkBuffer buffer(BufferHandle h) const;    // the current slot's copy
   VkBufferView texel_view(BufferHandle h) const;  // its BufferDesc::texel_format view
   VkDeviceSize buffer_size(BufferHandle h) const;
@@ -289,11 +308,13 @@ class FrameGraph {
   Status set_render_scale(float scale);
   // Per image: its used extent becomes ceil(relative extent / divisor) (1 = the relative extent),
   // for a technique stage that runs at a fraction of the internal resolution on some levels
-  // (ssrt's geometry at its transfer's cell size). Never reallocates; OutputRelative images only.
+  // (ssrt's geometry at its transfer's cell size). Absolute images (3D too): every dimension of
+  // the allocated size / divisor (a volume's cheaper levels). Never reallocates.
   Status set_extent_divisor(ImageHandle image, uint32_t divisor);
   VkExtent2D output_size() const { return output_size_; }
   float render_scale() const { return render_scale_; }
   VkExtent2D extent(ImageHandle image) const;  // used extent now
+  VkExtent3D extent3d(ImageHandle image, uint32_t mip = 0) const;  // used extent of one level
   VkExtent2D allocated_extent(ImageHandle image) const;
   const GpuImage& gpu_image(ImageHandle image) const;
   const GpuBuffer& gpu_buffer(BufferHandle buffer, uint32_t slot) const;

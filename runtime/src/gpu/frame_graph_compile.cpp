@@ -164,6 +164,21 @@ bool CompiledGraph::runs(const std::string& pass_name) const {
 Expected<CompiledGraph> compile_graph(std::span<const PassDecl> passes,
                                       std::span<const ResourceInfo> resources) {
   const size_t np = passes.size(), nr = resources.size();
+  // Subresources: one per mip level of each resource, flattened (first_sub[r] + level).
+  std::vector<uint32_t> first_sub(nr + 1, 0);
+  for (size_t r = 0; r < nr; ++r) {
+    const uint32_t levels = resources[r].is_image ? std::max(1u, resources[r].mip_levels) : 1u;
+    first_sub[r + 1] = first_sub[r] + levels;
+  }
+  const size_t ns = first_sub[nr];
+  auto levels_of = [&](uint32_t r) { return first_sub[r + 1] - first_sub[r]; };
+  // The levels a use covers: [base, base + count).
+  auto range_of = [&](const ResourceUse& use) -> std::pair<uint32_t, uint32_t> {
+    const uint32_t levels = levels_of(use.resource.id);
+    const uint32_t count = use.mip_count == 0 ? (use.base_mip < levels ? levels - use.base_mip : 0) : use.mip_count;
+    return {use.base_mip, count};
+  };
+
   // 1. Validate the declarations.
   for (size_t p = 0; p < np; ++p) {
     const PassDecl& pass = passes[p];
@@ -185,33 +200,48 @@ Expected<CompiledGraph> compile_graph(std::span<const PassDecl> passes,
         return fail(ErrorKind::BadUsage, what + ": only graphics passes use attachments and vertex/index buffers");
       if (pass.kind == PassKind::Transfer && is_shader_access(use.access))
         return fail(ErrorKind::BadUsage, what + ": a transfer pass runs no shaders");
-      for (size_t v = 0; v < u; ++v)
-        if (pass.uses[v].resource == use.resource)
+      const auto [base, count] = range_of(use);
+      if (count == 0 || base + count > levels_of(use.resource.id))
+        return fail(ErrorKind::BadUsage, what + ": mip levels " + std::to_string(base) + ".." +
+                                             std::to_string(base + count) + " outside the resource's " +
+                                             std::to_string(levels_of(use.resource.id)));
+      for (size_t v = 0; v < u; ++v) {
+        if (!(pass.uses[v].resource == use.resource)) continue;
+        const auto [vb, vc] = range_of(pass.uses[v]);
+        if (vb < base + count && base < vb + vc)
           return fail(ErrorKind::BadUsage, what + ": the resource is declared twice in one pass (declare one "
-                                                  "combined access, e.g. storage-read-write)");
+                                                  "combined access, e.g. storage-read-write, or disjoint mip levels)");
+      }
     }
   }
 
-  // 2. Culling. Each write makes a new version of a resource; a pass that reads a version needs
-  // the pass that wrote it. The passes that must run are those with side effects and the last
-  // writers of outputs (marked or history), plus everything they need, transitively. This is
-  // Filament's reference-counted culling phrased as reachability.
+  // 2. Culling. Each write makes a new version of a subresource; a pass that reads a version
+  // needs the pass that wrote it. The passes that must run are those with side effects and the
+  // last writers of outputs (marked or history, every level), plus everything they need,
+  // transitively. This is Filament's reference-counted culling phrased as reachability.
   std::vector<std::vector<uint32_t>> needs(np);
-  std::vector<int> last_writer(nr, -1);
+  std::vector<int> last_writer(ns, -1);
   for (size_t p = 0; p < np; ++p) {
-    for (const ResourceUse& use : passes[p].uses)
-      if (is_read(use.access) && last_writer[use.resource.id] >= 0)
-        needs[p].push_back(uint32_t(last_writer[use.resource.id]));
-    for (const ResourceUse& use : passes[p].uses)
-      if (is_write(use.access)) last_writer[use.resource.id] = int(p);
+    for (const ResourceUse& use : passes[p].uses) {
+      if (!is_read(use.access)) continue;
+      const auto [base, count] = range_of(use);
+      for (uint32_t m = base; m < base + count; ++m)
+        if (const int w = last_writer[first_sub[use.resource.id] + m]; w >= 0) needs[p].push_back(uint32_t(w));
+    }
+    for (const ResourceUse& use : passes[p].uses) {
+      if (!is_write(use.access)) continue;
+      const auto [base, count] = range_of(use);
+      for (uint32_t m = base; m < base + count; ++m) last_writer[first_sub[use.resource.id] + m] = int(p);
+    }
   }
   std::vector<char> alive(np, 0);
   std::vector<uint32_t> stack;
   for (size_t p = 0; p < np; ++p)
     if (passes[p].side_effect) stack.push_back(uint32_t(p));
   for (size_t r = 0; r < nr; ++r)
-    if ((resources[r].is_output || resources[r].history) && last_writer[r] >= 0)
-      stack.push_back(uint32_t(last_writer[r]));
+    if (resources[r].is_output || resources[r].history)
+      for (uint32_t k = first_sub[r]; k < first_sub[r + 1]; ++k)
+        if (last_writer[k] >= 0) stack.push_back(uint32_t(last_writer[k]));
   while (!stack.empty()) {
     const uint32_t p = stack.back();
     stack.pop_back();
@@ -220,11 +250,18 @@ Expected<CompiledGraph> compile_graph(std::span<const PassDecl> passes,
     for (uint32_t q : needs[p]) stack.push_back(q);
   }
 
-  // 3. Barriers for the passes that run, in order, from each resource's state.
+  // 3. Barriers for the passes that run, in order, from each subresource's state; neighbouring
+  // levels that need the same barrier share one.
   CompiledGraph g;
-  std::vector<ResourceState> st(nr);
-  for (size_t r = 0; r < nr; ++r) st[r] = resources[r].initial;
-  std::vector<char> touched(nr, 0);
+  std::vector<ResourceState> st(ns);
+  for (size_t r = 0; r < nr; ++r)
+    for (uint32_t m = 0; m < levels_of(uint32_t(r)); ++m)
+      st[first_sub[r] + m] = m < resources[r].initial_mips.size() ? resources[r].initial_mips[m] : resources[r].initial;
+  std::vector<char> touched(ns, 0);
+  auto same_barrier = [](const Barrier& a, const Barrier& b) {
+    return a.src_stages == b.src_stages && a.src_access == b.src_access && a.dst_stages == b.dst_stages &&
+           a.dst_access == b.dst_access && a.old_layout == b.old_layout && a.new_layout == b.new_layout;
+  };
   for (size_t p = 0; p < np; ++p) {
     if (!alive[p]) {
       g.culled.push_back(passes[p].name);
@@ -237,72 +274,99 @@ Expected<CompiledGraph> compile_graph(std::span<const PassDecl> passes,
       const uint32_t r = use.resource.id;
       const ResourceInfo& res = resources[r];
       const AccessInfo ai = access_info(passes[p].kind, use.access, res.is_image, false);
-      ResourceState& s = st[r];
-      const bool layout_change = res.is_image && s.layout != ai.layout;
       const bool writes = is_write(use.access);
-      Barrier b;
-      b.resource = use.resource;
-      b.resource_name = res.name;
-      b.dst_stages = ai.stages;
-      b.dst_access = ai.access;
-      b.old_layout = res.is_image ? s.layout : VK_IMAGE_LAYOUT_UNDEFINED;
-      b.new_layout = ai.layout;
-      if (writes || layout_change) {
-        // Write-after-write, write-after-read and layout transitions wait for the last write and
-        // every read since.
-        b.src_stages = s.write_stages | s.read_stages;
-        b.src_access = s.write_access;
-        // A first, write-only touch of a non-history image this frame discards the old contents.
-        if (res.is_image && !touched[r] && !res.history && write_only(use.access))
-          b.old_layout = VK_IMAGE_LAYOUT_UNDEFINED;
-        if (b.src_stages != 0 || layout_change) cp.barriers.push_back(b);
-        if (writes) {
-          s.write_stages = ai.stages;
-          s.write_access = ai.access & kWriteAccessBits;
-          s.read_stages = 0;
-          s.visible_stages = 0;
-          s.visible_access = 0;
-        } else {
-          // The transition is the last "write"; this read saw it through the barrier.
-          s.write_stages = ai.stages;
-          s.write_access = 0;
-          s.read_stages = ai.stages;
-          s.visible_stages = ai.stages;
-          s.visible_access = ai.access;
-        }
-        s.layout = res.is_image ? ai.layout : VK_IMAGE_LAYOUT_UNDEFINED;
-      } else {
-        // Read-after-write: one barrier per new consumer stage/access; reads after reads need none.
-        const bool covered = (ai.stages & ~s.visible_stages) == 0 && (ai.access & ~s.visible_access) == 0;
-        if (s.write_stages != 0 && !covered) {
-          b.src_stages = s.write_stages;
+      const auto [base, count] = range_of(use);
+      const size_t merge_from = cp.barriers.size();
+      for (uint32_t m = base; m < base + count; ++m) {
+        const uint32_t k = first_sub[r] + m;
+        ResourceState& s = st[k];
+        const bool layout_change = res.is_image && s.layout != ai.layout;
+        Barrier b;
+        b.resource = use.resource;
+        b.resource_name = res.name;
+        b.base_mip = m;
+        b.mip_count = 1;
+        b.dst_stages = ai.stages;
+        b.dst_access = ai.access;
+        b.old_layout = res.is_image ? s.layout : VK_IMAGE_LAYOUT_UNDEFINED;
+        b.new_layout = ai.layout;
+        bool emit = false;
+        if (writes || layout_change) {
+          // Write-after-write, write-after-read and layout transitions wait for the last write
+          // and every read since.
+          b.src_stages = s.write_stages | s.read_stages;
           b.src_access = s.write_access;
-          cp.barriers.push_back(b);
-          s.visible_stages |= ai.stages;
-          s.visible_access |= ai.access;
+          // A first, write-only touch of a non-history image this frame discards the old contents.
+          if (res.is_image && !touched[k] && !res.history && write_only(use.access))
+            b.old_layout = VK_IMAGE_LAYOUT_UNDEFINED;
+          emit = b.src_stages != 0 || layout_change;
+          if (writes) {
+            s.write_stages = ai.stages;
+            s.write_access = ai.access & kWriteAccessBits;
+            s.read_stages = 0;
+            s.visible_stages = 0;
+            s.visible_access = 0;
+          } else {
+            // The transition is the last "write"; this read saw it through the barrier.
+            s.write_stages = ai.stages;
+            s.write_access = 0;
+            s.read_stages = ai.stages;
+            s.visible_stages = ai.stages;
+            s.visible_access = ai.access;
+          }
+          s.layout = res.is_image ? ai.layout : VK_IMAGE_LAYOUT_UNDEFINED;
+        } else {
+          // Read-after-write: one barrier per new consumer stage/access; reads after reads need none.
+          const bool covered = (ai.stages & ~s.visible_stages) == 0 && (ai.access & ~s.visible_access) == 0;
+          if (s.write_stages != 0 && !covered) {
+            b.src_stages = s.write_stages;
+            b.src_access = s.write_access;
+            emit = true;
+            s.visible_stages |= ai.stages;
+            s.visible_access |= ai.access;
+          }
+          s.read_stages |= ai.stages;
         }
-        s.read_stages |= ai.stages;
+        touched[k] = 1;
+        if (!emit) continue;
+        if (cp.barriers.size() > merge_from) {
+          Barrier& last = cp.barriers.back();
+          if (last.base_mip + last.mip_count == m && same_barrier(last, b)) {
+            ++last.mip_count;
+            continue;
+          }
+        }
+        cp.barriers.push_back(std::move(b));
       }
-      touched[r] = 1;
     }
     g.passes.push_back(std::move(cp));
   }
   // Readback buffers written this frame are made visible to the host (read after the fence).
   for (size_t r = 0; r < nr; ++r) {
-    if (!resources[r].host_read || !touched[r] || st[r].write_access == 0) continue;
+    const uint32_t k = first_sub[r];
+    if (!resources[r].host_read || !touched[k] || st[k].write_access == 0) continue;
     Barrier b;
     b.resource = ResourceRef{resources[r].is_image, uint32_t(r)};
     b.resource_name = resources[r].name;
-    b.src_stages = st[r].write_stages;
-    b.src_access = st[r].write_access;
+    b.src_stages = st[k].write_stages;
+    b.src_access = st[k].write_access;
     b.dst_stages = VK_PIPELINE_STAGE_2_HOST_BIT;
     b.dst_access = VK_ACCESS_2_HOST_READ_BIT;
-    b.old_layout = b.new_layout = st[r].layout;
+    b.old_layout = b.new_layout = st[k].layout;
+    b.mip_count = levels_of(uint32_t(r));
     g.final_barriers.push_back(b);
-    st[r] = ResourceState{};
-    st[r].layout = b.new_layout;
+    for (uint32_t m = k; m < first_sub[r + 1]; ++m) {
+      st[m] = ResourceState{};
+      st[m].layout = b.new_layout;
+    }
   }
-  g.final_states = std::move(st);
+  g.final_states.resize(nr);
+  g.final_mip_states.resize(nr);
+  for (size_t r = 0; r < nr; ++r) {
+    g.final_states[r] = st[first_sub[r]];
+    if (levels_of(uint32_t(r)) > 1)
+      g.final_mip_states[r].assign(st.begin() + first_sub[r], st.begin() + first_sub[r + 1]);
+  }
   return g;
 }
 
