@@ -20,6 +20,13 @@ find_package(CLI11 QUIET)
 find_package(PNG REQUIRED)
 # glTF textures decode through libpng and libjpeg-turbo (image/texture_decode.h), not stb.
 find_package(JPEG REQUIRED)
+# SPIR-V reflection (gpu/reflect.h): a shader's GLSL declarations are the one source of its
+# descriptor layout and of the names a pass binds by. The C API's shared library (Debian has no
+# position-independent build of the C++ one).
+find_package(spirv_cross_c_shared QUIET)
+if(NOT TARGET spirv-cross-c-shared)
+  message(FATAL_ERROR "mrgi: SPIRV-Cross not found: install Debian package libspirv-cross-c-shared-dev (scripts/install-deps.sh)")
+endif()
 
 find_program(GLSLANG_VALIDATOR glslangValidator REQUIRED)
 

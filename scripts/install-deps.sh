@@ -5,7 +5,7 @@ set -euo pipefail
 PKGS=(
   build-essential cmake ninja-build pkg-config git
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools
-  glslang-tools spirv-tools
+  glslang-tools spirv-tools libspirv-cross-c-shared-dev
   libglm-dev libeigen3-dev libmeshoptimizer-dev libtinygltf-dev nlohmann-json3-dev libstb-dev libtinyexr-dev libopenexr-dev
   libcli11-dev libembree-dev libgtest-dev libgmock-dev libbenchmark-dev
   libapriltag-dev libv4l-dev libcamera-dev libopenni2-dev libusb-1.0-0-dev

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "gpu/frame_graph.h"
+#include "gpu/frame_graph_entries.h"
 #include "gpu/vk_check.h"
 
 namespace mrgi::gpu {
@@ -23,39 +24,6 @@ namespace {
 constexpr uint64_t kFrameTimeoutS = 120;
 constexpr uint64_t kFrameTimeoutNs = kFrameTimeoutS * 1000ull * 1000 * 1000;
 }
-
-struct FrameGraph::ImageEntry {
-  ImageDesc desc;
-  GpuImage gpu;
-  bool owned = true;
-  uint32_t divisor = 1;  // set_extent_divisor: used extent = ceil(relative extent / divisor)
-  ResourceState state;                    // level 0's (every level's when there is one)
-  std::vector<ResourceState> mip_states;  // every level's, when there are more
-  void set_all_levels(const ResourceState& s) {
-    state = s;
-    if (gpu.mip_levels > 1) mip_states.assign(gpu.mip_levels, s);
-  }
-};
-
-struct FrameGraph::BufferEntry {
-  BufferDesc desc;
-  std::vector<GpuBuffer> copies;       // one, or one per frame slot
-  std::vector<ResourceState> states;   // per copy
-  bool owned = true;
-};
-
-struct FrameGraph::Slot {
-  VkCommandBuffer cmd = VK_NULL_HANDLE;
-  VkFence fence = VK_NULL_HANDLE;
-  VkQueryPool queries = VK_NULL_HANDLE;
-  bool submitted = false;
-  int64_t frame_index = -1;
-  std::vector<std::string> pass_names;
-  std::vector<std::string> culled;
-  bool profiled = false;             // this slot's frame ran in profiling mode
-  std::vector<double> host_ms;       // profiling mode: per pass, submit to fence
-  std::vector<double> cpu_ms;        // profiling mode: per pass, process CPU time meanwhile
-};
 
 // --- PassBuilder / PassContext -------------------------------------------------------------------
 
@@ -161,6 +129,7 @@ Status FrameGraph::init() {
   }
   decls_.reserve(settings_.max_passes);
   executes_.reserve(settings_.max_passes);
+  shader_passes_.reserve(settings_.max_passes);
   if (const char* plant = std::getenv("MRGI_PLANT_SLOWDOWN")) {
     const std::string spec = plant;
     const size_t colon = spec.rfind(':');
@@ -452,6 +421,7 @@ Expected<std::optional<FrameTimings>> FrameGraph::begin_frame() {
   frame_index_ = next;
   slot_ = slot;
   pass_count_ = 0;
+  setup_error_.clear();
   outputs_.clear();
   compiled_valid_ = false;
   in_frame_ = true;
@@ -463,7 +433,9 @@ void FrameGraph::add_pass(const std::string& name, PassKind kind, const SetupFn&
   if (pass_count_ == decls_.size()) {
     decls_.emplace_back();
     executes_.emplace_back();
+    shader_passes_.emplace_back();
   }
+  shader_passes_[pass_count_].pipeline = nullptr;
   PassDecl& d = decls_[pass_count_];
   d.name.assign(name);
   d.kind = kind;
@@ -511,6 +483,7 @@ void FrameGraph::update_resource_infos() {
 
 Status FrameGraph::compile() {
   if (!in_frame_) return fail(ErrorKind::BadUsage, "compile: call begin_frame first");
+  if (!setup_error_.empty()) return fail(ErrorKind::BadUsage, setup_error_);
   for (const ResourceRef& o : outputs_)
     if (o.id >= images_.size() + buffers_.size())
       return fail(ErrorKind::BadUsage, "mark_output: invalid resource handle");
@@ -615,7 +588,7 @@ Status FrameGraph::execute(VkCommandBuffer cmd) {
     const CompiledPass& p = compiled_.passes[i];
     record_barriers(cmd, p.barriers);
     fn.cmd_write_timestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, slot.queries, 2 * i);
-    if (executes_[p.pass_index]) executes_[p.pass_index](cmd, ctx);
+    run_pass(cmd, p.pass_index, ctx);
     fn.cmd_write_timestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, slot.queries, 2 * i + 1);
   }
   record_barriers(cmd, compiled_.final_barriers);
@@ -697,7 +670,7 @@ Status FrameGraph::submit_profiled() {
     VK_CHECK(vkResetCommandBuffer(cmd, 0));
     VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
     record_barriers(cmd, p.barriers);
-    if (executes_[p.pass_index]) executes_[p.pass_index](cmd, ctx);
+    run_pass(cmd, p.pass_index, ctx);
     if (i + 1 == n) record_barriers(cmd, compiled_.final_barriers);
     VK_CHECK(vkEndCommandBuffer(cmd));
     // Recording is not timed: the pass's time is what the queue spends on it.

@@ -20,9 +20,11 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "gpu/context.h"
+#include "gpu/pipelines.h"
 #include "mrgi/expected.h"
 #include "mrgi/runtime.h"
 
@@ -208,6 +210,7 @@ class FrameGraph;
 
 class PassBuilder {
  public:
+  PassBuilder(const PassBuilder&) = default;
   void read(ImageHandle image, Access access = Access::Sampled);
   void write(ImageHandle image, Access access = Access::StorageWrite);
   void read(BufferHandle buffer, Access access = Access::StorageRead);
@@ -220,9 +223,38 @@ class PassBuilder {
 
  private:
   friend class FrameGraph;
+  friend class ShaderPassBuilder;
   PassBuilder(FrameGraph& graph, PassDecl& decl) : graph_(graph), decl_(decl) {}
   FrameGraph& graph_;
   PassDecl& decl_;
+};
+
+// A pass bound to one pipeline: its resources are bound by the names its shaders declare
+// (gpu/reflect.h) and each bind() is also the pass's declared use, its access read from the
+// declaration (a storage image or buffer: readonly -> StorageRead, writeonly -> StorageWrite,
+// neither -> StorageReadWrite; a sampler2D/3D -> Sampled; a uniform block -> UniformRead). The graph
+// binds the pipeline and pushes the descriptors before the pass's execute callback, which pushes
+// constants and dispatches or draws. A name the shader does not declare, a kind that does not fit
+// (an image for a buffer), or a shader binding left unbound fails compile() naming the pass, the
+// pipeline and the binding.
+class ShaderPassBuilder {
+ public:
+  void bind(std::string_view name, ImageHandle image);                   // every level
+  void bind(std::string_view name, ImageHandle image, uint32_t mip);     // one level's view
+  void bind_sampled(std::string_view name, ImageHandle image, VkSampler sampler);  // sampler2D, sampler3D
+  void bind(std::string_view name, BufferHandle buffer);
+  // Uses that are not descriptors (attachments, vertex / index / indirect buffers).
+  PassBuilder& uses() { return base_; }
+
+ private:
+  friend class FrameGraph;
+  ShaderPassBuilder(FrameGraph& graph, PassBuilder base, const Pipeline& pipeline, uint32_t pass)
+      : graph_(graph), base_(base), pipeline_(pipeline), pass_(pass) {}
+  void bind_resource(std::string_view name, ResourceRef ref, uint32_t mip, bool one_level, VkSampler sampler);
+  FrameGraph& graph_;
+  PassBuilder base_;
+  const Pipeline& pipeline_;
+  uint32_t pass_;
 };
 
 // Given to a pass's execute callback.
@@ -329,6 +361,11 @@ class FrameGraph {
   using SetupFn = std::function<void(PassBuilder&)>;
   using ExecuteFn = std::function<void(VkCommandBuffer, PassContext&)>;
   void add_pass(const std::string& name, PassKind kind, const SetupFn& setup, ExecuteFn execute);
+  // A pass of one pipeline whose descriptors the graph binds (ShaderPassBuilder). `pipeline`
+  // must outlive the frame.
+  using ShaderSetupFn = std::function<void(ShaderPassBuilder&)>;
+  void add_shader_pass(const std::string& name, PassKind kind, const Pipeline& pipeline,
+                       const ShaderSetupFn& setup, ExecuteFn execute);
   void mark_output(ImageHandle image);
   void mark_output(BufferHandle buffer);
   Status compile();
@@ -361,6 +398,24 @@ class FrameGraph {
  private:
   friend class PassContext;
   friend class PassBuilder;
+  friend class ShaderPassBuilder;
+  // A shader pass's descriptor, resolved when the pass is recorded.
+  struct BoundDescriptor {
+    uint32_t binding = 0;
+    VkDescriptorType type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    ResourceRef resource;
+    uint32_t mip = 0;
+    bool one_level = false;
+    VkSampler sampler = VK_NULL_HANDLE;
+  };
+  struct ShaderPassData {
+    const Pipeline* pipeline = nullptr;  // null: a plain pass
+    std::vector<BoundDescriptor> descriptors;
+  };
+  std::vector<ShaderPassData> shader_passes_;  // parallel to decls_
+  std::string setup_error_;                     // the first bind() error this frame
+  void bind_and_push(VkCommandBuffer cmd, const ShaderPassData& data) const;
+  void run_pass(VkCommandBuffer cmd, uint32_t pass_index, PassContext& ctx);
   struct ImageEntry;
   struct BufferEntry;
   struct Slot;

@@ -17,8 +17,40 @@ Expected<VkShaderModule> make_module(const Context& ctx, std::span<const uint32_
   return m;
 }
 
+// The descriptor layout: the shader's own declarations (reflect.h). A hand-written list (index =
+// binding number), where a caller still gives one, must say the same, binding for binding: a
+// binding written in two places that disagree fails here, at start-up, naming both.
+Expected<ShaderInterface> resolve_interface(const std::string& name, const ShaderInterface& reflected,
+                                            const std::vector<DescriptorBinding>& hand, uint32_t& push_bytes) {
+  const std::string what = "pipeline '" + name + "'";
+  if (!hand.empty()) {
+    for (uint32_t i = 0; i < hand.size(); ++i) {
+      const ShaderBinding* b = reflected.at_binding(i);
+      if (!b)
+        return fail(ErrorKind::BadUsage, what + ": binding " + std::to_string(i) + " (" +
+                                             descriptor_type_name(hand[i].type) + ") is not declared by the shader");
+      if (b->type != hand[i].type || b->count != hand[i].count)
+        return fail(ErrorKind::BadUsage, what + ": binding " + std::to_string(i) + " is a " + descriptor_type_name(hand[i].type) +
+                                             " x" + std::to_string(hand[i].count) + " here and a " +
+                                             descriptor_type_name(b->type) + " '" + b->name + "' x" +
+                                             std::to_string(b->count) + " in the shader");
+    }
+    for (const ShaderBinding& b : reflected.bindings)
+      if (b.binding >= hand.size())
+        return fail(ErrorKind::BadUsage, what + ": the shader's " + descriptor_type_name(b.type) + " '" + b.name +
+                                             "' (binding " + std::to_string(b.binding) + ") is missing here");
+  }
+  // Push constants: the C++ block is at least the GLSL one (it may round up to 16 bytes).
+  const uint32_t declared = (reflected.push_constant_bytes + 3u) & ~3u;
+  if (push_bytes == 0) push_bytes = declared;
+  if (push_bytes < declared)
+    return fail(ErrorKind::BadUsage, what + ": " + std::to_string(push_bytes) + " bytes of push constants, the shader declares " +
+                                         std::to_string(reflected.push_constant_bytes));
+  return reflected;
+}
+
 // Set 0 as a push-descriptor set, and the pipeline layout around it.
-Status make_layouts(const Context& ctx, const std::string& name, const std::vector<DescriptorBinding>& bindings,
+Status make_layouts(const Context& ctx, const std::string& name, const ShaderInterface& iface,
                     VkShaderStageFlags stages, uint32_t push_bytes, Pipeline& p) {
   if (push_bytes > ctx.properties().limits.maxPushConstantsSize)
     return fail(ErrorKind::BadUsage, "pipeline '" + name + "': " + std::to_string(push_bytes) +
@@ -26,11 +58,11 @@ Status make_layouts(const Context& ctx, const std::string& name, const std::vect
                                          std::to_string(ctx.properties().limits.maxPushConstantsSize));
   if (push_bytes % 4 != 0)
     return fail(ErrorKind::BadUsage, "pipeline '" + name + "': push constant size must be a multiple of 4");
-  std::vector<VkDescriptorSetLayoutBinding> b(bindings.size());
-  for (size_t i = 0; i < bindings.size(); ++i) {
-    b[i].binding = uint32_t(i);
-    b[i].descriptorType = bindings[i].type;
-    b[i].descriptorCount = bindings[i].count;
+  std::vector<VkDescriptorSetLayoutBinding> b(iface.bindings.size());
+  for (size_t i = 0; i < iface.bindings.size(); ++i) {
+    b[i].binding = iface.bindings[i].binding;
+    b[i].descriptorType = iface.bindings[i].type;
+    b[i].descriptorCount = iface.bindings[i].count;
     b[i].stageFlags = stages;
   }
   VkDescriptorSetLayoutCreateInfo dci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
@@ -47,7 +79,7 @@ Status make_layouts(const Context& ctx, const std::string& name, const std::vect
   VK_CHECK(vkCreatePipelineLayout(ctx.device(), &lci, nullptr, &p.layout));
   p.stages = stages;
   p.push_constant_bytes = push_bytes;
-  p.bindings = bindings;
+  p.interface = iface;
   return ok_status();
 }
 
@@ -56,9 +88,14 @@ Status make_layouts(const Context& ctx, const std::string& name, const std::vect
 Expected<Pipeline> create_compute_pipeline(const Context& ctx, const ComputePipelineDesc& desc) {
   Pipeline p;
   p.bind_point = VK_PIPELINE_BIND_POINT_COMPUTE;
+  auto reflected = reflect_shader(desc.spirv, "compute pipeline '" + desc.name + "'");
+  if (!reflected) return reflected.error();
+  uint32_t push_bytes = desc.push_constant_bytes;
+  auto iface = resolve_interface(desc.name, *reflected, desc.bindings, push_bytes);
+  if (!iface) return iface.error();
   auto module = make_module(ctx, desc.spirv, "compute pipeline '" + desc.name + "'");
   if (!module) return module.error();
-  Status s = make_layouts(ctx, desc.name, desc.bindings, VK_SHADER_STAGE_COMPUTE_BIT, desc.push_constant_bytes, p);
+  Status s = make_layouts(ctx, desc.name, *iface, VK_SHADER_STAGE_COMPUTE_BIT, push_bytes, p);
   if (s.ok()) {
     VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
     ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
@@ -104,7 +141,19 @@ Expected<Pipeline> create_graphics_pipeline(const Context& ctx, const GraphicsPi
     fs = *m;
   }
   const VkShaderStageFlags stages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
-  Status s = make_layouts(ctx, desc.name, desc.bindings, stages, desc.push_constant_bytes, p);
+  Expected<ShaderInterface> iface = reflect_shader(desc.vertex_spirv, what + " vertex shader");
+  if (iface && !desc.fragment_spirv.empty()) {
+    auto f = reflect_shader(desc.fragment_spirv, what + " fragment shader");
+    iface = f ? merge_interfaces(*iface, *f, what) : Expected<ShaderInterface>(f.error());
+  }
+  uint32_t push_bytes = desc.push_constant_bytes;
+  if (iface) iface = resolve_interface(desc.name, *iface, desc.bindings, push_bytes);
+  if (!iface) {
+    vkDestroyShaderModule(ctx.device(), *vs, nullptr);
+    if (fs) vkDestroyShaderModule(ctx.device(), fs, nullptr);
+    return iface.error();
+  }
+  Status s = make_layouts(ctx, desc.name, *iface, stages, push_bytes, p);
   if (s.ok()) {
     VkPipelineShaderStageCreateInfo st[2] = {{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO},
                                              {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO}};
@@ -279,6 +328,13 @@ void dispatch_2d(VkCommandBuffer cmd, const Pipeline& pipeline, const void* push
   if (bytes > 0 && push_constants)
     vkCmdPushConstants(cmd, pipeline.layout, pipeline.stages, 0, bytes, push_constants);
   vkCmdDispatch(cmd, (width + local_x - 1) / local_x, (height + local_y - 1) / local_y, 1);
+}
+
+void push_and_dispatch(VkCommandBuffer cmd, const Pipeline& pipeline, const void* push_constants, uint32_t bytes,
+                       VkExtent3D groups) {
+  if (bytes > 0 && push_constants)
+    vkCmdPushConstants(cmd, pipeline.layout, pipeline.stages, 0, bytes, push_constants);
+  vkCmdDispatch(cmd, groups.width, groups.height, groups.depth);
 }
 
 void dispatch_indirect(VkCommandBuffer cmd, const Pipeline& pipeline, const void* push_constants,

@@ -11,11 +11,13 @@
 #include <vector>
 
 #include "gpu/context.h"
+#include "gpu/reflect.h"
 #include "mrgi/expected.h"
 
 namespace mrgi::gpu {
 
-// Binding i of set 0 (index in the vector = binding number).
+// Binding i of set 0 (index in the vector = binding number). Optional: a pipeline's layout comes
+// from its shaders' declarations (reflect.h); a list given here is checked against them.
 struct DescriptorBinding {
   VkDescriptorType type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
   uint32_t count = 1;
@@ -24,8 +26,8 @@ struct DescriptorBinding {
 struct ComputePipelineDesc {
   std::string name;                    // for errors and debug names
   std::span<const uint32_t> spirv;     // entry point "main"
-  std::vector<DescriptorBinding> bindings;
-  uint32_t push_constant_bytes = 0;    // <= 128 (the guaranteed minimum)
+  std::vector<DescriptorBinding> bindings;  // empty: the shader's (checked when given)
+  uint32_t push_constant_bytes = 0;    // <= 128 (the guaranteed minimum); 0: the shader's block
   // Specialization constants: value i sets `layout(constant_id = i)` (32-bit int, uint or bool).
   // A path a configuration never takes should be compiled out this way, not branched around:
   // lavapipe runs every path of a shader at every invocation (compose.comp measured it).
@@ -43,8 +45,8 @@ struct GraphicsPipelineDesc {
   std::string name;
   std::span<const uint32_t> vertex_spirv;
   std::span<const uint32_t> fragment_spirv;  // empty: depth-only (shadow maps)
-  std::vector<DescriptorBinding> bindings;
-  uint32_t push_constant_bytes = 0;
+  std::vector<DescriptorBinding> bindings;  // empty: the shaders' (checked when given)
+  uint32_t push_constant_bytes = 0;          // 0: the shaders' block
   std::vector<uint32_t> vertex_strides;      // bytes, one per vertex binding (per-vertex rate)
   std::vector<VertexAttribute> attributes;
   VkPrimitiveTopology topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
@@ -69,7 +71,7 @@ struct Pipeline {
   VkPipelineBindPoint bind_point = VK_PIPELINE_BIND_POINT_COMPUTE;
   VkShaderStageFlags stages = 0;
   uint32_t push_constant_bytes = 0;
-  std::vector<DescriptorBinding> bindings;
+  ShaderInterface interface;  // set 0 as the shaders declare it, with the GLSL names
 };
 
 Expected<Pipeline> create_compute_pipeline(const Context& ctx, const ComputePipelineDesc& desc);
@@ -127,6 +129,11 @@ class DescriptorPush {
 void dispatch_2d(VkCommandBuffer cmd, const Pipeline& pipeline, const void* push_constants,
                  uint32_t bytes, uint32_t width, uint32_t height, uint32_t local_x = 8,
                  uint32_t local_y = 8);
+
+// For a pass whose pipeline the frame graph bound (FrameGraph::add_shader_pass): pushes the
+// constants (`bytes` = the pipeline's push_constant_bytes, or 0) and dispatches `groups`.
+void push_and_dispatch(VkCommandBuffer cmd, const Pipeline& pipeline, const void* push_constants, uint32_t bytes,
+                       VkExtent3D groups);
 
 // Binds, pushes the constants and dispatches the workgroup counts a GPU pass wrote into `args`
 // at `offset` (a VkDispatchIndirectCommand; the pass declares it Access::IndirectRead).
