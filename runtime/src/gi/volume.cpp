@@ -20,6 +20,10 @@ Expected<VoxelVolume> VoxelVolume::create(gpu::FrameGraph& graph, const VolumeSe
   if (s.resolution < 2 || s.resolution > 256) return volume_setting_error("resolution", "must be 2..256 cells");
   if (s.images < 1 || s.images > 4) return volume_setting_error("images", "must be 1..4");
   if (s.name.empty()) return volume_setting_error("name", "must not be empty");
+  if (s.format != VK_FORMAT_R16G16B16A16_SFLOAT && s.format != VK_FORMAT_R32G32B32A32_SFLOAT)
+    return volume_setting_error("format", "must be RGBA16F or RGBA32F");
+  if (s.mip_chain && s.format != VK_FORMAT_R16G16B16A16_SFLOAT)
+    return fail(ErrorKind::NotImplemented, "VolumeSettings.mip_chain: RGBA32F volumes have no mip-chain shader yet");
   VoxelVolume v;
   v.settings_ = s;
   if (s.mip_chain)
@@ -27,7 +31,7 @@ Expected<VoxelVolume> VoxelVolume::create(gpu::FrameGraph& graph, const VolumeSe
   for (uint32_t i = 0; i < s.images; ++i) {
     gpu::ImageDesc d;
     d.name = s.images == 1 ? s.name : s.name + "[" + std::to_string(i) + "]";
-    d.format = VK_FORMAT_R16G16B16A16_SFLOAT;
+    d.format = s.format;
     d.size_mode = gpu::SizeMode::Absolute;
     d.width = d.height = d.depth = s.resolution;
     d.mip_levels = v.levels_;

@@ -1,4 +1,4 @@
-// Voxel volumes, a shared block of the GI techniques (dlpv now; dvct and dir next): RGBA16F 3D
+// Voxel volumes, a shared block of the GI techniques (dlpv now; dvct and dir next): RGBA float 3D
 // images allocated once for the largest level, a used size per level (one divisor), clearing and
 // a mip chain. What a technique injects is its own pass; this block owns the images and the
 // passes every volume technique needs.
@@ -17,8 +17,11 @@ struct VolumeSettings {
   // Cells per side at the largest level, allocated at start-up (2..256). The paper sizes for
   // DLPV are 32 (Table 3's best) down to 8 (the reduced-volume fast path).
   uint32_t resolution = 32;
-  // RGBA16F images of the same size, 1..4 (DLPV: three, the 4 SH coefficients of R, G and B).
+  // Images of the same size, 1..4 (DLPV: three, the 4 SH coefficients of R, G and B).
   uint32_t images = 1;
+  // RGBA16F, or RGBA32F where values span more than half floats hold (light propagation: a lamp
+  // of 1e6 would overflow 65504). Mip chains are RGBA16F only.
+  VkFormat format = VK_FORMAT_R16G16B16A16_SFLOAT;
   // A full mip chain down to one cell (cone tracing reads coarser levels for wider cones).
   bool mip_chain = false;
 };

@@ -290,11 +290,16 @@ Status Context::init(const DeviceSettings& settings) {
   VkPhysicalDeviceDynamicRenderingFeatures dynr{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DYNAMIC_RENDERING_FEATURES};
   VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
   VkPhysicalDeviceVulkan11Features f11{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES};
+  // Float atomics (optional): the light propagation volumes sum VPLs into cells with
+  // imageAtomicAdd on R32F texel buffers (gi/lpv_inject.comp). Lavapipe and desktop GPUs have it.
+  VkPhysicalDeviceShaderAtomicFloatFeaturesEXT atomic_float{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_ATOMIC_FLOAT_FEATURES_EXT};
+  const bool has_atomic_float = device_has_extension(physical_, VK_EXT_SHADER_ATOMIC_FLOAT_EXTENSION_NAME);
   VkPhysicalDeviceFeatures2 have{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
   have.pNext = &sync2;
   sync2.pNext = &dynr;
   dynr.pNext = &f12;
   f12.pNext = &f11;
+  if (has_atomic_float) f11.pNext = &atomic_float;
   vkGetPhysicalDeviceFeatures2(physical_, &have);
   if (!sync2.synchronization2) return fail(ErrorKind::Device, who + " lacks the synchronization2 feature");
   if (!dynr.dynamicRendering) return fail(ErrorKind::Device, who + " lacks the dynamicRendering feature");
@@ -334,6 +339,14 @@ Status Context::init(const DeviceSettings& settings) {
   sync2_on.pNext = &dynr_on;
   dynr_on.pNext = &f12_on;
   f12_on.pNext = &f11_on;
+  VkPhysicalDeviceShaderAtomicFloatFeaturesEXT atomic_float_on{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_ATOMIC_FLOAT_FEATURES_EXT};
+  if (has_atomic_float && atomic_float.shaderImageFloat32AtomicAdd) {
+    atomic_float_on.shaderImageFloat32Atomics = VK_TRUE;
+    atomic_float_on.shaderImageFloat32AtomicAdd = VK_TRUE;
+    f11_on.pNext = &atomic_float_on;
+    extensions.push_back(VK_EXT_SHADER_ATOMIC_FLOAT_EXTENSION_NAME);
+    image_float_atomic_add_ = true;
+  }
 
   const float priority = 1.0f;
   VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};

@@ -117,6 +117,9 @@ class Context {
 
   // Validation (DeviceSettings::validate): every warning and error message, in order.
   bool validation_enabled() const { return validate_; }
+  // imageAtomicAdd on 32-bit float images and texel buffers (VK_EXT_shader_atomic_float), enabled
+  // where the device has it.
+  bool image_float_atomic_add() const { return image_float_atomic_add_; }
   size_t validation_message_count() const;
   std::vector<std::string> validation_messages() const;
   void clear_validation_messages();
@@ -171,6 +174,7 @@ class Context {
   DeviceFunctions fn_;
   PFN_vkSetDebugUtilsObjectNameEXT set_object_name_ = nullptr;
   bool validate_ = false;
+  bool image_float_atomic_add_ = false;
   uint64_t allocated_bytes_ = 0;
   uint64_t allocation_count_ = 0;
   mutable std::mutex messages_mutex_;

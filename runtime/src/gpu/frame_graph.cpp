@@ -212,11 +212,12 @@ Expected<BufferHandle> FrameGraph::create_buffer(const BufferDesc& desc, VkBuffe
   const bool texel = desc.texel_format != VK_FORMAT_UNDEFINED;
   if (texel) {
     // Texel sizes of the formats used so far; others are refused by name.
-    const VkDeviceSize texel_bytes = desc.texel_format == VK_FORMAT_R32_UINT ? 4 : 0;
+    const VkDeviceSize texel_bytes =
+        desc.texel_format == VK_FORMAT_R32_UINT || desc.texel_format == VK_FORMAT_R32_SFLOAT ? 4 : 0;
     if (texel_bytes == 0)
       return fail(ErrorKind::NotImplemented, what + ": texel_format " +
                                                  std::to_string(int(desc.texel_format)) +
-                                                 " (only R32_UINT views are implemented)");
+                                                 " (only R32_UINT and R32_SFLOAT views are implemented)");
     const VkDeviceSize texels = desc.size / texel_bytes;
     const uint32_t limit = context_.properties().limits.maxTexelBufferElements;
     if (desc.size % texel_bytes != 0 || texels > limit)

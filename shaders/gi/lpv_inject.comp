@@ -1,0 +1,65 @@
+#version 450
+// Injection into a light propagation volume (gi/light_propagation.h; DLPV paper Sec. 4.3): one
+// invocation per texel of a reflective shadow map, whose VPL (or, in direct mode, whose share of
+// the lamp's light) is summed into its cell as 2-band SH of intensity, with float atomics.
+//   indirect (paper eq. 12-13): I(w) = P / pi max(0, n . w), P the texel's reflected flux, at
+//     the texel's position moved half a cell along its normal (no self-illumination, no VPL
+//     behind its own surface);
+//   direct (Sec. 4.3.2): the light arriving at the texel, P_in (W), as an emitter facing the
+//     light's travel direction, moved half a cell towards the light.
+// `sign` is +1 for the map with the virtual object (R^rho) and -1 for the one without (R^mu):
+// VPLs both maps see cancel, new ones add, blocked ones subtract (eq. 13).
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_shader_atomic_float : require
+#include "shared/lpv_math.h"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(set = 0, binding = 0, rgba32f) uniform readonly image2D rsm_position;  // xyz world m, w 1 = surface
+layout(set = 0, binding = 1, rgba16f) uniform readonly image2D rsm_normal;    // xyz world, unit
+layout(set = 0, binding = 2, rgba32f) uniform readonly image2D rsm_flux;      // rgb reflected W, a: incident W per unit light colour
+layout(set = 0, binding = 3, r32f) uniform imageBuffer cells;                 // 12 per cell: channel * 4 + coefficient
+layout(push_constant) uniform InjectParams {
+  vec4 grid;       // xyz: the volume's min corner (m); w: cell size (m)
+  ivec4 sizes;     // x: cells per side; y, z: the map's used width and height; w: 1 = direct
+  vec4 light;      // xyz: direction the light travels (w 0) or the lamp's position (w 1)
+  vec4 colour;     // rgb: the lamp's colour (direct mode); w: sign, +1 or -1
+} params_block;
+
+void main() {
+  const vec4 grid = params_block.grid;  // copied first: MRGI_UNIFORM_COPIES
+  const ivec4 sizes = params_block.sizes;
+  const vec4 light = params_block.light;
+  const vec4 colour = params_block.colour;
+  const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+  if (p.x >= sizes.y || p.y >= sizes.z) return;
+  const vec4 pos = imageLoad(rsm_position, p);
+  if (pos.w < 0.5) return;
+  const vec3 n = normalize(imageLoad(rsm_normal, p).xyz);
+  const vec4 flux = imageLoad(rsm_flux, p);
+  const vec3 travel = light.w > 0.5 ? normalize(pos.xyz - light.xyz) : normalize(light.xyz);
+  vec3 at;
+  vec4 lobe;
+  vec3 power;
+  if (sizes.w == 1) {
+    at = pos.xyz - travel * (0.5 * grid.w);
+    lobe = sh4_cosine_lobe(travel) * (1.0 / MRGI_PI);
+    power = colour.xyz * flux.w;
+  } else {
+    if (dot(n, travel) >= 0.0) return;  // a surface the light reaches from behind reflects nothing
+    at = pos.xyz + n * (0.5 * grid.w);
+    lobe = sh4_cosine_lobe(n) * (1.0 / MRGI_PI);
+    power = flux.xyz;
+  }
+  const ivec3 c = ivec3(floor((at - grid.xyz) / grid.w));
+  if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(sizes.x)))) return;
+  const int base = ((c.z * sizes.x + c.y) * sizes.x + c.x) * 12;
+  const vec3 signed_power = power * colour.w;
+  for (int ch = 0; ch < 3; ++ch) {
+    const float w = signed_power[ch];
+    if (w == 0.0) continue;
+    imageAtomicAdd(cells, base + ch * 4 + 0, lobe.x * w);
+    imageAtomicAdd(cells, base + ch * 4 + 1, lobe.y * w);
+    imageAtomicAdd(cells, base + ch * 4 + 2, lobe.z * w);
+    imageAtomicAdd(cells, base + ch * 4 + 3, lobe.w * w);
+  }
+}
