@@ -67,21 +67,27 @@ MRGI_FN float lpv_negative_damping(float i_src, float i_dst, float strength) {
   return 1.0f / (1.0f + strength * g);
 }
 
+// What one channel of a cell gathers through its face of normal n_f from the neighbour at
+// offset a (a unit axis; n_f != a): `src` is the neighbour's intensity SH, `dst` the cell's own
+// (previous step, for the damping). With a and n_f constants (the shader spells out all 30
+// pairs, LPV_GATHER_ALL) every direction, basis and lobe folds to a constant.
+MRGI_FN vec4 lpv_gather_face(vec4 src, vec4 dst, vec3 a, vec3 n_f, float negative_damping) {
+  vec3 w = normalize(n_f * 0.5f - a);
+  float solid = dot(n_f, a) < -0.5f ? LPV_SOLID_ANGLE_FRONT : LPV_SOLID_ANGLE_SIDE;
+  float i_src = sh4_eval(src, w);
+  float flux = solid * i_src;
+  if (flux < 0.0f) flux *= lpv_negative_damping(i_src, sh4_eval(dst, w), negative_damping);
+  return sh4_cosine_lobe(n_f) * (flux / MRGI_PI);
+}
+
 // What one channel of a cell gathers in one propagation step from its neighbour at
-// lpv_axis(k): `src` is the neighbour's intensity SH, `dst` the cell's own (previous step, for
-// the damping).
+// lpv_axis(k): the 5 faces that neighbour sees (not the one between them, seen edge-on).
 MRGI_FN vec4 lpv_gather_from(vec4 src, vec4 dst, int k, float negative_damping) {
   vec3 a = lpv_axis(k);
   vec4 sum = vec4(0.0f);
   for (int f = 0; f < 6; ++f) {
-    if (f == k) continue;  // the face between the two cells: the neighbour sees it edge-on
-    vec3 n_f = lpv_axis(f);
-    vec3 w = normalize(n_f * 0.5f - a);
-    float solid = f == (k ^ 1) ? LPV_SOLID_ANGLE_FRONT : LPV_SOLID_ANGLE_SIDE;
-    float i_src = sh4_eval(src, w);
-    float flux = solid * i_src;
-    if (flux < 0.0f) flux *= lpv_negative_damping(i_src, sh4_eval(dst, w), negative_damping);
-    sum += sh4_cosine_lobe(n_f) * (flux / MRGI_PI);
+    if (f == k) continue;
+    sum += lpv_gather_face(src, dst, a, lpv_axis(f), negative_damping);
   }
   return sum;
 }

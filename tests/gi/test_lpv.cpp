@@ -14,6 +14,7 @@
 namespace {
 using namespace mrgi;
 using mrgi::test::VulkanTest;
+using mrgi::gpu::FrameTimings;
 namespace sh = mrgi::shader;
 
 constexpr uint32_t kN = 8;
@@ -31,7 +32,10 @@ struct Lpv {
   gi::RsmImages rsm;
   gpu::BufferHandle readback;
 
-  Lpv(gpu::Context& ctx, const std::vector<Texel>& texels, float damping = 1.0f) {
+  uint32_t n = kN;
+  std::vector<FrameTimings> timings;
+
+  Lpv(gpu::Context& ctx, const std::vector<Texel>& texels, float damping = 1.0f, uint32_t cells = kN) : n(cells) {
     gpu::FrameGraphSettings fs;
     fs.max_output_width = fs.max_output_height = 16;
     fs.frames_in_flight = 1;
@@ -40,7 +44,7 @@ struct Lpv {
     graph = std::move(*g);
     gi::LpvSettings s;
     s.name = "test lpv";
-    s.resolution = kN;
+    s.resolution = n;
     s.negative_damping = damping;
     auto v = gi::LightPropagationVolume::create(*graph, s);
     EXPECT_TRUE(v.ok()) << v.error().message;
@@ -70,7 +74,7 @@ struct Lpv {
     EXPECT_TRUE(graph->upload_image(rsm.flux, flux.data(), flux.size() * 4).ok());
     gpu::BufferDesc bd;
     bd.name = "lpv readback";
-    bd.size = VkDeviceSize(kN) * kN * kN * 16 * 3;
+    bd.size = VkDeviceSize(n) * n * n * 16 * 3;
     bd.memory = gpu::MemoryUsage::Readback;
     readback = *graph->create_buffer(bd, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
   }
@@ -91,9 +95,9 @@ struct Lpv {
         [this](VkCommandBuffer cmd, gpu::PassContext& p) {
           for (uint32_t c = 0; c < 3; ++c) {
             VkBufferImageCopy r{};
-            r.bufferOffset = VkDeviceSize(c) * kN * kN * kN * 16;
+            r.bufferOffset = VkDeviceSize(c) * n * n * n * 16;
             r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-            r.imageExtent = {kN, kN, kN};
+            r.imageExtent = {n, n, n};
             vkCmdCopyImageToBuffer(cmd, p.image(lpv->accumulated(c)), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                                    p.buffer(readback), 1, &r);
           }
@@ -102,10 +106,12 @@ struct Lpv {
     Status s = graph->compile();
     EXPECT_TRUE(s.ok()) << s.error().message;
     EXPECT_TRUE(graph->submit().ok());
-    EXPECT_TRUE(graph->flush().ok());
-    std::vector<std::vector<glm::vec4>> out(3, std::vector<glm::vec4>(kN * kN * kN));
+    auto done = graph->flush();
+    EXPECT_TRUE(done.ok());
+    if (done.ok()) timings.insert(timings.end(), done->begin(), done->end());
+    std::vector<std::vector<glm::vec4>> out(3, std::vector<glm::vec4>(size_t(n) * n * n));
     const auto* f = static_cast<const float*>(graph->mapped(readback, 0));
-    for (uint32_t c = 0; c < 3; ++c) std::memcpy(out[c].data(), f + size_t(c) * kN * kN * kN * 4, kN * kN * kN * 16);
+    for (uint32_t c = 0; c < 3; ++c) std::memcpy(out[c].data(), f + size_t(c) * n * n * n * 4, size_t(n) * n * n * 16);
     return out;
   }
   void inject(const char* label, gi::InjectKind kind, float sign, const gi::LpvLight& light = {}) {
@@ -248,6 +254,17 @@ TEST_F(VulkanTest, LpvRefusesBadSettingsByName) {
   EXPECT_EQ(v->set_cells(**g, 3).error().kind, ErrorKind::BadUsage);  // does not divide 8
   EXPECT_TRUE(v->set_cells(**g, 4).ok());
   EXPECT_EQ(v->cells(), 4u);
+}
+
+// Not a check (timings live in perf/): the propagation's cost on this device, for orientation.
+TEST_F(VulkanTest, DISABLED_LpvPropagationTimes) {
+  for (uint32_t n : {8u, 16u, 32u}) {
+    Lpv t(ctx(), {{glm::vec3(0.1f * n, 0.05f * n, 0.1f * n), glm::vec3(0, 1, 0), glm::vec4(1, 1, 1, 1)}}, 1.0f, n);
+    t.lpv->set_grid({glm::vec3(0.0f), 0.25f});
+    ASSERT_TRUE(t.graph->set_profiling(true).ok());
+    for (int f = 0; f < 4; ++f) t.run([&] { t.inject("rho", gi::InjectKind::Indirect, 1.0f, kSunFromAbove); }, n);
+    for (const PassTiming& p : t.timings.back().passes) std::printf("lpv %u^3, %u steps: %-24s %.2f ms\n", n, n, p.name.c_str(), p.gpu_ms);
+  }
 }
 
 }  // namespace
