@@ -1,0 +1,298 @@
+#include "gi/rsm.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "gpu/shaders.h"
+
+namespace mrgi::gi {
+namespace {
+
+constexpr VkFormat kPositionFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+constexpr VkFormat kNormalFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+constexpr VkFormat kFluxFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
+
+struct RsmPush {
+  glm::mat4 view_proj;
+  glm::vec4 light;
+  glm::vec4 colour;
+  glm::vec4 axis;
+  glm::ivec4 misc;
+};
+static_assert(sizeof(RsmPush) == 128, "the guaranteed push-constant size");
+
+glm::vec3 any_up(const glm::vec3& forward) {
+  return std::abs(forward.y) > 0.9f ? glm::vec3(1.0f, 0.0f, 0.0f) : glm::vec3(0.0f, 1.0f, 0.0f);
+}
+
+Expected<uint32_t> binding_of(const gpu::Pipeline& p, const char* name, const std::string& what) {
+  const gpu::ShaderBinding* b = p.interface.find(name);
+  if (!b) return fail(ErrorKind::Internal, what + ": shader binding '" + name + "' not found");
+  return b->binding;
+}
+
+}  // namespace
+
+Expected<RsmView> rsm_view(const LightDesc& lamp, const glm::vec3& centre, float radius, uint32_t size) {
+  if (!(radius > 0.0f) || size == 0) return fail(ErrorKind::BadUsage, "rsm_view: radius and size must be > 0");
+  RsmView v;
+  const glm::vec3 colour = lamp.color * lamp.intensity;
+  v.lpv.colour = colour;
+  if (lamp.type == LightType::Directional) {
+    const glm::vec3 dir = glm::normalize(lamp.direction);
+    // Casters up to 4 radii towards the lamp (a table above the volume still shadows it).
+    const glm::vec3 eye = centre - dir * (4.0f * radius);
+    const glm::mat4 view = glm::lookAt(eye, centre, any_up(dir));
+    const glm::mat4 proj = glm::ortho(-radius, radius, -radius, radius, 0.0f, 5.0f * radius);
+    v.view_proj = proj * view;
+    const float texel = 2.0f * radius / float(size);
+    v.light = glm::vec4(dir, -texel * texel);
+    v.colour = glm::vec4(colour, -2.0f);
+    v.axis = glm::vec4(dir, 0.0f);
+    v.lpv.direction_or_position = dir;
+    v.lpv.positional = false;
+    return v;
+  }
+  const glm::vec3 to_centre = centre - lamp.position;
+  const float dist = glm::length(to_centre);
+  glm::vec3 axis;
+  float half;
+  if (lamp.type == LightType::Spot) {
+    // The map looks along the spot: nothing outside its cone is lit.
+    axis = glm::normalize(lamp.direction);
+    half = glm::radians(std::min(lamp.outer_angle_deg, 75.0f));
+  } else {
+    if (!(dist > 1.05f * radius))
+      return fail(ErrorKind::BadUsage, "rsm_view: a point lamp at " + std::to_string(dist) +
+                                           " m from the volume's centre is inside its sphere (radius " +
+                                           std::to_string(radius) + " m): one perspective map cannot see it all");
+    axis = to_centre / dist;
+    half = std::asin(std::min(radius / dist, 0.965f));  // at most 75 degrees off the axis
+  }
+  const glm::mat4 view = glm::lookAt(lamp.position, lamp.position + axis, any_up(axis));
+  const float far_plane = std::max(dist + radius, 0.1f);
+  const glm::mat4 proj = glm::perspective(2.0f * half, 1.0f, 0.01f, far_plane);
+  v.view_proj = proj * view;
+  const float t = 2.0f * std::tan(half) / float(size);
+  v.light = glm::vec4(lamp.position, t * t);
+  const bool spot = lamp.type == LightType::Spot;
+  v.colour = glm::vec4(colour, spot ? std::cos(glm::radians(lamp.outer_angle_deg)) : -2.0f);
+  v.axis = glm::vec4(axis, spot ? std::cos(glm::radians(lamp.inner_angle_deg)) : 1.0f);
+  v.lpv.direction_or_position = lamp.position;
+  v.lpv.positional = true;
+  return v;
+}
+
+Expected<ReflectiveShadowMaps> ReflectiveShadowMaps::create(gpu::FrameGraph& graph, const technique::SceneGpu& scene,
+                                                            const RealGBuffer& real, const RsmSettings& s) {
+  if (s.size < 16 || s.size > 2048) return fail(ErrorKind::BadUsage, "RsmSettings.size: must be 16..2048 texels");
+  ReflectiveShadowMaps r;
+  r.settings_ = s;
+  r.scene_ = &scene;
+  r.real_ = real;
+  const char* which[2] = {" rho", " mu"};
+  for (int m = 0; m < 2; ++m) {
+    auto image = [&](const char* part, VkFormat f, VkImageUsageFlags usage) -> Expected<gpu::ImageHandle> {
+      gpu::ImageDesc d;
+      d.name = s.name + which[m] + part;
+      d.format = f;
+      d.size_mode = gpu::SizeMode::Absolute;
+      d.width = d.height = s.size;
+      return graph.create_image(d, usage);
+    };
+    const VkImageUsageFlags colour = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_STORAGE_BIT |
+                                     VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    auto p = image(" position", kPositionFormat, colour);
+    if (!p) return p.error();
+    auto n = image(" normal", kNormalFormat, colour);
+    if (!n) return n.error();
+    auto f = image(" flux", kFluxFormat, colour);
+    if (!f) return f.error();
+    auto d = image(" depth", kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
+    if (!d) return d.error();
+    r.maps_[m] = {*p, *n, *f, *d};
+  }
+  const gpu::Context& ctx = graph.context();
+  // The grid's index list for the finest grid (a point a G-buffer pixel).
+  const VkExtent2D g = graph.allocated_extent(real.position);
+  const VkDeviceSize cells = VkDeviceSize(std::max(1u, g.width - 1)) * std::max(1u, g.height - 1);
+  auto ib = graph.create_buffer({s.name + " grid indices", cells * 6 * 4},
+                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
+  if (!ib) return ib.error();
+  r.grid_indices_ = *ib;
+  auto ip = gpu::load_compute_pipeline(ctx, "baseline/shadow_caster_indices.comp", {});
+  if (!ip) return ip.error();
+  r.indices_pipeline_ = std::move(*ip);
+  auto frag = gpu::shader_spirv("gi/rsm.frag");
+  if (!frag) return frag.error();
+  auto grid_vs = gpu::shader_spirv("gi/rsm_grid.vert");
+  if (!grid_vs) return grid_vs.error();
+  auto mesh_vs = gpu::shader_spirv("gi/rsm_mesh.vert");
+  if (!mesh_vs) return mesh_vs.error();
+  gpu::GraphicsPipelineDesc pd;
+  pd.name = s.name + " grid";
+  pd.vertex_spirv = *grid_vs;
+  pd.fragment_spirv = *frag;
+  pd.color_formats = {kPositionFormat, kNormalFormat, kFluxFormat};
+  pd.depth_format = kDepthFormat;
+  pd.cull_mode = VK_CULL_MODE_NONE;
+  auto gp = gpu::create_graphics_pipeline(ctx, pd);
+  if (!gp) return gp.error();
+  r.grid_pipeline_ = gpu::PipelineHandle(ctx, std::move(*gp));
+  pd.name = s.name + " mesh";
+  pd.vertex_spirv = *mesh_vs;
+  pd.vertex_strides = {sizeof(technique::GpuVertex)};
+  pd.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
+                   {1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12},
+                   {2, 0, VK_FORMAT_R32G32_SFLOAT, 24}};
+  auto mp = gpu::create_graphics_pipeline(ctx, pd);
+  if (!mp) return mp.error();
+  r.mesh_pipeline_ = gpu::PipelineHandle(ctx, std::move(*mp));
+  // The draw pushes these by name: check once that the shaders declare them.
+  for (const char* name : {"real_position", "real_normal", "real_albedo", "base_color_maps"})
+    if (auto b = binding_of(*r.grid_pipeline_, name, pd.name); !b) return b.error();
+  for (const char* name : {"Materials", "base_color_maps"})
+    if (auto b = binding_of(*r.mesh_pipeline_, name, pd.name); !b) return b.error();
+  return r;
+}
+
+void ReflectiveShadowMaps::add_grid(gpu::FrameGraph& graph, uint32_t stride) {
+  const VkExtent2D g = graph.extent(real_.position);
+  grid_stride_ = std::max(1u, stride);
+  grid_points_ = {(g.width - 1) / grid_stride_ + 1, (g.height - 1) / grid_stride_ + 1};
+  const VkExtent2D points = grid_points_;
+  const uint32_t st = grid_stride_;
+  const gpu::Pipeline* pipe = &*indices_pipeline_;
+  const VkSampler nearest = graph.context().samplers().nearest_clamp;
+  graph.add_shader_pass(
+      settings_.name + " grid", gpu::PassKind::Compute, *indices_pipeline_,
+      [this, nearest](gpu::ShaderPassBuilder& b) {
+        b.bind_sampled("real_position", real_.position, nearest);
+        b.bind("Indices", grid_indices_);
+      },
+      [pipe, points, st](VkCommandBuffer cmd, gpu::PassContext&) {
+        const glm::ivec4 push(int(points.width), int(points.height), int(st), 0);
+        gpu::push_and_dispatch(cmd, *pipe, &push, sizeof push,
+                               {(points.width - 1 + 7) / 8, (points.height - 1 + 7) / 8, 1});
+      });
+}
+
+RsmImages ReflectiveShadowMaps::images(RsmMap map, uint32_t size) const {
+  const Maps& m = maps_[map == RsmMap::WithVirtual ? 0 : 1];
+  return {m.position, m.normal, m.flux, std::min(size, settings_.size), std::min(size, settings_.size)};
+}
+
+void ReflectiveShadowMaps::add_draw(gpu::FrameGraph& graph, const std::string& label, const RsmView& view,
+                                    RsmMap map, uint32_t size) {
+  const Maps m = maps_[map == RsmMap::WithVirtual ? 0 : 1];
+  const uint32_t s = std::min(size, settings_.size);
+  const technique::SceneGpu* sg = scene_;
+  const bool grid = grid_points_.width > 1 && grid_points_.height > 1;
+  const uint32_t grid_indices = grid ? (grid_points_.width - 1) * (grid_points_.height - 1) * 6 : 0;
+  const bool virtuals = map == RsmMap::WithVirtual && !sg->virtual_objects.empty();
+  const bool proxies = !sg->real_proxies.empty();
+  const RealGBuffer real = real_;
+  const gpu::BufferHandle indices = grid_indices_;
+  const gpu::Pipeline* grid_pipe = &*grid_pipeline_;
+  const gpu::Pipeline* mesh_pipe = &*mesh_pipeline_;
+  RsmPush push{view.view_proj, view.light, view.colour, view.axis, glm::ivec4(int(grid_stride_), -1, 0, 0)};
+  graph.add_pass(
+      settings_.name + " " + label, gpu::PassKind::Graphics,
+      [=](gpu::PassBuilder& b) {
+        if (grid_indices > 0) {
+          b.read(real.position, gpu::Access::Sampled);
+          b.read(real.normal, gpu::Access::Sampled);
+          b.read(real.albedo, gpu::Access::Sampled);
+          b.read(indices, gpu::Access::IndexBuffer);
+        }
+        if (proxies) {
+          b.read(sg->real_proxies.vertices, gpu::Access::VertexBuffer);
+          b.read(sg->real_proxies.indices, gpu::Access::IndexBuffer);
+        }
+        if (virtuals) {
+          b.read(sg->virtual_objects.vertices, gpu::Access::VertexBuffer);
+          b.read(sg->virtual_objects.indices, gpu::Access::IndexBuffer);
+        }
+        if (proxies || virtuals) b.read(sg->materials, gpu::Access::StorageRead);
+        b.read(sg->base_color_maps, gpu::Access::Sampled);
+        b.write(m.position, gpu::Access::ColorAttachmentWrite);
+        b.write(m.normal, gpu::Access::ColorAttachmentWrite);
+        b.write(m.flux, gpu::Access::ColorAttachmentWrite);
+        b.write(m.depth, gpu::Access::DepthAttachmentWrite);
+      },
+      [=](VkCommandBuffer cmd, gpu::PassContext& p) mutable {
+        const gpu::Context& ctx = p.context();
+        const VkImageLayout colour_layout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+        VkRenderingAttachmentInfo colour[3];
+        const gpu::ImageHandle targets[3] = {m.position, m.normal, m.flux};
+        for (int i = 0; i < 3; ++i) {
+          colour[i] = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+          colour[i].imageView = p.view(targets[i]);
+          colour[i].imageLayout = colour_layout;
+          colour[i].loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+          colour[i].storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+          colour[i].clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
+        }
+        VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+        depth.imageView = p.view(m.depth);
+        depth.imageLayout = gpu::access_info(gpu::PassKind::Graphics, gpu::Access::DepthAttachmentWrite, true, true).layout;
+        depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+        depth.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+        depth.clearValue.depthStencil = {1.0f, 0};
+        VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+        ri.renderArea = {{0, 0}, {s, s}};
+        ri.layerCount = 1;
+        ri.colorAttachmentCount = 3;
+        ri.pColorAttachments = colour;
+        ri.pDepthAttachment = &depth;
+        vkCmdBeginRendering(cmd, &ri);
+        const VkViewport vp{0.0f, 0.0f, float(s), float(s), 0.0f, 1.0f};
+        const VkRect2D sc{{0, 0}, {s, s}};
+        vkCmdSetViewport(cmd, 0, 1, &vp);
+        vkCmdSetScissor(cmd, 0, 1, &sc);
+        const VkSampler linear = ctx.samplers().linear_repeat, nearest = ctx.samplers().nearest_clamp;
+        if (grid_indices > 0) {
+          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, grid_pipe->pipeline);
+          const gpu::ShaderInterface& gi = grid_pipe->interface;
+          gpu::DescriptorPush()
+              .sampled_image(gi.find("real_position")->binding, p.view(real.position), nearest)
+              .sampled_image(gi.find("real_normal")->binding, p.view(real.normal), nearest)
+              .sampled_image(gi.find("real_albedo")->binding, p.view(real.albedo), nearest)
+              .sampled_image(gi.find("base_color_maps")->binding, sg->base_color_array_view(), linear)
+              .push(ctx, cmd, *grid_pipe);
+          vkCmdPushConstants(cmd, grid_pipe->layout, grid_pipe->stages, 0, sizeof push, &push);
+          vkCmdBindIndexBuffer(cmd, p.buffer(indices), 0, VK_INDEX_TYPE_UINT32);
+          vkCmdDrawIndexed(cmd, grid_indices, 1, 0, 0, 0);
+        }
+        if (proxies || virtuals) {
+          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mesh_pipe->pipeline);
+          const gpu::ShaderInterface& mi = mesh_pipe->interface;
+          gpu::DescriptorPush()
+              .storage_buffer(mi.find("Materials")->binding, p.buffer(sg->materials))
+              .sampled_image(mi.find("base_color_maps")->binding, sg->base_color_array_view(), linear)
+              .push(ctx, cmd, *mesh_pipe);
+          auto draw_set = [&](const technique::MeshSet& set, bool materials) {
+            VkBuffer vb = p.buffer(set.vertices);
+            VkDeviceSize offset = 0;
+            vkCmdBindVertexBuffers(cmd, 0, 1, &vb, &offset);
+            vkCmdBindIndexBuffer(cmd, p.buffer(set.indices), 0, VK_INDEX_TYPE_UINT32);
+            for (const technique::DrawRange& d : set.draws) {
+              // Proxies: their scene.json material hint is not on the GPU yet: mid grey.
+              push.misc.y = materials ? d.material : -1;
+              push.misc.z = materials ? 0 : int(0xff808080u);
+              vkCmdPushConstants(cmd, mesh_pipe->layout, mesh_pipe->stages, 0, sizeof push, &push);
+              vkCmdDrawIndexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0);
+            }
+          };
+          if (proxies) draw_set(sg->real_proxies, false);
+          if (virtuals) draw_set(sg->virtual_objects, true);
+        }
+        vkCmdEndRendering(cmd);
+      });
+}
+
+}  // namespace mrgi::gi

@@ -1,0 +1,78 @@
+// Reflective shadow maps (Dachsbacher & Stamminger 2005), the shared block of the VPL-based
+// techniques: per lamp, a map of world positions, normals and reflected flux, one WITH the
+// virtual objects (R^rho) and one without (R^mu) (DLPV paper Sec. 4.3). The real scene is the
+// depth camera's (a grid over the real G-buffer, the casters of baseline's shadow maps) and the
+// scene's proxy meshes; the virtual objects are their glTF meshes and materials.
+//
+// Maps are allocated at create() for `size` texels per side and drawn at a used size per frame
+// (a cheaper level draws a corner). One pair of maps serves every lamp in turn: the frame graph
+// orders each lamp's injection before the next lamp's drawing.
+#pragma once
+#include <cstdint>
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "gi/light_propagation.h"
+#include "gpu/frame_graph.h"
+#include "gpu/pipelines.h"
+#include "mrgi/expected.h"
+#include "mrgi/scene.h"
+#include "technique/scene_gpu.h"
+
+namespace mrgi::gi {
+
+struct RsmSettings {
+  std::string name = "rsm";
+  uint32_t size = 512;  // texels per side allocated (the largest level), 16..2048
+};
+
+// The real scene's G-buffer the grid is drawn from (recon/): positions (xyz, w depth; 0 none),
+// normals, albedo (rgb, a valid).
+struct RealGBuffer {
+  gpu::ImageHandle position, normal, albedo;
+};
+
+// One lamp's view for its maps, covering a sphere (the volume the maps feed).
+struct RsmView {
+  glm::mat4 view_proj{1.0f};
+  glm::vec4 light{0.0f};  // as gi/rsm.frag's push constant `light`
+  glm::vec4 colour{0.0f};
+  glm::vec4 axis{0.0f};
+  LpvLight lpv;           // the same lamp for the injection
+};
+// BadUsage for a lamp the maps cannot see the sphere from (a point lamp inside it: its light
+// leaves in every direction, which one perspective map cannot hold).
+Expected<RsmView> rsm_view(const LightDesc& lamp, const glm::vec3& centre, float radius, uint32_t size);
+
+enum class RsmMap : uint8_t { WithVirtual, RealOnly };
+
+class ReflectiveShadowMaps {
+ public:
+  static Expected<ReflectiveShadowMaps> create(gpu::FrameGraph& graph, const technique::SceneGpu& scene,
+                                               const RealGBuffer& real, const RsmSettings& settings);
+  // The real grid's index list for this frame (call once a frame before add_draw, when the real
+  // G-buffer changed): `stride` G-buffer pixels between grid points.
+  void add_grid(gpu::FrameGraph& graph, uint32_t stride);
+  // Draws one map for `view` at `size` texels per side (<= the allocated size).
+  void add_draw(gpu::FrameGraph& graph, const std::string& label, const RsmView& view, RsmMap map, uint32_t size);
+  // The map as the injection reads it.
+  RsmImages images(RsmMap map, uint32_t size) const;
+  uint32_t allocated_size() const { return settings_.size; }
+
+ private:
+  ReflectiveShadowMaps() = default;
+  struct Maps {
+    gpu::ImageHandle position, normal, flux, depth;
+  };
+  RsmSettings settings_;
+  const technique::SceneGpu* scene_ = nullptr;
+  RealGBuffer real_;
+  Maps maps_[2];
+  gpu::BufferHandle grid_indices_;
+  uint32_t grid_stride_ = 0;
+  VkExtent2D grid_points_{0, 0};
+  gpu::PipelineHandle grid_pipeline_, mesh_pipeline_, indices_pipeline_;
+};
+
+}  // namespace mrgi::gi
