@@ -13,6 +13,7 @@
 #include "shared/mrgi_shared.h"
 #include "common/frame_constants.glsl"
 #include "common/light_set.glsl"
+#include "common/surface_shading.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
@@ -79,31 +80,6 @@ float shadow_test(sampler2DArrayShadow map, int first_layer, int light, vec3 p, 
   return sum / float((2 * r + 1) * (2 * r + 1));
 }
 
-// GGX (Trowbridge-Reitz) with Smith height-correlated visibility and Schlick Fresnel, the glTF
-// metallic-roughness model; returns the BRDF times pi-free cosine is applied by the caller.
-vec3 brdf(vec3 n, vec3 v, vec3 l, vec3 base, float metallic, float roughness, bool specular) {
-  vec3 diffuse = base * (1.0f - metallic) / MRGI_PI;
-  if (!specular) return base / MRGI_PI;
-  vec3 h = normalize(v + l);
-  float nl = max(dot(n, l), 0.0f), nv = max(dot(n, v), 1e-4f), nh = max(dot(n, h), 0.0f);
-  float a = roughness * roughness, a2 = a * a;
-  float d = a2 / (MRGI_PI * pow(nh * nh * (a2 - 1.0f) + 1.0f, 2.0f));
-  float vis = 0.5f / max(nl * sqrt(nv * nv * (1.0f - a2) + a2) + nv * sqrt(nl * nl * (1.0f - a2) + a2), 1e-6f);
-  vec3 f0 = mix(vec3(0.04f), base, metallic);
-  vec3 f = f0 + (1.0f - f0) * pow(1.0f - max(dot(v, h), 0.0f), 5.0f);
-  return (1.0f - f) * diffuse + d * vis * f;
-}
-
-// E(n) of an ambient, linear RGB, >= 0 (SH bands 0..2 can dip below 0 away from the light).
-vec3 ambient_irradiance(AmbientIrradiance a, vec3 n) {
-  vec4 n4 = vec4(n, 1.0f);
-  return max(vec3(dot(n4, a.r * n4), dot(n4, a.g * n4), dot(n4, a.b * n4)), vec3(0.0f));
-}
-
-vec3 sanitize(vec3 c) {
-  return vec3(isnan(c.x) ? 0.0f : c.x, isnan(c.y) ? 0.0f : c.y, isnan(c.z) ? 0.0f : c.z);
-}
-
 void main() {
   frame = frame_ubo; level = level_block;  // MRGI_UNIFORM_COPIES
   ambient_rv = light_set.ambient_rv;
@@ -141,21 +117,8 @@ void main() {
   int count = min(light_set.count.x, MRGI_MAX_LIGHTS);
   for (int i = 0; i < count; ++i) {
     ShadowLight L = light_set.lights[i];
-    int type = int(L.position_type.w);
     vec3 wi;
-    vec3 irradiance_rgb;
-    if (type == MRGI_LIGHT_DIRECTIONAL) {
-      wi = -L.direction_real.xyz;
-      irradiance_rgb = L.intensity.rgb;
-    } else {
-      vec3 to_light = L.position_type.xyz - p;
-      float d2 = max(dot(to_light, to_light), 1e-6f);
-      wi = to_light * inversesqrt(d2);
-      float cone = 1.0f;
-      if (type == MRGI_LIGHT_SPOT)
-        cone = spot_falloff(dot(L.direction_real.xyz, -wi), L.cone.y, L.cone.x);
-      irradiance_rgb = L.intensity.rgb * cone / d2;
-    }
+    vec3 irradiance_rgb = light_incident(L, p, wi);
     float nl = dot(n, wi);
     if (nl <= 0.0f || all(equal(irradiance_rgb, vec3(0.0f)))) continue;
     vec3 lo = brdf(n, v, wi, alb.rgb, alb.a, roughness, is_virtual) * irradiance_rgb * nl;
