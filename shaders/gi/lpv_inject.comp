@@ -6,7 +6,12 @@
 //     the texel's position moved half a cell along its normal (no self-illumination, no VPL
 //     behind its own surface);
 //   direct (Sec. 4.3.2): the light arriving at the texel, P_in (W), as an emitter facing the
-//     light's travel direction, moved half a cell towards the light.
+//     light's travel direction, moved half a cell towards the light; only where the other map
+//     (`other_position`, R^rho for R^mu's texels) sees a different surface: the light the
+//     virtual objects block, as antiradiance. Deviation: the paper injects R^rho's direct light
+//     positively as well; a volume does not stop light at surfaces, so that light would flow on
+//     through the object into the shadow below it and cancel it (and light from the side that
+//     grazes past the real scene would add light nowhere blocked).
 // `sign` is +1 for the map with the virtual object (R^rho) and -1 for the one without (R^mu):
 // VPLs both maps see cancel, new ones add, blocked ones subtract (eq. 13).
 #extension GL_GOOGLE_include_directive : require
@@ -18,6 +23,7 @@ layout(set = 0, binding = 0, rgba32f) uniform readonly image2D rsm_position;  //
 layout(set = 0, binding = 1, rgba16f) uniform readonly image2D rsm_normal;    // xyz world, unit
 layout(set = 0, binding = 2, rgba32f) uniform readonly image2D rsm_flux;      // rgb reflected W, a: incident W per unit light colour
 layout(set = 0, binding = 3, r32f) uniform imageBuffer cells;                 // 12 per cell: channel * 4 + coefficient
+layout(set = 0, binding = 4, rgba32f) uniform readonly image2D other_position;  // direct mode: the other map
 layout(push_constant) uniform InjectParams {
   vec4 grid;       // xyz: the volume's min corner (m); w: cell size (m)
   ivec4 sizes;     // x: cells per side; y, z: the map's used width and height; w: 1 = direct
@@ -41,6 +47,8 @@ void main() {
   vec4 lobe;
   vec3 power;
   if (sizes.w == 1) {
+    const vec4 other = imageLoad(other_position, p);
+    if (other.w > 0.5 && distance(other.xyz, pos.xyz) <= 0.25 * grid.w) return;  // not blocked
     at = pos.xyz - travel * (0.5 * grid.w);
     lobe = sh4_cosine_lobe(travel) * (1.0 / MRGI_PI);
     power = colour.xyz * flux.w;

@@ -18,7 +18,7 @@ layout(push_constant) uniform RsmDraw {
   vec4 colour;  // rgb: colour x intensity; w: spot cos outer (-2: no cone)
   vec4 axis;    // xyz: the map's view axis; w: spot cos inner
   ivec4 misc;   // x: grid stride (G-buffer pixels between points); y: material (-1: proxy);
-                // z: a proxy's hint colour, linear RGB8 packed
+                // z: a proxy's hint colour, linear RGB8 packed; w: grid points per row
 } draw;
 layout(location = 0) in vec3 in_world;
 layout(location = 1) in vec3 in_normal;

@@ -13,7 +13,7 @@ layout(push_constant) uniform RsmDraw {
   vec4 colour;  // rgb: colour x intensity; w: spot cos outer (-2: no cone)
   vec4 axis;    // xyz: the map's view axis; w: spot cos inner
   ivec4 misc;   // x: grid stride (G-buffer pixels between points); y: material (-1: proxy);
-                // z: a proxy's hint colour, linear RGB8 packed
+                // z: a proxy's hint colour, linear RGB8 packed; w: grid points per row
 } draw;
 layout(location = 0) out vec3 out_world;
 layout(location = 1) out vec3 out_normal;
@@ -23,7 +23,7 @@ layout(location = 4) flat out float out_layer;  // base-colour texture layer, -1
 
 void main() {
   int stride = max(draw.misc.x, 1);
-  int row = (textureSize(real_position, 0).x - 1) / stride + 1;  // grid points per row
+  int row = max(draw.misc.w, 1);  // grid points per row over the G-buffer's used extent
   ivec2 g = ivec2(gl_VertexIndex % row, gl_VertexIndex / row) * stride;
   vec4 p = texelFetch(real_position, g, 0);
   out_world = p.xyz;

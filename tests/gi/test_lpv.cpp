@@ -30,6 +30,7 @@ struct Lpv {
   std::unique_ptr<gpu::FrameGraph> graph;
   std::optional<gi::LightPropagationVolume> lpv;
   gi::RsmImages rsm;
+  gi::RsmImages blocker;  // the same texels 0.3 m nearer the light (a virtual object between)
   gpu::BufferHandle readback;
 
   uint32_t n = kN;
@@ -62,14 +63,18 @@ struct Lpv {
     };
     rsm = {image("rsm position", VK_FORMAT_R32G32B32A32_SFLOAT), image("rsm normal", VK_FORMAT_R16G16B16A16_SFLOAT),
            image("rsm flux", VK_FORMAT_R32G32B32A32_SFLOAT), w, 1};
-    std::vector<float> pos, flux;
+    blocker = rsm;
+    blocker.position = image("blocker position", VK_FORMAT_R32G32B32A32_SFLOAT);
+    std::vector<float> pos, flux, blocked;
     std::vector<uint16_t> nor;
     for (const Texel& t : texels) {
+      blocked.insert(blocked.end(), {t.position.x, t.position.y + 0.3f, t.position.z, 1.0f});
       pos.insert(pos.end(), {t.position.x, t.position.y, t.position.z, 1.0f});
       for (float c : {t.normal.x, t.normal.y, t.normal.z, 0.0f}) nor.push_back(uint16_t(glm::packHalf1x16(c)));
       flux.insert(flux.end(), {t.flux.x, t.flux.y, t.flux.z, t.flux.w});
     }
     EXPECT_TRUE(graph->upload_image(rsm.position, pos.data(), pos.size() * 4).ok());
+    EXPECT_TRUE(graph->upload_image(blocker.position, blocked.data(), blocked.size() * 4).ok());
     EXPECT_TRUE(graph->upload_image(rsm.normal, nor.data(), nor.size() * 2).ok());
     EXPECT_TRUE(graph->upload_image(rsm.flux, flux.data(), flux.size() * 4).ok());
     gpu::BufferDesc bd;
@@ -115,7 +120,7 @@ struct Lpv {
     return out;
   }
   void inject(const char* label, gi::InjectKind kind, float sign, const gi::LpvLight& light = {}) {
-    lpv->add_inject(*graph, label, rsm, light, kind, sign);
+    lpv->add_inject(*graph, label, rsm, light, kind, sign, kind == gi::InjectKind::Direct ? &blocker : nullptr);
   }
 };
 
@@ -173,13 +178,19 @@ TEST_F(VulkanTest, LpvDeltaOfTwoEqualMapsIsZeroAndOfABlockedOneIsNegative) {
 }
 
 TEST_F(VulkanTest, LpvDirectLightIsInjectedTowardsTheLightAlongItsTravel) {
-  // Direct mode (Sec. 4.3.2): the light arriving at the texel (colour x incident W = 0.5 x 4),
+  // Direct mode (Sec. 4.3.2): where the other map sees a nearer surface (the texel is blocked),
+  // the light arriving at the texel (colour x incident W = 0.5 x 4),
   // as an emitter facing the way the light travels, half a cell towards the light (up): y 0.6 +
   // 0.125 = 0.725, cell (4, 2, 4).
   Lpv t(ctx(), {{glm::vec3(1.0f, 0.6f, 1.0f), glm::vec3(0, 1, 0), glm::vec4(0, 0, 0, 4)}});
   gi::LpvLight sun = kSunFromAbove;
   sun.colour = glm::vec3(0.5f, 0.25f, 0.0f);
   auto sum = t.run([&] { t.inject("direct", gi::InjectKind::Direct, 1.0f, sun); }, 0);
+  // Where the other map sees the same surface (nothing blocks the light), nothing is injected.
+  auto unblocked = t.run([&] {
+    t.lpv->add_inject(*t.graph, "unblocked", t.rsm, sun, gi::InjectKind::Direct, 1.0f, &t.rsm);
+  }, 0);
+  for (const glm::vec4& v : unblocked[0]) ASSERT_EQ(v, glm::vec4(0.0f));
   const glm::vec4 want = sh::lpv_vpl_intensity(glm::vec3(0, -1, 0), 2.0f);
   for (int k = 0; k < 4; ++k) EXPECT_NEAR(sum[0][cell(4, 2, 4)][k], want[k], 1e-6f);
   for (int k = 0; k < 4; ++k) EXPECT_NEAR(sum[1][cell(4, 2, 4)][k], want[k] * 0.5f, 1e-6f);

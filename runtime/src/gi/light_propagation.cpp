@@ -107,7 +107,10 @@ void LightPropagationVolume::add_clear(gpu::FrameGraph& graph) const {
 }
 
 void LightPropagationVolume::add_inject(gpu::FrameGraph& graph, const std::string& label, const RsmImages& rsm,
-                                        const LpvLight& light, InjectKind kind, float sign) const {
+                                        const LpvLight& light, InjectKind kind, float sign,
+                                        const RsmImages* other) const {
+  // Indirect mode reads no other map: the map's own positions stand in for the binding.
+  const gpu::ImageHandle other_position = kind == InjectKind::Direct && other ? other->position : rsm.position;
   const InjectPush push{glm::vec4(grid_.origin, grid_.cell_size),
                         glm::ivec4(int(cells()), int(rsm.width), int(rsm.height), kind == InjectKind::Direct ? 1 : 0),
                         glm::vec4(light.direction_or_position, light.positional ? 1.0f : 0.0f),
@@ -116,8 +119,9 @@ void LightPropagationVolume::add_inject(gpu::FrameGraph& graph, const std::strin
   const gpu::Pipeline* pipe = &*inject_;
   graph.add_shader_pass(
       settings_.name + " inject " + label, gpu::PassKind::Compute, *inject_,
-      [rsm, cells](gpu::ShaderPassBuilder& b) {
+      [rsm, cells, other_position](gpu::ShaderPassBuilder& b) {
         b.bind("rsm_position", rsm.position);
+        b.bind("other_position", other_position);
         b.bind("rsm_normal", rsm.normal);
         b.bind("rsm_flux", rsm.flux);
         b.bind("cells", cells);

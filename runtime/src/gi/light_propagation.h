@@ -51,6 +51,9 @@ struct LpvLight {
   glm::vec3 colour{1.0f};  // the lamp's colour (direct injection scales incident W by it)
 };
 
+// Indirect: the map's VPLs (eq. 12). Direct: the light arriving at the map's texels where
+// `other` (the pair's other map) sees another surface, i.e. the light the virtual objects block
+// (Sec. 4.3.2; lpv_inject.comp says where this differs from the paper).
 enum class InjectKind : uint8_t { Indirect, Direct };
 
 class LightPropagationVolume {
@@ -69,8 +72,9 @@ class LightPropagationVolume {
 
   void add_clear(gpu::FrameGraph& graph) const;
   // `sign` +1 or -1 (a delta volume's two maps). The pass is named "<name> inject <label>".
+  // `other`: Direct only (the map whose surfaces count as unblocked); nullptr for Indirect.
   void add_inject(gpu::FrameGraph& graph, const std::string& label, const RsmImages& rsm, const LpvLight& light,
-                  InjectKind kind, float sign) const;
+                  InjectKind kind, float sign, const RsmImages* other = nullptr) const;
   // The injected light as step 0, then `steps` propagation steps, all summed into accumulated():
   // one graph pass ("<name> propagate").
   void add_propagate(gpu::FrameGraph& graph, uint32_t steps) const;

@@ -199,7 +199,8 @@ void ReflectiveShadowMaps::add_draw(gpu::FrameGraph& graph, const std::string& l
   const gpu::BufferHandle indices = grid_indices_;
   const gpu::Pipeline* grid_pipe = &*grid_pipeline_;
   const gpu::Pipeline* mesh_pipe = &*mesh_pipeline_;
-  RsmPush push{view.view_proj, view.light, view.colour, view.axis, glm::ivec4(int(grid_stride_), -1, 0, 0)};
+  RsmPush push{view.view_proj, view.light, view.colour, view.axis,
+               glm::ivec4(int(grid_stride_), -1, 0, int(grid_points_.width))};
   graph.add_pass(
       settings_.name + " " + label, gpu::PassKind::Graphics,
       [=](gpu::PassBuilder& b) {

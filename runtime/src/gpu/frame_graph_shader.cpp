@@ -84,11 +84,11 @@ void ShaderPassBuilder::bind_resource(std::string_view name, ResourceRef ref, ui
       return;
     }
   data.descriptors.push_back({b->binding, b->type, ref, mip, one_level, sampler});
-  if (ref.is_image && one_level) {
-    base_.decl_.uses.push_back({ref, access, mip, 1});
-  } else {
-    base_.decl_.uses.push_back({ref, access});
-  }
+  const ResourceUse use = ref.is_image && one_level ? ResourceUse{ref, access, mip, 1} : ResourceUse{ref, access};
+  // One resource bound to two names the same way (a stand-in image) is one use of the pass.
+  for (const ResourceUse& u : base_.decl_.uses)
+    if (u == use) return;
+  base_.decl_.uses.push_back(use);
 }
 
 void FrameGraph::add_shader_pass(const std::string& name, PassKind kind, const Pipeline& pipeline,

@@ -97,12 +97,12 @@ class PipelineHandle {
   Pipeline p_;
 };
 
-// Collects up to 16 descriptor writes on the stack and pushes them (no heap, no pool).
+// Collects up to 24 descriptor writes on the stack and pushes them (no heap, no pool).
 // Images: storage images are in GENERAL, sampled ones in SHADER_READ_ONLY_OPTIMAL (what the frame
 // graph transitions them to).
 class DescriptorPush {
  public:
-  static constexpr uint32_t kMaxWrites = 16;
+  static constexpr uint32_t kMaxWrites = 24;
   DescriptorPush& storage_image(uint32_t binding, VkImageView view);
   DescriptorPush& sampled_image(uint32_t binding, VkImageView view, VkSampler sampler);
   DescriptorPush& storage_buffer(uint32_t binding, VkBuffer buffer, VkDeviceSize offset = 0,

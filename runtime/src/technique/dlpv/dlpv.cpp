@@ -1,0 +1,261 @@
+#include "technique/dlpv/dlpv.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <optional>
+#include <string>
+
+#include "common/light_set.glsl"
+#include "gi/light_propagation.h"
+#include "gi/rsm.h"
+#include "gpu/pipelines.h"
+#include "light/light_stage.h"
+#include "technique/scene_gpu.h"
+
+namespace mrgi::technique {
+
+const std::array<DlpvLevel, 4>& dlpv_levels() {
+  static const std::array<DlpvLevel, 4> levels = {{
+      {"paper", 32, 32, 512, 4, true, 1.0f},
+      {"medium", 16, 16, 256, 2, true, 1.0f},
+      {"fast", 8, 8, 128, 1, false, 0.75f},
+      {"fastest", 8, 4, 64, 1, false, 0.5f},
+  }};
+  return levels;
+}
+
+std::vector<QualityLevel> dlpv_ladder() {
+  std::vector<QualityLevel> out;
+  for (const DlpvLevel& l : dlpv_levels()) {
+    QualityLevel q;
+    q.name = l.name;
+    q.internal_scale = l.internal_scale;
+    q.knobs = {{"volume_cells", double(l.volume_cells), "cells per side of each volume"},
+               {"steps", double(l.steps), "propagation steps"},
+               {"rsm_size", double(l.rsm_size), "texels per side of each reflective shadow map"},
+               {"rsm_lamps", double(l.rsm_lamps), "real lamps, strongest first, with a map pair"},
+               {"rho_volume", l.rho_volume ? 1.0 : 0.0, "1: V^rho propagated for the virtual pixels"},
+               {"internal_scale", double(l.internal_scale), "fraction of the output width and height"}};
+    out.push_back(q);
+  }
+  return out;
+}
+
+namespace {
+
+struct MergePush {
+  glm::vec4 grid;    // min corner, cell size
+  glm::vec4 extent;  // cells allocated, cells used, V^Delta present, V^rho present
+};
+
+// The volume around the virtual objects: twice their largest bounding-box edge (paper Sec. 4.2),
+// at least 0.25 m (a thin object still has room around it for its shadow and bounce).
+constexpr float kMinVolumeSide = 0.25f;
+
+class Dlpv final : public Technique {
+ public:
+  explicit Dlpv(const SharedResources& shared) : shared_(shared), ladder_(dlpv_ladder()) {}
+  const std::string& name() const override { return name_; }
+  const std::vector<QualityLevel>& levels() const override { return ladder_; }
+  Status init();
+  Status record(const FrameInfo& info, std::vector<std::string>& skipped) override;
+
+ private:
+  void write_lights();
+
+  std::string name_ = "dlpv";
+  SharedResources shared_;
+  std::vector<QualityLevel> ladder_;
+  gpu::BufferHandle lights_;  // shader::LightSet, one per frame slot
+  std::optional<gi::ReflectiveShadowMaps> rsm_;
+  std::optional<gi::LightPropagationVolume> delta_, rho_;
+  gpu::PipelineHandle merge_;
+  bool has_virtual_ = false;
+  glm::vec3 centre_{0.0f};
+  float side_ = 1.0f;
+};
+
+Status Dlpv::init() {
+  gpu::FrameGraph& graph = *shared_.graph;
+  const SceneGpu& sg = *shared_.scene_gpu;
+  if (!shared_.light_stage) return fail(ErrorKind::Internal, "dlpv: no light stage");
+  auto lights = graph.create_buffer({"dlpv_lights", sizeof(shader::LightSet), gpu::MemoryUsage::Upload, true},
+                                    VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  if (!lights) return lights.error();
+  lights_ = *lights;
+  has_virtual_ = !sg.virtual_objects.empty();
+  uint32_t top_cells = 2, top_rsm = 16;
+  if (has_virtual_) {
+    const glm::vec3 size = sg.virtual_objects.bounds_max - sg.virtual_objects.bounds_min;
+    centre_ = 0.5f * (sg.virtual_objects.bounds_max + sg.virtual_objects.bounds_min);
+    side_ = std::max(kMinVolumeSide, 2.0f * std::max({size.x, size.y, size.z}));
+    for (const DlpvLevel& l : dlpv_levels()) {
+      top_cells = std::max(top_cells, l.volume_cells);
+      top_rsm = std::max(top_rsm, l.rsm_size);
+    }
+    gi::RsmSettings rs;
+    rs.name = "dlpv rsm";
+    rs.size = top_rsm;
+    auto rsm = gi::ReflectiveShadowMaps::create(
+        graph, sg, {shared_.real_position, shared_.real_normal, shared_.real_albedo}, rs);
+    if (!rsm) return rsm.error();
+    rsm_.emplace(std::move(*rsm));
+  }
+  // Without virtual objects nothing is injected; the volumes are then 2^3, allocated only so the
+  // merge binds images of the kind it declares (it reads none of them).
+  gi::LpvSettings ds;
+  ds.name = "dlpv delta";
+  ds.resolution = top_cells;
+  ds.negative_damping = 1.0f;
+  auto delta = gi::LightPropagationVolume::create(graph, ds);
+  if (!delta) return delta.error();
+  delta_.emplace(std::move(*delta));
+  gi::LpvSettings ps = ds;
+  ps.name = "dlpv rho";
+  ps.negative_damping = 0.0f;  // V^rho holds no antiradiance
+  auto rho = gi::LightPropagationVolume::create(graph, ps);
+  if (!rho) return rho.error();
+  rho_.emplace(std::move(*rho));
+  auto merge = gpu::load_compute_pipeline(*shared_.context, "dlpv/merge.comp", {});
+  if (!merge) return merge.error();
+  merge_ = std::move(*merge);
+  return ok_status();
+}
+
+void Dlpv::write_lights() {
+  const light::Lighting& lighting = shared_.light_stage->lighting();
+  auto* set = static_cast<shader::LightSet*>(shared_.graph->mapped(lights_, shared_.graph->slot()));
+  *set = shader::LightSet{};
+  const int n = std::min<int>(int(lighting.lights.size()), MRGI_MAX_LIGHTS);
+  set->count = glm::ivec4(n, 0, 0, 0);
+  for (int i = 0; i < n; ++i) {
+    const LightDesc& l = lighting.lights[size_t(i)];
+    shader::ShadowLight& s = set->lights[i];
+    const int type = l.type == LightType::Directional ? MRGI_LIGHT_DIRECTIONAL
+                     : l.type == LightType::Spot      ? MRGI_LIGHT_SPOT
+                                                      : MRGI_LIGHT_POINT;
+    s.position_type = glm::vec4(l.position, float(type));
+    s.direction_real = glm::vec4(glm::normalize(l.direction), l.real ? 1.0f : 0.0f);
+    s.intensity = glm::vec4(l.color * l.intensity, 0.0f);
+    s.cone = glm::vec4(std::cos(glm::radians(l.inner_angle_deg)), std::cos(glm::radians(l.outer_angle_deg)), 0.0f, 0.0f);
+    s.layers = glm::ivec4(-1, -1, 0, 0);
+  }
+  light::ShRgb both;
+  for (int i = 0; i < light::kMaxShCoeffs; ++i)
+    both[size_t(i)] = lighting.ambient_real[size_t(i)] + lighting.ambient_virtual[size_t(i)];
+  const auto rv = light::irradiance_matrices(both);
+  const auto r = light::irradiance_matrices(lighting.ambient_real);
+  set->ambient_rv = {rv[0], rv[1], rv[2]};
+  set->ambient_r = {r[0], r[1], r[2]};
+}
+
+Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
+  if (info.level < 0 || info.level >= int(dlpv_levels().size()))
+    return fail(ErrorKind::BadUsage, "dlpv: level " + std::to_string(info.level) + " outside 0.." +
+                                         std::to_string(dlpv_levels().size() - 1));
+  const DlpvLevel& level = dlpv_levels()[size_t(info.level)];
+  gpu::FrameGraph& graph = *shared_.graph;
+  write_lights();
+  const light::Lighting& lighting = shared_.light_stage->lighting();
+  bool delta_present = false, rho_present = false;
+  MergePush push{};
+  if (!has_virtual_) {
+    skipped.push_back("dlpv volumes: no virtual object in the scene");
+  } else {
+    MRGI_TRY(delta_->set_cells(graph, level.volume_cells));
+    MRGI_TRY(rho_->set_cells(graph, level.volume_cells));
+    const gi::LpvGrid grid{centre_ - glm::vec3(0.5f * side_), side_ / float(level.volume_cells)};
+    delta_->set_grid(grid);
+    rho_->set_grid(grid);
+    push.grid = glm::vec4(grid.origin, grid.cell_size);
+    const float radius = 0.5f * side_ * std::sqrt(3.0f);
+    // The real grid at about two points a map texel across the G-buffer's larger side.
+    const VkExtent2D g = graph.extent(shared_.real_position);
+    const uint32_t stride = std::max(1u, uint32_t(std::ceil(double(std::max(g.width, g.height)) / (level.rsm_size / 2.0))));
+    bool grid_added = false;
+    uint32_t lamps = 0;
+    for (size_t i = 0; i < lighting.lights.size() && lamps < level.rsm_lamps; ++i) {
+      const LightDesc& lamp = lighting.lights[i];
+      if (!lamp.real) continue;
+      auto view = gi::rsm_view(lamp, centre_, radius, level.rsm_size);
+      if (!view) {
+        skipped.push_back("dlpv rsm (light " + std::to_string(i) + "): " + view.error().message);
+        continue;
+      }
+      if (!grid_added) {
+        delta_->add_clear(graph);
+        if (level.rho_volume) rho_->add_clear(graph);
+        rsm_->add_grid(graph, stride);
+        grid_added = true;
+      }
+      const std::string id = std::to_string(i);
+      const gi::RsmImages rho_map = rsm_->images(gi::RsmMap::WithVirtual, level.rsm_size);
+      const gi::RsmImages mu_map = rsm_->images(gi::RsmMap::RealOnly, level.rsm_size);
+      rsm_->add_draw(graph, "rho " + id, *view, gi::RsmMap::WithVirtual, level.rsm_size);
+      delta_->add_inject(graph, "rho " + id, rho_map, view->lpv, gi::InjectKind::Indirect, 1.0f);
+      if (level.rho_volume) rho_->add_inject(graph, "rho " + id, rho_map, view->lpv, gi::InjectKind::Indirect, 1.0f);
+      rsm_->add_draw(graph, "mu " + id, *view, gi::RsmMap::RealOnly, level.rsm_size);
+      delta_->add_inject(graph, "mu " + id, mu_map, view->lpv, gi::InjectKind::Indirect, -1.0f);
+      delta_->add_inject(graph, "blocked direct " + id, mu_map, view->lpv, gi::InjectKind::Direct, -1.0f, &rho_map);
+      ++lamps;
+    }
+    if (lamps == 0) {
+      skipped.push_back("dlpv volumes: no real light to inject (no lamp, environment region or estimate)");
+    } else {
+      delta_->add_propagate(graph, level.steps);
+      delta_present = true;
+      if (level.rho_volume) {
+        rho_->add_propagate(graph, level.steps);
+        rho_present = true;
+      } else {
+        skipped.push_back("dlpv rho volume: level '" + std::string(level.name) +
+                          "' shades virtual pixels with lamps and ambient only");
+      }
+    }
+    push.extent = glm::vec4(float(delta_->settings().resolution), float(level.volume_cells), delta_present ? 1.0f : 0.0f,
+                            rho_present ? 1.0f : 0.0f);
+  }
+  const SharedResources& r = shared_;
+  const gpu::Pipeline* merge = &*merge_;
+  const gpu::Context& ctx = *shared_.context;
+  const VkSampler nearest = ctx.samplers().nearest_clamp, linear = ctx.samplers().linear_clamp;
+  const gpu::ImageHandle dvol[3] = {delta_->accumulated(0), delta_->accumulated(1), delta_->accumulated(2)};
+  const gpu::ImageHandle rvol[3] = {rho_->accumulated(0), rho_->accumulated(1), rho_->accumulated(2)};
+  graph.add_shader_pass(
+      "dlpv merge", gpu::PassKind::Compute, *merge_,
+      [&, nearest, linear](gpu::ShaderPassBuilder& b) {
+        b.bind("FrameUbo", r.frame_constants);
+        b.bind("LightUbo", lights_);
+        b.bind_sampled("real_position", r.real_position, nearest);
+        b.bind_sampled("real_normal", r.real_normal, nearest);
+        b.bind_sampled("real_albedo", r.real_albedo, nearest);
+        b.bind_sampled("virtual_position", r.virtual_position, nearest);
+        b.bind_sampled("virtual_normal", r.virtual_normal, nearest);
+        b.bind_sampled("virtual_albedo", r.virtual_albedo, nearest);
+        b.bind_sampled("virtual_emission", r.virtual_emission.valid() ? r.virtual_emission : r.virtual_albedo, nearest);
+        const char* d[3] = {"delta_r", "delta_g", "delta_b"};
+        const char* p[3] = {"rho_r", "rho_g", "rho_b"};
+        for (int c = 0; c < 3; ++c) {
+          b.bind_sampled(d[c], dvol[c], linear);
+          b.bind_sampled(p[c], rvol[c], linear);
+        }
+        b.bind("lit_rv", r.lit_rv);
+        b.bind("lit_r", r.lit_r);
+      },
+      [merge, push, lit = r.lit_rv](VkCommandBuffer cmd, gpu::PassContext& p) {
+        const VkExtent2D e = p.extent(lit);
+        gpu::push_and_dispatch(cmd, *merge, &push, sizeof push, {(e.width + 7) / 8, (e.height + 7) / 8, 1});
+      });
+  return ok_status();
+}
+
+}  // namespace
+
+Expected<std::unique_ptr<Technique>> create_dlpv(const SharedResources& shared) {
+  auto t = std::make_unique<Dlpv>(shared);
+  MRGI_TRY(t->init());
+  return std::unique_ptr<Technique>(std::move(t));
+}
+
+}  // namespace mrgi::technique

@@ -1,0 +1,48 @@
+// The `dlpv` technique: Delta Light Propagation Volumes (Franke 2013,
+// ../shared/papers/delta-light-propagation-volumes.md). Per real lamp of the light stage, a
+// reflective shadow map pair (gi/rsm.h: with and without the virtual objects) is injected into
+// one volume centred on the virtual objects as +R^rho - R^mu, VPLs (eq. 12-13) and direct light
+// (Sec. 4.3.2, the antiradiance that shadows), propagated (gi/light_propagation.h), and merged
+// as Algorithm 1 (shaders/dlpv/merge.comp). The best levels also propagate V^rho (R^rho alone)
+// for the virtual pixels' bounce light.
+//
+// Quality ladder (best first; DlpvLevel below, with units):
+//   level    volume  steps  RSM    RSM lamps  V^rho  internal scale
+//   paper    32^3    32     512^2  4          yes    1.0     the paper's settings (Sec. 5)
+//   medium   16^3    16     256^2  2          yes    1.0
+//   fast      8^3     8     128^2  1          no     0.75    the reduced-volume fast path
+//   fastest   8^3     4      64^2  1          no     0.5
+//
+// Where mrgi differs from the paper and why:
+//   - the propagation gathers with exact face solid angles and damps negative flux by the
+//     directional derivative along the propagation (shaders/shared/lpv_math.h says how); the
+//     paper names the cue, not the formula;
+//   - VPLs are summed with float atomics in a compute pass, not as points blended into slices
+//     (lavapipe rasterises points on one thread; the sums are the same);
+//   - real albedo is recon's per-pixel estimate (camera colour over the modelled light), the
+//     paper's eq. 1;
+//   - lamps beyond the level's RSM count still light directly (unshadowed), without bounce.
+#pragma once
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "technique/technique.h"
+
+namespace mrgi::technique {
+
+struct DlpvLevel {
+  const char* name;
+  uint32_t volume_cells;   // cells per side of each volume
+  uint32_t steps;          // propagation steps
+  uint32_t rsm_size;       // texels per side of each reflective shadow map
+  uint32_t rsm_lamps;      // real lamps (strongest first) with a map pair; others light directly
+  bool rho_volume;         // V^rho for the virtual pixels' bounce light
+  float internal_scale;    // fraction of the output width and height
+};
+const std::array<DlpvLevel, 4>& dlpv_levels();
+
+std::vector<QualityLevel> dlpv_ladder();
+Expected<std::unique_ptr<Technique>> create_dlpv(const SharedResources& shared);
+
+}  // namespace mrgi::technique

@@ -1,0 +1,112 @@
+#version 460
+// dlpv: the merge of the DLPV paper's Algorithm 1 into the two solutions compose reads.
+//   real pixel:    L_r  = albedo / pi (E_real_lamps(n) + E_ambient_r(n))   (the real scene as lit)
+//                  L_rv = albedo / pi (E_lamps(n) + E_ambient_rv(n) + E_delta(p, n))  (V^Delta:
+//                         bounce from the virtual objects, minus the light they block: shadow)
+//   virtual pixel: L_rv = BRDF x E_lamps + albedo / pi (E_ambient_rv(n) + E_rho(p, n)) + emission
+//                  (V^rho: bounce light from the real and virtual surfaces; without V^rho, at the
+//                  cheaper levels, the virtual pixel's own shading: lamps and ambient)
+// E_volume(p, n) = lpv_irradiance of the volume's accumulated intensity, trilinear at p (0 outside
+// the volume). Lamps are unshadowed here (Algorithm 1): a virtual object's shadow on the real
+// scene is the volume's antiradiance (paper Sec. 4.3.2), and real shadows are in the camera image.
+#extension GL_GOOGLE_include_directive : require
+#include "shared/mrgi_shared.h"
+#include "shared/lpv_math.h"
+#include "common/frame_constants.glsl"
+#include "common/light_set.glsl"
+#include "common/surface_shading.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
+FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
+layout(std140, set = 0, binding = 1) uniform LightUbo { LightSet light_set; };
+AmbientIrradiance ambient_rv, ambient_r;
+layout(set = 0, binding = 2) uniform sampler2D real_position;
+layout(set = 0, binding = 3) uniform sampler2D real_normal;
+layout(set = 0, binding = 4) uniform sampler2D real_albedo;
+layout(set = 0, binding = 5) uniform sampler2D virtual_position;
+layout(set = 0, binding = 6) uniform sampler2D virtual_normal;
+layout(set = 0, binding = 7) uniform sampler2D virtual_albedo;
+layout(set = 0, binding = 8) uniform sampler2D virtual_emission;
+layout(set = 0, binding = 9) uniform sampler3D delta_r;
+layout(set = 0, binding = 10) uniform sampler3D delta_g;
+layout(set = 0, binding = 11) uniform sampler3D delta_b;
+layout(set = 0, binding = 12) uniform sampler3D rho_r;
+layout(set = 0, binding = 13) uniform sampler3D rho_g;
+layout(set = 0, binding = 14) uniform sampler3D rho_b;
+layout(set = 0, binding = 15, rgba16f) writeonly uniform image2D lit_rv;
+layout(set = 0, binding = 16, rgba16f) writeonly uniform image2D lit_r;
+struct VolumeConstants {
+  vec4 grid;    // xyz: the volumes' min corner (m); w: cell size (m)
+  vec4 extent;  // x: cells allocated per side; y: cells used; z: 1 = V^Delta present; w: 1 = V^rho
+};
+layout(push_constant) uniform Volume { VolumeConstants volume_block; };
+VolumeConstants volume;
+
+// Irradiance from a volume's accumulated intensity at p for normal n, per channel.
+vec3 volume_irradiance(sampler3D r, sampler3D g, sampler3D b, vec3 p, vec3 n) {
+  vec3 cellf = (p - volume.grid.xyz) / volume.grid.w;  // in cells
+  if (any(lessThan(cellf, vec3(0.0f))) || any(greaterThan(cellf, vec3(volume.extent.y)))) return vec3(0.0f);
+  // The used corner of the allocation; clamped half a cell inside it so the trilinear filter
+  // never reads a cell beyond the used size (stale: this level did not write it).
+  vec3 uvw = clamp(cellf, vec3(0.5f), vec3(volume.extent.y - 0.5f)) / volume.extent.x;
+  return vec3(lpv_irradiance(textureLod(r, uvw, 0.0f), n, volume.grid.w),
+              lpv_irradiance(textureLod(g, uvw, 0.0f), n, volume.grid.w),
+              lpv_irradiance(textureLod(b, uvw, 0.0f), n, volume.grid.w));
+}
+
+void main() {
+  frame = frame_ubo;  // MRGI_UNIFORM_COPIES
+  volume = volume_block;
+  ambient_rv = light_set.ambient_rv;
+  ambient_r = light_set.ambient_r;
+  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+  if (any(greaterThanEqual(pixel, frame.internal_output_size.xy))) return;
+  vec4 vpos = texelFetch(virtual_position, pixel, 0);
+  bool is_virtual = vpos.w > 0.5f;
+  vec4 pos, nrm, alb;
+  if (is_virtual) {
+    pos = vpos;
+    nrm = texelFetch(virtual_normal, pixel, 0);
+    alb = texelFetch(virtual_albedo, pixel, 0);
+  } else {
+    pos = texelFetch(real_position, pixel, 0);
+    nrm = texelFetch(real_normal, pixel, 0);
+    alb = vec4(texelFetch(real_albedo, pixel, 0).rgb, 0.0f);
+    if (!(pos.w > 0.0f)) {  // no measurement: nothing is known there, both solutions are 0
+      imageStore(lit_rv, pixel, vec4(0.0f));
+      imageStore(lit_r, pixel, vec4(0.0f));
+      return;
+    }
+  }
+  vec3 p = pos.xyz;
+  vec3 n = normalize(nrm.xyz);
+  vec3 v = normalize(frame.camera_world.xyz - p);
+  vec3 lamps = vec3(0.0f), real_lamps = vec3(0.0f);  // every lamp; the real ones (light L_r)
+  int count = min(light_set.count.x, MRGI_MAX_LIGHTS);
+  for (int i = 0; i < count; ++i) {
+    ShadowLight L = light_set.lights[i];
+    vec3 wi;
+    vec3 e = light_incident(L, p, wi);
+    float nl = dot(n, wi);
+    if (nl <= 0.0f) continue;
+    vec3 lo = brdf(n, v, wi, alb.rgb, alb.a, is_virtual ? nrm.w : 1.0f, is_virtual) * e * nl;
+    lamps += lo;
+    if (L.direction_real.w > 0.5f) real_lamps += lo;
+  }
+  vec3 l_rv, l_r;
+  if (is_virtual) {
+    vec3 e = ambient_irradiance(ambient_rv, n);
+    if (volume.extent.w > 0.5f) e += volume_irradiance(rho_r, rho_g, rho_b, p, n);
+    l_rv = lamps + alb.rgb * max(e, vec3(0.0f)) * (1.0f / MRGI_PI) +
+           (frame.flags.y != 0 ? texelFetch(virtual_emission, pixel, 0).rgb : vec3(0.0f));
+    l_r = vec3(0.0f);
+  } else {
+    l_r = real_lamps + alb.rgb * ambient_irradiance(ambient_r, n) * (1.0f / MRGI_PI);
+    vec3 delta = volume.extent.z > 0.5f ? volume_irradiance(delta_r, delta_g, delta_b, p, n) : vec3(0.0f);
+    l_rv = lamps + alb.rgb * (ambient_irradiance(ambient_rv, n) + delta) * (1.0f / MRGI_PI);
+  }
+  // Half floats end at 65504, and antiradiance can overshoot below 0: clamp.
+  imageStore(lit_rv, pixel, vec4(clamp(sanitize(l_rv), vec3(0.0f), vec3(60000.0f)), 1.0f));
+  imageStore(lit_r, pixel, vec4(clamp(sanitize(l_r), vec3(0.0f), vec3(60000.0f)), 1.0f));
+}
