@@ -60,6 +60,10 @@ void main() {
   volume = volume_block;
   ambient_rv = light_set.ambient_rv;
   ambient_r = light_set.ambient_r;
+  const int count = min(light_set.count.x, MRGI_MAX_LIGHTS);
+  const ShadowLight lamp0 = light_set.lights[0], lamp1 = light_set.lights[1], lamp2 = light_set.lights[2],
+                    lamp3 = light_set.lights[3], lamp4 = light_set.lights[4], lamp5 = light_set.lights[5],
+                    lamp6 = light_set.lights[6], lamp7 = light_set.lights[7];
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
   if (any(greaterThanEqual(pixel, frame.internal_output_size.xy))) return;
   vec4 vpos = texelFetch(virtual_position, pixel, 0);
@@ -83,17 +87,22 @@ void main() {
   vec3 n = normalize(nrm.xyz);
   vec3 v = normalize(frame.camera_world.xyz - p);
   vec3 lamps = vec3(0.0f), real_lamps = vec3(0.0f);  // every lamp; the real ones (light L_r)
-  int count = min(light_set.count.x, MRGI_MAX_LIGHTS);
-  for (int i = 0; i < count; ++i) {
-    ShadowLight L = light_set.lights[i];
-    vec3 wi;
-    vec3 e = light_incident(L, p, wi);
-    float nl = dot(n, wi);
-    if (nl <= 0.0f) continue;
-    vec3 lo = brdf(n, v, wi, alb.rgb, alb.a, is_virtual ? nrm.w : 1.0f, is_virtual) * e * nl;
-    lamps += lo;
-    if (L.direction_real.w > 0.5f) real_lamps += lo;
+  // Spelled out over the 8 private copies (a loop indexing the uniform array gathered each
+  // light's values lane by lane on lavapipe: MRGI_UNIFORM_COPIES).
+#define MRGI_SHADE_LAMP(L, K) \
+  if (K < count) { \
+    vec3 wi; \
+    vec3 e = light_incident(L, p, wi); \
+    float nl = dot(n, wi); \
+    if (nl > 0.0f) { \
+      vec3 lo = brdf(n, v, wi, alb.rgb, alb.a, is_virtual ? nrm.w : 1.0f, is_virtual) * e * nl; \
+      lamps += lo; \
+      if (L.direction_real.w > 0.5f) real_lamps += lo; \
+    } \
   }
+  MRGI_SHADE_LAMP(lamp0, 0) MRGI_SHADE_LAMP(lamp1, 1) MRGI_SHADE_LAMP(lamp2, 2) MRGI_SHADE_LAMP(lamp3, 3)
+  MRGI_SHADE_LAMP(lamp4, 4) MRGI_SHADE_LAMP(lamp5, 5) MRGI_SHADE_LAMP(lamp6, 6) MRGI_SHADE_LAMP(lamp7, 7)
+#undef MRGI_SHADE_LAMP
   vec3 l_rv, l_r;
   if (is_virtual) {
     vec3 e = ambient_irradiance(ambient_rv, n);
