@@ -10,16 +10,18 @@
 #include "gi/rsm.h"
 #include "gpu/pipelines.h"
 #include "light/light_stage.h"
+#include "technique/baseline/baseline.h"
 #include "technique/scene_gpu.h"
 
 namespace mrgi::technique {
 
-const std::array<DlpvLevel, 4>& dlpv_levels() {
-  static const std::array<DlpvLevel, 4> levels = {{
-      {"paper", 32, 32, 512, 4, true, 1.0f},
-      {"medium", 16, 16, 256, 2, true, 1.0f},
-      {"fast", 8, 8, 128, 1, false, 0.75f},
-      {"fastest", 8, 4, 64, 1, false, 0.5f},
+const std::array<DlpvLevel, 5>& dlpv_levels() {
+  static const std::array<DlpvLevel, 5> levels = {{
+      {"paper", 32, 32, 512, 4, true, 1.0f, true, 0},
+      {"high", 32, 32, 512, 4, true, 1.0f, false, 0},
+      {"medium", 16, 16, 256, 2, true, 1.0f, false, 1},
+      {"fast", 8, 8, 128, 1, false, 0.75f, false, 2},
+      {"fastest", 8, 4, 64, 1, false, 0.5f, false, 3},
   }};
   return levels;
 }
@@ -35,7 +37,10 @@ std::vector<QualityLevel> dlpv_ladder() {
                {"rsm_size", double(l.rsm_size), "texels per side of each reflective shadow map"},
                {"rsm_lamps", double(l.rsm_lamps), "real lamps, strongest first, with a map pair"},
                {"rho_volume", l.rho_volume ? 1.0 : 0.0, "1: V^rho propagated for the virtual pixels"},
-               {"internal_scale", double(l.internal_scale), "fraction of the output width and height"}};
+               {"internal_scale", double(l.internal_scale), "fraction of the output width and height"},
+               {"antiradiance_shadows", l.antiradiance_shadows ? 1.0 : 0.0,
+                "1: shadows as the volume's antiradiance (Algorithm 1); 0: baseline's shadow maps"},
+               {"baseline_level", double(l.baseline_level), "baseline's level for the shadow maps"}};
     out.push_back(q);
   }
   return out;
@@ -69,7 +74,8 @@ class Dlpv final : public Technique {
   gpu::BufferHandle lights_;  // shader::LightSet, one per frame slot
   std::optional<gi::ReflectiveShadowMaps> rsm_;
   std::optional<gi::LightPropagationVolume> delta_, rho_;
-  gpu::PipelineHandle merge_;
+  gpu::PipelineHandle merge_, add_indirect_;
+  std::unique_ptr<Technique> baseline_;  // direct light with shadow maps (not antiradiance levels)
   bool has_virtual_ = false;
   glm::vec3 centre_{0.0f};
   float side_ = 1.0f;
@@ -119,6 +125,12 @@ Status Dlpv::init() {
   auto merge = gpu::load_compute_pipeline(*shared_.context, "dlpv/merge.comp", {});
   if (!merge) return merge.error();
   merge_ = std::move(*merge);
+  auto add = gpu::load_compute_pipeline(*shared_.context, "dlpv/add_indirect.comp", {});
+  if (!add) return add.error();
+  add_indirect_ = std::move(*add);
+  auto base = create_baseline(shared_);
+  if (!base) return base.error();
+  baseline_ = std::move(*base);
   return ok_status();
 }
 
@@ -155,6 +167,13 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
                                          std::to_string(dlpv_levels().size() - 1));
   const DlpvLevel& level = dlpv_levels()[size_t(info.level)];
   gpu::FrameGraph& graph = *shared_.graph;
+  const bool antiradiance = level.antiradiance_shadows;
+  if (!antiradiance) {
+    // Direct light and its shadows: baseline's passes at the matching level write both solutions.
+    FrameInfo base = info;
+    base.level = level.baseline_level;
+    MRGI_TRY(baseline_->record(base, skipped));
+  }
   write_lights();
   const light::Lighting& lighting = shared_.light_stage->lighting();
   bool delta_present = false, rho_present = false;
@@ -196,7 +215,8 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
       if (level.rho_volume) rho_->add_inject(graph, "rho " + id, rho_map, view->lpv, gi::InjectKind::Indirect, 1.0f);
       rsm_->add_draw(graph, "mu " + id, *view, gi::RsmMap::RealOnly, level.rsm_size);
       delta_->add_inject(graph, "mu " + id, mu_map, view->lpv, gi::InjectKind::Indirect, -1.0f);
-      delta_->add_inject(graph, "blocked direct " + id, mu_map, view->lpv, gi::InjectKind::Direct, -1.0f, &rho_map);
+      if (antiradiance)
+        delta_->add_inject(graph, "blocked direct " + id, mu_map, view->lpv, gi::InjectKind::Direct, -1.0f, &rho_map);
       ++lamps;
     }
     if (lamps == 0) {
@@ -221,6 +241,33 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   const VkSampler nearest = ctx.samplers().nearest_clamp, linear = ctx.samplers().linear_clamp;
   const gpu::ImageHandle dvol[3] = {delta_->accumulated(0), delta_->accumulated(1), delta_->accumulated(2)};
   const gpu::ImageHandle rvol[3] = {rho_->accumulated(0), rho_->accumulated(1), rho_->accumulated(2)};
+  if (!antiradiance) {
+    if (!delta_present && !rho_present) return ok_status();  // baseline's solutions as they are
+    const gpu::Pipeline* add = &*add_indirect_;
+    graph.add_shader_pass(
+        "dlpv add indirect", gpu::PassKind::Compute, *add_indirect_,
+        [&, nearest, linear](gpu::ShaderPassBuilder& b) {
+          b.bind("FrameUbo", r.frame_constants);
+          b.bind_sampled("real_position", r.real_position, nearest);
+          b.bind_sampled("real_normal", r.real_normal, nearest);
+          b.bind_sampled("real_albedo", r.real_albedo, nearest);
+          b.bind_sampled("virtual_position", r.virtual_position, nearest);
+          b.bind_sampled("virtual_normal", r.virtual_normal, nearest);
+          b.bind_sampled("virtual_albedo", r.virtual_albedo, nearest);
+          const char* d[3] = {"delta_r", "delta_g", "delta_b"};
+          const char* p[3] = {"rho_r", "rho_g", "rho_b"};
+          for (int c = 0; c < 3; ++c) {
+            b.bind_sampled(d[c], dvol[c], linear);
+            b.bind_sampled(p[c], rvol[c], linear);
+          }
+          b.bind("lit_rv", r.lit_rv);
+        },
+        [add, push, lit = r.lit_rv](VkCommandBuffer cmd, gpu::PassContext& p) {
+          const VkExtent2D e = p.extent(lit);
+          gpu::push_and_dispatch(cmd, *add, &push, sizeof push, {(e.width + 7) / 8, (e.height + 7) / 8, 1});
+        });
+    return ok_status();
+  }
   graph.add_shader_pass(
       "dlpv merge", gpu::PassKind::Compute, *merge_,
       [&, nearest, linear](gpu::ShaderPassBuilder& b) {

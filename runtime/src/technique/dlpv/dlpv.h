@@ -7,11 +7,15 @@
 // for the virtual pixels' bounce light.
 //
 // Quality ladder (best first; DlpvLevel below, with units):
-//   level    volume  steps  RSM    RSM lamps  V^rho  internal scale
-//   paper    32^3    32     512^2  4          yes    1.0     the paper's settings (Sec. 5)
-//   medium   16^3    16     256^2  2          yes    1.0
-//   fast      8^3     8     128^2  1          no     0.75    the reduced-volume fast path
-//   fastest   8^3     4      64^2  1          no     0.5
+//   level    volume  steps  RSM    RSM lamps  V^rho  internal scale  shadows
+//   paper    32^3    32     512^2  4          yes    1.0             antiradiance (Algorithm 1)
+//   high     32^3    32     512^2  4          yes    1.0             baseline high's shadow maps
+//   medium   16^3    16     256^2  2          yes    1.0             baseline medium's
+//   fast      8^3     8     128^2  1          no     0.75            baseline low's (the reduced-volume fast path)
+//   fastest   8^3     4      64^2  1          no     0.5             baseline lowest's
+// "paper" is the published method with its settings (Sec. 5); the others keep its volume and
+// light the scene directly with shadow maps (Sec. 7's alternative), because the antiradiance
+// shadow is coarse (a 32^3 volume over twice the object) and cut off where the volume ends.
 //
 // Where mrgi differs from the paper and why:
 //   - the propagation gathers with exact face solid angles and damps negative flux by the
@@ -39,8 +43,13 @@ struct DlpvLevel {
   uint32_t rsm_lamps;      // real lamps (strongest first) with a map pair; others light directly
   bool rho_volume;         // V^rho for the virtual pixels' bounce light
   float internal_scale;    // fraction of the output width and height
+  // true: the paper's Algorithm 1, shadows as the volume's antiradiance (blocked direct light
+  // injected). false: direct light with baseline's shadow maps (this baseline level), the volume
+  // carrying the bounce light's change only (the paper's Sec. 7 alternative).
+  bool antiradiance_shadows;
+  int baseline_level;      // baseline's level for the shadow maps (when not antiradiance)
 };
-const std::array<DlpvLevel, 4>& dlpv_levels();
+const std::array<DlpvLevel, 5>& dlpv_levels();
 
 std::vector<QualityLevel> dlpv_ladder();
 Expected<std::unique_ptr<Technique>> create_dlpv(const SharedResources& shared);

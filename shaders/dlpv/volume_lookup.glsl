@@ -1,0 +1,18 @@
+// The irradiance a dlpv volume gives a surface (merge.comp, add_indirect.comp): needs the
+// including shader's `volume` (VolumeConstants: grid, extent) and shared/lpv_math.h.
+#ifndef MRGI_DLPV_VOLUME_LOOKUP_GLSL
+#define MRGI_DLPV_VOLUME_LOOKUP_GLSL
+
+// Irradiance from a volume's accumulated intensity at p for normal n, per channel; 0 outside.
+vec3 volume_irradiance(sampler3D r, sampler3D g, sampler3D b, vec3 p, vec3 n) {
+  vec3 cellf = (p - volume.grid.xyz) / volume.grid.w;  // in cells
+  if (any(lessThan(cellf, vec3(0.0f))) || any(greaterThan(cellf, vec3(volume.extent.y)))) return vec3(0.0f);
+  // The used corner of the allocation; clamped half a cell inside it so the trilinear filter
+  // never reads a cell beyond the used size (stale: this level did not write it).
+  vec3 uvw = clamp(cellf, vec3(0.5f), vec3(volume.extent.y - 0.5f)) / volume.extent.x;
+  return vec3(lpv_irradiance(textureLod(r, uvw, 0.0f), n, volume.grid.w),
+              lpv_irradiance(textureLod(g, uvw, 0.0f), n, volume.grid.w),
+              lpv_irradiance(textureLod(b, uvw, 0.0f), n, volume.grid.w));
+}
+
+#endif  // MRGI_DLPV_VOLUME_LOOKUP_GLSL
