@@ -19,17 +19,6 @@ struct Options {
   std::string out;
 };
 
-void write_file(const std::string& path, const std::string& text) {
-  const std::string partial = path + ".partial";
-  {
-    std::ofstream f(partial);
-    f << text;
-    if (!f) throw CommandFailure(1, partial + ": cannot write");
-  }
-  if (std::rename(partial.c_str(), path.c_str()) != 0)
-    throw CommandFailure(1, path + ": cannot move the finished file into place");
-}
-
 void run(Options o) {
   perf::ensure_lp_num_threads();
   o.settings.level = resolve_level(o.settings.technique, o.level);
@@ -40,8 +29,8 @@ void run(Options o) {
   std::cout << md;
   if (!o.out.empty()) {
     std::filesystem::create_directories(o.out);
-    write_file(o.out + "/light-family.md", md);
-    write_file(o.out + "/light-family.json", perf::light_family_json(results));
+    write_text_file(o.out + "/light-family.md", md);
+    write_text_file(o.out + "/light-family.json", perf::light_family_json(results));
   }
 }
 

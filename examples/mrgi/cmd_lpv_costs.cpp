@@ -1,7 +1,5 @@
 // mrgi lpv-costs: the light propagation volume's cost tables beside the DLPV paper's Tables 2
 // and 3 (perf/include/mrgi/perf/lpv_costs.h).
-#include <cstdio>
-#include <fstream>
 #include <iostream>
 
 #include "commands.h"
@@ -23,15 +21,7 @@ void run(const Options& o) {
   }));
   const std::string md = perf::lpv_costs_markdown(c);
   std::cout << md;
-  if (o.out.empty()) return;
-  const std::string partial = o.out + ".partial";
-  {
-    std::ofstream f(partial);
-    f << md;
-    if (!f) throw CommandFailure(1, partial + ": cannot write");
-  }
-  if (std::rename(partial.c_str(), o.out.c_str()) != 0)
-    throw CommandFailure(1, o.out + ": cannot move the finished file into place");
+  if (!o.out.empty()) write_text_file(o.out, md);
 }
 
 void setup(CLI::App& app) {

@@ -1,7 +1,6 @@
 // mrgi peaks: this machine's multiply-add throughput, copy bandwidth and scattered image-load
 // rate as a Vulkan compute device (perf/include/mrgi/perf/peaks.h), beside the floor pass, in
 // Markdown on stdout (or JSON with --json); --out writes the Markdown to a file as well.
-#include <fstream>
 #include <iostream>
 
 #include <nlohmann/json.hpp>
@@ -23,16 +22,7 @@ void run_peaks(const PeaksOptions& o) {
   perf::ensure_lp_num_threads();  // before any Vulkan instance: lavapipe reads it then
   const perf::Peaks p = take(perf::measure_peaks(o.settings));
   const std::string md = perf::peaks_markdown(p);
-  if (!o.out.empty()) {
-    const std::string partial = o.out + ".partial";
-    {
-      std::ofstream f(partial);
-      f << md;
-      if (!f) throw CommandFailure(1, partial + ": cannot write");
-    }
-    if (std::rename(partial.c_str(), o.out.c_str()) != 0)
-      throw CommandFailure(1, o.out + ": cannot move the finished file into place");
-  }
+  if (!o.out.empty()) write_text_file(o.out, md);
   if (!o.json) {
     std::cout << md;
     return;

@@ -27,6 +27,10 @@ struct CommandFailure : std::runtime_error {
   CommandFailure(int code, const std::string& message) : std::runtime_error(message), exit_code(code) {}
 };
 
+// Writes `text` to PATH.partial and renames it to `path` when complete, so a failed or
+// interrupted run never leaves a half-written file under the final name (CommandFailure, exit 1).
+void write_text_file(const std::string& path, const std::string& text);
+
 // Exit code for an error kind: BadUsage -> 2, everything else -> 1.
 int exit_code_for(ErrorKind kind);
 [[noreturn]] void fail_with(const Error& error);

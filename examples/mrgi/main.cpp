@@ -8,6 +8,9 @@
 #include <map>
 
 #include "commands.h"
+
+#include <cstdio>
+#include <fstream>
 #include "mrgi/runtime.h"
 
 namespace mrgi::tool {
@@ -19,6 +22,17 @@ std::map<std::string, CommandSetup>& registry() {
 }  // namespace
 
 CommandRegistrar::CommandRegistrar(const char* name, CommandSetup setup) { registry()[name] = setup; }
+
+void write_text_file(const std::string& path, const std::string& text) {
+  const std::string partial = path + ".partial";
+  {
+    std::ofstream f(partial);
+    f << text;
+    if (!f) throw CommandFailure(1, partial + ": cannot write");
+  }
+  if (std::rename(partial.c_str(), path.c_str()) != 0)
+    throw CommandFailure(1, path + ": cannot move the finished file into place");
+}
 
 int exit_code_for(ErrorKind kind) { return kind == ErrorKind::BadUsage ? 2 : 1; }
 

@@ -42,7 +42,7 @@ Expected<std::vector<DeviceInfo>> list_devices(const DeviceSettings& settings);
 // Level "last" in the CLI resolves to technique_level_count(name) - 1.
 struct RuntimeSettings {
   DeviceSettings device;
-  std::string technique = "baseline";  // baseline | ssrt (later: dir, dlpv, dvct, specular)
+  std::string technique = "baseline";  // baseline | ssrt | dlpv (later: dir, dvct, specular)
   int level = 0;                       // 0 = the technique's best quality
   int output_width = 0;                // 0 = the colour camera's width
   int output_height = 0;

@@ -241,26 +241,30 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   const VkSampler nearest = ctx.samplers().nearest_clamp, linear = ctx.samplers().linear_clamp;
   const gpu::ImageHandle dvol[3] = {delta_->accumulated(0), delta_->accumulated(1), delta_->accumulated(2)};
   const gpu::ImageHandle rvol[3] = {rho_->accumulated(0), rho_->accumulated(1), rho_->accumulated(2)};
+  // What both shading passes (add_indirect.comp, merge.comp) declare alike.
+  auto bind_common = [&](gpu::ShaderPassBuilder& b) {
+    b.bind("FrameUbo", r.frame_constants);
+    b.bind_sampled("real_position", r.real_position, nearest);
+    b.bind_sampled("real_normal", r.real_normal, nearest);
+    b.bind_sampled("real_albedo", r.real_albedo, nearest);
+    b.bind_sampled("virtual_position", r.virtual_position, nearest);
+    b.bind_sampled("virtual_normal", r.virtual_normal, nearest);
+    b.bind_sampled("virtual_albedo", r.virtual_albedo, nearest);
+    const char* d[3] = {"delta_r", "delta_g", "delta_b"};
+    const char* p[3] = {"rho_r", "rho_g", "rho_b"};
+    for (int c = 0; c < 3; ++c) {
+      b.bind_sampled(d[c], dvol[c], linear);
+      b.bind_sampled(p[c], rvol[c], linear);
+    }
+    b.bind("lit_rv", r.lit_rv);
+  };
   if (!antiradiance) {
     if (!delta_present && !rho_present) return ok_status();  // baseline's solutions as they are
     const gpu::Pipeline* add = &*add_indirect_;
     graph.add_shader_pass(
         "dlpv add indirect", gpu::PassKind::Compute, *add_indirect_,
-        [&, nearest, linear](gpu::ShaderPassBuilder& b) {
-          b.bind("FrameUbo", r.frame_constants);
-          b.bind_sampled("real_position", r.real_position, nearest);
-          b.bind_sampled("real_normal", r.real_normal, nearest);
-          b.bind_sampled("real_albedo", r.real_albedo, nearest);
-          b.bind_sampled("virtual_position", r.virtual_position, nearest);
-          b.bind_sampled("virtual_normal", r.virtual_normal, nearest);
-          b.bind_sampled("virtual_albedo", r.virtual_albedo, nearest);
-          const char* d[3] = {"delta_r", "delta_g", "delta_b"};
-          const char* p[3] = {"rho_r", "rho_g", "rho_b"};
-          for (int c = 0; c < 3; ++c) {
-            b.bind_sampled(d[c], dvol[c], linear);
-            b.bind_sampled(p[c], rvol[c], linear);
-          }
-          b.bind("lit_rv", r.lit_rv);
+        [&](gpu::ShaderPassBuilder& b) {
+          bind_common(b);
         },
         [add, push, lit = r.lit_rv](VkCommandBuffer cmd, gpu::PassContext& p) {
           const VkExtent2D e = p.extent(lit);
@@ -270,23 +274,10 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   }
   graph.add_shader_pass(
       "dlpv merge", gpu::PassKind::Compute, *merge_,
-      [&, nearest, linear](gpu::ShaderPassBuilder& b) {
-        b.bind("FrameUbo", r.frame_constants);
+      [&](gpu::ShaderPassBuilder& b) {
+        bind_common(b);
         b.bind("LightUbo", lights_);
-        b.bind_sampled("real_position", r.real_position, nearest);
-        b.bind_sampled("real_normal", r.real_normal, nearest);
-        b.bind_sampled("real_albedo", r.real_albedo, nearest);
-        b.bind_sampled("virtual_position", r.virtual_position, nearest);
-        b.bind_sampled("virtual_normal", r.virtual_normal, nearest);
-        b.bind_sampled("virtual_albedo", r.virtual_albedo, nearest);
         b.bind_sampled("virtual_emission", r.virtual_emission.valid() ? r.virtual_emission : r.virtual_albedo, nearest);
-        const char* d[3] = {"delta_r", "delta_g", "delta_b"};
-        const char* p[3] = {"rho_r", "rho_g", "rho_b"};
-        for (int c = 0; c < 3; ++c) {
-          b.bind_sampled(d[c], dvol[c], linear);
-          b.bind_sampled(p[c], rvol[c], linear);
-        }
-        b.bind("lit_rv", r.lit_rv);
         b.bind("lit_r", r.lit_r);
       },
       [merge, push, lit = r.lit_rv](VkCommandBuffer cmd, gpu::PassContext& p) {
