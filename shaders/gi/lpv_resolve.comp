@@ -11,7 +11,7 @@ layout(set = 0, binding = 4, rgba32f) uniform writeonly image3D sum_r;
 layout(set = 0, binding = 5, rgba32f) uniform writeonly image3D sum_g;
 layout(set = 0, binding = 6, rgba32f) uniform writeonly image3D sum_b;
 layout(push_constant) uniform ResolveParams {
-  ivec4 cells_per_side;  // x
+  ivec4 cells_per_side;  // x: used, y: allocated
 } params_block;
 
 vec4 load4(int base) {
@@ -21,8 +21,20 @@ vec4 load4(int base) {
 
 void main() {
   const int n = params_block.cells_per_side.x;  // copied first: MRGI_UNIFORM_COPIES
+  const int allocated = params_block.cells_per_side.y;
   const ivec3 c = ivec3(gl_GlobalInvocationID);
-  if (any(greaterThanEqual(c, ivec3(n)))) return;
+  if (any(greaterThan(c, ivec3(n)))) return;
+  if (any(equal(c, ivec3(n)))) {
+    // The layer of cells just past the used corner: a trilinear lookup at the last used cell's
+    // centre gives them weight 0, and 0 x NaN is NaN, so they must hold finite values, whatever
+    // the memory held before (nothing else writes them while this size is in use).
+    if (n < allocated) {
+      imageStore(sum_r, c, vec4(0.0));
+      imageStore(sum_g, c, vec4(0.0));
+      imageStore(sum_b, c, vec4(0.0));
+    }
+    return;
+  }
   const int base = ((c.z * n + c.y) * n + c.x) * 12;
   const vec4 r = load4(base), g = load4(base + 4), b = load4(base + 8);
   imageStore(step_r, c, r);

@@ -85,4 +85,24 @@ inline ReplayResult replay_capture(const std::string& path, const std::string& t
   return g;
 }
 
+// Every frame of `capture` through a runtime made with `s`, outputs in `outs` (fatal failures
+// through gtest: check HasFatalFailure() after).
+inline void run_every_frame(CaptureReader& capture, const RuntimeSettings& s, std::vector<FrameOutput>& outs) {
+  const CaptureInfo& info = capture.info();
+  auto rt = create_runtime(s, CameraSetup{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera},
+                           *capture.scene());
+  ASSERT_TRUE(rt.ok()) << rt.error().message;
+  for (size_t i = 0; i < capture.frame_count(); ++i) {
+    auto f = capture.read_frame(i);
+    ASSERT_TRUE(f.ok());
+    f->index = int64_t(i);
+    auto o = (*rt)->process(*f);
+    ASSERT_TRUE(o.ok()) << o.error().message;
+    for (auto& x : *o) outs.push_back(std::move(x));
+  }
+  auto rest = (*rt)->flush();
+  ASSERT_TRUE(rest.ok()) << rest.error().message;
+  for (auto& x : *rest) outs.push_back(std::move(x));
+}
+
 }  // namespace mrgi::test

@@ -33,24 +33,6 @@ double median(std::vector<double> v) {
 
 // Every frame of `capture` through a runtime made with `s` (validation layers as `s` says), the
 // outputs in frame order as they come back.
-void run_every_frame(CaptureReader& capture, const RuntimeSettings& s, std::vector<FrameOutput>& outs) {
-  const CaptureInfo& info = capture.info();
-  auto rt = create_runtime(s, CameraSetup{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera},
-                           *capture.scene());
-  ASSERT_TRUE(rt.ok()) << rt.error().message;
-  for (size_t i = 0; i < capture.frame_count(); ++i) {
-    auto f = capture.read_frame(i);
-    ASSERT_TRUE(f.ok());
-    f->index = int64_t(i);
-    auto o = (*rt)->process(*f);
-    ASSERT_TRUE(o.ok()) << o.error().message;
-    for (auto& x : *o) outs.push_back(std::move(x));
-  }
-  auto rest = (*rt)->flush();
-  ASSERT_TRUE(rest.ok()) << rest.error().message;
-  for (auto& x : *rest) outs.push_back(std::move(x));
-}
-
 TEST(GoldenSsrt, EnvFisheyeLightDirectionAndRdeBeatBaseline) {
   const test::ReplayResult lit = test::replay_capture(kCapture, "baseline", 0);
   ASSERT_TRUE(lit.any && lit.pooled.all.rde_defined);
@@ -93,7 +75,7 @@ TEST(GoldenSsrt, FirstFrameIsPrimedOnceAndEveryFrameGivesOneOutput) {
     s.technique = technique;
     s.level = 3;
     std::vector<FrameOutput> outs;
-    run_every_frame(*capture, s, outs);
+    test::run_every_frame(*capture, s, outs);
     if (HasFatalFailure()) return;
     ASSERT_EQ(outs.size(), capture->frame_count()) << technique;
     int primed = 0;
@@ -126,7 +108,7 @@ TEST(GoldenSsrt, FusedComposeMatchesTheComposePass) {
     s.technique = "ssrt";
     s.level = 2;  // fast: 4x4 cells, tiled shade
     s.fuse_compose = fused == 1;
-    run_every_frame(*capture, s, runs[fused]);
+    test::run_every_frame(*capture, s, runs[fused]);
     if (HasFatalFailure()) return;
     ASSERT_EQ(runs[fused].size(), capture->frame_count());
   }

@@ -34,6 +34,11 @@ struct DeviceSettings {
   // in every frame (lavapipe: 2.2x faster frames; gpu/context.cpp keep_freed_memory). Costs the
   // process its peak heap for its life. Set false where the host application tunes malloc itself.
   bool keep_freed_memory = true;
+  // Debugging: every new allocation the host can see (all of them on lavapipe) is filled with
+  // 0xff bytes (NaN as floats) instead of what the allocator had (zero pages in a fresh process,
+  // an earlier runtime's data later), so a pass that reads memory nothing wrote this frame
+  // changes the output every time instead of once in a while. Also on with MRGI_POISON_MEMORY=1.
+  bool poison_memory = false;
 };
 
 // Lists the Vulkan devices and marks the one `settings` would pick.
@@ -59,6 +64,12 @@ struct RuntimeSettings {
   // the same formula (mrgi_shared.h compose_encoded); the outputs agree to 1/255 (the fused
   // path keeps the solutions in 32-bit floats, compose reads them from RGBA16F images).
   bool fuse_compose = true;
+  // For a technique that lists no tiles of its own: compose lists the 8 x 8 output tiles where
+  // the composite can move a pixel by more than half an 8-bit level from the camera's (any
+  // technique's solutions, shaders/compose/tile_classify.comp) and composites only those, the
+  // camera frame elsewhere (baseline lowest on desk_spot: compose 10.8 ms -> see
+  // perf/results). false: every pixel composited; the outputs agree to 1/255.
+  bool compose_tiles = true;
   // Profiling mode (also Runtime::set_profiling): each pass of a frame submitted on its own and
   // waited for, timed by the host clock, so FrameStats::passes add up to the frame. Frames then
   // do not overlap: use it to see where the time goes (bench, scheduler cost model), not to run.

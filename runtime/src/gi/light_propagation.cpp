@@ -137,7 +137,7 @@ void LightPropagationVolume::add_propagate(gpu::FrameGraph& graph, uint32_t step
   // each) instead of as 2 + steps graph passes (the paper's Table 3 goes to 256 steps; per-pass
   // bookkeeping and, in profiling mode, one submission per pass would dominate). The steps'
   // descriptors are pushed by the names the shaders declare (bindings_, looked up at create()).
-  const uint32_t n = cells();
+  const uint32_t n = cells(), alloc = settings_.resolution;
   const VoxelVolume* vols[2] = {&*steps_[0], &*steps_[1]};
   const VoxelVolume* sum = &*sum_;
   const gpu::BufferHandle cells = cells_;
@@ -172,8 +172,8 @@ void LightPropagationVolume::add_propagate(gpu::FrameGraph& graph, uint32_t step
           rp.storage_image(bind.resolve_sum[c], p.view(sum->image(c)));
         }
         rp.push(ctx, cmd, *resolve);
-        const ResolvePush rpush{glm::ivec4(int(n), 0, 0, 0)};
-        gpu::push_and_dispatch(cmd, *resolve, &rpush, sizeof rpush, groups_3d(n));
+        const ResolvePush rpush{glm::ivec4(int(n), int(alloc), 0, 0)};
+        gpu::push_and_dispatch(cmd, *resolve, &rpush, sizeof rpush, groups_3d(n + 1));  // + the border
         if (steps == 0) return;
         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, propagate->pipeline);
         for (uint32_t i = 0; i < steps; ++i) {

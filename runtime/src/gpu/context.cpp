@@ -223,6 +223,8 @@ Expected<std::unique_ptr<Context>> Context::create(const DeviceSettings& setting
 
 Status Context::init(const DeviceSettings& settings) {
   validate_ = settings.validate;
+  const char* poison_env = std::getenv("MRGI_POISON_MEMORY");
+  poison_memory_ = settings.poison_memory || (poison_env != nullptr && std::string(poison_env) == "1");
   VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
   mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
   mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
@@ -477,6 +479,14 @@ Expected<VkDeviceMemory> Context::allocate(const VkMemoryRequirements& req, Memo
   ai.memoryTypeIndex = uint32_t(best);
   VkDeviceMemory memory = VK_NULL_HANDLE;
   VK_CHECK(vkAllocateMemory(device_, &ai, nullptr, &memory));
+  // DeviceSettings::poison_memory: 0xff bytes (NaN as floats, 0xffffffff as indices).
+  if (poison_memory_ && (memory_properties_.memoryTypes[best].propertyFlags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT)) {
+    void* p = nullptr;
+    if (vkMapMemory(device_, memory, 0, VK_WHOLE_SIZE, 0, &p) == VK_SUCCESS) {
+      std::memset(p, 0xff, size_t(req.size));
+      vkUnmapMemory(device_, memory);
+    }
+  }
   allocated_bytes_ += req.size;
   ++allocation_count_;
   return memory;

@@ -174,6 +174,7 @@ class Context {
   DeviceFunctions fn_;
   PFN_vkSetDebugUtilsObjectNameEXT set_object_name_ = nullptr;
   bool validate_ = false;
+  bool poison_memory_ = false;  // DeviceSettings::poison_memory
   bool image_float_atomic_add_ = false;
   uint64_t allocated_bytes_ = 0;
   uint64_t allocation_count_ = 0;
