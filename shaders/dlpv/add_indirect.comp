@@ -32,7 +32,9 @@ struct VolumeConstants {
   vec4 grid;    // xyz: the volumes' min corner (m); w: cell size (m)
   vec4 extent;  // x: cells allocated per side; y: cells used; z: 1 = V^Delta present; w: 1 = V^rho
 };
-layout(push_constant) uniform Volume { VolumeConstants volume_block; };
+// rect: the internal pixels [x0, x1) x [y0, y1) the volume's box covers (technique/
+// screen_bounds.h); nothing outside it receives light from the volume, so it is not dispatched.
+layout(push_constant) uniform Volume { VolumeConstants volume_block; ivec4 rect_block; };
 VolumeConstants volume;
 
 #include "dlpv/volume_lookup.glsl"
@@ -40,8 +42,8 @@ VolumeConstants volume;
 void main() {
   frame = frame_ubo;  // MRGI_UNIFORM_COPIES
   volume = volume_block;
-  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
-  if (any(greaterThanEqual(pixel, frame.internal_output_size.xy))) return;
+  ivec2 pixel = rect_block.xy + ivec2(gl_GlobalInvocationID.xy);
+  if (any(greaterThanEqual(pixel, min(rect_block.zw, frame.internal_output_size.xy)))) return;
   vec4 vpos = texelFetch(virtual_position, pixel, 0);
   bool is_virtual = vpos.w > 0.5f;
   vec3 add;

@@ -268,6 +268,27 @@ MRGI_FN vec3 compose_encoded(vec3 camera_linear, vec3 l_r, vec3 l_rv, float virt
   return srgb_encode(clamp(finite3(out_linear), vec3(0.0f), vec3(1.0f)));
 }
 
+// Whether a real pixel whose tone-mapped solutions are tm_r, tm_rv (l * exposure clipped to
+// [0, 1], as compose_encoded makes them) composes to the camera's 8-bit value within
+// `tolerance` levels, for any camera value (compose's tile classifier, shaders/compose/
+// tile_classify.comp). The composite moves the linear camera value c by alpha |tm_rv - tm_r|.
+// Where tm_r >= 2 eps, alpha <= c / tm_r (the clamp at alpha_max only lowers it), so the move is
+// at most c r with r = |d| / tm_r, and the sRGB-encoded value's at most 255 max(x srgb'(x)) r =
+// 112.1 r (at x = 1: 1.055 / 2.4 x^(1 / 2.4); the linear segment's 12.92 x is smaller). Below
+// 2 eps alpha <= alpha_max (>= 1), the move is at most alpha_max |d| in linear terms and the
+// encoded value's at most 255 * 12.92 times that (the largest slope of the sRGB curve). A
+// bilinear mix of such texels (positive weights) stays within the largest of their bounds.
+MRGI_FN bool compose_channel_invisible(float tm_r, float tm_rv, float eps, float alpha_max, float tolerance) {
+  float d = abs(tm_rv - tm_r);
+  if (tm_r >= 2.0f * eps) return 112.1f * d <= tolerance * tm_r;
+  return 255.0f * 12.92f * max(alpha_max, 1.0f) * d <= tolerance;
+}
+MRGI_FN bool compose_tile_invisible(vec3 tm_r, vec3 tm_rv, float eps, float alpha_max, float tolerance) {
+  return compose_channel_invisible(tm_r.x, tm_rv.x, eps, alpha_max, tolerance) &&
+         compose_channel_invisible(tm_r.y, tm_rv.y, eps, alpha_max, tolerance) &&
+         compose_channel_invisible(tm_r.z, tm_rv.z, eps, alpha_max, tolerance);
+}
+
 #ifdef __cplusplus
 }  // namespace mrgi::shader
 #undef MRGI_FN

@@ -10,9 +10,12 @@
 // in shadows, shading or compositing fails while lavapipe's rasterisation differences do not.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 
 #include "common/replay_capture.h"
+#include "mrgi/platform/capture.h"
 #include "mrgi/runtime.h"
 
 namespace mrgi {
@@ -47,6 +50,60 @@ TEST(GoldenBaseline, EveryLevelBeatsTheUntouchedCameraFrame) {
     EXPECT_LT(g.pooled.real.rde, b.real) << "level " << level;
     EXPECT_LT(g.pooled.virtual_.rde, b.virtual_) << "level " << level;
     EXPECT_GT(g.pooled.all.ssim, 0.8) << "level " << level;
+  }
+}
+
+// Compose's tile classifier (RuntimeSettings::compose_tiles, shaders/compose/tile_classify.comp):
+// composing only the tiles whose composite can move a pixel by more than half a level must give
+// the frames of composing every pixel to 1/255, at the output's resolution (level 0) and below
+// it (level 3: solutions at half size, resampled), for baseline and for dlpv (whose indirect
+// pass changes real pixels away from the shadows). Validation layers on.
+TEST(GoldenBaseline, ComposeTilesMatchComposingEveryPixel) {
+  auto capture = CaptureReader::open(kCapture);
+  ASSERT_TRUE(capture.ok()) << capture.error().message;
+  const struct {
+    const char* technique;
+    int level;
+  } runs[] = {{"baseline", 0}, {"baseline", 3}, {"dlpv", 2}, {"dlpv", 3}};
+  for (const auto& run : runs) {
+    std::vector<FrameOutput> outs[2];
+    for (int tiles = 0; tiles < 2; ++tiles) {
+      RuntimeSettings s;
+      s.device.validate = true;
+      s.technique = run.technique;
+      s.level = run.level;
+      s.compose_tiles = tiles == 1;
+      test::run_every_frame(*capture, s, outs[tiles]);
+      if (HasFatalFailure()) return;
+      ASSERT_EQ(outs[tiles].size(), capture->frame_count());
+    }
+    size_t differing = 0, changed = 0, total = 0;
+    for (size_t i = 0; i < outs[0].size(); ++i) {
+      const FrameOutput& a = outs[0][i];
+      const FrameOutput& b = outs[1][i];
+      ASSERT_EQ(a.image.data.size(), b.image.data.size());
+      EXPECT_EQ(a.virtual_mask.data, b.virtual_mask.data) << run.technique << " frame " << i;
+      auto camera = capture->read_frame(i);
+      ASSERT_TRUE(camera.ok());
+      for (size_t p = 0; p < a.image.data.size() / 4; ++p) {
+        int worst = 0;
+        for (int c = 0; c < 3; ++c)
+          worst = std::max(worst, std::abs(int(a.image.data[4 * p + c]) - int(b.image.data[4 * p + c])));
+        ASSERT_LE(worst, 1) << run.technique << " level " << run.level << " frame " << i << " pixel " << p;
+        differing += worst > 0;
+        for (int c = 0; c < 3; ++c) changed += b.image.data[4 * p + c] != camera->color.data[3 * p + c] ? 1 : 0;
+        ++total;
+      }
+      bool classified = false, untiled_classified = false;
+      for (const PassTiming& t : b.stats.passes) classified |= t.name == "compose_tiles";
+      for (const PassTiming& t : a.stats.passes) untiled_classified |= t.name == "compose_tiles";
+      EXPECT_TRUE(classified) << run.technique << " frame " << i;
+      EXPECT_FALSE(untiled_classified) << run.technique << " frame " << i;
+    }
+    std::printf("%s level %d: %zu of %zu pixels 1/255 apart, %zu channels changed by the composite\n",
+                run.technique, run.level, differing, total, changed);
+    EXPECT_LT(differing, total / 50) << run.technique << " level " << run.level;
+    EXPECT_GT(changed, total / 100) << run.technique << ": the virtual object changes the frame";
   }
 }
 

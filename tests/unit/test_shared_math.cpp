@@ -289,4 +289,40 @@ TEST(SharedMath, ComposeEncodedIsTheCameraModelAroundDifferentialCompose) {
   }
 }
 
+// The tile classifier's bound (compose_tile_invisible): wherever it says a real pixel is
+// invisible, the composite is within the tolerance of the camera's 8-bit value for every camera
+// value, on a sweep over camera values, solutions (dark, mid, saturated) and changes; and a
+// plain shadow or bounce of a few per cent is never called invisible.
+TEST(SharedMath, ComposeTileInvisibleBoundsTheCompositesMove) {
+  const float eps = 1e-3f, amax = 10.0f, tol = 0.5f;
+  uint32_t state = 12345u;
+  auto uniform = [&state]() {
+    state = state * 1664525u + 1013904223u;
+    return float(state >> 8) / float(1u << 24);
+  };
+  int invisible = 0;
+  float worst = 0.0f;
+  for (int k = 0; k < 200000; ++k) {
+    // Solutions over decades (1e-5 .. 1) so the eps region and the clip at 1 both occur.
+    const float r = std::pow(10.0f, -5.0f * uniform()) * (uniform() < 0.05f ? 2.0f : 1.0f);
+    const float rel = std::pow(10.0f, -6.0f * uniform()) * (uniform() < 0.5f ? -1.0f : 1.0f);
+    const float rv = std::max(0.0f, r * (1.0f + rel));
+    const float cam = uniform();
+    const bool inv = compose_tile_invisible(vec3(std::min(r, 1.0f)), vec3(std::min(rv, 1.0f)), eps, amax, tol);
+    if (!inv) continue;
+    ++invisible;
+    const vec3 o = compose_encoded(vec3(cam), vec3(r), vec3(rv), 0.0f, 1.0f, eps, amax);
+    worst = std::max(worst, std::abs(o.x - srgb_encode1(cam)) * 255.0f);
+  }
+  EXPECT_GT(invisible, 50000) << "the sweep should exercise the invisible side";
+  EXPECT_LE(worst, tol * 1.01f) << "largest 8-bit move where the bound says invisible";
+  for (const float r : {0.01f, 0.2f, 0.9f}) {
+    EXPECT_FALSE(compose_tile_invisible(vec3(r), vec3(r * 0.97f), eps, amax, tol)) << "3% shadow at " << r;
+    EXPECT_FALSE(compose_tile_invisible(vec3(r), vec3(r * 1.02f, r, r), eps, amax, tol)) << "2% red bounce at " << r;
+  }
+  EXPECT_TRUE(compose_tile_invisible(vec3(0.3f), vec3(0.3f), eps, amax, tol));
+  EXPECT_TRUE(compose_tile_invisible(vec3(0.0f), vec3(0.0f), eps, amax, tol));
+  EXPECT_FALSE(compose_tile_invisible(vec3(0.0f), vec3(1e-4f), eps, amax, tol)) << "light on an unlit surface";
+}
+
 }  // namespace

@@ -55,6 +55,7 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
   } variants[] = {{"compose", 0, 0, 0, &c.pipeline_},
                   {"compose_same_internal", 0, 1, 0, &c.same_internal_pipeline_},
                   {"compose_tiled", 0, 1, 1, &c.tiled_pipeline_},
+                  {"compose_tiled_scaled", 0, 0, 1, &c.tiled_scaled_pipeline_},
                   {"compose_camera_only", 1, 0, 0, &c.camera_pipeline_}};
   auto no_tiles = graph.create_buffer({"compose_no_tiles", 16}, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (!no_tiles) return no_tiles.error();
@@ -69,14 +70,60 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
     if (!p) return p.error();
     *v.handle = gpu::PipelineHandle(context, std::move(*p));
   }
+  if (settings.classify_tiles) {
+    auto classify = gpu::load_compute_pipeline(context, "compose/tile_classify.comp", {});
+    if (!classify) return classify.error();
+    c.classify_pipeline_ = std::move(*classify);
+    auto state = graph.create_buffer({"compose_tile_state", 16 + VkDeviceSize(c.max_tiles_) * 4},
+                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
+                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    if (!state) return state.error();
+    c.classify_state_ = *state;
+    auto list = graph.create_buffer({"compose_tile_list", VkDeviceSize(c.max_tiles_) * 4},
+                                    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    if (!list) return list.error();
+    c.classify_list_ = *list;
+  }
   return c;
+}
+
+// The tiles of a frame whose technique listed none: reset, then tile_classify.comp over the
+// solutions' used extent.
+void Compose::record_classify(gpu::FrameGraph& graph) {
+  graph.add_pass(
+      "compose_tiles_reset", gpu::PassKind::Transfer,
+      [this](gpu::PassBuilder& b) { b.write(classify_state_, gpu::Access::TransferDst); },
+      [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
+        vkCmdFillBuffer(cmd, pass.buffer(classify_state_), 0, 4, 0u);               // x groups
+        vkCmdFillBuffer(cmd, pass.buffer(classify_state_), 4, 8, 1u);               // y, z
+        vkCmdFillBuffer(cmd, pass.buffer(classify_state_), 12, VK_WHOLE_SIZE, 0u);  // pad, flags
+      });
+  const gpu::Pipeline* pipe = &*classify_pipeline_;
+  graph.add_shader_pass(
+      "compose_tiles", gpu::PassKind::Compute, *classify_pipeline_,
+      [this](gpu::ShaderPassBuilder& b) {
+        b.bind("FrameUbo", in_.frame_constants);
+        b.bind("lit_rv", in_.lit_rv);
+        b.bind("lit_r", in_.lit_r);
+        b.bind("virtual_position", in_.virtual_position);
+        b.bind("TileState", classify_state_);
+        b.bind("TileList", classify_list_);
+      },
+      [this, pipe](VkCommandBuffer cmd, gpu::PassContext& pass) {
+        const VkExtent2D used = pass.extent(in_.lit_r);
+        const glm::vec4 push(settings_.eps, settings_.alpha_max, settings_.tile_tolerance, 0.0f);
+        gpu::push_and_dispatch(cmd, *pipe, &push, sizeof push, {(used.width + 7) / 8, (used.height + 7) / 8, 1});
+      });
+  in_.tile_args = classify_state_;
+  in_.tile_list = classify_list_;
+  in_.tiles_composed = false;
 }
 
 void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
   in_ = inputs;
-  const VkExtent2D used = graph.extent(in_.lit_r);
-  tiled_ = !in_.camera_only && in_.tile_args.valid() && in_.tile_list.valid() &&
-           used.width == width_ && used.height == height_;
+  const bool listed = in_.tile_args.valid() && in_.tile_list.valid();
+  if (!in_.camera_only && !listed && classify_state_.valid()) record_classify(graph);
+  tiled_ = !in_.camera_only && in_.tile_args.valid() && in_.tile_list.valid();
   const bool host_camera = tiled_ && same_size_as_camera_;
   slot_host_camera_[graph.slot()] = host_camera ? 1 : 0;
   const bool composed = host_camera && in_.tiles_composed;
@@ -145,7 +192,8 @@ void Compose::dispatch(VkCommandBuffer cmd, gpu::PassContext& pass, bool tiled_p
   const gpu::Context& ctx = pass.context();
   const VkExtent2D used = pass.extent(in_.lit_r);
   const bool same_internal = used.width == width_ && used.height == height_;
-  const gpu::Pipeline& pipeline = tiled_pass                         ? *tiled_pipeline_
+  const gpu::Pipeline& pipeline = tiled_pass                         ? (same_internal ? *tiled_pipeline_
+                                                                                      : *tiled_scaled_pipeline_)
                                   : (in_.camera_only || tiled_)      ? *camera_pipeline_
                                   : same_internal                    ? *same_internal_pipeline_
                                                                      : *pipeline_;

@@ -23,6 +23,13 @@ namespace mrgi::compose {
 struct ComposeSettings {
   float eps = 1e-3f;       // below this modelled real light, alpha blends to 1 (absolute delta)
   float alpha_max = 10.0f; // alpha = CI / TM(L_r) clamped to [0, alpha_max]
+  // For a technique that lists no tiles of its own (Technique::compose_tiles): compose lists the
+  // 8 x 8 output tiles whose composite can move a pixel by more than `tile_tolerance` 8-bit
+  // levels from the camera's (shaders/compose/tile_classify.comp, mrgi_shared.h
+  // compose_tile_invisible), and composites only those; the camera frame elsewhere. Off: every
+  // pixel composited (the A/B reference; outputs then differ by at most one level per channel).
+  bool classify_tiles = true;
+  float tile_tolerance = 0.5f;  // 8-bit levels; a rounding step can add one more
 };
 
 struct ComposeInputs {
@@ -85,8 +92,16 @@ class Compose {
   uint32_t width_ = 0, height_ = 0;
   ComposeInputs in_;
   gpu::BufferHandle output_, mask_;
-  // Composite (solutions resampled), composite at the solutions' own size, camera frame only.
-  gpu::PipelineHandle pipeline_, same_internal_pipeline_, camera_pipeline_, tiled_pipeline_;
+  void record_classify(gpu::FrameGraph& graph);
+
+  // Composite (solutions resampled), composite at the solutions' own size, camera frame only,
+  // and the composite over listed tiles from solutions at the output's size or resampled.
+  gpu::PipelineHandle pipeline_, same_internal_pipeline_, camera_pipeline_, tiled_pipeline_,
+      tiled_scaled_pipeline_;
+  // The tile classifier (ComposeSettings::classify_tiles): its pipeline, its state (dispatch
+  // arguments, then one flag per output tile) and its list.
+  gpu::PipelineHandle classify_pipeline_;
+  gpu::BufferHandle classify_state_, classify_list_;
   gpu::BufferHandle no_tiles_;  // bound as the tile list when there is none (never read)
   bool tiled_ = false;          // this frame: camera copy + composite over the listed tiles
   bool same_size_as_camera_ = false;

@@ -55,6 +55,10 @@ Expected<RsmView> rsm_view(const LightDesc& lamp, const glm::vec3& centre, float
     v.axis = glm::vec4(dir, 0.0f);
     v.lpv.direction_or_position = dir;
     v.lpv.positional = false;
+    // Orthographic: an error of e metres covers e / texel texels anywhere; as LodView's
+    // perspective rule with the eye far away (distance D, focal D / texel).
+    constexpr float kFar = 1.0e4f;
+    v.lod = {centre - dir * kFar, kFar / texel, 0.5f};
     return v;
   }
   const glm::vec3 to_centre = centre - lamp.position;
@@ -84,6 +88,7 @@ Expected<RsmView> rsm_view(const LightDesc& lamp, const glm::vec3& centre, float
   v.axis = glm::vec4(axis, spot ? std::cos(glm::radians(lamp.inner_angle_deg)) : 1.0f);
   v.lpv.direction_or_position = lamp.position;
   v.lpv.positional = true;
+  v.lod = {lamp.position, 1.0f / t, 0.5f};
   return v;
 }
 
@@ -199,6 +204,7 @@ void ReflectiveShadowMaps::add_draw(gpu::FrameGraph& graph, const std::string& l
   const gpu::BufferHandle indices = grid_indices_;
   const gpu::Pipeline* grid_pipe = &*grid_pipeline_;
   const gpu::Pipeline* mesh_pipe = &*mesh_pipeline_;
+  const technique::LodView lod = view.lod;
   RsmPush push{view.view_proj, view.light, view.colour, view.axis,
                glm::ivec4(int(grid_stride_), -1, 0, int(grid_points_.width))};
   graph.add_pass(
@@ -286,7 +292,10 @@ void ReflectiveShadowMaps::add_draw(gpu::FrameGraph& graph, const std::string& l
               push.misc.y = materials ? d.material : -1;
               push.misc.z = materials ? 0 : int(0xff808080u);
               vkCmdPushConstants(cmd, mesh_pipe->layout, mesh_pipe->stages, 0, sizeof push, &push);
-              vkCmdDrawIndexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0);
+              const technique::DrawRange::Lod& l =
+                  d.lods.empty() ? technique::DrawRange::Lod{d.first_index, d.index_count, 0.0f}
+                                 : d.lods[technique::MeshSet::select_lod(d, lod)];
+              vkCmdDrawIndexed(cmd, l.index_count, 1, l.first_index, d.vertex_offset, 0);
             }
           };
           if (proxies) draw_set(sg->real_proxies, false);

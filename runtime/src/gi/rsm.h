@@ -40,6 +40,9 @@ struct RsmView {
   glm::vec4 colour{0.0f};
   glm::vec4 axis{0.0f};
   LpvLight lpv;           // the same lamp for the injection
+  // The virtual meshes' level of detail as the map sees them: the coarsest whose error stays
+  // within half a map texel (a finer mesh adds triangles no texel resolves).
+  technique::LodView lod;
 };
 // BadUsage for a lamp the maps cannot see the sphere from (a point lamp inside it: its light
 // leaves in every direction, which one perspective map cannot hold).

@@ -211,8 +211,10 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
     *h = *img;
   }
 
+  compose::ComposeSettings compose_settings;
+  compose_settings.classify_tiles = settings.compose_tiles;
   auto comp = compose::Compose::create(*context_, *graph_, uint32_t(output_w_), uint32_t(output_h_),
-                                       output_w_ == c.width && output_h_ == c.height);
+                                       output_w_ == c.width && output_h_ == c.height, compose_settings);
   if (!comp) return comp.error();
   compose_.emplace(std::move(*comp));
 

@@ -12,6 +12,7 @@
 #include "light/light_stage.h"
 #include "technique/baseline/baseline.h"
 #include "technique/scene_gpu.h"
+#include "technique/screen_bounds.h"
 
 namespace mrgi::technique {
 
@@ -20,7 +21,7 @@ const std::array<DlpvLevel, 5>& dlpv_levels() {
       {"paper", 32, 32, 512, 4, true, 1.0f, true, 0},
       {"high", 32, 32, 512, 4, true, 1.0f, false, 0},
       {"medium", 16, 16, 256, 2, true, 1.0f, false, 1},
-      {"fast", 8, 8, 128, 1, false, 0.75f, false, 2},
+      {"fast", 8, 8, 128, 1, false, 0.5f, false, 3},
       {"fastest", 8, 4, 64, 1, false, 0.5f, false, 3},
   }};
   return levels;
@@ -51,6 +52,10 @@ namespace {
 struct MergePush {
   glm::vec4 grid;    // min corner, cell size
   glm::vec4 extent;  // cells allocated, cells used, V^Delta present, V^rho present
+};
+struct AddIndirectPush {
+  MergePush volume;
+  glm::ivec4 rect;  // internal pixels [x0, x1) x [y0, y1) the volume covers
 };
 
 // The volume around the virtual objects: twice their largest bounding-box edge (paper Sec. 4.2),
@@ -261,14 +266,21 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   if (!antiradiance) {
     if (!delta_present && !rho_present) return ok_status();  // baseline's solutions as they are
     const gpu::Pipeline* add = &*add_indirect_;
+    const auto* fc = static_cast<const shader::FrameConstants*>(graph.mapped(r.frame_constants, graph.slot()));
+    const glm::vec3 half(0.5f * side_);
+    const AddIndirectPush ap{push, box_pixels(*fc, centre_ - half, centre_ + half, 1)};
+    if (ap.rect.z <= ap.rect.x || ap.rect.w <= ap.rect.y) {
+      skipped.push_back("dlpv add indirect: the volume is outside the view");
+      return ok_status();
+    }
     graph.add_shader_pass(
         "dlpv add indirect", gpu::PassKind::Compute, *add_indirect_,
         [&](gpu::ShaderPassBuilder& b) {
           bind_common(b);
         },
-        [add, push, lit = r.lit_rv](VkCommandBuffer cmd, gpu::PassContext& p) {
-          const VkExtent2D e = p.extent(lit);
-          gpu::push_and_dispatch(cmd, *add, &push, sizeof push, {(e.width + 7) / 8, (e.height + 7) / 8, 1});
+        [add, ap](VkCommandBuffer cmd, gpu::PassContext&) {
+          const glm::uvec2 n(ap.rect.z - ap.rect.x, ap.rect.w - ap.rect.y);
+          gpu::push_and_dispatch(cmd, *add, &ap, sizeof ap, {(n.x + 7) / 8, (n.y + 7) / 8, 1});
         });
     return ok_status();
   }

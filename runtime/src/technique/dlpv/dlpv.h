@@ -11,7 +11,7 @@
 //   paper    32^3    32     512^2  4          yes    1.0             antiradiance (Algorithm 1)
 //   high     32^3    32     512^2  4          yes    1.0             baseline high's shadow maps
 //   medium   16^3    16     256^2  2          yes    1.0             baseline medium's
-//   fast      8^3     8     128^2  1          no     0.75            baseline low's (the reduced-volume fast path)
+//   fast      8^3     8     128^2  1          no     0.5             baseline lowest's (the reduced-volume fast path)
 //   fastest   8^3     4      64^2  1          no     0.5             baseline lowest's
 // "paper" is the published method with its settings (Sec. 5); the others keep its volume and
 // light the scene directly with shadow maps (Sec. 7's alternative), because the antiradiance

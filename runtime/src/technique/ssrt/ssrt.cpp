@@ -1,5 +1,8 @@
 #include "technique/ssrt/ssrt_internal.h"
+
 #include <array>
+
+#include "technique/screen_bounds.h"
 
 namespace mrgi::technique {
 namespace ssrt_detail {
@@ -119,32 +122,12 @@ bool Ssrt::project_virtual_bounds(float grow_m, glm::vec2& pmin, glm::vec2& pmax
   gpu::FrameGraph& graph = *shared_.graph;
   const auto* fc =
       static_cast<const shader::FrameConstants*>(graph.mapped(shared_.frame_constants, graph.slot()));
-  const glm::vec3 lo = sg.virtual_objects.bounds_min - glm::vec3(grow_m);
-  const glm::vec3 hi = sg.virtual_objects.bounds_max + glm::vec3(grow_m);
-  const glm::vec4 k = fc->internal_k;
-  const glm::vec2 size(fc->internal_output_size.x, fc->internal_output_size.y);
-  int out_count[5] = {0, 0, 0, 0, 0};  // behind, left, right, top, bottom
-  pmin = glm::vec2(1e30f);
-  pmax = glm::vec2(-1e30f);
-  for (int c = 0; c < 8; ++c) {
-    const glm::vec3 p((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
-    const glm::vec3 q = glm::vec3(fc->world_to_camera * glm::vec4(p, 1.0f));
-    if (q.z <= 1e-4f) {
-      ++out_count[0];
-      continue;
-    }
-    const float u = k.x * q.x / q.z + k.z, v = k.y * q.y / q.z + k.w;
-    pmin = glm::min(pmin, glm::vec2(u, v));
-    pmax = glm::max(pmax, glm::vec2(u, v));
-    out_count[1] += u < -0.5f;
-    out_count[2] += u > size.x - 0.5f;
-    out_count[3] += v < -0.5f;
-    out_count[4] += v > size.y - 0.5f;
-  }
-  for (int side = 0; side < 5; ++side)
-    if (out_count[side] == 8) return false;
-  behind = out_count[0] > 0;
-  return true;
+  const ScreenBounds b = project_box(*fc, sg.virtual_objects.bounds_min - glm::vec3(grow_m),
+                                     sg.virtual_objects.bounds_max + glm::vec3(grow_m));
+  pmin = b.min;
+  pmax = b.max;
+  behind = b.behind;
+  return b.visible;
 }
 
 // The smallest rectangle holding both [x0, x1) x [y0, y1) rectangles (an empty one adds nothing).

@@ -1,0 +1,66 @@
+#version 460
+// Compose's own tile list, for techniques that list none (Technique::compose_tiles): the 8 x 8
+// output tiles whose composite can differ visibly from the camera frame. One invocation per
+// solution texel (internal resolution, used extent); a texel that is virtual, or whose two
+// solutions differ by more than compose_tile_invisible allows, marks every output tile whose
+// pixels read it (compose.comp: the bilinear taps floor(ipos), floor(ipos) + 1 with
+// ipos = (p + 0.5) * used / out - 0.5, and the nearest texel for the virtual mask), and the first
+// to mark a tile appends it to the list. Outside the listed tiles compose writes the camera
+// frame (on the host when the output has the camera's size), so a technique whose solutions are
+// equal away from the virtual objects' influence (baseline, dlpv) pays for the composite only
+// where it shows. On lavapipe a shader runs all of its code for every invocation: pixels that
+// need no composite can only be saved by not dispatching them.
+// Output: args = VkDispatchIndirectCommand (x counted here; compose_tiles_reset set it to
+// (0, 1, 1) and every flag to 0 first), list = the tile indices (ty * tiles_x + tx), in no order.
+#extension GL_GOOGLE_include_directive : require
+#include "shared/mrgi_shared.h"
+#include "common/frame_constants.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
+FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
+layout(set = 0, binding = 1, rgba16f) readonly uniform image2D lit_rv;
+layout(set = 0, binding = 2, rgba16f) readonly uniform image2D lit_r;
+layout(set = 0, binding = 3, rgba32f) readonly uniform image2D virtual_position;  // w: coverage
+// words 0..3: VkDispatchIndirectCommand (x, y, z) and a pad; then one flag per output tile.
+layout(std430, set = 0, binding = 4) coherent buffer TileState { uint words[]; };
+layout(std430, set = 0, binding = 5) writeonly buffer TileList { uint list[]; };
+struct ClassifyConstants {
+  vec4 compose;  // x eps, y alpha_max (ComposeSettings), z tolerance (8-bit levels)
+};
+layout(push_constant) uniform Classify { ClassifyConstants classify_block; };
+ClassifyConstants classify;
+
+void mark(int tile) {
+  if (words[4 + tile] != 0u) return;  // (a plain read first: most marks find the tile listed)
+  if (atomicExchange(words[4 + tile], 1u) == 0u) list[atomicAdd(words[0], 1u)] = uint(tile);
+}
+
+void main() {
+  frame = frame_ubo;  // MRGI_UNIFORM_COPIES
+  classify = classify_block;
+  ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 used = frame.internal_output_size.xy;
+  ivec2 out_size = frame.internal_output_size.zw;
+  if (any(greaterThanEqual(texel, used))) return;
+  bool shows = imageLoad(virtual_position, texel).w > 0.5f;
+  if (!shows) {
+    float exposure = frame.camera.y;
+    vec3 rv = clamp(finite3(imageLoad(lit_rv, texel).rgb) * exposure, vec3(0.0f), vec3(1.0f));
+    vec3 r = clamp(finite3(imageLoad(lit_r, texel).rgb) * exposure, vec3(0.0f), vec3(1.0f));
+    shows = !compose_tile_invisible(r, rv, classify.compose.x, classify.compose.y, classify.compose.z);
+  }
+  if (!shows) return;
+  // Output pixels reading this texel: bilinear taps at floor(ipos) = texel - 1 or texel, i.e.
+  // (p + 0.5) * used / out in [texel - 0.5, texel + 1.5), and the nearest texel; widened by a
+  // pixel each way so rounding never loses one. At the output's own size only p = texel.
+  ivec2 p0 = texel, p1 = texel;
+  if (used != out_size) {
+    vec2 s = vec2(out_size) / vec2(used);
+    p0 = max(ivec2(floor((vec2(texel) - 0.5f) * s - 0.5f)) - 1, ivec2(0));
+    p1 = min(ivec2(ceil((vec2(texel) + 1.5f) * s - 0.5f)) + 1, out_size - 1);
+  }
+  int tiles_x = (out_size.x + 7) / 8;
+  for (int ty = p0.y / 8; ty <= p1.y / 8; ++ty)
+    for (int tx = p0.x / 8; tx <= p1.x / 8; ++tx) mark(ty * tiles_x + tx);
+}
