@@ -88,7 +88,8 @@ glm::vec3 Box::normal_at(const glm::vec3& q) const {
   return best;
 }
 
-SyntheticScene SyntheticScene::create(const std::string& folder, const glm::vec3& emission) {
+SyntheticScene SyntheticScene::create(const std::string& folder, const glm::vec3& emission,
+                                      const glm::vec3& base) {
   SyntheticScene s;
   s.intrinsics.width = 64;
   s.intrinsics.height = 48;
@@ -101,6 +102,7 @@ SyntheticScene SyntheticScene::create(const std::string& folder, const glm::vec3
   s.pose.translation = glm::dvec3(0.0, 2.0, 0.0);
   s.real_box = {{-0.2f, 0.0f, 0.4f}, {0.2f, 0.4f, 0.8f}};
 
+  s.virtual_base = base;
   write_cube_gltf(folder, s.virtual_base, emission);
   // C1: a virtual box whose shadow falls on open floor; C2: a thin virtual plate floating above
   // the real box, whose shadow covers part of the real box's own shadow (DIR Fig. 5).

@@ -48,7 +48,9 @@ struct SyntheticScene {
 
   // Writes the glTF cube and the environment image into `folder`.
   // `emission`: the cubes' glTF emissiveFactor (radiance; 0 = none).
-  static SyntheticScene create(const std::string& folder, const glm::vec3& emission = glm::vec3(0.0f));
+  // `base`: the cubes' glTF baseColorFactor (black: they only block light).
+  static SyntheticScene create(const std::string& folder, const glm::vec3& emission = glm::vec3(0.0f),
+                               const glm::vec3& base = glm::vec3(0.8f, 0.2f, 0.2f));
   CameraSetup cameras() const;
 
   // First surface a camera ray through pixel (u, v) hits; `with_virtual` includes the virtual boxes.

@@ -42,6 +42,7 @@ Expected<LightPropagationVolume> LightPropagationVolume::create(gpu::FrameGraph&
     vs.resolution = s.resolution;
     vs.images = 3;
     vs.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+    vs.history = i == 2;  // the accumulation: a frame that skips propagating reads the last one's
     auto vol = VoxelVolume::create(graph, vs);
     if (!vol) return vol.error();
     if (i < 2) {

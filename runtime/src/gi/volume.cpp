@@ -35,6 +35,7 @@ Expected<VoxelVolume> VoxelVolume::create(gpu::FrameGraph& graph, const VolumeSe
     d.size_mode = gpu::SizeMode::Absolute;
     d.width = d.height = d.depth = s.resolution;
     d.mip_levels = v.levels_;
+    d.history = s.history;
     auto h = graph.create_image(d, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
                                        VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
     if (!h) return h.error();

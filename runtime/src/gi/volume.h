@@ -24,6 +24,9 @@ struct VolumeSettings {
   VkFormat format = VK_FORMAT_R16G16B16A16_SFLOAT;
   // A full mip chain down to one cell (cone tracing reads coarser levels for wider cones).
   bool mip_chain = false;
+  // Contents kept between frames (gpu::ImageDesc::history): a frame that does not rewrite the
+  // volume reads what the last one left (dlpv reuses its volumes when nothing moved).
+  bool history = false;
 };
 
 class VoxelVolume {

@@ -62,6 +62,40 @@ struct AddIndirectPush {
 // at least 0.25 m (a thin object still has room around it for its shadow and bounce).
 constexpr float kMinVolumeSide = 0.25f;
 
+// Tolerances of the volumes' reuse (dlpv.h "Skips").
+constexpr double kReusePoseM = 1e-3, kReusePoseDeg = 0.1;
+constexpr double kReuseDepthMeanM = 2e-3, kReuseDepthValidity = 0.005;
+constexpr float kReuseLampM = 1e-3f, kReuseLampDeg = 0.5f, kReuseLampColour = 0.01f;
+
+// What this frame's volumes are made from, to decide whether the next frame may reuse them.
+struct VolumeSource {
+  bool valid = false;
+  int level = -1;
+  glm::dmat4 pose{1.0};
+  std::array<LightDesc, light::kMaxStageLights> lamps{};
+  size_t lamp_count = 0;
+  bool delta_present = false, rho_present = false;
+};
+
+bool lamp_close(const LightDesc& a, const LightDesc& b) {
+  if (a.type != b.type || a.real != b.real) return false;
+  const float cos_tol = std::cos(glm::radians(kReuseLampDeg));
+  const glm::vec3 ca = a.color * a.intensity, cb = b.color * b.intensity;
+  const float colour_scale = std::max({std::abs(ca.x), std::abs(ca.y), std::abs(ca.z), 1e-30f});
+  return glm::length(a.position - b.position) <= kReuseLampM &&
+         glm::dot(glm::normalize(a.direction), glm::normalize(b.direction)) >= cos_tol &&
+         glm::length(ca - cb) <= kReuseLampColour * colour_scale &&
+         std::abs(a.inner_angle_deg - b.inner_angle_deg) <= kReuseLampDeg &&
+         std::abs(a.outer_angle_deg - b.outer_angle_deg) <= kReuseLampDeg;
+}
+
+bool pose_close(const glm::dmat4& a, const glm::dmat4& b) {
+  if (glm::length(glm::dvec3(a[3]) - glm::dvec3(b[3])) > kReusePoseM) return false;
+  const glm::dmat3 r = glm::transpose(glm::dmat3(a)) * glm::dmat3(b);
+  const double cos_angle = std::clamp((r[0][0] + r[1][1] + r[2][2] - 1.0) / 2.0, -1.0, 1.0);
+  return std::acos(cos_angle) <= glm::radians(kReusePoseDeg);
+}
+
 class Dlpv final : public Technique {
  public:
   explicit Dlpv(const SharedResources& shared) : shared_(shared), ladder_(dlpv_ladder()) {}
@@ -81,6 +115,9 @@ class Dlpv final : public Technique {
   std::optional<gi::LightPropagationVolume> delta_, rho_;
   gpu::PipelineHandle merge_, add_indirect_;
   std::unique_ptr<Technique> baseline_;  // direct light with shadow maps (not antiradiance levels)
+  VolumeSource source_;                 // what the volumes in the images were made from
+  std::vector<uint16_t> source_depth_;  // that frame's depth (sized at init: no allocation later)
+  bool depth_close(const InputFrame* input) const;
   bool has_virtual_ = false;
   glm::vec3 centre_{0.0f};
   float side_ = 1.0f;
@@ -133,6 +170,7 @@ Status Dlpv::init() {
   auto add = gpu::load_compute_pipeline(*shared_.context, "dlpv/add_indirect.comp", {});
   if (!add) return add.error();
   add_indirect_ = std::move(*add);
+  source_depth_.assign(size_t(shared_.depth_intrinsics.width) * size_t(shared_.depth_intrinsics.height), 0);
   auto base = create_baseline(shared_);
   if (!base) return base.error();
   baseline_ = std::move(*base);
@@ -166,6 +204,26 @@ void Dlpv::write_lights() {
   set->ambient_r = {r[0], r[1], r[2]};
 }
 
+bool Dlpv::depth_close(const InputFrame* input) const {
+  if (input == nullptr || input->depth.data.size() != source_depth_.size()) return false;
+  const double metres_per_unit = 1.0 / shared_.depth_scale;
+  double sum_m = 0.0;
+  size_t both = 0, changed_validity = 0;
+  const uint16_t* now = input->depth.data.data();
+  for (size_t i = 0; i < source_depth_.size(); ++i) {
+    const bool a = source_depth_[i] != 0, b = now[i] != 0;
+    if (a != b) {
+      ++changed_validity;
+    } else if (a) {
+      sum_m += std::abs(double(now[i]) - double(source_depth_[i])) * metres_per_unit;
+      ++both;
+    }
+  }
+  const double n = double(std::max<size_t>(source_depth_.size(), 1));
+  return double(changed_validity) <= kReuseDepthValidity * n &&
+         (both == 0 || sum_m / double(both) <= kReuseDepthMeanM);
+}
+
 Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   if (info.level < 0 || info.level >= int(dlpv_levels().size()))
     return fail(ErrorKind::BadUsage, "dlpv: level " + std::to_string(info.level) + " outside 0.." +
@@ -196,9 +254,22 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     // The real grid at about two points a map texel across the G-buffer's larger side.
     const VkExtent2D g = graph.extent(shared_.real_position);
     const uint32_t stride = std::max(1u, uint32_t(std::ceil(double(std::max(g.width, g.height)) / (level.rsm_size / 2.0))));
+    // The real lamps the maps are drawn for this level (strongest first), as the reuse compares them.
+    VolumeSource now;
+    now.level = info.level;
+    now.pose = info.camera_to_world;
+    for (size_t i = 0; i < lighting.lights.size() && now.lamp_count < level.rsm_lamps; ++i)
+      if (lighting.lights[i].real && now.lamp_count < now.lamps.size()) now.lamps[now.lamp_count++] = lighting.lights[i];
+    bool reuse = source_.valid && source_.level == now.level && source_.lamp_count == now.lamp_count &&
+                 pose_close(source_.pose, now.pose) && depth_close(info.input);
+    for (size_t i = 0; reuse && i < now.lamp_count; ++i) reuse = lamp_close(source_.lamps[i], now.lamps[i]);
     bool grid_added = false;
     uint32_t lamps = 0;
-    for (size_t i = 0; i < lighting.lights.size() && lamps < level.rsm_lamps; ++i) {
+    if (reuse) {
+      lamps = uint32_t(now.lamp_count);
+      skipped.push_back("dlpv maps and volumes: reused (level, pose, depth and lamps within tolerance of the frame that made them)");
+    }
+    for (size_t i = 0; !reuse && i < lighting.lights.size() && lamps < level.rsm_lamps; ++i) {
       const LightDesc& lamp = lighting.lights[i];
       if (!lamp.real) continue;
       auto view = gi::rsm_view(lamp, centre_, radius, level.rsm_size);
@@ -224,7 +295,10 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
         delta_->add_inject(graph, "blocked direct " + id, mu_map, view->lpv, gi::InjectKind::Direct, -1.0f, &rho_map);
       ++lamps;
     }
-    if (lamps == 0) {
+    if (reuse) {
+      delta_present = source_.delta_present;
+      rho_present = source_.rho_present;
+    } else if (lamps == 0) {
       skipped.push_back("dlpv volumes: no real light to inject (no lamp, environment region or estimate)");
     } else {
       delta_->add_propagate(graph, level.steps);
@@ -232,10 +306,18 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
       if (level.rho_volume) {
         rho_->add_propagate(graph, level.steps);
         rho_present = true;
-      } else {
-        skipped.push_back("dlpv rho volume: level '" + std::string(level.name) +
-                          "' shades virtual pixels with lamps and ambient only");
       }
+    }
+    if (!level.rho_volume)
+      skipped.push_back("dlpv rho volume: level '" + std::string(level.name) +
+                        "' shades virtual pixels with lamps and ambient only");
+    if (!reuse) {
+      // Remembered only when made from a depth frame the next one can be compared with.
+      source_ = now;
+      source_.valid = info.input != nullptr && info.input->depth.data.size() == source_depth_.size();
+      source_.delta_present = delta_present;
+      source_.rho_present = rho_present;
+      if (source_.valid) std::copy(info.input->depth.data.begin(), info.input->depth.data.end(), source_depth_.begin());
     }
     push.extent = glm::vec4(float(delta_->settings().resolution), float(level.volume_cells), delta_present ? 1.0f : 0.0f,
                             rho_present ? 1.0f : 0.0f);
