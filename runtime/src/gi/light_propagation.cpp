@@ -14,6 +14,10 @@ struct InjectPush {
 struct ResolvePush {
   glm::ivec4 cells;
 };
+struct LocalPush {
+  glm::ivec4 sizes;  // used, allocated, steps
+  glm::vec4 damping;
+};
 struct PropagatePush {
   glm::ivec4 cells;
   glm::vec4 damping;
@@ -68,6 +72,9 @@ Expected<LightPropagationVolume> LightPropagationVolume::create(gpu::FrameGraph&
   auto propagate = gpu::load_compute_pipeline(ctx, "gi/lpv_propagate.comp", {});
   if (!propagate) return propagate.error();
   v.propagate_ = std::move(*propagate);
+  auto local = gpu::load_compute_pipeline(ctx, "gi/lpv_propagate_local.comp", {});
+  if (!local) return local.error();
+  v.propagate_local_ = std::move(*local);
   // The propagation pass pushes its own descriptors (one pass, many steps): by the shaders' names.
   auto find = [](const gpu::Pipeline& p, const std::string& name, uint32_t& out) -> Status {
     const gpu::ShaderBinding* b = p.interface.find(name);
@@ -133,6 +140,26 @@ void LightPropagationVolume::add_inject(gpu::FrameGraph& graph, const std::strin
 }
 
 void LightPropagationVolume::add_propagate(gpu::FrameGraph& graph, uint32_t steps) const {
+  if (cells() <= kLocalCells && !settings_.one_step_a_dispatch) {
+    // The reduced volumes: resolve and every step in one workgroup (lpv_propagate_local.comp).
+    const uint32_t n = cells(), alloc = settings_.resolution;
+    const VoxelVolume* sum = &*sum_;
+    const LocalPush push{glm::ivec4(int(n), int(alloc), int(steps), 0),
+                         glm::vec4(settings_.negative_damping, 0.0f, 0.0f, 0.0f)};
+    const gpu::Pipeline* pipe = &*propagate_local_;
+    graph.add_shader_pass(
+        settings_.name + " propagate", gpu::PassKind::Compute, *propagate_local_,
+        [this, sum](gpu::ShaderPassBuilder& b) {
+          b.bind("cells", cells_);
+          b.bind("sum_r", sum->image(0));
+          b.bind("sum_g", sum->image(1));
+          b.bind("sum_b", sum->image(2));
+        },
+        [pipe, push](VkCommandBuffer cmd, gpu::PassContext&) {
+          gpu::push_and_dispatch(cmd, *pipe, &push, sizeof push, {1, 1, 1});
+        });
+    return;
+  }
   // One graph pass for the resolve and every step: the steps' ping-pong images are the pass's
   // own, so the barriers between steps are recorded here (a compute-to-compute memory barrier
   // each) instead of as 2 + steps graph passes (the paper's Table 3 goes to 256 steps; per-pass

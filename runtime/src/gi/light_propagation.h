@@ -28,7 +28,12 @@ struct LpvSettings {
   // Strength of the damping of negative flux where it is a step along the propagation
   // (lpv_negative_damping, paper Sec. 4.4); 0 turns it off (the ablation).
   float negative_damping = 1.0f;
+  // Volumes of at most kLocalCells per side propagate every step in one workgroup
+  // (gi/lpv_propagate_local.comp: shared memory and barriers instead of a dispatch a step, the
+  // cost on a CPU device); true keeps them on the one-step-a-dispatch path (tests compare both).
+  bool one_step_a_dispatch = false;
 };
+inline constexpr uint32_t kLocalCells = 8;
 
 // Where the volume is this frame: its min corner and cell size, metres.
 struct LpvGrid {
@@ -89,6 +94,7 @@ class LightPropagationVolume {
   std::optional<VoxelVolume> sum_;
   gpu::BufferHandle cells_;              // injection sums, 12 floats a cell
   gpu::PipelineHandle inject_, resolve_, propagate_;
+  gpu::PipelineHandle propagate_local_;  // <= kLocalCells per side: every step in one workgroup
   struct Bindings {
     uint32_t cells = 0, resolve_step[3]{}, resolve_sum[3]{}, from[3]{}, to[3]{}, sum[3]{};
   } bindings_;
