@@ -3,6 +3,12 @@
 #ifndef MRGI_DLPV_VOLUME_LOOKUP_GLSL
 #define MRGI_DLPV_VOLUME_LOOKUP_GLSL
 
+// Whether p lies in the used volume (a surface outside it gets no light from the volume).
+bool volume_contains(vec3 p) {
+  vec3 cellf = (p - volume.grid.xyz) / volume.grid.w;
+  return all(greaterThanEqual(cellf, vec3(0.0f))) && all(lessThanEqual(cellf, vec3(volume.extent.y)));
+}
+
 // Irradiance from a volume's accumulated intensity at p for normal n, per channel; 0 outside.
 vec3 volume_irradiance(sampler3D r, sampler3D g, sampler3D b, vec3 p, vec3 n) {
   vec3 cellf = (p - volume.grid.xyz) / volume.grid.w;  // in cells

@@ -325,18 +325,18 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   const SharedResources& r = shared_;
   const gpu::Pipeline* merge = &*merge_;
   const gpu::Context& ctx = *shared_.context;
-  const VkSampler nearest = ctx.samplers().nearest_clamp, linear = ctx.samplers().linear_clamp;
+  const VkSampler linear = ctx.samplers().linear_clamp;
   const gpu::ImageHandle dvol[3] = {delta_->accumulated(0), delta_->accumulated(1), delta_->accumulated(2)};
   const gpu::ImageHandle rvol[3] = {rho_->accumulated(0), rho_->accumulated(1), rho_->accumulated(2)};
   // What both shading passes (add_indirect.comp, merge.comp) declare alike.
   auto bind_common = [&](gpu::ShaderPassBuilder& b) {
     b.bind("FrameUbo", r.frame_constants);
-    b.bind_sampled("real_position", r.real_position, nearest);
-    b.bind_sampled("real_normal", r.real_normal, nearest);
-    b.bind_sampled("real_albedo", r.real_albedo, nearest);
-    b.bind_sampled("virtual_position", r.virtual_position, nearest);
-    b.bind_sampled("virtual_normal", r.virtual_normal, nearest);
-    b.bind_sampled("virtual_albedo", r.virtual_albedo, nearest);
+    b.bind("real_position", r.real_position);
+    b.bind("real_normal", r.real_normal);
+    b.bind("real_albedo", r.real_albedo);
+    b.bind("virtual_position", r.virtual_position);
+    b.bind("virtual_normal", r.virtual_normal);
+    b.bind("virtual_albedo", r.virtual_albedo);
     const char* d[3] = {"delta_r", "delta_g", "delta_b"};
     const char* p[3] = {"rho_r", "rho_g", "rho_b"};
     for (int c = 0; c < 3; ++c) {
@@ -371,7 +371,7 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
       [&](gpu::ShaderPassBuilder& b) {
         bind_common(b);
         b.bind("LightUbo", lights_);
-        b.bind_sampled("virtual_emission", r.virtual_emission.valid() ? r.virtual_emission : r.virtual_albedo, nearest);
+        b.bind("virtual_emission", r.virtual_emission.valid() ? r.virtual_emission : r.virtual_albedo);
         b.bind("lit_r", r.lit_r);
       },
       [merge, push, lit = r.lit_rv](VkCommandBuffer cmd, gpu::PassContext& p) {
