@@ -15,6 +15,7 @@ namespace {
 
 struct ReplayOptions {
   std::string capture, technique = "baseline", out, level = "0", device, light = "declared";
+  std::vector<std::string> dlpv_ablation;
   int frames = 0, width = 0, height = 0;
   bool validate = false, quiet = false;
 };
@@ -35,6 +36,13 @@ void run_replay(const ReplayOptions& o) {
   settings.output_width = o.width;
   settings.output_height = o.height;
   settings.exposure = info.exposure;
+  for (const std::string& a : o.dlpv_ablation) {
+    if (a == "two-volumes") settings.dlpv_ablation.two_volumes = true;
+    if (a == "no-damping") settings.dlpv_ablation.no_negative_damping = true;
+    if (a == "no-shift") settings.dlpv_ablation.no_half_cell_shift = true;
+  }
+  if (settings.dlpv_ablation.any() && o.technique != "dlpv")
+    throw CommandFailure(2, "--dlpv-ablation: only for --technique dlpv");
   CameraSetup cameras{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera};
   SceneDesc scene = capture.scene() ? *capture.scene() : SceneDesc{};
   // The env intensity stays known for the truth of the direction error (env frames).
@@ -182,6 +190,12 @@ void setup(CLI::App& app) {
                   "declared: scene.json's lamps and environment light the scene (default); estimate: they are "
                   "ignored and the runtime estimates the light from the frames, as for an app that declares none")
       ->check(CLI::IsMember({"declared", "estimate"}));
+  cmd->add_option("--dlpv-ablation", opts->dlpv_ablation,
+                  "dlpv without one of the paper's ideas (mrgi/runtime.h DlpvAblation): two-volumes (V^rho and V^mu "
+                  "propagated apart, not V^Delta), no-damping (of negative flux), no-shift (VPLs at their surface, not "
+                  "half a cell along the normal); comma-separated")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"two-volumes", "no-damping", "no-shift"}));
   cmd->add_option("--device", opts->device, "Vulkan device: index or name part (default $MRGI_DEVICE, else lavapipe)");
   cmd->add_flag("--validate", opts->validate, "enable Vulkan validation layers");
   cmd->add_flag("--quiet,-q", opts->quiet, "no progress on stderr");

@@ -29,13 +29,18 @@ layout(set = 0, binding = 10) uniform sampler3D rho_r;
 layout(set = 0, binding = 11) uniform sampler3D rho_g;
 layout(set = 0, binding = 12) uniform sampler3D rho_b;
 layout(set = 0, binding = 13, rgba16f) uniform image2D lit_rv;
+// V^mu (DlpvAblation::two_volumes only; otherwise bound to V^Delta and not read).
+layout(set = 0, binding = 14) uniform sampler3D mu_r;
+layout(set = 0, binding = 15) uniform sampler3D mu_g;
+layout(set = 0, binding = 16) uniform sampler3D mu_b;
 struct VolumeConstants {
   vec4 grid;    // xyz: the volumes' min corner (m); w: cell size (m)
   vec4 extent;  // x: cells allocated per side; y: cells used; z: 1 = V^Delta present; w: 1 = V^rho
 };
 // rect: the internal pixels [x0, x1) x [y0, y1) the volume's box covers (technique/
 // screen_bounds.h); nothing outside it receives light from the volume, so it is not dispatched.
-layout(push_constant) uniform Volume { VolumeConstants volume_block; ivec4 rect_block; };
+// mode.x: 1 = the two-volume ablation, real pixels get E(V^rho) - E(V^mu) instead of E(V^Delta).
+layout(push_constant) uniform Volume { VolumeConstants volume_block; ivec4 rect_block; ivec4 mode_block; };
 VolumeConstants volume;
 
 #include "dlpv/volume_lookup.glsl"
@@ -58,7 +63,9 @@ void main() {
     // Outside the volume before the normal and albedo are read: most of the rectangle's pixels.
     if (!(pos.w > 0.0f) || !(volume.extent.z > 0.5f) || !volume_contains(pos.xyz)) return;
     vec3 n = normalize(imageLoad(real_normal, pixel).xyz);
-    add = imageLoad(real_albedo, pixel).rgb * volume_irradiance(delta_r, delta_g, delta_b, pos.xyz, n);
+    vec3 e = mode_block.x == 1 ? volume_irradiance(rho_r, rho_g, rho_b, pos.xyz, n) - volume_irradiance(mu_r, mu_g, mu_b, pos.xyz, n)
+                               : volume_irradiance(delta_r, delta_g, delta_b, pos.xyz, n);
+    add = imageLoad(real_albedo, pixel).rgb * e;
   }
   vec4 lit = imageLoad(lit_rv, pixel);
   lit.rgb = clamp(lit.rgb + add * (1.0f / MRGI_PI), vec3(0.0f), vec3(60000.0f));

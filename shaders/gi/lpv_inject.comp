@@ -29,6 +29,7 @@ layout(push_constant) uniform InjectParams {
   ivec4 sizes;     // x: cells per side; y, z: the map's used width and height; w: 1 = direct
   vec4 light;      // xyz: direction the light travels (w 0) or the lamp's position (w 1)
   vec4 colour;     // rgb: the lamp's colour (direct mode); w: sign, +1 or -1
+  vec4 options;    // x: VPL shift along the normal, cells (0.5; 0 only as an ablation)
 } params_block;
 
 void main() {
@@ -54,7 +55,7 @@ void main() {
     power = colour.xyz * flux.w;
   } else {
     if (dot(n, travel) >= 0.0) return;  // a surface the light reaches from behind reflects nothing
-    at = pos.xyz + n * (0.5 * grid.w);
+    at = pos.xyz + n * (params_block.options.x * grid.w);
     lobe = sh4_cosine_lobe(n) * (1.0 / MRGI_PI);
     power = flux.xyz;
   }

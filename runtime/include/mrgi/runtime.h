@@ -44,6 +44,19 @@ struct DeviceSettings {
 // Lists the Vulkan devices and marks the one `settings` would pick.
 Expected<std::vector<DeviceInfo>> list_devices(const DeviceSettings& settings);
 
+// Ablations of the `dlpv` technique (DLPV paper Sec. 4: what each of its ideas is worth; the
+// defaults are the paper's method). Read at start-up.
+struct DlpvAblation {
+  // The paper's V^Delta by delta injection (+R^rho - R^mu into one volume, eq. 13) replaced by
+  // two volumes, V^rho and V^mu, propagated separately and subtracted where a real pixel looks
+  // them up (the differential rendering of Debevec's kind the paper improves on). Levels with
+  // shadow-mapped direct light only (the paper level's antiradiance shadows need V^Delta).
+  bool two_volumes = false;
+  bool no_negative_damping = false;  // propagate V^Delta without damping negative flux (Sec. 4.4)
+  bool no_half_cell_shift = false;   // inject VPLs at their surface, not half a cell along the normal
+  bool any() const { return two_volumes || no_negative_damping || no_half_cell_shift; }
+};
+
 // Level "last" in the CLI resolves to technique_level_count(name) - 1.
 struct RuntimeSettings {
   DeviceSettings device;
@@ -70,6 +83,7 @@ struct RuntimeSettings {
   // camera frame elsewhere (baseline lowest on desk_spot: compose 10.8 ms -> see
   // perf/results). false: every pixel composited; the outputs agree to 1/255.
   bool compose_tiles = true;
+  DlpvAblation dlpv_ablation;  // the `dlpv` technique only; defaults: the paper's method
   // Profiling mode (also Runtime::set_profiling): each pass of a frame submitted on its own and
   // waited for, timed by the host clock, so FrameStats::passes add up to the frame. Frames then
   // do not overlap: use it to see where the time goes (bench, scheduler cost model), not to run.

@@ -10,6 +10,7 @@ struct InjectPush {
   glm::ivec4 sizes;
   glm::vec4 light;
   glm::vec4 colour;
+  glm::vec4 options;  // x: VPL shift along the normal, cells
 };
 struct ResolvePush {
   glm::ivec4 cells;
@@ -32,6 +33,8 @@ Expected<LightPropagationVolume> LightPropagationVolume::create(gpu::FrameGraph&
     return fail(ErrorKind::BadUsage, "LpvSettings.resolution: must be 2..128 cells");
   if (!(s.negative_damping >= 0.0f && s.negative_damping <= 100.0f))
     return fail(ErrorKind::BadUsage, "LpvSettings.negative_damping: must be in [0, 100]");
+  if (!(s.vpl_shift_cells >= 0.0f && s.vpl_shift_cells <= 1.0f))
+    return fail(ErrorKind::BadUsage, "LpvSettings.vpl_shift_cells: must be in [0, 1]");
   if (!graph.context().image_float_atomic_add())
     return fail(ErrorKind::Device, "light propagation volume '" + s.name + "': device '" +
                                        graph.context().info().name +
@@ -122,7 +125,8 @@ void LightPropagationVolume::add_inject(gpu::FrameGraph& graph, const std::strin
   const InjectPush push{glm::vec4(grid_.origin, grid_.cell_size),
                         glm::ivec4(int(cells()), int(rsm.width), int(rsm.height), kind == InjectKind::Direct ? 1 : 0),
                         glm::vec4(light.direction_or_position, light.positional ? 1.0f : 0.0f),
-                        glm::vec4(light.colour, sign)};
+                        glm::vec4(light.colour, sign),
+                        glm::vec4(settings_.vpl_shift_cells, 0.0f, 0.0f, 0.0f)};
   const gpu::BufferHandle cells = cells_;
   const gpu::Pipeline* pipe = &*inject_;
   graph.add_shader_pass(

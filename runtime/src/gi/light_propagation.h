@@ -32,6 +32,9 @@ struct LpvSettings {
   // (gi/lpv_propagate_local.comp: shared memory and barriers instead of a dispatch a step, the
   // cost on a CPU device); true keeps them on the one-step-a-dispatch path (tests compare both).
   bool one_step_a_dispatch = false;
+  // VPLs are injected this many cells along their surface normal (paper eq. 12: half a cell, so
+  // a surface does not light itself and no VPL sits behind its own surface); 0: the ablation.
+  float vpl_shift_cells = 0.5f;
 };
 inline constexpr uint32_t kLocalCells = 8;
 

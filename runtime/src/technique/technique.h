@@ -64,6 +64,7 @@ inline double knob(const QualityLevel& level, const std::string& name) {
 class SceneGpu;
 struct SharedResources {
   gpu::Context* context = nullptr;
+  DlpvAblation dlpv_ablation;  // RuntimeSettings::dlpv_ablation
   gpu::FrameGraph* graph = nullptr;
   const SceneDesc* scene = nullptr;
   const SceneGpu* scene_gpu = nullptr;     // uploaded virtual meshes and real proxies

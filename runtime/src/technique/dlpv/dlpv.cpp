@@ -56,6 +56,7 @@ struct MergePush {
 struct AddIndirectPush {
   MergePush volume;
   glm::ivec4 rect;  // internal pixels [x0, x1) x [y0, y1) the volume covers
+  glm::ivec4 mode;  // x: 1 = DlpvAblation::two_volumes
 };
 
 // The volume around the virtual objects: twice their largest bounding-box edge (paper Sec. 4.2),
@@ -113,6 +114,7 @@ class Dlpv final : public Technique {
   gpu::BufferHandle lights_;  // shader::LightSet, one per frame slot
   std::optional<gi::ReflectiveShadowMaps> rsm_;
   std::optional<gi::LightPropagationVolume> delta_, rho_;
+  std::optional<gi::LightPropagationVolume> mu_;  // DlpvAblation::two_volumes only
   gpu::PipelineHandle merge_, add_indirect_;
   std::unique_ptr<Technique> baseline_;  // direct light with shadow maps (not antiradiance levels)
   VolumeSource source_;                 // what the volumes in the images were made from
@@ -151,10 +153,12 @@ Status Dlpv::init() {
   }
   // Without virtual objects nothing is injected; the volumes are then 2^3, allocated only so the
   // merge binds images of the kind it declares (it reads none of them).
+  const DlpvAblation& ablation = shared_.dlpv_ablation;
   gi::LpvSettings ds;
   ds.name = "dlpv delta";
   ds.resolution = top_cells;
-  ds.negative_damping = 1.0f;
+  ds.negative_damping = ablation.no_negative_damping ? 0.0f : 1.0f;
+  ds.vpl_shift_cells = ablation.no_half_cell_shift ? 0.0f : 0.5f;
   auto delta = gi::LightPropagationVolume::create(graph, ds);
   if (!delta) return delta.error();
   delta_.emplace(std::move(*delta));
@@ -164,6 +168,13 @@ Status Dlpv::init() {
   auto rho = gi::LightPropagationVolume::create(graph, ps);
   if (!rho) return rho.error();
   rho_.emplace(std::move(*rho));
+  if (ablation.two_volumes) {
+    gi::LpvSettings ms = ps;
+    ms.name = "dlpv mu";
+    auto mu = gi::LightPropagationVolume::create(graph, ms);
+    if (!mu) return mu.error();
+    mu_.emplace(std::move(*mu));
+  }
   auto merge = gpu::load_compute_pipeline(*shared_.context, "dlpv/merge.comp", {});
   if (!merge) return merge.error();
   merge_ = std::move(*merge);
@@ -231,6 +242,11 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   const DlpvLevel& level = dlpv_levels()[size_t(info.level)];
   gpu::FrameGraph& graph = *shared_.graph;
   const bool antiradiance = level.antiradiance_shadows;
+  const bool two = mu_.has_value();  // DlpvAblation::two_volumes
+  if (two && antiradiance)
+    return fail(ErrorKind::BadUsage, std::string("dlpv: the two-volume ablation (DlpvAblation::two_volumes) needs a level "
+                                                 "with shadow-mapped direct light; level '") + level.name +
+                                         "' shadows with V^Delta's antiradiance");
   if (!antiradiance) {
     // Direct light and its shadows: baseline's passes at the matching level write both solutions.
     FrameInfo base = info;
@@ -249,6 +265,10 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     const gi::LpvGrid grid{centre_ - glm::vec3(0.5f * side_), side_ / float(level.volume_cells)};
     delta_->set_grid(grid);
     rho_->set_grid(grid);
+    if (two) {
+      MRGI_TRY(mu_->set_cells(graph, level.volume_cells));
+      mu_->set_grid(grid);
+    }
     push.grid = glm::vec4(grid.origin, grid.cell_size);
     const float radius = 0.5f * side_ * std::sqrt(3.0f);
     // The real grid at about two points a map texel across the G-buffer's larger side.
@@ -278,8 +298,13 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
         continue;
       }
       if (!grid_added) {
-        delta_->add_clear(graph);
-        if (level.rho_volume) rho_->add_clear(graph);
+        if (two) {
+          rho_->add_clear(graph);
+          mu_->add_clear(graph);
+        } else {
+          delta_->add_clear(graph);
+          if (level.rho_volume) rho_->add_clear(graph);
+        }
         rsm_->add_grid(graph, stride);
         grid_added = true;
       }
@@ -287,10 +312,15 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
       const gi::RsmImages rho_map = rsm_->images(gi::RsmMap::WithVirtual, level.rsm_size);
       const gi::RsmImages mu_map = rsm_->images(gi::RsmMap::RealOnly, level.rsm_size);
       rsm_->add_draw(graph, "rho " + id, *view, gi::RsmMap::WithVirtual, level.rsm_size);
-      delta_->add_inject(graph, "rho " + id, rho_map, view->lpv, gi::InjectKind::Indirect, 1.0f);
-      if (level.rho_volume) rho_->add_inject(graph, "rho " + id, rho_map, view->lpv, gi::InjectKind::Indirect, 1.0f);
+      if (!two) delta_->add_inject(graph, "rho " + id, rho_map, view->lpv, gi::InjectKind::Indirect, 1.0f);
+      if (level.rho_volume || two)
+        rho_->add_inject(graph, "rho " + id, rho_map, view->lpv, gi::InjectKind::Indirect, 1.0f);
       rsm_->add_draw(graph, "mu " + id, *view, gi::RsmMap::RealOnly, level.rsm_size);
-      delta_->add_inject(graph, "mu " + id, mu_map, view->lpv, gi::InjectKind::Indirect, -1.0f);
+      if (two) {
+        mu_->add_inject(graph, "mu " + id, mu_map, view->lpv, gi::InjectKind::Indirect, 1.0f);
+      } else {
+        delta_->add_inject(graph, "mu " + id, mu_map, view->lpv, gi::InjectKind::Indirect, -1.0f);
+      }
       if (antiradiance)
         delta_->add_inject(graph, "blocked direct " + id, mu_map, view->lpv, gi::InjectKind::Direct, -1.0f, &rho_map);
       ++lamps;
@@ -300,6 +330,12 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
       rho_present = source_.rho_present;
     } else if (lamps == 0) {
       skipped.push_back("dlpv volumes: no real light to inject (no lamp, environment region or estimate)");
+    } else if (two) {
+      // The ablation: V^rho and V^mu propagated apart; real pixels look up their difference.
+      rho_->add_propagate(graph, level.steps);
+      mu_->add_propagate(graph, level.steps);
+      delta_present = true;
+      rho_present = level.rho_volume;
     } else {
       delta_->add_propagate(graph, level.steps);
       delta_present = true;
@@ -350,7 +386,7 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     const gpu::Pipeline* add = &*add_indirect_;
     const auto* fc = static_cast<const shader::FrameConstants*>(graph.mapped(r.frame_constants, graph.slot()));
     const glm::vec3 half(0.5f * side_);
-    const AddIndirectPush ap{push, box_pixels(*fc, centre_ - half, centre_ + half, 1)};
+    const AddIndirectPush ap{push, box_pixels(*fc, centre_ - half, centre_ + half, 1), glm::ivec4(two ? 1 : 0, 0, 0, 0)};
     if (ap.rect.z <= ap.rect.x || ap.rect.w <= ap.rect.y) {
       skipped.push_back("dlpv add indirect: the volume is outside the view");
       return ok_status();
@@ -359,6 +395,8 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
         "dlpv add indirect", gpu::PassKind::Compute, *add_indirect_,
         [&](gpu::ShaderPassBuilder& b) {
           bind_common(b);
+          const char* m[3] = {"mu_r", "mu_g", "mu_b"};
+          for (uint32_t c = 0; c < 3; ++c) b.bind_sampled(m[c], two ? mu_->accumulated(c) : dvol[c], linear);
         },
         [add, ap](VkCommandBuffer cmd, gpu::PassContext&) {
           const glm::uvec2 n(ap.rect.z - ap.rect.x, ap.rect.w - ap.rect.y);
