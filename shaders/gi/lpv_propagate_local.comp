@@ -72,10 +72,19 @@ void main() {
     imageStore(sum_r, c, sr_sum);
     imageStore(sum_g, c, sg_sum);
     imageStore(sum_b, c, sb_sum);
-  } else if (all(lessThanEqual(c, ivec3(n))) && n < allocated) {
-    // The layer past the used corner, finite for the trilinear lookup (lpv_resolve.comp says why).
-    imageStore(sum_r, c, vec4(0.0));
-    imageStore(sum_g, c, vec4(0.0));
-    imageStore(sum_b, c, vec4(0.0));
+    // The layer past the used corner, finite for the trilinear lookup (lpv_resolve.comp says
+    // why): written by the last used cells (the workgroup has no invocation there when n = 8),
+    // each for the neighbours past it along the axes where it is last, and their combinations.
+    if (n < allocated) {
+      for (int bits = 1; bits < 8; ++bits) {
+        const ivec3 step = ivec3(bits & 1, (bits >> 1) & 1, (bits >> 2) & 1);
+        // Past the volume along an axis only from a cell that is last along it.
+        const ivec3 last = ivec3(equal(c, ivec3(n - 1)));
+        if (any(greaterThan(step, last))) continue;
+        imageStore(sum_r, c + step, vec4(0.0));
+        imageStore(sum_g, c + step, vec4(0.0));
+        imageStore(sum_b, c + step, vec4(0.0));
+      }
+    }
   }
 }

@@ -37,6 +37,14 @@ MRGI_FN vec4 sh_basis4(vec3 d) {
 }
 MRGI_FN float sh4_eval(vec4 c, vec3 d) { return dot(c, sh_basis4(d)); }
 
+// Bands 0-1 rotated by `r` (a rotation of directions): band 1 is k v . w with v = (-c.w, -c.y,
+// c.z), a vector, so it turns with r; band 0 does not turn. sh4_eval(result, d) =
+// sh4_eval(c, transpose(r) d). (sh_rotate16 in mrgi_shared.h for bands 0-3.)
+MRGI_FN vec4 sh4_rotate(vec4 c, mat3 r) {
+  vec3 v = r * vec3(-c.w, -c.y, c.z);
+  return vec4(c.x, -v.y, v.z, -v.x);
+}
+
 // SH2 of the clamped cosine max(0, n . w): A_l Y_lm(n) with A_0 = pi, A_1 = 2 pi / 3.
 MRGI_FN vec4 sh4_cosine_lobe(vec3 n) {
   vec4 y = sh_basis4(n);

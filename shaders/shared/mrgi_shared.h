@@ -19,16 +19,21 @@
 namespace mrgi::shader {
 using glm::abs;
 using glm::clamp;
+using glm::cos;
 using glm::dot;
 using glm::isinf;
 using glm::isnan;
+using glm::mat3;
 using glm::max;
 using glm::min;
 using glm::mix;
 using glm::normalize;
 using glm::packSnorm2x16;
 using glm::pow;
+using glm::sin;
 using glm::smoothstep;
+using glm::sqrt;
+using glm::transpose;
 using glm::unpackSnorm2x16;
 using glm::vec2;
 using glm::vec3;
@@ -192,6 +197,80 @@ MRGI_FN float sh_get(SH16 s, int i) {
 MRGI_FN float sh_dot(SH16 a, SH16 b) {
   return dot(a.c0, b.c0) + dot(a.c1, b.c1) + dot(a.c2, b.c2) + dot(a.c3, b.c3);
 }
+// a + s b, coefficient by coefficient.
+MRGI_FN SH16 sh_add_scaled(SH16 a, SH16 b, float s) {
+  SH16 r;
+  r.c0 = a.c0 + b.c0 * s;
+  r.c1 = a.c1 + b.c1 * s;
+  r.c2 = a.c2 + b.c2 * s;
+  r.c3 = a.c3 + b.c3 * s;
+  return r;
+}
+
+// The function `c` rotated by `r` (a rotation of directions): sh_dot(result, sh_basis16(d)) =
+// sh_dot(c, sh_basis16(transpose(r) d)) for every unit d. Projected with a product quadrature
+// exact for the product of two functions of bands <= 3 (degree 6): 4-point Gauss-Legendre in
+// z = cos(theta) (exact to degree 7) times 7 equally spaced azimuths (exact for frequencies
+// below 7), 28 points, so the rotation is exact to float rounding without per-band rotation
+// matrices (which would need arrays, not allowed here). About 56 basis evaluations: meant for
+// per-frame light (an environment estimate turned into the world frame), not per pixel.
+MRGI_FN SH16 sh_rotate16(SH16 c, mat3 r) {
+  SH16 acc;
+  acc.c0 = vec4(0.0f);
+  acc.c1 = vec4(0.0f);
+  acc.c2 = vec4(0.0f);
+  acc.c3 = vec4(0.0f);
+  mat3 back = transpose(r);
+  for (int i = 0; i < 4; ++i) {
+    float z = i == 0 ? -0.861136311594053f : (i == 1 ? -0.339981043584856f : (i == 2 ? 0.339981043584856f : 0.861136311594053f));
+    float w = (i == 0 || i == 3) ? 0.347854845137454f : 0.652145154862546f;
+    float ring = sqrt(max(0.0f, 1.0f - z * z));
+    for (int j = 0; j < 7; ++j) {
+      float phi = 2.0f * MRGI_PI * (float(j) + 0.5f) / 7.0f;
+      vec3 d = vec3(ring * cos(phi), ring * sin(phi), z);
+      float value = sh_dot(c, sh_basis16(back * d));
+      acc = sh_add_scaled(acc, sh_basis16(d), value * w * (2.0f * MRGI_PI / 7.0f));
+    }
+  }
+  return acc;
+}
+
+// ---- importance sampling by hierarchical warping ----------------------------------------------
+
+// One level of hierarchical sample warping (Clarberg, Jarosz, Akenine-Moeller and Jensen,
+// "Wavelet Importance Sampling", 2005, Sec. 4): a sample u in [0, 1)^2 at a texel of a mip
+// pyramid of importance picks one of its four children in proportion to their importance (q.x
+// at (0, 0), q.y at (1, 0), q.z at (0, 1), q.w at (1, 1)): first the column by u.x, then the row
+// in that column by u.y, and u is stretched back over [0, 1)^2 inside the child, so descending
+// the pyramid lands on a leaf texel with probability importance / total, continuously in u (the
+// warp keeps stratification: neighbouring u land on neighbouring texels). A zero-importance
+// parent splits evenly. child: which child; probability: of that child given the parent.
+struct WarpStep {
+  vec2 u;
+  ivec2 child;
+  float probability;
+};
+MRGI_FN WarpStep warp_step(vec2 u, vec4 q) {
+  q = max(q, vec4(0.0f));
+  float total = q.x + q.y + q.z + q.w;
+  if (!(total > 0.0f)) q = vec4(1.0f), total = 4.0f;
+  WarpStep s;
+  float p_left = (q.x + q.z) / total;
+  int cx = u.x < p_left ? 0 : 1;
+  float px = cx == 0 ? p_left : 1.0f - p_left;
+  float ux = cx == 0 ? u.x / p_left : (u.x - p_left) / (1.0f - p_left);
+  float top = cx == 0 ? q.x : q.y, bottom = cx == 0 ? q.z : q.w;
+  float p_top = top + bottom > 0.0f ? top / (top + bottom) : 0.5f;
+  int cy = u.y < p_top ? 0 : 1;
+  float py = cy == 0 ? p_top : 1.0f - p_top;
+  float uy = cy == 0 ? u.y / p_top : (u.y - p_top) / (1.0f - p_top);
+  const float below_one = 0.99999994f;  // the largest float below 1
+  s.u = vec2(clamp(ux, 0.0f, below_one), clamp(uy, 0.0f, below_one));
+  s.child = ivec2(cx, cy);
+  s.probability = px * py;
+  return s;
+}
+
 // Zonal factors of the clamped-cosine kernel per band (Ramamoorthi & Hanrahan 2001):
 // irradiance E(n) = sum_l A_l sum_m L_lm Y_lm(n); A = pi, 2pi/3, pi/4, 0 for l = 0..3.
 MRGI_FN SH16 sh_scale_cosine_lobe(SH16 radiance) {

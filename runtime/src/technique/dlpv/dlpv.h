@@ -27,6 +27,22 @@
 //     paper's eq. 1;
 //   - lamps beyond the level's RSM count still light directly (unshadowed), without bounce.
 //
+// Against the paper author's code (thefranke/dirtchamber, D3D11, MIT; read, not copied):
+//   - it propagates in a pixel shader over 2D texture-array slices with Kaplanyan's two
+//     constant face solid angles and a user "flux amplifier"; mrgi gathers in a compute shader
+//     with exact face solid angles and no amplifier, so the transport is physically scaled and
+//     needs no per-scene constant (what generalises to scenes nobody tuned for);
+//   - its delta propagation carries signed values with no damping (the threshold that would
+//     zero small values is commented out for its 2 ms); mrgi damps negative flux by the
+//     directional derivative (paper Sec. 4.4) and measures what that is worth
+//     (perf/results/dlpv/ablation: without it, V^Delta equals two volumes subtracted);
+//   - it splats VPLs as points into slices with additive blending; mrgi sums them with float
+//     atomics (lavapipe rasterises points on one thread), and runs every propagation step of a
+//     volume of at most 8^3 in one workgroup (a dispatch a step costs more than the step on a
+//     CPU device);
+//   - the same half-cell shift along the normal, the same rejection of VPLs facing away, and the
+//     same signed (dscale) injection of the two maps.
+//
 // Skips (each in FrameStats::skipped):
 //   - no virtual object, or no real lamp a map can see the volume from: no maps, no volumes;
 //   - the volumes are reused, with no map drawn, injected or propagated, while what made them
