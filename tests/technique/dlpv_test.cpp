@@ -21,6 +21,18 @@ namespace {
 
 float lin(uint8_t c) { return shader::srgb_decode1(float(c) / 255.0f); }
 
+// Every frame through `rt`, then its flush; the outputs appended in the order they come back.
+void run_frames(Runtime& rt, const std::vector<InputFrame>& frames, std::vector<FrameOutput>& outs) {
+  for (const InputFrame& f : frames) {
+    auto o = rt.process(f);
+    ASSERT_TRUE(o.ok()) << o.error().message;
+    for (auto& x : *o) outs.push_back(std::move(x));
+  }
+  auto rest = rt.flush();
+  ASSERT_TRUE(rest.ok()) << rest.error().message;
+  for (auto& x : *rest) outs.push_back(std::move(x));
+}
+
 TEST(Dlpv, EveryLevelLightsTheObjectAndDarkensTheFloorWithValidationOn) {
   mrgi::testing::TempDir dir;
   const SyntheticScene scene = SyntheticScene::create(dir.str());
@@ -34,16 +46,9 @@ TEST(Dlpv, EveryLevelLightsTheObjectAndDarkensTheFloorWithValidationOn) {
     auto rt = create_runtime(s, scene.cameras(), scene.scene);
     ASSERT_TRUE(rt.ok()) << rt.error().message;
     std::vector<FrameOutput> outs;
-    std::vector<InputFrame> inputs;
-    for (int i = 0; i < 3; ++i) {
-      inputs.push_back(scene.frame(i));
-      auto o = (*rt)->process(inputs.back());
-      ASSERT_TRUE(o.ok()) << o.error().message;
-      for (auto& f : *o) outs.push_back(std::move(f));
-    }
-    auto rest = (*rt)->flush();
-    ASSERT_TRUE(rest.ok()) << rest.error().message;
-    for (auto& f : *rest) outs.push_back(std::move(f));
+    const std::vector<InputFrame> inputs = {scene.frame(0), scene.frame(1), scene.frame(2)};
+    run_frames(**rt, inputs, outs);
+    if (HasFatalFailure()) return;
     ASSERT_EQ(outs.size(), 3u);
     const FrameOutput& out = outs.back();
     const InputFrame& in = inputs.back();
@@ -111,14 +116,8 @@ TEST(Dlpv, VolumesAreReusedOnlyWhileTheInputsStayWithinTolerance) {
   auto rt = make();
   ASSERT_TRUE(rt.ok()) << rt.error().message;
   std::vector<FrameOutput> outs;
-  for (const InputFrame& f : frames) {
-    auto o = (*rt)->process(f);
-    ASSERT_TRUE(o.ok()) << o.error().message;
-    for (auto& x : *o) outs.push_back(std::move(x));
-  }
-  auto rest = (*rt)->flush();
-  ASSERT_TRUE(rest.ok()) << rest.error().message;
-  for (auto& x : *rest) outs.push_back(std::move(x));
+  run_frames(**rt, frames, outs);
+  if (HasFatalFailure()) return;
   ASSERT_EQ(outs.size(), frames.size());
   auto reused = [](const FrameOutput& o) {
     for (const std::string& k : o.stats.skipped)
@@ -132,12 +131,8 @@ TEST(Dlpv, VolumesAreReusedOnlyWhileTheInputsStayWithinTolerance) {
   auto fresh = make();
   ASSERT_TRUE(fresh.ok()) << fresh.error().message;
   std::vector<FrameOutput> recomputed;
-  auto o = (*fresh)->process(frames[2]);
-  ASSERT_TRUE(o.ok()) << o.error().message;
-  for (auto& x : *o) recomputed.push_back(std::move(x));
-  auto r = (*fresh)->flush();
-  ASSERT_TRUE(r.ok()) << r.error().message;
-  for (auto& x : *r) recomputed.push_back(std::move(x));
+  run_frames(**fresh, {frames[2]}, recomputed);
+  if (HasFatalFailure()) return;
   ASSERT_EQ(recomputed.size(), 1u);
   EXPECT_FALSE(reused(recomputed[0]));
   int worst = 0;

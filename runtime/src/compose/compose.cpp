@@ -94,9 +94,7 @@ void Compose::record_classify(gpu::FrameGraph& graph) {
       "compose_tiles_reset", gpu::PassKind::Transfer,
       [this](gpu::PassBuilder& b) { b.write(classify_state_, gpu::Access::TransferDst); },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
-        vkCmdFillBuffer(cmd, pass.buffer(classify_state_), 0, 4, 0u);               // x groups
-        vkCmdFillBuffer(cmd, pass.buffer(classify_state_), 4, 8, 1u);               // y, z
-        vkCmdFillBuffer(cmd, pass.buffer(classify_state_), 12, VK_WHOLE_SIZE, 0u);  // pad, flags
+        gpu::reset_dispatch_args(cmd, pass.buffer(classify_state_), true);  // and the tile flags
       });
   const gpu::Pipeline* pipe = &*classify_pipeline_;
   graph.add_shader_pass(

@@ -345,6 +345,13 @@ void dispatch_indirect(VkCommandBuffer cmd, const Pipeline& pipeline, const void
   vkCmdDispatchIndirect(cmd, args, offset);
 }
 
+void reset_dispatch_args(VkCommandBuffer cmd, VkBuffer args, bool zero_rest) {
+  // Three fills over disjoint ranges: overlapping ones in one pass are a write-after-write hazard.
+  vkCmdFillBuffer(cmd, args, 0, 4, 0u);  // x groups
+  vkCmdFillBuffer(cmd, args, 4, 8, 1u);  // y, z
+  if (zero_rest) vkCmdFillBuffer(cmd, args, 12, VK_WHOLE_SIZE, 0u);
+}
+
 Expected<PipelineHandle> load_compute_pipeline(const Context& ctx, const char* shader,
                                                std::vector<DescriptorBinding> bindings,
                                                uint32_t push_constant_bytes) {

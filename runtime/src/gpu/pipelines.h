@@ -140,6 +140,11 @@ void push_and_dispatch(VkCommandBuffer cmd, const Pipeline& pipeline, const void
 void dispatch_indirect(VkCommandBuffer cmd, const Pipeline& pipeline, const void* push_constants,
                        uint32_t bytes, VkBuffer args, VkDeviceSize offset = 0);
 
+// Resets a VkDispatchIndirectCommand at the start of `args` to (0, 1, 1) for a pass that counts
+// workgroups into x with atomics (a transfer pass; the buffer needs TRANSFER_DST usage), and with
+// `zero_rest` every byte after it to 0 too (flags a counting pass keeps beside the arguments).
+void reset_dispatch_args(VkCommandBuffer cmd, VkBuffer args, bool zero_rest = false);
+
 // A compute pipeline from a registered shader (shaders.h: "folder/name.comp"), owned.
 Expected<PipelineHandle> load_compute_pipeline(const Context& ctx, const char* shader,
                                                std::vector<DescriptorBinding> bindings,

@@ -492,10 +492,7 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     graph.add_pass(
         "ssrt_shade_tiles_clear", gpu::PassKind::Transfer,
         [this](gpu::PassBuilder& b) { b.write(tile_args_, gpu::Access::TransferDst); },
-        [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
-          vkCmdFillBuffer(cmd, pass.buffer(tile_args_), 0, 4, 0u);  // x groups
-          vkCmdFillBuffer(cmd, pass.buffer(tile_args_), 4, 8, 1u);  // y, z
-        });
+        [this](VkCommandBuffer cmd, gpu::PassContext& pass) { gpu::reset_dispatch_args(cmd, pass.buffer(tile_args_)); });
     graph.add_pass(
         "ssrt_shade_tiles", gpu::PassKind::Compute,
         [this](gpu::PassBuilder& b) {
