@@ -53,7 +53,8 @@ struct QualityLevel {
 };
 
 // The value of the knob called `name` of `level`, 0 when the level has none (a ladder's own
-// names; a typed struct per level is issue 14's).
+// names). ssrt still reads its ladder this way; baseline (BaselineLevel) and dlpv (DlpvLevel)
+// read typed level structs and make their knobs from them.
 inline double knob(const QualityLevel& level, const std::string& name) {
   for (const Knob& k : level.knobs)
     if (k.name == name) return k.value;

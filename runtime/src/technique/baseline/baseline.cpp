@@ -220,14 +220,14 @@ Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped
   if (info.level < 0 || info.level >= int(ladder_.size()))
     return fail(ErrorKind::BadUsage, "baseline: level " + std::to_string(info.level) +
                                          " outside 0.." + std::to_string(ladder_.size() - 1));
-  const QualityLevel& level = ladder_[size_t(info.level)];
-  shadow_size_ = uint32_t(knob(level, "shadow_map_size"));
-  pcf_radius_ = int(knob(level, "pcf_radius"));
+  const BaselineLevel& level = baseline_levels()[size_t(info.level)];
+  shadow_size_ = level.shadow_map_size;
+  pcf_radius_ = level.pcf_radius;
   gpu::FrameGraph& graph = *shared_.graph;
-  grid_ = caster_grid(graph.extent(shared_.real_position), shadow_size_, knob(level, "caster_cell_shadow_texels"));
+  grid_ = caster_grid(graph.extent(shared_.real_position), shadow_size_, level.caster_cell_shadow_texels);
   const SceneGpu& sg = *shared_.scene_gpu;
   const SharedResources& s = shared_;
-  MRGI_TRY(update_lights(int(knob(level, "shadowed_estimated_lights"))));
+  MRGI_TRY(update_lights(level.shadowed_estimated_lights));
 
   if (plan_.primary.empty()) {
     skipped.push_back("shadow_primary: no lamp in the scene");
@@ -426,25 +426,33 @@ void Baseline::shade(VkCommandBuffer cmd, gpu::PassContext& pass) {
 
 }  // namespace
 
+const std::array<BaselineLevel, 4>& baseline_levels() {
+  static const std::array<BaselineLevel, 4> levels = {{
+      {"high", 2048, 1.0f, 1, 2.0, 4},
+      {"medium", 1024, 1.0f, 1, 2.0, 4},
+      {"low", 512, 0.75f, 1, 2.0, 2},
+      {"lowest", 256, 0.5f, 0, 2.0, 1},
+  }};
+  return levels;
+}
+
 std::vector<QualityLevel> baseline_ladder() {
-  auto level = [](const char* name, double size, double scale, double pcf, double cell_texels, double estimated) {
+  std::vector<QualityLevel> out;
+  for (const BaselineLevel& b : baseline_levels()) {
     QualityLevel l;
-    l.name = name;
-    l.internal_scale = float(scale);
-    l.knobs = {{"shadow_map_size", size, "texels per side of each map face"},
-               {"internal_scale", scale, "fraction of the output width and height"},
-               {"pcf_radius", pcf, "compare taps on each side of the centre tap"},
-               {"caster_cell_shadow_texels", cell_texels,
+    l.name = b.name;
+    l.internal_scale = b.internal_scale;
+    l.knobs = {{"shadow_map_size", double(b.shadow_map_size), "texels per side of each map face"},
+               {"internal_scale", double(b.internal_scale), "fraction of the output width and height"},
+               {"pcf_radius", double(b.pcf_radius), "compare taps on each side of the centre tap"},
+               {"caster_cell_shadow_texels", b.caster_cell_shadow_texels,
                 "shadow texels a real caster grid cell spans across the G-buffer's larger side"},
-               {"shadowed_estimated_lights", estimated,
+               {"shadowed_estimated_lights", double(b.shadowed_estimated_lights),
                 "of the light stage's estimated lights (environment regions, the probeless dominant "
                 "light), strongest first, how many get shadow maps; the rest light as SH ambient"}};
-    return l;
-  };
-  // Shadowed estimated lights: each costs two shadow maps and a shading term (env_fisheye,
-  // 4 at every level, session 12: high 461 ms, lowest 75 ms against 49 and 25 with none).
-  return {level("high", 2048, 1.0, 1, 2, 4), level("medium", 1024, 1.0, 1, 2, 4),
-          level("low", 512, 0.75, 1, 2, 2), level("lowest", 256, 0.5, 0, 2, 1)};
+    out.push_back(l);
+  }
+  return out;
 }
 
 Expected<std::unique_ptr<Technique>> create_baseline(const SharedResources& shared) {

@@ -20,12 +20,29 @@
 // Maps are allocated at 2048 for every lamp at start-up; lower levels render into and read the
 // top-left corner, so set_level never allocates.
 #pragma once
+#include <array>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
 #include "technique/technique.h"
 
 namespace mrgi::technique {
+
+// One level of the ladder above, typed (the generic QualityLevel knobs are made from it).
+struct BaselineLevel {
+  const char* name;
+  uint32_t shadow_map_size;         // texels per side of each map face
+  float internal_scale;             // fraction of the output width and height
+  int pcf_radius;                   // bilinear compare taps on each side of the centre tap
+  double caster_cell_shadow_texels; // shadow texels a real caster grid cell spans (see above)
+  // Of the light stage's estimated lights (environment regions, the probeless dominant light),
+  // strongest first, how many get shadow maps; the rest light as SH ambient. Each costs two
+  // maps and a shading term (env_fisheye, 4 at every level, session 12: high 461 ms, lowest
+  // 75 ms against 49 and 25 with none).
+  int shadowed_estimated_lights;
+};
+const std::array<BaselineLevel, 4>& baseline_levels();
 
 std::vector<QualityLevel> baseline_ladder();
 Expected<std::unique_ptr<Technique>> create_baseline(const SharedResources& shared);
