@@ -52,15 +52,6 @@ struct QualityLevel {
   float mesh_error_px = 0.0f;
 };
 
-// The value of the knob called `name` of `level`, 0 when the level has none (a ladder's own
-// names). ssrt still reads its ladder this way; baseline (BaselineLevel) and dlpv (DlpvLevel)
-// read typed level structs and make their knobs from them.
-inline double knob(const QualityLevel& level, const std::string& name) {
-  for (const Knob& k : level.knobs)
-    if (k.name == name) return k.value;
-  return 0.0;
-}
-
 // The shared start-up inputs of a technique (owned by the runtime, alive as long as it).
 class SceneGpu;
 struct SharedResources {

@@ -27,7 +27,7 @@ Status Ssrt::write_geometry_constants() {
   return ok_status();
 }
 
-Status Ssrt::record_real_geometry(const FrameInfo& info, const QualityLevel& level,
+Status Ssrt::record_real_geometry(const FrameInfo& info, const SsrtLevel& level,
                                   std::vector<std::string>& skipped) {
   MRGI_TRY(write_geometry_constants());
   if (!volume_center_) {
@@ -42,15 +42,15 @@ Status Ssrt::record_real_geometry(const FrameInfo& info, const QualityLevel& lev
     }
   }
   ssrt::VolumeFrame vf;
-  vf.resolution = uint32_t(knob(level, "volume_resolution"));
-  vf.aux_resolution = uint32_t(knob(level, "aux_resolution"));
+  vf.resolution = level.volume_resolution;
+  vf.aux_resolution = level.aux_resolution;
   vf.center = *volume_center_;
   vf.camera_to_world = info.camera_to_world;
   vf.depth = info.input ? &info.input->depth : nullptr;
   const LightEstimate& e = estimator().estimate();
   vf.direction_to_light = glm::vec3(e.direction_to_light[0], e.direction_to_light[1], e.direction_to_light[2]);
   MRGI_TRY(volume_->record(vf, skipped));
-  return filter_->record(volume_->depth_volume(), knob(level, "final_filter") > 0.5, skipped,
+  return filter_->record(volume_->depth_volume(), level.final_filter, skipped,
                          geometry_step_);
 }
 
@@ -269,13 +269,13 @@ Status Ssrt::record_geometry(const FrameInfo& info, std::vector<std::string>& sk
   if (info.level < 0 || info.level >= int(ladder_.size()))
     return fail(ErrorKind::BadUsage, "ssrt: level " + std::to_string(info.level) + " outside 0.." +
                                          std::to_string(ladder_.size() - 1));
-  const QualityLevel& level = ladder_[size_t(info.level)];
+  const SsrtLevel& level = ssrt_levels()[size_t(info.level)];
   level_ = info.level;
-  step_ = uint32_t(knob(level, "subsample"));
-  directions_ = uint32_t(knob(level, "directions"));
-  bands_ = uint32_t(knob(level, "sh_bands"));
-  geometry_step_ = uint32_t(knob(level, "geometry_step"));
-  occluder_step_ = uint32_t(knob(level, "occluder_step"));
+  step_ = level.subsample;
+  directions_ = level.directions;
+  bands_ = level.sh_bands;
+  geometry_step_ = level.geometry_step;
+  occluder_step_ = level.occluder_step;
   gpu::FrameGraph& graph = *shared_.graph;
   used_ = graph.extent(shared_.lit_r);
   grid_ = glm::uvec2((used_.width + step_ - 1) / step_, (used_.height + step_ - 1) / step_);
@@ -537,34 +537,7 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
 
 }  // namespace ssrt_detail
 
-std::vector<QualityLevel> ssrt_ladder() {
-  auto level = [](const char* name, double step, double n, double bands, double scale,
-                  double volume, double aux, double final_filter, double geometry_step,
-                  double occluder_step) {
-    QualityLevel l;
-    l.name = name;
-    l.internal_scale = float(scale);
-    // The fast levels draw the virtual meshes at a level of detail within half an internal
-    // pixel (desk_spot fast: virtual G-buffer 8.5 -> 4.3 ms, RDE 0.8280 -> 0.8283).
-    l.mesh_error_px = step >= 4 ? 0.5f : 0.0f;
-    l.knobs = {{"subsample", step, "pixels per cell side (transfer computed once per cell)"},
-               {"directions", n, "visibility directions per pixel (per 2x2 jitter set)"},
-               {"sh_bands", bands, "SH bands of transfer and estimated light"},
-               {"internal_scale", scale, "fraction of the output width and height"},
-               {"volume_resolution", volume, "TSDF voxels per side of the 2 m workspace cube"},
-               {"aux_resolution", aux, "texels per side of each auxiliary orthographic buffer"},
-               {"final_filter", final_filter, "1 = the third median pass (eq. 5) on, 0 = off"},
-               {"geometry_step", geometry_step,
-                "internal pixels per texel side of the volume ray cast, depth filters and their "
-                "G-buffer"},
-               {"occluder_step", occluder_step,
-                "internal pixels per texel side of the occluder G-buffer the transfer's samples "
-                "read (virtual surface, albedos; occluders.comp)"}};
-    l.knobs.push_back({"mesh_error_px", double(l.mesh_error_px),
-                       "projected error of the virtual meshes' level of detail, internal pixels "
-                       "(0 = full detail)"});
-    return l;
-  };
+const std::array<SsrtLevel, 4>& ssrt_levels() {
   // Full is the paper's desktop set-up (256^3, eq. 5 pass on); fast its mobile one (64^3, eq. 5
   // pass off) with the OursFast 4x4 sub-sampling; the fast levels also build the geometry
   // (ray cast, filters, G-buffer) once per transfer cell: the transfer reads its receivers at
@@ -575,10 +548,41 @@ std::vector<QualityLevel> ssrt_ladder() {
   // while the suite's RDE moved by at most 0.002 (desk_spot 0.8311 -> 0.8332, corner 0.7617 ->
   // 0.7604, others within 0.0006); fastest: 3.5 -> 1.2 ms, corner 0.8126 -> 0.8203, the others
   // within 0.002.
-  return {level("full", 1, 64, 4, 1.0, 256, 256, 1, 1, 1),
-          level("half", 2, 32, 4, 1.0, 256, 256, 1, 1, 1),
-          level("fast", 4, 32, 4, 1.0, 64, 32, 0, 4, 4),
-          level("fastest", 4, 16, 4, 0.5, 64, 32, 0, 2, 1)};
+  static const std::array<SsrtLevel, 4> levels = {{
+      {"full", 1, 64, 4, 1.0f, 256, 256, true, 1, 1, 0.0f},
+      {"half", 2, 32, 4, 1.0f, 256, 256, true, 1, 1, 0.0f},
+      {"fast", 4, 32, 4, 1.0f, 64, 32, false, 4, 4, 0.5f},
+      {"fastest", 4, 16, 4, 0.5f, 64, 32, false, 2, 1, 0.5f},
+  }};
+  return levels;
+}
+
+std::vector<QualityLevel> ssrt_ladder() {
+  std::vector<QualityLevel> out;
+  for (const SsrtLevel& v : ssrt_levels()) {
+    QualityLevel l;
+    l.name = v.name;
+    l.internal_scale = v.internal_scale;
+    l.mesh_error_px = v.mesh_error_px;
+    l.knobs = {{"subsample", double(v.subsample), "pixels per cell side (transfer computed once per cell)"},
+               {"directions", double(v.directions), "visibility directions per pixel (per 2x2 jitter set)"},
+               {"sh_bands", double(v.sh_bands), "SH bands of transfer and estimated light"},
+               {"internal_scale", double(v.internal_scale), "fraction of the output width and height"},
+               {"volume_resolution", double(v.volume_resolution), "TSDF voxels per side of the 2 m workspace cube"},
+               {"aux_resolution", double(v.aux_resolution), "texels per side of each auxiliary orthographic buffer"},
+               {"final_filter", v.final_filter ? 1.0 : 0.0, "1 = the third median pass (eq. 5) on, 0 = off"},
+               {"geometry_step", double(v.geometry_step),
+                "internal pixels per texel side of the volume ray cast, depth filters and their "
+                "G-buffer"},
+               {"occluder_step", double(v.occluder_step),
+                "internal pixels per texel side of the occluder G-buffer the transfer's samples "
+                "read (virtual surface, albedos; occluders.comp)"},
+               {"mesh_error_px", double(v.mesh_error_px),
+                "projected error of the virtual meshes' level of detail, internal pixels "
+                "(0 = full detail)"}};
+    out.push_back(l);
+  }
+  return out;
 }
 
 Expected<std::unique_ptr<Technique>> create_ssrt(const SharedResources& shared) {

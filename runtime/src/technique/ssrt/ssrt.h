@@ -113,6 +113,8 @@
 // saved nothing and cost the direction (46 degrees off; LightEstimatorSettings::
 // below_surface_penalty says why).
 #pragma once
+#include <array>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -120,6 +122,25 @@
 #include "technique/technique.h"
 
 namespace mrgi::technique {
+
+// One level of the ladder, typed (the generic QualityLevel knobs are made from it).
+struct SsrtLevel {
+  const char* name;
+  uint32_t subsample;          // pixels per cell side (transfer computed once per cell)
+  uint32_t directions;         // visibility directions per pixel (per 2x2 jitter set)
+  uint32_t sh_bands;           // SH bands of transfer and estimated light
+  float internal_scale;        // fraction of the output width and height
+  uint32_t volume_resolution;  // TSDF voxels per side of the 2 m workspace cube
+  uint32_t aux_resolution;     // texels per side of each auxiliary orthographic buffer
+  bool final_filter;           // the third median pass (eq. 5)
+  uint32_t geometry_step;      // internal pixels per texel side of the ray cast, filters, G-buffer
+  uint32_t occluder_step;      // internal pixels per texel side of the occluder G-buffer
+  // Projected error of the virtual meshes' level of detail, internal pixels (0 = full detail):
+  // the fast levels draw within half an internal pixel (desk_spot fast: virtual G-buffer 8.5 ->
+  // 4.3 ms, RDE 0.8280 -> 0.8283).
+  float mesh_error_px;
+};
+const std::array<SsrtLevel, 4>& ssrt_levels();
 
 std::vector<QualityLevel> ssrt_ladder();
 Expected<std::unique_ptr<Technique>> create_ssrt(const SharedResources& shared);

@@ -11,9 +11,9 @@ Status Ssrt::init() {
   ssrt::VolumeSettings vs;
   vs.max_resolution = 1;
   vs.max_aux_resolution = 1;
-  for (const QualityLevel& l : ladder_) {
-    vs.max_resolution = std::max(vs.max_resolution, uint32_t(knob(l, "volume_resolution")));
-    vs.max_aux_resolution = std::max(vs.max_aux_resolution, uint32_t(knob(l, "aux_resolution")));
+  for (const SsrtLevel& l : ssrt_levels()) {
+    vs.max_resolution = std::max(vs.max_resolution, l.volume_resolution);
+    vs.max_aux_resolution = std::max(vs.max_aux_resolution, l.aux_resolution);
   }
   auto geo_constants = graph.create_buffer(
       {"ssrt_geometry_constants", sizeof(shader::FrameConstants), gpu::MemoryUsage::Upload, true},
@@ -49,8 +49,8 @@ Status Ssrt::init() {
   // a uniform buffer with vector inserts but a storage buffer lane by lane in a branchy loop
   // (14 % of the transfer's sample loop).
   std::vector<glm::vec4> directions;
-  for (const QualityLevel& l : ladder_) {
-    auto sets = ssrt::make_sample_sets({uint32_t(knob(l, "directions")), kSampleSeed});
+  for (const SsrtLevel& l : ssrt_levels()) {
+    auto sets = ssrt::make_sample_sets({l.directions, kSampleSeed});
     if (!sets) return sets.error();
     sample_base_.push_back(uint32_t(directions.size()));
     chi_.push_back(sets->chi);
@@ -150,8 +150,8 @@ Status Ssrt::init() {
   // One blur per window radius the ladder uses, the radius a constant (upsample_blur.comp).
   auto blur_spv = gpu::shader_spirv("ssrt/upsample_blur.comp");
   if (!blur_spv) return blur_spv.error();
-  for (const QualityLevel& level : ladder_) {
-    const int step = int(knob(level, "subsample"));
+  for (const SsrtLevel& level : ssrt_levels()) {
+    const int step = int(level.subsample);
     if (step <= 1) continue;
     const int r = blur_radius_cells(step);
     if (std::any_of(blur_by_radius_.begin(), blur_by_radius_.end(),

@@ -112,7 +112,7 @@ class Ssrt final : public Technique {
   void consume_readback(uint32_t slot, std::vector<std::string>& notes);
   // The paper's geometry stage (Sec. 4): fuse the volume, ray-cast G_v and the aux layers, run
   // the depth filter chain into the G-buffer the transfer reads.
-  Status record_real_geometry(const FrameInfo& info, const QualityLevel& level,
+  Status record_real_geometry(const FrameInfo& info, const SsrtLevel& level,
                               std::vector<std::string>& skipped);
   void write_light();
   // Whether the virtual objects' influence region (bounds grown by the sampling radius) is in
