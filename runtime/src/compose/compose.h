@@ -40,8 +40,10 @@ struct ComposeInputs {
   // the solutions, not computed this frame, are not looked at.
   bool camera_only = false;
   // The technique's Technique::compose_tiles() (valid handles): outside the listed 8 x 8 tiles
-  // the output is the camera frame. Used when the solutions are at the output size; then
-  // compose runs as a camera copy over the frame and the composite over the tiles.
+  // the output is the camera frame (tile indices of the output, ty * ceil(w / 8) + tx). Without
+  // them compose lists its own (ComposeSettings::classify_tiles). Compose then runs the composite
+  // over the tiles only, from solutions at the output size or resampled, and takes the camera
+  // frame elsewhere (on the host at the camera's size, else a camera copy pass first).
   gpu::BufferHandle tile_args, tile_list;
   // The technique wrote the composite of those tiles into output() and mask() itself
   // (Technique::ComposeTiles::composed): compose adds no pass of its own, only the tile-list
