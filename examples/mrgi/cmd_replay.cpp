@@ -40,6 +40,7 @@ void run_replay(const ReplayOptions& o) {
     if (a == "two-volumes") settings.dlpv_ablation.two_volumes = true;
     if (a == "no-damping") settings.dlpv_ablation.no_negative_damping = true;
     if (a == "no-shift") settings.dlpv_ablation.no_half_cell_shift = true;
+    if (a == "no-self-bounce") settings.dlpv_ablation.no_virtual_self_bounce = true;
   }
   if (settings.dlpv_ablation.any() && o.technique != "dlpv")
     throw CommandFailure(2, "--dlpv-ablation: only for --technique dlpv");
@@ -193,9 +194,10 @@ void setup(CLI::App& app) {
   cmd->add_option("--dlpv-ablation", opts->dlpv_ablation,
                   "dlpv without one of the paper's ideas (mrgi/runtime.h DlpvAblation): two-volumes (V^rho and V^mu "
                   "propagated apart, not V^Delta), no-damping (of negative flux), no-shift (VPLs at their surface, not "
-                  "half a cell along the normal); comma-separated")
+                  "half a cell along the normal), no-self-bounce (V^rho from the real "
+                  "surfaces' VPLs only, not the virtual objects' own); comma-separated")
       ->delimiter(',')
-      ->check(CLI::IsMember({"two-volumes", "no-damping", "no-shift"}));
+      ->check(CLI::IsMember({"two-volumes", "no-damping", "no-shift", "no-self-bounce"}));
   cmd->add_option("--device", opts->device, "Vulkan device: index or name part (default $MRGI_DEVICE, else lavapipe)");
   cmd->add_flag("--validate", opts->validate, "enable Vulkan validation layers");
   cmd->add_flag("--quiet,-q", opts->quiet, "no progress on stderr");

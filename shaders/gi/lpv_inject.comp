@@ -5,6 +5,8 @@
 //   indirect (paper eq. 12-13): I(w) = P / pi max(0, n . w), P the texel's reflected flux, at
 //     the texel's position moved half a cell along its normal (no self-illumination, no VPL
 //     behind its own surface);
+//   indirect from real surfaces: the same for the texels of real surfaces only (position w 1;
+//     virtual ones are 2): V^rho without a virtual object's light onto itself (an ablation);
 //   direct (Sec. 4.3.2): the light arriving at the texel, P_in (W), as an emitter facing the
 //     light's travel direction, moved half a cell towards the light; only where the other map
 //     (`other_position`, R^rho for R^mu's texels) sees a different surface: the light the
@@ -19,14 +21,15 @@
 #include "shared/lpv_math.h"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(set = 0, binding = 0, rgba32f) uniform readonly image2D rsm_position;  // xyz world m, w 1 = surface
+layout(set = 0, binding = 0, rgba32f) uniform readonly image2D rsm_position;  // xyz world m, w 1 real, 2 virtual
 layout(set = 0, binding = 1, rgba16f) uniform readonly image2D rsm_normal;    // xyz world, unit
 layout(set = 0, binding = 2, rgba32f) uniform readonly image2D rsm_flux;      // rgb reflected W, a: incident W per unit light colour
 layout(set = 0, binding = 3, r32f) uniform imageBuffer cells;                 // 12 per cell: channel * 4 + coefficient
 layout(set = 0, binding = 4, rgba32f) uniform readonly image2D other_position;  // direct mode: the other map
 layout(push_constant) uniform InjectParams {
   vec4 grid;       // xyz: the volume's min corner (m); w: cell size (m)
-  ivec4 sizes;     // x: cells per side; y, z: the map's used width and height; w: 1 = direct
+  ivec4 sizes;     // x: cells per side; y, z: the map's used width and height; w: 0 indirect,
+                   // 1 direct, 2 indirect from real surfaces only
   vec4 light;      // xyz: direction the light travels (w 0) or the lamp's position (w 1)
   vec4 colour;     // rgb: the lamp's colour (direct mode); w: sign, +1 or -1
   vec4 options;    // x: VPL shift along the normal, cells (0.5; 0 only as an ablation)
@@ -54,6 +57,7 @@ void main() {
     lobe = sh4_cosine_lobe(travel) * (1.0 / MRGI_PI);
     power = colour.xyz * flux.w;
   } else {
+    if (sizes.w == 2 && pos.w > 1.5) return;  // a virtual surface's VPL
     if (dot(n, travel) >= 0.0) return;  // a surface the light reaches from behind reflects nothing
     at = pos.xyz + n * (params_block.options.x * grid.w);
     lobe = sh4_cosine_lobe(n) * (1.0 / MRGI_PI);

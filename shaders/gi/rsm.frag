@@ -25,7 +25,7 @@ layout(location = 1) in vec3 in_normal;
 layout(location = 2) in vec2 in_uv;
 layout(location = 3) in vec4 in_albedo;
 layout(location = 4) flat in float in_layer;
-layout(location = 0) out vec4 out_position;  // xyz world, w 1
+layout(location = 0) out vec4 out_position;  // xyz world, w 1 real surface, 2 virtual
 layout(location = 1) out vec4 out_normal;    // xyz unit, facing the light
 layout(location = 2) out vec4 out_flux;      // rgb reflected W, a incident W per unit colour
 
@@ -45,7 +45,7 @@ void main() {
     incident = -draw.light.w;
   }
   if (dot(n, travel) > 0.0f) n = -n;  // two-sided: the side the light reaches
-  out_position = vec4(in_world, 1.0f);
+  out_position = vec4(in_world, draw.misc.y >= 0 ? 2.0f : 1.0f);  // virtual meshes carry a material
   out_normal = vec4(n, 0.0f);
   out_flux = vec4(albedo * draw.colour.xyz * incident, incident);
 }

@@ -24,6 +24,7 @@ struct Texel {
   glm::vec3 position;
   glm::vec3 normal;
   glm::vec4 flux;  // rgb reflected, a incident per unit colour
+  bool virtual_surface = false;  // position w 2 (a virtual object's texel), else 1
 };
 
 struct Lpv {
@@ -72,7 +73,7 @@ struct Lpv {
     std::vector<uint16_t> nor;
     for (const Texel& t : texels) {
       blocked.insert(blocked.end(), {t.position.x, t.position.y + 0.3f, t.position.z, 1.0f});
-      pos.insert(pos.end(), {t.position.x, t.position.y, t.position.z, 1.0f});
+      pos.insert(pos.end(), {t.position.x, t.position.y, t.position.z, t.virtual_surface ? 2.0f : 1.0f});
       for (float c : {t.normal.x, t.normal.y, t.normal.z, 0.0f}) nor.push_back(uint16_t(glm::packHalf1x16(c)));
       flux.insert(flux.end(), {t.flux.x, t.flux.y, t.flux.z, t.flux.w});
     }
@@ -163,6 +164,23 @@ TEST_F(VulkanTest, LpvInjectsAVplHalfACellAlongItsNormal) {
     for (size_t i = 0; i < sum[c].size(); ++i) {
       const glm::vec4 expect = i == cell(4, 2, 4) ? want : glm::vec4(0.0f);
       for (int k = 0; k < 4; ++k) ASSERT_NEAR(sum[c][i][k], expect[k], 1e-6f) << "channel " << c << " cell " << i;
+    }
+  }
+}
+
+TEST_F(VulkanTest, LpvIndirectFromRealSurfacesLeavesVirtualTexelsOut) {
+  // A real floor texel and a virtual one (position w 2) two cells apart: IndirectFromReal
+  // injects the real one only, Indirect both.
+  Lpv t(ctx(), {{glm::vec3(1.0f, 0.5f, 1.0f), glm::vec3(0, 1, 0), glm::vec4(1, 1, 1, 1)},
+                {glm::vec3(1.5f, 0.5f, 1.0f), glm::vec3(0, 1, 0), glm::vec4(1, 1, 1, 1), true}});
+  auto real = t.run([&] { t.inject("rho", gi::InjectKind::IndirectFromReal, 1.0f, kSunFromAbove); }, 0);
+  auto all = t.run([&] { t.inject("rho", gi::InjectKind::Indirect, 1.0f, kSunFromAbove); }, 0);
+  const glm::vec4 vpl = sh::lpv_vpl_intensity(glm::vec3(0, 1, 0), 1.0f);
+  for (uint32_t c = 0; c < 3; ++c) {
+    for (int k = 0; k < 4; ++k) {
+      EXPECT_NEAR(real[c][cell(4, 2, 4)][k], vpl[k], 1e-6f);
+      EXPECT_NEAR(real[c][cell(6, 2, 4)][k], 0.0f, 1e-9f);
+      EXPECT_NEAR(all[c][cell(6, 2, 4)][k], vpl[k], 1e-6f);
     }
   }
 }

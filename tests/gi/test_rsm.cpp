@@ -136,7 +136,8 @@ TEST_F(VulkanTest, RsmPairHoldsFloorAndBoxAndTheirDeltaIsTheBoxTop) {
   const float area = std::pow(2.0f * kRadius / float(kMap), 2.0f);
   // The centre texel: the box top in R^rho (0.15 m up, albedo 0.8), the floor in R^mu (0.5).
   const glm::vec4 rho_p = at(0, kMap / 2, kMap / 2), mu_p = at(2, kMap / 2, kMap / 2);
-  EXPECT_EQ(rho_p.w, 1.0f);
+  EXPECT_EQ(rho_p.w, 2.0f);  // a virtual surface
+  EXPECT_EQ(mu_p.w, 1.0f);   // a real one
   EXPECT_NEAR(rho_p.y, 0.15f, 1e-3f);
   EXPECT_NEAR(mu_p.y, 0.0f, 1e-3f);
   const glm::vec4 rho_f = at(1, kMap / 2, kMap / 2), mu_f = at(3, kMap / 2, kMap / 2);

@@ -265,11 +265,13 @@ TEST(Dlpv, AblationsRunAndChangeTheFrame) {
   std::string error;
   const FrameOutput paper = first_frame({}, 1, &error);
   ASSERT_TRUE(error.empty()) << error;
-  DlpvAblation two, damping, shift;
+  DlpvAblation two, damping, shift, self;
   two.two_volumes = true;
   damping.no_negative_damping = true;
   shift.no_half_cell_shift = true;
-  for (const auto& [name, a] : {std::pair{"two volumes", two}, std::pair{"no damping", damping}, std::pair{"no shift", shift}}) {
+  self.no_virtual_self_bounce = true;
+  for (const auto& [name, a] : {std::pair{"two volumes", two}, std::pair{"no damping", damping}, std::pair{"no shift", shift},
+                                std::pair{"no self bounce", self}}) {
     const FrameOutput f = first_frame(a, 1, &error);
     ASSERT_TRUE(error.empty()) << name << ": " << error;
     ASSERT_EQ(f.image.data.size(), paper.image.data.size()) << name;

@@ -54,7 +54,11 @@ struct DlpvAblation {
   bool two_volumes = false;
   bool no_negative_damping = false;  // propagate V^Delta without damping negative flux (Sec. 4.4)
   bool no_half_cell_shift = false;   // inject VPLs at their surface, not half a cell along the normal
-  bool any() const { return two_volumes || no_negative_damping || no_half_cell_shift; }
+  // V^rho (the virtual pixels' bounce light) from the real surfaces' VPLs only, without the
+  // virtual objects' light onto themselves (which a volume of cells about an object's size
+  // cannot resolve: perf/results/dlpv/ablation says what it does to the frames).
+  bool no_virtual_self_bounce = false;
+  bool any() const { return two_volumes || no_negative_damping || no_half_cell_shift || no_virtual_self_bounce; }
 };
 
 // Level "last" in the CLI resolves to technique_level_count(name) - 1.

@@ -123,7 +123,8 @@ void LightPropagationVolume::add_inject(gpu::FrameGraph& graph, const std::strin
   // Indirect mode reads no other map: the map's own positions stand in for the binding.
   const gpu::ImageHandle other_position = kind == InjectKind::Direct && other ? other->position : rsm.position;
   const InjectPush push{glm::vec4(grid_.origin, grid_.cell_size),
-                        glm::ivec4(int(cells()), int(rsm.width), int(rsm.height), kind == InjectKind::Direct ? 1 : 0),
+                        glm::ivec4(int(cells()), int(rsm.width), int(rsm.height),
+                                   kind == InjectKind::Direct ? 1 : kind == InjectKind::IndirectFromReal ? 2 : 0),
                         glm::vec4(light.direction_or_position, light.positional ? 1.0f : 0.0f),
                         glm::vec4(light.colour, sign),
                         glm::vec4(settings_.vpl_shift_cells, 0.0f, 0.0f, 0.0f)};

@@ -46,7 +46,7 @@ struct LpvGrid {
 
 // A reflective shadow map as the injection reads it (gi/lpv_inject.comp's bindings).
 struct RsmImages {
-  gpu::ImageHandle position;  // RGBA32F: world xyz (m), w 1 where a surface was seen
+  gpu::ImageHandle position;  // RGBA32F: world xyz (m), w 1 a real surface, 2 a virtual one, 0 none
   gpu::ImageHandle normal;    // RGBA16F: world normal
   gpu::ImageHandle flux;      // RGBA32F: rgb reflected flux (W); a: incident W per unit light colour
   uint32_t width = 0, height = 0;  // the used size
@@ -59,10 +59,12 @@ struct LpvLight {
   glm::vec3 colour{1.0f};  // the lamp's colour (direct injection scales incident W by it)
 };
 
-// Indirect: the map's VPLs (eq. 12). Direct: the light arriving at the map's texels where
-// `other` (the pair's other map) sees another surface, i.e. the light the virtual objects block
-// (Sec. 4.3.2; lpv_inject.comp says where this differs from the paper).
-enum class InjectKind : uint8_t { Indirect, Direct };
+// Indirect: the map's VPLs (eq. 12). IndirectFromReal: the VPLs of its real surfaces only
+// (position w 1, not 2): the bounce light the real scene sends, without a virtual object's light
+// onto itself (DlpvAblation::no_virtual_self_bounce). Direct: the light arriving at the map's
+// texels where `other` (the pair's other map) sees another surface, i.e. the light the virtual
+// objects block (Sec. 4.3.2; lpv_inject.comp says where this differs from the paper).
+enum class InjectKind : uint8_t { Indirect, Direct, IndirectFromReal };
 
 class LightPropagationVolume {
  public:

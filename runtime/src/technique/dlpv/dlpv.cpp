@@ -314,7 +314,10 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
       rsm_->add_draw(graph, "rho " + id, *view, gi::RsmMap::WithVirtual, level.rsm_size);
       if (!two) delta_->add_inject(graph, "rho " + id, rho_map, view->lpv, gi::InjectKind::Indirect, 1.0f);
       if (level.rho_volume || two)
-        rho_->add_inject(graph, "rho " + id, rho_map, view->lpv, gi::InjectKind::Indirect, 1.0f);
+        rho_->add_inject(graph, "rho " + id, rho_map, view->lpv,
+                         !two && shared_.dlpv_ablation.no_virtual_self_bounce ? gi::InjectKind::IndirectFromReal
+                                                                              : gi::InjectKind::Indirect,
+                         1.0f);
       rsm_->add_draw(graph, "mu " + id, *view, gi::RsmMap::RealOnly, level.rsm_size);
       if (two) {
         mu_->add_inject(graph, "mu " + id, mu_map, view->lpv, gi::InjectKind::Indirect, 1.0f);
