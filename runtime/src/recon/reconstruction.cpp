@@ -148,65 +148,43 @@ void Reconstruction::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_cons
   history_extent_ = extent;
 
   if (warp) {
-    graph.add_pass(
-        "recon_warp", gpu::PassKind::Compute,
-        [this](gpu::PassBuilder& b) {
-          b.read(frame_constants_, gpu::Access::UniformRead);
-          b.read(filtered_depth_, gpu::Access::StorageRead);
-          b.write(warped_, gpu::Access::StorageReadWrite);
+    graph.add_shader_pass(
+        "recon_warp", gpu::PassKind::Compute, *warp_pipeline_,
+        [this](gpu::ShaderPassBuilder& b) {
+          b.bind("FrameUbo", frame_constants_);
+          b.bind("previous_depth", filtered_depth_);
+          b.bind("warped", warped_);
         },
         [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
-          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, warp_pipeline_->pipeline);
-          gpu::DescriptorPush()
-              .uniform_buffer(0, pass.buffer(frame_constants_))
-              .storage_image(1, pass.view(filtered_depth_))
-              .storage_image(2, pass.view(warped_))
-              .push(pass.context(), cmd, *warp_pipeline_);
           const VkExtent2D e = pass.extent(filtered_depth_);
           gpu::dispatch_2d(cmd, *warp_pipeline_, &previous_to_current_,
                            sizeof(previous_to_current_), e.width, e.height);
         });
   }
-  graph.add_pass(
-      "recon_positions", gpu::PassKind::Compute,
-      [this](gpu::PassBuilder& b) {
-        b.read(frame_constants_, gpu::Access::UniformRead);
-        b.read(color_upload_, gpu::Access::StorageRead);
-        b.read(depth_upload_, gpu::Access::StorageRead);
-        b.write(position_, gpu::Access::StorageWrite);
-        b.write(albedo_, gpu::Access::StorageWrite);
-        b.write(warped_, gpu::Access::StorageReadWrite);
-        b.write(filtered_depth_, gpu::Access::StorageWrite);
+  graph.add_shader_pass(
+      "recon_positions", gpu::PassKind::Compute, *positions_pipeline_,
+      [this](gpu::ShaderPassBuilder& b) {
+        b.bind("FrameUbo", frame_constants_);
+        b.bind("color_words", color_upload_);
+        b.bind("depth_words", depth_upload_);
+        b.bind("real_position", position_);
+        b.bind("real_albedo", albedo_);
+        b.bind("warped", warped_);
+        b.bind("filtered_depth", filtered_depth_);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, positions_pipeline_->pipeline);
-        gpu::DescriptorPush()
-            .uniform_buffer(0, pass.buffer(frame_constants_))
-            .storage_texel_buffer(1, pass.texel_view(color_upload_))
-            .storage_texel_buffer(2, pass.texel_view(depth_upload_))
-            .storage_image(3, pass.view(position_))
-            .storage_image(4, pass.view(albedo_))
-            .storage_image(5, pass.view(warped_))
-            .storage_image(6, pass.view(filtered_depth_))
-            .push(pass.context(), cmd, *positions_pipeline_);
         const VkExtent2D e = pass.extent(position_);
         gpu::dispatch_2d(cmd, *positions_pipeline_, &merge_push_, sizeof(merge_push_), e.width,
                          e.height);
       });
-  graph.add_pass(
-      "recon_normals", gpu::PassKind::Compute,
-      [this](gpu::PassBuilder& b) {
-        b.read(frame_constants_, gpu::Access::UniformRead);
-        b.read(position_, gpu::Access::StorageRead);
-        b.write(normal_, gpu::Access::StorageWrite);
+  graph.add_shader_pass(
+      "recon_normals", gpu::PassKind::Compute, *normals_pipeline_,
+      [this](gpu::ShaderPassBuilder& b) {
+        b.bind("FrameUbo", frame_constants_);
+        b.bind("real_position", position_);
+        b.bind("real_normal", normal_);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, normals_pipeline_->pipeline);
-        gpu::DescriptorPush()
-            .uniform_buffer(0, pass.buffer(frame_constants_))
-            .storage_image(1, pass.view(position_))
-            .storage_image(2, pass.view(normal_))
-            .push(pass.context(), cmd, *normals_pipeline_);
         const VkExtent2D e = pass.extent(normal_);
         gpu::dispatch_2d(cmd, *normals_pipeline_, &normal_push_, sizeof(normal_push_), e.width,
                          e.height);
