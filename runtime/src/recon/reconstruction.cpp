@@ -93,28 +93,16 @@ Expected<Reconstruction> Reconstruction::create(gpu::Context& context, gpu::Fram
   if (!wp) return wp.error();
   r.warped_ = *wp;
 
-  const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-  const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-  const auto texel = VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER;  // the camera uploads (upload_gather.glsl)
-  auto pos_spv = gpu::shader_spirv("recon/depth_to_positions.comp");
-  if (!pos_spv) return pos_spv.error();
-  auto pp = gpu::create_compute_pipeline(
-      context, {"recon_positions", *pos_spv, {{ubo}, {texel}, {texel}, {img}, {img}, {img}, {img}},
-                sizeof(MergePush)});
+  // Layouts and push-constant sizes come from the shaders (gpu/reflect.h); the passes bind by name.
+  auto pp = gpu::load_compute_pipeline(context, "recon/depth_to_positions.comp", {});
   if (!pp) return pp.error();
-  r.positions_pipeline_ = gpu::PipelineHandle(context, std::move(*pp));
-  auto nrm_spv = gpu::shader_spirv("recon/normals.comp");
-  if (!nrm_spv) return nrm_spv.error();
-  auto np = gpu::create_compute_pipeline(
-      context, {"recon_normals", *nrm_spv, {{ubo}, {img}, {img}}, sizeof(glm::ivec4)});
+  r.positions_pipeline_ = std::move(*pp);
+  auto np = gpu::load_compute_pipeline(context, "recon/normals.comp", {});
   if (!np) return np.error();
-  r.normals_pipeline_ = gpu::PipelineHandle(context, std::move(*np));
-  auto warp_spv = gpu::shader_spirv("recon/warp_depth.comp");
-  if (!warp_spv) return warp_spv.error();
-  auto wpp = gpu::create_compute_pipeline(
-      context, {"recon_warp", *warp_spv, {{ubo}, {img}, {img}}, sizeof(glm::mat4)});
+  r.normals_pipeline_ = std::move(*np);
+  auto wpp = gpu::load_compute_pipeline(context, "recon/warp_depth.comp", {});
   if (!wpp) return wpp.error();
-  r.warp_pipeline_ = gpu::PipelineHandle(context, std::move(*wpp));
+  r.warp_pipeline_ = std::move(*wpp);
   return r;
 }
 

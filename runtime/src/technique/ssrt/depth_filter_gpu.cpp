@@ -117,25 +117,20 @@ Expected<DepthFilterGpu> DepthFilterGpu::create(gpu::Context& ctx, gpu::FrameGra
   const float zero = 0.0f;  // defined contents and the GENERAL layout (never read by the shader)
   MRGI_TRY(graph.upload_image(f.no_volume_, &zero, sizeof(zero)));
 
-  const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-  const auto texel = VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER;  // the camera uploads (upload_gather.glsl)
-  const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-  auto p = gpu::load_compute_pipeline(ctx, "ssrt/depth_input.comp", {{ubo}, {texel}, {texel}, {img}, {img}},
-                    sizeof(WindowPush));
+  // Layouts and push-constant sizes come from the shaders (gpu/reflect.h); the passes bind by name.
+  auto p = gpu::load_compute_pipeline(ctx, "ssrt/depth_input.comp", {});
   if (!p) return p.error();
   f.input_pipe_ = std::move(*p);
-  p = gpu::load_compute_pipeline(ctx, "ssrt/depth_merge.comp", {{ubo}, {img}, {img}, {img}, {img}},
-               sizeof(WindowPush));
+  p = gpu::load_compute_pipeline(ctx, "ssrt/depth_merge.comp", {});
   if (!p) return p.error();
   f.merge_ = std::move(*p);
-  p = gpu::load_compute_pipeline(ctx, "ssrt/depth_bilateral.comp", {{ubo}, {img}, {img}}, sizeof(WindowPush));
+  p = gpu::load_compute_pipeline(ctx, "ssrt/depth_bilateral.comp", {});
   if (!p) return p.error();
   f.bilateral_pipe_ = std::move(*p);
-  p = gpu::load_compute_pipeline(ctx, "ssrt/depth_final.comp", {{ubo}, {img}, {img}}, sizeof(glm::ivec4));
+  p = gpu::load_compute_pipeline(ctx, "ssrt/depth_final.comp", {});
   if (!p) return p.error();
   f.final_pipe_ = std::move(*p);
-  p = gpu::load_compute_pipeline(ctx, "ssrt/depth_gbuffer.comp", {{ubo}, {img}, {img}, {img}},
-                                 sizeof(glm::ivec4));
+  p = gpu::load_compute_pipeline(ctx, "ssrt/depth_gbuffer.comp", {});
   if (!p) return p.error();
   f.gbuffer_ = std::move(*p);
 
@@ -182,84 +177,56 @@ Status DepthFilterGpu::record(gpu::ImageHandle depth_volume, bool final_pass,
   merge_push_.window.w = depth_volume.valid() ? 1 : 0;
   gpu::FrameGraph& graph = *graph_;
 
-  graph.add_pass(
-      "ssrt_depth_input", gpu::PassKind::Compute,
-      [this](gpu::PassBuilder& b) {
-        b.read(frame_constants_, gpu::Access::UniformRead);
-        b.read(color_upload_, gpu::Access::StorageRead);
-        b.read(depth_upload_, gpu::Access::StorageRead);
-        b.read(volume_, gpu::Access::StorageRead);
-        b.write(input_, gpu::Access::StorageWrite);
+  graph.add_shader_pass(
+      "ssrt_depth_input", gpu::PassKind::Compute, *input_pipe_,
+      [this](gpu::ShaderPassBuilder& b) {
+        b.bind("FrameUbo", frame_constants_);
+        b.bind("color_words", color_upload_);
+        b.bind("depth_words", depth_upload_);
+        b.bind("depth_volume", volume_);
+        b.bind("depth_input", input_);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, input_pipe_->pipeline);
-        gpu::DescriptorPush()
-            .uniform_buffer(0, pass.buffer(frame_constants_))
-            .storage_texel_buffer(1, pass.texel_view(color_upload_))
-            .storage_texel_buffer(2, pass.texel_view(depth_upload_))
-            .storage_image(3, pass.view(volume_))
-            .storage_image(4, pass.view(input_))
-            .push(pass.context(), cmd, *input_pipe_);
         const VkExtent2D e = pass.extent(input_);
         gpu::dispatch_2d(cmd, *input_pipe_, &merge_push_, sizeof(merge_push_), e.width, e.height);
       });
 
-  graph.add_pass(
-      "ssrt_depth_merge", gpu::PassKind::Compute,
-      [this](gpu::PassBuilder& b) {
-        b.read(frame_constants_, gpu::Access::UniformRead);
-        b.read(input_, gpu::Access::StorageRead);
-        b.read(volume_, gpu::Access::StorageRead);
-        b.write(merged_, gpu::Access::StorageWrite);
-        b.write(merged_intensity_, gpu::Access::StorageWrite);
+  graph.add_shader_pass(
+      "ssrt_depth_merge", gpu::PassKind::Compute, *merge_,
+      [this](gpu::ShaderPassBuilder& b) {
+        b.bind("FrameUbo", frame_constants_);
+        b.bind("depth_input", input_);
+        b.bind("depth_volume", volume_);
+        b.bind("merged", merged_);
+        b.bind("merged_intensity", merged_intensity_);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, merge_->pipeline);
-        gpu::DescriptorPush()
-            .uniform_buffer(0, pass.buffer(frame_constants_))
-            .storage_image(1, pass.view(input_))
-            .storage_image(2, pass.view(volume_))
-            .storage_image(3, pass.view(merged_))
-            .storage_image(4, pass.view(merged_intensity_))
-            .push(pass.context(), cmd, *merge_);
         const VkExtent2D e = pass.extent(merged_);
         gpu::dispatch_2d(cmd, *merge_, &merge_push_, sizeof(merge_push_), e.width, e.height);
       });
 
-  graph.add_pass(
-      "ssrt_depth_bilateral", gpu::PassKind::Compute,
-      [this](gpu::PassBuilder& b) {
-        b.read(frame_constants_, gpu::Access::UniformRead);
-        b.read(merged_intensity_, gpu::Access::StorageRead);
-        b.write(bilateral_, gpu::Access::StorageWrite);
+  graph.add_shader_pass(
+      "ssrt_depth_bilateral", gpu::PassKind::Compute, *bilateral_pipe_,
+      [this](gpu::ShaderPassBuilder& b) {
+        b.bind("FrameUbo", frame_constants_);
+        b.bind("merged_intensity", merged_intensity_);
+        b.bind("bilateral", bilateral_);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, bilateral_pipe_->pipeline);
-        gpu::DescriptorPush()
-            .uniform_buffer(0, pass.buffer(frame_constants_))
-            .storage_image(1, pass.view(merged_intensity_))
-            .storage_image(2, pass.view(bilateral_))
-            .push(pass.context(), cmd, *bilateral_pipe_);
         const VkExtent2D e = pass.extent(bilateral_);
         gpu::dispatch_2d(cmd, *bilateral_pipe_, &bilateral_push_, sizeof(bilateral_push_),
                          e.width, e.height);
       });
 
   if (final_pass) {
-    graph.add_pass(
-        "ssrt_depth_final", gpu::PassKind::Compute,
-        [this](gpu::PassBuilder& b) {
-          b.read(frame_constants_, gpu::Access::UniformRead);
-          b.read(bilateral_, gpu::Access::StorageRead);
-          b.write(final_, gpu::Access::StorageWrite);
+    graph.add_shader_pass(
+        "ssrt_depth_final", gpu::PassKind::Compute, *final_pipe_,
+        [this](gpu::ShaderPassBuilder& b) {
+          b.bind("FrameUbo", frame_constants_);
+          b.bind("bilateral", bilateral_);
+          b.bind("final_depth", final_);
         },
         [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
-          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, final_pipe_->pipeline);
-          gpu::DescriptorPush()
-              .uniform_buffer(0, pass.buffer(frame_constants_))
-              .storage_image(1, pass.view(bilateral_))
-              .storage_image(2, pass.view(final_))
-              .push(pass.context(), cmd, *final_pipe_);
           const VkExtent2D e = pass.extent(final_);
           gpu::dispatch_2d(cmd, *final_pipe_, &final_push_, sizeof(final_push_), e.width,
                            e.height);
@@ -270,22 +237,15 @@ Status DepthFilterGpu::record(gpu::ImageHandle depth_volume, bool final_pass,
     gbuffer_source_ = bilateral_;
   }
 
-  graph.add_pass(
-      "ssrt_gbuffer", gpu::PassKind::Compute,
-      [this](gpu::PassBuilder& b) {
-        b.read(frame_constants_, gpu::Access::UniformRead);
-        b.read(gbuffer_source_, gpu::Access::StorageRead);
-        b.write(position_, gpu::Access::StorageWrite);
-        b.write(normal_, gpu::Access::StorageWrite);
+  graph.add_shader_pass(
+      "ssrt_gbuffer", gpu::PassKind::Compute, *gbuffer_,
+      [this](gpu::ShaderPassBuilder& b) {
+        b.bind("FrameUbo", frame_constants_);
+        b.bind("depth", gbuffer_source_);
+        b.bind("position", position_);
+        b.bind("normal", normal_);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, gbuffer_->pipeline);
-        gpu::DescriptorPush()
-            .uniform_buffer(0, pass.buffer(frame_constants_))
-            .storage_image(1, pass.view(gbuffer_source_))
-            .storage_image(2, pass.view(position_))
-            .storage_image(3, pass.view(normal_))
-            .push(pass.context(), cmd, *gbuffer_);
         const VkExtent2D e = pass.extent(position_);
         gpu::dispatch_2d(cmd, *gbuffer_, &gbuffer_push_, sizeof(gbuffer_push_), e.width, e.height);
       });
