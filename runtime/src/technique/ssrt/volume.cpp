@@ -118,20 +118,17 @@ Expected<Volume> Volume::create(gpu::Context& ctx, gpu::FrameGraph& graph,
   if (!aux) return aux.error();
   v.aux_position_ = *aux;
 
-  const VkDescriptorType ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-  const VkDescriptorType img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-  const VkDescriptorType ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-  const VkDescriptorType texel = VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER;  // uploads, voxels
-  auto p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_fuse.comp", {{ubo}, {texel}, {ssbo}});
+  // Layouts come from the shaders (gpu/reflect.h); the passes bind by name.
+  auto p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_fuse.comp", {});
   if (!p) return p.error();
   v.fuse_ = std::move(*p);
-  p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_raycast.comp", {{ubo}, {ubo}, {texel}, {img}});
+  p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_raycast.comp", {});
   if (!p) return p.error();
   v.raycast_ = std::move(*p);
-  p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_normals.comp", {{ubo}, {ubo}, {texel}, {img}, {img}});
+  p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_normals.comp", {});
   if (!p) return p.error();
   v.normals_ = std::move(*p);
-  p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_aux.comp", {{ubo}, {ubo}, {texel}, {img}});
+  p = gpu::load_compute_pipeline(ctx, "ssrt/tsdf_aux.comp", {});
   if (!p) return p.error();
   v.aux_ = std::move(*p);
 
@@ -317,85 +314,51 @@ void Volume::add_passes(const VolumeFrame& frame, bool clear, bool fuse, bool vi
         });
   }
   if (fuse) {
-    graph.add_pass(
-        "ssrt_tsdf_fuse", gpu::PassKind::Compute,
-        [this](gpu::PassBuilder& b) {
-          b.read(params_, gpu::Access::UniformRead);
-          b.read(shared_.depth_upload, gpu::Access::StorageRead);
-          b.write(voxels_, gpu::Access::StorageReadWrite);
+    graph.add_shader_pass(
+        "ssrt_tsdf_fuse", gpu::PassKind::Compute, *fuse_,
+        [this](gpu::ShaderPassBuilder& b) {
+          b.bind("VolumeUbo", params_);
+          b.bind("depth_words", shared_.depth_upload);
+          b.bind("Voxels", voxels_);
         },
-        [this, res](VkCommandBuffer cmd, gpu::PassContext& pass) {
-          const gpu::Context& ctx = pass.context();
-          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, fuse_->pipeline);
-          gpu::DescriptorPush()
-              .uniform_buffer(0, pass.buffer(params_))
-              .storage_texel_buffer(1, pass.texel_view(shared_.depth_upload))
-              .storage_buffer(2, pass.buffer(voxels_))
-              .push(ctx, cmd, *fuse_);
-          gpu::dispatch_2d(cmd, *fuse_, nullptr, 0, res, res);
-        });
+        [this, res](VkCommandBuffer cmd, gpu::PassContext&) { gpu::dispatch_2d(cmd, *fuse_, nullptr, 0, res, res); });
   }
   if (!views) return;
-  graph.add_pass(
-      "ssrt_tsdf_raycast", gpu::PassKind::Compute,
-      [this](gpu::PassBuilder& b) {
-        b.read(shared_.frame_constants, gpu::Access::UniformRead);
-        b.read(params_, gpu::Access::UniformRead);
-        b.read(voxels_, gpu::Access::StorageRead);
-        b.write(depth_volume_, gpu::Access::StorageWrite);
+  graph.add_shader_pass(
+      "ssrt_tsdf_raycast", gpu::PassKind::Compute, *raycast_,
+      [this](gpu::ShaderPassBuilder& b) {
+        b.bind("FrameUbo", shared_.frame_constants);
+        b.bind("VolumeUbo", params_);
+        b.bind("voxels", voxels_);
+        b.bind("depth_volume", depth_volume_);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
-        const gpu::Context& ctx = pass.context();
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, raycast_->pipeline);
-        gpu::DescriptorPush()
-            .uniform_buffer(0, pass.buffer(shared_.frame_constants))
-            .uniform_buffer(1, pass.buffer(params_))
-            .storage_texel_buffer(2, pass.texel_view(voxels_))
-            .storage_image(3, pass.view(depth_volume_))
-            .push(ctx, cmd, *raycast_);
         const VkExtent2D e = pass.extent(depth_volume_);
         gpu::dispatch_2d(cmd, *raycast_, nullptr, 0, e.width, e.height);
       });
   // Culled by the graph unless something reads N_v (tsdf_normals.comp says why).
-  graph.add_pass(
-      "ssrt_tsdf_normals", gpu::PassKind::Compute,
-      [this](gpu::PassBuilder& b) {
-        b.read(shared_.frame_constants, gpu::Access::UniformRead);
-        b.read(params_, gpu::Access::UniformRead);
-        b.read(voxels_, gpu::Access::StorageRead);
-        b.read(depth_volume_, gpu::Access::StorageRead);
-        b.write(normal_volume_, gpu::Access::StorageWrite);
+  graph.add_shader_pass(
+      "ssrt_tsdf_normals", gpu::PassKind::Compute, *normals_,
+      [this](gpu::ShaderPassBuilder& b) {
+        b.bind("FrameUbo", shared_.frame_constants);
+        b.bind("VolumeUbo", params_);
+        b.bind("voxels", voxels_);
+        b.bind("depth_volume", depth_volume_);
+        b.bind("normal_volume", normal_volume_);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
-        const gpu::Context& ctx = pass.context();
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, normals_->pipeline);
-        gpu::DescriptorPush()
-            .uniform_buffer(0, pass.buffer(shared_.frame_constants))
-            .uniform_buffer(1, pass.buffer(params_))
-            .storage_texel_buffer(2, pass.texel_view(voxels_))
-            .storage_image(3, pass.view(depth_volume_))
-            .storage_image(4, pass.view(normal_volume_))
-            .push(ctx, cmd, *normals_);
         const VkExtent2D e = pass.extent(normal_volume_);
         gpu::dispatch_2d(cmd, *normals_, nullptr, 0, e.width, e.height);
       });
-  graph.add_pass(
-      "ssrt_tsdf_aux", gpu::PassKind::Compute,
-      [this](gpu::PassBuilder& b) {
-        b.read(params_, gpu::Access::UniformRead);
-        b.read(aux_views_, gpu::Access::UniformRead);
-        b.read(voxels_, gpu::Access::StorageRead);
-        b.write(aux_position_, gpu::Access::StorageWrite);
+  graph.add_shader_pass(
+      "ssrt_tsdf_aux", gpu::PassKind::Compute, *aux_,
+      [this](gpu::ShaderPassBuilder& b) {
+        b.bind("VolumeUbo", params_);
+        b.bind("AuxUbo", aux_views_);
+        b.bind("voxels", voxels_);
+        b.bind("aux_position", aux_position_);
       },
-      [this, aux_res](VkCommandBuffer cmd, gpu::PassContext& pass) {
-        const gpu::Context& ctx = pass.context();
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, aux_->pipeline);
-        gpu::DescriptorPush()
-            .uniform_buffer(0, pass.buffer(params_))
-            .uniform_buffer(1, pass.buffer(aux_views_))
-            .storage_texel_buffer(2, pass.texel_view(voxels_))
-            .storage_image(3, pass.view(aux_position_))
-            .push(ctx, cmd, *aux_);
+      [this, aux_res](VkCommandBuffer cmd, gpu::PassContext&) {
         // The layers stacked along y: rows [i aux_res, (i + 1) aux_res) are layer i.
         gpu::dispatch_2d(cmd, *aux_, nullptr, 0, aux_res, aux_res * SSRT_AUX_LAYERS);
       });
