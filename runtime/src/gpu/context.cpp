@@ -587,7 +587,9 @@ Expected<GpuImage> Context::create_image(const ImageCreateDesc& desc) {
   }
   VkImageViewCreateInfo vci{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
   vci.image = img.image;
-  vci.viewType = is_3d ? VK_IMAGE_VIEW_TYPE_3D : desc.layers > 1 ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_2D;
+  vci.viewType = is_3d                                 ? VK_IMAGE_VIEW_TYPE_3D
+                 : desc.layers > 1 || desc.array_view ? VK_IMAGE_VIEW_TYPE_2D_ARRAY
+                                                      : VK_IMAGE_VIEW_TYPE_2D;
   vci.format = desc.format;
   vci.subresourceRange = {img.aspect, 0, desc.mip_levels, 0, desc.layers};
   const VkResult view = vkCreateImageView(device_, &vci, nullptr, &img.view);

@@ -48,6 +48,7 @@ struct ImageCreateDesc {
   uint32_t depth = 1;
   uint32_t mip_levels = 1;
   uint32_t layers = 1;            // > 1: a 2D array view
+  bool array_view = false;        // a 2D array view with one layer too
   VkImageUsageFlags usage = 0;
   std::string name;               // debug name (shown by validation messages)
 };

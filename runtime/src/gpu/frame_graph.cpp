@@ -189,6 +189,7 @@ Expected<ImageHandle> FrameGraph::create_image(const ImageDesc& desc, VkImageUsa
   cd.depth = desc.depth;
   cd.mip_levels = desc.mip_levels;
   cd.layers = desc.layers;
+  cd.array_view = desc.array_view;
   cd.usage = usage | desc.extra_usage;
   cd.name = desc.name;
   auto img = context_.create_image(cd);

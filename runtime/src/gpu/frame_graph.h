@@ -61,6 +61,9 @@ struct ImageDesc {
   bool follows_render_scale = true;
   uint32_t mip_levels = 1;
   uint32_t layers = 1;
+  // Its views (PassContext::view, ShaderPassBuilder::bind) are 2D arrays with one layer too, for
+  // a shader's *2DArray* whose layer count varies with the scene (else 2D when layers is 1).
+  bool array_view = false;
   // Persistent: contents survive across frames (temporal history). The last write of a frame is
   // always kept (never culled) and its first read in a frame sees the previous frame's contents.
   bool history = false;

@@ -79,7 +79,6 @@ class Baseline final : public Technique {
   gpu::ImageHandle shadow_primary_, shadow_virtual_;
   ImageViews views_;
   std::vector<VkImageView> primary_layer_views_, virtual_layer_views_;
-  VkImageView primary_array_view_ = VK_NULL_HANDLE, virtual_array_view_ = VK_NULL_HANDLE;
   gpu::PipelineHandle grid_pipeline_, mesh_pipeline_, shade_pipeline_, caster_indices_pipeline_;
   gpu::BufferHandle caster_indices_;  // this frame's real caster mesh (shadow_caster_indices.comp)
   bool real_caster_faces_ = false;     // some face of the plan draws the real casters
@@ -127,6 +126,7 @@ Status Baseline::init() {
     d.size_mode = gpu::SizeMode::Absolute;
     d.width = d.height = kTopShadowSize;
     d.layers = uint32_t(std::max<size_t>(1, layers));
+    d.array_view = true;  // sampler2DArrayShadow, whatever the lamp count
     return graph.create_image(d, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT);
   };
   auto primary = make_map("shadow_primary", primary_layers);
@@ -137,21 +137,18 @@ Status Baseline::init() {
   shadow_virtual_ = *virt;
 
   views_ = ImageViews(ctx.device());
-  auto make_views = [&](gpu::ImageHandle h, size_t layers, std::vector<VkImageView>& per_layer,
-                        VkImageView& array) -> Status {
+  // A view a layer, for rendering each map (the shading pass samples the image's array view).
+  auto make_views = [&](gpu::ImageHandle h, size_t layers, std::vector<VkImageView>& per_layer) -> Status {
     const gpu::GpuImage& img = graph.gpu_image(h);
     for (size_t i = 0; i < layers; ++i) {
       auto v = views_.create(img, VK_IMAGE_VIEW_TYPE_2D, uint32_t(i), 1);
       if (!v) return v.error();
       per_layer.push_back(*v);
     }
-    auto a = views_.create(img, VK_IMAGE_VIEW_TYPE_2D_ARRAY, 0, img.layers);
-    if (!a) return a.error();
-    array = *a;
     return ok_status();
   };
-  MRGI_TRY(make_views(shadow_primary_, primary_layers, primary_layer_views_, primary_array_view_));
-  MRGI_TRY(make_views(shadow_virtual_, virtual_layers, virtual_layer_views_, virtual_array_view_));
+  MRGI_TRY(make_views(shadow_primary_, primary_layers, primary_layer_views_));
+  MRGI_TRY(make_views(shadow_virtual_, virtual_layers, virtual_layer_views_));
   depth_write_layout_ =
       gpu::access_info(gpu::PassKind::Graphics, gpu::Access::DepthAttachmentWrite, true, true).layout;
 
@@ -177,9 +174,7 @@ Status Baseline::init() {
                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
   if (!ib) return ib.error();
   caster_indices_ = *ib;
-  auto cip = gpu::load_compute_pipeline(ctx, "baseline/shadow_caster_indices.comp",
-                                        {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER}, {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
-                                        sizeof(glm::ivec4));
+  auto cip = gpu::load_compute_pipeline(ctx, "baseline/shadow_caster_indices.comp", {});
   if (!cip) return cip.error();
   caster_indices_pipeline_ = std::move(*cip);
 
@@ -199,20 +194,9 @@ Status Baseline::init() {
   if (!mp) return mp.error();
   mesh_pipeline_ = gpu::PipelineHandle(ctx, std::move(*mp));
 
-  auto shade_cs = gpu::shader_spirv("baseline/shade_direct.comp");
-  if (!shade_cs) return shade_cs.error();
-  gpu::ComputePipelineDesc shade;
-  shade.name = "baseline_shade_direct";
-  shade.spirv = *shade_cs;
-  const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-  const auto tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-  const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-  shade.bindings = {{ubo}, {ubo}, {tex}, {tex}, {tex}, {tex}, {tex}, {tex}, {tex}, {tex}, {img}, {img},
-                    {tex}};
-  shade.push_constant_bytes = sizeof(ShadePush);
-  auto sp = gpu::create_compute_pipeline(ctx, shade);
+  auto sp = gpu::load_compute_pipeline(ctx, "baseline/shade_direct.comp", {});  // layout from the shader
   if (!sp) return sp.error();
-  shade_pipeline_ = gpu::PipelineHandle(ctx, std::move(*sp));
+  shade_pipeline_ = std::move(*sp);
   return ok_status();
 }
 
@@ -233,19 +217,13 @@ Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped
     skipped.push_back("shadow_primary: no lamp in the scene");
   } else {
     if (real_caster_faces_ && grid_.index_count() > 0) {
-      graph.add_pass(
-          "shadow_caster_mesh", gpu::PassKind::Compute,
-          [this](gpu::PassBuilder& b) {
-            b.read(shared_.real_position, gpu::Access::Sampled);
-            b.write(caster_indices_, gpu::Access::StorageWrite);
+      graph.add_shader_pass(
+          "shadow_caster_mesh", gpu::PassKind::Compute, *caster_indices_pipeline_,
+          [this](gpu::ShaderPassBuilder& b) {
+            b.bind_sampled("real_position", shared_.real_position, shared_.context->samplers().nearest_clamp);
+            b.bind("Indices", caster_indices_);
           },
-          [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
-            const gpu::Context& c = pass.context();
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, caster_indices_pipeline_->pipeline);
-            gpu::DescriptorPush()
-                .sampled_image(0, pass.view(shared_.real_position), c.samplers().nearest_clamp)
-                .storage_buffer(1, pass.buffer(caster_indices_))
-                .push(c, cmd, *caster_indices_pipeline_);
+          [this](VkCommandBuffer cmd, gpu::PassContext&) {
             const glm::ivec4 g(int(grid_.points.width), int(grid_.points.height), int(grid_.stride), 0);
             gpu::dispatch_2d(cmd, *caster_indices_pipeline_, &g, sizeof(g), grid_.points.width - 1,
                              grid_.points.height - 1);
@@ -283,23 +261,26 @@ Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped
         });
   }
   (void)s;
-  graph.add_pass(
-      "shade_direct", gpu::PassKind::Compute,
-      [this](gpu::PassBuilder& b) {
+  const VkSampler nearest = shared_.context->samplers().nearest_clamp;
+  const VkSampler compare = shared_.context->samplers().shadow_compare;
+  graph.add_shader_pass(
+      "shade_direct", gpu::PassKind::Compute, *shade_pipeline_,
+      [this, nearest, compare](gpu::ShaderPassBuilder& b) {
         const SharedResources& r = shared_;
-        b.read(r.frame_constants, gpu::Access::UniformRead);
-        b.read(lights_, gpu::Access::UniformRead);
-        b.read(r.real_position, gpu::Access::Sampled);
-        b.read(r.real_normal, gpu::Access::Sampled);
-        b.read(r.real_albedo, gpu::Access::Sampled);
-        b.read(r.virtual_position, gpu::Access::Sampled);
-        b.read(r.virtual_normal, gpu::Access::Sampled);
-        b.read(r.virtual_albedo, gpu::Access::Sampled);
-        if (r.virtual_emission.valid()) b.read(r.virtual_emission, gpu::Access::Sampled);
-        b.read(shadow_primary_, gpu::Access::Sampled);
-        b.read(shadow_virtual_, gpu::Access::Sampled);
-        b.write(r.lit_rv, gpu::Access::StorageWrite);
-        b.write(r.lit_r, gpu::Access::StorageWrite);
+        b.bind("FrameUbo", r.frame_constants);
+        b.bind("LightUbo", lights_);
+        b.bind_sampled("real_position", r.real_position, nearest);
+        b.bind_sampled("real_normal", r.real_normal, nearest);
+        b.bind_sampled("real_albedo", r.real_albedo, nearest);
+        b.bind_sampled("virtual_position", r.virtual_position, nearest);
+        b.bind_sampled("virtual_normal", r.virtual_normal, nearest);
+        b.bind_sampled("virtual_albedo", r.virtual_albedo, nearest);
+        // Without emission the albedo stands in (bound, never read: flags.y is 0).
+        b.bind_sampled("virtual_emission", r.virtual_emission.valid() ? r.virtual_emission : r.virtual_albedo, nearest);
+        b.bind_sampled("shadow_primary", shadow_primary_, compare);
+        b.bind_sampled("shadow_virtual", shadow_virtual_, compare);
+        b.bind("lit_rv", r.lit_rv);
+        b.bind("lit_r", r.lit_r);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) { shade(cmd, pass); });
   return ok_status();
@@ -396,27 +377,7 @@ void Baseline::render_faces(VkCommandBuffer cmd, gpu::PassContext& pass,
 }
 
 void Baseline::shade(VkCommandBuffer cmd, gpu::PassContext& pass) {
-  const gpu::Context& ctx = pass.context();
   const SharedResources& r = shared_;
-  const VkSampler nearest = ctx.samplers().nearest_clamp;
-  const VkSampler compare = ctx.samplers().shadow_compare;
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, shade_pipeline_->pipeline);
-  gpu::DescriptorPush()
-      .uniform_buffer(0, pass.buffer(r.frame_constants))
-      .uniform_buffer(1, pass.buffer(lights_))
-      .sampled_image(2, pass.view(r.real_position), nearest)
-      .sampled_image(3, pass.view(r.real_normal), nearest)
-      .sampled_image(4, pass.view(r.real_albedo), nearest)
-      .sampled_image(5, pass.view(r.virtual_position), nearest)
-      .sampled_image(6, pass.view(r.virtual_normal), nearest)
-      .sampled_image(7, pass.view(r.virtual_albedo), nearest)
-      .sampled_image(8, primary_array_view_, compare)
-      .sampled_image(9, virtual_array_view_, compare)
-      .storage_image(10, pass.view(r.lit_rv))
-      .storage_image(11, pass.view(r.lit_r))
-      // Without emission the albedo stands in (bound, never read: flags.y is 0).
-      .sampled_image(12, pass.view(r.virtual_emission.valid() ? r.virtual_emission : r.virtual_albedo), nearest)
-      .push(ctx, cmd, *shade_pipeline_);
   ShadePush pc;
   pc.shadow = glm::vec4(float(shadow_size_) / float(kTopShadowSize), float(shadow_size_),
                         float(kTopShadowSize), float(pcf_radius_));
