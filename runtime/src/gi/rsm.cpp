@@ -269,7 +269,7 @@ void ReflectiveShadowMaps::add_draw(gpu::FrameGraph& graph, const std::string& l
               .sampled_image(gi.find("real_position")->binding, p.view(real.position), nearest)
               .sampled_image(gi.find("real_normal")->binding, p.view(real.normal), nearest)
               .sampled_image(gi.find("real_albedo")->binding, p.view(real.albedo), nearest)
-              .sampled_image(gi.find("base_color_maps")->binding, sg->base_color_array_view(), linear)
+              .sampled_image(gi.find("base_color_maps")->binding, p.view(sg->base_color_maps), linear)
               .push(ctx, cmd, *grid_pipe);
           vkCmdPushConstants(cmd, grid_pipe->layout, grid_pipe->stages, 0, sizeof push, &push);
           vkCmdBindIndexBuffer(cmd, p.buffer(indices), 0, VK_INDEX_TYPE_UINT32);
@@ -280,7 +280,7 @@ void ReflectiveShadowMaps::add_draw(gpu::FrameGraph& graph, const std::string& l
           const gpu::ShaderInterface& mi = mesh_pipe->interface;
           gpu::DescriptorPush()
               .storage_buffer(mi.find("Materials")->binding, p.buffer(sg->materials))
-              .sampled_image(mi.find("base_color_maps")->binding, sg->base_color_array_view(), linear)
+              .sampled_image(mi.find("base_color_maps")->binding, p.view(sg->base_color_maps), linear)
               .push(ctx, cmd, *mesh_pipe);
           auto draw_set = [&](const technique::MeshSet& set, bool materials) {
             VkBuffer vb = p.buffer(set.vertices);

@@ -67,12 +67,7 @@ Expected<VirtualGBuffer> VirtualGBuffer::create(gpu::Context& context, gpu::Fram
   desc.name = "virtual_gbuffer";
   desc.vertex_spirv = *vs;
   desc.fragment_spirv = *fs;
-  desc.bindings = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
-                   {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-                   {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
-                   {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
-                   {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER}};
-  desc.push_constant_bytes = 2 * sizeof(int32_t);  // material (per draw), real geometry step
+  // Bindings and push constants (material per draw, real geometry step) from the shaders.
   desc.vertex_strides = {sizeof(technique::GpuVertex)};
   desc.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(technique::GpuVertex, position)},
                      {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(technique::GpuVertex, normal)},
@@ -112,21 +107,24 @@ void VirtualGBuffer::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_cons
   lod_.focal_px = fc.internal_k.x;
   lod_.max_error_px = mesh_error_px;
   area_ = projected_area(graph.extent(position_), fc);
-  graph.add_pass(
-      "virtual_gbuffer", gpu::PassKind::Graphics,
-      [this](gpu::PassBuilder& b) {
-        b.read(frame_constants_, gpu::Access::UniformRead);
-        b.read(scene_->materials, gpu::Access::StorageRead);
-        b.read(scene_->base_color_maps, gpu::Access::Sampled);
-        b.read(scene_->virtual_objects.vertices, gpu::Access::VertexBuffer);
-        b.read(scene_->virtual_objects.indices, gpu::Access::IndexBuffer);
-        b.read(real_.position, gpu::Access::Sampled);
-        if (real_.normal != real_.position) b.read(real_.normal, gpu::Access::Sampled);
-        b.write(position_, gpu::Access::ColorAttachmentWrite);
-        b.write(normal_, gpu::Access::ColorAttachmentWrite);
-        b.write(albedo_, gpu::Access::ColorAttachmentWrite);
-        if (emission_.valid()) b.write(emission_, gpu::Access::ColorAttachmentWrite);
-        b.write(depth_, gpu::Access::DepthAttachmentWrite);
+  const VkSampler nearest = graph.context().samplers().nearest_clamp;
+  const VkSampler linear = graph.context().samplers().linear_repeat;
+  graph.add_shader_pass(
+      "virtual_gbuffer", gpu::PassKind::Graphics, *pipeline_,
+      [this, nearest, linear](gpu::ShaderPassBuilder& b) {
+        b.bind("FrameUbo", frame_constants_);
+        b.bind("Materials", scene_->materials);
+        b.bind_sampled("base_color_maps", scene_->base_color_maps, linear);
+        b.bind_sampled("real_position", real_.position, nearest);
+        b.bind_sampled("real_normal", real_.normal, nearest);
+        gpu::PassBuilder& u = b.uses();
+        u.read(scene_->virtual_objects.vertices, gpu::Access::VertexBuffer);
+        u.read(scene_->virtual_objects.indices, gpu::Access::IndexBuffer);
+        u.write(position_, gpu::Access::ColorAttachmentWrite);
+        u.write(normal_, gpu::Access::ColorAttachmentWrite);
+        u.write(albedo_, gpu::Access::ColorAttachmentWrite);
+        if (emission_.valid()) u.write(emission_, gpu::Access::ColorAttachmentWrite);
+        u.write(depth_, gpu::Access::DepthAttachmentWrite);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) { draw(cmd, pass); });
 }
@@ -206,15 +204,6 @@ void VirtualGBuffer::draw(VkCommandBuffer cmd, gpu::PassContext& pass) {
     const VkRect2D sc = area_;
     vkCmdSetViewport(cmd, 0, 1, &vp);
     vkCmdSetScissor(cmd, 0, 1, &sc);
-    const gpu::Context& ctx = pass.context();
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_->pipeline);
-    gpu::DescriptorPush()
-        .uniform_buffer(0, pass.buffer(frame_constants_))
-        .storage_buffer(1, pass.buffer(scene_->materials))
-        .sampled_image(2, pass.view(real_.position), ctx.samplers().nearest_clamp)
-        .sampled_image(3, scene_->base_color_array_view(), ctx.samplers().linear_repeat)
-        .sampled_image(4, pass.view(real_.normal), ctx.samplers().nearest_clamp)
-        .push(ctx, cmd, *pipeline_);
     const int32_t step = int32_t(real_.step);
     vkCmdPushConstants(cmd, pipeline_->layout, pipeline_->stages, sizeof(int32_t), sizeof(step),
                        &step);

@@ -229,23 +229,19 @@ Expected<std::unique_ptr<SceneGpu>> SceneGpu::create(gpu::Context& context, gpu:
   desc.format = VK_FORMAT_R8G8B8A8_SRGB;
   desc.width = desc.height = side;
   desc.layers = layers;
+  desc.array_view = true;  // sampler2DArray, also with one layer
   desc.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
   desc.name = "base_color_maps";
   auto image = context.create_image(desc);
   if (!image) return image.error();
   out->texture_array_ = *image;
   MRGI_TRY(context.upload_image(out->texture_array_, texels.data(), texels.size()));
-  out->views_ = ImageViews(context.device());
-  auto view = out->views_.create(out->texture_array_, VK_IMAGE_VIEW_TYPE_2D_ARRAY, 0, layers);
-  if (!view) return view.error();
-  out->array_view_ = *view;
   out->base_color_maps = graph.import_image("base_color_maps", out->texture_array_,
                                             VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, true);
   return out;
 }
 
 SceneGpu::~SceneGpu() {
-  views_.reset();
   context_.destroy(texture_array_);
 }
 

@@ -12,7 +12,6 @@
 #include "gpu/context.h"
 #include "gpu/frame_graph.h"
 #include "gpu/pipelines.h"
-#include "technique/image_views.h"
 #include "mrgi/expected.h"
 #include "mrgi/scene.h"
 
@@ -93,14 +92,11 @@ class SceneGpu {
   gpu::BufferHandle materials;        // shader::GpuMaterial[] (at least one entry)
   bool emissive = false;              // some virtual material emits (GpuMaterial::emission)
   gpu::ImageHandle base_color_maps;   // R8G8B8A8_SRGB array (at least one white layer)
-  VkImageView base_color_array_view() const { return array_view_; }  // 2D_ARRAY over all layers
 
  private:
   explicit SceneGpu(gpu::Context& context) : context_(context) {}
   gpu::Context& context_;
   gpu::GpuImage texture_array_;       // owned here, imported into the graph
-  ImageViews views_;
-  VkImageView array_view_ = VK_NULL_HANDLE;
 };
 
 }  // namespace mrgi::technique
