@@ -217,4 +217,53 @@ TEST_F(VulkanTest, ShaderPassBindingErrorsNameThePassAndBinding) {
   EXPECT_NE(overlap.error().message.find("declared twice"), std::string::npos) << overlap.error().message;
 }
 
+// bind_over: a pass that writes part of an image over an earlier pass's write declares it
+// read-write, so the earlier pass is kept; a plain bind of the writeonly image makes the earlier
+// write dead (rewritten unread) and the graph culls it.
+TEST_F(VulkanTest, ShaderPassBindOverKeepsTheEarlierWrite) {
+  auto pipe = gpu::load_compute_pipeline(ctx(), "floor.comp", {});  // src_image readonly, dst_image writeonly
+  ASSERT_TRUE(pipe.ok()) << pipe.error().message;
+  for (const bool over : {false, true}) {
+    Fixture f(ctx());
+    auto image = [&](const char* name) {
+      gpu::ImageDesc d;
+      d.name = name;
+      d.format = VK_FORMAT_R8G8B8A8_UNORM;
+      return *f.graph->create_image(d, VK_IMAGE_USAGE_STORAGE_BIT);
+    };
+    const gpu::ImageHandle src = image("src"), dst = image("dst");
+    ASSERT_TRUE(f.graph->begin_frame().ok());
+    f.graph->add_shader_pass("whole", gpu::PassKind::Compute, **pipe, [&](gpu::ShaderPassBuilder& b) {
+      b.bind("src_image", src);
+      b.bind("dst_image", dst);
+    }, {});
+    f.graph->add_shader_pass("tiles", gpu::PassKind::Compute, **pipe, [&](gpu::ShaderPassBuilder& b) {
+      b.bind("src_image", src);
+      if (over) {
+        b.bind_over("dst_image", dst);
+      } else {
+        b.bind("dst_image", dst);
+      }
+    }, {});
+    f.graph->mark_output(dst);
+    Status s = f.graph->compile();
+    ASSERT_TRUE(s.ok()) << s.error().message;
+    EXPECT_EQ(f.graph->compiled().runs("whole"), over) << (over ? "bind_over" : "bind");
+    EXPECT_TRUE(f.graph->compiled().runs("tiles"));
+  }
+  // Only for what the shader writes.
+  Fixture f(ctx());
+  gpu::ImageDesc d;
+  d.name = "img";
+  const gpu::ImageHandle img = *f.graph->create_image(d, VK_IMAGE_USAGE_STORAGE_BIT);
+  ASSERT_TRUE(f.graph->begin_frame().ok());
+  f.graph->add_shader_pass("probe", gpu::PassKind::Compute, **pipe, [&](gpu::ShaderPassBuilder& b) {
+    b.bind_over("src_image", img);
+  }, {});
+  Status s = f.graph->compile();
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message.find("bind_over is for storage images and buffers the shader writes"), std::string::npos)
+      << s.error().message;
+}
+
 }  // namespace

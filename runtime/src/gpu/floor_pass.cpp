@@ -9,17 +9,10 @@
 namespace mrgi::gpu {
 
 Expected<FloorPass> FloorPass::create(FrameGraph& graph) {
-  auto spirv = shader_spirv("floor.comp");
-  if (!spirv) return spirv.error();
-  ComputePipelineDesc pd;
-  pd.name = "floor";
-  pd.spirv = *spirv;
-  pd.bindings = {{VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}, {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}};
-  pd.push_constant_bytes = 8;
-  auto pipeline = create_compute_pipeline(graph.context(), pd);
+  auto pipeline = load_compute_pipeline(graph.context(), "floor.comp", {});  // layout from the shader
   if (!pipeline) return pipeline.error();
   FloorPass f;
-  f.pipeline_ = PipelineHandle(graph.context(), std::move(*pipeline));
+  f.pipeline_ = std::move(*pipeline);
   for (int i = 0; i < 2; ++i) {
     ImageDesc d;
     d.name = i == 0 ? "floor.a" : "floor.b";
@@ -39,16 +32,15 @@ Expected<FloorPass> FloorPass::create(FrameGraph& graph) {
 void FloorPass::add_to(FrameGraph& graph) {
   const ImageHandle src = images_[flip_], dst = images_[1 - flip_];
   const Pipeline* pipeline = &*pipeline_;
-  graph.add_pass(
-      "floor", PassKind::Compute,
-      [&](PassBuilder& b) {
-        b.read(src, Access::StorageRead);
-        b.write(dst, Access::StorageWrite);
+  graph.add_shader_pass(
+      "floor", PassKind::Compute, *pipeline,
+      [&](ShaderPassBuilder& b) {
+        b.bind("src_image", src);
+        b.bind("dst_image", dst);
       },
-      [src, dst, pipeline](VkCommandBuffer cmd, PassContext& ctx) {
+      [dst, pipeline](VkCommandBuffer cmd, PassContext& ctx) {
         const VkExtent2D e = ctx.extent(dst);
         const int32_t extent[2] = {int32_t(e.width), int32_t(e.height)};
-        DescriptorPush().storage_image(0, ctx.view(src)).storage_image(1, ctx.view(dst)).push(ctx.context(), cmd, *pipeline);
         dispatch_2d(cmd, *pipeline, extent, sizeof extent, e.width, e.height);
       });
   graph.mark_output(dst);

@@ -246,6 +246,11 @@ class ShaderPassBuilder {
   void bind(std::string_view name, ImageHandle image, uint32_t mip);     // one level's view
   void bind_sampled(std::string_view name, ImageHandle image, VkSampler sampler);  // sampler2D, sampler3D
   void bind(std::string_view name, BufferHandle buffer);
+  // A storage image or buffer the pass writes in part (tiles) over what an earlier pass of the
+  // frame wrote there: declared StorageReadWrite whatever the shader's qualifier, so that earlier
+  // write is neither culled as unread nor discarded by a layout transition.
+  void bind_over(std::string_view name, ImageHandle image);
+  void bind_over(std::string_view name, BufferHandle buffer);
   // Uses that are not descriptors (attachments, vertex / index / indirect buffers).
   PassBuilder& uses() { return base_; }
 
@@ -253,7 +258,8 @@ class ShaderPassBuilder {
   friend class FrameGraph;
   ShaderPassBuilder(FrameGraph& graph, PassBuilder base, const Pipeline& pipeline, uint32_t pass)
       : graph_(graph), base_(base), pipeline_(pipeline), pass_(pass) {}
-  void bind_resource(std::string_view name, ResourceRef ref, uint32_t mip, bool one_level, VkSampler sampler);
+  void bind_resource(std::string_view name, ResourceRef ref, uint32_t mip, bool one_level, VkSampler sampler,
+                     bool over = false);
   FrameGraph& graph_;
   PassBuilder base_;
   const Pipeline& pipeline_;

@@ -41,8 +41,15 @@ void ShaderPassBuilder::bind(std::string_view name, BufferHandle buffer) {
   bind_resource(name, ResourceRef{false, uint32_t(graph_.images_.size()) + buffer.id}, 0, false, VK_NULL_HANDLE);
 }
 
+void ShaderPassBuilder::bind_over(std::string_view name, ImageHandle image) {
+  bind_resource(name, ResourceRef{true, image.id}, 0, false, VK_NULL_HANDLE, true);
+}
+void ShaderPassBuilder::bind_over(std::string_view name, BufferHandle buffer) {
+  bind_resource(name, ResourceRef{false, uint32_t(graph_.images_.size()) + buffer.id}, 0, false, VK_NULL_HANDLE, true);
+}
+
 void ShaderPassBuilder::bind_resource(std::string_view name, ResourceRef ref, uint32_t mip, bool one_level,
-                                      VkSampler sampler) {
+                                      VkSampler sampler, bool over) {
   std::string& error = graph_.setup_error_;
   if (!error.empty()) return;  // the first error is the one reported
   const std::string where = "pass '" + base_.decl_.name + "', binding '" + std::string(name) + "'";
@@ -76,6 +83,13 @@ void ShaderPassBuilder::bind_resource(std::string_view name, ResourceRef ref, ui
   if (!access_for(*b, access)) {
     error = where + ": a " + std::string(descriptor_type_name(b->type)) + " is not bound by name";
     return;
+  }
+  if (over) {
+    if (access != Access::StorageWrite && access != Access::StorageReadWrite) {
+      error = where + ": bind_over is for storage images and buffers the shader writes";
+      return;
+    }
+    access = Access::StorageReadWrite;
   }
   FrameGraph::ShaderPassData& data = graph_.shader_passes_[pass_];
   for (const FrameGraph::BoundDescriptor& d : data.descriptors)
