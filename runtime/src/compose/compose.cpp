@@ -43,10 +43,6 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
   c.mask_ = *mask;
   auto spv = gpu::shader_spirv("compose/compose.comp");
   if (!spv) return spv.error();
-  const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-  const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-  const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-  const auto texel = VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER;  // the camera uploads (upload_gather.glsl)
   // compose.comp: kSameSize, kCameraOnly, kSameInternal; each path compiled out of the others'.
   const struct {
     const char* name;
@@ -61,9 +57,8 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
   if (!no_tiles) return no_tiles.error();
   c.no_tiles_ = *no_tiles;
   for (const auto& v : variants) {
-    gpu::ComputePipelineDesc d{v.name, *spv,
-                               {{ubo}, {texel}, {img}, {img}, {img}, {ssbo}, {ssbo}, {ssbo}},
-                               sizeof(ComposePush),
+    // Bindings and push constants from the shader (the passes bind by name).
+    gpu::ComputePipelineDesc d{v.name, *spv, {}, 0,
                                {same_size_as_camera ? 1u : 0u, v.camera_only, v.same_internal,
                                 v.tiled}};
     auto p = gpu::create_compute_pipeline(context, d);
@@ -125,42 +120,57 @@ void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
   const bool host_camera = tiled_ && same_size_as_camera_;
   slot_host_camera_[graph.slot()] = host_camera ? 1 : 0;
   const bool composed = host_camera && in_.tiles_composed;
+  // Every variant declares the same bindings (compose.comp's paths are compiled out of each
+  // other, not their declarations): the pass binds them all.
+  auto bind_inputs = [this](gpu::ShaderPassBuilder& b) {
+    b.bind("FrameUbo", in_.frame_constants);
+    b.bind("color_words", in_.color_upload);
+    b.bind("lit_rv", in_.lit_rv);
+    b.bind("lit_r", in_.lit_r);
+    b.bind("virtual_position", in_.virtual_position);
+  };
   if (tiled_ && !host_camera) {
     // The camera frame everywhere, then the composite over the technique's tiles.
-    graph.add_pass(
-        "compose_camera", gpu::PassKind::Compute,
-        [this](gpu::PassBuilder& b) {
-          b.read(in_.frame_constants, gpu::Access::UniformRead);
-          b.read(in_.color_upload, gpu::Access::StorageRead);
-          b.read(in_.lit_rv, gpu::Access::StorageRead);  // bound, not read by this pipeline
-          b.read(in_.lit_r, gpu::Access::StorageRead);
-          b.read(in_.virtual_position, gpu::Access::StorageRead);
-          b.read(no_tiles_, gpu::Access::StorageRead);
-          b.write(output_, gpu::Access::StorageWrite);
-          b.write(mask_, gpu::Access::StorageWrite);
+    const gpu::Pipeline* pipe = &*camera_pipeline_;
+    graph.add_shader_pass(
+        "compose_camera", gpu::PassKind::Compute, *pipe,
+        [this, bind_inputs](gpu::ShaderPassBuilder& b) {
+          bind_inputs(b);
+          b.bind("Tiles", no_tiles_);
+          b.bind("Output", output_);
+          b.bind("Mask", mask_);
         },
-        [this](VkCommandBuffer cmd, gpu::PassContext& pass) { dispatch(cmd, pass, false); });
+        [this, pipe](VkCommandBuffer cmd, gpu::PassContext& pass) { dispatch(cmd, pass, *pipe, false); });
   }
-  if (!composed) graph.add_pass(
-      "compose", gpu::PassKind::Compute,
-      [this](gpu::PassBuilder& b) {
-        b.read(in_.frame_constants, gpu::Access::UniformRead);
-        b.read(in_.color_upload, gpu::Access::StorageRead);
-        b.read(in_.lit_rv, gpu::Access::StorageRead);
-        b.read(in_.lit_r, gpu::Access::StorageRead);
-        b.read(in_.virtual_position, gpu::Access::StorageRead);
-        if (tiled_) {
-          b.read(in_.tile_args, gpu::Access::IndirectRead);
-          b.read(in_.tile_list, gpu::Access::StorageRead);
-        } else {
-          b.read(no_tiles_, gpu::Access::StorageRead);
-        }
-        const gpu::Access out = tiled_ && !same_size_as_camera_ ? gpu::Access::StorageReadWrite
-                                                                 : gpu::Access::StorageWrite;
-        b.write(output_, out);
-        b.write(mask_, out);
-      },
-      [this](VkCommandBuffer cmd, gpu::PassContext& pass) { dispatch(cmd, pass, tiled_); });
+  if (!composed) {
+    const VkExtent2D used = graph.extent(in_.lit_r);
+    const bool same_internal = used.width == width_ && used.height == height_;
+    const gpu::Pipeline* pipe = tiled_                         ? (same_internal ? &*tiled_pipeline_ : &*tiled_scaled_pipeline_)
+                                : in_.camera_only              ? &*camera_pipeline_
+                                : same_internal                ? &*same_internal_pipeline_
+                                                               : &*pipeline_;
+    // Over the camera pass's output (tiles only): declared read-write so that pass is kept.
+    const bool over = tiled_ && !same_size_as_camera_;
+    graph.add_shader_pass(
+        "compose", gpu::PassKind::Compute, *pipe,
+        [this, bind_inputs, over](gpu::ShaderPassBuilder& b) {
+          bind_inputs(b);
+          if (tiled_) {
+            b.bind("Tiles", in_.tile_list);
+            b.uses().read(in_.tile_args, gpu::Access::IndirectRead);
+          } else {
+            b.bind("Tiles", no_tiles_);
+          }
+          if (over) {
+            b.bind_over("Output", output_);
+            b.bind_over("Mask", mask_);
+          } else {
+            b.bind("Output", output_);
+            b.bind("Mask", mask_);
+          }
+        },
+        [this, pipe](VkCommandBuffer cmd, gpu::PassContext& pass) { dispatch(cmd, pass, *pipe, tiled_); });
+  }
   graph.mark_output(output_);
   graph.mark_output(mask_);
   if (!host_camera) return;
@@ -184,28 +194,9 @@ void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
   graph.mark_output(tile_readback_);
 }
 
-// tiled_pass: the composite over the listed tiles; otherwise the camera copy of a tiled frame
-// (tiled_ set) or the whole compose of an untiled one.
-void Compose::dispatch(VkCommandBuffer cmd, gpu::PassContext& pass, bool tiled_pass) {
-  const gpu::Context& ctx = pass.context();
-  const VkExtent2D used = pass.extent(in_.lit_r);
-  const bool same_internal = used.width == width_ && used.height == height_;
-  const gpu::Pipeline& pipeline = tiled_pass                         ? (same_internal ? *tiled_pipeline_
-                                                                                      : *tiled_scaled_pipeline_)
-                                  : (in_.camera_only || tiled_)      ? *camera_pipeline_
-                                  : same_internal                    ? *same_internal_pipeline_
-                                                                     : *pipeline_;
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline);
-  gpu::DescriptorPush()
-      .uniform_buffer(0, pass.buffer(in_.frame_constants))
-      .storage_texel_buffer(1, pass.texel_view(in_.color_upload))
-      .storage_image(2, pass.view(in_.lit_rv))
-      .storage_image(3, pass.view(in_.lit_r))
-      .storage_image(4, pass.view(in_.virtual_position))
-      .storage_buffer(5, pass.buffer(output_))
-      .storage_buffer(6, pass.buffer(mask_))
-      .storage_buffer(7, pass.buffer(tiled_pass ? in_.tile_list : no_tiles_))
-      .push(ctx, cmd, pipeline);
+// tiled_pass: the composite over the listed tiles (their count in tile_args); otherwise every
+// pixel (the camera copy of a tiled frame, or the whole compose of an untiled one).
+void Compose::dispatch(VkCommandBuffer cmd, gpu::PassContext& pass, const gpu::Pipeline& pipeline, bool tiled_pass) {
   ComposePush pc;
   pc.compose = glm::vec4(settings_.eps, settings_.alpha_max, 0.0f, 0.0f);
   if (tiled_pass) {

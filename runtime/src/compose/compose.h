@@ -88,7 +88,7 @@ class Compose {
   bool fusable() const { return same_size_as_camera_; }
 
  private:
-  void dispatch(VkCommandBuffer cmd, gpu::PassContext& pass, bool tiled_pass);
+  void dispatch(VkCommandBuffer cmd, gpu::PassContext& pass, const gpu::Pipeline& pipeline, bool tiled_pass);
 
   ComposeSettings settings_;
   uint32_t width_ = 0, height_ = 0;
