@@ -195,62 +195,44 @@ glm::ivec4 Ssrt::virtual_cells() const {
 
 void Ssrt::add_shade_pass(const char* name, ShadeMode mode, bool run_transfer) {
   gpu::FrameGraph& graph = *shared_.graph;
-  graph.add_pass(
-      name, gpu::PassKind::Compute,
-      [this, mode](gpu::PassBuilder& b) {
+  const bool compose = mode == ShadeMode::TiledCompose;
+  // The tiled passes rewrite some tiles of what the pass-through one wrote.
+  const bool tiled = mode == ShadeMode::Tiled || compose;
+  const gpu::Pipeline* pipe = compose                          ? &*shade_tiled_compose_
+                              : mode == ShadeMode::Tiled       ? &*shade_tiled_
+                              : mode == ShadeMode::PassThrough ? &*shade_pass_
+                                                               : &*shade_;
+  graph.add_shader_pass(
+      name, gpu::PassKind::Compute, *pipe,
+      [this, compose, tiled](gpu::ShaderPassBuilder& b) {
         const SharedResources& r = shared_;
-        // Declared on skipped frames too (the shader binds them but does not read them then),
-        // so the bindings are always in the layout the graph gave them.
-        b.read(coarse_, gpu::Access::StorageRead);
-        b.read(upsampled_, gpu::Access::StorageRead);
-        for (gpu::ImageHandle h : {geo_position_, r.virtual_position, r.virtual_albedo})
-          b.read(h, gpu::Access::StorageRead);
-        if (r.virtual_emission.valid()) b.read(r.virtual_emission, gpu::Access::StorageRead);
-        for (gpu::BufferHandle h : {r.color_upload, r.depth_upload, tile_list_})
-          b.read(h, gpu::Access::StorageRead);
-        b.read(r.frame_constants, gpu::Access::UniformRead);
-        // The tiled pass rewrites some tiles of what the pass-through one wrote.
-        const bool tiled = mode == ShadeMode::Tiled || mode == ShadeMode::TiledCompose;
-        const gpu::Access out = tiled ? gpu::Access::StorageReadWrite : gpu::Access::StorageWrite;
-        if (tiled) b.read(tile_args_, gpu::Access::IndirectRead);
+        // Bound on skipped frames too (the shader declares them, the variant may not read them).
+        b.bind("coarse", coarse_);
+        b.bind("real_position", geo_position_);
+        b.bind("color_words", r.color_upload);
+        b.bind("depth_words", r.depth_upload);
+        b.bind("FrameUbo", r.frame_constants);
+        b.bind("virtual_position", r.virtual_position);
+        b.bind("virtual_albedo", r.virtual_albedo);
+        // Without emission the albedo stands in (bound, never read: kEmission is false).
+        b.bind("virtual_emission", r.virtual_emission.valid() ? r.virtual_emission : r.virtual_albedo);
+        b.bind("upsampled", upsampled_);
+        b.bind("Tiles", tile_list_);
+        if (tiled) b.uses().read(tile_args_, gpu::Access::IndirectRead);
         // The solutions: bound by every variant, written by all but the composing one (which
         // writes the composite to the runtime's output instead; the rest get no_compose_).
-        b.write(r.lit_rv, out);
-        b.write(r.lit_r, out);
-        if (mode == ShadeMode::TiledCompose) {
-          b.write(r.composed_output, gpu::Access::StorageWrite);
-          b.write(r.composed_mask, gpu::Access::StorageWrite);
+        if (tiled) {
+          b.bind_over("lit_rv", r.lit_rv);
+          b.bind_over("lit_r", r.lit_r);
         } else {
-          b.write(no_compose_, gpu::Access::StorageWrite);
+          b.bind("lit_rv", r.lit_rv);
+          b.bind("lit_r", r.lit_r);
         }
+        b.bind("Output", compose ? r.composed_output : no_compose_);
+        b.bind("Mask", compose ? r.composed_mask : no_compose_);
       },
-      [this, mode, run_transfer](VkCommandBuffer cmd, gpu::PassContext& pass) {
-        const gpu::Context& ctx = pass.context();
+      [this, pipe, mode, compose, run_transfer](VkCommandBuffer cmd, gpu::PassContext& pass) {
         const SharedResources& r = shared_;
-        const bool compose = mode == ShadeMode::TiledCompose;
-        const gpu::Pipeline& pipe = compose                          ? *shade_tiled_compose_
-                                    : mode == ShadeMode::Tiled       ? *shade_tiled_
-                                    : mode == ShadeMode::PassThrough ? *shade_pass_
-                                                                     : *shade_;
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipe.pipeline);
-        gpu::DescriptorPush()
-            .storage_image(0, pass.view(coarse_))
-            .storage_image(1, pass.view(geo_position_))
-            .storage_texel_buffer(2, pass.texel_view(r.color_upload))
-            .storage_image(3, pass.view(r.virtual_position))
-            .storage_image(4, pass.view(r.virtual_albedo))
-            .storage_image(5, pass.view(r.lit_rv))
-            .storage_image(6, pass.view(r.lit_r))
-            .storage_image(7, pass.view(upsampled_))
-            .storage_buffer(8, pass.buffer(tile_list_))
-            .storage_texel_buffer(9, pass.texel_view(r.depth_upload))
-            // Without emission the albedo stands in (bound, never read: kEmission is false).
-            .storage_image(13, pass.view(r.virtual_emission.valid() ? r.virtual_emission
-                                                                     : r.virtual_albedo))
-            .uniform_buffer(10, pass.buffer(r.frame_constants))
-            .storage_buffer(11, pass.buffer(compose ? r.composed_output : no_compose_))
-            .storage_buffer(12, pass.buffer(compose ? r.composed_mask : no_compose_))
-            .push(ctx, cmd, pipe);
         ShadePush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), run_transfer ? 0 : 1),
                      glm::ivec4(int(used_.width), int(used_.height), int(geometry_step_), 0),
                      // Cells -> pixels, grown by the up-sampling footprint (Gauss radius plus
@@ -258,9 +240,9 @@ void Ssrt::add_shade_pass(const char* name, ShadeMode mode, bool run_transfer) {
                      influence_pixels(),
                      glm::vec4(kIndirectTolerance, r.compose_eps, r.compose_alpha_max, 0.0f)};
         if (mode == ShadeMode::Tiled || compose) {
-          gpu::dispatch_indirect(cmd, pipe, &pc, sizeof(pc), pass.buffer(tile_args_));
+          gpu::dispatch_indirect(cmd, *pipe, &pc, sizeof(pc), pass.buffer(tile_args_));
         } else {
-          gpu::dispatch_2d(cmd, pipe, &pc, sizeof(pc), used_.width, used_.height);
+          gpu::dispatch_2d(cmd, *pipe, &pc, sizeof(pc), used_.width, used_.height);
         }
       });
 }
