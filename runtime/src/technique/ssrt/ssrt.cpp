@@ -288,74 +288,50 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
                              "ssrt_upsample_blur"})
       skipped.push_back(std::string(pass) + ": " + why);
   } else {
-    graph.add_pass(
-        "ssrt_occluders", gpu::PassKind::Compute,
-        [this](gpu::PassBuilder& b) {
+    graph.add_shader_pass(
+        "ssrt_occluders", gpu::PassKind::Compute, *occluders_,
+        [this](gpu::ShaderPassBuilder& b) {
           const SharedResources& r = shared_;
-          b.read(r.frame_constants, gpu::Access::UniformRead);
-          b.read(r.color_upload, gpu::Access::StorageRead);
-          b.read(r.depth_upload, gpu::Access::StorageRead);
-          for (gpu::ImageHandle h : {r.virtual_position, r.virtual_normal, r.virtual_albedo,
-                                     geo_position_, geo_normal_})
-            b.read(h, gpu::Access::StorageRead);
-          b.write(occ_a_, gpu::Access::StorageWrite);
-          b.write(occ_b_, gpu::Access::StorageWrite);
+          b.bind("FrameUbo", r.frame_constants);
+          b.bind("color_words", r.color_upload);
+          b.bind("depth_words", r.depth_upload);
+          b.bind("virtual_position", r.virtual_position);
+          b.bind("virtual_normal", r.virtual_normal);
+          b.bind("virtual_albedo", r.virtual_albedo);
+          b.bind("real_position", geo_position_);
+          b.bind("real_normal", geo_normal_);
+          b.bind("occ_a", occ_a_);
+          b.bind("occ_b", occ_b_);
         },
         [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
-          const SharedResources& r = shared_;
-          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, occluders_->pipeline);
-          gpu::DescriptorPush()
-              .uniform_buffer(0, pass.buffer(r.frame_constants))
-              .storage_texel_buffer(1, pass.texel_view(r.color_upload))
-              .storage_texel_buffer(2, pass.texel_view(r.depth_upload))
-              .storage_image(3, pass.view(r.virtual_position))
-              .storage_image(4, pass.view(r.virtual_normal))
-              .storage_image(5, pass.view(r.virtual_albedo))
-              .storage_image(6, pass.view(geo_position_))
-              .storage_image(7, pass.view(geo_normal_))
-              .storage_image(8, pass.view(occ_a_))
-              .storage_image(9, pass.view(occ_b_))
-              .push(pass.context(), cmd, *occluders_);
           const glm::ivec4 pc(int(occluder_step_), int(used_.width), int(used_.height),
                               int(geometry_step_));
           const VkExtent2D e = pass.extent(occ_a_);
           gpu::dispatch_2d(cmd, *occluders_, &pc, sizeof(pc), e.width, e.height);
         });
-    graph.add_pass(
-        "ssrt_transfer", gpu::PassKind::Compute,
-        [this](gpu::PassBuilder& b) {
+    // Three variants of one shader (the paths each does not take compiled out), with the same
+    // bindings: the graph pushes the descriptors for transfer_, and the other two, bound for
+    // their regions, have compatible layouts, so the descriptors stay.
+    graph.add_shader_pass(
+        "ssrt_transfer", gpu::PassKind::Compute, *transfer_,
+        [this](gpu::ShaderPassBuilder& b) {
           const SharedResources& r = shared_;
-          b.read(r.frame_constants, gpu::Access::UniformRead);
-          b.read(light_, gpu::Access::UniformRead);
-          b.read(samples_, gpu::Access::UniformRead);
-          b.read(r.color_upload, gpu::Access::StorageRead);
-          b.read(r.depth_upload, gpu::Access::StorageRead);
-          for (gpu::ImageHandle h : {geo_position_, geo_normal_, r.virtual_position,
-                                     r.virtual_normal, occ_a_, occ_b_,
-                                     volume_->aux_position()})
-            b.read(h, gpu::Access::StorageRead);
-          b.read(volume_->aux_views(), gpu::Access::UniformRead);
-          b.write(coarse_, gpu::Access::StorageWrite);
+          b.bind("FrameUbo", r.frame_constants);
+          b.bind("LightUbo", light_);
+          b.bind("SampleDirections", samples_);
+          b.bind("real_position", geo_position_);
+          b.bind("real_normal", geo_normal_);
+          b.bind("color_words", r.color_upload);
+          b.bind("depth_words", r.depth_upload);
+          b.bind("virtual_position", r.virtual_position);
+          b.bind("virtual_normal", r.virtual_normal);
+          b.bind("occ_a", occ_a_);
+          b.bind("occ_b", occ_b_);
+          b.bind("coarse", coarse_);
+          b.bind("aux_position", volume_->aux_position());
+          b.bind("AuxUbo", volume_->aux_views());
         },
-        [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
-          const gpu::Context& ctx = pass.context();
-          const SharedResources& r = shared_;
-          gpu::DescriptorPush descriptors;
-          descriptors
-              .uniform_buffer(0, pass.buffer(r.frame_constants))
-              .uniform_buffer(1, pass.buffer(light_))
-              .uniform_buffer(2, pass.buffer(samples_))
-              .storage_image(3, pass.view(geo_position_))
-              .storage_image(4, pass.view(geo_normal_))
-              .storage_texel_buffer(5, pass.texel_view(r.color_upload))
-              .storage_image(6, pass.view(r.virtual_position))
-              .storage_image(7, pass.view(r.virtual_normal))
-              .storage_image(8, pass.view(occ_a_))
-              .storage_image(9, pass.view(coarse_))
-              .storage_image(10, pass.view(volume_->aux_position()))
-              .uniform_buffer(11, pass.buffer(volume_->aux_views()))
-              .storage_image(12, pass.view(occ_b_))
-              .storage_texel_buffer(13, pass.texel_view(r.depth_upload));
+        [this](VkCommandBuffer cmd, gpu::PassContext&) {
           const float sample_area = 3.14159265f * kRadiusM * kRadiusM / float(directions_);
           TransferPush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), int(directions_)),
                           glm::ivec4(int(sample_base_[size_t(level_)]), int(bands_),
@@ -387,8 +363,6 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
             pc.region = d.region;
             if (pc.region.z <= pc.region.x || pc.region.w <= pc.region.y) continue;
             const gpu::Pipeline& pipe = *d.pipe;
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipe.pipeline);
-            descriptors.push(ctx, cmd, pipe);
             gpu::dispatch_2d(cmd, pipe, &pc, sizeof(pc), uint32_t(pc.region.z - pc.region.x),
                              uint32_t(pc.region.w - pc.region.y));
           }
@@ -396,42 +370,27 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
         });
     const uint32_t strips_x = (grid_.x + kStripCells - 1) / kStripCells;
     const uint32_t partial_count = strips_x * grid_.y;
-    graph.add_pass(
-        "ssrt_light_reduce", gpu::PassKind::Compute,
-        [this](gpu::PassBuilder& b) {
-          b.read(coarse_, gpu::Access::StorageRead);
-          b.read(shared_.frame_constants, gpu::Access::UniformRead);
-          b.read(shared_.color_upload, gpu::Access::StorageRead);
-          b.read(shared_.depth_upload, gpu::Access::StorageRead);
-          b.write(partials_, gpu::Access::StorageWrite);
+    graph.add_shader_pass(
+        "ssrt_light_reduce", gpu::PassKind::Compute, *reduce_,
+        [this](gpu::ShaderPassBuilder& b) {
+          b.bind("coarse", coarse_);
+          b.bind("FrameUbo", shared_.frame_constants);
+          b.bind("color_words", shared_.color_upload);
+          b.bind("depth_words", shared_.depth_upload);
+          b.bind("Partials", partials_);
         },
-        [this, strips_x, partial_count](VkCommandBuffer cmd, gpu::PassContext& pass) {
-          const gpu::Context& ctx = pass.context();
-          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, reduce_->pipeline);
-          gpu::DescriptorPush()
-              .storage_image(0, pass.view(coarse_))
-              .storage_texel_buffer(1, pass.texel_view(shared_.color_upload))
-              .uniform_buffer(3, pass.buffer(shared_.frame_constants))
-              .storage_texel_buffer(4, pass.texel_view(shared_.depth_upload))
-              .storage_buffer(2, pass.buffer(partials_))
-              .push(ctx, cmd, *reduce_);
+        [this, strips_x, partial_count](VkCommandBuffer cmd, gpu::PassContext&) {
           ReducePush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), int(kStripCells)),
                         glm::ivec4(int(used_.width), int(used_.height), int(strips_x), 0)};
           gpu::dispatch_2d(cmd, *reduce_, &pc, sizeof(pc), partial_count, 1, 64, 1);
         });
-    graph.add_pass(
-        "ssrt_light_reduce_final", gpu::PassKind::Compute,
-        [this](gpu::PassBuilder& b) {
-          b.read(partials_, gpu::Access::StorageRead);
-          b.write(result_, gpu::Access::StorageWrite);
+    graph.add_shader_pass(
+        "ssrt_light_reduce_final", gpu::PassKind::Compute, *reduce_final_,
+        [this](gpu::ShaderPassBuilder& b) {
+          b.bind("Partials", partials_);
+          b.bind("Result", result_);
         },
-        [this, partial_count](VkCommandBuffer cmd, gpu::PassContext& pass) {
-          const gpu::Context& ctx = pass.context();
-          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, reduce_final_->pipeline);
-          gpu::DescriptorPush()
-              .storage_buffer(0, pass.buffer(partials_))
-              .storage_buffer(1, pass.buffer(result_))
-              .push(ctx, cmd, *reduce_final_);
+        [this, partial_count](VkCommandBuffer cmd, gpu::PassContext&) {
           FinalPush pc{glm::ivec4(int(partial_count), 0, 0, 0)};
           gpu::dispatch_2d(cmd, *reduce_final_, &pc, sizeof(pc), kReduceEntries, 1, 24, 1);
         });
@@ -439,22 +398,16 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     pending_[graph.slot()] = info.frame_index;
     pending_bands_[graph.slot()] = int(bands_);
     if (step_ > 1) {
-      graph.add_pass(
-          "ssrt_upsample_blur", gpu::PassKind::Compute,
-          [this](gpu::PassBuilder& b) {
-            b.read(coarse_, gpu::Access::StorageRead);
-            b.write(upsampled_, gpu::Access::StorageWrite);
+      const gpu::Pipeline* blur = &*blur_;
+      for (const auto& [r, pipe] : blur_by_radius_)
+        if (r == blur_radius_cells(int(step_))) blur = &*pipe;
+      graph.add_shader_pass(
+          "ssrt_upsample_blur", gpu::PassKind::Compute, *blur,
+          [this](gpu::ShaderPassBuilder& b) {
+            b.bind("coarse", coarse_);
+            b.bind("upsampled", upsampled_);
           },
-          [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
-            const gpu::Context& ctx = pass.context();
-            const gpu::Pipeline* blur = &*blur_;
-            for (const auto& [r, pipe] : blur_by_radius_)
-              if (r == blur_radius_cells(int(step_))) blur = &*pipe;
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, blur->pipeline);
-            gpu::DescriptorPush()
-                .storage_image(0, pass.view(coarse_))
-                .storage_image(1, pass.view(upsampled_))
-                .push(ctx, cmd, *blur);
+          [this, blur](VkCommandBuffer cmd, gpu::PassContext&) {
             BlurPush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), 0),
                         glm::vec4(kGaussRadiusPx, 0.0f, 0.0f, 0.0f)};
             gpu::dispatch_2d(cmd, *blur, &pc, sizeof(pc), grid_.x, grid_.y);
@@ -475,21 +428,14 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
         "ssrt_shade_tiles_clear", gpu::PassKind::Transfer,
         [this](gpu::PassBuilder& b) { b.write(tile_args_, gpu::Access::TransferDst); },
         [this](VkCommandBuffer cmd, gpu::PassContext& pass) { gpu::reset_dispatch_args(cmd, pass.buffer(tile_args_)); });
-    graph.add_pass(
-        "ssrt_shade_tiles", gpu::PassKind::Compute,
-        [this](gpu::PassBuilder& b) {
-          b.read(upsampled_, gpu::Access::StorageRead);
-          b.write(tile_args_, gpu::Access::StorageReadWrite);
-          b.write(tile_list_, gpu::Access::StorageWrite);
+    graph.add_shader_pass(
+        "ssrt_shade_tiles", gpu::PassKind::Compute, *shade_tiles_,
+        [this](gpu::ShaderPassBuilder& b) {
+          b.bind("upsampled", upsampled_);
+          b.bind("Args", tile_args_);
+          b.bind("Tiles", tile_list_);
         },
-        [this, tiles](VkCommandBuffer cmd, gpu::PassContext& pass) {
-          const gpu::Context& ctx = pass.context();
-          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, shade_tiles_->pipeline);
-          gpu::DescriptorPush()
-              .storage_image(0, pass.view(upsampled_))
-              .storage_buffer(1, pass.buffer(tile_args_))
-              .storage_buffer(2, pass.buffer(tile_list_))
-              .push(ctx, cmd, *shade_tiles_);
+        [this, tiles](VkCommandBuffer cmd, gpu::PassContext&) {
           TilesPush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), 0),
                        glm::ivec4(int(tiles.x), int(tiles.y), 0, 0), virtual_pixels(),
                        glm::vec4(kTileTolerance, 0.0f, 0.0f, 0.0f)};
