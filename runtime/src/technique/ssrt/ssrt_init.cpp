@@ -107,10 +107,8 @@ Status Ssrt::init() {
   if (!upsampled) return upsampled.error();
   upsampled_ = *upsampled;
 
-  const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-  const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-  const auto texel = VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER;  // the camera uploads (upload_gather.glsl)
-  const auto img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+  // Layouts from the shaders (gpu/reflect.h; the passes bind by name); push sizes are the C++
+  // structs', checked against the shaders' declarations.
   auto transfer_spv = gpu::shader_spirv("ssrt/transfer.comp");
   if (!transfer_spv) return transfer_spv.error();
   // Variants (transfer.comp's constants kRealReceivers, kRealOnly): the general path, real
@@ -124,27 +122,22 @@ Status Ssrt::init() {
                            {"ssrt_transfer_real_only", 1, 1, &transfer_real_only_}};
   for (const auto& variant : transfer_variants) {
     gpu::ComputePipelineDesc d{variant.name, *transfer_spv,
-                               {{ubo}, {ubo}, {ubo}, {img}, {img}, {texel}, {img}, {img}, {img},
-                                {img}, {img}, {ubo}, {img}, {texel}},
+                               {},
                                sizeof(TransferPush), {variant.real_receivers, variant.real_only}};
     auto tp = gpu::create_compute_pipeline(ctx, d);
     if (!tp) return tp.error();
     *variant.handle = gpu::PipelineHandle(ctx, std::move(*tp));
   }
-  auto p = gpu::load_compute_pipeline(ctx, "ssrt/occluders.comp",
-                                      {{ubo}, {texel}, {texel}, {img}, {img}, {img}, {img}, {img},
-                                       {img}, {img}},
-                                      sizeof(glm::ivec4));
+  auto p = gpu::load_compute_pipeline(ctx, "ssrt/occluders.comp", {}, sizeof(glm::ivec4));
   if (!p) return p.error();
   occluders_ = std::move(*p);
-  p = gpu::load_compute_pipeline(ctx, "ssrt/light_reduce.comp",
-                                 {{img}, {texel}, {ssbo}, {ubo}, {texel}}, sizeof(ReducePush));
+  p = gpu::load_compute_pipeline(ctx, "ssrt/light_reduce.comp", {}, sizeof(ReducePush));
   if (!p) return p.error();
   reduce_ = std::move(*p);
-  p = gpu::load_compute_pipeline(ctx, "ssrt/light_reduce_final.comp", {{ssbo}, {ssbo}}, sizeof(FinalPush));
+  p = gpu::load_compute_pipeline(ctx, "ssrt/light_reduce_final.comp", {}, sizeof(FinalPush));
   if (!p) return p.error();
   reduce_final_ = std::move(*p);
-  p = gpu::load_compute_pipeline(ctx, "ssrt/upsample_blur.comp", {{img}, {img}}, sizeof(BlurPush));
+  p = gpu::load_compute_pipeline(ctx, "ssrt/upsample_blur.comp", {}, sizeof(BlurPush));
   if (!p) return p.error();
   blur_ = std::move(*p);
   // One blur per window radius the ladder uses, the radius a constant (upsample_blur.comp).
@@ -157,7 +150,7 @@ Status Ssrt::init() {
     if (std::any_of(blur_by_radius_.begin(), blur_by_radius_.end(),
                     [r](const auto& e) { return e.first == r; }))
       continue;
-    gpu::ComputePipelineDesc d{"ssrt_upsample_blur_r" + std::to_string(r), *blur_spv, {{img}, {img}},
+    gpu::ComputePipelineDesc d{"ssrt_upsample_blur_r" + std::to_string(r), *blur_spv, {},
                                sizeof(BlurPush), {uint32_t(r)}};
     auto bp = gpu::create_compute_pipeline(ctx, d);
     if (!bp) return bp.error();
@@ -179,16 +172,14 @@ Status Ssrt::init() {
   const uint32_t emission = shared_.virtual_emission.valid() ? 1u : 0u;
   for (const auto& v : shade_variants) {
     gpu::ComputePipelineDesc d{v.name, *shade_spv,
-                               {{img}, {img}, {texel}, {img}, {img}, {img}, {img}, {img}, {ssbo},
-                                {texel}, {ubo}, {ssbo}, {ssbo}, {img}},
+                               {},
                                sizeof(ShadePush),
                                {v.pass_through, v.tiled, v.local_x, v.local_y, v.compose, emission}};
     auto sp = gpu::create_compute_pipeline(ctx, d);
     if (!sp) return sp.error();
     *v.handle = gpu::PipelineHandle(ctx, std::move(*sp));
   }
-  p = gpu::load_compute_pipeline(ctx, "ssrt/shade_tiles.comp", {{img}, {ssbo}, {ssbo}},
-                                 sizeof(TilesPush));
+  p = gpu::load_compute_pipeline(ctx, "ssrt/shade_tiles.comp", {}, sizeof(TilesPush));
   if (!p) return p.error();
   shade_tiles_ = std::move(*p);
   const uint32_t max_tiles = ((top.width + 7) / 8) * ((top.height + 7) / 8);
