@@ -266,4 +266,16 @@ TEST_F(VulkanTest, ShaderPassBindOverKeepsTheEarlierWrite) {
       << s.error().message;
 }
 
+// Passes that push descriptors by hand check their names when the pipeline is made.
+TEST_F(VulkanTest, RequireBindingsNamesTheMissingOne) {
+  auto pipe = gpu::load_compute_pipeline(ctx(), "gi/volume_downsample.comp", {});
+  ASSERT_TRUE(pipe.ok()) << pipe.error().message;
+  EXPECT_TRUE(gpu::require_bindings(**pipe, "downsample", {"finer", "coarser"}).ok());
+  Status s = gpu::require_bindings(**pipe, "downsample", {"finer", "finest"});
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.error().kind, ErrorKind::BadUsage);
+  EXPECT_NE(s.error().message.find("pipeline 'downsample': its shaders declare no binding 'finest'"), std::string::npos)
+      << s.error().message;
+}
+
 }  // namespace

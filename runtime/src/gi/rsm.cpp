@@ -148,6 +148,7 @@ Expected<ReflectiveShadowMaps> ReflectiveShadowMaps::create(gpu::FrameGraph& gra
   auto gp = gpu::create_graphics_pipeline(ctx, pd);
   if (!gp) return gp.error();
   r.grid_pipeline_ = gpu::PipelineHandle(ctx, std::move(*gp));
+  MRGI_TRY(gpu::require_bindings(*r.grid_pipeline_, "rsm grid", {"real_position", "real_normal", "real_albedo", "base_color_maps"}));
   pd.name = s.name + " mesh";
   pd.vertex_spirv = *mesh_vs;
   pd.vertex_strides = {sizeof(technique::GpuVertex)};
@@ -157,6 +158,7 @@ Expected<ReflectiveShadowMaps> ReflectiveShadowMaps::create(gpu::FrameGraph& gra
   auto mp = gpu::create_graphics_pipeline(ctx, pd);
   if (!mp) return mp.error();
   r.mesh_pipeline_ = gpu::PipelineHandle(ctx, std::move(*mp));
+  MRGI_TRY(gpu::require_bindings(*r.mesh_pipeline_, "rsm mesh", {"Materials", "base_color_maps"}));
   // The draw pushes these by name: check once that the shaders declare them.
   for (const char* name : {"real_position", "real_normal", "real_albedo", "base_color_maps"})
     if (auto b = binding_of(*r.grid_pipeline_, name, pd.name); !b) return b.error();

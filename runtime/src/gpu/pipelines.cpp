@@ -352,6 +352,14 @@ void reset_dispatch_args(VkCommandBuffer cmd, VkBuffer args, bool zero_rest) {
   if (zero_rest) vkCmdFillBuffer(cmd, args, 12, VK_WHOLE_SIZE, 0u);
 }
 
+Status require_bindings(const Pipeline& pipeline, const std::string& what,
+                        std::initializer_list<std::string_view> names) {
+  for (std::string_view n : names)
+    if (!pipeline.interface.find(n))
+      return fail(ErrorKind::BadUsage, "pipeline '" + what + "': its shaders declare no binding '" + std::string(n) + "'");
+  return ok_status();
+}
+
 Expected<PipelineHandle> load_compute_pipeline(const Context& ctx, const char* shader,
                                                std::vector<DescriptorBinding> bindings,
                                                uint32_t push_constant_bytes) {

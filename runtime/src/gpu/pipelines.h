@@ -2,6 +2,8 @@
 // set 0 of every pipeline is a push-descriptor set, so nothing is allocated per frame and no
 // pool is needed. Push constants are visible to all the pipeline's stages.
 #pragma once
+#include <initializer_list>
+#include <string_view>
 #include <vulkan/vulkan.h>
 
 #include <array>
@@ -144,6 +146,13 @@ void dispatch_indirect(VkCommandBuffer cmd, const Pipeline& pipeline, const void
 // workgroups into x with atomics (a transfer pass; the buffer needs TRANSFER_DST usage), and with
 // `zero_rest` every byte after it to 0 too (flags a counting pass keeps beside the arguments).
 void reset_dispatch_args(VkCommandBuffer cmd, VkBuffer args, bool zero_rest = false);
+
+// For passes that push descriptors by hand (several pipelines in one pass, where
+// FrameGraph::add_shader_pass does not apply): checked once when the pipeline is made, so that
+// pipeline.interface.find(name)->binding is safe when recording. BadUsage names `what` (the
+// pipeline) and the binding its shaders do not declare.
+Status require_bindings(const Pipeline& pipeline, const std::string& what,
+                        std::initializer_list<std::string_view> names);
 
 // A compute pipeline from a registered shader (shaders.h: "folder/name.comp"), owned.
 Expected<PipelineHandle> load_compute_pipeline(const Context& ctx, const char* shader,

@@ -157,7 +157,6 @@ Status Baseline::init() {
   gpu::GraphicsPipelineDesc grid;
   grid.name = "baseline_shadow_depth_grid";
   grid.vertex_spirv = *grid_vs;
-  grid.bindings = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1}};
   grid.push_constant_bytes = sizeof(GridPush);
   grid.depth_format = VK_FORMAT_D32_SFLOAT;
   grid.cull_mode = VK_CULL_MODE_NONE;
@@ -166,6 +165,7 @@ Status Baseline::init() {
   auto gp = gpu::create_graphics_pipeline(ctx, grid);
   if (!gp) return gp.error();
   grid_pipeline_ = gpu::PipelineHandle(ctx, std::move(*gp));
+  MRGI_TRY(gpu::require_bindings(*grid_pipeline_, grid.name, {"real_position"}));
 
   // Index buffer for the finest grid any level uses (one point a G-buffer pixel).
   const VkExtent2D gbuffer = graph.allocated_extent(shared_.real_position);
@@ -356,7 +356,8 @@ void Baseline::render_faces(VkCommandBuffer cmd, gpu::PassContext& pass,
     if (face.real_casters && grid_indices > 0) {
       vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, grid_pipeline_->pipeline);
       gpu::DescriptorPush()
-          .sampled_image(0, pass.view(shared_.real_position), ctx.samplers().nearest_clamp)
+          .sampled_image(grid_pipeline_->interface.find("real_position")->binding, pass.view(shared_.real_position),
+                         ctx.samplers().nearest_clamp)
           .push(ctx, cmd, *grid_pipeline_);
       GridPush pc{face.view_proj, glm::ivec4(int(grid_.points.width), int(grid_.points.height), int(grid_.stride), 0)};
       vkCmdPushConstants(cmd, grid_pipeline_->layout, grid_pipeline_->stages, 0, sizeof(pc), &pc);
