@@ -9,8 +9,17 @@
 // a virtual object occludes the sky's bright part for the real surface below it. The rest of
 // the light is an ambient irradiance in SH (bands 0..2), unshadowed: the real part lights both
 // solutions, a virtual environment L_rv only.
+// kVolumeBounce (dlpv's shadow-mapped levels, technique/dlpv/dlpv.h): also the bounce light of
+// dlpv's volumes (L_r is left as it is: the real scene's own bounce is in the camera image):
+//   real pixel:    L_rv += albedo / pi E_delta(p, n)   (V^Delta: the virtual objects' bounce onto
+//                  the real scene, minus the bounce they block; E_rho - E_mu in the two-volume
+//                  ablation)
+//   virtual pixel: L_rv += albedo / pi E_rho(p, n)     (V^rho; levels without it add nothing)
+// Here, not in a pass of its own: that pass's G-buffer reads and read-modify-write of L_rv cost
+// more than its lookups (5.9 ms at dlpv fast on desk_spot, 18 ms on corner, profiled).
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
+#include "shared/lpv_math.h"
 #include "common/frame_constants.glsl"
 #include "common/light_set.glsl"
 #include "common/surface_shading.glsl"
@@ -31,12 +40,31 @@ layout(set = 0, binding = 8) uniform sampler2DArrayShadow shadow_primary;
 layout(set = 0, binding = 9) uniform sampler2DArrayShadow shadow_virtual;
 layout(set = 0, binding = 10, rgba16f) writeonly uniform image2D lit_rv;
 layout(set = 0, binding = 11, rgba16f) writeonly uniform image2D lit_r;
+layout(constant_id = 0) const bool kVolumeBounce = false;
+// dlpv's volumes (kVolumeBounce; without it a stand-in is bound and never read).
+layout(set = 0, binding = 13) uniform sampler3D delta_r;
+layout(set = 0, binding = 14) uniform sampler3D delta_g;
+layout(set = 0, binding = 15) uniform sampler3D delta_b;
+layout(set = 0, binding = 16) uniform sampler3D rho_r;
+layout(set = 0, binding = 17) uniform sampler3D rho_g;
+layout(set = 0, binding = 18) uniform sampler3D rho_b;
+layout(set = 0, binding = 19) uniform sampler3D mu_r;  // V^mu: the two-volume ablation only
+layout(set = 0, binding = 20) uniform sampler3D mu_g;
+layout(set = 0, binding = 21) uniform sampler3D mu_b;
 struct LevelConstants {
   vec4 shadow;  // x used map size / allocated size, y used size (texels), z allocated size,
                 // w PCF radius (taps each side of the centre)
 };
-layout(push_constant) uniform Level { LevelConstants level_block; };
+struct VolumeConstants {
+  vec4 grid;    // xyz: the volumes' min corner (m); w: cell size (m)
+  vec4 extent;  // x: cells allocated per side; y: cells used; z: 1 = V^Delta present; w: 1 = V^rho
+};
+// volume_mode.x: 1 = DlpvAblation::two_volumes (real pixels get E(V^rho) - E(V^mu)).
+layout(push_constant) uniform Level { LevelConstants level_block; VolumeConstants volume_block; ivec4 volume_mode; };
 LevelConstants level;
+VolumeConstants volume;
+
+#include "dlpv/volume_lookup.glsl"
 
 const float kNormalOffsetTexels = 1.5f;  // shadow lookup moved along the normal, in texels
 
@@ -82,6 +110,7 @@ float shadow_test(sampler2DArrayShadow map, int first_layer, int light, vec3 p, 
 
 void main() {
   frame = frame_ubo; level = level_block;  // MRGI_UNIFORM_COPIES
+  if (kVolumeBounce) volume = volume_block;
   ambient_rv = light_set.ambient_rv;
   ambient_r = light_set.ambient_r;
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
@@ -130,6 +159,16 @@ void main() {
       l_r += lo * r_p * st_primary;          // eq. 2
     } else {
       l_rv += lo * st_primary;               // the virtual lamp's map holds every caster
+    }
+  }
+  if (kVolumeBounce) {
+    if (is_virtual) {
+      if (volume.extent.w > 0.5f)
+        l_rv += alb.rgb * (1.0f - alb.a) * max(volume_irradiance(rho_r, rho_g, rho_b, p, n), vec3(0.0f)) * (1.0f / MRGI_PI);
+    } else if (volume.extent.z > 0.5f && volume_contains(p)) {
+      vec3 e = volume_mode.x == 1 ? volume_irradiance(rho_r, rho_g, rho_b, p, n) - volume_irradiance(mu_r, mu_g, mu_b, p, n)
+                                  : volume_irradiance(delta_r, delta_g, delta_b, p, n);
+      l_rv += alb.rgb * e * (1.0f / MRGI_PI);
     }
   }
   // Half floats end at 65504: clamp so no Inf reaches compose.

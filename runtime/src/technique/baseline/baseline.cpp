@@ -1,6 +1,8 @@
 #include "technique/baseline/baseline.h"
 
 #include <algorithm>
+#include <array>
+#include <optional>
 #include <cmath>
 #include <string>
 
@@ -47,6 +49,7 @@ CasterGrid caster_grid(VkExtent2D gbuffer, uint32_t shadow_size, double cell_tex
 
 struct ShadePush {
   glm::vec4 shadow;
+  VolumeBounce::Constants volume;  // shade_direct.comp's VolumeConstants (kVolumeBounce only)
 };
 
 class Baseline final : public Technique {
@@ -56,6 +59,7 @@ class Baseline final : public Technique {
   const std::vector<QualityLevel>& levels() const override { return ladder_; }
   Status init();
   Status record(const FrameInfo& info, std::vector<std::string>& skipped) override;
+  void set_volume_bounce(const VolumeBounce* bounce) { bounce_ = bounce ? std::optional<VolumeBounce>(*bounce) : std::nullopt; }
 
  private:
   void render_faces(VkCommandBuffer cmd, gpu::PassContext& pass, const std::vector<ShadowFace>& faces,
@@ -80,6 +84,9 @@ class Baseline final : public Technique {
   ImageViews views_;
   std::vector<VkImageView> primary_layer_views_, virtual_layer_views_;
   gpu::PipelineHandle grid_pipeline_, mesh_pipeline_, shade_pipeline_, caster_indices_pipeline_;
+  gpu::PipelineHandle shade_bounce_pipeline_;  // shade_direct.comp with kVolumeBounce
+  gpu::ImageHandle no_volume_;                 // bound for the volumes when there is no bounce
+  std::optional<VolumeBounce> bounce_;         // this frame's (set_volume_bounce)
   gpu::BufferHandle caster_indices_;  // this frame's real caster mesh (shadow_caster_indices.comp)
   bool real_caster_faces_ = false;     // some face of the plan draws the real casters
   VkImageLayout depth_write_layout_ = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
@@ -194,9 +201,24 @@ Status Baseline::init() {
   if (!mp) return mp.error();
   mesh_pipeline_ = gpu::PipelineHandle(ctx, std::move(*mp));
 
-  auto sp = gpu::load_compute_pipeline(ctx, "baseline/shade_direct.comp", {});  // layout from the shader
-  if (!sp) return sp.error();
-  shade_pipeline_ = std::move(*sp);
+  auto shade_spv = gpu::shader_spirv("baseline/shade_direct.comp");
+  if (!shade_spv) return shade_spv.error();
+  for (const uint32_t bounce : {0u, 1u}) {  // layout from the shader; kVolumeBounce
+    auto sp = gpu::create_compute_pipeline(
+        ctx, {bounce ? "baseline_shade_direct_bounce" : "baseline_shade_direct", *shade_spv, {}, sizeof(ShadePush), {bounce}});
+    if (!sp) return sp.error();
+    (bounce ? shade_bounce_pipeline_ : shade_pipeline_) = gpu::PipelineHandle(ctx, std::move(*sp));
+  }
+  gpu::ImageDesc nv;
+  nv.name = "baseline_no_volume";
+  nv.format = VK_FORMAT_R16G16B16A16_SFLOAT;
+  nv.size_mode = gpu::SizeMode::Absolute;
+  nv.width = nv.height = nv.depth = 2;
+  auto no_volume = graph.create_image(nv, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
+  if (!no_volume) return no_volume.error();
+  no_volume_ = *no_volume;
+  const std::array<uint16_t, 2 * 2 * 2 * 4> zero{};  // defined contents, never read
+  MRGI_TRY(graph.upload_image(no_volume_, zero.data(), sizeof zero));
   return ok_status();
 }
 
@@ -263,9 +285,15 @@ Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped
   (void)s;
   const VkSampler nearest = shared_.context->samplers().nearest_clamp;
   const VkSampler compare = shared_.context->samplers().shadow_compare;
+  const VkSampler linear = shared_.context->samplers().linear_clamp;
   graph.add_shader_pass(
-      "shade_direct", gpu::PassKind::Compute, *shade_pipeline_,
-      [this, nearest, compare](gpu::ShaderPassBuilder& b) {
+      "shade_direct", gpu::PassKind::Compute, bounce_ ? *shade_bounce_pipeline_ : *shade_pipeline_,
+      [this, nearest, compare, linear](gpu::ShaderPassBuilder& b) {
+        const char* names[9] = {"delta_r", "delta_g", "delta_b", "rho_r", "rho_g", "rho_b", "mu_r", "mu_g", "mu_b"};
+        for (int i = 0; i < 9; ++i) {
+          const gpu::ImageHandle* set = !bounce_ ? nullptr : i < 3 ? bounce_->delta : i < 6 ? bounce_->rho : bounce_->mu;
+          b.bind_sampled(names[i], set ? set[i % 3] : no_volume_, linear);
+        }
         const SharedResources& r = shared_;
         b.bind("FrameUbo", r.frame_constants);
         b.bind("LightUbo", lights_);
@@ -379,14 +407,19 @@ void Baseline::render_faces(VkCommandBuffer cmd, gpu::PassContext& pass,
 
 void Baseline::shade(VkCommandBuffer cmd, gpu::PassContext& pass) {
   const SharedResources& r = shared_;
-  ShadePush pc;
+  ShadePush pc{};
   pc.shadow = glm::vec4(float(shadow_size_) / float(kTopShadowSize), float(shadow_size_),
                         float(kTopShadowSize), float(pcf_radius_));
+  if (bounce_) pc.volume = bounce_->constants;
   const VkExtent2D e = pass.extent(r.lit_rv);
-  gpu::dispatch_2d(cmd, *shade_pipeline_, &pc, sizeof(pc), e.width, e.height);
+  gpu::dispatch_2d(cmd, bounce_ ? *shade_bounce_pipeline_ : *shade_pipeline_, &pc, sizeof(pc), e.width, e.height);
 }
 
 }  // namespace
+
+void set_volume_bounce(Technique& baseline, const VolumeBounce* bounce) {
+  if (auto* b = dynamic_cast<Baseline*>(&baseline)) b->set_volume_bounce(bounce);
+}
 
 const std::array<BaselineLevel, 4>& baseline_levels() {
   static const std::array<BaselineLevel, 4> levels = {{

@@ -25,6 +25,8 @@
 #include <memory>
 #include <vector>
 
+#include <glm/glm.hpp>
+
 #include "technique/technique.h"
 
 namespace mrgi::technique {
@@ -45,6 +47,21 @@ struct BaselineLevel {
 const std::array<BaselineLevel, 4>& baseline_levels();
 
 std::vector<QualityLevel> baseline_ladder();
+
+// The bounce light of dlpv's volumes, added in baseline's shading pass
+// (shaders/baseline/shade_direct.comp, kVolumeBounce) instead of a pass of its own.
+struct VolumeBounce {
+  gpu::ImageHandle delta[3], rho[3];  // V^Delta and V^rho, per colour channel (sampler3D)
+  gpu::ImageHandle mu[3];             // V^mu (two_volumes only; else any of the above)
+  struct Constants {
+    glm::vec4 grid;    // xyz: the volumes' min corner (m); w: cell size (m)
+    glm::vec4 extent;  // x: cells allocated per side; y: cells used; z: 1 = V^Delta present; w: 1 = V^rho
+    glm::ivec4 mode;   // x: 1 = DlpvAblation::two_volumes (real pixels: E(V^rho) - E(V^mu))
+  } constants;
+};
+// For the next record() of `baseline` (a technique made by create_baseline; others ignore it);
+// nullptr: none. The images must be written by passes recorded before that record().
+void set_volume_bounce(Technique& baseline, const VolumeBounce* bounce);
 Expected<std::unique_ptr<Technique>> create_baseline(const SharedResources& shared);
 
 }  // namespace mrgi::technique

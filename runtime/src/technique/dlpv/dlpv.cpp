@@ -12,7 +12,6 @@
 #include "light/light_stage.h"
 #include "technique/baseline/baseline.h"
 #include "technique/scene_gpu.h"
-#include "technique/screen_bounds.h"
 
 namespace mrgi::technique {
 
@@ -52,11 +51,6 @@ namespace {
 struct MergePush {
   glm::vec4 grid;    // min corner, cell size
   glm::vec4 extent;  // cells allocated, cells used, V^Delta present, V^rho present
-};
-struct AddIndirectPush {
-  MergePush volume;
-  glm::ivec4 rect;  // internal pixels [x0, x1) x [y0, y1) the volume covers
-  glm::ivec4 mode;  // x: 1 = DlpvAblation::two_volumes
 };
 
 // The volume around the virtual objects: twice their largest bounding-box edge (paper Sec. 4.2),
@@ -115,7 +109,7 @@ class Dlpv final : public Technique {
   std::optional<gi::ReflectiveShadowMaps> rsm_;
   std::optional<gi::LightPropagationVolume> delta_, rho_;
   std::optional<gi::LightPropagationVolume> mu_;  // DlpvAblation::two_volumes only
-  gpu::PipelineHandle merge_, add_indirect_;
+  gpu::PipelineHandle merge_;
   std::unique_ptr<Technique> baseline_;  // direct light with shadow maps (not antiradiance levels)
   VolumeSource source_;                 // what the volumes in the images were made from
   std::vector<uint16_t> source_depth_;  // that frame's depth (sized at init: no allocation later)
@@ -178,9 +172,6 @@ Status Dlpv::init() {
   auto merge = gpu::load_compute_pipeline(*shared_.context, "dlpv/merge.comp", {});
   if (!merge) return merge.error();
   merge_ = std::move(*merge);
-  auto add = gpu::load_compute_pipeline(*shared_.context, "dlpv/add_indirect.comp", {});
-  if (!add) return add.error();
-  add_indirect_ = std::move(*add);
   source_depth_.assign(size_t(shared_.depth_intrinsics.width) * size_t(shared_.depth_intrinsics.height), 0);
   auto base = create_baseline(shared_);
   if (!base) return base.error();
@@ -247,12 +238,6 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     return fail(ErrorKind::BadUsage, std::string("dlpv: the two-volume ablation (DlpvAblation::two_volumes) needs a level "
                                                  "with shadow-mapped direct light; level '") + level.name +
                                          "' shadows with V^Delta's antiradiance");
-  if (!antiradiance) {
-    // Direct light and its shadows: baseline's passes at the matching level write both solutions.
-    FrameInfo base = info;
-    base.level = level.baseline_level;
-    MRGI_TRY(baseline_->record(base, skipped));
-  }
   write_lights();
   const light::Lighting& lighting = shared_.light_stage->lighting();
   bool delta_present = false, rho_present = false;
@@ -367,50 +352,38 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   const VkSampler linear = ctx.samplers().linear_clamp;
   const gpu::ImageHandle dvol[3] = {delta_->accumulated(0), delta_->accumulated(1), delta_->accumulated(2)};
   const gpu::ImageHandle rvol[3] = {rho_->accumulated(0), rho_->accumulated(1), rho_->accumulated(2)};
-  // What both shading passes (add_indirect.comp, merge.comp) declare alike.
-  auto bind_common = [&](gpu::ShaderPassBuilder& b) {
-    b.bind("FrameUbo", r.frame_constants);
-    b.bind("real_position", r.real_position);
-    b.bind("real_normal", r.real_normal);
-    b.bind("real_albedo", r.real_albedo);
-    b.bind("virtual_position", r.virtual_position);
-    b.bind("virtual_normal", r.virtual_normal);
-    b.bind("virtual_albedo", r.virtual_albedo);
-    const char* d[3] = {"delta_r", "delta_g", "delta_b"};
-    const char* p[3] = {"rho_r", "rho_g", "rho_b"};
-    for (int c = 0; c < 3; ++c) {
-      b.bind_sampled(d[c], dvol[c], linear);
-      b.bind_sampled(p[c], rvol[c], linear);
-    }
-    b.bind("lit_rv", r.lit_rv);
-  };
   if (!antiradiance) {
-    if (!delta_present && !rho_present) return ok_status();  // baseline's solutions as they are
-    const gpu::Pipeline* add = &*add_indirect_;
-    const auto* fc = static_cast<const shader::FrameConstants*>(graph.mapped(r.frame_constants, graph.slot()));
-    const glm::vec3 half(0.5f * side_);
-    const AddIndirectPush ap{push, box_pixels(*fc, centre_ - half, centre_ + half, 1), glm::ivec4(two ? 1 : 0, 0, 0, 0)};
-    if (ap.rect.z <= ap.rect.x || ap.rect.w <= ap.rect.y) {
-      skipped.push_back("dlpv add indirect: the volume is outside the view");
-      return ok_status();
-    }
-    graph.add_shader_pass(
-        "dlpv add indirect", gpu::PassKind::Compute, *add_indirect_,
-        [&](gpu::ShaderPassBuilder& b) {
-          bind_common(b);
-          const char* m[3] = {"mu_r", "mu_g", "mu_b"};
-          for (uint32_t c = 0; c < 3; ++c) b.bind_sampled(m[c], two ? mu_->accumulated(c) : dvol[c], linear);
-        },
-        [add, ap](VkCommandBuffer cmd, gpu::PassContext&) {
-          const glm::uvec2 n(ap.rect.z - ap.rect.x, ap.rect.w - ap.rect.y);
-          gpu::push_and_dispatch(cmd, *add, &ap, sizeof ap, {(n.x + 7) / 8, (n.y + 7) / 8, 1});
-        });
-    return ok_status();
+    // Direct light and its shadows: baseline's passes at the matching level write both
+    // solutions, recorded after the volumes so that its shading adds their bounce light in the
+    // same pass (shaders/baseline/shade_direct.comp, kVolumeBounce).
+    FrameInfo base = info;
+    base.level = level.baseline_level;
+    const bool bounce_present = delta_present || rho_present;
+    VolumeBounce bounce{{dvol[0], dvol[1], dvol[2]},
+                        {rvol[0], rvol[1], rvol[2]},
+                        {two ? mu_->accumulated(0) : dvol[0], two ? mu_->accumulated(1) : dvol[1],
+                         two ? mu_->accumulated(2) : dvol[2]},
+                        {push.grid, push.extent, glm::ivec4(two ? 1 : 0, 0, 0, 0)}};
+    set_volume_bounce(*baseline_, bounce_present ? &bounce : nullptr);
+    return baseline_->record(base, skipped);
   }
   graph.add_shader_pass(
       "dlpv merge", gpu::PassKind::Compute, *merge_,
       [&](gpu::ShaderPassBuilder& b) {
-        bind_common(b);
+        b.bind("FrameUbo", r.frame_constants);
+        b.bind("real_position", r.real_position);
+        b.bind("real_normal", r.real_normal);
+        b.bind("real_albedo", r.real_albedo);
+        b.bind("virtual_position", r.virtual_position);
+        b.bind("virtual_normal", r.virtual_normal);
+        b.bind("virtual_albedo", r.virtual_albedo);
+        const char* d[3] = {"delta_r", "delta_g", "delta_b"};
+        const char* p[3] = {"rho_r", "rho_g", "rho_b"};
+        for (int c = 0; c < 3; ++c) {
+          b.bind_sampled(d[c], dvol[c], linear);
+          b.bind_sampled(p[c], rvol[c], linear);
+        }
+        b.bind("lit_rv", r.lit_rv);
         b.bind("LightUbo", lights_);
         b.bind("virtual_emission", r.virtual_emission.valid() ? r.virtual_emission : r.virtual_albedo);
         b.bind("lit_r", r.lit_r);

@@ -16,6 +16,9 @@
 // "paper" is the published method with its settings (Sec. 5); the others keep its volume and
 // light the scene directly with shadow maps (Sec. 7's alternative), because the antiradiance
 // shadow is coarse (a 32^3 volume over twice the object) and cut off where the volume ends.
+// Those levels record baseline's passes after the volumes, and baseline's shading pass adds the
+// volumes' bounce light as it shades each pixel (shade_direct.comp kVolumeBounce, set through
+// set_volume_bounce): a pass of its own cost its G-buffer reads and L_rv's read-modify-write.
 //
 // Where mrgi differs from the paper and why:
 //   - the propagation gathers with exact face solid angles and damps negative flux by the
