@@ -1,4 +1,4 @@
-// The irradiance a dlpv volume gives a surface (merge.comp, add_indirect.comp): needs the
+// The irradiance a dlpv volume gives a surface (dlpv/merge.comp, baseline/shade_direct.comp): needs the
 // including shader's `volume` (VolumeConstants: grid, extent) and shared/lpv_math.h.
 #ifndef MRGI_DLPV_VOLUME_LOOKUP_GLSL
 #define MRGI_DLPV_VOLUME_LOOKUP_GLSL
