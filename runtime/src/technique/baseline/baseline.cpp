@@ -297,14 +297,14 @@ Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped
         const SharedResources& r = shared_;
         b.bind("FrameUbo", r.frame_constants);
         b.bind("LightUbo", lights_);
-        b.bind_sampled("real_position", r.real_position, nearest);
-        b.bind_sampled("real_normal", r.real_normal, nearest);
-        b.bind_sampled("real_albedo", r.real_albedo, nearest);
-        b.bind_sampled("virtual_position", r.virtual_position, nearest);
-        b.bind_sampled("virtual_normal", r.virtual_normal, nearest);
-        b.bind_sampled("virtual_albedo", r.virtual_albedo, nearest);
+        b.bind("real_position", r.real_position);
+        b.bind("real_normal", r.real_normal);
+        b.bind("real_albedo", r.real_albedo);
+        b.bind("virtual_position", r.virtual_position);
+        b.bind("virtual_normal", r.virtual_normal);
+        b.bind("virtual_albedo", r.virtual_albedo);
         // Without emission the albedo stands in (bound, never read: flags.y is 0).
-        b.bind_sampled("virtual_emission", r.virtual_emission.valid() ? r.virtual_emission : r.virtual_albedo, nearest);
+        b.bind("virtual_emission", r.virtual_emission.valid() ? r.virtual_emission : r.virtual_albedo);
         b.bind_sampled("shadow_primary", shadow_primary_, compare);
         b.bind_sampled("shadow_virtual", shadow_virtual_, compare);
         b.bind("lit_rv", r.lit_rv);
