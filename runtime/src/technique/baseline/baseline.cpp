@@ -283,12 +283,11 @@ Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped
         });
   }
   (void)s;
-  const VkSampler nearest = shared_.context->samplers().nearest_clamp;
   const VkSampler compare = shared_.context->samplers().shadow_compare;
   const VkSampler linear = shared_.context->samplers().linear_clamp;
   graph.add_shader_pass(
       "shade_direct", gpu::PassKind::Compute, bounce_ ? *shade_bounce_pipeline_ : *shade_pipeline_,
-      [this, nearest, compare, linear](gpu::ShaderPassBuilder& b) {
+      [this, compare, linear](gpu::ShaderPassBuilder& b) {
         const char* names[9] = {"delta_r", "delta_g", "delta_b", "rho_r", "rho_g", "rho_b", "mu_r", "mu_g", "mu_b"};
         for (int i = 0; i < 9; ++i) {
           const gpu::ImageHandle* set = !bounce_ ? nullptr : i < 3 ? bounce_->delta : i < 6 ? bounce_->rho : bounce_->mu;
