@@ -20,6 +20,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
 #include "shared/lpv_math.h"
+#include "dlpv/volume_lookup.glsl"
 #include "common/frame_constants.glsl"
 #include "common/light_set.glsl"
 #include "common/surface_shading.glsl"
@@ -56,16 +57,10 @@ struct LevelConstants {
   vec4 shadow;  // x used map size / allocated size, y used size (texels), z allocated size,
                 // w PCF radius (taps each side of the centre)
 };
-struct VolumeConstants {
-  vec4 grid;    // xyz: the volumes' min corner (m); w: cell size (m)
-  vec4 extent;  // x: cells allocated per side; y: cells used; z: 1 = V^Delta present; w: 1 = V^rho
-};
 // volume_mode.x: 1 = DlpvAblation::two_volumes (real pixels get E(V^rho) - E(V^mu)).
 layout(push_constant) uniform Level { LevelConstants level_block; VolumeConstants volume_block; ivec4 volume_mode; };
 LevelConstants level;
-VolumeConstants volume;
 
-#include "dlpv/volume_lookup.glsl"
 
 const float kNormalOffsetTexels = 1.5f;  // shadow lookup moved along the normal, in texels
 

@@ -13,6 +13,7 @@
 // The G-buffers are read as storage images: on lavapipe a sampled texelFetch costs 2-3x as much.
 #include "shared/mrgi_shared.h"
 #include "shared/lpv_math.h"
+#include "dlpv/volume_lookup.glsl"
 #include "common/frame_constants.glsl"
 #include "common/light_set.glsl"
 #include "common/surface_shading.glsl"
@@ -37,14 +38,8 @@ layout(set = 0, binding = 13) uniform sampler3D rho_g;
 layout(set = 0, binding = 14) uniform sampler3D rho_b;
 layout(set = 0, binding = 15, rgba16f) writeonly uniform image2D lit_rv;
 layout(set = 0, binding = 16, rgba16f) writeonly uniform image2D lit_r;
-struct VolumeConstants {
-  vec4 grid;    // xyz: the volumes' min corner (m); w: cell size (m)
-  vec4 extent;  // x: cells allocated per side; y: cells used; z: 1 = V^Delta present; w: 1 = V^rho
-};
 layout(push_constant) uniform Volume { VolumeConstants volume_block; };
-VolumeConstants volume;
 
-#include "dlpv/volume_lookup.glsl"
 
 void main() {
   frame = frame_ubo;  // MRGI_UNIFORM_COPIES

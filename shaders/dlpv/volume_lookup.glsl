@@ -1,7 +1,14 @@
-// The irradiance a dlpv volume gives a surface (dlpv/merge.comp, baseline/shade_direct.comp): needs the
-// including shader's `volume` (VolumeConstants: grid, extent) and shared/lpv_math.h.
+// The irradiance a dlpv volume gives a surface (dlpv/merge.comp, baseline/shade_direct.comp),
+// from `volume`, which the including shader fills from its push constants; needs
+// shared/lpv_math.h.
 #ifndef MRGI_DLPV_VOLUME_LOOKUP_GLSL
 #define MRGI_DLPV_VOLUME_LOOKUP_GLSL
+
+struct VolumeConstants {
+  vec4 grid;    // xyz: the volumes' min corner (m); w: cell size (m)
+  vec4 extent;  // x: cells allocated per side; y: cells used; z: 1 = V^Delta present; w: 1 = V^rho
+};
+VolumeConstants volume;  // private copy of the push constants' (MRGI_UNIFORM_COPIES)
 
 // Whether p lies in the used volume (a surface outside it gets no light from the volume).
 bool volume_contains(vec3 p) {

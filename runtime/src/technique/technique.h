@@ -94,6 +94,23 @@ struct SharedResources {
   float compose_eps = 1e-3f, compose_alpha_max = 10.0f;
 };
 
+// The shared G-buffers and solutions under the names the shading shaders declare them
+// (baseline/shade_direct.comp, dlpv/merge.comp): FrameUbo, real_* and virtual_* (read), lit_rv
+// and lit_r (written). Without emission the albedo stands in for virtual_emission (bound, never
+// read: FrameConstants::flags.y is 0).
+inline void bind_shading_gbuffers(gpu::ShaderPassBuilder& b, const SharedResources& r) {
+  b.bind("FrameUbo", r.frame_constants);
+  b.bind("real_position", r.real_position);
+  b.bind("real_normal", r.real_normal);
+  b.bind("real_albedo", r.real_albedo);
+  b.bind("virtual_position", r.virtual_position);
+  b.bind("virtual_normal", r.virtual_normal);
+  b.bind("virtual_albedo", r.virtual_albedo);
+  b.bind("virtual_emission", r.virtual_emission.valid() ? r.virtual_emission : r.virtual_albedo);
+  b.bind("lit_rv", r.lit_rv);
+  b.bind("lit_r", r.lit_r);
+}
+
 // Real geometry as a G-buffer another stage reads (the virtual G-buffer's depth test: real
 // surfaces hide virtual ones): positions (xyz world, w camera depth in metres, all 0 = none)
 // with one texel per `step` x `step` internal pixels, and their normals (xyz world), which a

@@ -293,21 +293,10 @@ Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped
           const gpu::ImageHandle* set = !bounce_ ? nullptr : i < 3 ? bounce_->delta : i < 6 ? bounce_->rho : bounce_->mu;
           b.bind_sampled(names[i], set ? set[i % 3] : no_volume_, linear);
         }
-        const SharedResources& r = shared_;
-        b.bind("FrameUbo", r.frame_constants);
+        bind_shading_gbuffers(b, shared_);
         b.bind("LightUbo", lights_);
-        b.bind("real_position", r.real_position);
-        b.bind("real_normal", r.real_normal);
-        b.bind("real_albedo", r.real_albedo);
-        b.bind("virtual_position", r.virtual_position);
-        b.bind("virtual_normal", r.virtual_normal);
-        b.bind("virtual_albedo", r.virtual_albedo);
-        // Without emission the albedo stands in (bound, never read: flags.y is 0).
-        b.bind("virtual_emission", r.virtual_emission.valid() ? r.virtual_emission : r.virtual_albedo);
         b.bind_sampled("shadow_primary", shadow_primary_, compare);
         b.bind_sampled("shadow_virtual", shadow_virtual_, compare);
-        b.bind("lit_rv", r.lit_rv);
-        b.bind("lit_r", r.lit_r);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) { shade(cmd, pass); });
   return ok_status();

@@ -370,23 +370,14 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   graph.add_shader_pass(
       "dlpv merge", gpu::PassKind::Compute, *merge_,
       [&](gpu::ShaderPassBuilder& b) {
-        b.bind("FrameUbo", r.frame_constants);
-        b.bind("real_position", r.real_position);
-        b.bind("real_normal", r.real_normal);
-        b.bind("real_albedo", r.real_albedo);
-        b.bind("virtual_position", r.virtual_position);
-        b.bind("virtual_normal", r.virtual_normal);
-        b.bind("virtual_albedo", r.virtual_albedo);
+        bind_shading_gbuffers(b, r);
+        b.bind("LightUbo", lights_);
         const char* d[3] = {"delta_r", "delta_g", "delta_b"};
         const char* p[3] = {"rho_r", "rho_g", "rho_b"};
         for (int c = 0; c < 3; ++c) {
           b.bind_sampled(d[c], dvol[c], linear);
           b.bind_sampled(p[c], rvol[c], linear);
         }
-        b.bind("lit_rv", r.lit_rv);
-        b.bind("LightUbo", lights_);
-        b.bind("virtual_emission", r.virtual_emission.valid() ? r.virtual_emission : r.virtual_albedo);
-        b.bind("lit_r", r.lit_r);
       },
       [merge, push, lit = r.lit_rv](VkCommandBuffer cmd, gpu::PassContext& p) {
         const VkExtent2D e = p.extent(lit);
