@@ -42,7 +42,11 @@ layout(set = 0, binding = 8) uniform sampler2DArrayShadow shadow_primary;
 layout(set = 0, binding = 9) uniform sampler2DArrayShadow shadow_virtual;
 layout(set = 0, binding = 10, rgba16f) writeonly uniform image2D lit_rv;
 layout(set = 0, binding = 11, rgba16f) writeonly uniform image2D lit_r;
-layout(constant_id = 0) const bool kVolumeBounce = false;
+// 0: direct light only (baseline); 1: dlpv's bounce (V^Delta on real pixels, V^rho on virtual
+// ones); 2: the two-volume ablation (real pixels E(V^rho) - E(V^mu)). A specialisation constant,
+// not a push constant: on lavapipe a shader pays for all of its code, taken or not (compose.comp),
+// so the ablation's six extra fetches are compiled out of the pipeline the levels use.
+layout(constant_id = 0) const int kVolumeBounce = 0;
 // dlpv's volumes (kVolumeBounce; without it a stand-in is bound and never read).
 layout(set = 0, binding = 13) uniform sampler3D delta_r;
 layout(set = 0, binding = 14) uniform sampler3D delta_g;
@@ -57,7 +61,7 @@ struct LevelConstants {
   vec4 shadow;  // x used map size / allocated size, y used size (texels), z allocated size,
                 // w PCF radius (taps each side of the centre)
 };
-// volume_mode.x: 1 = DlpvAblation::two_volumes (real pixels get E(V^rho) - E(V^mu)).
+// volume_mode: unused here (kVolumeBounce holds the mode; baseline.h's VolumeBounce::Constants).
 layout(push_constant) uniform Level { LevelConstants level_block; VolumeConstants volume_block; ivec4 volume_mode; };
 LevelConstants level;
 
@@ -106,7 +110,7 @@ float shadow_test(sampler2DArrayShadow map, int first_layer, int light, vec3 p, 
 
 void main() {
   frame = frame_ubo; level = level_block;  // MRGI_UNIFORM_COPIES
-  if (kVolumeBounce) volume = volume_block;
+  if (kVolumeBounce != 0) volume = volume_block;
   ambient_rv = light_set.ambient_rv;
   ambient_r = light_set.ambient_r;
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
@@ -157,12 +161,12 @@ void main() {
       l_rv += lo * st_primary;               // the virtual lamp's map holds every caster
     }
   }
-  if (kVolumeBounce) {
+  if (kVolumeBounce != 0) {
     if (is_virtual) {
       if (volume.extent.w > 0.5f)
         l_rv += alb.rgb * (1.0f - alb.a) * max(volume_irradiance(rho_r, rho_g, rho_b, p, n), vec3(0.0f)) * (1.0f / MRGI_PI);
     } else if (volume.extent.z > 0.5f && volume_contains(p)) {
-      vec3 e = volume_mode.x == 1 ? volume_irradiance(rho_r, rho_g, rho_b, p, n) - volume_irradiance(mu_r, mu_g, mu_b, p, n)
+      vec3 e = kVolumeBounce == 2 ? volume_irradiance(rho_r, rho_g, rho_b, p, n) - volume_irradiance(mu_r, mu_g, mu_b, p, n)
                                   : volume_irradiance(delta_r, delta_g, delta_b, p, n);
       l_rv += alb.rgb * e * (1.0f / MRGI_PI);
     }

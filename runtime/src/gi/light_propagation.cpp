@@ -2,6 +2,8 @@
 
 #include <string>
 
+#include "gpu/shaders.h"
+
 namespace mrgi::gi {
 namespace {
 
@@ -66,9 +68,14 @@ Expected<LightPropagationVolume> LightPropagationVolume::create(gpu::FrameGraph&
   if (!cells) return cells.error();
   v.cells_ = *cells;
   const gpu::Context& ctx = graph.context();
-  auto inject = gpu::load_compute_pipeline(ctx, "gi/lpv_inject.comp", {});
-  if (!inject) return inject.error();
-  v.inject_ = std::move(*inject);
+  auto inject_spv = gpu::shader_spirv("gi/lpv_inject.comp");
+  if (!inject_spv) return inject_spv.error();
+  for (uint32_t mode = 0; mode < 4; ++mode) {  // lpv_inject.comp's kMode: one pipeline a mode
+    auto inject = gpu::create_compute_pipeline(
+        ctx, {s.name + " inject " + std::to_string(mode), *inject_spv, {}, sizeof(InjectPush), {mode}});
+    if (!inject) return inject.error();
+    v.inject_[mode] = gpu::PipelineHandle(ctx, std::move(*inject));
+  }
   auto resolve = gpu::load_compute_pipeline(ctx, "gi/lpv_resolve.comp", {});
   if (!resolve) return resolve.error();
   v.resolve_ = std::move(*resolve);
@@ -120,23 +127,25 @@ void LightPropagationVolume::add_clear(gpu::FrameGraph& graph) const {
 void LightPropagationVolume::add_inject(gpu::FrameGraph& graph, const std::string& label, const RsmImages& rsm,
                                         const LpvLight& light, InjectKind kind, float sign,
                                         const RsmImages* other) const {
-  // Indirect mode reads no other map: the map's own positions stand in for the binding.
-  const gpu::ImageHandle other_position = kind == InjectKind::Direct && other ? other->position : rsm.position;
+  // Without another map the map's own images stand in for the bindings (never read).
+  const RsmImages o = other ? *other : rsm;
+  const int mode = kind == InjectKind::Direct ? 1 : kind == InjectKind::IndirectFromReal ? 2 : other ? 3 : 0;
   const InjectPush push{glm::vec4(grid_.origin, grid_.cell_size),
-                        glm::ivec4(int(cells()), int(rsm.width), int(rsm.height),
-                                   kind == InjectKind::Direct ? 1 : kind == InjectKind::IndirectFromReal ? 2 : 0),
+                        glm::ivec4(int(cells()), int(rsm.width), int(rsm.height), 0),
                         glm::vec4(light.direction_or_position, light.positional ? 1.0f : 0.0f),
                         glm::vec4(light.colour, sign),
                         glm::vec4(settings_.vpl_shift_cells, 0.0f, 0.0f, 0.0f)};
   const gpu::BufferHandle cells = cells_;
-  const gpu::Pipeline* pipe = &*inject_;
+  const gpu::Pipeline* pipe = &*inject_[mode];
   graph.add_shader_pass(
-      settings_.name + " inject " + label, gpu::PassKind::Compute, *inject_,
-      [rsm, cells, other_position](gpu::ShaderPassBuilder& b) {
+      settings_.name + " inject " + label, gpu::PassKind::Compute, *pipe,
+      [rsm, cells, o](gpu::ShaderPassBuilder& b) {
         b.bind("rsm_position", rsm.position);
-        b.bind("other_position", other_position);
         b.bind("rsm_normal", rsm.normal);
         b.bind("rsm_flux", rsm.flux);
+        b.bind("other_position", o.position);
+        b.bind("other_normal", o.normal);
+        b.bind("other_flux", o.flux);
         b.bind("cells", cells);
       },
       [pipe, push, rsm](VkCommandBuffer cmd, gpu::PassContext&) {

@@ -82,7 +82,10 @@ class LightPropagationVolume {
 
   void add_clear(gpu::FrameGraph& graph) const;
   // `sign` +1 or -1 (a delta volume's two maps). The pass is named "<name> inject <label>".
-  // `other`: Direct only (the map whose surfaces count as unblocked); nullptr for Indirect.
+  // `other`: for Direct, the map whose surfaces count as unblocked; for Indirect, if given, the
+  // pair's other map, injected in the same pass with -sign (eq. 13 in one pass, the delta pair):
+  // only the texels where the two maps hold different surfaces, since the others cancel exactly
+  // (R^rho is R^mu's copy outside the virtual objects, ReflectiveShadowMaps::add_pair).
   void add_inject(gpu::FrameGraph& graph, const std::string& label, const RsmImages& rsm, const LpvLight& light,
                   InjectKind kind, float sign, const RsmImages* other = nullptr) const;
   // The injected light as step 0, then `steps` propagation steps, all summed into accumulated():
@@ -98,7 +101,8 @@ class LightPropagationVolume {
   std::optional<VoxelVolume> steps_[2];  // ping-pong
   std::optional<VoxelVolume> sum_;
   gpu::BufferHandle cells_;              // injection sums, 12 floats a cell
-  gpu::PipelineHandle inject_, resolve_, propagate_;
+  gpu::PipelineHandle inject_[4];  // by lpv_inject.comp's kMode
+  gpu::PipelineHandle resolve_, propagate_;
   gpu::PipelineHandle propagate_local_;  // <= kLocalCells per side: every step in one workgroup
   struct Bindings {
     uint32_t cells = 0, resolve_step[3]{}, resolve_sum[3]{}, from[3]{}, to[3]{}, sum[3]{};

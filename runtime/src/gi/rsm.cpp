@@ -110,14 +110,15 @@ Expected<ReflectiveShadowMaps> ReflectiveShadowMaps::create(gpu::FrameGraph& gra
       return graph.create_image(d, usage);
     };
     const VkImageUsageFlags colour = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_STORAGE_BIT |
-                                     VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+                                     VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
     auto p = image(" position", kPositionFormat, colour);
     if (!p) return p.error();
     auto n = image(" normal", kNormalFormat, colour);
     if (!n) return n.error();
     auto f = image(" flux", kFluxFormat, colour);
     if (!f) return f.error();
-    auto d = image(" depth", kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
+    auto d = image(" depth", kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT |
+                                               VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
     if (!d) return d.error();
     r.maps_[m] = {*p, *n, *f, *d};
   }
@@ -193,15 +194,41 @@ RsmImages ReflectiveShadowMaps::images(RsmMap map, uint32_t size) const {
   return {m.position, m.normal, m.flux, std::min(size, settings_.size), std::min(size, settings_.size)};
 }
 
-void ReflectiveShadowMaps::add_draw(gpu::FrameGraph& graph, const std::string& label, const RsmView& view,
-                                    RsmMap map, uint32_t size) {
-  const Maps m = maps_[map == RsmMap::WithVirtual ? 0 : 1];
+void ReflectiveShadowMaps::add_pair(gpu::FrameGraph& graph, const std::string& id, const RsmView& view,
+                                    uint32_t size) {
   const uint32_t s = std::min(size, settings_.size);
+  add_map_draw(graph, "mu " + id, view, maps_[1], s, true, false);
+  const Maps from = maps_[1], to = maps_[0];
+  graph.add_pass(
+      settings_.name + " rho copy " + id, gpu::PassKind::Transfer,
+      [from, to](gpu::PassBuilder& b) {
+        for (gpu::ImageHandle h : {from.position, from.normal, from.flux, from.depth}) b.read(h, gpu::Access::TransferSrc);
+        for (gpu::ImageHandle h : {to.position, to.normal, to.flux, to.depth}) b.write(h, gpu::Access::TransferDst);
+      },
+      [from, to, s](VkCommandBuffer cmd, gpu::PassContext& p) {
+        const gpu::ImageHandle src[4] = {from.position, from.normal, from.flux, from.depth};
+        const gpu::ImageHandle dst[4] = {to.position, to.normal, to.flux, to.depth};
+        for (int i = 0; i < 4; ++i) {
+          VkImageCopy region{};
+          region.srcSubresource = {i == 3 ? VkImageAspectFlags(VK_IMAGE_ASPECT_DEPTH_BIT) : VkImageAspectFlags(VK_IMAGE_ASPECT_COLOR_BIT), 0, 0, 1};
+          region.dstSubresource = region.srcSubresource;
+          region.extent = {s, s, 1};
+          vkCmdCopyImage(cmd, p.image(src[i]), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, p.image(dst[i]),
+                         VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+        }
+      });
+  add_map_draw(graph, "rho " + id, view, maps_[0], s, false, true);
+}
+
+void ReflectiveShadowMaps::add_map_draw(gpu::FrameGraph& graph, const std::string& label, const RsmView& view,
+                                        const Maps& m, uint32_t s, bool real_casters, bool virtual_casters) {
   const technique::SceneGpu* sg = scene_;
-  const bool grid = grid_points_.width > 1 && grid_points_.height > 1;
+  const bool grid = real_casters && grid_points_.width > 1 && grid_points_.height > 1;
   const uint32_t grid_indices = grid ? (grid_points_.width - 1) * (grid_points_.height - 1) * 6 : 0;
-  const bool virtuals = map == RsmMap::WithVirtual && !sg->virtual_objects.empty();
-  const bool proxies = !sg->real_proxies.empty();
+  const bool virtuals = virtual_casters && !sg->virtual_objects.empty();
+  const bool proxies = real_casters && !sg->real_proxies.empty();
+  // Over the real casters' copy (add_pair) the attachments are loaded, not cleared.
+  const VkAttachmentLoadOp load = real_casters ? VK_ATTACHMENT_LOAD_OP_CLEAR : VK_ATTACHMENT_LOAD_OP_LOAD;
   const RealGBuffer real = real_;
   const gpu::BufferHandle indices = grid_indices_;
   const gpu::Pipeline* grid_pipe = &*grid_pipeline_;
@@ -228,10 +255,17 @@ void ReflectiveShadowMaps::add_draw(gpu::FrameGraph& graph, const std::string& l
         }
         if (proxies || virtuals) b.read(sg->materials, gpu::Access::StorageRead);
         b.read(sg->base_color_maps, gpu::Access::Sampled);
-        b.write(m.position, gpu::Access::ColorAttachmentWrite);
-        b.write(m.normal, gpu::Access::ColorAttachmentWrite);
-        b.write(m.flux, gpu::Access::ColorAttachmentWrite);
-        b.write(m.depth, gpu::Access::DepthAttachmentWrite);
+        if (real_casters) {
+          b.write(m.position, gpu::Access::ColorAttachmentWrite);
+          b.write(m.normal, gpu::Access::ColorAttachmentWrite);
+          b.write(m.flux, gpu::Access::ColorAttachmentWrite);
+          b.write(m.depth, gpu::Access::DepthAttachmentWrite);
+        } else {  // drawn over the copy of the real casters' map
+          b.write(m.position, gpu::Access::ColorAttachmentReadWrite);
+          b.write(m.normal, gpu::Access::ColorAttachmentReadWrite);
+          b.write(m.flux, gpu::Access::ColorAttachmentReadWrite);
+          b.write(m.depth, gpu::Access::DepthAttachmentReadWrite);
+        }
       },
       [=](VkCommandBuffer cmd, gpu::PassContext& p) mutable {
         const gpu::Context& ctx = p.context();
@@ -242,15 +276,17 @@ void ReflectiveShadowMaps::add_draw(gpu::FrameGraph& graph, const std::string& l
           colour[i] = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
           colour[i].imageView = p.view(targets[i]);
           colour[i].imageLayout = colour_layout;
-          colour[i].loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+          colour[i].loadOp = load;
           colour[i].storeOp = VK_ATTACHMENT_STORE_OP_STORE;
           colour[i].clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
         }
         VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
         depth.imageView = p.view(m.depth);
-        depth.imageLayout = gpu::access_info(gpu::PassKind::Graphics, gpu::Access::DepthAttachmentWrite, true, true).layout;
-        depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-        depth.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+        depth.imageLayout = gpu::access_info(gpu::PassKind::Graphics,
+                                             real_casters ? gpu::Access::DepthAttachmentWrite : gpu::Access::DepthAttachmentReadWrite,
+                                             true, true).layout;
+        depth.loadOp = load;
+        depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;  // R^rho starts from R^mu's
         depth.clearValue.depthStencil = {1.0f, 0};
         VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
         ri.renderArea = {{0, 0}, {s, s}};

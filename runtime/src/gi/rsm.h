@@ -54,11 +54,15 @@ class ReflectiveShadowMaps {
  public:
   static Expected<ReflectiveShadowMaps> create(gpu::FrameGraph& graph, const technique::SceneGpu& scene,
                                                const RealGBuffer& real, const RsmSettings& settings);
-  // The real grid's index list for this frame (call once a frame before add_draw, when the real
+  // The real grid's index list for this frame (call once a frame before add_pair, when the real
   // G-buffer changed): `stride` G-buffer pixels between grid points.
   void add_grid(gpu::FrameGraph& graph, uint32_t stride);
-  // Draws one map for `view` at `size` texels per side (<= the allocated size).
-  void add_draw(gpu::FrameGraph& graph, const std::string& label, const RsmView& view, RsmMap map, uint32_t size);
+  // Draws the pair for `view` at `size` texels per side (<= the allocated size): R^mu (the real
+  // casters), then R^rho as R^mu's copy with the virtual objects drawn over it, so the real
+  // casters are drawn once and the texels no virtual object covers are equal bit for bit in
+  // both maps (a delta injection leaves them out: LightPropagationVolume::add_inject's `other`).
+  // Passes "<name> mu <id>", "<name> rho copy <id>", "<name> rho <id>".
+  void add_pair(gpu::FrameGraph& graph, const std::string& id, const RsmView& view, uint32_t size);
   // The map as the injection reads it.
   RsmImages images(RsmMap map, uint32_t size) const;
   uint32_t allocated_size() const { return settings_.size; }
@@ -68,6 +72,8 @@ class ReflectiveShadowMaps {
   struct Maps {
     gpu::ImageHandle position, normal, flux, depth;
   };
+  void add_map_draw(gpu::FrameGraph& graph, const std::string& label, const RsmView& view, const Maps& m,
+                    uint32_t size, bool real_casters, bool virtual_casters);
   RsmSettings settings_;
   const technique::SceneGpu* scene_ = nullptr;
   RealGBuffer real_;

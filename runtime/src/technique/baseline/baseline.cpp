@@ -83,8 +83,11 @@ class Baseline final : public Technique {
   gpu::ImageHandle shadow_primary_, shadow_virtual_;
   ImageViews views_;
   std::vector<VkImageView> primary_layer_views_, virtual_layer_views_;
-  gpu::PipelineHandle grid_pipeline_, mesh_pipeline_, shade_pipeline_, caster_indices_pipeline_;
-  gpu::PipelineHandle shade_bounce_pipeline_;  // shade_direct.comp with kVolumeBounce
+  gpu::PipelineHandle grid_pipeline_, mesh_pipeline_, caster_indices_pipeline_;
+  gpu::PipelineHandle shade_pipelines_[3];  // shade_direct.comp by kVolumeBounce
+  const gpu::Pipeline& shade_pipeline() const {
+    return *shade_pipelines_[!bounce_ ? 0 : bounce_->constants.mode.x == 1 ? 2 : 1];
+  }
   gpu::ImageHandle no_volume_;                 // bound for the volumes when there is no bounce
   std::optional<VolumeBounce> bounce_;         // this frame's (set_volume_bounce)
   gpu::BufferHandle caster_indices_;  // this frame's real caster mesh (shadow_caster_indices.comp)
@@ -203,11 +206,14 @@ Status Baseline::init() {
 
   auto shade_spv = gpu::shader_spirv("baseline/shade_direct.comp");
   if (!shade_spv) return shade_spv.error();
-  for (const uint32_t bounce : {0u, 1u}) {  // layout from the shader; kVolumeBounce
-    auto sp = gpu::create_compute_pipeline(
-        ctx, {bounce ? "baseline_shade_direct_bounce" : "baseline_shade_direct", *shade_spv, {}, sizeof(ShadePush), {bounce}});
+  // Layouts from the shader; kVolumeBounce 0 (direct only), 1 (dlpv's bounce), 2 (its
+  // two-volume ablation).
+  const char* shade_names[3] = {"baseline_shade_direct", "baseline_shade_direct_bounce",
+                                "baseline_shade_direct_bounce_two_volumes"};
+  for (uint32_t mode = 0; mode < 3; ++mode) {
+    auto sp = gpu::create_compute_pipeline(ctx, {shade_names[mode], *shade_spv, {}, sizeof(ShadePush), {mode}});
     if (!sp) return sp.error();
-    (bounce ? shade_bounce_pipeline_ : shade_pipeline_) = gpu::PipelineHandle(ctx, std::move(*sp));
+    shade_pipelines_[mode] = gpu::PipelineHandle(ctx, std::move(*sp));
   }
   gpu::ImageDesc nv;
   nv.name = "baseline_no_volume";
@@ -286,7 +292,7 @@ Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped
   const VkSampler compare = shared_.context->samplers().shadow_compare;
   const VkSampler linear = shared_.context->samplers().linear_clamp;
   graph.add_shader_pass(
-      "shade_direct", gpu::PassKind::Compute, bounce_ ? *shade_bounce_pipeline_ : *shade_pipeline_,
+      "shade_direct", gpu::PassKind::Compute, shade_pipeline(),
       [this, compare, linear](gpu::ShaderPassBuilder& b) {
         const char* names[9] = {"delta_r", "delta_g", "delta_b", "rho_r", "rho_g", "rho_b", "mu_r", "mu_g", "mu_b"};
         for (int i = 0; i < 9; ++i) {
@@ -400,7 +406,7 @@ void Baseline::shade(VkCommandBuffer cmd, gpu::PassContext& pass) {
                         float(kTopShadowSize), float(pcf_radius_));
   if (bounce_) pc.volume = bounce_->constants;
   const VkExtent2D e = pass.extent(r.lit_rv);
-  gpu::dispatch_2d(cmd, bounce_ ? *shade_bounce_pipeline_ : *shade_pipeline_, &pc, sizeof(pc), e.width, e.height);
+  gpu::dispatch_2d(cmd, shade_pipeline(), &pc, sizeof(pc), e.width, e.height);
 }
 
 }  // namespace

@@ -296,19 +296,16 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
       const std::string id = std::to_string(i);
       const gi::RsmImages rho_map = rsm_->images(gi::RsmMap::WithVirtual, level.rsm_size);
       const gi::RsmImages mu_map = rsm_->images(gi::RsmMap::RealOnly, level.rsm_size);
-      rsm_->add_draw(graph, "rho " + id, *view, gi::RsmMap::WithVirtual, level.rsm_size);
-      if (!two) delta_->add_inject(graph, "rho " + id, rho_map, view->lpv, gi::InjectKind::Indirect, 1.0f);
+      rsm_->add_pair(graph, id, *view, level.rsm_size);
+      // V^Delta = R^rho's VPLs - R^mu's, from the texels the virtual objects cover (the rest
+      // cancel exactly, rsm.h), in one pass.
+      if (!two) delta_->add_inject(graph, "delta " + id, rho_map, view->lpv, gi::InjectKind::Indirect, 1.0f, &mu_map);
       if (level.rho_volume || two)
         rho_->add_inject(graph, "rho " + id, rho_map, view->lpv,
                          !two && shared_.dlpv_ablation.no_virtual_self_bounce ? gi::InjectKind::IndirectFromReal
                                                                               : gi::InjectKind::Indirect,
                          1.0f);
-      rsm_->add_draw(graph, "mu " + id, *view, gi::RsmMap::RealOnly, level.rsm_size);
-      if (two) {
-        mu_->add_inject(graph, "mu " + id, mu_map, view->lpv, gi::InjectKind::Indirect, 1.0f);
-      } else {
-        delta_->add_inject(graph, "mu " + id, mu_map, view->lpv, gi::InjectKind::Indirect, -1.0f);
-      }
+      if (two) mu_->add_inject(graph, "mu " + id, mu_map, view->lpv, gi::InjectKind::Indirect, 1.0f);
       if (antiradiance)
         delta_->add_inject(graph, "blocked direct " + id, mu_map, view->lpv, gi::InjectKind::Direct, -1.0f, &rho_map);
       ++lamps;
