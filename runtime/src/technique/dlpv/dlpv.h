@@ -29,6 +29,10 @@
 //   - real albedo is recon's per-pixel estimate (camera colour over the modelled light), the
 //     paper's eq. 1;
 //   - lamps beyond the level's RSM count still light directly (unshadowed), without bounce.
+//   - R^rho is drawn as R^mu's copy with the virtual objects drawn over it (gi/rsm.h add_pair),
+//     and V^Delta is injected from the texels where the two maps differ only, both maps in one
+//     pass: the same maps and the same sum (the other texels cancel exactly), for the real
+//     casters drawn once and a fraction of the injection's work.
 //
 // Against the paper author's code (thefranke/dirtchamber, D3D11, MIT; read, not copied):
 //   - it propagates in a pixel shader over 2D texture-array slices with Kaplanyan's two
