@@ -42,11 +42,15 @@ layout(set = 0, binding = 8) uniform sampler2DArrayShadow shadow_primary;
 layout(set = 0, binding = 9) uniform sampler2DArrayShadow shadow_virtual;
 layout(set = 0, binding = 10, rgba16f) writeonly uniform image2D lit_rv;
 layout(set = 0, binding = 11, rgba16f) writeonly uniform image2D lit_r;
-// 0: direct light only (baseline); 1: dlpv's bounce (V^Delta on real pixels, V^rho on virtual
-// ones); 2: the two-volume ablation (real pixels E(V^rho) - E(V^mu)). A specialisation constant,
-// not a push constant: on lavapipe a shader pays for all of its code, taken or not (compose.comp),
-// so the ablation's six extra fetches are compiled out of the pipeline the levels use.
+// Bits: 1 real pixels add V^Delta's bounce, 2 virtual pixels add V^rho's, 4 real pixels add
+// E(V^rho) - E(V^mu) (the two-volume ablation); 0 direct light only (baseline). A
+// specialisation constant, not a push constant: on lavapipe a shader pays for all of its code,
+// taken or not (compose.comp), so a level without V^rho, or without the ablation, compiles
+// those volume fetches out.
 layout(constant_id = 0) const int kVolumeBounce = 0;
+const bool kDeltaOnReal = (kVolumeBounce & 1) != 0;
+const bool kRhoOnVirtual = (kVolumeBounce & 2) != 0;
+const bool kTwoVolumesOnReal = (kVolumeBounce & 4) != 0;
 // dlpv's volumes (kVolumeBounce; without it a stand-in is bound and never read).
 layout(set = 0, binding = 13) uniform sampler3D delta_r;
 layout(set = 0, binding = 14) uniform sampler3D delta_g;
@@ -163,11 +167,11 @@ void main() {
   }
   if (kVolumeBounce != 0) {
     if (is_virtual) {
-      if (volume.extent.w > 0.5f)
+      if (kRhoOnVirtual && volume.extent.w > 0.5f)
         l_rv += alb.rgb * (1.0f - alb.a) * max(volume_irradiance(rho_r, rho_g, rho_b, p, n), vec3(0.0f)) * (1.0f / MRGI_PI);
-    } else if (volume.extent.z > 0.5f && volume_contains(p)) {
-      vec3 e = kVolumeBounce == 2 ? volume_irradiance(rho_r, rho_g, rho_b, p, n) - volume_irradiance(mu_r, mu_g, mu_b, p, n)
-                                  : volume_irradiance(delta_r, delta_g, delta_b, p, n);
+    } else if ((kDeltaOnReal || kTwoVolumesOnReal) && volume.extent.z > 0.5f && volume_contains(p)) {
+      vec3 e = kTwoVolumesOnReal ? volume_irradiance(rho_r, rho_g, rho_b, p, n) - volume_irradiance(mu_r, mu_g, mu_b, p, n)
+                                 : volume_irradiance(delta_r, delta_g, delta_b, p, n);
       l_rv += alb.rgb * e * (1.0f / MRGI_PI);
     }
   }

@@ -84,9 +84,12 @@ class Baseline final : public Technique {
   ImageViews views_;
   std::vector<VkImageView> primary_layer_views_, virtual_layer_views_;
   gpu::PipelineHandle grid_pipeline_, mesh_pipeline_, caster_indices_pipeline_;
-  gpu::PipelineHandle shade_pipelines_[3];  // shade_direct.comp by kVolumeBounce
+  static constexpr uint32_t kShadeModes[] = {0, 1, 3, 4, 6};
+  gpu::PipelineHandle shade_pipelines_[8];  // shade_direct.comp by kVolumeBounce (kShadeModes)
   const gpu::Pipeline& shade_pipeline() const {
-    return *shade_pipelines_[!bounce_ ? 0 : bounce_->constants.mode.x == 1 ? 2 : 1];
+    if (!bounce_) return *shade_pipelines_[0];
+    const bool two = bounce_->constants.mode.x == 1, rho = bounce_->constants.extent.w > 0.5f;
+    return *shade_pipelines_[(two ? 4u : 1u) | (rho ? 2u : 0u)];
   }
   gpu::ImageHandle no_volume_;                 // bound for the volumes when there is no bounce
   std::optional<VolumeBounce> bounce_;         // this frame's (set_volume_bounce)
@@ -206,12 +209,11 @@ Status Baseline::init() {
 
   auto shade_spv = gpu::shader_spirv("baseline/shade_direct.comp");
   if (!shade_spv) return shade_spv.error();
-  // Layouts from the shader; kVolumeBounce 0 (direct only), 1 (dlpv's bounce), 2 (its
-  // two-volume ablation).
-  const char* shade_names[3] = {"baseline_shade_direct", "baseline_shade_direct_bounce",
-                                "baseline_shade_direct_bounce_two_volumes"};
-  for (uint32_t mode = 0; mode < 3; ++mode) {
-    auto sp = gpu::create_compute_pipeline(ctx, {shade_names[mode], *shade_spv, {}, sizeof(ShadePush), {mode}});
+  // Layouts from the shader; one pipeline per kVolumeBounce in use: 0 direct only, 1 V^Delta on
+  // real pixels, 3 and V^rho on virtual ones, 4 and 6 the two-volume ablation without and with.
+  for (const uint32_t mode : kShadeModes) {
+    auto sp = gpu::create_compute_pipeline(
+        ctx, {"baseline_shade_direct_" + std::to_string(mode), *shade_spv, {}, sizeof(ShadePush), {mode}});
     if (!sp) return sp.error();
     shade_pipelines_[mode] = gpu::PipelineHandle(ctx, std::move(*sp));
   }
