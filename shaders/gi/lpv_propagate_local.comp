@@ -1,8 +1,8 @@
 #version 450
 // Resolve and every propagation step of a light propagation volume of at most 8^3 cells in one
-// dispatch of one workgroup (gi/light_propagation.h: the reduced-volume levels): each invocation
-// owns a cell, the previous step lives in shared memory, and the steps are separated by
-// workgroup barriers instead of dispatches. On lavapipe a dispatch with its barrier costs about
+// dispatch of three workgroups, one per colour channel (gi/light_propagation.h: the
+// reduced-volume levels): each invocation owns a cell, the previous step lives in shared memory,
+// and the steps are separated by workgroup barriers instead of dispatches. On lavapipe a dispatch with its barrier costs about
 // 1.6 ms of CPU at 8^3, far more than the step's arithmetic (8 steps: 13 CPU ms per frame,
 // measured at dlpv's fast level); here the steps cost their arithmetic. Same gather as the
 // one-step-a-dispatch path (gi/lpv_gather.glsl), same results to float rounding
@@ -20,7 +20,7 @@ layout(push_constant) uniform LocalParams {
   vec4 damping;  // x: strength of the damping of negative flux (lpv_negative_damping)
 } params_block;
 
-shared vec4 step_r[512], step_g[512], step_b[512];  // the previous step, 24 KiB
+shared vec4 step_c[512];  // this workgroup's channel, the previous step, 8 KiB
 
 vec4 load4(int base) {
   return vec4(imageLoad(cells, base).x, imageLoad(cells, base + 1).x, imageLoad(cells, base + 2).x,
@@ -29,49 +29,42 @@ vec4 load4(int base) {
 
 int slot(ivec3 q) { return (q.z * 8 + q.y) * 8 + q.x; }
 
+void store_sum(int channel, ivec3 q, vec4 v) {
+  if (channel == 0) imageStore(sum_r, q, v);
+  else if (channel == 1) imageStore(sum_g, q, v);
+  else imageStore(sum_b, q, v);
+}
+
 void main() {
   const int n = params_block.sizes.x;  // copied first: MRGI_UNIFORM_COPIES
   const int allocated = params_block.sizes.y;
   const int steps = params_block.sizes.z;
   const float damping = params_block.damping.x;
+  // The colour channels propagate independently (the damping too is per channel): one
+  // workgroup each, so lavapipe's threads share the work instead of one doing all of it.
+  const int channel = int(gl_WorkGroupID.x);
   const ivec3 c = ivec3(gl_LocalInvocationID);
   const bool used = all(lessThan(c, ivec3(n)));
-  vec4 own_r = vec4(0.0), own_g = vec4(0.0), own_b = vec4(0.0);
-  if (used) {
-    const int base = ((c.z * n + c.y) * n + c.x) * 12;
-    own_r = load4(base);
-    own_g = load4(base + 4);
-    own_b = load4(base + 8);
-  }
-  vec4 sr_sum = own_r, sg_sum = own_g, sb_sum = own_b;
-  step_r[slot(c)] = own_r;
-  step_g[slot(c)] = own_g;
-  step_b[slot(c)] = own_b;
+  vec4 own_r = vec4(0.0);
+  if (used) own_r = load4(((c.z * n + c.y) * n + c.x) * 12 + channel * 4);
+  vec4 sum = own_r;
+  step_c[slot(c)] = own_r;
   barrier();
-#define LPV_LOAD_R(q) step_r[slot(q)]
-#define LPV_LOAD_G(q) step_g[slot(q)]
-#define LPV_LOAD_B(q) step_b[slot(q)]
+#define LPV_GATHER_ONE
+#define LPV_LOAD_R(q) step_c[slot(q)]
   for (int s = 0; s < steps; ++s) {
-    vec4 r = vec4(0.0), g = vec4(0.0), b = vec4(0.0);
+    vec4 r = vec4(0.0);
     if (used) {
 #include "gi/lpv_gather.glsl"
     }
     barrier();  // every cell has read the previous step
-    step_r[slot(c)] = r;
-    step_g[slot(c)] = g;
-    step_b[slot(c)] = b;
+    step_c[slot(c)] = r;
     own_r = r;
-    own_g = g;
-    own_b = b;
-    sr_sum += r;
-    sg_sum += g;
-    sb_sum += b;
+    sum += r;
     barrier();  // the new step is complete
   }
   if (used) {
-    imageStore(sum_r, c, sr_sum);
-    imageStore(sum_g, c, sg_sum);
-    imageStore(sum_b, c, sb_sum);
+    store_sum(channel, c, sum);
     // The layer past the used corner, finite for the trilinear lookup (lpv_resolve.comp says
     // why): written by the last used cells (the workgroup has no invocation there when n = 8),
     // each for the neighbours past it along the axes where it is last, and their combinations.
@@ -81,9 +74,7 @@ void main() {
         // Past the volume along an axis only from a cell that is last along it.
         const ivec3 last = ivec3(equal(c, ivec3(n - 1)));
         if (any(greaterThan(step, last))) continue;
-        imageStore(sum_r, c + step, vec4(0.0));
-        imageStore(sum_g, c + step, vec4(0.0));
-        imageStore(sum_b, c + step, vec4(0.0));
+        store_sum(channel, c + step, vec4(0.0));
       }
     }
   }

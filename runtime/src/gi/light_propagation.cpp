@@ -155,7 +155,8 @@ void LightPropagationVolume::add_inject(gpu::FrameGraph& graph, const std::strin
 
 void LightPropagationVolume::add_propagate(gpu::FrameGraph& graph, uint32_t steps) const {
   if (cells() <= kLocalCells && !settings_.one_step_a_dispatch) {
-    // The reduced volumes: resolve and every step in one workgroup (lpv_propagate_local.comp).
+    // The reduced volumes: resolve and every step in one dispatch, a workgroup per colour channel
+    // (lpv_propagate_local.comp).
     const uint32_t n = cells(), alloc = settings_.resolution;
     const VoxelVolume* sum = &*sum_;
     const LocalPush push{glm::ivec4(int(n), int(alloc), int(steps), 0),
@@ -170,7 +171,7 @@ void LightPropagationVolume::add_propagate(gpu::FrameGraph& graph, uint32_t step
           b.bind("sum_b", sum->image(2));
         },
         [pipe, push](VkCommandBuffer cmd, gpu::PassContext&) {
-          gpu::push_and_dispatch(cmd, *pipe, &push, sizeof push, {1, 1, 1});
+          gpu::push_and_dispatch(cmd, *pipe, &push, sizeof push, {3, 1, 1});  // a workgroup a channel
         });
     return;
   }
