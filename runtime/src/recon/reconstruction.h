@@ -3,7 +3,8 @@
 //   upload          colour (sRGB8) and depth (u16) copied into this frame slot's upload buffers;
 //                   the pose change since the previous frame is computed here (CPU, double)
 //   recon_warp      the previous frame's filtered depth + weight (history image) forward-
-//                   projected into this view (atomicMin scatter); skipped on the first frame,
+//                   projected into this view as its grid mesh (each pixel a triangle covers gets
+//                   the interpolated depth; atomicMin between surfaces); skipped on the first frame,
 //                   after a render-scale change, or when settings.temporal is off
 //   recon_positions raw depth (3x3 median) merged with the warped depth (weighted running
 //                   average; new depth alone where the two are different surfaces) -> view
