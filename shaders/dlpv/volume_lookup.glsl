@@ -16,31 +16,16 @@ bool volume_contains(vec3 p) {
   return all(greaterThanEqual(cellf, vec3(0.0f))) && all(lessThanEqual(cellf, vec3(volume.extent.y)));
 }
 
-// A volume's accumulated intensity SH at p, trilinearly filtered, per channel; false (and 0)
-// outside the used volume.
-bool volume_sh(sampler3D r, sampler3D g, sampler3D b, vec3 p, out vec4 sr, out vec4 sg, out vec4 sb) {
-  sr = sg = sb = vec4(0.0f);
+// Irradiance from a volume's accumulated intensity at p for normal n, per channel; 0 outside.
+vec3 volume_irradiance(sampler3D r, sampler3D g, sampler3D b, vec3 p, vec3 n) {
   vec3 cellf = (p - volume.grid.xyz) / volume.grid.w;  // in cells
-  if (any(lessThan(cellf, vec3(0.0f))) || any(greaterThan(cellf, vec3(volume.extent.y)))) return false;
+  if (any(lessThan(cellf, vec3(0.0f))) || any(greaterThan(cellf, vec3(volume.extent.y)))) return vec3(0.0f);
   // The used corner of the allocation; clamped half a cell inside it so the trilinear filter
   // never reads a cell beyond the used size (stale: this level did not write it).
   vec3 uvw = clamp(cellf, vec3(0.5f), vec3(volume.extent.y - 0.5f)) / volume.extent.x;
-  sr = textureLod(r, uvw, 0.0f);
-  sg = textureLod(g, uvw, 0.0f);
-  sb = textureLod(b, uvw, 0.0f);
-  return true;
-}
-
-// Irradiance for normal n from a cell's (or a filtered) intensity SH, per channel.
-vec3 volume_sh_irradiance(vec4 sr, vec4 sg, vec4 sb, vec3 n) {
-  return vec3(lpv_irradiance(sr, n, volume.grid.w), lpv_irradiance(sg, n, volume.grid.w),
-              lpv_irradiance(sb, n, volume.grid.w));
-}
-
-// Irradiance from a volume's accumulated intensity at p for normal n, per channel; 0 outside.
-vec3 volume_irradiance(sampler3D r, sampler3D g, sampler3D b, vec3 p, vec3 n) {
-  vec4 sr, sg, sb;
-  return volume_sh(r, g, b, p, sr, sg, sb) ? volume_sh_irradiance(sr, sg, sb, n) : vec3(0.0f);
+  return vec3(lpv_irradiance(textureLod(r, uvw, 0.0f), n, volume.grid.w),
+              lpv_irradiance(textureLod(g, uvw, 0.0f), n, volume.grid.w),
+              lpv_irradiance(textureLod(b, uvw, 0.0f), n, volume.grid.w));
 }
 
 #endif  // MRGI_DLPV_VOLUME_LOOKUP_GLSL

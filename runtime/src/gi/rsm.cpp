@@ -286,7 +286,8 @@ void ReflectiveShadowMaps::add_map_draw(gpu::FrameGraph& graph, const std::strin
                                              real_casters ? gpu::Access::DepthAttachmentWrite : gpu::Access::DepthAttachmentReadWrite,
                                              true, true).layout;
         depth.loadOp = load;
-        depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;  // R^rho starts from R^mu's
+        // R^mu's depth is copied into R^rho (add_pair); R^rho's own is not read after the draw.
+        depth.storeOp = real_casters ? VK_ATTACHMENT_STORE_OP_STORE : VK_ATTACHMENT_STORE_OP_DONT_CARE;
         depth.clearValue.depthStencil = {1.0f, 0};
         VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
         ri.renderArea = {{0, 0}, {s, s}};
