@@ -1,0 +1,125 @@
+#include "gi/vpl.h"
+
+#include <string>
+
+#include "common/vpl.glsl"
+
+namespace mrgi::gi {
+namespace {
+
+Error vpl_setting_error(const std::string& field, const std::string& rule) {
+  return fail(ErrorKind::BadUsage, "VplSettings." + field + ": " + rule);
+}
+
+bool power_of_two(uint32_t v) { return v != 0 && (v & (v - 1)) == 0; }
+
+}  // namespace
+
+Expected<VplSampler> VplSampler::create(gpu::FrameGraph& graph, const VplSettings& s) {
+  if (s.name.empty()) return vpl_setting_error("name", "must not be empty");
+  if (s.max_vpls < 1 || s.max_vpls > 4096) return vpl_setting_error("max_vpls", "must be 1..4096 slots");
+  if (!power_of_two(s.map_size) || s.map_size < 16 || s.map_size > 4096)
+    return vpl_setting_error("map_size", "must be a power of two, 16..4096 texels");
+  VplSampler v;
+  v.settings_ = s;
+  while ((s.map_size >> v.levels_) > 0) ++v.levels_;
+  gpu::ImageDesc d;
+  d.name = s.name + " importance";
+  d.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+  d.size_mode = gpu::SizeMode::Absolute;
+  d.width = d.height = s.map_size;
+  d.mip_levels = v.levels_;
+  auto pyramid = graph.create_image(d, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT);
+  if (!pyramid) return pyramid.error();
+  v.pyramid_ = *pyramid;
+  auto buffer = graph.create_buffer({s.name + " slots", VkDeviceSize(s.max_vpls) * sizeof(shader::Vpl)},
+                                    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                                        VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  if (!buffer) return buffer.error();
+  v.vpls_ = *buffer;
+  const gpu::Context& ctx = graph.context();
+  auto ip = gpu::load_compute_pipeline(ctx, "gi/vpl_importance.comp", {});
+  if (!ip) return ip.error();
+  v.importance_ = std::move(*ip);
+  auto dp = gpu::load_compute_pipeline(ctx, "gi/importance_downsample.comp", {});
+  if (!dp) return dp.error();
+  v.downsample_ = std::move(*dp);
+  auto sp = gpu::load_compute_pipeline(ctx, "gi/vpl_sample.comp", {});
+  if (!sp) return sp.error();
+  v.sample_ = std::move(*sp);
+  return v;
+}
+
+void VplSampler::add_clear(gpu::FrameGraph& graph) const {
+  const gpu::BufferHandle b = vpls_;
+  graph.add_pass(
+      settings_.name + " clear", gpu::PassKind::Transfer, [b](gpu::PassBuilder& p) { p.write(b, gpu::Access::TransferDst); },
+      [b](VkCommandBuffer cmd, gpu::PassContext& p) { vkCmdFillBuffer(cmd, p.buffer(b), 0, VK_WHOLE_SIZE, 0); });
+}
+
+Status VplSampler::add_sample(gpu::FrameGraph& graph, const std::string& id, const RsmImages& rho, const RsmImages& mu,
+                              bool real_lamp, uint32_t first, uint32_t count) {
+  const uint32_t side = rho.width;
+  if (rho.height != side || mu.width != side || mu.height != side || !power_of_two(side) || side > settings_.map_size)
+    return fail(ErrorKind::BadUsage, "vpl '" + settings_.name + "': the maps must be square, equal, a power of two and at most " +
+                                         std::to_string(settings_.map_size) + " texels per side (got " +
+                                         std::to_string(rho.width) + "x" + std::to_string(rho.height) + ")");
+  if (count == 0 || first + count > settings_.max_vpls)
+    return fail(ErrorKind::BadUsage, "vpl '" + settings_.name + "': slots " + std::to_string(first) + " + " +
+                                         std::to_string(count) + " outside the " + std::to_string(settings_.max_vpls) +
+                                         " allocated (none is an error too)");
+  MRGI_TRY(graph.set_extent_divisor(pyramid_, settings_.map_size / side));
+  uint32_t top = 0;
+  while ((side >> top) > 1) ++top;
+  const gpu::ImageHandle pyramid = pyramid_;
+  const gpu::Pipeline* ip = &*importance_;
+  const glm::ivec4 isize(int(side), real_lamp ? 1 : 0, 0, 0);
+  graph.add_shader_pass(
+      settings_.name + " importance " + id, gpu::PassKind::Compute, *importance_,
+      [=](gpu::ShaderPassBuilder& b) {
+        b.bind("rho_position", rho.position);
+        b.bind("rho_flux", rho.flux);
+        b.bind("mu_position", mu.position);
+        b.bind("mu_flux", mu.flux);
+        b.bind("importance", pyramid, 0);
+      },
+      [ip, isize, side](VkCommandBuffer cmd, gpu::PassContext&) {
+        gpu::push_and_dispatch(cmd, *ip, &isize, sizeof isize, {(side + 7) / 8, (side + 7) / 8, 1});
+      });
+  const gpu::Pipeline* dp = &*downsample_;
+  for (uint32_t m = 1; m <= top; ++m) {
+    const uint32_t s = side >> m;
+    const glm::ivec4 dsize(int(s), 0, 0, 0);
+    graph.add_shader_pass(
+        settings_.name + " pyramid " + id + " " + std::to_string(m), gpu::PassKind::Compute, *downsample_,
+        [pyramid, m](gpu::ShaderPassBuilder& b) {
+          b.bind("finer", pyramid, m - 1);
+          b.bind("coarser", pyramid, m);
+        },
+        [dp, dsize, s](VkCommandBuffer cmd, gpu::PassContext&) {
+          gpu::push_and_dispatch(cmd, *dp, &dsize, sizeof dsize, {(s + 7) / 8, (s + 7) / 8, 1});
+        });
+  }
+  const gpu::Pipeline* sp = &*sample_;
+  const gpu::BufferHandle vpls = vpls_;
+  const glm::ivec4 slots(int(first), int(count), int(top), real_lamp ? 1 : 0);
+  const VkSampler nearest = graph.context().samplers().nearest_clamp;
+  graph.add_shader_pass(
+      settings_.name + " sample " + id, gpu::PassKind::Compute, *sample_,
+      [=](gpu::ShaderPassBuilder& b) {
+        b.bind_sampled("importance", pyramid, nearest);
+        b.bind("rho_position", rho.position);
+        b.bind("rho_normal", rho.normal);
+        b.bind("rho_flux", rho.flux);
+        b.bind("mu_position", mu.position);
+        b.bind("mu_normal", mu.normal);
+        b.bind("mu_flux", mu.flux);
+        b.bind_over("Vpls", vpls);  // other pairs' slots and the clear stay
+      },
+      [sp, slots, count](VkCommandBuffer cmd, gpu::PassContext&) {
+        gpu::push_and_dispatch(cmd, *sp, &slots, sizeof slots, {(count + 63) / 64, 1, 1});
+      });
+  return ok_status();
+}
+
+}  // namespace mrgi::gi

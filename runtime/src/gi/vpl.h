@@ -1,0 +1,56 @@
+// Virtual point lights from reflective shadow map pairs, a shared block of the VPL-based
+// techniques (dir now): per real lamp, the DIR paper's two maps (Sec. 3.3, 3.7) are gi/rsm.h's
+// pair (R^mu holds the real casters; R^rho's virtual texels are what a map of the virtual
+// casters alone would show the lamp, the rest is R^mu), sampled into a buffer of VPL slots
+// (common/vpl.glsl) by importance: a Halton value picks the real or the virtual map in
+// proportion to the texels each covers, hierarchical warping (Clarberg et al. 2005, the GPU
+// walk of gi/importance.h's pyramid) picks a texel in proportion to its reflected flux's
+// luminance, and the VPL's flux is divided by the probability of that choice (the paper's
+// intensity compensation: the VPLs' expected sum is the maps' reflected flux).
+//
+// Allocated once: `max_vpls` slots and one importance pyramid (RGBA32F mip chain) for maps up to
+// `map_size` texels per side; a pair is sampled at its used size (a power of two).
+#pragma once
+#include <cstdint>
+#include <string>
+
+#include "gi/light_propagation.h"
+#include "gpu/frame_graph.h"
+#include "gpu/pipelines.h"
+#include "mrgi/expected.h"
+
+namespace mrgi::gi {
+
+struct VplSettings {
+  std::string name = "vpl";  // prefix of the resources' and passes' names
+  uint32_t max_vpls = 256;   // VPL slots allocated (the largest level's count), 1..4096
+  uint32_t map_size = 512;   // largest map side sampled (texels), a power of two, 16..4096
+};
+
+class VplSampler {
+ public:
+  // BadUsage naming the field for settings out of range.
+  static Expected<VplSampler> create(gpu::FrameGraph& graph, const VplSettings& settings);
+
+  // A transfer pass emptying every slot (flags 0: lights nothing); "<name> clear".
+  void add_clear(gpu::FrameGraph& graph) const;
+  // Slots [first, first + count) from the pair `rho` / `mu` (gi/rsm.h images at their used size,
+  // square, a power of two <= map_size) of a real lamp (`real_lamp`: both maps and the path
+  // flags of Sec. 3.3; else R^rho's texels as one map, as the paper's virtual spot light).
+  // Passes "<name> importance <id>", "<name> pyramid <id> <level>", "<name> sample <id>".
+  Status add_sample(gpu::FrameGraph& graph, const std::string& id, const RsmImages& rho, const RsmImages& mu,
+                    bool real_lamp, uint32_t first, uint32_t count);
+
+  gpu::BufferHandle buffer() const { return vpls_; }  // shader::Vpl[max_vpls]
+  uint32_t max_vpls() const { return settings_.max_vpls; }
+
+ private:
+  VplSampler() = default;
+  VplSettings settings_;
+  uint32_t levels_ = 1;
+  gpu::ImageHandle pyramid_;
+  gpu::BufferHandle vpls_;
+  gpu::PipelineHandle importance_, downsample_, sample_;
+};
+
+}  // namespace mrgi::gi

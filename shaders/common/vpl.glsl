@@ -1,0 +1,28 @@
+// A virtual point light as the VPL buffer holds it (gi/vpl.h writes it, gi/ism.h and the dir
+// shading read it), with the DIR paper's path flags (differential-instant-radiosity-reciprocal-
+// shading.md Sec. 3.3-3.6). Shared by C++ and GLSL like frame_constants.glsl: vec4 members only.
+#ifndef MRGI_VPL_GLSL
+#define MRGI_VPL_GLSL
+#ifdef __cplusplus
+#include <glm/glm.hpp>
+namespace mrgi::shader {
+using glm::vec4;
+#endif
+
+// Flag bits, stored in Vpl::position.w as a float (exact for these small integers).
+#define MRGI_VPL_VALID 1      // the slot holds a VPL (0: empty, lights nothing)
+#define MRGI_VPL_REAL_PATH 2  // r(x): its light path holds only real lamps and real surfaces (eq. 9-10)
+#define MRGI_VPL_REAL_ONLY 4  // ir(VPL): lights real surfaces only, in L_r (VPL 3 of the paper's
+                              // Fig. 6: a real surface a virtual object hides from the lamp)
+
+struct Vpl {
+  vec4 position;  // xyz world (m); w: MRGI_VPL_* bits
+  vec4 normal;    // xyz unit normal of its surface, on the side the light arrived from; w unused
+  vec4 flux;      // rgb reflected flux (W), already divided by the probability of drawing it; w unused
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(Vpl) == 48, "std430 mirror");
+}  // namespace mrgi::shader
+#endif
+#endif  // MRGI_VPL_GLSL

@@ -1,0 +1,88 @@
+#version 450
+// VPLs from a reflective shadow map pair (gi/vpl.h; DIR paper Sec. 3.7): one invocation per VPL
+// slot. A Halton value picks the map, the real one (R^mu: the real casters) or the virtual one
+// (R^rho's virtual texels), in proportion to the texels each covers; two more Halton values
+// descend that map's importance pyramid by hierarchical warping (Clarberg et al. 2005,
+// mrgi_shared.h warp_step) to a texel drawn in proportion to its reflected flux's luminance. The
+// VPL takes the texel's position, normal and flux, the flux divided by the probability of
+// drawing it (the map's share of the slots times the texel's share of the map's luminance, times
+// the slot count): the paper's intensity compensation, so the VPLs' expected sum is the maps'.
+// Flags (Sec. 3.3-3.6): a VPL on a real surface of a real lamp's map is on a real path; one
+// whose texel R^rho covers with a virtual surface lights real surfaces only (the paper's VPL 3:
+// it cancels the real bounce the virtual object blocks).
+#extension GL_GOOGLE_include_directive : require
+#include "shared/mrgi_shared.h"
+#include "shared/vpl_math.h"
+#include "common/vpl.glsl"
+
+layout(local_size_x = 64) in;
+layout(set = 0, binding = 0) uniform sampler2D importance;  // the pyramid, every level (nearest)
+layout(set = 0, binding = 1, rgba32f) uniform readonly image2D rho_position;
+layout(set = 0, binding = 2, rgba16f) uniform readonly image2D rho_normal;
+layout(set = 0, binding = 3, rgba32f) uniform readonly image2D rho_flux;
+layout(set = 0, binding = 4, rgba32f) uniform readonly image2D mu_position;
+layout(set = 0, binding = 5, rgba16f) uniform readonly image2D mu_normal;
+layout(set = 0, binding = 6, rgba32f) uniform readonly image2D mu_flux;
+layout(std430, set = 0, binding = 7) writeonly buffer Vpls { Vpl vpls[]; };
+layout(push_constant) uniform Params {
+  ivec4 slots;  // x: first slot; y: slots of this pair; z: the pyramid's top level (used side
+                // 2^z); w: 1 real lamp, 0 virtual
+} params;
+
+void main() {
+  int j = int(gl_GlobalInvocationID.x);
+  if (j >= params.slots.y) return;
+  int slot = params.slots.x + j;
+  Vpl v;
+  v.position = vec4(0.0f);
+  v.normal = vec4(0.0f, 0.0f, 1.0f, 0.0f);
+  v.flux = vec4(0.0f);
+  int top = params.slots.z;
+  vec4 total = texelFetch(importance, ivec2(0), top);
+  float covered = total.z + total.w;
+  uint h = uint(slot) + 1u;  // Halton index 0 is the origin in every base
+  bool use_virtual = covered > 0.0f && halton(h, 2u) < total.w / covered;
+  float p_map = covered > 0.0f ? (use_virtual ? total.w : total.z) / covered : 0.0f;
+  float map_total = use_virtual ? total.y : total.x;
+  if (p_map > 0.0f && map_total > 0.0f) {
+    vec2 u = vec2(halton(h, 3u), halton(h, 5u));
+    ivec2 at = ivec2(0);
+    float p = 1.0f;
+    for (int level = top; level > 0; --level) {
+      ivec2 b = at * 2;
+      vec4 c00 = texelFetch(importance, b, level - 1), c10 = texelFetch(importance, b + ivec2(1, 0), level - 1);
+      vec4 c01 = texelFetch(importance, b + ivec2(0, 1), level - 1), c11 = texelFetch(importance, b + ivec2(1, 1), level - 1);
+      vec4 q = use_virtual ? vec4(c00.y, c10.y, c01.y, c11.y) : vec4(c00.x, c10.x, c01.x, c11.x);
+      WarpStep s = warp_step(u, q);
+      at = b + s.child;
+      p *= s.probability;
+      u = s.u;
+    }
+    bool real_lamp = params.slots.w != 0;
+    vec4 pos, nrm, flux;
+    if (use_virtual || !real_lamp) {
+      pos = imageLoad(rho_position, at);
+      nrm = imageLoad(rho_normal, at);
+      flux = imageLoad(rho_flux, at);
+    } else {
+      pos = imageLoad(mu_position, at);
+      nrm = imageLoad(mu_normal, at);
+      flux = imageLoad(mu_flux, at);
+    }
+    float weight = p * p_map * float(params.slots.y);
+    if (pos.w > 0.5f && weight > 0.0f) {
+      int flags = MRGI_VPL_VALID;
+      if (!use_virtual && real_lamp) {
+        flags |= MRGI_VPL_REAL_PATH;
+        if (imageLoad(rho_position, at).w > 1.5f) flags |= MRGI_VPL_REAL_ONLY;
+      }
+      vec3 n = nrm.xyz;
+      float len = length(n);
+      v.position = vec4(pos.xyz, float(flags));
+      v.normal = vec4(len > 0.0f ? n / len : vec3(0.0f, 0.0f, 1.0f), 0.0f);
+      vec3 f = max(flux.rgb, vec3(0.0f)) / weight;
+      v.flux = vec4(all(lessThan(f, vec3(3.0e38f))) ? f : vec3(0.0f), 0.0f);  // no NaN or Inf VPL
+    }
+  }
+  vpls[slot] = v;
+}
