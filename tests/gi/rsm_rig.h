@@ -52,7 +52,7 @@ struct RsmRig {
       d.format = f;
       d.size_mode = gpu::SizeMode::Absolute;
       d.width = d.height = kG;
-      return *graph->create_image(d, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
+      return *graph->create_image(d, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
     };
     real = {image("real position", VK_FORMAT_R32G32B32A32_SFLOAT), image("real normal", VK_FORMAT_R16G16B16A16_SFLOAT),
             image("real albedo", VK_FORMAT_R16G16B16A16_SFLOAT)};

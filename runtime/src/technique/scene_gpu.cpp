@@ -88,11 +88,14 @@ Expected<MeshSet> upload_meshes(gpu::Context& ctx, gpu::FrameGraph& graph, const
   // Never zero-sized (Vulkan forbids it); an empty set simply has no draws.
   const VkDeviceSize vbytes = std::max<VkDeviceSize>(64, data.vertices.size() * sizeof(GpuVertex));
   const VkDeviceSize ibytes = std::max<VkDeviceSize>(64, data.indices.size() * sizeof(uint32_t));
+  // Storage too: compute passes read the meshes as lists (gi/ism.h samples points on them).
   auto vb = graph.create_buffer({name + "_vertices", vbytes}, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT |
-                                                              VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+                                                              VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                                                              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (!vb) return vb.error();
   auto ib = graph.create_buffer({name + "_indices", ibytes}, VK_BUFFER_USAGE_INDEX_BUFFER_BIT |
-                                                             VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+                                                             VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                                                             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (!ib) return ib.error();
   if (!data.vertices.empty()) {
     MRGI_TRY(ctx.upload_buffer(graph.gpu_buffer(*vb, 0), data.vertices.data(),

@@ -1,0 +1,33 @@
+// The splat step of the ISM passes (ism_splat_real.comp, ism_splat_virtual.comp): a point p that
+// stands for `area` m^2 of surface, splatted into VPL `vpl`'s map as a square of texels sized to
+// the solid angle it covers from the VPL (the paper's "splats sized to fill", Sec. 4.3), each
+// texel keeping the nearest distance (atomic min on the float's bits: non-negative floats order
+// as their bits do). The including shader declares `vpls` (Vpl[]), `splat` (r32ui) and `params`.
+#ifndef MRGI_ISM_SPLAT_GLSL
+#define MRGI_ISM_SPLAT_GLSL
+
+void ism_splat(int vpl, vec3 p, float area) {
+  Vpl v = vpls[vpl];
+  if ((int(v.position.w) & MRGI_VPL_VALID) == 0) return;
+  vec3 d = p - v.position.xyz;
+  float dist2 = dot(d, d);
+  if (!(dist2 > 1e-12f) || isinf(dist2)) return;
+  float dist = sqrt(dist2);
+  vec3 w = d / dist;
+  int side = params.tiles.y;
+  vec2 uv = paraboloid_uv(w, v.normal.xyz);
+  if (dot(uv, uv) > 1.0f) return;
+  ivec2 texel = clamp(ivec2(floor((uv * 0.5f + 0.5f) * float(side))), ivec2(0), ivec2(side - 1));
+  float texels = area / dist2 / paraboloid_texel_solid_angle(uv, float(side));
+  int r = clamp(int(sqrt(max(texels, 0.0f) / MRGI_PI) + 0.5f), 0, MRGI_ISM_MAX_SPLAT_RADIUS);
+  ivec2 origin = ism_tile_origin(vpl, params.tiles.z, side);
+  uint bits = floatBitsToUint(dist);
+  for (int y = -r; y <= r; ++y)
+    for (int x = -r; x <= r; ++x) {
+      ivec2 q = texel + ivec2(x, y);
+      if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(side)))) continue;
+      imageAtomicMin(splat, origin + q, bits);
+    }
+}
+
+#endif
