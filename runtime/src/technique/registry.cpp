@@ -1,6 +1,7 @@
 #include <string>
 
 #include "technique/baseline/baseline.h"
+#include "technique/dir/dir.h"
 #include "technique/dlpv/dlpv.h"
 #include "technique/ssrt/ssrt.h"
 #include "technique/technique.h"
@@ -14,6 +15,7 @@ const std::vector<TechniqueEntry>& registered_techniques() {
       {"baseline", &baseline_ladder, &create_baseline},
       {"ssrt", &ssrt_ladder, &create_ssrt},
       {"dlpv", &dlpv_ladder, &create_dlpv},
+      {"dir", &dir_ladder, &create_dir},
   };
   return entries;
 }
@@ -26,7 +28,6 @@ Expected<const TechniqueEntry*> find_technique(const std::string& name) {
   }
   // Techniques of DESIGN.md that are not built yet say so by name instead of "unknown".
   static const std::pair<const char*, const char*> planned[] = {
-      {"dir", "Differential Instant Radiosity (VPLs, imperfect shadow maps)"},
       {"dvct", "Delta Voxel Cone Tracing"},
       {"specular", "mirrors, glass and caustics inside DIR"},
   };

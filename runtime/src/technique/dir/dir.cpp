@@ -1,0 +1,265 @@
+#include "technique/dir/dir.h"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <string>
+
+#include "gi/ism.h"
+#include "gi/rsm.h"
+#include "gi/vpl.h"
+#include "gpu/pipelines.h"
+#include "light/light_stage.h"
+#include "technique/baseline/baseline.h"
+#include "technique/scene_gpu.h"
+
+namespace mrgi::technique {
+
+const std::array<DirLevel, 5>& dir_levels() {
+  static const std::array<DirLevel, 5> levels = {{
+      {"paper", 256, 128, 1024, 512, 4, 4, 1.0f, 0},
+      {"high", 256, 64, 512, 256, 4, 4, 1.0f, 1},
+      {"medium", 64, 64, 512, 256, 2, 4, 1.0f, 1},
+      {"fast", 32, 32, 256, 128, 1, 4, 0.5f, 3},
+      {"fastest", 16, 32, 128, 64, 1, 4, 0.5f, 3},
+  }};
+  return levels;
+}
+
+std::vector<QualityLevel> dir_ladder() {
+  std::vector<QualityLevel> out;
+  for (const DirLevel& l : dir_levels()) {
+    QualityLevel q;
+    q.name = l.name;
+    q.internal_scale = l.internal_scale;
+    q.knobs = {{"vpls", double(l.vpls), "virtual point lights"},
+               {"ism_size", double(l.ism_size), "texels per side of each VPL's imperfect shadow maps"},
+               {"points_per_vpl", double(l.points_per_vpl), "points splatted into each of a VPL's two maps"},
+               {"rsm_size", double(l.rsm_size), "texels per side of each reflective shadow map"},
+               {"rsm_lamps", double(l.rsm_lamps), "lamps, strongest first, whose maps spawn VPLs"},
+               {"interleave", double(l.interleave), "side of the interleaved-sampling block (pixels)"},
+               {"internal_scale", double(l.internal_scale), "fraction of the output width and height"},
+               {"baseline_level", double(l.baseline_level), "baseline's level for the direct light"}};
+    out.push_back(q);
+  }
+  return out;
+}
+
+namespace {
+
+// shaders/dir/dir_params.glsl DirParams.
+struct DirPush {
+  glm::ivec4 vpls;
+  glm::vec4 lighting;
+};
+
+// The sphere the maps are fitted to: twice the virtual objects' largest bounding-box edge across
+// (at least 0.25 m), as dlpv's volume: where the bounce that differs between the solutions starts.
+constexpr float kMinInfluenceSide = 0.25f;
+// The ISM test: a point is lit when its distance is within bias of the map's (relative, and
+// absolute in metres): the maps are sparse splats of a few hundred points, a texel spans degrees.
+constexpr float kIsmBiasRelative = 0.05f, kIsmBiasMetres = 0.01f;
+
+class Dir final : public Technique {
+ public:
+  explicit Dir(const SharedResources& shared) : shared_(shared), ladder_(dir_ladder()) {}
+  const std::string& name() const override { return name_; }
+  const std::vector<QualityLevel>& levels() const override { return ladder_; }
+  Status init();
+  Status record(const FrameInfo& info, std::vector<std::string>& skipped) override;
+
+ private:
+  std::string name_ = "dir";
+  SharedResources shared_;
+  std::vector<QualityLevel> ladder_;
+  std::optional<gi::ReflectiveShadowMaps> rsm_;
+  std::optional<gi::VplSampler> vpls_;
+  std::optional<gi::ImperfectShadowMaps> ism_;
+  gpu::ImageHandle indirect_rv_, indirect_r_;
+  gpu::PipelineHandle shade_, merge_;
+  std::unique_ptr<Technique> baseline_;
+  // This frame's lamps with VPLs (light index, view); reserved at init (no allocation per frame).
+  std::vector<std::pair<size_t, gi::RsmView>> planned_;
+  bool has_virtual_ = false;
+  glm::vec3 centre_{0.0f};
+  float radius_ = 1.0f;
+};
+
+Status Dir::init() {
+  gpu::FrameGraph& graph = *shared_.graph;
+  const SceneGpu& sg = *shared_.scene_gpu;
+  if (!shared_.light_stage) return fail(ErrorKind::Internal, "dir: no light stage");
+  has_virtual_ = !sg.virtual_objects.empty();
+  uint32_t top_vpls = 1, top_ism = 8, top_rsm = 16, top_lamps = 1;
+  for (const DirLevel& l : dir_levels()) {
+    top_vpls = std::max(top_vpls, l.vpls);
+    top_ism = std::max(top_ism, l.ism_size);
+    top_rsm = std::max(top_rsm, l.rsm_size);
+    top_lamps = std::max(top_lamps, l.rsm_lamps);
+  }
+  planned_.reserve(top_lamps);
+  if (has_virtual_) {
+    const glm::vec3 size = sg.virtual_objects.bounds_max - sg.virtual_objects.bounds_min;
+    centre_ = 0.5f * (sg.virtual_objects.bounds_max + sg.virtual_objects.bounds_min);
+    const float side = std::max(kMinInfluenceSide, 2.0f * std::max({size.x, size.y, size.z}));
+    radius_ = 0.5f * side * std::sqrt(3.0f);
+    gi::RsmSettings rs;
+    rs.name = "dir rsm";
+    rs.size = top_rsm;
+    auto rsm = gi::ReflectiveShadowMaps::create(graph, sg, {shared_.real_position, shared_.real_normal, shared_.real_albedo}, rs);
+    if (!rsm) return rsm.error();
+    rsm_.emplace(std::move(*rsm));
+    gi::VplSettings vs;
+    vs.name = "dir vpl";
+    vs.max_vpls = top_vpls;
+    vs.map_size = top_rsm;
+    auto vpls = gi::VplSampler::create(graph, vs);
+    if (!vpls) return vpls.error();
+    vpls_.emplace(std::move(*vpls));
+    gi::IsmSettings is;
+    is.name = "dir ism";
+    is.max_vpls = top_vpls;
+    is.map_size = top_ism;
+    auto ism = gi::ImperfectShadowMaps::create(graph, sg, shared_.real_position, is);
+    if (!ism) return ism.error();
+    ism_.emplace(std::move(*ism));
+  }
+  auto image = [&](const char* name) {
+    gpu::ImageDesc d;
+    d.name = name;
+    d.format = VK_FORMAT_R16G16B16A16_SFLOAT;
+    return graph.create_image(d, VK_IMAGE_USAGE_STORAGE_BIT);
+  };
+  auto rv = image("dir indirect rv");
+  if (!rv) return rv.error();
+  indirect_rv_ = *rv;
+  auto r = image("dir indirect r");
+  if (!r) return r.error();
+  indirect_r_ = *r;
+  auto shade = gpu::load_compute_pipeline(graph.context(), "dir/shade_vpl.comp", {});
+  if (!shade) return shade.error();
+  shade_ = std::move(*shade);
+  auto merge = gpu::load_compute_pipeline(graph.context(), "dir/merge.comp", {});
+  if (!merge) return merge.error();
+  merge_ = std::move(*merge);
+  auto base = create_baseline(shared_);
+  if (!base) return base.error();
+  baseline_ = std::move(*base);
+  return ok_status();
+}
+
+Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
+  if (info.level < 0 || info.level >= int(dir_levels().size()))
+    return fail(ErrorKind::BadUsage, "dir: level " + std::to_string(info.level) + " outside 0.." +
+                                         std::to_string(dir_levels().size() - 1));
+  const DirLevel& level = dir_levels()[size_t(info.level)];
+  gpu::FrameGraph& graph = *shared_.graph;
+  const light::Lighting& lighting = shared_.light_stage->lighting();
+  skipped.push_back("dir environment VPLs, multiple bounces, glossy VPLs, temporal smoothing: not built yet "
+                    "(issue 15); the environment lights directly through baseline's regions and ambient");
+  FrameInfo base = info;
+  base.level = level.baseline_level;
+  planned_.clear();
+  if (!has_virtual_) {
+    skipped.push_back("dir VPLs: no virtual object in the scene (the bounce is the same in both solutions)");
+    return baseline_->record(base, skipped);
+  }
+  for (size_t i = 0; i < lighting.lights.size() && planned_.size() < level.rsm_lamps; ++i) {
+    auto view = gi::rsm_view(lighting.lights[i], centre_, radius_, level.rsm_size);
+    if (!view) {
+      skipped.push_back("dir rsm (light " + std::to_string(i) + "): " + view.error().message);
+      continue;
+    }
+    planned_.push_back({i, *view});
+  }
+  if (planned_.empty()) {
+    skipped.push_back("dir VPLs: no light a map can see the virtual objects from");
+    return baseline_->record(base, skipped);
+  }
+  // The real grid at about two points a map texel across the G-buffer's larger side (dlpv's rule).
+  const VkExtent2D g = graph.extent(shared_.real_position);
+  const uint32_t stride = std::max(1u, uint32_t(std::ceil(double(std::max(g.width, g.height)) / (level.rsm_size / 2.0))));
+  vpls_->add_clear(graph);
+  rsm_->add_grid(graph, stride);
+  const uint32_t lamps = uint32_t(planned_.size());
+  uint32_t first = 0;
+  for (uint32_t k = 0; k < lamps; ++k) {
+    const auto& [i, view] = planned_[k];
+    const uint32_t count = level.vpls / lamps + (k < level.vpls % lamps ? 1 : 0);
+    const std::string id = std::to_string(i);
+    rsm_->add_pair(graph, id, view, level.rsm_size);
+    MRGI_TRY(vpls_->add_sample(graph, id, rsm_->images(gi::RsmMap::WithVirtual, level.rsm_size),
+                               rsm_->images(gi::RsmMap::RealOnly, level.rsm_size), lighting.lights[i].real, first, count));
+    first += count;
+  }
+  // The G-buffer's focal lengths in its own pixels (the colour camera's, scaled to its size).
+  const Intrinsics& c = shared_.color_intrinsics;
+  const glm::vec2 focal(float(c.fx * double(g.width) / double(std::max(1, c.width))),
+                        float(c.fy * double(g.height) / double(std::max(1, c.height))));
+  gi::IsmFrame f;
+  f.vpls = level.vpls;
+  f.map_size = level.ism_size;
+  f.points_per_vpl = level.points_per_vpl;
+  f.focal_px = focal;
+  MRGI_TRY(ism_->add_build(graph, vpls_->buffer(), f));
+
+  // A VPL stands for the light of the map's area over the VPL count, (2 radius)^2 / vpls: its
+  // 1 / d^2 is clamped at that disk's radius.
+  const float clamp_m = 2.0f * radius_ / std::sqrt(float(M_PI) * float(level.vpls));
+  const DirPush push{glm::ivec4(int(level.vpls), int(level.ism_size), int(ism_->tiles_per_row(level.vpls)),
+                                int(level.interleave)),
+                     glm::vec4(clamp_m, kIsmBiasRelative, kIsmBiasMetres, 0.0f)};
+  const SharedResources& r = shared_;
+  const gpu::Pipeline* shade = &*shade_;
+  const gpu::BufferHandle vpl_buffer = vpls_->buffer();
+  const gpu::ImageHandle distances = ism_->distances(), irv = indirect_rv_, ir = indirect_r_;
+  graph.add_shader_pass(
+      "dir shade vpls", gpu::PassKind::Compute, *shade_,
+      [&](gpu::ShaderPassBuilder& b) {
+        b.bind("FrameUbo", r.frame_constants);
+        b.bind("real_position", r.real_position);
+        b.bind("real_normal", r.real_normal);
+        b.bind("real_albedo", r.real_albedo);
+        b.bind("virtual_position", r.virtual_position);
+        b.bind("virtual_normal", r.virtual_normal);
+        b.bind("virtual_albedo", r.virtual_albedo);
+        b.bind("Vpls", vpl_buffer);
+        b.bind("ism_distances", distances, 0);
+        b.bind("indirect_rv", irv);
+        b.bind("indirect_r", ir);
+      },
+      [shade, push, irv](VkCommandBuffer cmd, gpu::PassContext& p) {
+        const VkExtent2D e = p.extent(irv);
+        gpu::dispatch_2d(cmd, *shade, &push, sizeof push, e.width, e.height);
+      });
+  MRGI_TRY(baseline_->record(base, skipped));
+  const gpu::Pipeline* merge = &*merge_;
+  graph.add_shader_pass(
+      "dir merge", gpu::PassKind::Compute, *merge_,
+      [&](gpu::ShaderPassBuilder& b) {
+        b.bind("FrameUbo", r.frame_constants);
+        b.bind("real_position", r.real_position);
+        b.bind("real_normal", r.real_normal);
+        b.bind("virtual_position", r.virtual_position);
+        b.bind("virtual_normal", r.virtual_normal);
+        b.bind("indirect_rv", irv);
+        b.bind("indirect_r", ir);
+        b.bind_over("lit_rv", r.lit_rv);
+        b.bind_over("lit_r", r.lit_r);
+      },
+      [merge, push, lit = r.lit_rv](VkCommandBuffer cmd, gpu::PassContext& p) {
+        const VkExtent2D e = p.extent(lit);
+        gpu::dispatch_2d(cmd, *merge, &push, sizeof push, e.width, e.height);
+      });
+  return ok_status();
+}
+
+}  // namespace
+
+Expected<std::unique_ptr<Technique>> create_dir(const SharedResources& shared) {
+  auto t = std::make_unique<Dir>(shared);
+  MRGI_TRY(t->init());
+  return std::unique_ptr<Technique>(std::move(t));
+}
+
+}  // namespace mrgi::technique

@@ -1,0 +1,63 @@
+// The `dir` technique: Differential Instant Radiosity (Knecht et al., "Reciprocal Shading for
+// Mixed Reality", ../shared/papers/differential-instant-radiosity-reciprocal-shading.md). Per
+// lamp of the light stage (declared lamps, environment regions, the probeless light), the pair of
+// reflective shadow maps (gi/rsm.h) gives VPLs by importance with the paper's path flags
+// (gi/vpl.h, Sec. 3.7); each VPL gets a real and a virtual imperfect shadow map (gi/ism.h,
+// Sec. 3.3); one pass shades every pixel's share of the VPLs into both solutions with the flags
+// (shaders/dir/shade_vpl.comp, eq. 6-8), interleaved 4x4 and merged geometry-aware
+// (shaders/dir/merge.comp). Direct light is baseline's at the level's baseline level: the same
+// real/virtual shadow-map pair per lamp, eq. 1-5.
+//
+// Quality ladder (best first; DirLevel below, with units):
+//   level    VPLs  ISM    points/VPL  RSM    RSM lamps  interleave  internal scale  baseline
+//   paper    256   128^2  1024        512^2  4          4x4         1.0             high
+//   high     256    64^2   512        256^2  4          4x4         1.0             medium
+//   medium    64    64^2   512        256^2  2          4x4         1.0             medium
+//   fast      32    32^2   256        128^2  1          4x4         0.5             lowest
+//   fastest   16    32^2   128         64^2  1          4x4         0.5             lowest
+// "paper" is the paper's settings (Sec. 6: 256 VPLs, 128^2 ISMs, 1024 points a VPL, 4x4 split).
+//
+// Where mrgi differs from the paper and why:
+//   - the paper's two RSMs per real lamp (real casters; virtual casters) are gi/rsm.h's pair
+//     (R^mu: real casters; R^rho: R^mu with the virtual objects drawn over it): R^rho's virtual
+//     texels are the virtual map's texels the lamp reaches, and a real texel R^rho covers is the
+//     paper's VPL 3 (ir = 1); a virtual surface behind a real one, which only the paper's
+//     virtual map holds, lights neither solution, so nothing is lost;
+//   - each map is fitted to the sphere around the virtual objects (twice their largest extent,
+//     as dlpv's volume), not to the whole lamp cone: the bounce that differs between the
+//     solutions starts there;
+//   - ISMs are splatted in compute with atomic min (lavapipe rasterises points on one thread)
+//     onto paraboloid maps (the paper's are hemispherical too) and filled by a two-level
+//     pull-push;
+//   - interleaved sampling runs in place instead of on a split G-buffer (shade_vpl.comp says why);
+//   - the VPLs' 1 / d^2 is clamped at the radius of the disk a VPL stands for (the map's area
+//     over the VPL count): the paper does not say how it bounds it;
+//   - not yet built (they say so in FrameStats::skipped): VPLs of the environment on a hemisphere
+//     (the environment lights directly through baseline's shadowed regions and SH ambient),
+//     multiple bounces, glossy VPLs, temporal smoothing, the skips of the issue.
+#pragma once
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "technique/technique.h"
+
+namespace mrgi::technique {
+
+struct DirLevel {
+  const char* name;
+  uint32_t vpls;            // VPL slots shaded
+  uint32_t ism_size;        // texels per side of each VPL's imperfect shadow maps
+  uint32_t points_per_vpl;  // points splatted into each of a VPL's two maps
+  uint32_t rsm_size;        // texels per side of each reflective shadow map
+  uint32_t rsm_lamps;       // lamps (strongest first) whose maps spawn VPLs; the slots split evenly
+  uint32_t interleave;      // side of the interleaving block (4: 4x4, 1: every pixel every VPL)
+  float internal_scale;     // fraction of the output width and height
+  int baseline_level;       // baseline's level for the direct light
+};
+const std::array<DirLevel, 5>& dir_levels();
+
+std::vector<QualityLevel> dir_ladder();
+Expected<std::unique_ptr<Technique>> create_dir(const SharedResources& shared);
+
+}  // namespace mrgi::technique

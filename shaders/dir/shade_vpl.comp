@@ -1,0 +1,91 @@
+#version 460
+// dir: the indirect light of the VPLs (gi/vpl.h) at every pixel, with the DIR paper's path flags
+// (differential-instant-radiosity-reciprocal-shading.md eq. 6-8), so both solutions come out of
+// one pass:
+//   L_rv += L_o (1 - ir(VPL)) min(st_r, st_v)
+//   L_r  += L_o r(path) r(p) st_r
+// L_o = albedo / pi x the VPL's irradiance at p (shared/vpl_math.h vpl_irradiance; diffuse:
+// the virtual surfaces' base colour x (1 - metallic)); st_r, st_v: the VPL's real and virtual
+// imperfect shadow maps (gi/ism.h), one tap each, with a bias that grows with the distance (an
+// ISM is a sparse, splatted depth map).
+// Interleaved sampling (the paper's 4x4 G-buffer split, Segovia et al. 2006): the pixel at
+// (x, y) shades only the VPLs j = (x mod 4) + 4 (y mod 4) (mod 16), its sum scaled by 16, and
+// merge.comp averages the 16 neighbours of a 4x4 block geometry-aware. The paper splits the
+// G-buffer into 16 sub-images for a GPU's caches; on a CPU device the pixels of a block share
+// them anyway, so mrgi interleaves in place.
+#extension GL_GOOGLE_include_directive : require
+#include "shared/mrgi_shared.h"
+#include "shared/vpl_math.h"
+#include "common/frame_constants.glsl"
+#include "common/vpl.glsl"
+#include "gi/ism_common.glsl"
+#include "dir/dir_params.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
+FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
+layout(set = 0, binding = 1, rgba32f) readonly uniform image2D real_position;
+layout(set = 0, binding = 2, rgba16f) readonly uniform image2D real_normal;
+layout(set = 0, binding = 3, rgba16f) readonly uniform image2D real_albedo;
+layout(set = 0, binding = 4, rgba32f) readonly uniform image2D virtual_position;
+layout(set = 0, binding = 5, rgba16f) readonly uniform image2D virtual_normal;
+layout(set = 0, binding = 6, rgba16f) readonly uniform image2D virtual_albedo;
+layout(std430, set = 0, binding = 7) readonly buffer Vpls { Vpl vpls[]; };
+layout(set = 0, binding = 8, rg32f) readonly uniform image2D ism_distances;  // level 0: x real, y virtual
+layout(set = 0, binding = 9, rgba16f) writeonly uniform image2D indirect_rv;
+layout(set = 0, binding = 10, rgba16f) writeonly uniform image2D indirect_r;
+layout(push_constant) uniform Params { DirParams params_block; };
+DirParams params;
+
+void main() {
+  frame = frame_ubo; params = params_block;  // MRGI_UNIFORM_COPIES
+  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+  if (any(greaterThanEqual(pixel, frame.internal_output_size.xy))) return;
+  vec4 vpos = imageLoad(virtual_position, pixel);
+  bool is_virtual = vpos.w > 0.5f;
+  vec4 pos, nrm;
+  vec3 albedo;
+  if (is_virtual) {
+    pos = vpos;
+    nrm = imageLoad(virtual_normal, pixel);
+    vec4 a = imageLoad(virtual_albedo, pixel);
+    albedo = a.rgb * (1.0f - a.a);
+  } else {
+    pos = imageLoad(real_position, pixel);
+    nrm = imageLoad(real_normal, pixel);
+    albedo = imageLoad(real_albedo, pixel).rgb;
+  }
+  vec3 l_rv = vec3(0.0f), l_r = vec3(0.0f);
+  float nlen = length(nrm.xyz);
+  if ((is_virtual || pos.w > 0.0f) && nlen > 0.0f) {
+    vec3 p = pos.xyz, n = nrm.xyz / nlen;
+    int count = params.vpls.x, side = params.vpls.y, row = params.vpls.z, step = params.vpls.w * params.vpls.w;
+    int first = params.vpls.w > 1 ? (pixel.x % params.vpls.w) + params.vpls.w * (pixel.y % params.vpls.w) : 0;
+    for (int j = first; j < count; j += step) {
+      Vpl v = vpls[j];
+      int flags = int(v.position.w);
+      if ((flags & MRGI_VPL_VALID) == 0) continue;
+      bool real_only = (flags & MRGI_VPL_REAL_ONLY) != 0;
+      if (real_only && is_virtual) continue;  // ir(VPL): real surfaces only
+      vec3 q = v.position.xyz;
+      float e = vpl_irradiance(p, n, q, v.normal.xyz, 1.0f, params.lighting.x);
+      if (!(e > 0.0f)) continue;
+      vec3 d = p - q;
+      float dist = length(d);
+      ivec2 t = ism_texel(d / dist, v.normal.xyz, side);
+      if (t.x < 0) continue;
+      vec2 stored = imageLoad(ism_distances, ism_tile_origin(j, row, side) + t).xy;
+      float limit = dist * (1.0f - params.lighting.y) - params.lighting.z;
+      float st_r = stored.x >= limit ? 1.0f : 0.0f;
+      float st_v = stored.y >= limit ? 1.0f : 0.0f;
+      vec3 l_o = albedo * (1.0f / MRGI_PI) * v.flux.rgb * e;
+      if (!real_only) l_rv += l_o * min(st_r, st_v);                                  // eq. 6, 8
+      if (!is_virtual && (flags & MRGI_VPL_REAL_PATH) != 0) l_r += l_o * st_r;        // eq. 7
+    }
+    // The pixel's share of the VPLs stands for all of them (merge.comp averages the block).
+    l_rv *= float(step);
+    l_r *= float(step);
+  }
+  imageStore(indirect_rv, pixel, vec4(clamp(l_rv, vec3(0.0f), vec3(60000.0f)), 1.0f));
+  imageStore(indirect_r, pixel, vec4(clamp(l_r, vec3(0.0f), vec3(60000.0f)), 1.0f));
+}
