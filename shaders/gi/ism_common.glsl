@@ -10,6 +10,7 @@
 #define MRGI_ISM_EMPTY 0xffffffffu  // a splat texel no point reached
 #define MRGI_ISM_NONE 1.0e30f       // a resolved texel with no surface: the VPL's light passes
 #define MRGI_ISM_MAX_SPLAT_RADIUS 3 // texels each side of a splat's centre
+#define MRGI_ISM_MIN_ELEVATION_COS 0.1f  // points below ~6 degrees over a VPL's plane splat nothing
 
 struct IsmParams {
   ivec4 tiles;   // x: VPL slots mapped; y: map side (texels); z: tiles per atlas row; w: points per VPL

@@ -14,6 +14,11 @@ void ism_splat(int vpl, vec3 p, float area) {
   if (!(dist2 > 1e-12f) || isinf(dist2)) return;
   float dist = sqrt(dist2);
   vec3 w = d / dist;
+  // Points (nearly) in the VPL's own tangent plane are left out: they lie on its own surface,
+  // can only hide directions along that plane, where the VPL emits (cos) almost nothing, and their
+  // splats, large for being so near, would hide the directions just above the plane: the floor
+  // around a lit box, the box's foot seen from a floor VPL.
+  if (dot(w, v.normal.xyz) < MRGI_ISM_MIN_ELEVATION_COS) return;
   int side = params.tiles.y;
   vec2 uv = paraboloid_uv(w, v.normal.xyz);
   if (dot(uv, uv) > 1.0f) return;

@@ -296,7 +296,7 @@ struct FrameGraphSettings {
   uint32_t max_output_height = 480;
   float max_render_scale = 1.0f;     // (0, 1]; OutputRelative images also x this at most
   uint32_t frames_in_flight = 2;     // 1..3
-  uint32_t max_passes = 64;          // timestamp queries per slot = 2 x this
+  uint32_t max_passes = 128;         // timestamp queries per slot = 2 x this (dir paper: 78 passes)
   // Profiling mode (set_profiling): each pass is submitted on its own and waited for, and its
   // time is the host's wall clock from submit to fence. Needed where the driver's timestamps do
   // not bracket the work they surround: lavapipe writes a timestamp when a rasteriser thread
