@@ -1,5 +1,5 @@
 // Push constants of dir's VPL shading and merge (technique/dir/dir.h), shared by
-// shade_vpl.comp and merge.comp.
+// shade_vpl.comp, merge_rows.comp and merge_columns.comp.
 #ifndef MRGI_DIR_PARAMS_GLSL
 #define MRGI_DIR_PARAMS_GLSL
 

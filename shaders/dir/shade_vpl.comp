@@ -10,7 +10,8 @@
 // ISM is a sparse, splatted depth map).
 // Interleaved sampling (the paper's 4x4 G-buffer split, Segovia et al. 2006): the pixel at
 // (x, y) shades only the VPLs j = (x mod 4) + 4 (y mod 4) (mod 16), its sum scaled by 16, and
-// merge.comp averages the 16 neighbours of a 4x4 block geometry-aware. The paper splits the
+// merge_rows.comp and merge_columns.comp average the 16 neighbours of a 4x4 block
+// geometry-aware. Written packed with the pixel's surface key (indirect_pack.glsl). The paper splits the
 // G-buffer into 16 sub-images for a GPU's caches; on a CPU device the pixels of a block share
 // them anyway, so mrgi interleaves in place.
 #extension GL_GOOGLE_include_directive : require
@@ -20,6 +21,7 @@
 #include "common/vpl.glsl"
 #include "gi/ism_common.glsl"
 #include "dir/dir_params.glsl"
+#include "dir/indirect_pack.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
@@ -32,8 +34,7 @@ layout(set = 0, binding = 5, rgba16f) readonly uniform image2D virtual_normal;
 layout(set = 0, binding = 6, rgba16f) readonly uniform image2D virtual_albedo;
 layout(std430, set = 0, binding = 7) readonly buffer Vpls { Vpl vpls[]; };
 layout(set = 0, binding = 8, rg32f) readonly uniform image2D ism_distances;  // level 0: x real, y virtual
-layout(set = 0, binding = 9, rgba16f) writeonly uniform image2D indirect_rv;
-layout(set = 0, binding = 10, rgba16f) writeonly uniform image2D indirect_r;
+layout(set = 0, binding = 9, rgba32ui) writeonly uniform uimage2D indirect;  // indirect_pack.glsl
 layout(push_constant) uniform Params { DirParams params_block; };
 DirParams params;
 
@@ -57,8 +58,10 @@ void main() {
   }
   vec3 l_rv = vec3(0.0f), l_r = vec3(0.0f);
   float nlen = length(nrm.xyz);
-  if ((is_virtual || pos.w > 0.0f) && nlen > 0.0f) {
-    vec3 p = pos.xyz, n = nrm.xyz / nlen;
+  bool surface = (is_virtual || pos.w > 0.0f) && nlen > 0.0f;
+  vec3 n = surface ? nrm.xyz / nlen : vec3(0.0f, 0.0f, 1.0f);
+  if (surface) {
+    vec3 p = pos.xyz;
     int count = params.vpls.x, side = params.vpls.y, row = params.vpls.z, step = params.vpls.w * params.vpls.w;
     int first = params.vpls.w > 1 ? (pixel.x % params.vpls.w) + params.vpls.w * (pixel.y % params.vpls.w) : 0;
     for (int j = first; j < count; j += step) {
@@ -82,10 +85,13 @@ void main() {
       if (!real_only) l_rv += l_o * min(st_r, st_v);                                  // eq. 6, 8
       if (!is_virtual && (flags & MRGI_VPL_REAL_PATH) != 0) l_r += l_o * st_r;        // eq. 7
     }
-    // The pixel's share of the VPLs stands for all of them (merge.comp averages the block).
+    // The pixel's share of the VPLs stands for all of them (the merge averages the block).
     l_rv *= float(step);
     l_r *= float(step);
   }
-  imageStore(indirect_rv, pixel, vec4(clamp(l_rv, vec3(0.0f), vec3(60000.0f)), 1.0f));
-  imageStore(indirect_r, pixel, vec4(clamp(l_r, vec3(0.0f), vec3(60000.0f)), 1.0f));
+  float camera_distance = surface ? max(distance(pos.xyz, frame.camera_world.xyz), 1e-3f) : 0.0f;
+  uvec4 packed_value = pack_indirect(clamp(l_rv, vec3(0.0f), vec3(60000.0f)), clamp(l_r, vec3(0.0f), vec3(60000.0f)), n,
+                                     camera_distance, is_virtual);
+  if (!surface) packed_value.w = 0u;
+  imageStore(indirect, pixel, packed_value);
 }

@@ -52,6 +52,11 @@ struct DirPush {
   glm::ivec4 vpls;
   glm::vec4 lighting;
 };
+// merge_rows.comp / merge_columns.comp: DirParams and the internal size.
+struct MergePush {
+  DirPush params;
+  glm::ivec4 size;
+};
 
 // The sphere the maps are fitted to: twice the virtual objects' largest bounding-box edge across
 // (at least 0.25 m), as dlpv's volume: where the bounce that differs between the solutions starts.
@@ -75,8 +80,8 @@ class Dir final : public Technique {
   std::optional<gi::ReflectiveShadowMaps> rsm_;
   std::optional<gi::VplSampler> vpls_;
   std::optional<gi::ImperfectShadowMaps> ism_;
-  gpu::ImageHandle indirect_rv_, indirect_r_;
-  gpu::PipelineHandle shade_, merge_;
+  gpu::ImageHandle indirect_, rows_;  // RGBA32UI, shaders/dir/indirect_pack.glsl
+  gpu::PipelineHandle shade_, merge_rows_, merge_columns_;
   std::unique_ptr<Technique> baseline_;
   // This frame's lamps with VPLs (light index, view); reserved at init (no allocation per frame).
   std::vector<std::pair<size_t, gi::RsmView>> planned_;
@@ -127,21 +132,21 @@ Status Dir::init() {
   auto image = [&](const char* name) {
     gpu::ImageDesc d;
     d.name = name;
-    d.format = VK_FORMAT_R16G16B16A16_SFLOAT;
+    d.format = VK_FORMAT_R32G32B32A32_UINT;
     return graph.create_image(d, VK_IMAGE_USAGE_STORAGE_BIT);
   };
-  auto rv = image("dir indirect rv");
-  if (!rv) return rv.error();
-  indirect_rv_ = *rv;
-  auto r = image("dir indirect r");
-  if (!r) return r.error();
-  indirect_r_ = *r;
-  auto shade = gpu::load_compute_pipeline(graph.context(), "dir/shade_vpl.comp", {});
-  if (!shade) return shade.error();
-  shade_ = std::move(*shade);
-  auto merge = gpu::load_compute_pipeline(graph.context(), "dir/merge.comp", {});
-  if (!merge) return merge.error();
-  merge_ = std::move(*merge);
+  auto indirect = image("dir indirect");
+  if (!indirect) return indirect.error();
+  indirect_ = *indirect;
+  auto rows = image("dir indirect rows");
+  if (!rows) return rows.error();
+  rows_ = *rows;
+  for (auto [shader, out] : {std::pair{"dir/shade_vpl.comp", &shade_}, std::pair{"dir/merge_rows.comp", &merge_rows_},
+                             std::pair{"dir/merge_columns.comp", &merge_columns_}}) {
+    auto p = gpu::load_compute_pipeline(graph.context(), shader, {});
+    if (!p) return p.error();
+    *out = std::move(*p);
+  }
   auto base = create_baseline(shared_);
   if (!base) return base.error();
   baseline_ = std::move(*base);
@@ -212,7 +217,7 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   const SharedResources& r = shared_;
   const gpu::Pipeline* shade = &*shade_;
   const gpu::BufferHandle vpl_buffer = vpls_->buffer();
-  const gpu::ImageHandle distances = ism_->distances(), irv = indirect_rv_, ir = indirect_r_;
+  const gpu::ImageHandle distances = ism_->distances(), indirect = indirect_, rows = rows_;
   graph.add_shader_pass(
       "dir shade vpls", gpu::PassKind::Compute, *shade_,
       [&](gpu::ShaderPassBuilder& b) {
@@ -225,31 +230,37 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
         b.bind("virtual_albedo", r.virtual_albedo);
         b.bind("Vpls", vpl_buffer);
         b.bind("ism_distances", distances, 0);
-        b.bind("indirect_rv", irv);
-        b.bind("indirect_r", ir);
+        b.bind("indirect", indirect);
       },
-      [shade, push, irv](VkCommandBuffer cmd, gpu::PassContext& p) {
-        const VkExtent2D e = p.extent(irv);
+      [shade, push, indirect](VkCommandBuffer cmd, gpu::PassContext& p) {
+        const VkExtent2D e = p.extent(indirect);
         gpu::dispatch_2d(cmd, *shade, &push, sizeof push, e.width, e.height);
       });
   MRGI_TRY(baseline_->record(base, skipped));
-  const gpu::Pipeline* merge = &*merge_;
+  const gpu::Pipeline* merge_rows = &*merge_rows_;
   graph.add_shader_pass(
-      "dir merge", gpu::PassKind::Compute, *merge_,
+      "dir merge rows", gpu::PassKind::Compute, *merge_rows_,
       [&](gpu::ShaderPassBuilder& b) {
-        b.bind("FrameUbo", r.frame_constants);
-        b.bind("real_position", r.real_position);
-        b.bind("real_normal", r.real_normal);
-        b.bind("virtual_position", r.virtual_position);
-        b.bind("virtual_normal", r.virtual_normal);
-        b.bind("indirect_rv", irv);
-        b.bind("indirect_r", ir);
+        b.bind("indirect", indirect);
+        b.bind("rows", rows);
+      },
+      [merge_rows, push, rows](VkCommandBuffer cmd, gpu::PassContext& p) {
+        const VkExtent2D e = p.extent(rows);
+        const MergePush m{push, glm::ivec4(int(e.width), int(e.height), 0, 0)};
+        gpu::dispatch_2d(cmd, *merge_rows, &m, sizeof m, e.width, e.height);
+      });
+  const gpu::Pipeline* merge_columns = &*merge_columns_;
+  graph.add_shader_pass(
+      "dir merge columns", gpu::PassKind::Compute, *merge_columns_,
+      [&](gpu::ShaderPassBuilder& b) {
+        b.bind("rows", rows);
         b.bind_over("lit_rv", r.lit_rv);
         b.bind_over("lit_r", r.lit_r);
       },
-      [merge, push, lit = r.lit_rv](VkCommandBuffer cmd, gpu::PassContext& p) {
+      [merge_columns, push, lit = r.lit_rv](VkCommandBuffer cmd, gpu::PassContext& p) {
         const VkExtent2D e = p.extent(lit);
-        gpu::dispatch_2d(cmd, *merge, &push, sizeof push, e.width, e.height);
+        const MergePush m{push, glm::ivec4(int(e.width), int(e.height), 0, 0)};
+        gpu::dispatch_2d(cmd, *merge_columns, &m, sizeof m, e.width, e.height);
       });
   return ok_status();
 }

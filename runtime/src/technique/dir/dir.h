@@ -5,7 +5,7 @@
 // (gi/vpl.h, Sec. 3.7); each VPL gets a real and a virtual imperfect shadow map (gi/ism.h,
 // Sec. 3.3); one pass shades every pixel's share of the VPLs into both solutions with the flags
 // (shaders/dir/shade_vpl.comp, eq. 6-8), interleaved 4x4 and merged geometry-aware
-// (shaders/dir/merge.comp). Direct light is baseline's at the level's baseline level: the same
+// (shaders/dir/merge_rows.comp, merge_columns.comp: separable). Direct light is baseline's at the level's baseline level: the same
 // real/virtual shadow-map pair per lamp, eq. 1-5.
 //
 // Quality ladder (best first; DirLevel below, with units):
