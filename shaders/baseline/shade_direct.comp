@@ -17,6 +17,10 @@
 //   virtual pixel: L_rv += albedo / pi E_rho(p, n)     (V^rho; levels without it add nothing)
 // Here, not in a pass of its own: that pass's G-buffer reads and read-modify-write of L_rv cost
 // more than its lookups (5.9 ms at dlpv fast on desk_spot, 18 ms on corner, profiled).
+// Bit 8 (dir, technique/dir/dir.h): also dir's merged VPL light (shaders/dir/merge_columns.comp)
+// into both solutions, L_rv += indirect_rv, L_r += indirect_r, up-sampled from its resolution
+// (volume_mode.y G-buffer pixels a texel) by bilinear weights times the surface test of
+// dir/indirect_pack.glsl (plain bilinear where no neighbour is on the pixel's surface).
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
 #include "shared/lpv_math.h"
@@ -24,6 +28,7 @@
 #include "common/frame_constants.glsl"
 #include "common/light_set.glsl"
 #include "common/surface_shading.glsl"
+#include "dir/indirect_pack.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
@@ -51,6 +56,7 @@ layout(constant_id = 0) const int kVolumeBounce = 0;
 const bool kDeltaOnReal = (kVolumeBounce & 1) != 0;
 const bool kRhoOnVirtual = (kVolumeBounce & 2) != 0;
 const bool kTwoVolumesOnReal = (kVolumeBounce & 4) != 0;
+const bool kDirIndirect = (kVolumeBounce & 8) != 0;
 // dlpv's volumes (kVolumeBounce; without it a stand-in is bound and never read).
 layout(set = 0, binding = 13) uniform sampler3D delta_r;
 layout(set = 0, binding = 14) uniform sampler3D delta_g;
@@ -61,6 +67,7 @@ layout(set = 0, binding = 18) uniform sampler3D rho_b;
 layout(set = 0, binding = 19) uniform sampler3D mu_r;  // V^mu: the two-volume ablation only
 layout(set = 0, binding = 20) uniform sampler3D mu_g;
 layout(set = 0, binding = 21) uniform sampler3D mu_b;
+layout(set = 0, binding = 22, rgba32ui) readonly uniform uimage2D dir_indirect;  // bit 8 only
 struct LevelConstants {
   vec4 shadow;  // x used map size / allocated size, y used size (texels), z allocated size,
                 // w PCF radius (taps each side of the centre)
@@ -174,6 +181,32 @@ void main() {
                                  : volume_irradiance(delta_r, delta_g, delta_b, p, n);
       l_rv += alb.rgb * e * (1.0f / MRGI_PI);
     }
+  }
+  if (kDirIndirect) {
+    int d = max(volume_mode.y, 1);
+    uint key = pack_indirect(vec3(0.0f), vec3(0.0f), n, max(distance(p, frame.camera_world.xyz), 1e-3f), is_virtual).w;
+    ivec2 low = (frame.internal_output_size.xy + d - 1) / d;
+    vec2 f = (vec2(pixel) + 0.5f) / float(d) - 0.5f;
+    ivec2 i0 = ivec2(floor(f));
+    vec2 t = f - vec2(i0);
+    vec3 sum_rv = vec3(0.0f), sum_r = vec3(0.0f), any_rv = vec3(0.0f), any_r = vec3(0.0f);
+    float w_sum = 0.0f;
+    for (int k = 0; k < 4; ++k) {
+      ivec2 o = ivec2(k & 1, k >> 1);
+      uvec4 tap = imageLoad(dir_indirect, clamp(i0 + o, ivec2(0), low - 1));
+      float w = (o.x == 1 ? t.x : 1.0f - t.x) * (o.y == 1 ? t.y : 1.0f - t.y);
+      vec3 rv = unpack_indirect_rv(tap), r = unpack_indirect_r(tap);
+      any_rv += w * rv;
+      any_r += w * r;
+      if (same_surface(key, tap.w)) {
+        sum_rv += w * rv;
+        sum_r += w * r;
+        w_sum += w;
+      }
+    }
+    bool matched = w_sum > 1e-6f;
+    l_rv += matched ? sum_rv / w_sum : any_rv;
+    l_r += r_p * (matched ? sum_r / w_sum : any_r);
   }
   // Half floats end at 65504: clamp so no Inf reaches compose.
   imageStore(lit_rv, pixel, vec4(clamp(sanitize(l_rv), vec3(0.0f), vec3(60000.0f)), 1.0f));

@@ -12,12 +12,12 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0, rgba32ui) readonly uniform uimage2D indirect;
 layout(set = 0, binding = 1, rgba32ui) writeonly uniform uimage2D rows;
-layout(push_constant) uniform Params { DirParams params_block; ivec4 size; };
+layout(push_constant) uniform Params { DirParams params_block; };
 DirParams params;
 
 void main() {
   params = params_block;  // MRGI_UNIFORM_COPIES
-  ivec2 extent = size.xy;
+  ivec2 extent = params.extent.xy;
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
   if (any(greaterThanEqual(pixel, extent))) return;
   uvec4 centre = imageLoad(indirect, pixel);

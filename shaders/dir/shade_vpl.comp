@@ -40,8 +40,11 @@ DirParams params;
 
 void main() {
   frame = frame_ubo; params = params_block;  // MRGI_UNIFORM_COPIES
-  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
-  if (any(greaterThanEqual(pixel, frame.internal_output_size.xy))) return;
+  // One texel per `extent.z` x `extent.z` G-buffer pixels (the fast levels shade the indirect
+  // light at half resolution; baseline's shading pass up-samples it, geometry-aware).
+  ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
+  if (any(greaterThanEqual(texel, params.extent.xy))) return;
+  ivec2 pixel = min(texel * params.extent.z, frame.internal_output_size.xy - 1);
   vec4 vpos = imageLoad(virtual_position, pixel);
   bool is_virtual = vpos.w > 0.5f;
   vec4 pos, nrm;
@@ -63,7 +66,7 @@ void main() {
   if (surface) {
     vec3 p = pos.xyz;
     int count = params.vpls.x, side = params.vpls.y, row = params.vpls.z, step = params.vpls.w * params.vpls.w;
-    int first = params.vpls.w > 1 ? (pixel.x % params.vpls.w) + params.vpls.w * (pixel.y % params.vpls.w) : 0;
+    int first = params.vpls.w > 1 ? (texel.x % params.vpls.w) + params.vpls.w * (texel.y % params.vpls.w) : 0;
     for (int j = first; j < count; j += step) {
       Vpl v = vpls[j];
       int flags = int(v.position.w);
@@ -93,5 +96,5 @@ void main() {
   uvec4 packed_value = pack_indirect(clamp(l_rv, vec3(0.0f), vec3(60000.0f)), clamp(l_r, vec3(0.0f), vec3(60000.0f)), n,
                                      camera_distance, is_virtual);
   if (!surface) packed_value.w = 0u;
-  imageStore(indirect, pixel, packed_value);
+  imageStore(indirect, texel, packed_value);
 }

@@ -60,6 +60,7 @@ class Baseline final : public Technique {
   Status init();
   Status record(const FrameInfo& info, std::vector<std::string>& skipped) override;
   void set_volume_bounce(const VolumeBounce* bounce) { bounce_ = bounce ? std::optional<VolumeBounce>(*bounce) : std::nullopt; }
+  void set_dir_indirect(const DirIndirect* indirect) { dir_ = indirect ? std::optional<DirIndirect>(*indirect) : std::nullopt; }
 
  private:
   void render_faces(VkCommandBuffer cmd, gpu::PassContext& pass, const std::vector<ShadowFace>& faces,
@@ -84,15 +85,18 @@ class Baseline final : public Technique {
   ImageViews views_;
   std::vector<VkImageView> primary_layer_views_, virtual_layer_views_;
   gpu::PipelineHandle grid_pipeline_, mesh_pipeline_, caster_indices_pipeline_;
-  static constexpr uint32_t kShadeModes[] = {0, 1, 3, 4, 6};
-  gpu::PipelineHandle shade_pipelines_[8];  // shade_direct.comp by kVolumeBounce (kShadeModes)
+  static constexpr uint32_t kShadeModes[] = {0, 1, 3, 4, 6, 8};
+  gpu::PipelineHandle shade_pipelines_[9];  // shade_direct.comp by kVolumeBounce (kShadeModes)
   const gpu::Pipeline& shade_pipeline() const {
+    if (dir_) return *shade_pipelines_[8];
     if (!bounce_) return *shade_pipelines_[0];
     const bool two = bounce_->constants.mode.x == 1, rho = bounce_->constants.extent.w > 0.5f;
     return *shade_pipelines_[(two ? 4u : 1u) | (rho ? 2u : 0u)];
   }
   gpu::ImageHandle no_volume_;                 // bound for the volumes when there is no bounce
   std::optional<VolumeBounce> bounce_;         // this frame's (set_volume_bounce)
+  gpu::ImageHandle no_indirect_;               // bound for dir_indirect when there is none
+  std::optional<DirIndirect> dir_;             // this frame's (set_dir_indirect)
   gpu::BufferHandle caster_indices_;  // this frame's real caster mesh (shadow_caster_indices.comp)
   bool real_caster_faces_ = false;     // some face of the plan draws the real casters
   VkImageLayout depth_write_layout_ = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
@@ -210,7 +214,8 @@ Status Baseline::init() {
   auto shade_spv = gpu::shader_spirv("baseline/shade_direct.comp");
   if (!shade_spv) return shade_spv.error();
   // Layouts from the shader; one pipeline per kVolumeBounce in use: 0 direct only, 1 V^Delta on
-  // real pixels, 3 and V^rho on virtual ones, 4 and 6 the two-volume ablation without and with.
+  // real pixels, 3 and V^rho on virtual ones, 4 and 6 the two-volume ablation without and with,
+  // 8 dir's VPL light.
   for (const uint32_t mode : kShadeModes) {
     auto sp = gpu::create_compute_pipeline(
         ctx, {"baseline_shade_direct_" + std::to_string(mode), *shade_spv, {}, sizeof(ShadePush), {mode}});
@@ -227,6 +232,16 @@ Status Baseline::init() {
   no_volume_ = *no_volume;
   const std::array<uint16_t, 2 * 2 * 2 * 4> zero{};  // defined contents, never read
   MRGI_TRY(graph.upload_image(no_volume_, zero.data(), sizeof zero));
+  gpu::ImageDesc ni;
+  ni.name = "baseline_no_indirect";
+  ni.format = VK_FORMAT_R32G32B32A32_UINT;
+  ni.size_mode = gpu::SizeMode::Absolute;
+  ni.width = ni.height = 1;
+  auto no_indirect = graph.create_image(ni, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
+  if (!no_indirect) return no_indirect.error();
+  no_indirect_ = *no_indirect;
+  const std::array<uint32_t, 4> none{};  // defined contents, never read
+  MRGI_TRY(graph.upload_image(no_indirect_, none.data(), sizeof none));
   return ok_status();
 }
 
@@ -302,6 +317,7 @@ Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped
           b.bind_sampled(names[i], set ? set[i % 3] : no_volume_, linear);
         }
         bind_shading_gbuffers(b, shared_);
+        b.bind("dir_indirect", dir_ ? dir_->merged : no_indirect_);
         b.bind("LightUbo", lights_);
         b.bind_sampled("shadow_primary", shadow_primary_, compare);
         b.bind_sampled("shadow_virtual", shadow_virtual_, compare);
@@ -407,6 +423,7 @@ void Baseline::shade(VkCommandBuffer cmd, gpu::PassContext& pass) {
   pc.shadow = glm::vec4(float(shadow_size_) / float(kTopShadowSize), float(shadow_size_),
                         float(kTopShadowSize), float(pcf_radius_));
   if (bounce_) pc.volume = bounce_->constants;
+  if (dir_) pc.volume.mode.y = dir_->divisor;
   const VkExtent2D e = pass.extent(r.lit_rv);
   gpu::dispatch_2d(cmd, shade_pipeline(), &pc, sizeof(pc), e.width, e.height);
 }
@@ -415,6 +432,10 @@ void Baseline::shade(VkCommandBuffer cmd, gpu::PassContext& pass) {
 
 void set_volume_bounce(Technique& baseline, const VolumeBounce* bounce) {
   if (auto* b = dynamic_cast<Baseline*>(&baseline)) b->set_volume_bounce(bounce);
+}
+
+void set_dir_indirect(Technique& baseline, const DirIndirect* indirect) {
+  if (auto* b = dynamic_cast<Baseline*>(&baseline)) b->set_dir_indirect(indirect);
 }
 
 const std::array<BaselineLevel, 4>& baseline_levels() {

@@ -62,6 +62,16 @@ struct VolumeBounce {
 // For the next record() of `baseline` (a technique made by create_baseline; others ignore it);
 // nullptr: none. The images must be written by passes recorded before that record().
 void set_volume_bounce(Technique& baseline, const VolumeBounce* bounce);
+
+// dir's merged VPL light (technique/dir, shaders/dir/indirect_pack.glsl), added to both
+// solutions in baseline's shading pass (shade_direct.comp kVolumeBounce bit 8), up-sampled from
+// `divisor` x `divisor` G-buffer pixels a texel. Exclusive with a VolumeBounce.
+struct DirIndirect {
+  gpu::ImageHandle merged;  // RGBA32UI
+  int divisor = 1;
+};
+// As set_volume_bounce: for the next record(); nullptr: none.
+void set_dir_indirect(Technique& baseline, const DirIndirect* indirect);
 Expected<std::unique_ptr<Technique>> create_baseline(const SharedResources& shared);
 
 }  // namespace mrgi::technique

@@ -17,11 +17,11 @@ namespace mrgi::technique {
 
 const std::array<DirLevel, 5>& dir_levels() {
   static const std::array<DirLevel, 5> levels = {{
-      {"paper", 256, 128, 1024, 512, 4, 4, 1.0f, 0},
-      {"high", 256, 64, 512, 256, 4, 4, 1.0f, 1},
-      {"medium", 64, 64, 512, 256, 2, 4, 1.0f, 1},
-      {"fast", 32, 32, 256, 128, 1, 4, 0.5f, 3},
-      {"fastest", 16, 32, 128, 64, 1, 4, 0.5f, 3},
+      {"paper", 256, 128, 1024, 512, 4, 4, 1, 1.0f, 0},
+      {"high", 256, 64, 512, 256, 4, 4, 1, 1.0f, 1},
+      {"medium", 64, 64, 512, 256, 2, 4, 1, 1.0f, 1},
+      {"fast", 32, 32, 256, 128, 1, 4, 2, 0.5f, 3},
+      {"fastest", 16, 32, 128, 64, 1, 4, 2, 0.5f, 3},
   }};
   return levels;
 }
@@ -38,6 +38,7 @@ std::vector<QualityLevel> dir_ladder() {
                {"rsm_size", double(l.rsm_size), "texels per side of each reflective shadow map"},
                {"rsm_lamps", double(l.rsm_lamps), "lamps, strongest first, whose maps spawn VPLs"},
                {"interleave", double(l.interleave), "side of the interleaved-sampling block (pixels)"},
+               {"indirect_divisor", double(l.indirect_divisor), "G-buffer pixels per side of an indirect-light texel"},
                {"internal_scale", double(l.internal_scale), "fraction of the output width and height"},
                {"baseline_level", double(l.baseline_level), "baseline's level for the direct light"}};
     out.push_back(q);
@@ -51,11 +52,7 @@ namespace {
 struct DirPush {
   glm::ivec4 vpls;
   glm::vec4 lighting;
-};
-// merge_rows.comp / merge_columns.comp: DirParams and the internal size.
-struct MergePush {
-  DirPush params;
-  glm::ivec4 size;
+  glm::ivec4 extent;
 };
 
 // The sphere the maps are fitted to: twice the virtual objects' largest bounding-box edge across
@@ -80,7 +77,7 @@ class Dir final : public Technique {
   std::optional<gi::ReflectiveShadowMaps> rsm_;
   std::optional<gi::VplSampler> vpls_;
   std::optional<gi::ImperfectShadowMaps> ism_;
-  gpu::ImageHandle indirect_, rows_;  // RGBA32UI, shaders/dir/indirect_pack.glsl
+  gpu::ImageHandle indirect_, rows_, merged_;  // RGBA32UI, shaders/dir/indirect_pack.glsl
   gpu::PipelineHandle shade_, merge_rows_, merge_columns_;
   std::unique_ptr<Technique> baseline_;
   // This frame's lamps with VPLs (light index, view); reserved at init (no allocation per frame).
@@ -141,6 +138,9 @@ Status Dir::init() {
   auto rows = image("dir indirect rows");
   if (!rows) return rows.error();
   rows_ = *rows;
+  auto merged = image("dir indirect merged");
+  if (!merged) return merged.error();
+  merged_ = *merged;
   for (auto [shader, out] : {std::pair{"dir/shade_vpl.comp", &shade_}, std::pair{"dir/merge_rows.comp", &merge_rows_},
                              std::pair{"dir/merge_columns.comp", &merge_columns_}}) {
     auto p = gpu::load_compute_pipeline(graph.context(), shader, {});
@@ -164,6 +164,7 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
                     "(issue 15); the environment lights directly through baseline's regions and ambient");
   FrameInfo base = info;
   base.level = level.baseline_level;
+  set_dir_indirect(*baseline_, nullptr);
   planned_.clear();
   if (!has_virtual_) {
     skipped.push_back("dir VPLs: no virtual object in the scene (the bounce is the same in both solutions)");
@@ -211,13 +212,16 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   // A VPL stands for the light of the map's area over the VPL count, (2 radius)^2 / vpls: its
   // 1 / d^2 is clamped at that disk's radius.
   const float clamp_m = 2.0f * radius_ / std::sqrt(float(M_PI) * float(level.vpls));
+  for (gpu::ImageHandle h : {indirect_, rows_, merged_}) MRGI_TRY(graph.set_extent_divisor(h, level.indirect_divisor));
+  const VkExtent2D low = graph.extent(indirect_);
   const DirPush push{glm::ivec4(int(level.vpls), int(level.ism_size), int(ism_->tiles_per_row(level.vpls)),
                                 int(level.interleave)),
-                     glm::vec4(clamp_m, kIsmBiasRelative, kIsmBiasMetres, 0.0f)};
+                     glm::vec4(clamp_m, kIsmBiasRelative, kIsmBiasMetres, 0.0f),
+                     glm::ivec4(int(low.width), int(low.height), int(level.indirect_divisor), 0)};
   const SharedResources& r = shared_;
   const gpu::Pipeline* shade = &*shade_;
   const gpu::BufferHandle vpl_buffer = vpls_->buffer();
-  const gpu::ImageHandle distances = ism_->distances(), indirect = indirect_, rows = rows_;
+  const gpu::ImageHandle distances = ism_->distances(), indirect = indirect_, rows = rows_, merged = merged_;
   graph.add_shader_pass(
       "dir shade vpls", gpu::PassKind::Compute, *shade_,
       [&](gpu::ShaderPassBuilder& b) {
@@ -232,11 +236,9 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
         b.bind("ism_distances", distances, 0);
         b.bind("indirect", indirect);
       },
-      [shade, push, indirect](VkCommandBuffer cmd, gpu::PassContext& p) {
-        const VkExtent2D e = p.extent(indirect);
-        gpu::dispatch_2d(cmd, *shade, &push, sizeof push, e.width, e.height);
+      [shade, push, low](VkCommandBuffer cmd, gpu::PassContext&) {
+        gpu::dispatch_2d(cmd, *shade, &push, sizeof push, low.width, low.height);
       });
-  MRGI_TRY(baseline_->record(base, skipped));
   const gpu::Pipeline* merge_rows = &*merge_rows_;
   graph.add_shader_pass(
       "dir merge rows", gpu::PassKind::Compute, *merge_rows_,
@@ -244,24 +246,22 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
         b.bind("indirect", indirect);
         b.bind("rows", rows);
       },
-      [merge_rows, push, rows](VkCommandBuffer cmd, gpu::PassContext& p) {
-        const VkExtent2D e = p.extent(rows);
-        const MergePush m{push, glm::ivec4(int(e.width), int(e.height), 0, 0)};
-        gpu::dispatch_2d(cmd, *merge_rows, &m, sizeof m, e.width, e.height);
+      [merge_rows, push, low](VkCommandBuffer cmd, gpu::PassContext&) {
+        gpu::dispatch_2d(cmd, *merge_rows, &push, sizeof push, low.width, low.height);
       });
   const gpu::Pipeline* merge_columns = &*merge_columns_;
   graph.add_shader_pass(
       "dir merge columns", gpu::PassKind::Compute, *merge_columns_,
       [&](gpu::ShaderPassBuilder& b) {
         b.bind("rows", rows);
-        b.bind_over("lit_rv", r.lit_rv);
-        b.bind_over("lit_r", r.lit_r);
+        b.bind("merged", merged);
       },
-      [merge_columns, push, lit = r.lit_rv](VkCommandBuffer cmd, gpu::PassContext& p) {
-        const VkExtent2D e = p.extent(lit);
-        const MergePush m{push, glm::ivec4(int(e.width), int(e.height), 0, 0)};
-        gpu::dispatch_2d(cmd, *merge_columns, &m, sizeof m, e.width, e.height);
+      [merge_columns, push, low](VkCommandBuffer cmd, gpu::PassContext&) {
+        gpu::dispatch_2d(cmd, *merge_columns, &push, sizeof push, low.width, low.height);
       });
+  const DirIndirect to_add{merged_, int(level.indirect_divisor)};
+  set_dir_indirect(*baseline_, &to_add);
+  return baseline_->record(base, skipped);
   return ok_status();
 }
 

@@ -5,16 +5,19 @@
 // (gi/vpl.h, Sec. 3.7); each VPL gets a real and a virtual imperfect shadow map (gi/ism.h,
 // Sec. 3.3); one pass shades every pixel's share of the VPLs into both solutions with the flags
 // (shaders/dir/shade_vpl.comp, eq. 6-8), interleaved 4x4 and merged geometry-aware
-// (shaders/dir/merge_rows.comp, merge_columns.comp: separable). Direct light is baseline's at the level's baseline level: the same
+// (shaders/dir/merge_rows.comp, merge_columns.comp: separable); baseline's shading pass adds it
+// to both solutions with its direct light, at the level's baseline level: the same
 // real/virtual shadow-map pair per lamp, eq. 1-5.
 //
 // Quality ladder (best first; DirLevel below, with units):
-//   level    VPLs  ISM    points/VPL  RSM    RSM lamps  interleave  internal scale  baseline
-//   paper    256   128^2  1024        512^2  4          4x4         1.0             high
-//   high     256    64^2   512        256^2  4          4x4         1.0             medium
-//   medium    64    64^2   512        256^2  2          4x4         1.0             medium
-//   fast      32    32^2   256        128^2  1          4x4         0.5             lowest
-//   fastest   16    32^2   128         64^2  1          4x4         0.5             lowest
+//   level    VPLs  ISM    points/VPL  RSM    RSM lamps  interleave  indirect  internal scale  baseline
+//   paper    256   128^2  1024        512^2  4          4x4         1         1.0             high
+//   high     256    64^2   512        256^2  4          4x4         1         1.0             medium
+//   medium    64    64^2   512        256^2  2          4x4         1         1.0             medium
+//   fast      32    32^2   256        128^2  1          4x4         1/2       0.5             lowest
+//   fastest   16    32^2   128         64^2  1          4x4         1/2       0.5             lowest
+// "indirect": the VPL light is shaded at this fraction of the internal resolution and
+// up-sampled geometry-aware in baseline's shading pass (the fast path).
 // "paper" is the paper's settings (Sec. 6: 256 VPLs, 128^2 ISMs, 1024 points a VPL, 4x4 split).
 //
 // Where mrgi differs from the paper and why:
@@ -52,6 +55,7 @@ struct DirLevel {
   uint32_t rsm_size;        // texels per side of each reflective shadow map
   uint32_t rsm_lamps;       // lamps (strongest first) whose maps spawn VPLs; the slots split evenly
   uint32_t interleave;      // side of the interleaving block (4: 4x4, 1: every pixel every VPL)
+  uint32_t indirect_divisor;  // G-buffer pixels per side of an indirect-light texel (1, 2, 4)
   float internal_scale;     // fraction of the output width and height
   int baseline_level;       // baseline's level for the direct light
 };
