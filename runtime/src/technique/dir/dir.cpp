@@ -18,7 +18,7 @@ namespace mrgi::technique {
 const std::array<DirLevel, 5>& dir_levels() {
   static const std::array<DirLevel, 5> levels = {{
       {"paper", 256, 128, 1024, 512, 4, 4, 1, 1.0f, 0},
-      {"high", 256, 64, 512, 256, 4, 4, 1, 1.0f, 1},
+      {"high", 256, 64, 512, 256, 4, 4, 1, 1.0f, 0},
       {"medium", 64, 64, 512, 256, 2, 4, 1, 1.0f, 1},
       {"fast", 32, 32, 256, 128, 1, 4, 2, 0.5f, 3},
       {"fastest", 16, 32, 128, 64, 1, 4, 2, 0.5f, 3},

@@ -12,7 +12,7 @@
 // Quality ladder (best first; DirLevel below, with units):
 //   level    VPLs  ISM    points/VPL  RSM    RSM lamps  interleave  indirect  internal scale  baseline
 //   paper    256   128^2  1024        512^2  4          4x4         1         1.0             high
-//   high     256    64^2   512        256^2  4          4x4         1         1.0             medium
+//   high     256    64^2   512        256^2  4          4x4         1         1.0             high
 //   medium    64    64^2   512        256^2  2          4x4         1         1.0             medium
 //   fast      32    32^2   256        128^2  1          4x4         1/2       0.5             lowest
 //   fastest   16    32^2   128         64^2  1          4x4         1/2       0.5             lowest
