@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -112,13 +113,95 @@ TEST(Dir, EveryLevelRunsAndItsVplsLightTheObjectBeyondBaseline) {
   }
 }
 
+// The skip of issue 15 (technique/input_reuse.h): identical frames reuse the VPLs and ISMs and
+// give the recomputed frame's output bit for bit; a depth frame 1.8 mm off everywhere (within the
+// 2 mm tolerance) is reused too and stays within a few 8-bit levels of a runtime that
+// recomputes it; 1 cm of depth or 5 cm of camera motion recompute. Validation on.
+TEST(Dir, VplsAndIsmsAreReusedOnlyWhileTheInputsStayWithinTolerance) {
+  mrgi::testing::TempDir dir;
+  const SyntheticScene scene = SyntheticScene::create(dir.str());
+  auto make = [&]() {
+    RuntimeSettings s;
+    s.device.validate = true;
+    s.technique = "dir";
+    s.level = 2;
+    s.frames_in_flight = 1;  // each process() returns the previous frame: outputs in order
+    return create_runtime(s, scene.cameras(), scene.scene);
+  };
+  auto shifted_depth = [&](int64_t index, int units) {
+    InputFrame f = scene.frame(index);
+    for (uint16_t& d : f.depth.data)
+      if (d != 0) d = uint16_t(int(d) + units);
+    return f;
+  };
+  InputFrame moved = scene.frame(4);
+  moved.pose->translation.x += 0.05;
+  const int mm = int(scene.depth_scale / 1000.0);
+  const std::vector<InputFrame> frames = {scene.frame(0), scene.frame(1), shifted_depth(2, 9 * mm / 5),
+                                          shifted_depth(3, 10 * mm), moved};
+  auto run_all = [](Runtime& rt, const std::vector<InputFrame>& in, std::vector<FrameOutput>& out) {
+    for (const InputFrame& f : in) {
+      auto o = rt.process(f);
+      ASSERT_TRUE(o.ok()) << o.error().message;
+      for (auto& x : *o) out.push_back(std::move(x));
+    }
+    auto rest = rt.flush();
+    ASSERT_TRUE(rest.ok()) << rest.error().message;
+    for (auto& x : *rest) out.push_back(std::move(x));
+  };
+  auto rt = make();
+  ASSERT_TRUE(rt.ok()) << rt.error().message;
+  std::vector<FrameOutput> outs;
+  run_all(**rt, frames, outs);
+  if (HasFatalFailure()) return;
+  ASSERT_EQ(outs.size(), frames.size());
+  auto reused = [](const FrameOutput& o) {
+    for (const std::string& k : o.stats.skipped)
+      if (k.rfind("dir maps, VPLs and ISMs: reused", 0) == 0) return true;
+    return false;
+  };
+  const bool want[] = {false, true, true, false, false};
+  for (size_t i = 0; i < outs.size(); ++i) EXPECT_EQ(reused(outs[i]), want[i]) << "frame " << i;
+  EXPECT_TRUE(outs[1].image.data == outs[0].image.data) << "a reused frame differs from the recomputed one";
+  auto fresh = make();
+  ASSERT_TRUE(fresh.ok()) << fresh.error().message;
+  std::vector<FrameOutput> recomputed;
+  run_all(**fresh, {frames[2]}, recomputed);
+  if (HasFatalFailure()) return;
+  ASSERT_EQ(recomputed.size(), 1u);
+  EXPECT_FALSE(reused(recomputed[0]));
+  int worst = 0;
+  for (size_t k = 0; k < recomputed[0].image.data.size(); ++k)
+    worst = std::max(worst, std::abs(int(recomputed[0].image.data[k]) - int(outs[2].image.data[k])));
+  std::printf("dir reuse at 1.8 mm of depth change: largest change %d / 255\n", worst);
+  EXPECT_LE(worst, 4) << "reuse within tolerance moved a pixel by more than 4/255";
+}
+
+// A spot whose cone misses the virtual objects draws R^mu only (issue 15's skip) and says so.
+TEST(Dir, ASpotMissingTheObjectsDrawsNoVirtualMap) {
+  mrgi::testing::TempDir dir;
+  SyntheticScene scene = SyntheticScene::create(dir.str());
+  // Straight down from (-1.2, 1.2, 0), a 10 degree cone: both virtual boxes lie 50+ degrees off.
+  for (LightDesc* l : {&scene.lamp, &scene.scene.lights[0]}) {
+    l->direction = glm::vec3(0.0f, -1.0f, 0.0f);
+    l->inner_angle_deg = 8.0f;
+    l->outer_angle_deg = 10.0f;
+  }
+  const std::vector<FrameOutput> outs = run(scene, "dir", 3, 2, true);
+  ASSERT_EQ(outs.size(), 2u);
+  bool note = false;  // on the first frame (the second reuses its maps)
+  for (const std::string& k : outs.front().stats.skipped) note |= k.find("no virtual object in the lamp's cone") != std::string::npos;
+  EXPECT_TRUE(note);
+}
+
 // Stress (issue 15): 1,000 frames at the fast level for a lamp at 1e6, a point lamp inside the
 // virtual object (no map can hold it: skipped and said, the frame still lit directly), a black
 // object (its map covers texels but reflects nothing: no VPL from the virtual map) and a spot
-// cone so narrow that its map is lit in a few texels (every VPL drawn from them). VPLs and ISMs
-// are rebuilt every frame, so nothing may accumulate: frames of the same input are equal bit for
-// bit once the reconstruction's filter has settled (the last against the 100th from last), and
-// the mean light of the last frames is within 1 % of frames 8-9's.
+// cone so narrow that its map is lit in a few texels (every VPL drawn from them). The depth
+// alternates by 1 cm (beyond the reuse tolerance), so VPLs and ISMs are rebuilt every frame and
+// nothing may accumulate: frames of the same input are equal bit for bit once the
+// reconstruction's filter has settled (the last against the 100th from last), and the mean
+// light of the last frames is within 1 % of frames 8-9's.
 struct StressVariant {
   const char* name;
   glm::vec3 base;
@@ -158,21 +241,26 @@ TEST_P(DirStress, ThousandFramesStayFiniteAndDoNotGrow) {
   s.level = 3;
   auto rt = create_runtime(s, scene.cameras(), scene.scene);
   ASSERT_TRUE(rt.ok()) << rt.error().message;
-  const InputFrame frame = scene.frame(0);
+  InputFrame frames[2] = {scene.frame(0), scene.frame(1)};
+  for (uint16_t& d : frames[1].depth.data)
+    if (d != 0) d = uint16_t(d + uint16_t(scene.depth_scale / 100.0));
   constexpr int n = 1000;
   std::vector<FrameOutput> kept(n);
   int seen = 0;
-  bool inside_note = false;
+  bool inside_note = false, reused = false;
   auto take = [&](std::vector<FrameOutput>& outs) {
     for (FrameOutput& o : outs) {
-      for (const std::string& note : o.stats.skipped) inside_note |= note.find("inside its sphere") != std::string::npos;
+      for (const std::string& note : o.stats.skipped) {
+        inside_note |= note.find("inside its sphere") != std::string::npos;
+        reused |= note.rfind("dir maps, VPLs and ISMs: reused", 0) == 0;
+      }
       const int64_t k = o.stats.frame_index;
       if (k >= 0 && k < n && (k < 10 || k >= n - 102)) kept[size_t(k)] = std::move(o);
       ++seen;
     }
   };
   for (int k = 0; k < n; ++k) {
-    InputFrame f = frame;
+    InputFrame f = frames[k % 2];
     f.index = k;
     auto o = (*rt)->process(f);
     ASSERT_TRUE(o.ok()) << "frame " << k << ": " << o.error().message;
@@ -182,6 +270,7 @@ TEST_P(DirStress, ThousandFramesStayFiniteAndDoNotGrow) {
   ASSERT_TRUE(rest.ok()) << rest.error().message;
   take(*rest);
   ASSERT_EQ(seen, n);
+  EXPECT_FALSE(reused) << "every frame must rebuild its VPLs and ISMs here";
   EXPECT_EQ(inside_note, GetParam() == 1) << "the point lamp inside the object is said to be skipped";
   for (int k = n - 2; k < n; ++k)
     EXPECT_TRUE(kept[size_t(k)].image.data == kept[size_t(k - 100)].image.data)

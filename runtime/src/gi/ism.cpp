@@ -43,9 +43,10 @@ Expected<ImperfectShadowMaps> ImperfectShadowMaps::create(gpu::FrameGraph& graph
   m.scene_ = &scene;
   m.real_position_ = real_position;
   const uint32_t atlas = m.tiles_per_row(s.max_vpls) * s.map_size;
-  auto image = [&](const std::string& what, VkFormat format, uint32_t levels) {
+  auto image = [&](const std::string& what, VkFormat format, uint32_t levels, bool history = false) {
     gpu::ImageDesc d;
     d.name = s.name + " " + what;
+    d.history = history;
     d.format = format;
     d.size_mode = gpu::SizeMode::Absolute;
     d.width = d.height = atlas;
@@ -59,7 +60,7 @@ Expected<ImperfectShadowMaps> ImperfectShadowMaps::create(gpu::FrameGraph& graph
   auto sv = image("splat virtual", VK_FORMAT_R32_UINT, 1);
   if (!sv) return sv.error();
   m.splat_virtual_ = *sv;
-  auto dist = image("distances", VK_FORMAT_R32G32_SFLOAT, kPullLevels + 1);
+  auto dist = image("distances", VK_FORMAT_R32G32_SFLOAT, kPullLevels + 1, s.history);
   if (!dist) return dist.error();
   m.distances_ = *dist;
 

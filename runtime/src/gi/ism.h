@@ -24,6 +24,9 @@ struct IsmSettings {
   std::string name = "ism";
   uint32_t max_vpls = 256;  // VPL slots (the VPL buffer's), 1..4096
   uint32_t map_size = 128;  // texels per side of one VPL's map, a power of two, 8..512
+  // The maps keep their contents between frames (gpu::ImageDesc::history): a frame that does not
+  // build them reads what the last one left (dir reuses its ISMs while nothing moved).
+  bool history = false;
 };
 
 // What one frame's maps are made of.

@@ -194,6 +194,23 @@ RsmImages ReflectiveShadowMaps::images(RsmMap map, uint32_t size) const {
   return {m.position, m.normal, m.flux, std::min(size, settings_.size), std::min(size, settings_.size)};
 }
 
+bool lamp_reaches_sphere(const LightDesc& lamp, const glm::vec3& centre, float radius) {
+  if (lamp.type != LightType::Spot) return true;
+  const glm::vec3 to = centre - lamp.position;
+  const float d = glm::length(to);
+  if (d <= radius) return true;
+  const float axis_len = glm::length(lamp.direction);
+  if (!(axis_len > 0.0f)) return true;
+  // The sphere meets the cone when its centre is within the cone's half-angle plus the angle the
+  // sphere subtends from the apex.
+  const float angle = std::acos(std::clamp(glm::dot(to / d, lamp.direction / axis_len), -1.0f, 1.0f));
+  return angle <= glm::radians(std::clamp(lamp.outer_angle_deg, 0.0f, 180.0f)) + std::asin(radius / d);
+}
+
+void ReflectiveShadowMaps::add_real(gpu::FrameGraph& graph, const std::string& id, const RsmView& view, uint32_t size) {
+  add_map_draw(graph, "mu " + id, view, maps_[1], std::min(size, settings_.size), true, false);
+}
+
 void ReflectiveShadowMaps::add_pair(gpu::FrameGraph& graph, const std::string& id, const RsmView& view,
                                     uint32_t size) {
   const uint32_t s = std::min(size, settings_.size);

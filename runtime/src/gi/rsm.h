@@ -48,6 +48,10 @@ struct RsmView {
 // leaves in every direction, which one perspective map cannot hold).
 Expected<RsmView> rsm_view(const LightDesc& lamp, const glm::vec3& centre, float radius, uint32_t size);
 
+// Whether the lamp's light can reach the sphere: false only for a spot lamp whose outer cone
+// misses it (its light then meets no virtual object in it).
+bool lamp_reaches_sphere(const LightDesc& lamp, const glm::vec3& centre, float radius);
+
 enum class RsmMap : uint8_t { WithVirtual, RealOnly };
 
 class ReflectiveShadowMaps {
@@ -63,6 +67,9 @@ class ReflectiveShadowMaps {
   // both maps (a delta injection leaves them out: LightPropagationVolume::add_inject's `other`).
   // Passes "<name> mu <id>", "<name> rho copy <id>", "<name> rho <id>".
   void add_pair(gpu::FrameGraph& graph, const std::string& id, const RsmView& view, uint32_t size);
+  // R^mu alone (pass "<name> mu <id>"), for a lamp whose light reaches no virtual object
+  // (sees_sphere): R^rho would be its copy; read R^mu as both.
+  void add_real(gpu::FrameGraph& graph, const std::string& id, const RsmView& view, uint32_t size);
   // The map as the injection reads it.
   RsmImages images(RsmMap map, uint32_t size) const;
   uint32_t allocated_size() const { return settings_.size; }

@@ -32,7 +32,9 @@ Expected<VplSampler> VplSampler::create(gpu::FrameGraph& graph, const VplSetting
   auto pyramid = graph.create_image(d, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT);
   if (!pyramid) return pyramid.error();
   v.pyramid_ = *pyramid;
-  auto buffer = graph.create_buffer({s.name + " slots", VkDeviceSize(s.max_vpls) * sizeof(shader::Vpl)},
+  gpu::BufferDesc bd{s.name + " slots", VkDeviceSize(s.max_vpls) * sizeof(shader::Vpl)};
+  bd.history = s.history;
+  auto buffer = graph.create_buffer(bd,
                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
                                         VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
   if (!buffer) return buffer.error();

@@ -25,6 +25,9 @@ struct VplSettings {
   std::string name = "vpl";  // prefix of the resources' and passes' names
   uint32_t max_vpls = 256;   // VPL slots allocated (the largest level's count), 1..4096
   uint32_t map_size = 512;   // largest map side sampled (texels), a power of two, 16..4096
+  // The slots keep their contents between frames (gpu::BufferDesc::history): a frame that does
+  // not sample reads what the last one left (dir reuses its VPLs while nothing moved).
+  bool history = false;
 };
 
 class VplSampler {

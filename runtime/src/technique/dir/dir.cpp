@@ -11,6 +11,7 @@
 #include "gpu/pipelines.h"
 #include "light/light_stage.h"
 #include "technique/baseline/baseline.h"
+#include "technique/input_reuse.h"
 #include "technique/scene_gpu.h"
 
 namespace mrgi::technique {
@@ -82,6 +83,14 @@ class Dir final : public Technique {
   std::unique_ptr<Technique> baseline_;
   // This frame's lamps with VPLs (light index, view); reserved at init (no allocation per frame).
   std::vector<std::pair<size_t, gi::RsmView>> planned_;
+  InputReuse reuse_;  // what the VPLs and ISMs in the buffers were made from
+  // Whether the lamp's light reaches a virtual object: the bounding sphere of some mesh range.
+  bool lamp_reaches_objects(const LightDesc& lamp) const {
+    for (const DrawRange& d : shared_.scene_gpu->virtual_objects.draws)
+      if (gi::lamp_reaches_sphere(lamp, 0.5f * (d.bounds_min + d.bounds_max), 0.5f * glm::length(d.bounds_max - d.bounds_min)))
+        return true;
+    return false;
+  }
   bool has_virtual_ = false;
   glm::vec3 centre_{0.0f};
   float radius_ = 1.0f;
@@ -115,6 +124,7 @@ Status Dir::init() {
     vs.name = "dir vpl";
     vs.max_vpls = top_vpls;
     vs.map_size = top_rsm;
+    vs.history = true;  // reused while nothing moved (InputReuse)
     auto vpls = gi::VplSampler::create(graph, vs);
     if (!vpls) return vpls.error();
     vpls_.emplace(std::move(*vpls));
@@ -122,6 +132,7 @@ Status Dir::init() {
     is.name = "dir ism";
     is.max_vpls = top_vpls;
     is.map_size = top_ism;
+    is.history = true;
     auto ism = gi::ImperfectShadowMaps::create(graph, sg, shared_.real_position, is);
     if (!ism) return ism.error();
     ism_.emplace(std::move(*ism));
@@ -147,6 +158,7 @@ Status Dir::init() {
     if (!p) return p.error();
     *out = std::move(*p);
   }
+  reuse_.reserve(size_t(shared_.depth_intrinsics.width) * size_t(shared_.depth_intrinsics.height), shared_.depth_scale);
   auto base = create_baseline(shared_);
   if (!base) return base.error();
   baseline_ = std::move(*base);
@@ -168,6 +180,7 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   planned_.clear();
   if (!has_virtual_) {
     skipped.push_back("dir VPLs: no virtual object in the scene (the bounce is the same in both solutions)");
+    reuse_.forget();
     return baseline_->record(base, skipped);
   }
   for (size_t i = 0; i < lighting.lights.size() && planned_.size() < level.rsm_lamps; ++i) {
@@ -180,34 +193,51 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   }
   if (planned_.empty()) {
     skipped.push_back("dir VPLs: no light a map can see the virtual objects from");
+    reuse_.forget();
     return baseline_->record(base, skipped);
   }
-  // The real grid at about two points a map texel across the G-buffer's larger side (dlpv's rule).
-  const VkExtent2D g = graph.extent(shared_.real_position);
-  const uint32_t stride = std::max(1u, uint32_t(std::ceil(double(std::max(g.width, g.height)) / (level.rsm_size / 2.0))));
-  vpls_->add_clear(graph);
-  rsm_->add_grid(graph, stride);
-  const uint32_t lamps = uint32_t(planned_.size());
-  uint32_t first = 0;
-  for (uint32_t k = 0; k < lamps; ++k) {
-    const auto& [i, view] = planned_[k];
-    const uint32_t count = level.vpls / lamps + (k < level.vpls % lamps ? 1 : 0);
-    const std::string id = std::to_string(i);
-    rsm_->add_pair(graph, id, view, level.rsm_size);
-    MRGI_TRY(vpls_->add_sample(graph, id, rsm_->images(gi::RsmMap::WithVirtual, level.rsm_size),
-                               rsm_->images(gi::RsmMap::RealOnly, level.rsm_size), lighting.lights[i].real, first, count));
-    first += count;
+  // The VPLs and ISMs in the buffers stand for this frame's while its inputs stay within
+  // tolerance of the frame that made them (technique/input_reuse.h): no map, VPL or ISM pass.
+  reuse_.set_frame(info.level, info.camera_to_world, info.input);
+  for (const auto& [i, view] : planned_) reuse_.add_lamp(lighting.lights[i]);
+  if (reuse_.close()) {
+    skipped.push_back("dir maps, VPLs and ISMs: reused (level, pose, depth and lamps within tolerance of the frame that made them)");
+  } else {
+    // The real grid at about two points a map texel across the G-buffer's larger side (dlpv's rule).
+    const VkExtent2D g = graph.extent(shared_.real_position);
+    const uint32_t stride = std::max(1u, uint32_t(std::ceil(double(std::max(g.width, g.height)) / (level.rsm_size / 2.0))));
+    vpls_->add_clear(graph);
+    rsm_->add_grid(graph, stride);
+    const uint32_t lamps = uint32_t(planned_.size());
+    uint32_t first = 0;
+    for (uint32_t k = 0; k < lamps; ++k) {
+      const auto& [i, view] = planned_[k];
+      const uint32_t count = level.vpls / lamps + (k < level.vpls % lamps ? 1 : 0);
+      const std::string id = std::to_string(i);
+      const gi::RsmImages mu = rsm_->images(gi::RsmMap::RealOnly, level.rsm_size);
+      if (lamp_reaches_objects(lighting.lights[i])) {
+        rsm_->add_pair(graph, id, view, level.rsm_size);
+        MRGI_TRY(vpls_->add_sample(graph, id, rsm_->images(gi::RsmMap::WithVirtual, level.rsm_size), mu,
+                                   lighting.lights[i].real, first, count));
+      } else {
+        // The spot's cone misses the virtual objects: R^rho would be R^mu's copy (issue 15's skip).
+        skipped.push_back("dir rsm rho " + id + ": no virtual object in the lamp's cone (R^mu stands for both maps)");
+        rsm_->add_real(graph, id, view, level.rsm_size);
+        MRGI_TRY(vpls_->add_sample(graph, id, mu, mu, lighting.lights[i].real, first, count));
+      }
+      first += count;
+    }
+    // The G-buffer's focal lengths in its own pixels (the colour camera's, scaled to its size).
+    const Intrinsics& c = shared_.color_intrinsics;
+    gi::IsmFrame f;
+    f.vpls = level.vpls;
+    f.map_size = level.ism_size;
+    f.points_per_vpl = level.points_per_vpl;
+    f.focal_px = glm::vec2(float(c.fx * double(g.width) / double(std::max(1, c.width))),
+                           float(c.fy * double(g.height) / double(std::max(1, c.height))));
+    MRGI_TRY(ism_->add_build(graph, vpls_->buffer(), f));
+    reuse_.remember();
   }
-  // The G-buffer's focal lengths in its own pixels (the colour camera's, scaled to its size).
-  const Intrinsics& c = shared_.color_intrinsics;
-  const glm::vec2 focal(float(c.fx * double(g.width) / double(std::max(1, c.width))),
-                        float(c.fy * double(g.height) / double(std::max(1, c.height))));
-  gi::IsmFrame f;
-  f.vpls = level.vpls;
-  f.map_size = level.ism_size;
-  f.points_per_vpl = level.points_per_vpl;
-  f.focal_px = focal;
-  MRGI_TRY(ism_->add_build(graph, vpls_->buffer(), f));
 
   // A VPL stands for the light of the map's area over the VPL count, (2 radius)^2 / vpls: its
   // 1 / d^2 is clamped at that disk's radius.

@@ -37,7 +37,19 @@
 //     over the VPL count): the paper does not say how it bounds it;
 //   - not yet built (they say so in FrameStats::skipped): VPLs of the environment on a hemisphere
 //     (the environment lights directly through baseline's shadowed regions and SH ambient),
-//     multiple bounces, glossy VPLs, temporal smoothing, the skips of the issue.
+//     multiple bounces, glossy VPLs, temporal smoothing, the ablation switches.
+//
+// Skips (each in FrameStats::skipped):
+//   - no virtual object, or no lamp a map can see them from: no maps, VPLs or ISMs (baseline only);
+//   - a spot lamp whose outer cone misses every virtual mesh range's bounding sphere: R^mu only,
+//     read as both maps (R^rho would be its copy);
+//   - the maps, VPLs and ISMs are reused, none drawn, sampled or splatted, while the level, the
+//     camera pose, the depth frame and the lamps stay within technique/input_reuse.h's
+//     tolerances of the frame that made them (the virtual objects are static: their pose joins
+//     the comparison with dynamic scenes); a reused frame stays within 4/255 of the recomputed
+//     one at 1.8 mm of depth change (tests/technique/dir_test.cpp: 3/255 measured).
+// The ISMs' virtual maps are splatted whenever the maps are made: a virtual object outside every
+// lamp's cone still blocks the bounce between real surfaces, which only its ISM shows.
 #pragma once
 #include <array>
 #include <memory>

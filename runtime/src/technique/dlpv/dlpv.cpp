@@ -11,6 +11,7 @@
 #include "gpu/pipelines.h"
 #include "light/light_stage.h"
 #include "technique/baseline/baseline.h"
+#include "technique/input_reuse.h"
 #include "technique/scene_gpu.h"
 
 namespace mrgi::technique {
@@ -57,40 +58,6 @@ struct MergePush {
 // at least 0.25 m (a thin object still has room around it for its shadow and bounce).
 constexpr float kMinVolumeSide = 0.25f;
 
-// Tolerances of the volumes' reuse (dlpv.h "Skips").
-constexpr double kReusePoseM = 1e-3, kReusePoseDeg = 0.1;
-constexpr double kReuseDepthMeanM = 2e-3, kReuseDepthValidity = 0.005;
-constexpr float kReuseLampM = 1e-3f, kReuseLampDeg = 0.5f, kReuseLampColour = 0.01f;
-
-// What this frame's volumes are made from, to decide whether the next frame may reuse them.
-struct VolumeSource {
-  bool valid = false;
-  int level = -1;
-  glm::dmat4 pose{1.0};
-  std::array<LightDesc, light::kMaxStageLights> lamps{};
-  size_t lamp_count = 0;
-  bool delta_present = false, rho_present = false;
-};
-
-bool lamp_close(const LightDesc& a, const LightDesc& b) {
-  if (a.type != b.type || a.real != b.real) return false;
-  const float cos_tol = std::cos(glm::radians(kReuseLampDeg));
-  const glm::vec3 ca = a.color * a.intensity, cb = b.color * b.intensity;
-  const float colour_scale = std::max({std::abs(ca.x), std::abs(ca.y), std::abs(ca.z), 1e-30f});
-  return glm::length(a.position - b.position) <= kReuseLampM &&
-         glm::dot(glm::normalize(a.direction), glm::normalize(b.direction)) >= cos_tol &&
-         glm::length(ca - cb) <= kReuseLampColour * colour_scale &&
-         std::abs(a.inner_angle_deg - b.inner_angle_deg) <= kReuseLampDeg &&
-         std::abs(a.outer_angle_deg - b.outer_angle_deg) <= kReuseLampDeg;
-}
-
-bool pose_close(const glm::dmat4& a, const glm::dmat4& b) {
-  if (glm::length(glm::dvec3(a[3]) - glm::dvec3(b[3])) > kReusePoseM) return false;
-  const glm::dmat3 r = glm::transpose(glm::dmat3(a)) * glm::dmat3(b);
-  const double cos_angle = std::clamp((r[0][0] + r[1][1] + r[2][2] - 1.0) / 2.0, -1.0, 1.0);
-  return std::acos(cos_angle) <= glm::radians(kReusePoseDeg);
-}
-
 class Dlpv final : public Technique {
  public:
   explicit Dlpv(const SharedResources& shared) : shared_(shared), ladder_(dlpv_ladder()) {}
@@ -111,9 +78,8 @@ class Dlpv final : public Technique {
   std::optional<gi::LightPropagationVolume> mu_;  // DlpvAblation::two_volumes only
   gpu::PipelineHandle merge_;
   std::unique_ptr<Technique> baseline_;  // direct light with shadow maps (not antiradiance levels)
-  VolumeSource source_;                 // what the volumes in the images were made from
-  std::vector<uint16_t> source_depth_;  // that frame's depth (sized at init: no allocation later)
-  bool depth_close(const InputFrame* input) const;
+  InputReuse reuse_;                    // what the volumes in the images were made from
+  bool source_delta_ = false, source_rho_ = false;  // which volumes that frame made
   bool has_virtual_ = false;
   glm::vec3 centre_{0.0f};
   float side_ = 1.0f;
@@ -172,7 +138,7 @@ Status Dlpv::init() {
   auto merge = gpu::load_compute_pipeline(*shared_.context, "dlpv/merge.comp", {});
   if (!merge) return merge.error();
   merge_ = std::move(*merge);
-  source_depth_.assign(size_t(shared_.depth_intrinsics.width) * size_t(shared_.depth_intrinsics.height), 0);
+  reuse_.reserve(size_t(shared_.depth_intrinsics.width) * size_t(shared_.depth_intrinsics.height), shared_.depth_scale);
   auto base = create_baseline(shared_);
   if (!base) return base.error();
   baseline_ = std::move(*base);
@@ -204,26 +170,6 @@ void Dlpv::write_lights() {
   const auto r = light::irradiance_matrices(lighting.ambient_real);
   set->ambient_rv = {rv[0], rv[1], rv[2]};
   set->ambient_r = {r[0], r[1], r[2]};
-}
-
-bool Dlpv::depth_close(const InputFrame* input) const {
-  if (input == nullptr || input->depth.data.size() != source_depth_.size()) return false;
-  const double metres_per_unit = 1.0 / shared_.depth_scale;
-  double sum_m = 0.0;
-  size_t both = 0, changed_validity = 0;
-  const uint16_t* now = input->depth.data.data();
-  for (size_t i = 0; i < source_depth_.size(); ++i) {
-    const bool a = source_depth_[i] != 0, b = now[i] != 0;
-    if (a != b) {
-      ++changed_validity;
-    } else if (a) {
-      sum_m += std::abs(double(now[i]) - double(source_depth_[i])) * metres_per_unit;
-      ++both;
-    }
-  }
-  const double n = double(std::max<size_t>(source_depth_.size(), 1));
-  return double(changed_validity) <= kReuseDepthValidity * n &&
-         (both == 0 || sum_m / double(both) <= kReuseDepthMeanM);
 }
 
 Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
@@ -260,18 +206,17 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     const VkExtent2D g = graph.extent(shared_.real_position);
     const uint32_t stride = std::max(1u, uint32_t(std::ceil(double(std::max(g.width, g.height)) / (level.rsm_size / 2.0))));
     // The real lamps the maps are drawn for this level (strongest first), as the reuse compares them.
-    VolumeSource now;
-    now.level = info.level;
-    now.pose = info.camera_to_world;
-    for (size_t i = 0; i < lighting.lights.size() && now.lamp_count < level.rsm_lamps; ++i)
-      if (lighting.lights[i].real && now.lamp_count < now.lamps.size()) now.lamps[now.lamp_count++] = lighting.lights[i];
-    bool reuse = source_.valid && source_.level == now.level && source_.lamp_count == now.lamp_count &&
-                 pose_close(source_.pose, now.pose) && depth_close(info.input);
-    for (size_t i = 0; reuse && i < now.lamp_count; ++i) reuse = lamp_close(source_.lamps[i], now.lamps[i]);
+    reuse_.set_frame(info.level, info.camera_to_world, info.input);
+    for (size_t i = 0, n = 0; i < lighting.lights.size() && n < level.rsm_lamps; ++i)
+      if (lighting.lights[i].real) {
+        reuse_.add_lamp(lighting.lights[i]);
+        ++n;
+      }
+    const bool reuse = reuse_.close();
     bool grid_added = false;
     uint32_t lamps = 0;
     if (reuse) {
-      lamps = uint32_t(now.lamp_count);
+      lamps = uint32_t(reuse_.lamp_count());
       skipped.push_back("dlpv maps and volumes: reused (level, pose, depth and lamps within tolerance of the frame that made them)");
     }
     for (size_t i = 0; !reuse && i < lighting.lights.size() && lamps < level.rsm_lamps; ++i) {
@@ -311,8 +256,8 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
       ++lamps;
     }
     if (reuse) {
-      delta_present = source_.delta_present;
-      rho_present = source_.rho_present;
+      delta_present = source_delta_;
+      rho_present = source_rho_;
     } else if (lamps == 0) {
       skipped.push_back("dlpv volumes: no real light to inject (no lamp, environment region or estimate)");
     } else if (two) {
@@ -334,11 +279,9 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
                         "' shades virtual pixels with lamps and ambient only");
     if (!reuse) {
       // Remembered only when made from a depth frame the next one can be compared with.
-      source_ = now;
-      source_.valid = info.input != nullptr && info.input->depth.data.size() == source_depth_.size();
-      source_.delta_present = delta_present;
-      source_.rho_present = rho_present;
-      if (source_.valid) std::copy(info.input->depth.data.begin(), info.input->depth.data.end(), source_depth_.begin());
+      reuse_.remember();
+      source_delta_ = delta_present;
+      source_rho_ = rho_present;
     }
     push.extent = glm::vec4(float(delta_->settings().resolution), float(level.volume_cells), delta_present ? 1.0f : 0.0f,
                             rho_present ? 1.0f : 0.0f);

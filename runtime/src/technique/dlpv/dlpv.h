@@ -59,6 +59,7 @@
 //     and 1 % of its colour. (The reconstruction is a function of depth and pose, so the real
 //     grid the maps draw moves by about the depth change.) A reused frame stays within 4/255
 //     per channel of the recomputed one (tests/technique/dlpv_test.cpp: 3/255 measured at 1.8 mm).
+//     The comparison is technique/input_reuse.h, shared with dir.
 #pragma once
 #include <array>
 #include <memory>
