@@ -16,6 +16,7 @@ namespace {
 struct ReplayOptions {
   std::string capture, technique = "baseline", out, level = "0", device, light = "declared";
   std::vector<std::string> dlpv_ablation;
+  std::vector<std::string> dir_ablation;
   int frames = 0, width = 0, height = 0;
   bool validate = false, quiet = false;
 };
@@ -44,6 +45,12 @@ void run_replay(const ReplayOptions& o) {
   }
   if (settings.dlpv_ablation.any() && o.technique != "dlpv")
     throw CommandFailure(2, "--dlpv-ablation: only for --technique dlpv");
+  for (const std::string& a : o.dir_ablation) {
+    if (a == "one-shadow-map") settings.dir_ablation.one_shadow_map = true;
+    if (a == "no-real-only-vpls") settings.dir_ablation.no_real_only_vpls = true;
+  }
+  if (settings.dir_ablation.any() && o.technique != "dir")
+    throw CommandFailure(2, "--dir-ablation: only for --technique dir");
   CameraSetup cameras{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera};
   SceneDesc scene = capture.scene() ? *capture.scene() : SceneDesc{};
   // The env intensity stays known for the truth of the direction error (env frames).
@@ -198,6 +205,12 @@ void setup(CLI::App& app) {
                   "surfaces' VPLs only, not the virtual objects' own); comma-separated")
       ->delimiter(',')
       ->check(CLI::IsMember({"two-volumes", "no-damping", "no-shift", "no-self-bounce"}));
+  cmd->add_option("--dir-ablation", opts->dir_ablation,
+                  "dir without one of the paper's ideas (mrgi/runtime.h DirAblation): one-shadow-map (one ISM a VPL "
+                  "with the nearest surface and its kind, not one each), no-real-only-vpls (no ir(VPL): the real bounce "
+                  "a virtual object blocks stays in L_r); comma-separated")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"one-shadow-map", "no-real-only-vpls"}));
   cmd->add_option("--device", opts->device, "Vulkan device: index or name part (default $MRGI_DEVICE, else lavapipe)");
   cmd->add_flag("--validate", opts->validate, "enable Vulkan validation layers");
   cmd->add_flag("--quiet,-q", opts->quiet, "no progress on stderr");

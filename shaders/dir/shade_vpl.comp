@@ -36,6 +36,11 @@ layout(std430, set = 0, binding = 7) readonly buffer Vpls { Vpl vpls[]; };
 layout(set = 0, binding = 8, rg32f) readonly uniform image2D ism_distances;  // level 0: x real, y virtual
 layout(set = 0, binding = 9, rgba32ui) writeonly uniform uimage2D indirect;  // indirect_pack.glsl
 layout(push_constant) uniform Params { DirParams params_block; };
+// Ablations (mrgi/runtime.h DirAblation), one pipeline each: bit 1 one shadow map (the nearest
+// surface and its kind), bit 2 no ir(VPL) (real-only VPLs light nothing).
+layout(constant_id = 0) const int kAblation = 0;
+const bool kOneShadowMap = (kAblation & 1) != 0;
+const bool kNoRealOnly = (kAblation & 2) != 0;
 DirParams params;
 
 void main() {
@@ -72,7 +77,7 @@ void main() {
       int flags = int(v.position.w);
       if ((flags & MRGI_VPL_VALID) == 0) continue;
       bool real_only = (flags & MRGI_VPL_REAL_ONLY) != 0;
-      if (real_only && is_virtual) continue;  // ir(VPL): real surfaces only
+      if (real_only && (is_virtual || kNoRealOnly)) continue;  // ir(VPL): real surfaces only
       vec3 q = v.position.xyz;
       float e = vpl_irradiance(p, n, q, v.normal.xyz, 1.0f, params.lighting.x);
       if (!(e > 0.0f)) continue;
@@ -84,6 +89,11 @@ void main() {
       float limit = dist * (1.0f - params.lighting.y) - params.lighting.z;
       float st_r = stored.x >= limit ? 1.0f : 0.0f;
       float st_v = stored.y >= limit ? 1.0f : 0.0f;
+      if (kOneShadowMap) {  // one map: only the nearest blocker is known, and its kind
+        bool real_nearest = stored.x <= stored.y;
+        st_r = real_nearest ? st_r : 1.0f;
+        st_v = real_nearest ? 1.0f : st_v;
+      }
       vec3 l_o = albedo * (1.0f / MRGI_PI) * v.flux.rgb * e;
       if (!real_only) l_rv += l_o * min(st_r, st_v);                                  // eq. 6, 8
       if (!is_virtual && (flags & MRGI_VPL_REAL_PATH) != 0) l_r += l_o * st_r;        // eq. 7

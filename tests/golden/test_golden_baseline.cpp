@@ -56,15 +56,15 @@ TEST(GoldenBaseline, EveryLevelBeatsTheUntouchedCameraFrame) {
 // Compose's tile classifier (RuntimeSettings::compose_tiles, shaders/compose/tile_classify.comp):
 // composing only the tiles whose composite can move a pixel by more than half a level must give
 // the frames of composing every pixel to 1/255, at the output's resolution (level 0) and below
-// it (level 3: solutions at half size, resampled), for baseline and for dlpv (whose indirect
-// pass changes real pixels away from the shadows). Validation layers on.
+// it (level 3: solutions at half size, resampled), for baseline, dlpv and dir (whose indirect
+// light changes real pixels away from the shadows). Validation layers on.
 TEST(GoldenBaseline, ComposeTilesMatchComposingEveryPixel) {
   auto capture = CaptureReader::open(kCapture);
   ASSERT_TRUE(capture.ok()) << capture.error().message;
   const struct {
     const char* technique;
     int level;
-  } runs[] = {{"baseline", 0}, {"baseline", 3}, {"dlpv", 2}, {"dlpv", 3}};
+  } runs[] = {{"baseline", 0}, {"baseline", 3}, {"dlpv", 2}, {"dlpv", 3}, {"dir", 2}, {"dir", 3}};
   for (const auto& run : runs) {
     std::vector<FrameOutput> outs[2];
     for (int tiles = 0; tiles < 2; ++tiles) {

@@ -61,10 +61,25 @@ struct DlpvAblation {
   bool any() const { return two_volumes || no_negative_damping || no_half_cell_shift || no_virtual_self_bounce; }
 };
 
+// Ablations of the `dir` technique (DIR paper Sec. 3.3: what its two ideas for the VPLs are
+// worth; the defaults are the paper's method). Read at start-up. They change the VPL light only:
+// the direct light is baseline's two shadow maps either way.
+struct DirAblation {
+  // One imperfect shadow map per VPL holding the nearest surface, real or virtual, with a flag
+  // for which (Knecht et al. 2010, the paper's [4]), instead of one each: a real surface behind a
+  // virtual blocker no longer shadows L_r (the double shadow of the paper's Fig. 5).
+  bool one_shadow_map = false;
+  // No ir(VPL): the real surfaces a virtual object hides from the lamp get no VPLs of their own
+  // (VPL 3 of Fig. 6), so the real bounce the object blocks is not taken away from L_r (the
+  // inconsistent colour bleeding of Fig. 14).
+  bool no_real_only_vpls = false;
+  bool any() const { return one_shadow_map || no_real_only_vpls; }
+};
+
 // Level "last" in the CLI resolves to technique_level_count(name) - 1.
 struct RuntimeSettings {
   DeviceSettings device;
-  std::string technique = "baseline";  // baseline | ssrt | dlpv (later: dir, dvct, specular)
+  std::string technique = "baseline";  // baseline | ssrt | dlpv | dir (later: dvct, specular)
   int level = 0;                       // 0 = the technique's best quality
   int output_width = 0;                // 0 = the colour camera's width
   int output_height = 0;
@@ -89,6 +104,7 @@ struct RuntimeSettings {
   // to 1/255 (tests/golden/test_golden_baseline.cpp: identical on the golden capture).
   bool compose_tiles = true;
   DlpvAblation dlpv_ablation;  // the `dlpv` technique only; defaults: the paper's method
+  DirAblation dir_ablation;    // the `dir` technique only; defaults: the paper's method
   // Profiling mode (also Runtime::set_profiling): each pass of a frame submitted on its own and
   // waited for, timed by the host clock, so FrameStats::passes add up to the frame. Frames then
   // do not overlap: use it to see where the time goes (bench, scheduler cost model), not to run.

@@ -221,6 +221,7 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   technique::SharedResources shared;
   shared.context = context_.get();
   shared.dlpv_ablation = settings.dlpv_ablation;
+  shared.dir_ablation = settings.dir_ablation;
   shared.graph = graph_.get();
   shared.scene = &scene_;
   shared.scene_gpu = scene_gpu_.get();

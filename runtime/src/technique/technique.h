@@ -57,6 +57,7 @@ class SceneGpu;
 struct SharedResources {
   gpu::Context* context = nullptr;
   DlpvAblation dlpv_ablation;  // RuntimeSettings::dlpv_ablation
+  DirAblation dir_ablation;    // RuntimeSettings::dir_ablation
   gpu::FrameGraph* graph = nullptr;
   const SceneDesc* scene = nullptr;
   const SceneGpu* scene_gpu = nullptr;     // uploaded virtual meshes and real proxies

@@ -9,6 +9,7 @@
 #include "gi/rsm.h"
 #include "gi/vpl.h"
 #include "gpu/pipelines.h"
+#include "gpu/shaders.h"
 #include "light/light_stage.h"
 #include "technique/baseline/baseline.h"
 #include "technique/input_reuse.h"
@@ -152,8 +153,15 @@ Status Dir::init() {
   auto merged = image("dir indirect merged");
   if (!merged) return merged.error();
   merged_ = *merged;
-  for (auto [shader, out] : {std::pair{"dir/shade_vpl.comp", &shade_}, std::pair{"dir/merge_rows.comp", &merge_rows_},
-                             std::pair{"dir/merge_columns.comp", &merge_columns_}}) {
+  // The shading pass with the ablations compiled in (shade_vpl.comp kAblation), the others plain.
+  const DirAblation& ablation = shared_.dir_ablation;
+  const uint32_t ablation_bits = (ablation.one_shadow_map ? 1u : 0u) | (ablation.no_real_only_vpls ? 2u : 0u);
+  auto shade_spv = gpu::shader_spirv("dir/shade_vpl.comp");
+  if (!shade_spv) return shade_spv.error();
+  auto shade = gpu::create_compute_pipeline(graph.context(), {"dir shade vpls", *shade_spv, {}, sizeof(DirPush), {ablation_bits}});
+  if (!shade) return shade.error();
+  shade_ = gpu::PipelineHandle(graph.context(), std::move(*shade));
+  for (auto [shader, out] : {std::pair{"dir/merge_rows.comp", &merge_rows_}, std::pair{"dir/merge_columns.comp", &merge_columns_}}) {
     auto p = gpu::load_compute_pipeline(graph.context(), shader, {});
     if (!p) return p.error();
     *out = std::move(*p);

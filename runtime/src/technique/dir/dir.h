@@ -37,7 +37,9 @@
 //     over the VPL count): the paper does not say how it bounds it;
 //   - not yet built (they say so in FrameStats::skipped): VPLs of the environment on a hemisphere
 //     (the environment lights directly through baseline's shadowed regions and SH ambient),
-//     multiple bounces, glossy VPLs, temporal smoothing, the ablation switches.
+//     multiple bounces, glossy VPLs, temporal smoothing.
+// Ablations (mrgi/runtime.h DirAblation, `mrgi replay --dir-ablation`): one ISM a VPL instead of
+// two, no ir(VPL); they change the VPL light only (the direct light keeps baseline's two maps).
 //
 // Skips (each in FrameStats::skipped):
 //   - no virtual object, or no lamp a map can see them from: no maps, VPLs or ISMs (baseline only);
