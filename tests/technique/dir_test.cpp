@@ -15,6 +15,7 @@
 #include "capture/temp_dir.h"
 #include "mrgi/runtime.h"
 #include "../../shaders/shared/mrgi_shared.h"
+#include "stress_run.h"
 #include "synthetic_scene.h"
 #include "technique/dir/dir.h"
 
@@ -206,11 +207,6 @@ TEST(Dir, ASpotMissingTheObjectsDrawsNoVirtualMap) {
 // nothing may accumulate: frames of the same input are equal bit for bit once the
 // reconstruction's filter has settled (the last against the 100th from last), and the mean
 // light of the last frames is within 1 % of frames 8-9's.
-struct StressVariant {
-  const char* name;
-  glm::vec3 base;
-  void (*edit)(SyntheticScene&);
-};
 const StressVariant kStress[] = {
     {"lamp_at_1e6", glm::vec3(0.8f, 0.2f, 0.2f), [](SyntheticScene& s) { s.scene.lights[0].intensity = 1e6f; }},
     {"point_lamp_inside_the_object", glm::vec3(0.8f, 0.2f, 0.2f),
@@ -226,63 +222,15 @@ const StressVariant kStress[] = {
      }},
 };
 
-double mean_light(const FrameOutput& o) {
-  double sum = 0.0;
-  for (size_t k = 0; k < o.image.data.size(); ++k)
-    if (k % 4 != 3) sum += lin(o.image.data[k]);
-  return sum / double(std::max<size_t>(o.image.data.size(), 1));
-}
-
 class DirStress : public ::testing::TestWithParam<int> {};
 
 TEST_P(DirStress, ThousandFramesStayFiniteAndDoNotGrow) {
-  const StressVariant& v = kStress[GetParam()];
   mrgi::testing::TempDir dir;
-  SyntheticScene scene = SyntheticScene::create(dir.str(), glm::vec3(0.0f), v.base);
-  v.edit(scene);
-  RuntimeSettings s;
-  s.technique = "dir";
-  s.level = 3;
-  auto rt = create_runtime(s, scene.cameras(), scene.scene);
-  ASSERT_TRUE(rt.ok()) << rt.error().message;
-  InputFrame frames[2] = {scene.frame(0), scene.frame(1)};
-  for (uint16_t& d : frames[1].depth.data)
-    if (d != 0) d = uint16_t(d + uint16_t(scene.depth_scale / 100.0));
-  constexpr int n = 1000;
-  std::vector<FrameOutput> kept(n);
-  int seen = 0;
-  bool inside_note = false, reused = false;
-  auto take = [&](std::vector<FrameOutput>& outs) {
-    for (FrameOutput& o : outs) {
-      for (const std::string& note : o.stats.skipped) {
-        inside_note |= note.find("inside its sphere") != std::string::npos;
-        reused |= note.rfind("dir maps, VPLs and ISMs: reused", 0) == 0;
-      }
-      const int64_t k = o.stats.frame_index;
-      if (k >= 0 && k < n && (k < 10 || k >= n - 102)) kept[size_t(k)] = std::move(o);
-      ++seen;
-    }
-  };
-  for (int k = 0; k < n; ++k) {
-    InputFrame f = frames[k % 2];
-    f.index = k;
-    auto o = (*rt)->process(f);
-    ASSERT_TRUE(o.ok()) << "frame " << k << ": " << o.error().message;
-    take(*o);
-  }
-  auto rest = (*rt)->flush();
-  ASSERT_TRUE(rest.ok()) << rest.error().message;
-  take(*rest);
-  ASSERT_EQ(seen, n);
-  EXPECT_FALSE(reused) << "every frame must rebuild its VPLs and ISMs here";
-  EXPECT_EQ(inside_note, GetParam() == 1) << "the point lamp inside the object is said to be skipped";
-  for (int k = n - 2; k < n; ++k)
-    EXPECT_TRUE(kept[size_t(k)].image.data == kept[size_t(k - 100)].image.data)
-        << "frame " << k << " differs from frame " << k - 100 << " (same input)";
-  const double early = mean_light(kept[8]) + mean_light(kept[9]);
-  const double late = mean_light(kept[n - 2]) + mean_light(kept[n - 1]);
-  EXPECT_GT(early, 0.0);
-  EXPECT_NEAR(late / early, 1.0, 0.01) << "mean light of the last frames against frames 8-9";
+  StressOutcome o;
+  run_stress(kStress[GetParam()], dir.str(), "dir", 3, "dir maps, VPLs and ISMs: reused", 1000, o);
+  if (HasFatalFailure()) return;
+  check_stress_outcome(o);
+  EXPECT_EQ(o.inside_note, GetParam() == 1) << "the point lamp inside the object is said to be skipped";
 }
 
 INSTANTIATE_TEST_SUITE_P(Variants, DirStress, ::testing::Range(0, int(std::size(kStress))),

@@ -1,0 +1,94 @@
+// The 1,000-frame stress of the GI techniques (issues 14 and 15: "no NaN, no energy growth over
+// 1,000 frames"), shared by dlpv_test.cpp and dir_test.cpp: a variant of the synthetic scene
+// run at one level for `n` frames whose depth alternates by 1 cm (beyond the reuse tolerance of
+// technique/input_reuse.h, so the light-dependent work is rebuilt every frame), keeping frames
+// 0-9 and the last 102, and the notes it saw. check_stress_outcome() then asks that nothing was
+// reused, that frames of the same input are equal bit for bit once the reconstruction's filter
+// has settled (the last two against the 100th before them) and that the mean output light of the
+// last two frames is within 1 % of frames 8-9's.
+#pragma once
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "mrgi/runtime.h"
+#include "../../shaders/shared/mrgi_shared.h"
+#include "synthetic_scene.h"
+
+namespace mrgi::test {
+
+struct StressVariant {
+  const char* name;
+  glm::vec3 base;                 // the virtual objects' base colour (black: they reflect nothing)
+  void (*edit)(SyntheticScene&);  // the variant's change to the scene
+};
+
+struct StressOutcome {
+  int frames = 0;                   // asked for
+  int seen = 0;                     // outputs that came back
+  bool reused = false;              // a frame carried `reuse_note`
+  bool inside_note = false;         // a frame said a lamp was inside the sphere its maps fit
+  std::vector<FrameOutput> kept;    // by frame index; only 0-9 and the last 102 are filled
+};
+
+inline double stress_mean_light(const FrameOutput& o) {
+  double sum = 0.0;
+  for (size_t k = 0; k < o.image.data.size(); ++k)
+    if (k % 4 != 3) sum += shader::srgb_decode1(float(o.image.data[k]) / 255.0f);
+  return sum / double(std::max<size_t>(o.image.data.size(), 1));
+}
+
+// Fatal failures (a frame refused) return early: the caller checks HasFatalFailure().
+inline void run_stress(const StressVariant& v, const std::string& folder, const std::string& technique, int level,
+                       const std::string& reuse_note, int n, StressOutcome& out) {
+  SyntheticScene scene = SyntheticScene::create(folder, glm::vec3(0.0f), v.base);
+  v.edit(scene);
+  RuntimeSettings s;
+  s.technique = technique;
+  s.level = level;
+  auto rt = create_runtime(s, scene.cameras(), scene.scene);
+  ASSERT_TRUE(rt.ok()) << rt.error().message;
+  InputFrame frames[2] = {scene.frame(0), scene.frame(1)};
+  for (uint16_t& d : frames[1].depth.data)
+    if (d != 0) d = uint16_t(d + uint16_t(scene.depth_scale / 100.0));
+  out.frames = n;
+  out.kept.assign(size_t(n), FrameOutput{});
+  auto take = [&](std::vector<FrameOutput>& outs) {
+    for (FrameOutput& o : outs) {
+      for (const std::string& note : o.stats.skipped) {
+        out.reused |= note.rfind(reuse_note, 0) == 0;
+        out.inside_note |= note.find("inside its sphere") != std::string::npos;
+      }
+      const int64_t k = o.stats.frame_index;
+      if (k >= 0 && k < n && (k < 10 || k >= n - 102)) out.kept[size_t(k)] = std::move(o);
+      ++out.seen;
+    }
+  };
+  for (int k = 0; k < n; ++k) {
+    InputFrame f = frames[k % 2];
+    f.index = k;
+    auto o = (*rt)->process(f);
+    ASSERT_TRUE(o.ok()) << "frame " << k << ": " << o.error().message;
+    take(*o);
+  }
+  auto rest = (*rt)->flush();
+  ASSERT_TRUE(rest.ok()) << rest.error().message;
+  take(*rest);
+}
+
+inline void check_stress_outcome(const StressOutcome& o) {
+  const int n = o.frames;
+  ASSERT_EQ(o.seen, n);
+  EXPECT_FALSE(o.reused) << "every frame must rebuild its light-dependent work here";
+  for (int k = n - 2; k < n; ++k)
+    EXPECT_TRUE(o.kept[size_t(k)].image.data == o.kept[size_t(k - 100)].image.data)
+        << "frame " << k << " differs from frame " << k - 100 << " (same input)";
+  const double early = stress_mean_light(o.kept[8]) + stress_mean_light(o.kept[9]);
+  const double late = stress_mean_light(o.kept[size_t(n - 2)]) + stress_mean_light(o.kept[size_t(n - 1)]);
+  EXPECT_GT(early, 0.0);
+  EXPECT_NEAR(late / early, 1.0, 0.01) << "mean light of the last frames against frames 8-9";
+}
+
+}  // namespace mrgi::test
