@@ -124,62 +124,7 @@ TEST(Dir, EveryLevelRunsAndItsVplsLightTheObjectBeyondBaseline) {
 // recomputes it; 1 cm of depth or 5 cm of camera motion recompute. Validation on.
 TEST(Dir, VplsAndIsmsAreReusedOnlyWhileTheInputsStayWithinTolerance) {
   mrgi::testing::TempDir dir;
-  const SyntheticScene scene = SyntheticScene::create(dir.str());
-  auto make = [&]() {
-    RuntimeSettings s;
-    s.device.validate = true;
-    s.technique = "dir";
-    s.level = 2;
-    s.frames_in_flight = 1;  // each process() returns the previous frame: outputs in order
-    return create_runtime(s, scene.cameras(), scene.scene);
-  };
-  auto shifted_depth = [&](int64_t index, int units) {
-    InputFrame f = scene.frame(index);
-    for (uint16_t& d : f.depth.data)
-      if (d != 0) d = uint16_t(int(d) + units);
-    return f;
-  };
-  InputFrame moved = scene.frame(4);
-  moved.pose->translation.x += 0.05;
-  const int mm = int(scene.depth_scale / 1000.0);
-  const std::vector<InputFrame> frames = {scene.frame(0), scene.frame(1), shifted_depth(2, 9 * mm / 5),
-                                          shifted_depth(3, 10 * mm), moved};
-  auto run_all = [](Runtime& rt, const std::vector<InputFrame>& in, std::vector<FrameOutput>& out) {
-    for (const InputFrame& f : in) {
-      auto o = rt.process(f);
-      ASSERT_TRUE(o.ok()) << o.error().message;
-      for (auto& x : *o) out.push_back(std::move(x));
-    }
-    auto rest = rt.flush();
-    ASSERT_TRUE(rest.ok()) << rest.error().message;
-    for (auto& x : *rest) out.push_back(std::move(x));
-  };
-  auto rt = make();
-  ASSERT_TRUE(rt.ok()) << rt.error().message;
-  std::vector<FrameOutput> outs;
-  run_all(**rt, frames, outs);
-  if (HasFatalFailure()) return;
-  ASSERT_EQ(outs.size(), frames.size());
-  auto reused = [](const FrameOutput& o) {
-    for (const std::string& k : o.stats.skipped)
-      if (k.rfind("dir maps, VPLs and ISMs: reused", 0) == 0) return true;
-    return false;
-  };
-  const bool want[] = {false, true, true, false, false};
-  for (size_t i = 0; i < outs.size(); ++i) EXPECT_EQ(reused(outs[i]), want[i]) << "frame " << i;
-  EXPECT_TRUE(outs[1].image.data == outs[0].image.data) << "a reused frame differs from the recomputed one";
-  auto fresh = make();
-  ASSERT_TRUE(fresh.ok()) << fresh.error().message;
-  std::vector<FrameOutput> recomputed;
-  run_all(**fresh, {frames[2]}, recomputed);
-  if (HasFatalFailure()) return;
-  ASSERT_EQ(recomputed.size(), 1u);
-  EXPECT_FALSE(reused(recomputed[0]));
-  int worst = 0;
-  for (size_t k = 0; k < recomputed[0].image.data.size(); ++k)
-    worst = std::max(worst, std::abs(int(recomputed[0].image.data[k]) - int(outs[2].image.data[k])));
-  std::printf("dir reuse at 1.8 mm of depth change: largest change %d / 255\n", worst);
-  EXPECT_LE(worst, 4) << "reuse within tolerance moved a pixel by more than 4/255";
+  check_reuse_within_tolerance(dir.str(), "dir", 2, "dir maps, VPLs and ISMs: reused");
 }
 
 // A spot whose cone misses the virtual objects draws R^mu only (issue 15's skip) and says so.

@@ -94,53 +94,7 @@ TEST(Dlpv, EveryLevelLightsTheObjectAndDarkensTheFloorWithValidationOn) {
 // recompute. Validation on.
 TEST(Dlpv, VolumesAreReusedOnlyWhileTheInputsStayWithinTolerance) {
   mrgi::testing::TempDir dir;
-  const SyntheticScene scene = SyntheticScene::create(dir.str());
-  auto make = [&]() {
-    RuntimeSettings s;
-    s.device.validate = true;
-    s.technique = "dlpv";
-    s.level = 2;
-    s.frames_in_flight = 1;  // each process() returns the previous frame: outputs in order
-    return create_runtime(s, scene.cameras(), scene.scene);
-  };
-  auto shifted_depth = [&](int64_t index, int units) {
-    InputFrame f = scene.frame(index);
-    for (uint16_t& d : f.depth.data)
-      if (d != 0) d = uint16_t(int(d) + units);
-    return f;
-  };
-  InputFrame moved = scene.frame(4);
-  moved.pose->translation.x += 0.05;
-  const int mm = int(scene.depth_scale / 1000.0);
-  const std::vector<InputFrame> frames = {scene.frame(0), scene.frame(1), shifted_depth(2, 9 * mm / 5),
-                                          shifted_depth(3, 10 * mm), moved};
-  auto rt = make();
-  ASSERT_TRUE(rt.ok()) << rt.error().message;
-  std::vector<FrameOutput> outs;
-  run_frames(**rt, frames, outs);
-  if (HasFatalFailure()) return;
-  ASSERT_EQ(outs.size(), frames.size());
-  auto reused = [](const FrameOutput& o) {
-    for (const std::string& k : o.stats.skipped)
-      if (k.rfind("dlpv maps and volumes: reused", 0) == 0) return true;
-    return false;
-  };
-  const bool want[] = {false, true, true, false, false};
-  for (size_t i = 0; i < outs.size(); ++i) EXPECT_EQ(reused(outs[i]), want[i]) << "frame " << i;
-  EXPECT_TRUE(outs[1].image.data == outs[0].image.data) << "a reused frame differs from the recomputed one";
-  // Frame 2 recomputed by a runtime that has no earlier volumes.
-  auto fresh = make();
-  ASSERT_TRUE(fresh.ok()) << fresh.error().message;
-  std::vector<FrameOutput> recomputed;
-  run_frames(**fresh, {frames[2]}, recomputed);
-  if (HasFatalFailure()) return;
-  ASSERT_EQ(recomputed.size(), 1u);
-  EXPECT_FALSE(reused(recomputed[0]));
-  int worst = 0;
-  for (size_t k = 0; k < recomputed[0].image.data.size(); ++k)
-    worst = std::max(worst, std::abs(int(recomputed[0].image.data[k]) - int(outs[2].image.data[k])));
-  std::printf("reuse at 1.8 mm of depth change: largest change %d / 255\n", worst);
-  EXPECT_LE(worst, 4) << "reuse within tolerance moved a pixel by more than 4/255";
+  check_reuse_within_tolerance(dir.str(), "dlpv", 2, "dlpv maps and volumes: reused");
 }
 
 // Stress (issue 14): 1,000 frames at the fast level, each recomputing its maps and volumes (the

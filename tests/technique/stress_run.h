@@ -1,4 +1,5 @@
-// The 1,000-frame stress of the GI techniques (issues 14 and 15: "no NaN, no energy growth over
+// Harnesses shared by the GI techniques' tests (dlpv_test.cpp, dir_test.cpp). The 1,000-frame
+// stress (issues 14 and 15: "no NaN, no energy growth over
 // 1,000 frames"), shared by dlpv_test.cpp and dir_test.cpp: a variant of the synthetic scene
 // run at one level for `n` frames whose depth alternates by 1 cm (beyond the reuse tolerance of
 // technique/input_reuse.h, so the light-dependent work is rebuilt every frame), keeping frames
@@ -10,6 +11,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -89,6 +92,73 @@ inline void check_stress_outcome(const StressOutcome& o) {
   const double late = stress_mean_light(o.kept[size_t(n - 2)]) + stress_mean_light(o.kept[size_t(n - 1)]);
   EXPECT_GT(early, 0.0);
   EXPECT_NEAR(late / early, 1.0, 0.01) << "mean light of the last frames against frames 8-9";
+}
+
+// The reuse skip of the GI techniques (technique/input_reuse.h), shared by dlpv_test.cpp and
+// dir_test.cpp: five frames of the synthetic scene with validation on, one frame in flight (each
+// process() returns the previous frame, so outputs come in order): frame 0, frame 1 (identical
+// input), frame 2 with the depth 1.8 mm off everywhere (within the 2 mm tolerance), frame 3 with
+// it 1 cm off, frame 4 with the camera 5 cm to the side. Frames 1 and 2 must carry `reuse_note`,
+// the others not; frame 1 must equal frame 0 bit for bit; frame 2 must stay within 4/255 per
+// channel of a fresh runtime that computes it (the largest change is printed).
+inline void check_reuse_within_tolerance(const std::string& folder, const std::string& technique, int level,
+                                         const std::string& reuse_note) {
+  const SyntheticScene scene = SyntheticScene::create(folder);
+  auto make = [&]() {
+    RuntimeSettings s;
+    s.device.validate = true;
+    s.technique = technique;
+    s.level = level;
+    s.frames_in_flight = 1;
+    return create_runtime(s, scene.cameras(), scene.scene);
+  };
+  auto shifted_depth = [&](int64_t index, int units) {
+    InputFrame f = scene.frame(index);
+    for (uint16_t& d : f.depth.data)
+      if (d != 0) d = uint16_t(int(d) + units);
+    return f;
+  };
+  auto run_all = [](Runtime& rt, const std::vector<InputFrame>& in, std::vector<FrameOutput>& out) {
+    for (const InputFrame& f : in) {
+      auto o = rt.process(f);
+      ASSERT_TRUE(o.ok()) << o.error().message;
+      for (auto& x : *o) out.push_back(std::move(x));
+    }
+    auto rest = rt.flush();
+    ASSERT_TRUE(rest.ok()) << rest.error().message;
+    for (auto& x : *rest) out.push_back(std::move(x));
+  };
+  InputFrame moved = scene.frame(4);
+  moved.pose->translation.x += 0.05;
+  const int mm = int(scene.depth_scale / 1000.0);
+  const std::vector<InputFrame> frames = {scene.frame(0), scene.frame(1), shifted_depth(2, 9 * mm / 5),
+                                          shifted_depth(3, 10 * mm), moved};
+  auto rt = make();
+  ASSERT_TRUE(rt.ok()) << rt.error().message;
+  std::vector<FrameOutput> outs;
+  run_all(**rt, frames, outs);
+  if (::testing::Test::HasFatalFailure()) return;
+  ASSERT_EQ(outs.size(), frames.size());
+  auto reused = [&](const FrameOutput& o) {
+    for (const std::string& k : o.stats.skipped)
+      if (k.rfind(reuse_note, 0) == 0) return true;
+    return false;
+  };
+  const bool want[] = {false, true, true, false, false};
+  for (size_t i = 0; i < outs.size(); ++i) EXPECT_EQ(reused(outs[i]), want[i]) << "frame " << i;
+  EXPECT_TRUE(outs[1].image.data == outs[0].image.data) << "a reused frame differs from the recomputed one";
+  auto fresh = make();
+  ASSERT_TRUE(fresh.ok()) << fresh.error().message;
+  std::vector<FrameOutput> recomputed;
+  run_all(**fresh, {frames[2]}, recomputed);
+  if (::testing::Test::HasFatalFailure()) return;
+  ASSERT_EQ(recomputed.size(), 1u);
+  EXPECT_FALSE(reused(recomputed[0]));
+  int worst = 0;
+  for (size_t k = 0; k < recomputed[0].image.data.size(); ++k)
+    worst = std::max(worst, std::abs(int(recomputed[0].image.data[k]) - int(outs[2].image.data[k])));
+  std::printf("%s reuse at 1.8 mm of depth change: largest change %d / 255\n", technique.c_str(), worst);
+  EXPECT_LE(worst, 4) << "reuse within tolerance moved a pixel by more than 4/255";
 }
 
 }  // namespace mrgi::test
