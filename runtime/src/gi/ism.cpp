@@ -1,6 +1,7 @@
 #include "gi/ism.h"
 
 #include <cmath>
+#include <bit>
 #include <string>
 #include <vector>
 
@@ -12,8 +13,6 @@ namespace {
 Error ism_setting_error(const std::string& field, const std::string& rule) {
   return fail(ErrorKind::BadUsage, "IsmSettings." + field + ": " + rule);
 }
-
-bool power_of_two(uint32_t v) { return v != 0 && (v & (v - 1)) == 0; }
 
 // gi/ism_common.glsl IsmParams.
 struct IsmPush {
@@ -36,7 +35,7 @@ Expected<ImperfectShadowMaps> ImperfectShadowMaps::create(gpu::FrameGraph& graph
                                                           gpu::ImageHandle real_position, const IsmSettings& s) {
   if (s.name.empty()) return ism_setting_error("name", "must not be empty");
   if (s.max_vpls < 1 || s.max_vpls > 4096) return ism_setting_error("max_vpls", "must be 1..4096");
-  if (!power_of_two(s.map_size) || s.map_size < 8 || s.map_size > 512)
+  if (!std::has_single_bit(s.map_size) || s.map_size < 8 || s.map_size > 512)
     return ism_setting_error("map_size", "must be a power of two, 8..512 texels");
   ImperfectShadowMaps m;
   m.settings_ = s;
@@ -102,7 +101,7 @@ Status ImperfectShadowMaps::add_build(gpu::FrameGraph& graph, gpu::BufferHandle 
   if (f.vpls < 1 || f.vpls > settings_.max_vpls)
     return fail(ErrorKind::BadUsage, "ism '" + settings_.name + "': " + std::to_string(f.vpls) + " VPLs, 1.." +
                                          std::to_string(settings_.max_vpls) + " allocated");
-  if (!power_of_two(f.map_size) || f.map_size > settings_.map_size || f.map_size < (1u << kPullLevels))
+  if (!std::has_single_bit(f.map_size) || f.map_size > settings_.map_size || f.map_size < (1u << kPullLevels))
     return fail(ErrorKind::BadUsage, "ism '" + settings_.name + "': map size " + std::to_string(f.map_size) +
                                          " must be a power of two, " + std::to_string(1u << kPullLevels) + ".." +
                                          std::to_string(settings_.map_size));

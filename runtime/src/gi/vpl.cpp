@@ -1,5 +1,6 @@
 #include "gi/vpl.h"
 
+#include <bit>
 #include <string>
 
 #include "common/vpl.glsl"
@@ -11,14 +12,12 @@ Error vpl_setting_error(const std::string& field, const std::string& rule) {
   return fail(ErrorKind::BadUsage, "VplSettings." + field + ": " + rule);
 }
 
-bool power_of_two(uint32_t v) { return v != 0 && (v & (v - 1)) == 0; }
-
 }  // namespace
 
 Expected<VplSampler> VplSampler::create(gpu::FrameGraph& graph, const VplSettings& s) {
   if (s.name.empty()) return vpl_setting_error("name", "must not be empty");
   if (s.max_vpls < 1 || s.max_vpls > 4096) return vpl_setting_error("max_vpls", "must be 1..4096 slots");
-  if (!power_of_two(s.map_size) || s.map_size < 16 || s.map_size > 4096)
+  if (!std::has_single_bit(s.map_size) || s.map_size < 16 || s.map_size > 4096)
     return vpl_setting_error("map_size", "must be a power of two, 16..4096 texels");
   VplSampler v;
   v.settings_ = s;
@@ -62,7 +61,7 @@ void VplSampler::add_clear(gpu::FrameGraph& graph) const {
 Status VplSampler::add_sample(gpu::FrameGraph& graph, const std::string& id, const RsmImages& rho, const RsmImages& mu,
                               bool real_lamp, uint32_t first, uint32_t count) {
   const uint32_t side = rho.width;
-  if (rho.height != side || mu.width != side || mu.height != side || !power_of_two(side) || side > settings_.map_size)
+  if (rho.height != side || mu.width != side || mu.height != side || !std::has_single_bit(side) || side > settings_.map_size)
     return fail(ErrorKind::BadUsage, "vpl '" + settings_.name + "': the maps must be square, equal, a power of two and at most " +
                                          std::to_string(settings_.map_size) + " texels per side (got " +
                                          std::to_string(rho.width) + "x" + std::to_string(rho.height) + ")");
