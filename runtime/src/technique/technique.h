@@ -99,7 +99,9 @@ struct SharedResources {
 // (baseline/shade_direct.comp, dlpv/merge.comp): FrameUbo, real_* and virtual_* (read), lit_rv
 // and lit_r (written). Without emission the albedo stands in for virtual_emission (bound, never
 // read: FrameConstants::flags.y is 0).
-inline void bind_shading_gbuffers(gpu::ShaderPassBuilder& b, const SharedResources& r) {
+// The frame constants and the six G-buffer images, for a pass that reads them and writes
+// something of its own (dir's VPL shading).
+inline void bind_gbuffer_reads(gpu::ShaderPassBuilder& b, const SharedResources& r) {
   b.bind("FrameUbo", r.frame_constants);
   b.bind("real_position", r.real_position);
   b.bind("real_normal", r.real_normal);
@@ -107,6 +109,9 @@ inline void bind_shading_gbuffers(gpu::ShaderPassBuilder& b, const SharedResourc
   b.bind("virtual_position", r.virtual_position);
   b.bind("virtual_normal", r.virtual_normal);
   b.bind("virtual_albedo", r.virtual_albedo);
+}
+inline void bind_shading_gbuffers(gpu::ShaderPassBuilder& b, const SharedResources& r) {
+  bind_gbuffer_reads(b, r);
   b.bind("virtual_emission", r.virtual_emission.valid() ? r.virtual_emission : r.virtual_albedo);
   b.bind("lit_rv", r.lit_rv);
   b.bind("lit_r", r.lit_r);

@@ -263,13 +263,7 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   graph.add_shader_pass(
       "dir shade vpls", gpu::PassKind::Compute, *shade_,
       [&](gpu::ShaderPassBuilder& b) {
-        b.bind("FrameUbo", r.frame_constants);
-        b.bind("real_position", r.real_position);
-        b.bind("real_normal", r.real_normal);
-        b.bind("real_albedo", r.real_albedo);
-        b.bind("virtual_position", r.virtual_position);
-        b.bind("virtual_normal", r.virtual_normal);
-        b.bind("virtual_albedo", r.virtual_albedo);
+        bind_gbuffer_reads(b, r);
         b.bind("Vpls", vpl_buffer);
         b.bind("ism_distances", distances, 0);
         b.bind("indirect", indirect);
