@@ -48,6 +48,7 @@ void run_replay(const ReplayOptions& o) {
   for (const std::string& a : o.dir_ablation) {
     if (a == "one-shadow-map") settings.dir_ablation.one_shadow_map = true;
     if (a == "no-real-only-vpls") settings.dir_ablation.no_real_only_vpls = true;
+    if (a == "one-bounce") settings.dir_ablation.one_bounce = true;
   }
   if (settings.dir_ablation.any() && o.technique != "dir")
     throw CommandFailure(2, "--dir-ablation: only for --technique dir");
@@ -208,9 +209,10 @@ void setup(CLI::App& app) {
   cmd->add_option("--dir-ablation", opts->dir_ablation,
                   "dir without one of the paper's ideas (mrgi/runtime.h DirAblation): one-shadow-map (one ISM a VPL "
                   "with the nearest surface and its kind, not one each), no-real-only-vpls (no ir(VPL): the real bounce "
-                  "a virtual object blocks stays in L_r); comma-separated")
+                  "a virtual object blocks stays in L_r), one-bounce (no bounce light source: the lamps' VPLs only, "
+                  "at the levels with multiple bounces); comma-separated")
       ->delimiter(',')
-      ->check(CLI::IsMember({"one-shadow-map", "no-real-only-vpls"}));
+      ->check(CLI::IsMember({"one-shadow-map", "no-real-only-vpls", "one-bounce"}));
   cmd->add_option("--device", opts->device, "Vulkan device: index or name part (default $MRGI_DEVICE, else lavapipe)");
   cmd->add_flag("--validate", opts->validate, "enable Vulkan validation layers");
   cmd->add_flag("--quiet,-q", opts->quiet, "no progress on stderr");

@@ -19,7 +19,7 @@ layout(set = 0, binding = 4, r32ui) uniform uimage2D splat;
 layout(push_constant) uniform Params { IsmParams params; };
 #include "gi/ism_splat.glsl"
 
-vec3 vertex_position(uint v) { return vec3(vertex_words[v * 8u], vertex_words[v * 8u + 1u], vertex_words[v * 8u + 2u]); }
+#include "gi/virtual_points.glsl"
 
 void main() {
   int n = params.tiles.x;
@@ -28,19 +28,6 @@ void main() {
   if (i >= n * params.tiles.w || triangles <= 0) return;
   vec2 u = ism_point_u(i / n, i % n);
   float v3 = halton(uint(i / n) + 1u, 11u);  // the third coordinate: another base
-  int t = min(int(u.x * float(triangles)), triangles - 1);
-  int lo = 0, hi = params.source.y - 1;  // the range holding triangle t
-  while (lo < hi) {
-    int mid = (lo + hi + 1) / 2;
-    if (ranges[mid].w <= t) lo = mid; else hi = mid - 1;
-  }
-  ivec4 range = ranges[lo];
-  uint first = uint(range.x + 3 * (t - range.w));
-  uint base = uint(range.z);
-  vec3 a = vertex_position(base + indices[first]), b = vertex_position(base + indices[first + 1u]),
-       c = vertex_position(base + indices[first + 2u]);
-  float su = sqrt(u.y), v = v3;
-  vec3 p = a * (1.0f - su) + b * (su * (1.0f - v)) + c * (su * v);
-  float area = 0.5f * length(cross(b - a, c - a));
-  ism_splat(i % n, p, area * float(triangles) / float(params.tiles.w));
+  VirtualPoint p = virtual_point(vec3(u, v3), triangles, params.source.y);
+  ism_splat(i % n, p.position, p.area / float(params.tiles.w));
 }

@@ -124,7 +124,40 @@ TEST(Dir, EveryLevelRunsAndItsVplsLightTheObjectBeyondBaseline) {
 // recomputes it; 1 cm of depth or 5 cm of camera motion recompute. Validation on.
 TEST(Dir, VplsAndIsmsAreReusedOnlyWhileTheInputsStayWithinTolerance) {
   mrgi::testing::TempDir dir;
-  check_reuse_within_tolerance(dir.str(), "dir", 2, "dir maps, VPLs and ISMs: reused");
+  check_reuse_within_tolerance(dir.str(), "dir", 3, "dir maps, VPLs and ISMs: reused");
+}
+
+// With bounce slots (medium) a still scene is not reused at once: the bounce light source adds a
+// bounce each frame (kBounceGenerations frames), then the VPLs are reused. The first frame has
+// no previous VPLs to bounce and says so; the fast level has no bounce pass and says so.
+TEST(Dir, WithBounceSlotsStillFramesAreReusedOnceTheBounceSettled) {
+  mrgi::testing::TempDir dir;
+  SyntheticScene scene = SyntheticScene::create(dir.str());
+  aim_at_the_virtual_box(scene);
+  const std::vector<FrameOutput> outs = run(scene, "dir", 2, 6, true);
+  ASSERT_EQ(outs.size(), 6u);
+  auto has = [](const FrameOutput& o, const std::string& note) {
+    for (const std::string& k : o.stats.skipped)
+      if (k.rfind(note, 0) == 0) return true;
+    return false;
+  };
+  const bool reused[] = {false, false, false, false, true, true};
+  for (size_t i = 0; i < outs.size(); ++i)
+    EXPECT_EQ(has(outs[i], "dir maps, VPLs and ISMs: reused"), reused[i]) << "frame " << i;
+  EXPECT_TRUE(has(outs[0], "dir bounce VPLs: no previous frame's VPLs"));
+  EXPECT_FALSE(has(outs[1], "dir bounce VPLs"));
+  EXPECT_TRUE(outs[5].image.data == outs[4].image.data) << "a reused frame differs from the one that made its VPLs";
+  // Each generation adds the next bounce on top of the last: the change shrinks.
+  auto change = [&](size_t a, size_t b) {
+    double sum = 0.0;
+    for (size_t k = 0; k < outs[a].image.data.size(); ++k) sum += std::abs(int(outs[a].image.data[k]) - int(outs[b].image.data[k]));
+    return sum;
+  };
+  std::printf("dir medium, still frames: change 1-2 %.0f, 2-3 %.0f, 3-4 %.0f (sum of 8-bit levels)\n", change(1, 2), change(2, 3),
+              change(3, 4));
+  const std::vector<FrameOutput> fast = run(scene, "dir", 3, 2, false);
+  ASSERT_EQ(fast.size(), 2u);
+  EXPECT_TRUE(has(fast[1], "dir bounce VPLs: none at this level"));
 }
 
 // A spot whose cone misses the virtual objects draws R^mu only (issue 15's skip) and says so.

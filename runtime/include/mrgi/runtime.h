@@ -73,7 +73,10 @@ struct DirAblation {
   // (VPL 3 of Fig. 6), so the real bounce the object blocks is not taken away from L_r (the
   // inconsistent colour bleeding of Fig. 14).
   bool no_real_only_vpls = false;
-  bool any() const { return one_shadow_map || no_real_only_vpls; }
+  // One bounce: no bounce light source (Sec. 3.7), its VPL slots go to the lamps, so the light
+  // stops after the lamps' VPLs (the levels with multiple bounces only).
+  bool one_bounce = false;
+  bool any() const { return one_shadow_map || no_real_only_vpls || one_bounce; }
 };
 
 // Level "last" in the CLI resolves to technique_level_count(name) - 1.

@@ -48,6 +48,9 @@ Expected<VplSampler> VplSampler::create(gpu::FrameGraph& graph, const VplSetting
   auto sp = gpu::load_compute_pipeline(ctx, "gi/vpl_sample.comp", {});
   if (!sp) return sp.error();
   v.sample_ = std::move(*sp);
+  auto cp = gpu::load_compute_pipeline(ctx, "gi/vpl_copy.comp", {});
+  if (!cp) return cp.error();
+  v.copy_ = std::move(*cp);
   return v;
 }
 
@@ -56,6 +59,27 @@ void VplSampler::add_clear(gpu::FrameGraph& graph) const {
   graph.add_pass(
       settings_.name + " clear", gpu::PassKind::Transfer, [b](gpu::PassBuilder& p) { p.write(b, gpu::Access::TransferDst); },
       [b](VkCommandBuffer cmd, gpu::PassContext& p) { vkCmdFillBuffer(cmd, p.buffer(b), 0, VK_WHOLE_SIZE, 0); });
+}
+
+Status VplSampler::add_copy(gpu::FrameGraph& graph, const std::string& id, gpu::BufferHandle source, uint32_t first,
+                            uint32_t count) const {
+  if (count == 0 || first + count > settings_.max_vpls)
+    return fail(ErrorKind::BadUsage, "vpl '" + settings_.name + "': copy into slots " + std::to_string(first) + " + " +
+                                         std::to_string(count) + " outside the " + std::to_string(settings_.max_vpls) +
+                                         " allocated (none is an error too)");
+  const gpu::Pipeline* cp = &*copy_;
+  const gpu::BufferHandle vpls = vpls_;
+  const glm::ivec4 slots(int(first), int(count), 0, 0);
+  graph.add_shader_pass(
+      settings_.name + " copy " + id, gpu::PassKind::Compute, *copy_,
+      [=](gpu::ShaderPassBuilder& b) {
+        b.bind("Source", source);
+        b.bind_over("Vpls", vpls);  // the other slots stay
+      },
+      [cp, slots, count](VkCommandBuffer cmd, gpu::PassContext&) {
+        gpu::push_and_dispatch(cmd, *cp, &slots, sizeof slots, {(count + 63) / 64, 1, 1});
+      });
+  return ok_status();
 }
 
 Status VplSampler::add_sample(gpu::FrameGraph& graph, const std::string& id, const RsmImages& rho, const RsmImages& mu,

@@ -44,6 +44,11 @@ class VplSampler {
   Status add_sample(gpu::FrameGraph& graph, const std::string& id, const RsmImages& rho, const RsmImages& mu,
                     bool real_lamp, uint32_t first, uint32_t count);
 
+  // Slots [first, first + count) from `source` (shader::Vpl[count], the bounce light source's);
+  // the other slots keep what they hold. Pass "<name> copy <id>".
+  Status add_copy(gpu::FrameGraph& graph, const std::string& id, gpu::BufferHandle source, uint32_t first,
+                  uint32_t count) const;
+
   gpu::BufferHandle buffer() const { return vpls_; }  // shader::Vpl[max_vpls]
   uint32_t max_vpls() const { return settings_.max_vpls; }
 
@@ -53,7 +58,7 @@ class VplSampler {
   uint32_t levels_ = 1;
   gpu::ImageHandle pyramid_;
   gpu::BufferHandle vpls_;
-  gpu::PipelineHandle importance_, downsample_, sample_;
+  gpu::PipelineHandle importance_, downsample_, sample_, copy_;
 };
 
 }  // namespace mrgi::gi

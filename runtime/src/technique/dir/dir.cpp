@@ -8,6 +8,7 @@
 #include "gi/ism.h"
 #include "gi/rsm.h"
 #include "gi/vpl.h"
+#include "gi/vpl_bounce.h"
 #include "gpu/pipelines.h"
 #include "gpu/shaders.h"
 #include "light/light_stage.h"
@@ -19,11 +20,11 @@ namespace mrgi::technique {
 
 const std::array<DirLevel, 5>& dir_levels() {
   static const std::array<DirLevel, 5> levels = {{
-      {"paper", 256, 128, 1024, 512, 4, 4, 1, 1.0f, 0},
-      {"high", 256, 64, 512, 256, 4, 4, 1, 1.0f, 0},
-      {"medium", 64, 64, 512, 256, 2, 4, 1, 1.0f, 1},
-      {"fast", 32, 32, 256, 128, 1, 4, 2, 0.5f, 3},
-      {"fastest", 16, 32, 128, 64, 1, 4, 2, 0.5f, 3},
+      {"paper", 256, 64, 128, 1024, 512, 4, 4, 1, 1.0f, 0},
+      {"high", 256, 64, 64, 512, 256, 4, 4, 1, 1.0f, 0},
+      {"medium", 64, 16, 64, 512, 256, 2, 4, 1, 1.0f, 1},
+      {"fast", 32, 0, 32, 256, 128, 1, 4, 2, 0.5f, 3},
+      {"fastest", 16, 0, 32, 128, 64, 1, 4, 2, 0.5f, 3},
   }};
   return levels;
 }
@@ -35,6 +36,7 @@ std::vector<QualityLevel> dir_ladder() {
     q.name = l.name;
     q.internal_scale = l.internal_scale;
     q.knobs = {{"vpls", double(l.vpls), "virtual point lights"},
+               {"bounce_vpls", double(l.bounce_vpls), "of them, the bounce light source's (0: one bounce)"},
                {"ism_size", double(l.ism_size), "texels per side of each VPL's imperfect shadow maps"},
                {"points_per_vpl", double(l.points_per_vpl), "points splatted into each of a VPL's two maps"},
                {"rsm_size", double(l.rsm_size), "texels per side of each reflective shadow map"},
@@ -63,6 +65,9 @@ constexpr float kMinInfluenceSide = 0.25f;
 // The ISM test: a point is lit when its distance is within bias of the map's (relative, and
 // absolute in metres): the maps are sparse splats of a few hundred points, a texel spans degrees.
 constexpr float kIsmBiasRelative = 0.05f, kIsmBiasMetres = 0.01f;
+// Frames the bounce runs on still inputs before the VPLs are reused: each adds a bounce to the
+// last (the light of the lamps' VPLs, then 2, 3, 4 bounces: a path tracer's depth 5).
+constexpr int kBounceGenerations = 3;
 
 class Dir final : public Technique {
  public:
@@ -79,6 +84,13 @@ class Dir final : public Technique {
   std::optional<gi::ReflectiveShadowMaps> rsm_;
   std::optional<gi::VplSampler> vpls_;
   std::optional<gi::ImperfectShadowMaps> ism_;
+  std::optional<gi::VplBounce> bounce_;
+  // What the VPL buffer and ISMs hold from the last frame that made them (the bounce reads them).
+  struct Made {
+    bool valid = false;
+    uint32_t vpls = 0, ism_size = 0, tiles_per_row = 0;
+  } made_;
+  int bounce_generations_ = 0;  // frames the bounce ran on inputs within reuse tolerance
   gpu::ImageHandle indirect_, rows_, merged_;  // RGBA32UI, shaders/dir/indirect_pack.glsl
   gpu::PipelineHandle shade_, merge_rows_, merge_columns_;
   std::unique_ptr<Technique> baseline_;
@@ -102,9 +114,10 @@ Status Dir::init() {
   const SceneGpu& sg = *shared_.scene_gpu;
   if (!shared_.light_stage) return fail(ErrorKind::Internal, "dir: no light stage");
   has_virtual_ = !sg.virtual_objects.empty();
-  uint32_t top_vpls = 1, top_ism = 8, top_rsm = 16, top_lamps = 1;
+  uint32_t top_vpls = 1, top_ism = 8, top_rsm = 16, top_lamps = 1, top_bounce = 0;
   for (const DirLevel& l : dir_levels()) {
     top_vpls = std::max(top_vpls, l.vpls);
+    top_bounce = std::max(top_bounce, l.bounce_vpls);
     top_ism = std::max(top_ism, l.ism_size);
     top_rsm = std::max(top_rsm, l.rsm_size);
     top_lamps = std::max(top_lamps, l.rsm_lamps);
@@ -137,6 +150,15 @@ Status Dir::init() {
     auto ism = gi::ImperfectShadowMaps::create(graph, sg, shared_.real_position, is);
     if (!ism) return ism.error();
     ism_.emplace(std::move(*ism));
+    if (top_bounce > 0 && !shared_.dir_ablation.one_bounce) {
+      gi::VplBounceSettings bs;
+      bs.name = "dir bounce";
+      bs.max_slots = top_bounce;
+      auto bounce = gi::VplBounce::create(graph, sg, ism_->virtual_triangles(),
+                                          {shared_.real_position, shared_.real_normal, shared_.real_albedo}, bs);
+      if (!bounce) return bounce.error();
+      bounce_.emplace(std::move(*bounce));
+    }
   }
   auto image = [&](const char* name) {
     gpu::ImageDesc d;
@@ -180,7 +202,7 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   const DirLevel& level = dir_levels()[size_t(info.level)];
   gpu::FrameGraph& graph = *shared_.graph;
   const light::Lighting& lighting = shared_.light_stage->lighting();
-  skipped.push_back("dir environment VPLs, multiple bounces, glossy VPLs, temporal smoothing: not built yet "
+  skipped.push_back("dir environment VPLs, glossy VPLs, temporal smoothing: not built yet "
                     "(issue 15); the environment lights directly through baseline's regions and ambient");
   FrameInfo base = info;
   base.level = level.baseline_level;
@@ -189,6 +211,7 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   if (!has_virtual_) {
     skipped.push_back("dir VPLs: no virtual object in the scene (the bounce is the same in both solutions)");
     reuse_.forget();
+    made_.valid = false;
     return baseline_->record(base, skipped);
   }
   for (size_t i = 0; i < lighting.lights.size() && planned_.size() < level.rsm_lamps; ++i) {
@@ -202,25 +225,60 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   if (planned_.empty()) {
     skipped.push_back("dir VPLs: no light a map can see the virtual objects from");
     reuse_.forget();
+    made_.valid = false;
     return baseline_->record(base, skipped);
   }
   // The VPLs and ISMs in the buffers stand for this frame's while its inputs stay within
   // tolerance of the frame that made them (technique/input_reuse.h): no map, VPL or ISM pass.
   reuse_.set_frame(info.level, info.camera_to_world, info.input);
   for (const auto& [i, view] : planned_) reuse_.add_lamp(lighting.lights[i]);
-  if (reuse_.close()) {
+  const uint32_t bounce_slots = bounce_ ? level.bounce_vpls : 0;
+  if (bounce_slots == 0)
+    skipped.push_back(level.bounce_vpls == 0 ? "dir bounce VPLs: none at this level (one bounce)"
+                                             : "dir bounce VPLs: off (ablation one-bounce)");
+  // A VPL stands for the light of the map's area over the VPL count, (2 radius)^2 / vpls: its
+  // 1 / d^2 is clamped at that disk's radius.
+  const float clamp_m = 2.0f * radius_ / std::sqrt(float(M_PI) * float(level.vpls));
+  const bool close = reuse_.close();
+  if (close && (bounce_slots == 0 || bounce_generations_ >= kBounceGenerations)) {
     skipped.push_back("dir maps, VPLs and ISMs: reused (level, pose, depth and lamps within tolerance of the frame that made them)");
   } else {
-    // The real grid at about two points a map texel across the G-buffer's larger side (dlpv's rule).
+    bounce_generations_ = close ? bounce_generations_ + 1 : 0;
+    // The G-buffer's focal lengths in its own pixels (the colour camera's, scaled to its size).
     const VkExtent2D g = graph.extent(shared_.real_position);
+    const Intrinsics& c = shared_.color_intrinsics;
+    const glm::vec2 focal_px(float(c.fx * double(g.width) / double(std::max(1, c.width))),
+                             float(c.fy * double(g.height) / double(std::max(1, c.height))));
+    // The bounce light source reads the previous frame's VPLs and ISMs, so it runs first.
+    const bool bounce = bounce_slots > 0 && made_.valid;
+    if (bounce_slots > 0 && !made_.valid)
+      skipped.push_back("dir bounce VPLs: no previous frame's VPLs to bounce (the first frame that makes them)");
+    if (bounce) {
+      gi::BounceFrame bf;
+      bf.slots = bounce_slots;
+      bf.source_vpls = made_.vpls;
+      bf.source_ism_size = made_.ism_size;
+      bf.source_tiles_per_row = made_.tiles_per_row;
+      bf.centre = centre_;
+      bf.radius = radius_;
+      bf.clamp_m = clamp_m;
+      bf.bias_relative = kIsmBiasRelative;
+      bf.bias_m = kIsmBiasMetres;
+      bf.focal_px = focal_px;
+      MRGI_TRY(bounce_->add_bounce(graph, vpls_->buffer(), ism_->distances(), bf));
+    }
+    const uint32_t lamp_vpls = level.vpls - bounce_slots;
+    // The real grid at about two points a map texel across the G-buffer's larger side (dlpv's rule).
     const uint32_t stride = std::max(1u, uint32_t(std::ceil(double(std::max(g.width, g.height)) / (level.rsm_size / 2.0))));
     vpls_->add_clear(graph);
+    if (bounce) MRGI_TRY(vpls_->add_copy(graph, "bounce", bounce_->buffer(), lamp_vpls, bounce_slots));
     rsm_->add_grid(graph, stride);
     const uint32_t lamps = uint32_t(planned_.size());
     uint32_t first = 0;
     for (uint32_t k = 0; k < lamps; ++k) {
       const auto& [i, view] = planned_[k];
-      const uint32_t count = level.vpls / lamps + (k < level.vpls % lamps ? 1 : 0);
+      const uint32_t count = lamp_vpls / lamps + (k < lamp_vpls % lamps ? 1 : 0);
+      if (count == 0) continue;
       const std::string id = std::to_string(i);
       const gi::RsmImages mu = rsm_->images(gi::RsmMap::RealOnly, level.rsm_size);
       if (lamp_reaches_objects(lighting.lights[i])) {
@@ -235,21 +293,15 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
       }
       first += count;
     }
-    // The G-buffer's focal lengths in its own pixels (the colour camera's, scaled to its size).
-    const Intrinsics& c = shared_.color_intrinsics;
     gi::IsmFrame f;
     f.vpls = level.vpls;
     f.map_size = level.ism_size;
     f.points_per_vpl = level.points_per_vpl;
-    f.focal_px = glm::vec2(float(c.fx * double(g.width) / double(std::max(1, c.width))),
-                           float(c.fy * double(g.height) / double(std::max(1, c.height))));
+    f.focal_px = focal_px;
     MRGI_TRY(ism_->add_build(graph, vpls_->buffer(), f));
     reuse_.remember();
+    made_ = {true, level.vpls, level.ism_size, ism_->tiles_per_row(level.vpls)};
   }
-
-  // A VPL stands for the light of the map's area over the VPL count, (2 radius)^2 / vpls: its
-  // 1 / d^2 is clamped at that disk's radius.
-  const float clamp_m = 2.0f * radius_ / std::sqrt(float(M_PI) * float(level.vpls));
   for (gpu::ImageHandle h : {indirect_, rows_, merged_}) MRGI_TRY(graph.set_extent_divisor(h, level.indirect_divisor));
   const VkExtent2D low = graph.extent(indirect_);
   const DirPush push{glm::ivec4(int(level.vpls), int(level.ism_size), int(ism_->tiles_per_row(level.vpls)),
@@ -294,7 +346,6 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   const DirIndirect to_add{merged_, int(level.indirect_divisor)};
   set_dir_indirect(*baseline_, &to_add);
   return baseline_->record(base, skipped);
-  return ok_status();
 }
 
 }  // namespace

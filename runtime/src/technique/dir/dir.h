@@ -10,14 +10,16 @@
 // real/virtual shadow-map pair per lamp, eq. 1-5.
 //
 // Quality ladder (best first; DirLevel below, with units):
-//   level    VPLs  ISM    points/VPL  RSM    RSM lamps  interleave  indirect  internal scale  baseline
-//   paper    256   128^2  1024        512^2  4          4x4         1         1.0             high
-//   high     256    64^2   512        256^2  4          4x4         1         1.0             high
-//   medium    64    64^2   512        256^2  2          4x4         1         1.0             medium
-//   fast      32    32^2   256        128^2  1          4x4         1/2       0.5             lowest
-//   fastest   16    32^2   128         64^2  1          4x4         1/2       0.5             lowest
-// "indirect": the VPL light is shaded at this fraction of the internal resolution and
-// up-sampled geometry-aware in baseline's shading pass (the fast path).
+//   level    VPLs  bounce  ISM    points/VPL  RSM    RSM lamps  interleave  indirect  scale  baseline
+//   paper    256   64      128^2  1024        512^2  4          4x4         1         1.0    high
+//   high     256   64       64^2   512        256^2  4          4x4         1         1.0    high
+//   medium    64   16       64^2   512        256^2  2          4x4         1         1.0    medium
+//   fast      32    0       32^2   256        128^2  1          4x4         1/2       0.5    lowest
+//   fastest   16    0       32^2   128         64^2  1          4x4         1/2       0.5    lowest
+// "bounce": of the VPLs, the slots of the bounce light source (gi/vpl_bounce.h: multiple bounces
+// over frames; 0: one bounce, the fast path); the rest are the lamps'. "indirect": the
+// VPL light is shaded at this fraction of the internal resolution and up-sampled geometry-aware
+// in baseline's shading pass. "scale": internal scale, the fraction of the output's side.
 // "paper" is the paper's settings (Sec. 6: 256 VPLs, 128^2 ISMs, 1024 points a VPL, 4x4 split).
 //
 // Where mrgi differs from the paper and why:
@@ -35,21 +37,28 @@
 //   - interleaved sampling runs in place instead of on a split G-buffer (shade_vpl.comp says why);
 //   - the VPLs' 1 / d^2 is clamped at the radius of the disk a VPL stands for (the map's area
 //     over the VPL count): the paper does not say how it bounds it;
+//   - the bounce light source keeps one candidate a slot drawn in proportion to its flux, not the
+//     strongest (shaders/gi/vpl_bounce.comp: the maximum biases the sum);
 //   - not yet built (they say so in FrameStats::skipped): VPLs of the environment on a hemisphere
 //     (the environment lights directly through baseline's shadowed regions and SH ambient),
-//     multiple bounces, glossy VPLs, temporal smoothing.
+//     glossy VPLs, temporal smoothing.
 // Ablations (mrgi/runtime.h DirAblation, `mrgi replay --dir-ablation`): one ISM a VPL instead of
-// two, no ir(VPL); they change the VPL light only (the direct light keeps baseline's two maps).
+// two, no ir(VPL), one bounce; they change the VPL light only (the direct light keeps baseline's
+// two maps).
 //
 // Skips (each in FrameStats::skipped):
 //   - no virtual object, or no lamp a map can see them from: no maps, VPLs or ISMs (baseline only);
 //   - a spot lamp whose outer cone misses every virtual mesh range's bounding sphere: R^mu only,
 //     read as both maps (R^rho would be its copy);
+//   - no bounce pass at the levels without bounce slots (and none on a frame after one without
+//     VPLs: the bounce reads the previous frame's);
 //   - the maps, VPLs and ISMs are reused, none drawn, sampled or splatted, while the level, the
 //     camera pose, the depth frame and the lamps stay within technique/input_reuse.h's
 //     tolerances of the frame that made them (the virtual objects are static: their pose joins
 //     the comparison with dynamic scenes); a reused frame stays within 4/255 of the recomputed
-//     one at 1.8 mm of depth change (tests/technique/dir_test.cpp: 3/255 measured).
+//     one at 1.8 mm of depth change (tests/technique/dir_test.cpp: 3/255 measured); with bounce
+//     slots only once the bounce has run kBounceGenerations frames on still inputs (each adds
+//     one bounce), so a still scene keeps its multiple bounces.
 // The ISMs' virtual maps are splatted whenever the maps are made: a virtual object outside every
 // lamp's cone still blocks the bounce between real surfaces, which only its ISM shows.
 #pragma once
@@ -64,6 +73,7 @@ namespace mrgi::technique {
 struct DirLevel {
   const char* name;
   uint32_t vpls;            // VPL slots shaded
+  uint32_t bounce_vpls;     // of them, the bounce light source's (0: one bounce)
   uint32_t ism_size;        // texels per side of each VPL's imperfect shadow maps
   uint32_t points_per_vpl;  // points splatted into each of a VPL's two maps
   uint32_t rsm_size;        // texels per side of each reflective shadow map
