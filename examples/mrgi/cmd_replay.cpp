@@ -49,6 +49,7 @@ void run_replay(const ReplayOptions& o) {
     if (a == "one-shadow-map") settings.dir_ablation.one_shadow_map = true;
     if (a == "no-real-only-vpls") settings.dir_ablation.no_real_only_vpls = true;
     if (a == "one-bounce") settings.dir_ablation.one_bounce = true;
+    if (a == "no-environment-vpls") settings.dir_ablation.no_environment_vpls = true;
   }
   if (settings.dir_ablation.any() && o.technique != "dir")
     throw CommandFailure(2, "--dir-ablation: only for --technique dir");
@@ -210,9 +211,10 @@ void setup(CLI::App& app) {
                   "dir without one of the paper's ideas (mrgi/runtime.h DirAblation): one-shadow-map (one ISM a VPL "
                   "with the nearest surface and its kind, not one each), no-real-only-vpls (no ir(VPL): the real bounce "
                   "a virtual object blocks stays in L_r), one-bounce (no bounce light source: the lamps' VPLs only, "
-                  "at the levels with multiple bounces); comma-separated")
+                  "at the levels with multiple bounces), no-environment-vpls (the environment light baseline leaves "
+                  "unshadowed stays unshadowed); comma-separated")
       ->delimiter(',')
-      ->check(CLI::IsMember({"one-shadow-map", "no-real-only-vpls", "one-bounce"}));
+      ->check(CLI::IsMember({"one-shadow-map", "no-real-only-vpls", "one-bounce", "no-environment-vpls"}));
   cmd->add_option("--device", opts->device, "Vulkan device: index or name part (default $MRGI_DEVICE, else lavapipe)");
   cmd->add_flag("--validate", opts->validate, "enable Vulkan validation layers");
   cmd->add_flag("--quiet,-q", opts->quiet, "no progress on stderr");

@@ -14,11 +14,17 @@ using glm::vec4;
 #define MRGI_VPL_REAL_PATH 2  // r(x): its light path holds only real lamps and real surfaces (eq. 9-10)
 #define MRGI_VPL_REAL_ONLY 4  // ir(VPL): lights real surfaces only, in L_r (VPL 3 of the paper's
                               // Fig. 6: a real surface a virtual object hides from the lamp)
+#define MRGI_VPL_DIRECTIONAL 8  // a distant light: a region of the environment (the paper's
+                                // environment VPLs, Sec. 3.7), fields as below
 
+// A point VPL is a diffuse surface point; a directional one (MRGI_VPL_DIRECTIONAL) stands for
+// light arriving from one direction, its shadow map orthographic (gi/ism_common.glsl).
 struct Vpl {
-  vec4 position;  // xyz world (m); w: MRGI_VPL_* bits
-  vec4 normal;    // xyz unit normal of its surface, on the side the light arrived from; w unused
-  vec4 flux;      // rgb reflected flux (W), already divided by the probability of drawing it; w unused
+  vec4 position;  // xyz world (m): the point; directional: the centre of its map. w: MRGI_VPL_* bits
+  vec4 normal;    // xyz unit normal of its surface, on the side the light arrived from; w unused.
+                  // Directional: xyz unit direction towards the light; w the map's half side (m)
+  vec4 flux;      // rgb reflected flux (W), already divided by the probability of drawing it;
+                  // directional: irradiance (W/m^2 at normal incidence). w unused
 };
 
 #ifdef __cplusplus

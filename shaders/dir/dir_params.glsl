@@ -7,7 +7,8 @@ struct DirParams {
   ivec4 vpls;     // x: VPL slots in use; y: ISM side (texels); z: ISM tiles per atlas row;
                   // w: interleave side (4: each pixel of a 4x4 block shades every 16th VPL; 1: all)
   vec4 lighting;  // x: distance clamp (m, vpl_irradiance); y: ISM relative bias; z: ISM bias (m)
-  ivec4 extent;   // x, y: the indirect images' used size; z: G-buffer pixels per indirect texel
+  ivec4 extent;   // x, y: the indirect images' used size; z: G-buffer pixels per indirect texel;
+                  // w: the first environment VPL's slot (x: none), shaded at every pixel
 };
 
 #endif

@@ -19,7 +19,6 @@
 #include "shared/vpl_math.h"
 #include "common/frame_constants.glsl"
 #include "common/vpl.glsl"
-#include "gi/ism_common.glsl"
 #include "dir/dir_params.glsl"
 #include "dir/indirect_pack.glsl"
 
@@ -36,6 +35,7 @@ layout(std430, set = 0, binding = 7) readonly buffer Vpls { Vpl vpls[]; };
 layout(set = 0, binding = 8, rg32f) readonly uniform image2D ism_distances;  // level 0: x real, y virtual
 layout(set = 0, binding = 9, rgba32ui) writeonly uniform uimage2D indirect;  // indirect_pack.glsl
 layout(push_constant) uniform Params { DirParams params_block; };
+#include "gi/vpl_light.glsl"
 // Ablations (mrgi/runtime.h DirAblation), one pipeline each: bit 1 one shadow map (the nearest
 // surface and its kind), bit 2 no ir(VPL) (real-only VPLs light nothing).
 layout(constant_id = 0) const int kAblation = 0;
@@ -72,38 +72,51 @@ void main() {
     vec3 p = pos.xyz;
     int count = params.vpls.x, side = params.vpls.y, row = params.vpls.z, step = params.vpls.w * params.vpls.w;
     int first = params.vpls.w > 1 ? (texel.x % params.vpls.w) + params.vpls.w * (texel.y % params.vpls.w) : 0;
-    for (int j = first; j < count; j += step) {
-      Vpl v = vpls[j];
-      int flags = int(v.position.w);
-      if ((flags & MRGI_VPL_VALID) == 0) continue;
-      bool real_only = (flags & MRGI_VPL_REAL_ONLY) != 0;
-      if (real_only && (is_virtual || kNoRealOnly)) continue;  // ir(VPL): real surfaces only
-      vec3 q = v.position.xyz;
-      float e = vpl_irradiance(p, n, q, v.normal.xyz, 1.0f, params.lighting.x);
-      if (!(e > 0.0f)) continue;
-      vec3 d = p - q;
-      float dist = length(d);
-      ivec2 t = ism_texel(d / dist, v.normal.xyz, side);
-      if (t.x < 0) continue;
-      vec2 stored = imageLoad(ism_distances, ism_tile_origin(j, row, side) + t).xy;
-      float limit = dist * (1.0f - params.lighting.y) - params.lighting.z;
-      float st_r = stored.x >= limit ? 1.0f : 0.0f;
-      float st_v = stored.y >= limit ? 1.0f : 0.0f;
-      if (kOneShadowMap) {  // one map: only the nearest blocker is known, and its kind
-        bool real_nearest = stored.x <= stored.y;
-        st_r = real_nearest ? st_r : 1.0f;
-        st_v = real_nearest ? 1.0f : st_v;
+    // The lamps' and the bounce's VPLs interleaved, each standing for `step` (the merge
+    // averages the block); the environment's (slots [extent.w, count): the direct light of the
+    // environment, the dominant term where it shines) at every pixel, each for itself.
+    int environment = min(params.extent.w, count);
+    for (int k = 0; k < 2; ++k) {
+      int begin = k == 0 ? first : environment, end = k == 0 ? environment : count, stride = k == 0 ? step : 1;
+      float weight = float(stride);
+      for (int j = begin; j < end; j += stride) {
+        Vpl v = vpls[j];
+        int flags = int(v.position.w);
+        if ((flags & MRGI_VPL_VALID) == 0) continue;
+        bool real_only = (flags & MRGI_VPL_REAL_ONLY) != 0;
+        if (real_only && (is_virtual || kNoRealOnly)) continue;  // ir(VPL): real surfaces only
+        float e = vpl_receive(v, p, n, params.lighting.x);
+        if (!(e > 0.0f)) continue;
+        vec2 stored;
+        vec2 st = vpl_visibility(v, j, p, n, side, row, params.lighting.y, params.lighting.z, stored);
+        float st_r = st.x, st_v = st.y;
+        if (kOneShadowMap) {  // one map: only the nearest blocker is known, and its kind
+          bool real_nearest = stored.x <= stored.y;
+          st_r = real_nearest ? st_r : 1.0f;
+          st_v = real_nearest ? 1.0f : st_v;
+        }
+        vec3 l_o = albedo * (1.0f / MRGI_PI) * v.flux.rgb * e;
+        bool real_path = (flags & MRGI_VPL_REAL_PATH) != 0;
+        if ((flags & MRGI_VPL_DIRECTIONAL) != 0) {
+          // An environment region whose light baseline's shading adds unshadowed (its SH
+          // ambient): only what the VPL's maps take away. Real pixels: the paper's difference
+          // L_rv - L_r of this VPL, L_o (min(st_r, st_v) - st_r), into L_rv (L_r keeps baseline's
+          // smooth level, the denominator of the composite; the sparse real ISM's self-shadowing
+          // of real surfaces would make it noisy and cancels in the difference anyway); virtual
+          // pixels: L_o (min(st_r, st_v) - 1), so L_rv holds the region's light times its
+          // visibility, as the paper's.
+          if (is_virtual) l_rv += weight * l_o * (min(st_r, st_v) - 1.0f);
+          else if (real_path) l_rv += weight * l_o * (min(st_r, st_v) - st_r);
+          continue;
+        }
+        if (!real_only) l_rv += weight * l_o * min(st_r, st_v);                          // eq. 6, 8
+        if (!is_virtual && real_path) l_r += weight * l_o * st_r;                         // eq. 7
       }
-      vec3 l_o = albedo * (1.0f / MRGI_PI) * v.flux.rgb * e;
-      if (!real_only) l_rv += l_o * min(st_r, st_v);                                  // eq. 6, 8
-      if (!is_virtual && (flags & MRGI_VPL_REAL_PATH) != 0) l_r += l_o * st_r;        // eq. 7
     }
-    // The pixel's share of the VPLs stands for all of them (the merge averages the block).
-    l_rv *= float(step);
-    l_r *= float(step);
   }
   float camera_distance = surface ? max(distance(pos.xyz, frame.camera_world.xyz), 1e-3f) : 0.0f;
-  uvec4 packed_value = pack_indirect(clamp(l_rv, vec3(0.0f), vec3(60000.0f)), clamp(l_r, vec3(0.0f), vec3(60000.0f)), n,
+  // L_rv may be negative (an environment region's occlusion, taken from baseline's ambient).
+  uvec4 packed_value = pack_indirect(clamp(l_rv, vec3(-60000.0f), vec3(60000.0f)), clamp(l_r, vec3(0.0f), vec3(60000.0f)), n,
                                      camera_distance, is_virtual);
   if (!surface) packed_value.w = 0u;
   imageStore(indirect, texel, packed_value);

@@ -11,6 +11,11 @@
 #define MRGI_ISM_NONE 1.0e30f       // a resolved texel with no surface: the VPL's light passes
 #define MRGI_ISM_MAX_SPLAT_RADIUS 3 // texels each side of a splat's centre
 #define MRGI_ISM_MIN_ELEVATION_COS 0.1f  // points below ~6 degrees over a VPL's plane splat nothing
+// A pull-push parent is valid where this many of its four children are: 1 fills every hole
+// within a 4 x 4 block of a splat, growing a silhouette by up to 3 texels (a virtual object's
+// shadow dilated by a quarter of its size on a 64^2 map); 2 fills the holes of a sparse surface,
+// which have valid neighbours, and grows a silhouette by about one.
+#define MRGI_ISM_PULL_MIN_CHILDREN 2.0f
 
 struct IsmParams {
   ivec4 tiles;   // x: VPL slots mapped; y: map side (texels); z: tiles per atlas row; w: points per VPL
@@ -37,6 +42,20 @@ vec2 ism_point_u(int k, int vpl) {
 ivec2 ism_texel(vec3 w, vec3 n, int side) {
   vec2 uv = paraboloid_uv(w, n);
   if (dot(uv, uv) > 1.0f) return ivec2(-1);
+  return clamp(ivec2(floor((uv * 0.5f + 0.5f) * float(side))), ivec2(0), ivec2(side - 1));
+}
+
+// A directional VPL's map (MRGI_VPL_DIRECTIONAL, common/vpl.glsl): orthographic along the light,
+// a square of 2 x half_side metres around `centre` across it (the tangent frame of the direction
+// `towards` the light), holding each texel's nearest depth from a plane MRGI_ISM_ORTHO_REACH half
+// sides towards the light (casters that far above the centre still shadow it, as gi/rsm.h's
+// directional maps). The texel of p, (-1, -1) outside the square; `depth` p's own depth.
+#define MRGI_ISM_ORTHO_REACH 4.0f
+ivec2 ism_ortho_texel(vec3 p, vec3 centre, vec3 towards, float half_side, int side, out float depth) {
+  vec3 d = p - centre;
+  vec2 uv = vec2(dot(d, frame_tangent(towards)), dot(d, frame_bitangent(towards))) / half_side;
+  depth = max(MRGI_ISM_ORTHO_REACH * half_side - dot(d, towards), 0.0f);
+  if (any(greaterThan(abs(uv), vec2(1.0f)))) return ivec2(-1);
   return clamp(ivec2(floor((uv * 0.5f + 0.5f) * float(side))), ivec2(0), ivec2(side - 1));
 }
 

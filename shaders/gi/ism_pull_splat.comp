@@ -1,7 +1,8 @@
 #version 450
 // Pull-push hole filling of the ISMs (gi/ism.h; Ritschel et al. 2008 Sec. 4, Marroquim et al.
 // 2007), pull from the splats: each texel of level 1 the mean of its four children's distances
-// that a point reached, per atlas (x real, y virtual); -1 where none did. Tiles are a power of
+// that a point reached, per atlas (x real, y virtual), where at least MRGI_ISM_PULL_MIN_CHILDREN
+// did; else -1. Tiles are a power of
 // two wide, so a texel's children never cross into another VPL's tile.
 #extension GL_GOOGLE_include_directive : require
 #include "gi/ism_common.glsl"
@@ -27,5 +28,5 @@ void main() {
     sum += d * valid;
     count += valid;
   }
-  imageStore(coarser, t, vec4(mix(vec2(-1.0f), sum / max(count, vec2(1.0f)), greaterThan(count, vec2(0.0f))), 0.0f, 0.0f));
+  imageStore(coarser, t, vec4(mix(vec2(-1.0f), sum / max(count, vec2(1.0f)), greaterThanEqual(count, vec2(MRGI_ISM_PULL_MIN_CHILDREN))), 0.0f, 0.0f));
 }

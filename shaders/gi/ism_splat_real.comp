@@ -13,6 +13,7 @@ layout(local_size_x = 64) in;
 layout(std430, set = 0, binding = 0) readonly buffer Vpls { Vpl vpls[]; };
 layout(set = 0, binding = 1, rgba32f) uniform readonly image2D real_position;  // xyz world, w depth (0 none)
 layout(set = 0, binding = 2, r32ui) uniform uimage2D splat;
+layout(set = 0, binding = 3, rgba16f) uniform readonly image2D real_normal;
 layout(push_constant) uniform Params { IsmParams params; };
 #include "gi/ism_splat.glsl"
 
@@ -25,5 +26,7 @@ void main() {
   vec4 p = imageLoad(real_position, pixel);
   if (!(p.w > 0.0f)) return;
   float footprint = p.w * p.w / (params.camera.x * params.camera.y);
-  ism_splat(i % n, p.xyz, footprint * float(size.x * size.y) / float(params.tiles.w));
+  vec3 nrm = imageLoad(real_normal, pixel).xyz;
+  float len = length(nrm);
+  ism_splat(i % n, p.xyz, len > 0.0f ? nrm / len : vec3(0.0f), footprint * float(size.x * size.y) / float(params.tiles.w));
 }

@@ -29,5 +29,5 @@ void main() {
   vec2 u = ism_point_u(i / n, i % n);
   float v3 = halton(uint(i / n) + 1u, 11u);  // the third coordinate: another base
   VirtualPoint p = virtual_point(vec3(u, v3), triangles, params.source.y);
-  ism_splat(i % n, p.position, p.area / float(params.tiles.w));
+  ism_splat(i % n, p.position, p.normal, p.area / float(params.tiles.w));
 }

@@ -8,9 +8,10 @@
 //      odd ones the virtual meshes (gi/virtual_points.glsl);
 //   2. a source VPL of the previous frame is drawn by a Halton value in proportion to its flux's
 //      luminance (the paper's importance sampling of the source);
-//   3. the source's light reaching the point (shared/vpl_math.h vpl_irradiance, over the draw's
-//      probability) times the point's diffuse albedo and the area it stands for is the candidate's
-//      reflected flux; its visibility is the source's real and virtual ISMs.
+//   3. the source's light reaching the point (gi/vpl_light.glsl: a point VPL's or an environment
+//      region's, over the draw's probability) times the point's diffuse albedo and the area it
+//      stands for is the candidate's reflected flux; its visibility is the source's real and
+//      virtual ISMs.
 // The paper keeps the strongest candidate of a slot (reversed depth test) and does not say how
 // its intensity is compensated; keeping the maximum biases the sum. mrgi keeps one candidate
 // drawn in proportion to the luminance of its flux and divides its flux by that probability
@@ -25,7 +26,6 @@
 #include "shared/vpl_math.h"
 #include "common/vpl.glsl"
 #include "common/scene_materials.glsl"
-#include "gi/ism_common.glsl"
 
 #define MRGI_BOUNCE_CANDIDATES 64
 #define MRGI_BOUNCE_MAX_SOURCES 256
@@ -50,6 +50,7 @@ layout(push_constant) uniform Params {
   vec4 camera;   // x, y: the G-buffer's focal lengths in its pixels
 } params;
 #include "gi/virtual_points.glsl"
+#include "gi/vpl_light.glsl"
 
 shared float cdf[MRGI_BOUNCE_MAX_SOURCES];
 shared float weight[MRGI_BOUNCE_CANDIDATES];
@@ -61,7 +62,10 @@ void main() {
   int sources = min(params.source.x, MRGI_BOUNCE_MAX_SOURCES);
   for (int j = k; j < sources; j += MRGI_BOUNCE_CANDIDATES) {
     Vpl v = vpls[j];
-    float l = (int(v.position.w) & MRGI_VPL_VALID) != 0 ? luminance(max(v.flux.rgb, vec3(0.0f))) : 0.0f;
+    // The source's power: a point VPL's flux; a directional one's irradiance over its map's
+    // cross-section (the disk of its half side), so both kinds are drawn by what they bring.
+    float power = vpl_directional(v) ? MRGI_PI * v.normal.w * v.normal.w : 1.0f;
+    float l = (int(v.position.w) & MRGI_VPL_VALID) != 0 ? luminance(max(v.flux.rgb, vec3(0.0f))) * power : 0.0f;
     cdf[j] = l > 0.0f && l < 3.0e38f ? l : 0.0f;
   }
   barrier();
@@ -113,7 +117,7 @@ void main() {
   int flags = 0;
   int j = 0;
   if (ok) {
-    float target = halton(index, 7u) * total;
+    float target = halton(index, want_virtual ? 13u : 7u) * total;  // bases apart from the point's
     int lo = 0, hi = sources - 1;
     while (lo < hi) {
       int mid = (lo + hi) / 2;
@@ -125,15 +129,12 @@ void main() {
     int source_flags = int(v.position.w);
     bool source_ir = (source_flags & MRGI_VPL_REAL_ONLY) != 0;
     bool source_real = (source_flags & MRGI_VPL_REAL_PATH) != 0;
-    float e = vpl_irradiance(x, n, v.position.xyz, v.normal.xyz, 1.0f, params.test.x);
+    float e = vpl_receive(v, x, n, params.test.x);
     // 3. Visibility: the source's ISMs of the previous frame.
-    vec3 d = x - v.position.xyz;
-    float dist = length(d);
-    ivec2 t = dist > 0.0f ? ism_texel(d / dist, v.normal.xyz, params.source.y) : ivec2(-1);
-    if (p_source > 0.0f && e > 0.0f && t.x >= 0 && !(want_virtual && source_ir)) {
-      vec2 stored = imageLoad(ism_distances, ism_tile_origin(j, params.source.z, params.source.y) + t).xy;
-      float limit = dist * (1.0f - params.test.y) - params.test.z;
-      bool st_r = stored.x >= limit, st_v = stored.y >= limit;
+    if (p_source > 0.0f && e > 0.0f && !(want_virtual && source_ir)) {
+      vec2 stored;
+      vec2 st = vpl_visibility(v, j, x, n, params.source.y, params.source.z, params.test.y, params.test.z, stored);
+      bool st_r = st.x > 0.5f, st_v = st.y > 0.5f;
       if (want_virtual) {
         flags = st_r && st_v ? MRGI_VPL_VALID : 0;                  // a virtual surface: L_rv only
       } else if (source_ir) {

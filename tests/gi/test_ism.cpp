@@ -31,13 +31,15 @@ struct Maps {
 
 const glm::vec3 kDown(0.0f, -1.0f, 0.0f);
 const glm::vec3 kVpl0(1.0f, 0.5f, 1.0f), kVpl1(0.7f, 0.3f, 0.7f);
+const glm::vec3 kOrthoCentre(1.0f, 0.1f, 1.0f);
+constexpr float kOrthoHalf = 0.3f;
 
 Maps build(gpu::Context& ctx, uint32_t points_per_vpl) {
   test::RsmRig r(ctx);
   gi::IsmSettings is;
   is.max_vpls = 4;
   is.map_size = kSide;
-  auto ism = gi::ImperfectShadowMaps::create(*r.graph, *r.scene, r.real.position, is);
+  auto ism = gi::ImperfectShadowMaps::create(*r.graph, *r.scene, r.real.position, r.real.normal, is);
   EXPECT_TRUE(ism.ok()) << ism.error().message;
   gpu::BufferDesc vd{"test vpls", 4 * sizeof(shader::Vpl), gpu::MemoryUsage::Upload};
   const gpu::BufferHandle vpls = *r.graph->create_buffer(vd, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
@@ -45,14 +47,18 @@ Maps build(gpu::Context& ctx, uint32_t points_per_vpl) {
   v[0] = {glm::vec4(kVpl0, float(MRGI_VPL_VALID)), glm::vec4(kDown, 0.0f), glm::vec4(1.0f)};
   v[1] = {glm::vec4(kVpl1, float(MRGI_VPL_VALID)), glm::vec4(kDown, 0.0f), glm::vec4(1.0f)};
   v[2] = {glm::vec4(0.0f), glm::vec4(kDown, 0.0f), glm::vec4(0.0f)};  // empty slot: splats nothing
+  // A directional VPL (an environment region) straight above: its map is orthographic over the
+  // 0.6 m square around (1, 0.1, 1).
+  v[3] = {glm::vec4(kOrthoCentre, float(MRGI_VPL_VALID | MRGI_VPL_DIRECTIONAL)), glm::vec4(0.0f, 1.0f, 0.0f, kOrthoHalf),
+          glm::vec4(1.0f)};
   Maps out;
-  out.row = ism->tiles_per_row(3);
+  out.row = ism->tiles_per_row(4);
   const uint32_t atlas = out.row * kSide;
   gpu::BufferDesc bd{"ism readback", VkDeviceSize(atlas) * atlas * 8, gpu::MemoryUsage::Readback};
   const gpu::BufferHandle readback = *r.graph->create_buffer(bd, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
   EXPECT_TRUE(r.graph->begin_frame().ok());
   gi::IsmFrame f;
-  f.vpls = 3;
+  f.vpls = 4;
   f.map_size = kSide;
   f.points_per_vpl = points_per_vpl;
   f.focal_px = glm::vec2(1.5f * float(test::kG - 1));  // 1 m across kG - 1 pixel steps at 1.5 m
@@ -109,6 +115,31 @@ TEST_F(VulkanTest, IsmsHoldTheDistanceToTheRealAndTheVirtualSurfaces) {
       filled += (d.x < 1e29f || d.y < 1e29f) ? 1 : 0;
     }
   EXPECT_EQ(filled, 0);
+}
+
+TEST_F(VulkanTest, ADirectionalVplsMapIsOrthographicAlongItsLight) {
+  const Maps m = build(ctx(), 1024);
+  const glm::vec3 up(0.0f, 1.0f, 0.0f);
+  auto texel = [&](glm::vec3 p, float& depth) {
+    float d = 0.0f;
+    const glm::vec3 x = p - kOrthoCentre;
+    const glm::vec2 uv = glm::vec2(glm::dot(x, shader::frame_tangent(up)), glm::dot(x, shader::frame_bitangent(up))) / kOrthoHalf;
+    d = std::max(4.0f * kOrthoHalf - glm::dot(x, up), 0.0f);  // MRGI_ISM_ORTHO_REACH half sides above
+    depth = d;
+    const glm::ivec2 t = glm::clamp(glm::ivec2(glm::floor((uv * 0.5f + 0.5f) * float(kSide))), glm::ivec2(0), glm::ivec2(int(kSide) - 1));
+    const glm::ivec2 origin = glm::ivec2(3 % int(m.row), 3 / int(m.row)) * int(kSide);
+    return m.texels[size_t(origin.y + t.y) * (m.row * kSide) + size_t(origin.x + t.x)];
+  };
+  float depth = 0.0f;
+  // Over the box's middle: the floor (real) at its depth, the box's top (virtual) 0.15 m nearer.
+  glm::vec2 d = texel(glm::vec3(1.0f, 0.0f, 1.0f), depth);
+  EXPECT_NEAR(d.x, depth, 0.01f);
+  EXPECT_NEAR(d.y, depth - 0.15f, 0.01f);
+  // 0.2 m off the box: floor only; no virtual surface (splats and the fill reach a few texels of
+  // 1.9 cm, not 12 cm).
+  d = texel(glm::vec3(1.2f, 0.0f, 0.95f), depth);
+  EXPECT_NEAR(d.x, depth, 0.01f);
+  EXPECT_GT(d.y, 1e29f);
 }
 
 TEST_F(VulkanTest, IsmOfASparseCloudStillCoversTheFloor) {

@@ -30,7 +30,7 @@ std::vector<shader::Vpl> bounce(gpu::Context& ctx, int source_flags) {
   gi::IsmSettings is;
   is.max_vpls = 1;
   is.map_size = 64;
-  auto ism = gi::ImperfectShadowMaps::create(*r.graph, *r.scene, r.real.position, is);
+  auto ism = gi::ImperfectShadowMaps::create(*r.graph, *r.scene, r.real.position, r.real.normal, is);
   EXPECT_TRUE(ism.ok()) << ism.error().message;
   gi::VplBounceSettings bs;
   bs.max_slots = kSlots;

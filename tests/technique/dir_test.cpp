@@ -25,9 +25,10 @@ namespace {
 float lin(uint8_t c) { return shader::srgb_decode1(float(c) / 255.0f); }
 
 std::vector<FrameOutput> run(const SyntheticScene& scene, const std::string& technique, int level, int frames,
-                             bool validate) {
+                             bool validate, const DirAblation& ablation = {}) {
   RuntimeSettings s;
   s.device.validate = validate;
+  s.dir_ablation = ablation;
   s.technique = technique;
   s.level = level;
   auto rt = create_runtime(s, scene.cameras(), scene.scene);
@@ -81,7 +82,10 @@ TEST(Dir, EveryLevelRunsAndItsVplsLightTheObjectBeyondBaseline) {
   aim_at_the_virtual_box(scene);
   for (int level = 0; level < int(technique::dir_levels().size()); ++level) {
     SCOPED_TRACE(level);
-    const std::vector<FrameOutput> outs = run(scene, "dir", level, 3, true);
+    // The lamp's bounce alone (the environment VPLs take the ambient's occlusion away, below).
+    DirAblation no_env;
+    no_env.no_environment_vpls = true;
+    const std::vector<FrameOutput> outs = run(scene, "dir", level, 3, true, no_env);
     ASSERT_EQ(outs.size(), 3u);
     bool not_built = false;
     for (const std::string& k : outs.back().stats.skipped) not_built |= k.find("not built yet") != std::string::npos;
@@ -97,8 +101,12 @@ TEST(Dir, EveryLevelRunsAndItsVplsLightTheObjectBeyondBaseline) {
     // L_r D_v D_r E, only in L_rv): redder than baseline's there.
     const Box& box = scene.virtual_boxes[0];
     const int w = scene.intrinsics.width, h = scene.intrinsics.height;
-    double red = 0.0, green = 0.0;
+    double red = 0.0, green = 0.0, env_change = 0.0;
     int n = 0;
+    // The environment VPLs: the uniform sky the boxes hide from the floor around them (which
+    // baseline's unshadowed SH ambient keeps) is taken away there.
+    const std::vector<FrameOutput> with_env = run(scene, "dir", level, 3, false);
+    ASSERT_EQ(with_env.size(), 3u);
     for (int v = 0; v < h; ++v)
       for (int u = 0; u < w; ++u) {
         const SurfaceHit hit = scene.trace(u, v, true);
@@ -108,12 +116,16 @@ TEST(Dir, EveryLevelRunsAndItsVplsLightTheObjectBeyondBaseline) {
         if (glm::length(glm::vec2(hit.point.x - near.x, hit.point.z - near.z)) > 0.2f) continue;
         const size_t o = (size_t(v) * w + u) * 4;
         red += lin(outs.back().image.data[o]) - lin(base.back().image.data[o]);
+        for (int c = 0; c < 3; ++c) env_change += lin(with_env.back().image.data[o + c]) - lin(outs.back().image.data[o + c]);
         green += lin(outs.back().image.data[o + 1]) - lin(base.back().image.data[o + 1]);
         ++n;
       }
     ASSERT_GT(n, 0);
     EXPECT_GT(red / n, 0.002) << "the boxes' red bounce on the floor around them";
     EXPECT_GT(red, 2.0 * green) << "the bounce takes the boxes' colour (red 0.8, green 0.2)";
+    std::printf("level %d: floor around the boxes, environment VPLs change it by %.5f (linear, mean of RGB)\n", level,
+                env_change / (3.0 * n));
+    EXPECT_LT(env_change / (3.0 * n), -5e-4) << "the boxes shadow the environment's light on the floor around them";
     for (uint8_t c : outs.back().image.data) ASSERT_LE(c, 255);  // (a frame came back whole)
   }
 }

@@ -76,7 +76,10 @@ struct DirAblation {
   // One bounce: no bounce light source (Sec. 3.7), its VPL slots go to the lamps, so the light
   // stops after the lamps' VPLs (the levels with multiple bounces only).
   bool one_bounce = false;
-  bool any() const { return one_shadow_map || no_real_only_vpls || one_bounce; }
+  // No environment VPLs (Sec. 3.7): the environment's regions baseline does not shadow stay its
+  // unshadowed SH ambient, so a virtual object casts no shadow of that light.
+  bool no_environment_vpls = false;
+  bool any() const { return one_shadow_map || no_real_only_vpls || one_bounce || no_environment_vpls; }
 };
 
 // Level "last" in the CLI resolves to technique_level_count(name) - 1.

@@ -33,7 +33,8 @@ uint32_t ImperfectShadowMaps::tiles_per_row(uint32_t vpls) const {
 }
 
 Expected<ImperfectShadowMaps> ImperfectShadowMaps::create(gpu::FrameGraph& graph, const technique::SceneGpu& scene,
-                                                          gpu::ImageHandle real_position, const IsmSettings& s) {
+                                                          gpu::ImageHandle real_position, gpu::ImageHandle real_normal,
+                                                          const IsmSettings& s) {
   if (s.name.empty()) return ism_setting_error("name", "must not be empty");
   if (s.max_vpls < 1 || s.max_vpls > 4096) return ism_setting_error("max_vpls", "must be 1..4096");
   if (!std::has_single_bit(s.map_size) || s.map_size < 8 || s.map_size > 512)
@@ -42,6 +43,7 @@ Expected<ImperfectShadowMaps> ImperfectShadowMaps::create(gpu::FrameGraph& graph
   m.settings_ = s;
   m.scene_ = &scene;
   m.real_position_ = real_position;
+  m.real_normal_ = real_normal;
   const uint32_t atlas = m.tiles_per_row(s.max_vpls) * s.map_size;
   auto image = [&](const std::string& what, VkFormat format, uint32_t levels, bool history = false) {
     gpu::ImageDesc d;
@@ -140,12 +142,13 @@ Status ImperfectShadowMaps::add_build(gpu::FrameGraph& graph, gpu::BufferHandle 
   const IsmPush real_push{glm::ivec4(int(f.vpls), int(f.map_size), int(row), int(f.points_per_vpl)),
                           glm::ivec4(int(g.width), int(g.height), 0, 0), glm::vec4(f.focal_px, 0.0f, 0.0f)};
   const gpu::Pipeline* splat_real = &*splat_real_pipe_;
-  const gpu::ImageHandle position = real_position_;
+  const gpu::ImageHandle position = real_position_, normal = real_normal_;
   graph.add_shader_pass(
       settings_.name + " splat real", gpu::PassKind::Compute, *splat_real_pipe_,
       [=](gpu::ShaderPassBuilder& b) {
         b.bind("Vpls", vpls);
         b.bind("real_position", position);
+        b.bind("real_normal", normal);
         b.bind("splat", sr);
       },
       [=](VkCommandBuffer cmd, gpu::PassContext&) {

@@ -48,10 +48,11 @@ struct IsmFrame {
 
 class ImperfectShadowMaps {
  public:
-  // `real_position`: the real G-buffer (xyz world, w depth, 0 none). BadUsage naming the field
-  // for settings out of range.
+  // `real_position`, `real_normal`: the real G-buffer (xyz world, w depth, 0 none; unit normal).
+  // BadUsage naming the field for settings out of range.
   static Expected<ImperfectShadowMaps> create(gpu::FrameGraph& graph, const technique::SceneGpu& scene,
-                                              gpu::ImageHandle real_position, const IsmSettings& settings);
+                                              gpu::ImageHandle real_position, gpu::ImageHandle real_normal,
+                                              const IsmSettings& settings);
   // Passes "<name> clear", "<name> splat real", "<name> splat virtual" (with virtual objects),
   // "<name> pull 1", "<name> pull 2", "<name> push 1", "<name> resolve".
   Status add_build(gpu::FrameGraph& graph, gpu::BufferHandle vpls, const IsmFrame& frame);
@@ -65,7 +66,7 @@ class ImperfectShadowMaps {
   ImperfectShadowMaps() = default;
   IsmSettings settings_;
   const technique::SceneGpu* scene_ = nullptr;
-  gpu::ImageHandle real_position_;
+  gpu::ImageHandle real_position_, real_normal_;
   gpu::ImageHandle splat_real_, splat_virtual_, distances_;
   VirtualTriangles virtual_;
   gpu::PipelineHandle clear_, splat_real_pipe_, splat_virtual_pipe_, pull_splat_, pull_, push_, resolve_;

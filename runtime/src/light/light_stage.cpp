@@ -155,6 +155,11 @@ void LightStage::finish_declared() {
   e.timestamp = t;
 }
 
+const std::vector<EnvLight>& LightStage::environment_regions() const {
+  static const std::vector<EnvLight> none;
+  return lighting_.environment && env_ && env_->valid() ? env_->lights() : none;
+}
+
 void LightStage::set_environment_lighting(bool real) {
   // Lamps first (unchanged), then the strongest regions as shadowed directional lights; the SH
   // of the other regions is the ambient.

@@ -116,6 +116,12 @@ class LightStage {
                        int solve_bands, std::vector<std::string>& notes);
 
   const Lighting& lighting() const { return lighting_; }
+  // Every region of this frame's environment cut (strongest first; empty without an environment
+  // or before its first image), for the techniques that light with all of it (dir's environment
+  // VPLs); their region_sh add up to the environment's SH. `environment_real()`: scene.json's
+  // environment.real.
+  const std::vector<EnvLight>& environment_regions() const;
+  bool environment_real() const { return scene_.environment.real; }
   const LightEstimator& estimator() const { return *estimator_; }
   // The largest number of shadowed lights any frame can have (for shadow map allocation).
   int max_lights() const { return max_lights_; }

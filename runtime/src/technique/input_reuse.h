@@ -39,7 +39,8 @@ class InputReuse {
   void forget() { source_.valid = false; }
   size_t lamp_count() const { return now_.lamp_count; }
 
-  static constexpr size_t kMaxLamps = light::kMaxStageLights;
+  // The stage's lamps and up to 16 environment regions (dir's environment VPLs).
+  static constexpr size_t kMaxLamps = light::kMaxStageLights + 16;
 
  private:
   struct Source {

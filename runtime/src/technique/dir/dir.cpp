@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 
+#include "common/vpl.glsl"
 #include "gi/ism.h"
 #include "gi/rsm.h"
 #include "gi/vpl.h"
@@ -20,11 +21,11 @@ namespace mrgi::technique {
 
 const std::array<DirLevel, 5>& dir_levels() {
   static const std::array<DirLevel, 5> levels = {{
-      {"paper", 256, 64, 128, 1024, 512, 4, 4, 1, 1.0f, 0},
-      {"high", 256, 64, 64, 512, 256, 4, 4, 1, 1.0f, 0},
-      {"medium", 64, 16, 64, 512, 256, 2, 4, 1, 1.0f, 1},
-      {"fast", 32, 0, 32, 256, 128, 1, 4, 2, 0.5f, 3},
-      {"fastest", 16, 0, 32, 128, 64, 1, 4, 2, 0.5f, 3},
+      {"paper", 256, 64, 16, 128, 1024, 512, 4, 4, 1, 1.0f, 0},
+      {"high", 256, 64, 16, 64, 512, 256, 4, 4, 1, 1.0f, 0},
+      {"medium", 64, 16, 16, 64, 512, 256, 2, 4, 1, 1.0f, 1},
+      {"fast", 32, 0, 8, 32, 256, 128, 1, 4, 2, 0.5f, 3},
+      {"fastest", 16, 0, 4, 32, 128, 64, 1, 4, 2, 0.5f, 3},
   }};
   return levels;
 }
@@ -37,6 +38,7 @@ std::vector<QualityLevel> dir_ladder() {
     q.internal_scale = l.internal_scale;
     q.knobs = {{"vpls", double(l.vpls), "virtual point lights"},
                {"bounce_vpls", double(l.bounce_vpls), "of them, the bounce light source's (0: one bounce)"},
+               {"env_vpls", double(l.env_vpls), "of them, at most this many environment regions' (directional VPLs)"},
                {"ism_size", double(l.ism_size), "texels per side of each VPL's imperfect shadow maps"},
                {"points_per_vpl", double(l.points_per_vpl), "points splatted into each of a VPL's two maps"},
                {"rsm_size", double(l.rsm_size), "texels per side of each reflective shadow map"},
@@ -68,6 +70,8 @@ constexpr float kIsmBiasRelative = 0.05f, kIsmBiasMetres = 0.01f;
 // Frames the bounce runs on still inputs before the VPLs are reused: each adds a bounce to the
 // last (the light of the lamps' VPLs, then 2, 3, 4 bounces: a path tracer's depth 5).
 constexpr int kBounceGenerations = 3;
+// Environment VPLs allocated (the most any level places).
+constexpr uint32_t kMaxEnvVpls = 16;
 
 class Dir final : public Technique {
  public:
@@ -91,6 +95,7 @@ class Dir final : public Technique {
     uint32_t vpls = 0, ism_size = 0, tiles_per_row = 0;
   } made_;
   int bounce_generations_ = 0;  // frames the bounce ran on inputs within reuse tolerance
+  gpu::BufferHandle env_vpls_;  // this frame's environment VPLs (upload, per frame slot)
   gpu::ImageHandle indirect_, rows_, merged_;  // RGBA32UI, shaders/dir/indirect_pack.glsl
   gpu::PipelineHandle shade_, merge_rows_, merge_columns_;
   std::unique_ptr<Technique> baseline_;
@@ -147,7 +152,7 @@ Status Dir::init() {
     is.max_vpls = top_vpls;
     is.map_size = top_ism;
     is.history = true;
-    auto ism = gi::ImperfectShadowMaps::create(graph, sg, shared_.real_position, is);
+    auto ism = gi::ImperfectShadowMaps::create(graph, sg, shared_.real_position, shared_.real_normal, is);
     if (!ism) return ism.error();
     ism_.emplace(std::move(*ism));
     if (top_bounce > 0 && !shared_.dir_ablation.one_bounce) {
@@ -160,6 +165,10 @@ Status Dir::init() {
       bounce_.emplace(std::move(*bounce));
     }
   }
+  gpu::BufferDesc ed{"dir environment vpls", VkDeviceSize(kMaxEnvVpls) * sizeof(shader::Vpl), gpu::MemoryUsage::Upload};
+  auto env = graph.create_buffer(ed, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  if (!env) return env.error();
+  env_vpls_ = *env;
   auto image = [&](const char* name) {
     gpu::ImageDesc d;
     d.name = name;
@@ -202,8 +211,7 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   const DirLevel& level = dir_levels()[size_t(info.level)];
   gpu::FrameGraph& graph = *shared_.graph;
   const light::Lighting& lighting = shared_.light_stage->lighting();
-  skipped.push_back("dir environment VPLs, glossy VPLs, temporal smoothing: not built yet "
-                    "(issue 15); the environment lights directly through baseline's regions and ambient");
+  skipped.push_back("dir glossy VPLs, temporal smoothing: not built yet (issue 15)");
   FrameInfo base = info;
   base.level = level.baseline_level;
   set_dir_indirect(*baseline_, nullptr);
@@ -232,7 +240,26 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   // tolerance of the frame that made them (technique/input_reuse.h): no map, VPL or ISM pass.
   reuse_.set_frame(info.level, info.camera_to_world, info.input);
   for (const auto& [i, view] : planned_) reuse_.add_lamp(lighting.lights[i]);
+  // Environment VPLs: the strongest regions of the stage's cut, one directional VPL each.
+  const std::vector<light::EnvLight>& regions = shared_.light_stage->environment_regions();
   const uint32_t bounce_slots = bounce_ ? level.bounce_vpls : 0;
+  // The regions baseline shades with shadow maps at its level come first in the cut; the VPLs
+  // take the next ones, whose light baseline adds unshadowed in its SH ambient.
+  size_t shadowed = 0;
+  for (uint8_t f : lighting.foldable) shadowed += f != 0 ? 1 : 0;
+  shadowed = std::min(shadowed, size_t(std::max(0, baseline_levels()[size_t(level.baseline_level)].shadowed_estimated_lights)));
+  const size_t first_region = std::min(shadowed, regions.size());
+  const uint32_t env_slots =
+      shared_.dir_ablation.no_environment_vpls
+          ? 0u
+          : std::min({level.env_vpls, uint32_t(regions.size() - first_region), level.vpls - bounce_slots - 1});
+  for (uint32_t k = 0; k < env_slots; ++k) {
+    LightDesc l;
+    l.type = LightType::Directional;
+    l.direction = glm::vec3(-regions[first_region + k].direction);
+    l.color = glm::vec3(regions[first_region + k].irradiance);
+    reuse_.add_lamp(l);
+  }
   if (bounce_slots == 0)
     skipped.push_back(level.bounce_vpls == 0 ? "dir bounce VPLs: none at this level (one bounce)"
                                              : "dir bounce VPLs: off (ablation one-bounce)");
@@ -267,11 +294,21 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
       bf.focal_px = focal_px;
       MRGI_TRY(bounce_->add_bounce(graph, vpls_->buffer(), ism_->distances(), bf));
     }
-    const uint32_t lamp_vpls = level.vpls - bounce_slots;
+    const uint32_t lamp_vpls = level.vpls - bounce_slots - env_slots;
     // The real grid at about two points a map texel across the G-buffer's larger side (dlpv's rule).
     const uint32_t stride = std::max(1u, uint32_t(std::ceil(double(std::max(g.width, g.height)) / (level.rsm_size / 2.0))));
     vpls_->add_clear(graph);
     if (bounce) MRGI_TRY(vpls_->add_copy(graph, "bounce", bounce_->buffer(), lamp_vpls, bounce_slots));
+    if (env_slots > 0) {
+      auto* env = static_cast<shader::Vpl*>(graph.mapped(env_vpls_, graph.slot()));
+      const float flags = float(MRGI_VPL_VALID | MRGI_VPL_DIRECTIONAL |
+                                (shared_.light_stage->environment_real() ? MRGI_VPL_REAL_PATH : 0));
+      for (uint32_t k = 0; k < env_slots; ++k) {
+        const light::EnvLight& r = regions[first_region + k];
+        env[k] = {glm::vec4(centre_, flags), glm::vec4(glm::vec3(r.direction), radius_), glm::vec4(glm::vec3(r.irradiance), 0.0f)};
+      }
+      MRGI_TRY(vpls_->add_copy(graph, "environment", env_vpls_, lamp_vpls + bounce_slots, env_slots));
+    }
     rsm_->add_grid(graph, stride);
     const uint32_t lamps = uint32_t(planned_.size());
     uint32_t first = 0;
@@ -307,7 +344,7 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   const DirPush push{glm::ivec4(int(level.vpls), int(level.ism_size), int(ism_->tiles_per_row(level.vpls)),
                                 int(level.interleave)),
                      glm::vec4(clamp_m, kIsmBiasRelative, kIsmBiasMetres, 0.0f),
-                     glm::ivec4(int(low.width), int(low.height), int(level.indirect_divisor), 0)};
+                     glm::ivec4(int(low.width), int(low.height), int(level.indirect_divisor), int(level.vpls - env_slots))};
   const SharedResources& r = shared_;
   const gpu::Pipeline* shade = &*shade_;
   const gpu::BufferHandle vpl_buffer = vpls_->buffer();

@@ -10,14 +10,18 @@
 // real/virtual shadow-map pair per lamp, eq. 1-5.
 //
 // Quality ladder (best first; DirLevel below, with units):
-//   level    VPLs  bounce  ISM    points/VPL  RSM    RSM lamps  interleave  indirect  scale  baseline
-//   paper    256   64      128^2  1024        512^2  4          4x4         1         1.0    high
-//   high     256   64       64^2   512        256^2  4          4x4         1         1.0    high
-//   medium    64   16       64^2   512        256^2  2          4x4         1         1.0    medium
-//   fast      32    0       32^2   256        128^2  1          4x4         1/2       0.5    lowest
-//   fastest   16    0       32^2   128         64^2  1          4x4         1/2       0.5    lowest
+//   level    VPLs  bounce  env  ISM    points/VPL  RSM    RSM lamps  interleave  indirect  scale  baseline
+//   paper    256   64      16   128^2  1024        512^2  4          4x4         1         1.0    high
+//   high     256   64      16    64^2   512        256^2  4          4x4         1         1.0    high
+//   medium    64   16      16    64^2   512        256^2  2          4x4         1         1.0    medium
+//   fast      32    0       8    32^2   256        128^2  1          4x4         1/2       0.5    lowest
+//   fastest   16    0       4    32^2   128         64^2  1          4x4         1/2       0.5    lowest
 // "bounce": of the VPLs, the slots of the bounce light source (gi/vpl_bounce.h: multiple bounces
-// over frames; 0: one bounce, the fast path); the rest are the lamps'. "indirect": the
+// over frames; 0: one bounce, the fast path). "env": of the VPLs, at most this many
+// environment VPLs (Sec. 3.7): the light stage's median-cut regions, strongest first, each a
+// directional VPL with an orthographic ISM around the virtual objects, carrying its region's
+// light with visibility into both solutions; baseline then shades no region and keeps the SH of
+// the regions without a VPL as its ambient. The rest of the slots are the lamps'. "indirect": the
 // VPL light is shaded at this fraction of the internal resolution and up-sampled geometry-aware
 // in baseline's shading pass. "scale": internal scale, the fraction of the output's side.
 // "paper" is the paper's settings (Sec. 6: 256 VPLs, 128^2 ISMs, 1024 points a VPL, 4x4 split).
@@ -39,9 +43,12 @@
 //     over the VPL count): the paper does not say how it bounds it;
 //   - the bounce light source keeps one candidate a slot drawn in proportion to its flux, not the
 //     strongest (shaders/gi/vpl_bounce.comp: the maximum biases the sum);
-//   - not yet built (they say so in FrameStats::skipped): VPLs of the environment on a hemisphere
-//     (the environment lights directly through baseline's shadowed regions and SH ambient),
-//     glossy VPLs, temporal smoothing.
+//   - environment VPLs are the light stage's median-cut regions (equal-energy regions: importance
+//     sampling, as the paper's hierarchical warping of the fisheye image) as directional VPLs with
+//     orthographic ISMs over the influence sphere, not point VPLs on a hemisphere: a point on a
+//     hemisphere a few radii out lights the sphere's near side several times its far side (1/d^2)
+//     and sees it through a few texels of its map;
+//   - not yet built (they say so in FrameStats::skipped): glossy VPLs, temporal smoothing.
 // Ablations (mrgi/runtime.h DirAblation, `mrgi replay --dir-ablation`): one ISM a VPL instead of
 // two, no ir(VPL), one bounce; they change the VPL light only (the direct light keeps baseline's
 // two maps).
@@ -74,6 +81,7 @@ struct DirLevel {
   const char* name;
   uint32_t vpls;            // VPL slots shaded
   uint32_t bounce_vpls;     // of them, the bounce light source's (0: one bounce)
+  uint32_t env_vpls;        // of them, at most this many environment regions' (directional)
   uint32_t ism_size;        // texels per side of each VPL's imperfect shadow maps
   uint32_t points_per_vpl;  // points splatted into each of a VPL's two maps
   uint32_t rsm_size;        // texels per side of each reflective shadow map
