@@ -18,12 +18,12 @@
 //   fastest   16    0       4    32^2   128         64^2  1          4x4         1/2       0.5    lowest
 // "bounce": of the VPLs, the slots of the bounce light source (gi/vpl_bounce.h: multiple bounces
 // over frames; 0: one bounce, the fast path). "env": of the VPLs, at most this many
-// environment VPLs (Sec. 3.7): the light stage's median-cut regions, strongest first, each a
-// directional VPL with an orthographic ISM around the virtual objects, carrying its region's
-// light with visibility into both solutions; baseline then shades no region and keeps the SH of
-// the regions without a VPL as its ambient. The rest of the slots are the lamps'. "indirect": the
-// VPL light is shaded at this fraction of the internal resolution and up-sampled geometry-aware
-// in baseline's shading pass. "scale": internal scale, the fraction of the output's side.
+// environment VPLs (Sec. 3.7): the light stage's median-cut regions after those baseline shades
+// with shadow maps at its level, each a directional VPL with an orthographic ISM over the
+// influence sphere, shaded at every pixel (not interleaved: it is direct light); its light is in
+// baseline's SH ambient, unshadowed, so the VPL adds what its maps take away (below). The rest
+// of the slots are the lamps'. "indirect": the VPL light is shaded at this fraction of the
+// internal resolution and up-sampled geometry-aware in baseline's shading pass. "scale": internal scale, the fraction of the output's side.
 // "paper" is the paper's settings (Sec. 6: 256 VPLs, 128^2 ISMs, 1024 points a VPL, 4x4 split).
 //
 // Where mrgi differs from the paper and why:
@@ -45,13 +45,18 @@
 //     strongest (shaders/gi/vpl_bounce.comp: the maximum biases the sum);
 //   - environment VPLs are the light stage's median-cut regions (equal-energy regions: importance
 //     sampling, as the paper's hierarchical warping of the fisheye image) as directional VPLs with
-//     orthographic ISMs over the influence sphere, not point VPLs on a hemisphere: a point on a
-//     hemisphere a few radii out lights the sphere's near side several times its far side (1/d^2)
-//     and sees it through a few texels of its map;
+//     orthographic ISMs, not point VPLs on a hemisphere (a point a few radii out lights the
+//     sphere's near side several times its far side and sees it through a few texels); and they
+//     correct baseline's unshadowed ambient instead of carrying the light themselves: on real
+//     pixels L_rv gets L_o (min(st_r, st_v) - st_r), the paper's L_rv - L_r of the VPL, while L_r
+//     keeps baseline's smooth level (the composite divides by it; the sparse real ISM's
+//     self-shadowing made it noisy: env_fisheye real RDE 1.31 carrying the light, 0.87 so); on
+//     virtual pixels L_o (min(st_r, st_v) - 1), so L_rv holds the region's light times its
+//     visibility as the paper's. The strongest regions keep baseline's shadow maps;
 //   - not yet built (they say so in FrameStats::skipped): glossy VPLs, temporal smoothing.
 // Ablations (mrgi/runtime.h DirAblation, `mrgi replay --dir-ablation`): one ISM a VPL instead of
-// two, no ir(VPL), one bounce; they change the VPL light only (the direct light keeps baseline's
-// two maps).
+// two, no ir(VPL), one bounce, no environment VPLs; they change the VPL light only (the lamps'
+// direct light keeps baseline's two maps).
 //
 // Skips (each in FrameStats::skipped):
 //   - no virtual object, or no lamp a map can see them from: no maps, VPLs or ISMs (baseline only);
