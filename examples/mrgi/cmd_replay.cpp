@@ -50,6 +50,7 @@ void run_replay(const ReplayOptions& o) {
     if (a == "no-real-only-vpls") settings.dir_ablation.no_real_only_vpls = true;
     if (a == "one-bounce") settings.dir_ablation.one_bounce = true;
     if (a == "no-environment-vpls") settings.dir_ablation.no_environment_vpls = true;
+    if (a == "no-temporal-smoothing") settings.dir_ablation.no_temporal_smoothing = true;
   }
   if (settings.dir_ablation.any() && o.technique != "dir")
     throw CommandFailure(2, "--dir-ablation: only for --technique dir");
@@ -212,9 +213,10 @@ void setup(CLI::App& app) {
                   "with the nearest surface and its kind, not one each), no-real-only-vpls (no ir(VPL): the real bounce "
                   "a virtual object blocks stays in L_r), one-bounce (no bounce light source: the lamps' VPLs only, "
                   "at the levels with multiple bounces), no-environment-vpls (the environment light baseline leaves "
-                  "unshadowed stays unshadowed); comma-separated")
+                  "unshadowed stays unshadowed), no-temporal-smoothing (each frame's VPL light alone); comma-separated")
       ->delimiter(',')
-      ->check(CLI::IsMember({"one-shadow-map", "no-real-only-vpls", "one-bounce", "no-environment-vpls"}));
+      ->check(CLI::IsMember({"one-shadow-map", "no-real-only-vpls", "one-bounce", "no-environment-vpls",
+                             "no-temporal-smoothing"}));
   cmd->add_option("--device", opts->device, "Vulkan device: index or name part (default $MRGI_DEVICE, else lavapipe)");
   cmd->add_flag("--validate", opts->validate, "enable Vulkan validation layers");
   cmd->add_flag("--quiet,-q", opts->quiet, "no progress on stderr");

@@ -2,6 +2,8 @@
 // lamp, a virtual bunny on a real desk in front of a wall), validation on: each changes the
 // frames (it is not ignored) and keeps them finite. The synthetic scene of tests/technique has
 // no real surface the changed VPL light reaches (a flat floor seen from above), hence this one.
+// (no_environment_vpls: this capture has no environment; tests/technique/dir_test.cpp measures
+// it on the synthetic scene's sky.)
 #include <gtest/gtest.h>
 
 #include <string>
@@ -29,11 +31,12 @@ TEST(DirAblation, EachChangesTheFrames) {
   run(DirAblation{}, paper);
   if (HasFatalFailure()) return;
   ASSERT_FALSE(paper.empty());
-  DirAblation one, no_ir;
+  DirAblation one, no_ir, one_bounce;
   one.one_shadow_map = true;
   no_ir.no_real_only_vpls = true;
-  for (const DirAblation& a : {one, no_ir}) {
-    SCOPED_TRACE(a.one_shadow_map ? "one_shadow_map" : "no_real_only_vpls");
+  one_bounce.one_bounce = true;  // level 1 (high) has bounce slots
+  for (const DirAblation& a : {one, no_ir, one_bounce}) {
+    SCOPED_TRACE(a.one_shadow_map ? "one_shadow_map" : a.no_real_only_vpls ? "no_real_only_vpls" : "one_bounce");
     std::vector<FrameOutput> outs;
     run(a, outs);
     if (HasFatalFailure()) return;

@@ -146,7 +146,9 @@ TEST(Dir, WithBounceSlotsStillFramesAreReusedOnceTheBounceSettled) {
   mrgi::testing::TempDir dir;
   SyntheticScene scene = SyntheticScene::create(dir.str());
   aim_at_the_virtual_box(scene);
-  const std::vector<FrameOutput> outs = run(scene, "dir", 2, 6, true);
+  DirAblation plain;  // the frames themselves, not the smoothing's convergence
+  plain.no_temporal_smoothing = true;
+  const std::vector<FrameOutput> outs = run(scene, "dir", 2, 6, true, plain);
   ASSERT_EQ(outs.size(), 6u);
   auto has = [](const FrameOutput& o, const std::string& note) {
     for (const std::string& k : o.stats.skipped)
@@ -170,6 +172,35 @@ TEST(Dir, WithBounceSlotsStillFramesAreReusedOnceTheBounceSettled) {
   const std::vector<FrameOutput> fast = run(scene, "dir", 3, 2, false);
   ASSERT_EQ(fast.size(), 2u);
   EXPECT_TRUE(has(fast[1], "dir bounce VPLs: none at this level"));
+}
+
+// Temporal smoothing (shaders/dir/temporal.comp): on still frames (reused VPLs) it converges to
+// the frame itself, so it adds no bias, and the first frame, with no history, says so. (Its
+// damping of VPL flicker is measured on the suite's captures, where camera motion re-samples
+// the VPLs: perf/tools/temporal_stability.py, perf/results/dir/; the synthetic scene's VPLs are
+// the same from frame to frame.)
+TEST(Dir, TemporalSmoothingKeepsStillFramesAndSaysWhenItHasNoHistory) {
+  mrgi::testing::TempDir dir;
+  SyntheticScene scene = SyntheticScene::create(dir.str());
+  aim_at_the_virtual_box(scene);
+  DirAblation off;
+  off.no_temporal_smoothing = true;
+  const std::vector<FrameOutput> on = run(scene, "dir", 3, 8, true), plain = run(scene, "dir", 3, 8, false, off);
+  ASSERT_EQ(on.size(), 8u);
+  ASSERT_EQ(plain.size(), 8u);
+  int worst = 0;
+  for (size_t k = 0; k < on.back().image.data.size(); ++k)
+    worst = std::max(worst, std::abs(int(on.back().image.data[k]) - int(plain.back().image.data[k])));
+  std::printf("dir fast, still frames: smoothed and plain differ by at most %d / 255 after 8 frames\n", worst);
+  EXPECT_LE(worst, 1) << "on still frames the smoothed light is the frame's own";
+  auto has = [](const FrameOutput& o, const std::string& note) {
+    for (const std::string& k : o.stats.skipped)
+      if (k.rfind(note, 0) == 0) return true;
+    return false;
+  };
+  EXPECT_TRUE(has(on.front(), "dir temporal smoothing: no history"));
+  EXPECT_FALSE(has(on.back(), "dir temporal smoothing"));
+  EXPECT_TRUE(has(plain.back(), "dir temporal smoothing: off"));
 }
 
 // A spot whose cone misses the virtual objects draws R^mu only (issue 15's skip) and says so.

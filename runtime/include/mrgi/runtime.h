@@ -79,7 +79,12 @@ struct DirAblation {
   // No environment VPLs (Sec. 3.7): the environment's regions baseline does not shadow stay its
   // unshadowed SH ambient, so a virtual object casts no shadow of that light.
   bool no_environment_vpls = false;
-  bool any() const { return one_shadow_map || no_real_only_vpls || one_bounce || no_environment_vpls; }
+  // No temporal smoothing of the VPL light (the paper's [4]: blending the previous frame's by a
+  // confidence from normal, position and illumination change): each frame's VPLs alone.
+  bool no_temporal_smoothing = false;
+  bool any() const {
+    return one_shadow_map || no_real_only_vpls || one_bounce || no_environment_vpls || no_temporal_smoothing;
+  }
 };
 
 // Level "last" in the CLI resolves to technique_level_count(name) - 1.

@@ -21,11 +21,11 @@ namespace mrgi::technique {
 
 const std::array<DirLevel, 5>& dir_levels() {
   static const std::array<DirLevel, 5> levels = {{
-      {"paper", 256, 64, 16, 128, 1024, 512, 4, 4, 1, 1.0f, 0},
-      {"high", 256, 64, 16, 64, 512, 256, 4, 4, 1, 1.0f, 0},
-      {"medium", 64, 16, 16, 64, 512, 256, 2, 4, 1, 1.0f, 1},
-      {"fast", 32, 0, 8, 32, 256, 128, 1, 4, 2, 0.5f, 3},
-      {"fastest", 16, 0, 4, 32, 128, 64, 1, 4, 2, 0.5f, 3},
+      {"paper", 256, 64, 16, 128, 1024, 512, 4, 4, 1, 1.0f, 0.0f, 0},
+      {"high", 256, 64, 16, 64, 512, 256, 4, 4, 1, 1.0f, 0.0f, 0},
+      {"medium", 64, 16, 16, 64, 512, 256, 2, 4, 1, 1.0f, 0.0f, 1},
+      {"fast", 32, 0, 8, 32, 256, 128, 1, 4, 2, 0.5f, 0.5f, 3},
+      {"fastest", 16, 0, 4, 32, 128, 64, 1, 4, 2, 0.5f, 0.5f, 3},
   }};
   return levels;
 }
@@ -36,6 +36,7 @@ std::vector<QualityLevel> dir_ladder() {
     QualityLevel q;
     q.name = l.name;
     q.internal_scale = l.internal_scale;
+    q.mesh_error_px = l.mesh_error_px;
     q.knobs = {{"vpls", double(l.vpls), "virtual point lights"},
                {"bounce_vpls", double(l.bounce_vpls), "of them, the bounce light source's (0: one bounce)"},
                {"env_vpls", double(l.env_vpls), "of them, at most this many environment regions' (directional VPLs)"},
@@ -46,6 +47,7 @@ std::vector<QualityLevel> dir_ladder() {
                {"interleave", double(l.interleave), "side of the interleaved-sampling block (pixels)"},
                {"indirect_divisor", double(l.indirect_divisor), "G-buffer pixels per side of an indirect-light texel"},
                {"internal_scale", double(l.internal_scale), "fraction of the output width and height"},
+               {"mesh_error_px", double(l.mesh_error_px), "largest projected error of the virtual meshes' level of detail (internal pixels)"},
                {"baseline_level", double(l.baseline_level), "baseline's level for the direct light"}};
     out.push_back(q);
   }
@@ -72,6 +74,19 @@ constexpr float kIsmBiasRelative = 0.05f, kIsmBiasMetres = 0.01f;
 constexpr int kBounceGenerations = 3;
 // Environment VPLs allocated (the most any level places).
 constexpr uint32_t kMaxEnvVpls = 16;
+// Temporal smoothing (shaders/dir/temporal.comp): the share of the history kept at full
+// confidence (a time constant of about 1 / (1 - 0.8) = 5 frames, the flicker of a VPL set
+// averaged over that many), and the relative luminance change where the confidence starts to
+// fall (to 0 at twice it).
+constexpr float kTemporalBlend = 0.8f, kTemporalChange = 0.5f;
+
+// shaders/dir/temporal.comp Params.
+struct TemporalPush {
+  glm::mat4 previous_world_to_camera;
+  glm::vec4 previous_camera;
+  glm::ivec4 extent;
+  glm::vec4 params;
+};
 
 class Dir final : public Technique {
  public:
@@ -97,7 +112,15 @@ class Dir final : public Technique {
   int bounce_generations_ = 0;  // frames the bounce ran on inputs within reuse tolerance
   gpu::BufferHandle env_vpls_;  // this frame's environment VPLs (upload, per frame slot)
   gpu::ImageHandle indirect_, rows_, merged_;  // RGBA32UI, shaders/dir/indirect_pack.glsl
-  gpu::PipelineHandle shade_, merge_rows_, merge_columns_;
+  gpu::ImageHandle smoothed_[2];               // temporal smoothing, alternate frames (history)
+  gpu::PipelineHandle shade_, merge_rows_, merge_columns_, temporal_;
+  // What the last smoothed image was made from: valid, its level, which image, the pose.
+  struct History {
+    bool valid = false;
+    int level = -1;
+    int image = 0;
+    glm::dmat4 camera_to_world{1.0};
+  } history_;
   std::unique_ptr<Technique> baseline_;
   // This frame's lamps with VPLs (light index, view); reserved at init (no allocation per frame).
   std::vector<std::pair<size_t, gi::RsmView>> planned_;
@@ -184,6 +207,15 @@ Status Dir::init() {
   auto merged = image("dir indirect merged");
   if (!merged) return merged.error();
   merged_ = *merged;
+  for (int k = 0; k < 2; ++k) {
+    gpu::ImageDesc d;
+    d.name = k == 0 ? "dir indirect smoothed 0" : "dir indirect smoothed 1";
+    d.format = VK_FORMAT_R32G32B32A32_UINT;
+    d.history = true;  // read by the next frame
+    auto h = graph.create_image(d, VK_IMAGE_USAGE_STORAGE_BIT);
+    if (!h) return h.error();
+    smoothed_[k] = *h;
+  }
   // The shading pass with the ablations compiled in (shade_vpl.comp kAblation), the others plain.
   const DirAblation& ablation = shared_.dir_ablation;
   const uint32_t ablation_bits = (ablation.one_shadow_map ? 1u : 0u) | (ablation.no_real_only_vpls ? 2u : 0u);
@@ -192,7 +224,8 @@ Status Dir::init() {
   auto shade = gpu::create_compute_pipeline(graph.context(), {"dir shade vpls", *shade_spv, {}, sizeof(DirPush), {ablation_bits}});
   if (!shade) return shade.error();
   shade_ = gpu::PipelineHandle(graph.context(), std::move(*shade));
-  for (auto [shader, out] : {std::pair{"dir/merge_rows.comp", &merge_rows_}, std::pair{"dir/merge_columns.comp", &merge_columns_}}) {
+  for (auto [shader, out] : {std::pair{"dir/merge_rows.comp", &merge_rows_}, std::pair{"dir/merge_columns.comp", &merge_columns_},
+                             std::pair{"dir/temporal.comp", &temporal_}}) {
     auto p = gpu::load_compute_pipeline(graph.context(), shader, {});
     if (!p) return p.error();
     *out = std::move(*p);
@@ -211,7 +244,7 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   const DirLevel& level = dir_levels()[size_t(info.level)];
   gpu::FrameGraph& graph = *shared_.graph;
   const light::Lighting& lighting = shared_.light_stage->lighting();
-  skipped.push_back("dir glossy VPLs, temporal smoothing: not built yet (issue 15)");
+  skipped.push_back("dir glossy VPLs: not built yet (issue 15); every VPL reflects diffusely");
   FrameInfo base = info;
   base.level = level.baseline_level;
   set_dir_indirect(*baseline_, nullptr);
@@ -220,6 +253,7 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     skipped.push_back("dir VPLs: no virtual object in the scene (the bounce is the same in both solutions)");
     reuse_.forget();
     made_.valid = false;
+    history_.valid = false;
     return baseline_->record(base, skipped);
   }
   for (size_t i = 0; i < lighting.lights.size() && planned_.size() < level.rsm_lamps; ++i) {
@@ -234,6 +268,7 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     skipped.push_back("dir VPLs: no light a map can see the virtual objects from");
     reuse_.forget();
     made_.valid = false;
+    history_.valid = false;
     return baseline_->record(base, skipped);
   }
   // The VPLs and ISMs in the buffers stand for this frame's while its inputs stay within
@@ -339,7 +374,8 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     reuse_.remember();
     made_ = {true, level.vpls, level.ism_size, ism_->tiles_per_row(level.vpls)};
   }
-  for (gpu::ImageHandle h : {indirect_, rows_, merged_}) MRGI_TRY(graph.set_extent_divisor(h, level.indirect_divisor));
+  for (gpu::ImageHandle h : {indirect_, rows_, merged_, smoothed_[0], smoothed_[1]})
+    MRGI_TRY(graph.set_extent_divisor(h, level.indirect_divisor));
   const VkExtent2D low = graph.extent(indirect_);
   const DirPush push{glm::ivec4(int(level.vpls), int(level.ism_size), int(ism_->tiles_per_row(level.vpls)),
                                 int(level.interleave)),
@@ -380,7 +416,38 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
       [merge_columns, push, low](VkCommandBuffer cmd, gpu::PassContext&) {
         gpu::dispatch_2d(cmd, *merge_columns, &push, sizeof push, low.width, low.height);
       });
-  const DirIndirect to_add{merged_, int(level.indirect_divisor)};
+  DirIndirect to_add{merged_, int(level.indirect_divisor)};
+  if (shared_.dir_ablation.no_temporal_smoothing) {
+    skipped.push_back("dir temporal smoothing: off (ablation no-temporal-smoothing)");
+    history_.valid = false;
+  } else {
+    // The previous frame's smoothed light is the history while it was made at this level (the
+    // same grid and intrinsics); the pose may differ (reprojected).
+    const bool have = history_.valid && history_.level == info.level;
+    const int read = history_.image, write = 1 - history_.image;
+    const glm::dmat4 previous = history_.camera_to_world;
+    const TemporalPush tp{glm::mat4(glm::inverse(previous)), glm::vec4(glm::vec3(previous[3]), have ? 1.0f : 0.0f),
+                          glm::ivec4(int(low.width), int(low.height), int(level.indirect_divisor), 0),
+                          glm::vec4(kTemporalBlend, 0.0f, 0.0f, kTemporalChange)};
+    const gpu::Pipeline* temporal = &*temporal_;
+    const gpu::ImageHandle history = smoothed_[read], smoothed = smoothed_[write];
+    graph.add_shader_pass(
+        "dir temporal", gpu::PassKind::Compute, *temporal_,
+        [&](gpu::ShaderPassBuilder& b) {
+          b.bind("FrameUbo", r.frame_constants);
+          b.bind("real_position", r.real_position);
+          b.bind("virtual_position", r.virtual_position);
+          b.bind("merged", merged);
+          b.bind("history", history);
+          b.bind("smoothed", smoothed);
+        },
+        [temporal, tp, low](VkCommandBuffer cmd, gpu::PassContext&) {
+          gpu::dispatch_2d(cmd, *temporal, &tp, sizeof tp, low.width, low.height);
+        });
+    if (!have) skipped.push_back("dir temporal smoothing: no history at this level yet (the frame's own light)");
+    history_ = {true, info.level, write, info.camera_to_world};
+    to_add.merged = smoothed_[write];
+  }
   set_dir_indirect(*baseline_, &to_add);
   return baseline_->record(base, skipped);
 }

@@ -53,10 +53,14 @@
 //     self-shadowing made it noisy: env_fisheye real RDE 1.31 carrying the light, 0.87 so); on
 //     virtual pixels L_o (min(st_r, st_v) - 1), so L_rv holds the region's light times its
 //     visibility as the paper's. The strongest regions keep baseline's shadow maps;
-//   - not yet built (they say so in FrameStats::skipped): glossy VPLs, temporal smoothing.
+//   - temporal smoothing (the paper's [4]) reprojects the previous frame's smoothed light by the
+//     pose and blends it by a confidence from the change of normal and camera distance (the
+//     merge's same-surface test on the reprojected taps) and of the light's luminance
+//     (shaders/dir/temporal.comp), after the merge, at the indirect light's resolution;
+//   - not yet built (it says so in FrameStats::skipped): glossy VPLs.
 // Ablations (mrgi/runtime.h DirAblation, `mrgi replay --dir-ablation`): one ISM a VPL instead of
-// two, no ir(VPL), one bounce, no environment VPLs; they change the VPL light only (the lamps'
-// direct light keeps baseline's two maps).
+// two, no ir(VPL), one bounce, no environment VPLs, no temporal smoothing; they change the VPL
+// light only (the lamps' direct light keeps baseline's two maps).
 //
 // Skips (each in FrameStats::skipped):
 //   - no virtual object, or no lamp a map can see them from: no maps, VPLs or ISMs (baseline only);
@@ -94,6 +98,7 @@ struct DirLevel {
   uint32_t interleave;      // side of the interleaving block (4: 4x4, 1: every pixel every VPL)
   uint32_t indirect_divisor;  // G-buffer pixels per side of an indirect-light texel (1, 2, 4)
   float internal_scale;     // fraction of the output width and height
+  float mesh_error_px;      // QualityLevel::mesh_error_px: the virtual G-buffer's level of detail
   int baseline_level;       // baseline's level for the direct light
 };
 const std::array<DirLevel, 5>& dir_levels();
