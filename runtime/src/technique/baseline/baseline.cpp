@@ -256,7 +256,7 @@ Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped
   grid_ = caster_grid(graph.extent(shared_.real_position), shadow_size_, level.caster_cell_shadow_texels);
   const SceneGpu& sg = *shared_.scene_gpu;
   const SharedResources& s = shared_;
-  MRGI_TRY(update_lights(level.shadowed_estimated_lights));
+  MRGI_TRY(update_lights(dir_ && dir_->shadowed_estimated >= 0 ? dir_->shadowed_estimated : level.shadowed_estimated_lights));
 
   if (plan_.primary.empty()) {
     skipped.push_back("shadow_primary: no lamp in the scene");

@@ -69,6 +69,10 @@ void set_volume_bounce(Technique& baseline, const VolumeBounce* bounce);
 struct DirIndirect {
   gpu::ImageHandle merged;  // RGBA32UI
   int divisor = 1;
+  // Of the estimated lights, how many get shadow maps this frame instead of the level's
+  // BaselineLevel::shadowed_estimated_lights (-1: the level's); the rest light as SH ambient
+  // (dir's fast levels: its environment VPLs shadow them).
+  int shadowed_estimated = -1;
 };
 // As set_volume_bounce: for the next record(); nullptr: none.
 void set_dir_indirect(Technique& baseline, const DirIndirect* indirect);

@@ -21,11 +21,11 @@ namespace mrgi::technique {
 
 const std::array<DirLevel, 5>& dir_levels() {
   static const std::array<DirLevel, 5> levels = {{
-      {"paper", 256, 64, 16, 128, 1024, 512, 4, 4, 1, 1.0f, 0.0f, 0},
-      {"high", 256, 64, 16, 64, 512, 256, 4, 4, 1, 1.0f, 0.0f, 0},
-      {"medium", 64, 16, 16, 64, 512, 256, 2, 4, 1, 1.0f, 0.0f, 1},
-      {"fast", 32, 0, 8, 32, 256, 128, 1, 4, 2, 0.5f, 0.5f, 3},
-      {"fastest", 16, 0, 4, 32, 128, 64, 1, 4, 2, 0.5f, 0.5f, 3},
+      {"paper", 256, 64, 16, 128, 1024, 512, 4, 4, 1, 1.0f, 0.0f, -1, 0},
+      {"high", 256, 64, 16, 64, 512, 256, 4, 4, 1, 1.0f, 0.0f, -1, 0},
+      {"medium", 64, 16, 16, 64, 512, 256, 2, 4, 1, 1.0f, 0.0f, -1, 1},
+      {"fast", 32, 0, 8, 32, 256, 128, 1, 4, 2, 0.5f, 0.5f, 0, 3},
+      {"fastest", 16, 0, 4, 32, 128, 64, 1, 4, 2, 0.5f, 0.5f, 0, 3},
   }};
   return levels;
 }
@@ -48,6 +48,7 @@ std::vector<QualityLevel> dir_ladder() {
                {"indirect_divisor", double(l.indirect_divisor), "G-buffer pixels per side of an indirect-light texel"},
                {"internal_scale", double(l.internal_scale), "fraction of the output width and height"},
                {"mesh_error_px", double(l.mesh_error_px), "largest projected error of the virtual meshes' level of detail (internal pixels)"},
+               {"shadowed_env", double(l.shadowed_env), "environment regions baseline shadows with maps (-1: its level's)"},
                {"baseline_level", double(l.baseline_level), "baseline's level for the direct light"}};
     out.push_back(q);
   }
@@ -282,7 +283,12 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   // take the next ones, whose light baseline adds unshadowed in its SH ambient.
   size_t shadowed = 0;
   for (uint8_t f : lighting.foldable) shadowed += f != 0 ? 1 : 0;
-  shadowed = std::min(shadowed, size_t(std::max(0, baseline_levels()[size_t(level.baseline_level)].shadowed_estimated_lights)));
+  // A level that leaves the regions' shadows to the VPLs (shadowed_env >= 0) does so only when
+  // there are environment VPLs (else the estimated lights, the probeless one too, keep their maps).
+  const bool env_override = level.shadowed_env >= 0 && !shared_.dir_ablation.no_environment_vpls && !regions.empty();
+  const int baseline_shadowed =
+      env_override ? level.shadowed_env : baseline_levels()[size_t(level.baseline_level)].shadowed_estimated_lights;
+  shadowed = std::min(shadowed, size_t(std::max(0, baseline_shadowed)));
   const size_t first_region = std::min(shadowed, regions.size());
   const uint32_t env_slots =
       shared_.dir_ablation.no_environment_vpls
@@ -417,6 +423,7 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
         gpu::dispatch_2d(cmd, *merge_columns, &push, sizeof push, low.width, low.height);
       });
   DirIndirect to_add{merged_, int(level.indirect_divisor)};
+  to_add.shadowed_estimated = env_override ? level.shadowed_env : -1;
   if (shared_.dir_ablation.no_temporal_smoothing) {
     skipped.push_back("dir temporal smoothing: off (ablation no-temporal-smoothing)");
     history_.valid = false;

@@ -99,6 +99,7 @@ struct DirLevel {
   uint32_t indirect_divisor;  // G-buffer pixels per side of an indirect-light texel (1, 2, 4)
   float internal_scale;     // fraction of the output width and height
   float mesh_error_px;      // QualityLevel::mesh_error_px: the virtual G-buffer's level of detail
+  int shadowed_env;         // environment regions baseline shadows with maps (-1: its level's)
   int baseline_level;       // baseline's level for the direct light
 };
 const std::array<DirLevel, 5>& dir_levels();
