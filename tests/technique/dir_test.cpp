@@ -264,5 +264,22 @@ TEST_P(DirStress, ThousandFramesStayFiniteAndDoNotGrow) {
 INSTANTIATE_TEST_SUITE_P(Variants, DirStress, ::testing::Range(0, int(std::size(kStress))),
                          [](const ::testing::TestParamInfo<int>& info) { return std::string(kStress[info.param].name); });
 
+// The same at medium, whose bounce light source feeds each frame's VPLs on the last frame's: 1,000
+// generations of bounces must not grow (the estimator's expected flux is the surfaces' albedo
+// times what reaches them, below 1 a bounce).
+class DirStressMultiBounce : public ::testing::TestWithParam<int> {};
+
+TEST_P(DirStressMultiBounce, ThousandFramesStayFiniteAndDoNotGrow) {
+  mrgi::testing::TempDir dir;
+  StressOutcome o;
+  ASSERT_GT(technique::dir_levels()[2].bounce_vpls, 0u);
+  run_stress(kStress[GetParam()], dir.str(), "dir", 2, "dir maps, VPLs and ISMs: reused", 1000, o);
+  if (HasFatalFailure()) return;
+  check_stress_outcome(o);
+}
+
+INSTANTIATE_TEST_SUITE_P(Variants, DirStressMultiBounce, ::testing::Values(0),
+                         [](const ::testing::TestParamInfo<int>& info) { return std::string(kStress[info.param].name); });
+
 }  // namespace
 }  // namespace mrgi::test
