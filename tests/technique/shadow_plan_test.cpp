@@ -91,6 +91,31 @@ TEST(ShadowPlan, SpotAndDirectionalMapsCoverTheirTargets) {
   }
 }
 
+// The level of detail a face draws the virtual meshes at (ShadowFace::lod_*): a geometric error
+// of e metres at distance d projects to e x focal / d texels, as the face's projection maps it
+// (checked against the matrix: 1 cm across the view at the target, in NDC x side / 2 texels).
+TEST(ShadowPlan, FacesKnowTheirTexelScaleForTheMeshesLevelOfDetail) {
+  SceneDesc scene;
+  LightDesc spot = lamp(LightType::Spot, true, {0, 2, 0}, {0, -1, 0});
+  spot.outer_angle_deg = 40.0f;
+  scene.lights = {spot, lamp(LightType::Directional, false, {0, 0, 0}, glm::normalize(glm::vec3(1, -2, 0)))};
+  Bounds b;
+  b.add({-0.3f, 0.0f, -0.3f}, {0.3f, 0.5f, 0.3f});
+  auto plan = plan_shadow_maps(scene, b);
+  ASSERT_TRUE(plan.ok());
+  const float side = 256.0f;
+  for (const ShadowFace& f : plan->primary) {
+    SCOPED_TRACE(f.light);
+    ASSERT_GT(f.lod_focal_per_texel, 0.0f);
+    const glm::mat4& m = plan->light_set.face_view_proj[f.light * 6 + f.face];
+    const glm::vec3 target = f.light == 0 ? glm::vec3(0, 0, 0) : glm::vec3(0, 0.25f, 0);
+    const glm::vec3 across = f.light == 0 ? glm::vec3(0.01f, 0, 0) : glm::vec3(0, 0, 0.01f);
+    const float texels = glm::length(glm::vec2(ndc(m, target + across) - ndc(m, target))) * 0.5f * side;
+    const float predicted = 0.01f * f.lod_focal_per_texel * side / glm::length(target - f.lod_eye);
+    EXPECT_NEAR(predicted / texels, 1.0f, 0.02f);
+  }
+}
+
 TEST(ShadowPlan, RefusesTooManyLampsAndZeroDirections) {
   SceneDesc scene;
   scene.path = "scene.json";
