@@ -66,14 +66,20 @@ TEST(ShadowPlan, CubeFacesSeeWhatTheShaderLooksUpInThem) {
   }
 }
 
-TEST(ShadowPlan, SpotAndDirectionalMapsCoverTheirTargets) {
+// A real spot straight down from 2 m (40-degree cone) and a virtual directional lamp, over a
+// 0.6 x 0.5 x 0.6 m box of bounds.
+Expected<ShadowPlan> spot_and_directional(Bounds& b) {
   SceneDesc scene;
   LightDesc spot = lamp(LightType::Spot, true, {0, 2, 0}, {0, -1, 0});
   spot.outer_angle_deg = 40.0f;
   scene.lights = {spot, lamp(LightType::Directional, false, {0, 0, 0}, glm::normalize(glm::vec3(1, -2, 0)))};
-  Bounds b;
   b.add({-0.3f, 0.0f, -0.3f}, {0.3f, 0.5f, 0.3f});
-  auto plan = plan_shadow_maps(scene, b);
+  return plan_shadow_maps(scene, b);
+}
+
+TEST(ShadowPlan, SpotAndDirectionalMapsCoverTheirTargets) {
+  Bounds b;
+  auto plan = spot_and_directional(b);
   ASSERT_TRUE(plan.ok());
   // A floor point on the spot's 35-degree line is inside its map; one at 85 degrees is not.
   const glm::vec3 inside = ndc(plan->light_set.face_view_proj[0], {2.0f * std::tan(glm::radians(35.0f)), 0, 0});
@@ -95,13 +101,8 @@ TEST(ShadowPlan, SpotAndDirectionalMapsCoverTheirTargets) {
 // of e metres at distance d projects to e x focal / d texels, as the face's projection maps it
 // (checked against the matrix: 1 cm across the view at the target, in NDC x side / 2 texels).
 TEST(ShadowPlan, FacesKnowTheirTexelScaleForTheMeshesLevelOfDetail) {
-  SceneDesc scene;
-  LightDesc spot = lamp(LightType::Spot, true, {0, 2, 0}, {0, -1, 0});
-  spot.outer_angle_deg = 40.0f;
-  scene.lights = {spot, lamp(LightType::Directional, false, {0, 0, 0}, glm::normalize(glm::vec3(1, -2, 0)))};
   Bounds b;
-  b.add({-0.3f, 0.0f, -0.3f}, {0.3f, 0.5f, 0.3f});
-  auto plan = plan_shadow_maps(scene, b);
+  auto plan = spot_and_directional(b);
   ASSERT_TRUE(plan.ok());
   const float side = 256.0f;
   for (const ShadowFace& f : plan->primary) {
