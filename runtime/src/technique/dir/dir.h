@@ -7,7 +7,10 @@
 // (shaders/dir/shade_vpl.comp, eq. 6-8), interleaved 4x4 and merged geometry-aware
 // (shaders/dir/merge_rows.comp, merge_columns.comp: separable); baseline's shading pass adds it
 // to both solutions with its direct light, at the level's baseline level: the same
-// real/virtual shadow-map pair per lamp, eq. 1-5.
+// real/virtual shadow-map pair per lamp, eq. 1-5. Beside the lamps' VPLs: the bounce light
+// source's (gi/vpl_bounce.h: VPLs lit by last frame's, eq. 9-10, multiple bounces over frames)
+// and the environment's (directional VPLs, one per median-cut region); the merged light is
+// smoothed over frames (shaders/dir/temporal.comp) before baseline adds it.
 //
 // Quality ladder (best first; DirLevel below, with units):
 //   level    VPLs  bounce  env  ISM    points/VPL  RSM    RSM lamps  interleave  indirect  scale  baseline
