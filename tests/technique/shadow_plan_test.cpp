@@ -97,7 +97,7 @@ TEST(ShadowPlan, SpotAndDirectionalMapsCoverTheirTargets) {
   }
 }
 
-// The level of detail a face draws the virtual meshes at (ShadowFace::lod_*): a geometric error
+// The level of detail a face draws the virtual meshes at (ShadowFace::lod_per_texel): an error
 // of e metres at distance d projects to e x focal / d texels, as the face's projection maps it
 // (checked against the matrix: 1 cm across the view at the target, in NDC x side / 2 texels).
 TEST(ShadowPlan, FacesKnowTheirTexelScaleForTheMeshesLevelOfDetail) {
@@ -107,12 +107,12 @@ TEST(ShadowPlan, FacesKnowTheirTexelScaleForTheMeshesLevelOfDetail) {
   const float side = 256.0f;
   for (const ShadowFace& f : plan->primary) {
     SCOPED_TRACE(f.light);
-    ASSERT_GT(f.lod_focal_per_texel, 0.0f);
+    ASSERT_GT(f.lod_per_texel.focal_px, 0.0f);
     const glm::mat4& m = plan->light_set.face_view_proj[f.light * 6 + f.face];
     const glm::vec3 target = f.light == 0 ? glm::vec3(0, 0, 0) : glm::vec3(0, 0.25f, 0);
     const glm::vec3 across = f.light == 0 ? glm::vec3(0.01f, 0, 0) : glm::vec3(0, 0, 0.01f);
     const float texels = glm::length(glm::vec2(ndc(m, target + across) - ndc(m, target))) * 0.5f * side;
-    const float predicted = 0.01f * f.lod_focal_per_texel * side / glm::length(target - f.lod_eye);
+    const float predicted = 0.01f * f.lod_per_texel.focal_px * side / glm::length(target - f.lod_per_texel.camera_world);
     EXPECT_NEAR(predicted / texels, 1.0f, 0.02f);
   }
 }

@@ -61,9 +61,10 @@ struct DlpvAblation {
   bool any() const { return two_volumes || no_negative_damping || no_half_cell_shift || no_virtual_self_bounce; }
 };
 
-// Ablations of the `dir` technique (DIR paper Sec. 3.3: what its two ideas for the VPLs are
-// worth; the defaults are the paper's method). Read at start-up. They change the VPL light only:
-// the direct light is baseline's two shadow maps either way.
+// Ablations of the `dir` technique (DIR paper Sec. 3.3 and 3.7: what its ideas for the VPLs are
+// worth; the defaults are the paper's method). Read at start-up. They change the VPL light; the
+// lamps' direct light is baseline's two shadow maps either way (no_environment_vpls also gives
+// the fast levels' environment regions back to baseline's maps).
 struct DirAblation {
   // One imperfect shadow map per VPL holding the nearest surface, real or virtual, with a flag
   // for which (Knecht et al. 2010, the paper's [4]), instead of one each: a real surface behind a

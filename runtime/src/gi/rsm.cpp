@@ -55,10 +55,7 @@ Expected<RsmView> rsm_view(const LightDesc& lamp, const glm::vec3& centre, float
     v.axis = glm::vec4(dir, 0.0f);
     v.lpv.direction_or_position = dir;
     v.lpv.positional = false;
-    // Orthographic: an error of e metres covers e / texel texels anywhere; as LodView's
-    // perspective rule with the eye far away (distance D, focal D / texel).
-    constexpr float kFar = 1.0e4f;
-    v.lod = {centre - dir * kFar, kFar / texel, 0.5f};
+    v.lod = technique::orthographic_lod_view(centre, dir, texel, 0.5f);
     return v;
   }
   const glm::vec3 to_centre = centre - lamp.position;

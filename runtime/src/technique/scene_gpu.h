@@ -14,6 +14,7 @@
 #include "gpu/pipelines.h"
 #include "mrgi/expected.h"
 #include "mrgi/scene.h"
+#include "technique/lod_view.h"
 
 namespace mrgi::technique {
 
@@ -44,15 +45,6 @@ struct DrawRange {
   };
   std::vector<Lod> lods;
   glm::vec3 bounds_min{0.0f}, bounds_max{0.0f};  // world AABB of the range's vertices
-};
-
-// What a draw needs to choose a level of detail: the camera centre (world) and the focal
-// length in pixels of the image drawn; a range is drawn with the coarsest level whose error,
-// projected at the range's nearest distance from the camera, stays within `max_error_px`.
-struct LodView {
-  glm::vec3 camera_world{0.0f};
-  float focal_px = 0.0f;
-  float max_error_px = 0.5f;
 };
 
 struct MeshSet {

@@ -416,8 +416,10 @@ void Baseline::render_faces(VkCommandBuffer cmd, gpu::PassContext& pass,
       if (virtuals) {
         // The coarsest level of detail within half a map texel: finer geometry the map cannot
         // hold (desk_spot's bunny at full detail into 256^2 maps: 2 ms of a 30 ms frame).
-        const LodView lod{face.lod_eye, face.lod_focal_per_texel * float(s), kCasterErrorTexels};
-        sg.virtual_objects.draw(cmd, pass, nullptr, nullptr, face.lod_focal_per_texel > 0.0f ? &lod : nullptr);
+        LodView lod = face.lod_per_texel;
+        lod.focal_px *= float(s);
+        lod.max_error_px = kCasterErrorTexels;
+        sg.virtual_objects.draw(cmd, pass, nullptr, nullptr, lod.focal_px > 0.0f ? &lod : nullptr);
       }
     }
     vkCmdEndRendering(cmd);

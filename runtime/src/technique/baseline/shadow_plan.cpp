@@ -83,18 +83,17 @@ Status plan_shadow_maps(const std::vector<LightDesc>& lights, const Bounds& boun
 
     const int faces = l.type == LightType::Point ? 6 : 1;
     glm::mat4 mats[6];
-    glm::vec3 lod_eye = l.position;
-    float lod_focal = 0.0f;  // per texel of the map's side
+    LodView lod{l.position, 0.0f, 0.0f};  // for a map one texel wide
     if (l.type == LightType::Point) {
       for (int f = 0; f < 6; ++f)
         mats[f] = perspective_view_proj(l.position, kCubeDirs[f], glm::radians(90.0f));
       g.cone.z = 2.0f;  // 2 tan(45 deg)
-      lod_focal = 1.0f / g.cone.z;
+      lod.focal_px = 1.0f / g.cone.z;
     } else if (l.type == LightType::Spot) {
       const float fov = std::min(2.0f * outer, glm::radians(kMaxSpotFovDeg));
       mats[0] = perspective_view_proj(l.position, dir, fov);
       g.cone.z = 2.0f * std::tan(0.5f * fov);
-      lod_focal = 1.0f / g.cone.z;
+      lod.focal_px = 1.0f / g.cone.z;
     } else {
       glm::vec3 centre(0.0f);
       float half = kMinOrthoHalfWidth;
@@ -109,11 +108,7 @@ Status plan_shadow_maps(const std::vector<LightDesc>& lights, const Bounds& boun
       const glm::mat4 proj = glm::orthoRH_ZO(-half, half, -half, half, 0.0f, kOrthoDepth);
       mats[0] = proj * view;
       g.cone.w = 2.0f * half;
-      // Orthographic: an error of e metres covers e / texel texels anywhere; as a perspective
-      // eye far away (distance D, focal D / texel), like gi/rsm.h's directional maps.
-      constexpr float kFar = 1.0e4f;
-      lod_eye = centre - dir * kFar;
-      lod_focal = kFar / (2.0f * half);
+      lod = orthographic_lod_view(centre, dir, 2.0f * half, 0.0f);  // one texel spans the map
     }
     for (int f = 0; f < faces; ++f) plan.light_set.face_view_proj[li * 6 + f] = mats[f];
 
@@ -124,8 +119,7 @@ Status plan_shadow_maps(const std::vector<LightDesc>& lights, const Bounds& boun
       sf.face = f;
       sf.layer = int(plan.primary.size());
       sf.view_proj = mats[f];
-      sf.lod_eye = lod_eye;
-      sf.lod_focal_per_texel = lod_focal;
+      sf.lod_per_texel = lod;
       sf.real_casters = true;
       sf.virtual_casters = !l.real;  // a virtual lamp's single map holds every caster
       plan.primary.push_back(sf);
@@ -139,8 +133,7 @@ Status plan_shadow_maps(const std::vector<LightDesc>& lights, const Bounds& boun
         sf.face = f;
         sf.layer = int(plan.virtual_only.size());
         sf.view_proj = mats[f];
-        sf.lod_eye = lod_eye;
-        sf.lod_focal_per_texel = lod_focal;
+        sf.lod_per_texel = lod;
         sf.virtual_casters = true;
         plan.virtual_only.push_back(sf);
       }

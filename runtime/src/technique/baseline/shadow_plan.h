@@ -20,6 +20,7 @@
 #include "../../../../shaders/common/light_set.glsl"
 #include "mrgi/expected.h"
 #include "mrgi/scene.h"
+#include "technique/lod_view.h"
 
 namespace mrgi::technique {
 
@@ -38,11 +39,9 @@ struct ShadowFace {
   glm::mat4 view_proj{1.0f};
   bool real_casters = false;     // the depth-camera grid mesh and the real proxies
   bool virtual_casters = false;  // the glTF virtual objects
-  // The virtual meshes' level of detail for this face (technique::LodView): seen from lod_eye
-  // (the lamp; a directional map's eye far along its light), lod_focal_per_texel x the map's
-  // side = its focal length in texels.
-  glm::vec3 lod_eye{0.0f};
-  float lod_focal_per_texel = 0.0f;
+  // The virtual meshes' level of detail for this face, for a map one texel wide: its focal_px
+  // times the map's side is the focal length in texels (max_error_px left to the drawer).
+  LodView lod_per_texel;
 };
 
 struct ShadowPlan {
