@@ -13,6 +13,37 @@
 namespace mrgi::tool {
 namespace {
 
+// The ablation switches by their command-line names, each written once (parsing and the
+// option's allowed values both read these tables).
+template <typename A>
+struct AblationName {
+  const char* name;
+  bool A::*flag;
+};
+constexpr AblationName<DlpvAblation> kDlpvAblations[] = {{"two-volumes", &DlpvAblation::two_volumes},
+                                                         {"no-damping", &DlpvAblation::no_negative_damping},
+                                                         {"no-shift", &DlpvAblation::no_half_cell_shift},
+                                                         {"no-self-bounce", &DlpvAblation::no_virtual_self_bounce}};
+constexpr AblationName<DirAblation> kDirAblations[] = {{"one-shadow-map", &DirAblation::one_shadow_map},
+                                                       {"no-real-only-vpls", &DirAblation::no_real_only_vpls},
+                                                       {"one-bounce", &DirAblation::one_bounce},
+                                                       {"no-environment-vpls", &DirAblation::no_environment_vpls},
+                                                       {"no-temporal-smoothing", &DirAblation::no_temporal_smoothing}};
+
+template <typename A, size_t N>
+void set_ablations(const std::vector<std::string>& given, const AblationName<A> (&names)[N], A& out) {
+  for (const std::string& g : given)
+    for (const AblationName<A>& n : names)
+      if (g == n.name) out.*n.flag = true;
+}
+
+template <typename A, size_t N>
+std::vector<std::string> ablation_names(const AblationName<A> (&names)[N]) {
+  std::vector<std::string> out;
+  for (const AblationName<A>& n : names) out.push_back(n.name);
+  return out;
+}
+
 struct ReplayOptions {
   std::string capture, technique = "baseline", out, level = "0", device, light = "declared";
   std::vector<std::string> dlpv_ablation;
@@ -37,21 +68,10 @@ void run_replay(const ReplayOptions& o) {
   settings.output_width = o.width;
   settings.output_height = o.height;
   settings.exposure = info.exposure;
-  for (const std::string& a : o.dlpv_ablation) {
-    if (a == "two-volumes") settings.dlpv_ablation.two_volumes = true;
-    if (a == "no-damping") settings.dlpv_ablation.no_negative_damping = true;
-    if (a == "no-shift") settings.dlpv_ablation.no_half_cell_shift = true;
-    if (a == "no-self-bounce") settings.dlpv_ablation.no_virtual_self_bounce = true;
-  }
+  set_ablations(o.dlpv_ablation, kDlpvAblations, settings.dlpv_ablation);
   if (settings.dlpv_ablation.any() && o.technique != "dlpv")
     throw CommandFailure(2, "--dlpv-ablation: only for --technique dlpv");
-  for (const std::string& a : o.dir_ablation) {
-    if (a == "one-shadow-map") settings.dir_ablation.one_shadow_map = true;
-    if (a == "no-real-only-vpls") settings.dir_ablation.no_real_only_vpls = true;
-    if (a == "one-bounce") settings.dir_ablation.one_bounce = true;
-    if (a == "no-environment-vpls") settings.dir_ablation.no_environment_vpls = true;
-    if (a == "no-temporal-smoothing") settings.dir_ablation.no_temporal_smoothing = true;
-  }
+  set_ablations(o.dir_ablation, kDirAblations, settings.dir_ablation);
   if (settings.dir_ablation.any() && o.technique != "dir")
     throw CommandFailure(2, "--dir-ablation: only for --technique dir");
   CameraSetup cameras{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera};
@@ -207,7 +227,7 @@ void setup(CLI::App& app) {
                   "half a cell along the normal), no-self-bounce (V^rho from the real "
                   "surfaces' VPLs only, not the virtual objects' own); comma-separated")
       ->delimiter(',')
-      ->check(CLI::IsMember({"two-volumes", "no-damping", "no-shift", "no-self-bounce"}));
+      ->check(CLI::IsMember(ablation_names(kDlpvAblations)));
   cmd->add_option("--dir-ablation", opts->dir_ablation,
                   "dir without one of the paper's ideas (mrgi/runtime.h DirAblation): one-shadow-map (one ISM a VPL "
                   "with the nearest surface and its kind, not one each), no-real-only-vpls (no ir(VPL): the real bounce "
@@ -215,8 +235,7 @@ void setup(CLI::App& app) {
                   "at the levels with multiple bounces), no-environment-vpls (the environment light baseline leaves "
                   "unshadowed stays unshadowed), no-temporal-smoothing (each frame's VPL light alone); comma-separated")
       ->delimiter(',')
-      ->check(CLI::IsMember({"one-shadow-map", "no-real-only-vpls", "one-bounce", "no-environment-vpls",
-                             "no-temporal-smoothing"}));
+      ->check(CLI::IsMember(ablation_names(kDirAblations)));
   cmd->add_option("--device", opts->device, "Vulkan device: index or name part (default $MRGI_DEVICE, else lavapipe)");
   cmd->add_flag("--validate", opts->validate, "enable Vulkan validation layers");
   cmd->add_flag("--quiet,-q", opts->quiet, "no progress on stderr");
