@@ -38,8 +38,8 @@ layout(set = 0, binding = 1, r32ui) readonly uniform uimageBuffer color_words;  
 layout(set = 0, binding = 2, rgba16f) readonly uniform image2D lit_rv;
 layout(set = 0, binding = 3, rgba16f) readonly uniform image2D lit_r;
 layout(set = 0, binding = 4, rgba32f) readonly uniform image2D virtual_position;  // w: coverage
+// RGBA8 words, the virtual mask in alpha (mrgi_shared.h pack_output_word).
 layout(std430, set = 0, binding = 5) writeonly buffer Output { uint out_rgba8[]; };
-layout(std430, set = 0, binding = 6) writeonly buffer Mask { uint out_mask[]; };
 layout(std430, set = 0, binding = 7) readonly buffer Tiles { uint list[]; } tiles;
 struct ParamsConstants {
   vec4 compose;      // x eps (linear camera units), y alpha_max
@@ -92,9 +92,10 @@ void main() {
   ivec2 pixel = spread_invocation_id();
   ivec2 out_size = frame.internal_output_size.zw;
   if (kTiled) {
-    uint t = tiles.list[spread_workgroup_index_1d()];
+    int t = int(tiles.list[spread_workgroup_index_1d()]);
     int tiles_x = (out_size.x + 7) / 8;
-    pixel = ivec2(int(t) % tiles_x, int(t) / tiles_x) * 8 + ivec2(gl_LocalInvocationID.xy);
+    int ty = div_nonneg1(t, tiles_x);  // (a vector integer division is 8 scalar ones on lavapipe)
+    pixel = ivec2(t - ty * tiles_x, ty) * 8 + ivec2(gl_LocalInvocationID.xy);
   }
   if (any(greaterThanEqual(pixel, out_size))) return;
   uint index = uint(pixel.y * out_size.x + pixel.x);
@@ -102,11 +103,10 @@ void main() {
   if (kCameraOnly) {  // nothing virtual in view: the solutions were not computed
     if (kSameSize) {
       uvec3 c = camera_bytes(pixel);
-      out_rgba8[index] = c.x | (c.y << 8u) | (c.z << 16u) | 0xff000000u;
+      out_rgba8[index] = c.x | (c.y << 8u) | (c.z << 16u);
     } else {
-      out_rgba8[index] = packUnorm4x8(vec4(srgb_encode(clamp(camera_at(rel, pixel), vec3(0.0f), vec3(1.0f))), 1.0f));
+      out_rgba8[index] = pack_output_word(srgb_encode(clamp(camera_at(rel, pixel), vec3(0.0f), vec3(1.0f))), false);
     }
-    out_mask[index] = 0u;
     return;
   }
   ivec2 used = frame.internal_output_size.xy;
@@ -116,6 +116,5 @@ void main() {
   float is_virtual = imageLoad(virtual_position, ip).w > 0.5f ? 1.0f : 0.0f;
   vec3 encoded = compose_encoded(camera_at(rel, pixel), r, rv, is_virtual, frame.camera.y,
                                  params.compose.x, params.compose.y);
-  out_rgba8[index] = packUnorm4x8(vec4(encoded, 1.0f));
-  out_mask[index] = is_virtual > 0.5f ? 1u : 0u;
+  out_rgba8[index] = pack_output_word(encoded, is_virtual > 0.5f);
 }

@@ -52,8 +52,8 @@ layout(set = 0, binding = 5, rgba16f) writeonly uniform image2D lit_rv;
 layout(set = 0, binding = 6, rgba16f) writeonly uniform image2D lit_r;
 layout(set = 0, binding = 7, rgba32ui) readonly uniform uimage2D upsampled;
 layout(std430, set = 0, binding = 8) readonly buffer Tiles { uint list[]; } tiles;
-layout(std430, set = 0, binding = 11) writeonly buffer Output { uint out_rgba8[]; };  // kCompose
-layout(std430, set = 0, binding = 12) writeonly buffer Mask { uint out_mask[]; };     // kCompose
+// kCompose: RGBA8 words, the virtual mask in alpha (mrgi_shared.h pack_output_word).
+layout(std430, set = 0, binding = 11) writeonly buffer Output { uint out_rgba8[]; };
 layout(set = 0, binding = 13, rgba16f) readonly uniform image2D virtual_emission;  // rgb radiance
 struct PushConstants {
   ivec4 grid;   // x, y cells; z step in pixels; w unused
@@ -154,8 +154,7 @@ void store_solutions(ivec2 pixel, PixelInputs p, vec3 l_r, vec3 l_rv) {
     uint index = uint(pixel.y * frame.internal_output_size.z + pixel.x);
     vec3 encoded = compose_encoded(p.camera, finite3(l_r), finite3(l_rv), p.virt ? 1.0f : 0.0f,
                                    frame.camera.y, pc.opts.y, pc.opts.z);
-    out_rgba8[index] = packUnorm4x8(vec4(encoded, 1.0f));
-    out_mask[index] = p.virt ? 1u : 0u;
+    out_rgba8[index] = pack_output_word(encoded, p.virt);
     return;
   }
   imageStore(lit_r, pixel, vec4(l_r, 1.0f));

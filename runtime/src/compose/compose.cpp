@@ -37,10 +37,6 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (!out) return out.error();
   c.output_ = *out;
-  auto mask = graph.create_buffer({"virtual_mask", bytes, gpu::MemoryUsage::Readback, true},
-                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-  if (!mask) return mask.error();
-  c.mask_ = *mask;
   auto spv = gpu::shader_spirv("compose/compose.comp");
   if (!spv) return spv.error();
   // compose.comp: kSameSize, kCameraOnly, kSameInternal; each path compiled out of the others'.
@@ -138,7 +134,6 @@ void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
           bind_inputs(b);
           b.bind("Tiles", no_tiles_);
           b.bind("Output", output_);
-          b.bind("Mask", mask_);
         },
         [this, pipe](VkCommandBuffer cmd, gpu::PassContext& pass) { dispatch(cmd, pass, *pipe, false); });
   }
@@ -163,16 +158,13 @@ void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
           }
           if (over) {
             b.bind_over("Output", output_);
-            b.bind_over("Mask", mask_);
           } else {
             b.bind("Output", output_);
-            b.bind("Mask", mask_);
           }
         },
         [this, pipe](VkCommandBuffer cmd, gpu::PassContext& pass) { dispatch(cmd, pass, *pipe, tiled_); });
   }
   graph.mark_output(output_);
-  graph.mark_output(mask_);
   if (!host_camera) return;
   // A technique's list may be smaller than this output's tile count (it lists only its used
   // extent's tiles); the count in args never exceeds what it holds.
@@ -206,20 +198,30 @@ void Compose::dispatch(VkCommandBuffer cmd, gpu::PassContext& pass, const gpu::P
   }
 }
 
+namespace {
+// `count` words of the readback buffer (mrgi_shared.h pack_output_word: packUnorm4x8, r in the
+// low byte, so on a little-endian host the bytes are RGBA; the mask in alpha, 0 or 255) into
+// RGBA8 pixels with alpha 255 and the mask.
+void unpack_output_words(const uint32_t* words, uint8_t* rgba, uint8_t* mask, size_t count) {
+  static_assert(std::endian::native == std::endian::little, "RGBA8 words are R | G << 8 | B << 16");
+  for (size_t i = 0; i < count; ++i) {
+    const uint32_t v = words[i];
+    mask[i] = (v >> 24) >= 128u ? 255 : 0;
+    const uint32_t opaque = v | 0xff000000u;
+    std::memcpy(rgba + 4 * i, &opaque, 4);
+  }
+}
+}  // namespace
+
 Status Compose::read(const gpu::FrameGraph& graph, uint32_t slot, ImageRGBA8& image,
                      Image<uint8_t, 1>& mask) const {
   const gpu::GpuBuffer& ob = graph.gpu_buffer(output_, slot);
-  const gpu::GpuBuffer& mb = graph.gpu_buffer(mask_, slot);
   MRGI_TRY(graph.context().invalidate(ob));
-  MRGI_TRY(graph.context().invalidate(mb));
   reuse_or_allocate(image, int(width_), int(height_), false);  // every pixel written below
   reuse_or_allocate(mask, int(width_), int(height_));   // zero, tiles written below
-  const uint8_t* out = static_cast<const uint8_t*>(graph.mapped(output_, slot));
-  const uint32_t* m = static_cast<const uint32_t*>(graph.mapped(mask_, slot));
+  const auto* out = static_cast<const uint32_t*>(graph.mapped(output_, slot));
   if (!slot_host_camera_[slot]) {
-    // Packed with packUnorm4x8 (r in the low byte): on a little-endian host the bytes are RGBA.
-    std::memcpy(image.data.data(), out, image.data.size());
-    for (size_t i = 0; i < mask.data.size(); ++i) mask.data[i] = m[i] != 0 ? 255 : 0;
+    unpack_output_words(out, image.data.data(), mask.data.data(), mask.data.size());
     return ok_status();
   }
   // The camera frame (this slot's upload: RGB8 at the output size), then the composed tiles.
@@ -256,8 +258,7 @@ Status Compose::read(const gpu::FrameGraph& graph, uint32_t slot, ImageRGBA8& im
     const uint32_t w = std::min(8u, width_ - x0);
     for (uint32_t y = y0; y < std::min(y0 + 8, height_); ++y) {
       const size_t i = size_t(y) * width_ + x0;
-      std::memcpy(px + 4 * i, out + 4 * i, size_t(w) * 4);
-      for (uint32_t x = 0; x < w; ++x) mask.data[i + x] = m[i + x] != 0 ? 255 : 0;
+      unpack_output_words(out + i, px + 4 * i, mask.data.data() + i, w);
     }
   }
   return ok_status();

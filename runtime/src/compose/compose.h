@@ -1,8 +1,8 @@
 // Compose (DESIGN.md "One frame, as data"): tone-maps L_rv and L_r with the camera's response and
 // adds their difference onto the camera frame per caustics-DIR eq. 1-2 (shaders/compose/
 // compose.comp says how and why in linear space), at the output resolution (the solutions are
-// upsampled bilinearly when the internal resolution is lower). Writes the RGBA8 sRGB frame and
-// the virtual-pixel mask straight into this slot's readback buffers. A tiled frame at the
+// upsampled bilinearly when the internal resolution is lower). Writes the RGBA8 sRGB frame with
+// the virtual-pixel mask in its alpha straight into this slot's readback buffer. A tiled frame at the
 // camera's size writes only the listed tiles there, with a copy of the tile list: read() takes
 // the camera frame from the upload on the host and lays the tiles over it (0.3 ms of host time
 // against 2.4 ms for a full-frame camera copy pass on lavapipe at 640x480). A technique may write
@@ -45,7 +45,7 @@ struct ComposeInputs {
   // over the tiles only, from solutions at the output size or resampled, and takes the camera
   // frame elsewhere (on the host at the camera's size, else a camera copy pass first).
   gpu::BufferHandle tile_args, tile_list;
-  // The technique wrote the composite of those tiles into output() and mask() itself
+  // The technique wrote the composite of those tiles into output() itself
   // (Technique::ComposeTiles::composed): compose adds no pass of its own, only the tile-list
   // readback, and lays the tiles over the camera frame on the host. Honoured only for a frame
   // at the camera's size whose solutions have the output's size (fusable()).
@@ -78,12 +78,11 @@ class Compose {
   // (resized to the output size; non-zero mask = virtual pixel).
   Status read(const gpu::FrameGraph& graph, uint32_t slot, ImageRGBA8& image,
               Image<uint8_t, 1>& mask) const;
-  // Where a technique composes its own tiles: the readback buffers (RGBA8 packed as
-  // packUnorm4x8 of the sRGB value, and a uint per pixel, non-zero = virtual), row-major at the
-  // output size, and the guards (mrgi_shared.h compose_encoded). fusable(): the output has the
-  // camera's size, the only case in which tiles_composed is honoured.
+  // Where a technique composes its own tiles: the readback buffer (RGBA8 words, the virtual
+  // mask in alpha: mrgi_shared.h pack_output_word), row-major at the output size, and the
+  // guards (mrgi_shared.h compose_encoded). fusable(): the output has the camera's size, the
+  // only case in which tiles_composed is honoured.
   gpu::BufferHandle output() const { return output_; }
-  gpu::BufferHandle mask() const { return mask_; }
   const ComposeSettings& settings() const { return settings_; }
   bool fusable() const { return same_size_as_camera_; }
 
@@ -93,7 +92,7 @@ class Compose {
   ComposeSettings settings_;
   uint32_t width_ = 0, height_ = 0;
   ComposeInputs in_;
-  gpu::BufferHandle output_, mask_;
+  gpu::BufferHandle output_;
   void record_classify(gpu::FrameGraph& graph);
 
   // Composite (solutions resampled), composite at the solutions' own size, camera frame only,

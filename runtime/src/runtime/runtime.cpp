@@ -239,7 +239,6 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   shared.compose_honours_tiles = true;  // record(): compose uses Technique::compose_tiles()
   if (settings.fuse_compose && compose_->fusable()) {
     shared.composed_output = compose_->output();
-    shared.composed_mask = compose_->mask();
   }
   shared.compose_eps = compose_->settings().eps;
   shared.compose_alpha_max = compose_->settings().alpha_max;

@@ -88,10 +88,10 @@ struct SharedResources {
   // The runtime's compose output, for a technique that composes its own tiles (ComposeTiles::
   // composed): valid handles only when the runtime honours that, i.e. compose_honours_tiles is
   // set and the output has the colour camera's size (a frame whose solutions have another size
-  // than the output is composed by the runtime). RGBA8 (packUnorm4x8 of the sRGB value) and a
-  // uint per pixel (non-zero = virtual), row-major at the output size; the guards of
+  // than the output is composed by the runtime). RGBA8 words with the virtual mask in alpha
+  // (mrgi_shared.h pack_output_word), row-major at the output size; the guards of
   // mrgi_shared.h compose_encoded in linear camera units.
-  gpu::BufferHandle composed_output, composed_mask;
+  gpu::BufferHandle composed_output;
   float compose_eps = 1e-3f, compose_alpha_max = 10.0f;
 };
 
@@ -171,7 +171,7 @@ class Technique {
   // host reads the list back to lay the tiles over the camera frame). Null handles (the
   // default): compose every pixel from the solutions.
   // composed: this frame's passes also wrote the composite of those tiles into
-  // SharedResources::composed_output / composed_mask (compose_encoded, the runtime's formula),
+  // SharedResources::composed_output (compose_encoded, the runtime's formula),
   // so compose runs no pass of its own; only where those handles are valid, for solutions at
   // the output size.
   struct ComposeTiles {

@@ -229,7 +229,6 @@ void Ssrt::add_shade_pass(const char* name, ShadeMode mode, bool run_transfer) {
           b.bind("lit_r", r.lit_r);
         }
         b.bind("Output", compose ? r.composed_output : no_compose_);
-        b.bind("Mask", compose ? r.composed_mask : no_compose_);
       },
       [this, pipe, mode, compose, run_transfer](VkCommandBuffer cmd, gpu::PassContext& pass) {
         const SharedResources& r = shared_;
@@ -447,7 +446,7 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     const VkExtent2D out = graph.output_size();
     const bool at_output = shared_.compose_honours_tiles && used_.width == out.width &&
                            used_.height == out.height;
-    const bool fused = at_output && shared_.composed_output.valid() && shared_.composed_mask.valid();
+    const bool fused = at_output && shared_.composed_output.valid();
     if (at_output) {
       compose_tiles_ = {tile_args_, tile_list_, fused};
       skipped.push_back("ssrt_shade: pass-through left out, compose copies the camera frame "
