@@ -8,11 +8,11 @@
 // branch per lane, a texel buffer with vector inserts (ssrt's shade, occluders and fuse took
 // 10-25 % less).
 // and includes shared/mrgi_shared.h (project_pinhole); camera_at() also needs the frame
-// constants as `frame` (common/frame_constants.glsl).
+// constants as `frame` (common/frame_constants.glsl). A shader that reads only the colour
+// (compose.comp) defines MRGI_UPLOAD_COLOR_ONLY first and declares no depth_words.
 #ifndef MRGI_UPLOAD_GATHER_GLSL
 #define MRGI_UPLOAD_GATHER_GLSL
 
-uint color_byte(uint index) { return (imageLoad(color_words, int(index >> 2)).x >> ((index & 3u) * 8u)) & 0xffu; }
 // The three bytes of colour pixel `pixel` (row-major) from the two words they lie in: two reads
 // instead of three (every buffer read is a per-lane gather on lavapipe). The second word is
 // clamped to the buffer (the last pixel's bytes can end in the last word).
@@ -26,6 +26,7 @@ uvec3 color_rgb8(uint pixel) {
   uint v = shift == 0u ? lo : (lo >> shift) | (hi << (32u - shift));
   return uvec3(v & 0xffu, (v >> 8u) & 0xffu, (v >> 16u) & 0xffu);
 }
+#ifndef MRGI_UPLOAD_COLOR_ONLY
 uint depth_value(uint index) { return (imageLoad(depth_words, int(index >> 1)).x >> ((index & 1u) * 16u)) & 0xffffu; }
 
 // Nearest pixel of a camera with intrinsics k and size for a camera-space ray (any z > 0);
@@ -58,5 +59,6 @@ vec4 camera_at(vec2 p) {
   return vec4(albedo, measured ? 1.0f : 0.0f);
 }
 #endif
+#endif  // MRGI_UPLOAD_COLOR_ONLY
 
 #endif  // MRGI_UPLOAD_GATHER_GLSL

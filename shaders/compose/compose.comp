@@ -47,13 +47,13 @@ struct ParamsConstants {
 layout(push_constant) uniform Params { ParamsConstants params_block; };
 ParamsConstants params;
 
-uint color_byte(uint index) { return (imageLoad(color_words, int(index >> 2)).x >> ((index & 3u) * 8u)) & 0xffu; }
+#define MRGI_UPLOAD_COLOR_ONLY
+#include "common/upload_gather.glsl"
 
 uvec3 camera_bytes(ivec2 p) {
   ivec2 size = frame.color_depth_size.xy;
   p = clamp(p, ivec2(0), size - 1);
-  uint base = uint(p.y * size.x + p.x) * 3u;
-  return uvec3(color_byte(base), color_byte(base + 1u), color_byte(base + 2u));
+  return color_rgb8(uint(p.y * size.x + p.x));
 }
 
 vec3 camera_linear(ivec2 p) { return srgb_decode(vec3(camera_bytes(p)) / 255.0f); }

@@ -143,8 +143,7 @@ void main() {
   vec3 albedo = vec3(0.0f);
   ivec2 cp = nearest_pixel(ray, frame.color_k, color_size);
   if (cp.x >= 0) {
-    uint base = uint(cp.y * color_size.x + cp.x) * 3u;
-    vec3 encoded = vec3(color_byte(base), color_byte(base + 1u), color_byte(base + 2u)) / 255.0f;
+    vec3 encoded = vec3(color_rgb8(uint(cp.y * color_size.x + cp.x))) / 255.0f;
     albedo = clamp(camera_to_radiance(encoded, frame.camera.y), vec3(0.0f), vec3(1.0f));
   }
   imageStore(real_albedo, pixel, vec4(albedo, 1.0f));

@@ -50,9 +50,8 @@ void main() {
   uint grey = 0u;
   ivec2 cp = nearest_pixel(ray, frame.color_k, color_size);
   if (cp.x >= 0) {
-    uint base = uint(cp.y * color_size.x + cp.x) * 3u;
-    grey = (77u * color_byte(base) + 150u * color_byte(base + 1u) +
-            29u * color_byte(base + 2u) + 128u) >> 8;
+    uvec3 c = color_rgb8(uint(cp.y * color_size.x + cp.x));
+    grey = (77u * c.x + 150u * c.y + 29u * c.z + 128u) >> 8;
   }
   bool agree = false;
   if (d_c > 0.0f && pc.window.w != 0) {
