@@ -86,10 +86,11 @@ int cube_face(vec3 d) {
   return d.z >= 0.0f ? 4 : 5;
 }
 
-// Fraction of the lamp seen from p through one map (1 lit, 0 shadowed), PCF over
-// (2r+1)^2 bilinear compare taps. Points outside the map's frustum are lit.
-float shadow_test(sampler2DArrayShadow map, int first_layer, int light, vec3 p, vec3 n) {
-  ShadowLight L = light_set.lights[light];
+// Where p (moved along n by kNormalOffsetTexels) falls in lamp `light`'s maps: the map
+// coordinates in the used corner (xy), the depth (z) and the face (w; 0 unless a point lamp's
+// cube), or w = -1 outside the frustum (lit). Once a lamp for both of its maps: they share
+// the projection (the matrix is a per-pixel gather from the uniform buffer on lavapipe).
+vec4 shadow_coord(int light, ShadowLight L, vec3 p, vec3 n) {
   int type = int(L.position_type.w);
   int face = 0;
   float texel_world;
@@ -102,18 +103,24 @@ float shadow_test(sampler2DArrayShadow map, int first_layer, int light, vec3 p, 
   }
   vec3 q = p + n * (kNormalOffsetTexels * texel_world);
   vec4 clip = light_set.face_view_proj[light * 6 + face] * vec4(q, 1.0f);
-  if (!(clip.w > 0.0f)) return 1.0f;
+  if (!(clip.w > 0.0f)) return vec4(0.0f, 0.0f, 0.0f, -1.0f);
   vec3 ndc = clip.xyz / clip.w;
-  if (any(greaterThan(abs(ndc.xy), vec2(1.0f))) || ndc.z > 1.0f || ndc.z < 0.0f) return 1.0f;
-  vec2 uv = (ndc.xy * 0.5f + 0.5f) * level.shadow.x;  // into the used corner of the map
+  if (any(greaterThan(abs(ndc.xy), vec2(1.0f))) || ndc.z > 1.0f || ndc.z < 0.0f) return vec4(0.0f, 0.0f, 0.0f, -1.0f);
+  return vec4((ndc.xy * 0.5f + 0.5f) * level.shadow.x, ndc.z, float(face));
+}
+
+// Fraction of the lamp seen through one map at c (shadow_coord; 1 lit, 0 shadowed), PCF over
+// (2r+1)^2 bilinear compare taps.
+float shadow_test(sampler2DArrayShadow map, int first_layer, vec4 c) {
+  if (c.w < 0.0f) return 1.0f;
   float texel = 1.0f / level.shadow.z;
   vec2 lo = vec2(0.5f * texel), hi = vec2(level.shadow.x - 0.5f * texel);
   int r = int(level.shadow.w);
   float sum = 0.0f;
   for (int j = -r; j <= r; ++j) {
     for (int i = -r; i <= r; ++i) {
-      vec2 t = clamp(uv + vec2(i, j) * texel, lo, hi);
-      sum += texture(map, vec4(t, float(first_layer + face), ndc.z));
+      vec2 t = clamp(c.xy + vec2(i, j) * texel, lo, hi);
+      sum += texture(map, vec4(t, float(first_layer) + c.w, c.z));
     }
   }
   return sum / float((2 * r + 1) * (2 * r + 1));
@@ -162,10 +169,11 @@ void main() {
     float nl = dot(n, wi);
     if (nl <= 0.0f || all(equal(irradiance_rgb, vec3(0.0f)))) continue;
     vec3 lo = brdf(n, v, wi, alb.rgb, alb.a, roughness, is_virtual) * irradiance_rgb * nl;
-    float st_primary = shadow_test(shadow_primary, L.layers.x, i, p, n);
+    vec4 at = shadow_coord(i, L, p, n);
+    float st_primary = shadow_test(shadow_primary, L.layers.x, at);
     bool real_lamp = L.direction_real.w > 0.5f;
     if (real_lamp) {
-      float st_v = L.layers.y >= 0 ? shadow_test(shadow_virtual, L.layers.y, i, p, n) : 1.0f;
+      float st_v = L.layers.y >= 0 ? shadow_test(shadow_virtual, L.layers.y, at) : 1.0f;
       l_rv += lo * min(st_primary, st_v);   // eq. 1, 3
       l_r += lo * r_p * st_primary;          // eq. 2
     } else {

@@ -12,17 +12,28 @@ vec3 brdf(vec3 n, vec3 v, vec3 l, vec3 base, float metallic, float roughness, bo
   vec3 h = normalize(v + l);
   float nl = max(dot(n, l), 0.0f), nv = max(dot(n, v), 1e-4f), nh = max(dot(n, h), 0.0f);
   float a = roughness * roughness, a2 = a * a;
-  float d = a2 / (MRGI_PI * pow(nh * nh * (a2 - 1.0f) + 1.0f, 2.0f));
+  float denom = nh * nh * (a2 - 1.0f) + 1.0f;
+  float d = a2 / (MRGI_PI * denom * denom);
   float vis = 0.5f / max(nl * sqrt(nv * nv * (1.0f - a2) + a2) + nv * sqrt(nl * nl * (1.0f - a2) + a2), 1e-6f);
   vec3 f0 = mix(vec3(0.04f), base, metallic);
-  vec3 f = f0 + (1.0f - f0) * pow(1.0f - max(dot(v, h), 0.0f), 5.0f);
+  float m = 1.0f - max(dot(v, h), 0.0f), m2 = m * m;
+  vec3 f = f0 + (1.0f - f0) * (m2 * m2 * m);  // (pow(x, 5) is exp2(5 log2 x) on lavapipe)
   return (1.0f - f) * diffuse + d * vis * f;
 }
 
 // E(n) of an ambient, linear RGB, >= 0 (SH bands 0..2 can dip below 0 away from the light).
+// The matrices are symmetric (light/light_stage.cpp irradiance_matrices), so n4^T M n4 is 10
+// multiply-adds over the distinct products of n4, shared by the channels, instead of M n4's 16
+// and a dot product per channel (every shading invocation pays this on lavapipe).
+float symmetric_form(mat4 m, vec3 sq, vec3 mixed, vec3 n) {
+  return m[0][0] * sq.x + m[1][1] * sq.y + m[2][2] * sq.z + m[3][3] +
+         2.0f * (m[1][0] * mixed.x + m[2][0] * mixed.y + m[2][1] * mixed.z + m[3][0] * n.x + m[3][1] * n.y +
+                 m[3][2] * n.z);
+}
 vec3 ambient_irradiance(AmbientIrradiance a, vec3 n) {
-  vec4 n4 = vec4(n, 1.0f);
-  return max(vec3(dot(n4, a.r * n4), dot(n4, a.g * n4), dot(n4, a.b * n4)), vec3(0.0f));
+  vec3 sq = n * n, mixed = vec3(n.x * n.y, n.x * n.z, n.y * n.z);
+  return max(vec3(symmetric_form(a.r, sq, mixed, n), symmetric_form(a.g, sq, mixed, n),
+                  symmetric_form(a.b, sq, mixed, n)), vec3(0.0f));
 }
 
 vec3 sanitize(vec3 c) {
