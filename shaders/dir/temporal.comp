@@ -9,7 +9,8 @@
 // falls from 1 to 0 as the relative change of the light's luminance grows from `params.w` to
 // twice that: flicker of a few VPLs moves a merged pixel by tens of percent, a lamp or an object
 // that moved by more. Output = mix(current, history, blend x confidence), packed with the
-// current key; it is the next frame's history.
+// current key; it is the next frame's history. The current light is the merge's: this pass
+// runs its column half (dir/merge_column.glsl) on the row-merged image itself.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
 #include "common/frame_constants.glsl"
@@ -20,15 +21,17 @@ layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo
 FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(set = 0, binding = 1, rgba32f) readonly uniform image2D real_position;
 layout(set = 0, binding = 2, rgba32f) readonly uniform image2D virtual_position;
-layout(set = 0, binding = 3, rgba32ui) readonly uniform uimage2D merged;
+layout(set = 0, binding = 3, rgba32ui) readonly uniform uimage2D rows;  // merge_rows.comp's
 layout(set = 0, binding = 4, rgba32ui) readonly uniform uimage2D history;
 layout(set = 0, binding = 5, rgba32ui) writeonly uniform uimage2D smoothed;
 layout(push_constant) uniform Params {
   mat4 previous_world_to_camera;  // the previous frame's pose, inverted
   vec4 previous_camera;           // xyz its camera centre (world); w: 1 = history valid
-  ivec4 extent;                   // x, y: the indirect images' used size; z: G-buffer pixels a texel
+  ivec4 extent;                   // x, y: the indirect images' used size; z: G-buffer pixels a
+                                  // texel; w: the merge's side (DirParams vpls.w)
   vec4 params;                    // x: blend; w: relative luminance change where confidence starts to fall
 } params_block;
+#include "dir/merge_column.glsl"
 
 void main() {
   frame = frame_ubo;  // MRGI_UNIFORM_COPIES
@@ -38,7 +41,7 @@ void main() {
   vec4 params = params_block.params;
   ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
   if (any(greaterThanEqual(texel, extent.xy))) return;
-  uvec4 current = imageLoad(merged, texel);
+  uvec4 current = merge_column(texel, extent.xy, extent.w);
   if (current.w == 0u || previous_camera.w < 0.5f) {
     imageStore(smoothed, texel, current);
     return;

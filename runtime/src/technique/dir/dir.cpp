@@ -412,21 +412,22 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
       [merge_rows, push, low](VkCommandBuffer cmd, gpu::PassContext&) {
         gpu::dispatch_2d(cmd, *merge_rows, &push, sizeof push, low.width, low.height);
       });
-  const gpu::Pipeline* merge_columns = &*merge_columns_;
-  graph.add_shader_pass(
-      "dir merge columns", gpu::PassKind::Compute, *merge_columns_,
-      [&](gpu::ShaderPassBuilder& b) {
-        b.bind("rows", rows);
-        b.bind("merged", merged);
-      },
-      [merge_columns, push, low](VkCommandBuffer cmd, gpu::PassContext&) {
-        gpu::dispatch_2d(cmd, *merge_columns, &push, sizeof push, low.width, low.height);
-      });
   DirIndirect to_add{merged_, int(level.indirect_divisor)};
   to_add.shadowed_estimated = env_override ? level.shadowed_env : -1;
   if (shared_.dir_ablation.no_temporal_smoothing) {
     skipped.push_back("dir temporal smoothing: off (ablation no-temporal-smoothing)");
     history_.valid = false;
+    // The merge's column half as a pass of its own (temporal.comp runs it otherwise).
+    const gpu::Pipeline* merge_columns = &*merge_columns_;
+    graph.add_shader_pass(
+        "dir merge columns", gpu::PassKind::Compute, *merge_columns_,
+        [&](gpu::ShaderPassBuilder& b) {
+          b.bind("rows", rows);
+          b.bind("merged", merged);
+        },
+        [merge_columns, push, low](VkCommandBuffer cmd, gpu::PassContext&) {
+          gpu::dispatch_2d(cmd, *merge_columns, &push, sizeof push, low.width, low.height);
+        });
   } else {
     // The previous frame's smoothed light is the history while it was made at this level (the
     // same grid and intrinsics); the pose may differ (reprojected).
@@ -434,7 +435,7 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     const int read = history_.image, write = 1 - history_.image;
     const glm::dmat4 previous = history_.camera_to_world;
     const TemporalPush tp{glm::mat4(glm::inverse(previous)), glm::vec4(glm::vec3(previous[3]), have ? 1.0f : 0.0f),
-                          glm::ivec4(int(low.width), int(low.height), int(level.indirect_divisor), 0),
+                          glm::ivec4(int(low.width), int(low.height), int(level.indirect_divisor), int(level.interleave)),
                           glm::vec4(kTemporalBlend, 0.0f, 0.0f, kTemporalChange)};
     const gpu::Pipeline* temporal = &*temporal_;
     const gpu::ImageHandle history = smoothed_[read], smoothed = smoothed_[write];
@@ -444,7 +445,7 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
           b.bind("FrameUbo", r.frame_constants);
           b.bind("real_position", r.real_position);
           b.bind("virtual_position", r.virtual_position);
-          b.bind("merged", merged);
+          b.bind("rows", rows);
           b.bind("history", history);
           b.bind("smoothed", smoothed);
         },

@@ -5,7 +5,8 @@
 // (gi/vpl.h, Sec. 3.7); each VPL gets a real and a virtual imperfect shadow map (gi/ism.h,
 // Sec. 3.3); one pass shades every pixel's share of the VPLs into both solutions with the flags
 // (shaders/dir/shade_vpl.comp, eq. 6-8), interleaved 4x4 and merged geometry-aware
-// (shaders/dir/merge_rows.comp, merge_columns.comp: separable); baseline's shading pass adds it
+// (shaders/dir/merge_rows.comp, dir/merge_column.glsl: separable; the column half runs inside
+// the temporal smoothing's pass when that is on); baseline's shading pass adds it
 // to both solutions with its direct light, at the level's baseline level: the same
 // real/virtual shadow-map pair per lamp, eq. 1-5. Beside the lamps' VPLs: the bounce light
 // source's (gi/vpl_bounce.h: VPLs lit by last frame's, eq. 9-10, multiple bounces over frames)
