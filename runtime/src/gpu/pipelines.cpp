@@ -58,6 +58,11 @@ Status make_layouts(const Context& ctx, const std::string& name, const ShaderInt
                                          std::to_string(ctx.properties().limits.maxPushConstantsSize));
   if (push_bytes % 4 != 0)
     return fail(ErrorKind::BadUsage, "pipeline '" + name + "': push constant size must be a multiple of 4");
+  // Every binding is pushed each time the pipeline is used (DescriptorPush): no more than it holds.
+  if (iface.bindings.size() > DescriptorPush::kMaxWrites)
+    return fail(ErrorKind::BadUsage, "pipeline '" + name + "': " + std::to_string(iface.bindings.size()) +
+                                         " descriptor bindings, more than a push-descriptor set takes (" +
+                                         std::to_string(DescriptorPush::kMaxWrites) + ")");
   std::vector<VkDescriptorSetLayoutBinding> b(iface.bindings.size());
   for (size_t i = 0; i < iface.bindings.size(); ++i) {
     b[i].binding = iface.bindings[i].binding;

@@ -99,12 +99,14 @@ class PipelineHandle {
   Pipeline p_;
 };
 
-// Collects up to 24 descriptor writes on the stack and pushes them (no heap, no pool).
+// Collects up to 32 descriptor writes on the stack and pushes them (no heap, no pool); 32 is
+// VK_KHR_push_descriptor's guaranteed maxPushDescriptors, and make_layouts refuses a pipeline
+// with more bindings.
 // Images: storage images are in GENERAL, sampled ones in SHADER_READ_ONLY_OPTIMAL (what the frame
 // graph transitions them to).
 class DescriptorPush {
  public:
-  static constexpr uint32_t kMaxWrites = 24;
+  static constexpr uint32_t kMaxWrites = 32;
   DescriptorPush& storage_image(uint32_t binding, VkImageView view);
   DescriptorPush& sampled_image(uint32_t binding, VkImageView view, VkSampler sampler);
   DescriptorPush& storage_buffer(uint32_t binding, VkBuffer buffer, VkDeviceSize offset = 0,
