@@ -9,16 +9,9 @@
 vec3 brdf(vec3 n, vec3 v, vec3 l, vec3 base, float metallic, float roughness, bool specular) {
   vec3 diffuse = base * (1.0f - metallic) / MRGI_PI;
   if (!specular) return base / MRGI_PI;
-  vec3 h = normalize(v + l);
-  float nl = max(dot(n, l), 0.0f), nv = max(dot(n, v), 1e-4f), nh = max(dot(n, h), 0.0f);
-  float a = roughness * roughness, a2 = a * a;
-  float denom = nh * nh * (a2 - 1.0f) + 1.0f;
-  float d = a2 / (MRGI_PI * denom * denom);
-  float vis = 0.5f / max(nl * sqrt(nv * nv * (1.0f - a2) + a2) + nv * sqrt(nl * nl * (1.0f - a2) + a2), 1e-6f);
   vec3 f0 = mix(vec3(0.04f), base, metallic);
-  float m = 1.0f - max(dot(v, h), 0.0f), m2 = m * m;
-  vec3 f = f0 + (1.0f - f0) * (m2 * m2 * m);  // (pow(x, 5) is exp2(5 log2 x) on lavapipe)
-  return (1.0f - f) * diffuse + d * vis * f;
+  vec3 f = f0 + (1.0f - f0) * schlick_weight(dot(v, normalize(v + l)));
+  return (1.0f - f) * diffuse + ggx_d_vis(n, l, v, roughness) * f;
 }
 
 // E(n) of an ambient, linear RGB, >= 0 (SH bands 0..2 can dip below 0 away from the light).

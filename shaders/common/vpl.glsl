@@ -17,18 +17,24 @@ using glm::vec4;
 #define MRGI_VPL_DIRECTIONAL 8  // a distant light: a region of the environment (the paper's
                                 // environment VPLs, Sec. 3.7), fields as below
 
-// A point VPL is a diffuse surface point; a directional one (MRGI_VPL_DIRECTIONAL) stands for
-// light arriving from one direction, its shadow map orthographic (gi/ism_common.glsl).
+// A point VPL is a surface point, a cosine emitter with, on a glossy surface, a specular lobe
+// (shared/vpl_math.h vpl_intensity); a directional one (MRGI_VPL_DIRECTIONAL) stands for light
+// arriving from one direction, its shadow map orthographic (gi/ism_common.glsl).
 struct Vpl {
   vec4 position;  // xyz world (m): the point; directional: the centre of its map. w: MRGI_VPL_* bits
   vec4 normal;    // xyz unit normal of its surface, on the side the light arrived from; w unused.
                   // Directional: xyz unit direction towards the light; w the map's half side (m)
-  vec4 flux;      // rgb reflected flux (W), already divided by the probability of drawing it;
-                  // directional: irradiance (W/m^2 at normal incidence). w unused
+  vec4 flux;      // rgb reflected flux of the cosine emitter (W), already divided by the
+                  // probability of drawing it; directional: irradiance (W/m^2 at normal
+                  // incidence). w unused
+  vec4 lobe;      // xyz unit direction its light arrived from; w the lobe's roughness, < 0 none
+                  // (a diffuse VPL: every real surface's, the paper's real specular is 0)
+  vec4 specular;  // rgb Phi_in F0 (W), w Phi_in's luminance (W), as flux divided by the
+                  // probability of drawing it (vpl_math.h vpl_glossy_split); 0 without a lobe
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(Vpl) == 48, "std430 mirror");
+static_assert(sizeof(Vpl) == 80, "std430 mirror");
 }  // namespace mrgi::shader
 #endif
 #endif  // MRGI_VPL_GLSL

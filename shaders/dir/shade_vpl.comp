@@ -5,7 +5,11 @@
 //   L_rv += L_o (1 - ir(VPL)) min(st_r, st_v)
 //   L_r  += L_o r(path) r(p) st_r
 // L_o = albedo / pi x the VPL's irradiance at p (shared/vpl_math.h vpl_irradiance; diffuse:
-// the virtual surfaces' base colour x (1 - metallic)); st_r, st_v: the VPL's real and virtual
+// the virtual surfaces' base colour x (1 - metallic)); with glossy VPLs (kGlossy: a scene with a
+// glossy virtual material) the VPLs' specular lobes are in their irradiance
+// (vpl_irradiance_rgb) and a virtual surface reflects it by its whole BRDF towards the camera
+// (common/surface_shading.glsl brdf: the paper's potentially glossy D at both ends of the DD
+// segment; real surfaces stay diffuse, the paper's real specular is 0); st_r, st_v: the VPL's real and virtual
 // imperfect shadow maps (gi/ism.h), one tap each, with a bias that grows with the distance (an
 // ISM is a sparse, splatted depth map).
 // Interleaved sampling (the paper's 4x4 G-buffer split, Segovia et al. 2006): the pixel at
@@ -21,6 +25,8 @@
 #include "common/vpl.glsl"
 #include "dir/dir_params.glsl"
 #include "dir/indirect_pack.glsl"
+#include "common/light_set.glsl"
+#include "common/surface_shading.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
@@ -35,10 +41,12 @@ layout(std430, set = 0, binding = 7) readonly buffer Vpls { Vpl vpls[]; };
 layout(set = 0, binding = 8, rg32f) readonly uniform image2D ism_distances;  // level 0: x real, y virtual
 layout(set = 0, binding = 9, rgba32ui) writeonly uniform uimage2D indirect;  // indirect_pack.glsl
 layout(push_constant) uniform Params { DirParams params_block; };
-#include "gi/vpl_light.glsl"
 // Ablations (mrgi/runtime.h DirAblation), one pipeline each: bit 1 one shadow map (the nearest
 // surface and its kind), bit 2 no ir(VPL) (real-only VPLs light nothing).
 layout(constant_id = 0) const int kAblation = 0;
+layout(constant_id = 1) const bool kGlossy = false;
+const bool kGlossyLobes = kGlossy;  // gi/vpl_light.glsl
+#include "gi/vpl_light.glsl"
 const bool kOneShadowMap = (kAblation & 1) != 0;
 const bool kNoRealOnly = (kAblation & 2) != 0;
 DirParams params;
@@ -54,11 +62,12 @@ void main() {
   bool is_virtual = vpos.w > 0.5f;
   vec4 pos, nrm;
   vec3 albedo;
+  vec4 base = vec4(0.0f);  // a virtual surface's base colour and metallic (kGlossy)
   if (is_virtual) {
     pos = vpos;
     nrm = imageLoad(virtual_normal, pixel);
-    vec4 a = imageLoad(virtual_albedo, pixel);
-    albedo = a.rgb * (1.0f - a.a);
+    base = imageLoad(virtual_albedo, pixel);
+    albedo = base.rgb * (1.0f - base.a);
   } else {
     pos = imageLoad(real_position, pixel);
     nrm = imageLoad(real_normal, pixel);
@@ -70,6 +79,8 @@ void main() {
   vec3 n = surface ? nrm.xyz / nlen : vec3(0.0f, 0.0f, 1.0f);
   if (surface) {
     vec3 p = pos.xyz;
+    vec3 view = normalize(frame.camera_world.xyz - p);
+    bool glossy_receiver = kGlossy && is_virtual;
     int count = params.vpls.x, side = params.vpls.y, row = params.vpls.z, step = params.vpls.w * params.vpls.w;
     int first = params.vpls.w > 1 ? (texel.x % params.vpls.w) + params.vpls.w * (texel.y % params.vpls.w) : 0;
     // The lamps' and the bounce's VPLs interleaved, each standing for `step` (the merge
@@ -85,8 +96,8 @@ void main() {
         if ((flags & MRGI_VPL_VALID) == 0) continue;
         bool real_only = (flags & MRGI_VPL_REAL_ONLY) != 0;
         if (real_only && (is_virtual || kNoRealOnly)) continue;  // ir(VPL): real surfaces only
-        float e = vpl_receive(v, p, n, params.lighting.x);
-        if (!(e > 0.0f)) continue;
+        vec3 e = vpl_incident(v, p, n, params.lighting.x);
+        if (!any(greaterThan(e, vec3(0.0f)))) continue;
         vec2 stored;
         vec2 st = vpl_visibility(v, j, p, n, side, row, params.lighting.y, params.lighting.z, stored);
         float st_r = st.x, st_v = st.y;
@@ -95,7 +106,8 @@ void main() {
           st_r = real_nearest ? st_r : 1.0f;
           st_v = real_nearest ? 1.0f : st_v;
         }
-        vec3 l_o = albedo * (1.0f / MRGI_PI) * v.flux.rgb * e;
+        vec3 l_o = glossy_receiver ? brdf(n, view, vpl_direction(v, p), base.rgb, base.a, max(nrm.w, MRGI_VPL_MIN_ROUGHNESS), true) * e
+                                   : albedo * (1.0f / MRGI_PI) * e;
         bool real_path = (flags & MRGI_VPL_REAL_PATH) != 0;
         if ((flags & MRGI_VPL_DIRECTIONAL) != 0) {
           // An environment region whose light baseline's shading adds unshadowed (its SH

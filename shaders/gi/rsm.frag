@@ -6,7 +6,9 @@
 //   point / spot: I(w) x the texel's solid angle (at the map's centre, x cos^3 of the angle from
 //     its axis), times the spot cone.
 // Reflected flux = albedo x that x colour (a diffuse surface reflects albedo of what it gets;
-// the cosine is in the texel's footprint on the surface, so it cancels).
+// the cosine is in the texel's footprint on the surface, so it cancels); a glossy virtual
+// surface's split into a diffuse part and a lobe is made from it when VPLs are drawn
+// (gi/vpl_sample.comp), with the metallic and roughness written beside it.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
 
@@ -24,14 +26,15 @@ layout(location = 0) in vec3 in_world;
 layout(location = 1) in vec3 in_normal;
 layout(location = 2) in vec2 in_uv;
 layout(location = 3) in vec4 in_albedo;
-layout(location = 4) flat in float in_layer;
-layout(location = 0) out vec4 out_position;  // xyz world, w 1 real surface, 2 virtual
-layout(location = 1) out vec4 out_normal;    // xyz unit, facing the light
+layout(location = 4) flat in vec4 in_material;  // x base-colour texture layer (-1 none), y metallic,
+                                                // z roughness (< 0: diffuse, no specular lobe)
+layout(location = 0) out vec4 out_position;  // xyz world, w 1 real surface, virtual 2 + metallic / 2
+layout(location = 1) out vec4 out_normal;    // xyz unit, facing the light; w roughness (< 0: diffuse)
 layout(location = 2) out vec4 out_flux;      // rgb reflected W, a incident W per unit colour
 
 void main() {
   vec3 albedo = in_albedo.xyz;
-  if (in_layer >= 0.0f) albedo *= texture(base_color_maps, vec3(in_uv, in_layer)).xyz;
+  if (in_material.x >= 0.0f) albedo *= texture(base_color_maps, vec3(in_uv, in_material.x)).xyz;
   vec3 n = normalize(in_normal);
   float incident;
   vec3 travel;
@@ -45,7 +48,9 @@ void main() {
     incident = -draw.light.w;
   }
   if (dot(n, travel) > 0.0f) n = -n;  // two-sided: the side the light reaches
-  out_position = vec4(in_world, draw.misc.y >= 0 ? 2.0f : 1.0f);  // virtual meshes carry a material
-  out_normal = vec4(n, 0.0f);
+  // Virtual meshes carry a material: its metallic rides in w's fraction (readers test w > 1.5),
+  // its roughness in the normal's w, for glossy VPLs (gi/vpl_sample.comp).
+  out_position = vec4(in_world, draw.misc.y >= 0 ? 2.0f + 0.5f * clamp(in_material.y, 0.0f, 1.0f) : 1.0f);
+  out_normal = vec4(n, in_material.z);
   out_flux = vec4(albedo * draw.colour.xyz * incident, incident);
 }

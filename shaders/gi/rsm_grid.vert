@@ -19,7 +19,7 @@ layout(location = 0) out vec3 out_world;
 layout(location = 1) out vec3 out_normal;
 layout(location = 2) out vec2 out_uv;
 layout(location = 3) out vec4 out_albedo;   // rgb linear albedo
-layout(location = 4) flat out float out_layer;  // base-colour texture layer, -1 none
+layout(location = 4) flat out vec4 out_material;  // gi/rsm.frag's in_material
 
 void main() {
   int stride = max(draw.misc.x, 1);
@@ -31,6 +31,6 @@ void main() {
   vec4 a = texelFetch(real_albedo, g, 0);
   out_albedo = vec4(a.w > 0.0f ? a.xyz : vec3(0.0f), 1.0f);
   out_uv = vec2(0.0f);
-  out_layer = -1.0f;
+  out_material = vec4(-1.0f, 0.0f, -1.0f, 0.0f);  // diffuse (the paper's real specular is 0)
   gl_Position = draw.view_proj * vec4(p.xyz, 1.0f);
 }

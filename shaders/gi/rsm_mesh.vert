@@ -23,7 +23,7 @@ layout(location = 0) out vec3 out_world;
 layout(location = 1) out vec3 out_normal;
 layout(location = 2) out vec2 out_uv;
 layout(location = 3) out vec4 out_albedo;
-layout(location = 4) flat out float out_layer;
+layout(location = 4) flat out vec4 out_material;  // gi/rsm.frag's in_material
 
 void main() {
   out_world = in_position;
@@ -32,10 +32,10 @@ void main() {
   if (draw.misc.y >= 0) {
     GpuMaterial m = materials[draw.misc.y];
     out_albedo = m.base_color_factor;
-    out_layer = m.params.z;
+    out_material = vec4(m.params.z, m.params.x, m.params.y, 0.0f);
   } else {
     out_albedo = unpackUnorm4x8(uint(draw.misc.z));  // the proxy's material hint
-    out_layer = -1.0f;
+    out_material = vec4(-1.0f, 0.0f, -1.0f, 0.0f);  // diffuse (the paper's real specular is 0)
   }
   gl_Position = draw.view_proj * vec4(in_position, 1.0f);
 }

@@ -21,6 +21,10 @@
 // source reaches in L_r but a virtual object hides from it in L_rv carries ir = 1 (lights real
 // surfaces only, in L_r: it cancels the bounce the object blocks); an ir source spawns only real
 // points and ignores the virtual casters (Sec. 3.6).
+// kGlossy (gi/vpl_bounce.h VplBounceSettings::glossy): the sources' specular lobes light the
+// candidates (the paper's "glossy light bounce"), and a candidate on a virtual surface whose
+// material has a lobe becomes a glossy VPL lit from its source's direction (vpl_math.h
+// vpl_glossy_split); the draws weigh the lobe's flux with the cosine emitter's.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
 #include "shared/vpl_math.h"
@@ -49,6 +53,8 @@ layout(push_constant) uniform Params {
   vec4 test;     // x: the VPLs' 1/d^2 clamp distance (m); y, z: ISM bias relative and metres
   vec4 camera;   // x, y: the G-buffer's focal lengths in its pixels
 } params;
+layout(constant_id = 0) const bool kGlossy = false;
+const bool kGlossyLobes = kGlossy;  // gi/vpl_light.glsl
 #include "gi/virtual_points.glsl"
 #include "gi/vpl_light.glsl"
 
@@ -65,7 +71,8 @@ void main() {
     // The source's power: a point VPL's flux; a directional one's irradiance over its map's
     // cross-section (the disk of its half side), so both kinds are drawn by what they bring.
     float power = vpl_directional(v) ? MRGI_PI * v.normal.w * v.normal.w : 1.0f;
-    float l = (int(v.position.w) & MRGI_VPL_VALID) != 0 ? luminance(max(v.flux.rgb, vec3(0.0f))) * power : 0.0f;
+    vec3 reflected = max(v.flux.rgb, vec3(0.0f)) + (kGlossy && v.lobe.w >= 0.0f ? max(v.specular.rgb, vec3(0.0f)) : vec3(0.0f));
+    float l = (int(v.position.w) & MRGI_VPL_VALID) != 0 ? luminance(reflected) * power : 0.0f;
     cdf[j] = l > 0.0f && l < 3.0e38f ? l : 0.0f;
   }
   barrier();
@@ -87,6 +94,8 @@ void main() {
   uint index = uint(slot * per_kind + (has_virtual ? k / 2 : k)) + 1u;  // Halton index 0 is the origin
   bool ok = total > 0.0f;
   vec3 x = vec3(0.0f), n = vec3(0.0f, 0.0f, 1.0f), albedo = vec3(0.0f);
+  vec3 base = vec3(0.0f);
+  float metallic = 0.0f, roughness = -1.0f;  // the candidate's lobe (kGlossy, virtual; < 0 none)
   float area = 0.0f;
   if (want_virtual) {
     VirtualPoint p = virtual_point(vec3(halton(index, 2u), halton(index, 3u), halton(index, 5u)), params.points.z,
@@ -94,8 +103,13 @@ void main() {
     x = p.position;
     n = p.normal;
     GpuMaterial m = materials[range_material[p.range]];
-    albedo = m.base_color_factor.rgb * (1.0f - m.params.x);  // diffuse: base colour x (1 - metallic)
-    if (m.params.z >= 0.0f) albedo *= textureLod(base_color_maps, vec3(p.uv, m.params.z), 0.0f).rgb;
+    base = m.base_color_factor.rgb;
+    if (m.params.z >= 0.0f) base *= textureLod(base_color_maps, vec3(p.uv, m.params.z), 0.0f).rgb;
+    albedo = base * (1.0f - m.params.x);  // diffuse: base colour x (1 - metallic)
+    if (kGlossy) {
+      metallic = m.params.x;
+      roughness = m.params.y;
+    }
     area = p.area / float(slots * per_kind);
   } else {
     ivec2 size = params.points.xy;
@@ -114,6 +128,7 @@ void main() {
   // 2. The source VPL, drawn in proportion to its flux's luminance.
   float flux_weight = 0.0f;
   vec3 flux = vec3(0.0f);
+  vec4 lobe = vec4(0.0f, 0.0f, 1.0f, -1.0f), specular = vec4(0.0f);
   int flags = 0;
   int j = 0;
   if (ok) {
@@ -129,9 +144,9 @@ void main() {
     int source_flags = int(v.position.w);
     bool source_ir = (source_flags & MRGI_VPL_REAL_ONLY) != 0;
     bool source_real = (source_flags & MRGI_VPL_REAL_PATH) != 0;
-    float e = vpl_receive(v, x, n, params.test.x);
+    vec3 e = vpl_incident(v, x, n, params.test.x);
     // 3. Visibility: the source's ISMs of the previous frame.
-    if (p_source > 0.0f && e > 0.0f && !(want_virtual && source_ir)) {
+    if (p_source > 0.0f && any(greaterThan(e, vec3(0.0f))) && !(want_virtual && source_ir)) {
       vec2 stored;
       vec2 st = vpl_visibility(v, j, x, n, params.source.y, params.source.z, params.test.y, params.test.z, stored);
       bool st_r = st.x > 0.5f, st_v = st.y > 0.5f;
@@ -144,8 +159,15 @@ void main() {
       } else {
         flags = st_r && st_v ? MRGI_VPL_VALID : 0;                  // the path met a virtual object
       }
-      flux = albedo * max(v.flux.rgb, vec3(0.0f)) * (e / p_source * area);
-      float w = luminance(flux);
+      vec3 incident = max(e, vec3(0.0f)) * (area / p_source);  // Phi_in of the candidate's area
+      flux = albedo * incident;
+      if (kGlossy && want_virtual && roughness >= 0.0f) {
+        VplGlossySplit s = vpl_glossy_split(incident, base, metallic);
+        flux = s.diffuse_flux;
+        specular = vec4(s.specular_flux, s.incident_luminance);
+        lobe = vec4(vpl_direction(v, x), roughness);
+      }
+      float w = luminance(flux + specular.rgb);
       flux_weight = flags != 0 && w > 0.0f && w < 3.0e38f ? w : 0.0f;
     }
   }
@@ -172,6 +194,8 @@ void main() {
       empty.position = vec4(0.0f);
       empty.normal = vec4(0.0f, 0.0f, 1.0f, 0.0f);
       empty.flux = vec4(0.0f);
+      empty.lobe = vec4(0.0f, 0.0f, 1.0f, -1.0f);
+      empty.specular = vec4(0.0f);
       bounce[slot] = empty;
     }
   }
@@ -181,8 +205,13 @@ void main() {
     Vpl b;
     b.position = vec4(x, float(flags));
     b.normal = vec4(n, 0.0f);
-    vec3 f = flux * (weight[0] / mine);  // over the probability mine / sum of the draw
-    b.flux = vec4(all(lessThan(f, vec3(3.0e38f))) ? f : vec3(0.0f), 0.0f);
+    float scale = weight[0] / mine;  // over the probability mine / sum of the draw
+    vec3 f = flux * scale;
+    vec4 sp = specular * scale;
+    bool finite = all(lessThan(f, vec3(3.0e38f))) && all(lessThan(sp, vec4(3.0e38f)));
+    b.flux = vec4(finite ? f : vec3(0.0f), 0.0f);
+    b.lobe = finite ? lobe : vec4(0.0f, 0.0f, 1.0f, -1.0f);
+    b.specular = finite ? sp : vec4(0.0f);
     bounce[slot] = b;
   }
 }

@@ -1,7 +1,8 @@
 // What a VPL (common/vpl.glsl) gives a surface point, shared by the passes that gather VPL light
 // (shaders/dir/shade_vpl.comp) and the bounce light source (gi/vpl_bounce.comp), so a point VPL
 // and a directional one (an environment region) are read the same way everywhere. The including
-// shader declares `ism_distances` (rg32f, level 0 of gi/ism.h's atlas: x real, y virtual).
+// shader declares `ism_distances` (rg32f, level 0 of gi/ism.h's atlas: x real, y virtual) and
+// the constant bool kGlossyLobes.
 #ifndef MRGI_VPL_LIGHT_GLSL
 #define MRGI_VPL_LIGHT_GLSL
 #include "shared/vpl_math.h"
@@ -10,11 +11,23 @@
 
 bool vpl_directional(Vpl v) { return (int(v.position.w) & MRGI_VPL_DIRECTIONAL) != 0; }
 
-// Irradiance at p (unit normal n) per unit of the VPL's flux field, unoccluded: a point VPL's
-// vpl_irradiance (its 1 / d^2 clamped at `min_distance`); a directional one's cosine.
-float vpl_receive(Vpl v, vec3 p, vec3 n, float min_distance) {
-  if (vpl_directional(v)) return max(dot(n, v.normal.xyz), 0.0f);
-  return vpl_irradiance(p, n, v.position.xyz, v.normal.xyz, 1.0f, min_distance);
+// Irradiance [W/m^2] (rgb) the VPL gives p (unit normal n), unoccluded: a point VPL's cosine
+// emitter and, with kGlossyLobes and a lobe, its specular lobe (vpl_math.h vpl_irradiance_rgb,
+// its 1 / d^2 clamped at `min_distance`); a directional one's irradiance times the cosine.
+// kGlossyLobes: the including shader's specialisation (false: a lobe-free pipeline, whose
+// VPLs carry none, compiles the lobe out; lavapipe runs every branch).
+vec3 vpl_incident(Vpl v, vec3 p, vec3 n, float min_distance) {
+  if (vpl_directional(v)) return v.flux.rgb * max(dot(n, v.normal.xyz), 0.0f);
+  vec4 lobe = kGlossyLobes ? v.lobe : vec4(0.0f, 0.0f, 1.0f, -1.0f);
+  return vpl_irradiance_rgb(p, n, v.position.xyz, v.normal.xyz, v.flux.rgb, lobe, v.specular, min_distance);
+}
+
+// Unit direction from p towards where the VPL's light comes from.
+vec3 vpl_direction(Vpl v, vec3 p) {
+  if (vpl_directional(v)) return v.normal.xyz;
+  vec3 d = v.position.xyz - p;
+  float l = length(d);
+  return l > 0.0f ? d / l : v.normal.xyz;
 }
 
 // Whether p (unit normal n) is lit by VPL `slot` as its two imperfect shadow maps see it: x real

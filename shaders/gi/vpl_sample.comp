@@ -10,6 +10,10 @@
 // Flags (Sec. 3.3-3.6): a VPL on a real surface of a real lamp's map is on a real path; one
 // whose texel R^rho covers with a virtual surface lights real surfaces only (the paper's VPL 3:
 // it cancels the real bounce the virtual object blocks).
+// kGlossy (a scene with a glossy virtual material, gi/vpl.h VplSettings::glossy): a VPL on a
+// virtual texel takes its material's split into a cosine emitter and a specular lobe around the
+// lamp's mirror direction (shared/vpl_math.h vpl_glossy_split; the map's flux is the base colour
+// times the incident flux, rsm.frag); without it, and on real texels, every VPL is diffuse.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
 #include "shared/vpl_math.h"
@@ -27,7 +31,11 @@ layout(std430, set = 0, binding = 7) writeonly buffer Vpls { Vpl vpls[]; };
 layout(push_constant) uniform Params {
   ivec4 slots;  // x: first slot; y: slots of this pair; z: the pyramid's top level (used side
                 // 2^z); w: 1 real lamp, 0 virtual
+  vec4 lamp;    // the maps' lamp (gi/rsm.h RsmView::light): xyz its position (w > 0) or the
+                // direction its light travels (w < 0)
+  vec4 colour;  // rgb its colour x intensity (what the maps' flux alpha is per unit of)
 } params;
+layout(constant_id = 0) const bool kGlossy = false;
 
 void main() {
   int j = int(gl_GlobalInvocationID.x);
@@ -37,6 +45,8 @@ void main() {
   v.position = vec4(0.0f);
   v.normal = vec4(0.0f, 0.0f, 1.0f, 0.0f);
   v.flux = vec4(0.0f);
+  v.lobe = vec4(0.0f, 0.0f, 1.0f, -1.0f);
+  v.specular = vec4(0.0f);
   int top = params.slots.z;
   vec4 total = texelFetch(importance, ivec2(0), top);
   float covered = total.z + total.w;
@@ -81,7 +91,23 @@ void main() {
       v.position = vec4(pos.xyz, float(flags));
       v.normal = vec4(len > 0.0f ? n / len : vec3(0.0f, 0.0f, 1.0f), 0.0f);
       vec3 f = max(flux.rgb, vec3(0.0f)) / weight;
-      v.flux = vec4(all(lessThan(f, vec3(3.0e38f))) ? f : vec3(0.0f), 0.0f);  // no NaN or Inf VPL
+      vec4 specular = vec4(0.0f);
+      if (kGlossy && pos.w > 1.5f && nrm.w >= 0.0f) {
+        // A virtual texel of a material with a lobe: flux = base x Phi_in, flux.a = Phi_in per
+        // unit of the lamp's colour.
+        vec3 incident = max(flux.a, 0.0f) * params.colour.rgb;
+        vec3 base = clamp(flux.rgb / max(incident, vec3(1e-30f)), vec3(0.0f), vec3(1.0f));
+        VplGlossySplit s = vpl_glossy_split(incident / weight, base, clamp((pos.w - 2.0f) * 2.0f, 0.0f, 1.0f));
+        f = s.diffuse_flux;
+        specular = vec4(s.specular_flux, s.incident_luminance);
+        vec3 towards = params.lamp.w > 0.0f ? params.lamp.xyz - pos.xyz : -params.lamp.xyz;
+        float tl = length(towards);
+        v.lobe = vec4(tl > 0.0f ? towards / tl : v.normal.xyz, nrm.w);
+      }
+      bool finite = all(lessThan(f, vec3(3.0e38f))) && all(lessThan(specular, vec4(3.0e38f)));
+      v.flux = vec4(finite ? f : vec3(0.0f), 0.0f);  // no NaN or Inf VPL
+      v.specular = finite ? specular : vec4(0.0f);
+      if (!finite) v.lobe.w = -1.0f;
     }
   }
   vpls[slot] = v;

@@ -97,6 +97,29 @@ MRGI_FN vec3 srgb_decode(vec3 encoded) {
   return vec3(srgb_decode1(encoded.x), srgb_decode1(encoded.y), srgb_decode1(encoded.z));
 }
 
+// ---- microfacet BRDF -----------------------------------------------------------------------
+
+// GGX (Trowbridge-Reitz) distribution times Smith's height-correlated visibility, D(h) V(l, v),
+// for unit normal n and unit directions l (towards the light) and v (towards the viewer), both
+// away from the surface; alpha = roughness^2 (glTF metallic-roughness). The specular BRDF is this
+// times the Fresnel term (shaders/common/surface_shading.glsl brdf; gi VPL lobes,
+// shared/vpl_math.h vpl_intensity). Roughness 0 is a mirror: D is a delta the caller must not
+// sample (its value here is 0 or NaN).
+MRGI_FN float ggx_d_vis(vec3 n, vec3 l, vec3 v, float roughness) {
+  vec3 h = normalize(l + v);
+  float nl = max(dot(n, l), 0.0f), nv = max(dot(n, v), 1e-4f), nh = max(dot(n, h), 0.0f);
+  float a = roughness * roughness, a2 = a * a;
+  float denom = nh * nh * (a2 - 1.0f) + 1.0f;
+  float d = a2 / (MRGI_PI * denom * denom);
+  float vis = 0.5f / max(nl * sqrt(nv * nv * (1.0f - a2) + a2) + nv * sqrt(nl * nl * (1.0f - a2) + a2), 1e-6f);
+  return d * vis;
+}
+// Schlick's Fresnel factor (1 - cos)^5 (the caller mixes F0 towards 1 by it); pow-free.
+MRGI_FN float schlick_weight(float cos_theta) {
+  float m = 1.0f - clamp(cos_theta, 0.0f, 1.0f), m2 = m * m;
+  return m2 * m2 * m;
+}
+
 // Rec. 709 / sRGB primaries luminance of linear RGB.
 MRGI_FN float luminance(vec3 linear_rgb) {
   return dot(linear_rgb, vec3(0.2126f, 0.7152f, 0.0722f));

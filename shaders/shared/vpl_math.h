@@ -70,6 +70,65 @@ MRGI_FN float paraboloid_texel_solid_angle(vec2 uv, float size) {
   return 4.0f / (k * k) * (4.0f / (size * size));
 }
 
+// ---- glossy VPLs (the paper's "potentially glossy" D of LDDE paths, Sec. 3.1) ---------------
+// A VPL on a surface with a specular lobe (a virtual material of the glTF metallic-roughness
+// model) reflects the flux it received, Phi_in from unit direction `incident` (towards where the
+// light came from), by the BRDF: its intensity towards w is Phi_in f_r(incident, w) (n . w).
+// mrgi splits it into
+//   - the diffuse part, a cosine emitter of flux = Phi_in base (1 - metallic) (1 - F0): brdf()'s
+//     (1 - F) with F at normal incidence (F depends on w; the rest of it is at most F0's share);
+//   - the specular part, Phi_in F D V (n . w) (mrgi_shared.h ggx_d_vis), F Schlick's from F0 =
+//     mix(0.04, base, metallic): the VPL stores Phi_in F0 (rgb) and Phi_in's luminance for the
+//     grazing term (Phi_in F = Phi_in F0 + (Phi_in - Phi_in F0) (1 - w.h)^5, Phi_in taken grey
+//     there: only the tint of the grazing rise is lost).
+// The lobe is at least MRGI_VPL_MIN_ROUGHNESS wide: a VPL stands for the light of its share of the
+// maps (hundreds of texels), not for one point, and a narrower lobe turns it into a spot that the
+// few dozen VPLs of a frame cannot average (a mirror's reflection is issue 19's caustic maps).
+#define MRGI_VPL_MIN_ROUGHNESS 0.3f
+
+struct VplGlossySplit {
+  vec3 diffuse_flux;   // W: the cosine emitter's reflected flux
+  vec3 specular_flux;  // W: Phi_in F0
+  float incident_luminance;  // W: luminance of Phi_in
+};
+MRGI_FN VplGlossySplit vpl_glossy_split(vec3 incident_flux, vec3 base, float metallic) {
+  VplGlossySplit s;
+  vec3 f0 = mix(vec3(0.04f), base, metallic);
+  s.diffuse_flux = incident_flux * base * (1.0f - metallic) * (vec3(1.0f) - f0);
+  s.specular_flux = incident_flux * f0;
+  s.incident_luminance = dot(incident_flux, vec3(0.2126f, 0.7152f, 0.0722f));
+  return s;
+}
+
+// Intensity [W/sr] towards unit direction w of a VPL of unit normal nq: the cosine emitter of
+// `flux` plus, where lobe.w >= 0, the specular lobe of roughness lobe.w (at least
+// MRGI_VPL_MIN_ROUGHNESS) around the mirror direction of lobe.xyz (the unit incident direction),
+// with specular = (Phi_in F0 rgb, Phi_in luminance) as vpl_glossy_split makes them.
+MRGI_FN vec3 vpl_intensity(vec3 nq, vec3 w, vec3 flux, vec4 lobe, vec4 specular) {
+  float c = max(dot(nq, w), 0.0f);
+  vec3 i = flux * (c / MRGI_PI);
+  if (lobe.w >= 0.0f && c > 0.0f && dot(nq, vec3(lobe)) > 0.0f) {
+    vec3 l = vec3(lobe);
+    vec3 f0_flux = vec3(specular);
+    vec3 f = f0_flux + (vec3(specular.w) - f0_flux) * schlick_weight(dot(w, normalize(l + w)));
+    i += f * (ggx_d_vis(nq, l, w, max(lobe.w, MRGI_VPL_MIN_ROUGHNESS)) * c);
+  }
+  return i;
+}
+
+// Irradiance [W/m^2] (rgb) at p (unit normal np) from a VPL at q (unit normal nq) as
+// vpl_intensity describes it, unoccluded, its 1 / d^2 clamped at `min_distance` as
+// vpl_irradiance's.
+MRGI_FN vec3 vpl_irradiance_rgb(vec3 p, vec3 np, vec3 q, vec3 nq, vec3 flux, vec4 lobe, vec4 specular,
+                                float min_distance) {
+  vec3 v = p - q;
+  float d2 = dot(v, v);
+  if (!(d2 > 0.0f)) return vec3(0.0f);
+  vec3 w = v / sqrt(d2);
+  float receive = max(-dot(np, w), 0.0f);
+  return vpl_intensity(nq, w, flux, lobe, specular) * (receive / max(d2, min_distance * min_distance));
+}
+
 // Irradiance [W/m^2] at p (unit normal np) from a VPL at q (unit normal nq, reflected flux
 // `flux` W), unoccluded. The distance is clamped to `min_distance` [m]: the 1 / d^2 of a point
 // light is unbounded next to it, where a VPL stands for light spread over its surroundings

@@ -4,7 +4,8 @@
 // are built from the same clouds. The bounce VPLs' flux must add up to the light the floor and
 // the box reflect (integrated on the CPU), each kind apart; their flags must follow eq. 9 (the
 // box's are virtual paths, the floor the box hides from the source is ir = 1), and an ir source
-// must spawn nothing on the box.
+// must spawn nothing on the box. A glossy source (a specular lobe, shared/vpl_math.h
+// vpl_intensity) must put the light of its lobe on the floor where the lobe points.
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -25,7 +26,12 @@ const glm::vec3 kSource(1.15f, 0.45f, 1.1f);
 const glm::vec3 kDown(0.0f, -1.0f, 0.0f);
 const glm::vec3 kBoxLo(0.925f, 0.0f, 0.925f), kBoxHi(1.075f, 0.15f, 1.075f);
 
-std::vector<shader::Vpl> bounce(gpu::Context& ctx, int source_flags) {
+shader::Vpl diffuse_source(int flags) {
+  return {glm::vec4(kSource, float(flags)), glm::vec4(kDown, 0.0f), glm::vec4(1.0f, 1.0f, 1.0f, 0.0f),
+          glm::vec4(0.0f, 0.0f, 1.0f, -1.0f), glm::vec4(0.0f)};
+}
+
+std::vector<shader::Vpl> bounce(gpu::Context& ctx, const shader::Vpl& source_vpl, bool glossy = false) {
   test::RsmRig r(ctx);
   gi::IsmSettings is;
   is.max_vpls = 1;
@@ -34,12 +40,12 @@ std::vector<shader::Vpl> bounce(gpu::Context& ctx, int source_flags) {
   EXPECT_TRUE(ism.ok()) << ism.error().message;
   gi::VplBounceSettings bs;
   bs.max_slots = kSlots;
+  bs.glossy = glossy;
   auto b = gi::VplBounce::create(*r.graph, *r.scene, ism->virtual_triangles(), {r.real.position, r.real.normal, r.real.albedo}, bs);
   EXPECT_TRUE(b.ok()) << b.error().message;
   gpu::BufferDesc vd{"source vpls", sizeof(shader::Vpl), gpu::MemoryUsage::Upload};
   const gpu::BufferHandle source = *r.graph->create_buffer(vd, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-  *static_cast<shader::Vpl*>(r.graph->mapped(source, 0)) = {glm::vec4(kSource, float(source_flags)), glm::vec4(kDown, 0.0f),
-                                                            glm::vec4(1.0f, 1.0f, 1.0f, 0.0f)};
+  *static_cast<shader::Vpl*>(r.graph->mapped(source, 0)) = source_vpl;
   gpu::BufferDesc rd{"bounce readback", kSlots * sizeof(shader::Vpl), gpu::MemoryUsage::Readback};
   const gpu::BufferHandle readback = *r.graph->create_buffer(rd, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
   EXPECT_TRUE(r.graph->begin_frame().ok());
@@ -85,15 +91,22 @@ std::vector<shader::Vpl> bounce(gpu::Context& ctx, int source_flags) {
 // cells of a rectangle (origin o, edges a, b, normal nrm), unoccluded (the floor's candidates are
 // tested against the real casters only, and nothing real stands over it; a box face the source
 // sees is not hidden by the convex box).
-double reflected(glm::vec3 o, glm::vec3 a, glm::vec3 b, glm::vec3 nrm, float albedo) {
+// `source`: the VPL (vpl_irradiance_rgb, channel x); `weighted_x`: the flux-weighted mean x.
+double reflected(glm::vec3 o, glm::vec3 a, glm::vec3 b, glm::vec3 nrm, float albedo, const shader::Vpl& source,
+                 double* weighted_x = nullptr) {
   constexpr int n = 200;
-  double sum = 0.0;
+  double sum = 0.0, sum_x = 0.0;
   const double cell = double(glm::length(a)) * double(glm::length(b)) / double(n * n);
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) {
       const glm::vec3 p = o + a * ((float(i) + 0.5f) / n) + b * ((float(j) + 0.5f) / n);
-      sum += double(albedo) * double(shader::vpl_irradiance(p, nrm, kSource, kDown, 1.0f, kClamp)) * cell;
+      const double f = double(albedo) * double(shader::vpl_irradiance_rgb(p, nrm, glm::vec3(source.position), glm::vec3(source.normal),
+                                                                          glm::vec3(source.flux), source.lobe, source.specular, kClamp).x) *
+                       cell;
+      sum += f;
+      sum_x += f * double(p.x);
     }
+  if (weighted_x) *weighted_x = sum > 0.0 ? sum_x / sum : 0.0;
   return sum;
 }
 
@@ -117,16 +130,17 @@ bool on_box(glm::vec3 p) {
 }
 
 TEST_F(VulkanTest, BounceVplsCarryTheLightTheSurfacesReflect) {
-  const std::vector<shader::Vpl> v = bounce(ctx(), MRGI_VPL_VALID | MRGI_VPL_REAL_PATH);
+  const shader::Vpl source = diffuse_source(MRGI_VPL_VALID | MRGI_VPL_REAL_PATH);
+  const std::vector<shader::Vpl> v = bounce(ctx(), source);
   // The floor (its G-buffer spans 32 pixels of 1/31 m: 1.033 m a side) and the box's faces the
   // source sees from above and from its +x, +z side.
   const float side = float(test::kG) / float(test::kG - 1);
   const double floor_flux = reflected(glm::vec3(0.5f - 0.5f / float(test::kG - 1), 0.0f, 0.5f - 0.5f / float(test::kG - 1)),
-                                      glm::vec3(side, 0, 0), glm::vec3(0, 0, side), glm::vec3(0, 1, 0), 0.5f);
+                                      glm::vec3(side, 0, 0), glm::vec3(0, 0, side), glm::vec3(0, 1, 0), 0.5f, source);
   const float e = 0.15f;
-  const double box_flux = reflected(glm::vec3(kBoxLo.x, kBoxHi.y, kBoxLo.z), glm::vec3(e, 0, 0), glm::vec3(0, 0, e), glm::vec3(0, 1, 0), 0.8f) +
-                          reflected(glm::vec3(kBoxHi.x, 0, kBoxLo.z), glm::vec3(0, e, 0), glm::vec3(0, 0, e), glm::vec3(1, 0, 0), 0.8f) +
-                          reflected(glm::vec3(kBoxLo.x, 0, kBoxHi.z), glm::vec3(e, 0, 0), glm::vec3(0, e, 0), glm::vec3(0, 0, 1), 0.8f);
+  const double box_flux = reflected(glm::vec3(kBoxLo.x, kBoxHi.y, kBoxLo.z), glm::vec3(e, 0, 0), glm::vec3(0, 0, e), glm::vec3(0, 1, 0), 0.8f, source) +
+                          reflected(glm::vec3(kBoxHi.x, 0, kBoxLo.z), glm::vec3(0, e, 0), glm::vec3(0, 0, e), glm::vec3(1, 0, 0), 0.8f, source) +
+                          reflected(glm::vec3(kBoxLo.x, 0, kBoxHi.z), glm::vec3(e, 0, 0), glm::vec3(0, e, 0), glm::vec3(0, 0, 1), 0.8f, source);
   double real_sum = 0.0, virtual_sum = 0.0;
   int real_only = 0, virtual_paths = 0, empty = 0;
   for (const shader::Vpl& b : v) {
@@ -166,7 +180,7 @@ TEST_F(VulkanTest, BounceVplsCarryTheLightTheSurfacesReflect) {
 }
 
 TEST_F(VulkanTest, AnIrSourceSpawnsOnlyIrVplsOnRealSurfaces) {
-  const std::vector<shader::Vpl> v = bounce(ctx(), MRGI_VPL_VALID | MRGI_VPL_REAL_PATH | MRGI_VPL_REAL_ONLY);
+  const std::vector<shader::Vpl> v = bounce(ctx(), diffuse_source(MRGI_VPL_VALID | MRGI_VPL_REAL_PATH | MRGI_VPL_REAL_ONLY));
   int valid = 0;
   for (const shader::Vpl& b : v) {
     const int flags = int(b.position.w);
@@ -176,6 +190,35 @@ TEST_F(VulkanTest, AnIrSourceSpawnsOnlyIrVplsOnRealSurfaces) {
     EXPECT_FALSE(on_box(glm::vec3(b.position))) << "an ir source's light ignores (and never lands on) the virtual objects";
   }
   EXPECT_GT(valid, int(kSlots) / 2);
+}
+
+TEST_F(VulkanTest, AGlossySourceLightsTheFloorWhereItsLobePoints) {
+  // Only a specular lobe (no cosine emitter), its light arriving from down and to -x: the mirror
+  // direction points down and to +x, away from the box.
+  shader::Vpl source = diffuse_source(MRGI_VPL_VALID | MRGI_VPL_REAL_PATH);
+  source.flux = glm::vec4(0.0f);
+  source.lobe = glm::vec4(glm::normalize(glm::vec3(-0.6f, -1.0f, 0.0f)), 0.4f);
+  source.specular = glm::vec4(1.0f, 1.0f, 1.0f, 1.0f);  // Phi_in F0 = Phi_in = 1 W: a white metal
+  const std::vector<shader::Vpl> v = bounce(ctx(), source, true);
+  const float side = float(test::kG) / float(test::kG - 1);
+  double expected_x = 0.0;
+  const double floor_flux = reflected(glm::vec3(0.5f - 0.5f / float(test::kG - 1), 0.0f, 0.5f - 0.5f / float(test::kG - 1)),
+                                      glm::vec3(side, 0, 0), glm::vec3(0, 0, side), glm::vec3(0, 1, 0), 0.5f, source, &expected_x);
+  double sum = 0.0, sum_x = 0.0;
+  for (const shader::Vpl& b : v) {
+    const int flags = int(b.position.w);
+    ASSERT_TRUE(std::isfinite(b.flux.x) && b.flux.x >= 0.0f);
+    if ((flags & MRGI_VPL_VALID) == 0 || (flags & MRGI_VPL_REAL_PATH) == 0) continue;
+    EXPECT_LT(b.lobe.w, 0.0f) << "a VPL on a real surface is diffuse (the paper's real specular is 0)";
+    sum += b.flux.x;
+    sum_x += double(b.flux.x) * double(b.position.x);
+  }
+  const double mean_x = sum > 0.0 ? sum_x / sum : 0.0;
+  std::printf("glossy bounce: floor %.4f W (expected %.4f), flux-weighted x %.3f (expected %.3f; the source at %.3f)\n", sum,
+              floor_flux, mean_x, expected_x, double(kSource.x));
+  EXPECT_GT(expected_x, double(kSource.x) + 0.05) << "the lobe points to +x (the test's premise)";
+  EXPECT_NEAR(sum / floor_flux, 1.0, 0.15);
+  EXPECT_NEAR(mean_x, expected_x, 0.05);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "common/vpl.glsl"
+#include "gpu/shaders.h"
 
 namespace mrgi::gi {
 namespace {
@@ -45,9 +46,11 @@ Expected<VplSampler> VplSampler::create(gpu::FrameGraph& graph, const VplSetting
   auto dp = gpu::load_compute_pipeline(ctx, "gi/importance_downsample.comp", {});
   if (!dp) return dp.error();
   v.downsample_ = std::move(*dp);
-  auto sp = gpu::load_compute_pipeline(ctx, "gi/vpl_sample.comp", {});
+  auto sample_spv = gpu::shader_spirv("gi/vpl_sample.comp");
+  if (!sample_spv) return sample_spv.error();
+  auto sp = gpu::create_compute_pipeline(ctx, {s.name + " sample", *sample_spv, {}, 0, {s.glossy ? 1u : 0u}});
   if (!sp) return sp.error();
-  v.sample_ = std::move(*sp);
+  v.sample_ = gpu::PipelineHandle(ctx, std::move(*sp));
   auto cp = gpu::load_compute_pipeline(ctx, "gi/vpl_copy.comp", {});
   if (!cp) return cp.error();
   v.copy_ = std::move(*cp);
@@ -83,7 +86,7 @@ Status VplSampler::add_copy(gpu::FrameGraph& graph, const std::string& id, gpu::
 }
 
 Status VplSampler::add_sample(gpu::FrameGraph& graph, const std::string& id, const RsmImages& rho, const RsmImages& mu,
-                              bool real_lamp, uint32_t first, uint32_t count) {
+                              bool real_lamp, const VplLamp& lamp, uint32_t first, uint32_t count) {
   const uint32_t side = rho.width;
   if (rho.height != side || mu.width != side || mu.height != side || !std::has_single_bit(side) || side > settings_.map_size)
     return fail(ErrorKind::BadUsage, "vpl '" + settings_.name + "': the maps must be square, equal, a power of two and at most " +
@@ -127,7 +130,10 @@ Status VplSampler::add_sample(gpu::FrameGraph& graph, const std::string& id, con
   }
   const gpu::Pipeline* sp = &*sample_;
   const gpu::BufferHandle vpls = vpls_;
-  const glm::ivec4 slots(int(first), int(count), int(top), real_lamp ? 1 : 0);
+  struct {
+    glm::ivec4 slots;
+    glm::vec4 lamp, colour;
+  } const push{glm::ivec4(int(first), int(count), int(top), real_lamp ? 1 : 0), lamp.light, glm::vec4(lamp.colour, 0.0f)};
   const VkSampler nearest = graph.context().samplers().nearest_clamp;
   graph.add_shader_pass(
       settings_.name + " sample " + id, gpu::PassKind::Compute, *sample_,
@@ -141,8 +147,8 @@ Status VplSampler::add_sample(gpu::FrameGraph& graph, const std::string& id, con
         b.bind("mu_flux", mu.flux);
         b.bind_over("Vpls", vpls);  // other pairs' slots and the clear stay
       },
-      [sp, slots, count](VkCommandBuffer cmd, gpu::PassContext&) {
-        gpu::push_and_dispatch(cmd, *sp, &slots, sizeof slots, {(count + 63) / 64, 1, 1});
+      [sp, push, count](VkCommandBuffer cmd, gpu::PassContext&) {
+        gpu::push_and_dispatch(cmd, *sp, &push, sizeof push, {(count + 63) / 64, 1, 1});
       });
   return ok_status();
 }

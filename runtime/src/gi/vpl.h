@@ -28,6 +28,18 @@ struct VplSettings {
   // The slots keep their contents between frames (gpu::BufferDesc::history): a frame that does
   // not sample reads what the last one left (dir reuses its VPLs while nothing moved).
   bool history = false;
+  // VPLs on virtual texels whose material has a specular lobe (glTF roughness, metallic) get it
+  // (common/vpl.glsl Vpl::lobe, shared/vpl_math.h vpl_glossy_split); off: every VPL diffuse,
+  // reflecting its texel's whole flux. Fixed for the sampler's life (a scene's materials are).
+  bool glossy = false;
+};
+
+// The lamp of a pair of maps as the VPLs need it: where its light comes from (gi/rsm.h
+// RsmView::light: xyz position, w > 0; or xyz the direction it travels, w < 0) and its colour x
+// intensity (the maps' flux alpha is per unit of it).
+struct VplLamp {
+  glm::vec4 light{0.0f, 0.0f, 0.0f, 1.0f};
+  glm::vec3 colour{1.0f};
 };
 
 class VplSampler {
@@ -42,7 +54,7 @@ class VplSampler {
   // flags of Sec. 3.3; else R^rho's texels as one map, as the paper's virtual spot light).
   // Passes "<name> importance <id>", "<name> pyramid <id> <level>", "<name> sample <id>".
   Status add_sample(gpu::FrameGraph& graph, const std::string& id, const RsmImages& rho, const RsmImages& mu,
-                    bool real_lamp, uint32_t first, uint32_t count);
+                    bool real_lamp, const VplLamp& lamp, uint32_t first, uint32_t count);
 
   // Slots [first, first + count) from `source` (shader::Vpl[count], the bounce light source's);
   // the other slots keep what they hold. Pass "<name> copy <id>".

@@ -1,6 +1,7 @@
 #include "gi/vpl_bounce.h"
 
 #include "common/vpl.glsl"
+#include "gpu/shaders.h"
 
 namespace mrgi::gi {
 namespace {
@@ -31,9 +32,11 @@ Expected<VplBounce> VplBounce::create(gpu::FrameGraph& graph, const technique::S
                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
   if (!buffer) return buffer.error();
   b.bounce_ = *buffer;
-  auto p = gpu::load_compute_pipeline(graph.context(), "gi/vpl_bounce.comp", {});
+  auto spv = gpu::shader_spirv("gi/vpl_bounce.comp");
+  if (!spv) return spv.error();
+  auto p = gpu::create_compute_pipeline(graph.context(), {s.name, *spv, {}, 0, {s.glossy ? 1u : 0u}});
   if (!p) return p.error();
-  b.pipeline_ = std::move(*p);
+  b.pipeline_ = gpu::PipelineHandle(graph.context(), std::move(*p));
   return b;
 }
 

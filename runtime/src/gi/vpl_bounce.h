@@ -28,6 +28,9 @@ namespace mrgi::gi {
 struct VplBounceSettings {
   std::string name = "vpl bounce";  // prefix of the resources' and passes' names
   uint32_t max_slots = 64;          // bounce VPL slots allocated (the largest level's), 1..1024
+  // Glossy VPLs (gi/vpl.h VplSettings::glossy): the sources' lobes light the candidates, and a
+  // candidate on a virtual surface with a lobe becomes a glossy VPL; off: every VPL diffuse.
+  bool glossy = false;
 };
 
 // The real G-buffer the real candidates are read from (xyz world + depth, normal, albedo).

@@ -188,6 +188,7 @@ Expected<std::unique_ptr<SceneGpu>> SceneGpu::create(gpu::Context& context, gpu:
                            glm::vec4(glm::max(mat.emissive, glm::vec3(0.0f)), emissive_layer)});
       const glm::vec3 e = materials.back().emission;
       out->emissive = out->emissive || e.x > 0.0f || e.y > 0.0f || e.z > 0.0f;
+      out->glossy = out->glossy || mat.metallic > kGlossyMetallic || mat.roughness < kGlossyRoughness;
     }
     for (const Texture& t : m.textures) textures.push_back(&t.image);
     append_model(m, material_base, virtual_data, true);

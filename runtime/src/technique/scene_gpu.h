@@ -83,6 +83,12 @@ class SceneGpu {
   MeshSet real_proxies;
   gpu::BufferHandle materials;        // shader::GpuMaterial[] (at least one entry)
   bool emissive = false;              // some virtual material emits (GpuMaterial::emission)
+  // Some virtual material is glossy: metallic above kGlossyMetallic or roughness below
+  // kGlossyRoughness (factors; textures are not looked at). Specular work on VPLs (dir's glossy
+  // VPLs) is skipped without one: a dielectric rougher than that reflects 4 % of its light in a
+  // lobe broader than the VPLs' merge can tell from a cosine.
+  bool glossy = false;
+  static constexpr float kGlossyMetallic = 0.1f, kGlossyRoughness = 0.7f;
   gpu::ImageHandle base_color_maps;   // R8G8B8A8_SRGB array (at least one white layer)
 
  private:

@@ -123,6 +123,7 @@ class Dir final : public Technique {
     glm::dmat4 camera_to_world{1.0};
   } history_;
   std::unique_ptr<Technique> baseline_;
+  bool glossy_ = false;  // glossy VPLs: the scene has a glossy virtual material (SceneGpu::glossy)
   // This frame's lamps with VPLs (light index, view); reserved at init (no allocation per frame).
   std::vector<std::pair<size_t, gi::RsmView>> planned_;
   InputReuse reuse_;  // what the VPLs and ISMs in the buffers were made from
@@ -168,6 +169,7 @@ Status Dir::init() {
     vs.max_vpls = top_vpls;
     vs.map_size = top_rsm;
     vs.history = true;  // reused while nothing moved (InputReuse)
+    vs.glossy = sg.glossy;
     auto vpls = gi::VplSampler::create(graph, vs);
     if (!vpls) return vpls.error();
     vpls_.emplace(std::move(*vpls));
@@ -183,6 +185,7 @@ Status Dir::init() {
       gi::VplBounceSettings bs;
       bs.name = "dir bounce";
       bs.max_slots = top_bounce;
+      bs.glossy = sg.glossy;
       auto bounce = gi::VplBounce::create(graph, sg, ism_->virtual_triangles(),
                                           {shared_.real_position, shared_.real_normal, shared_.real_albedo}, bs);
       if (!bounce) return bounce.error();
@@ -222,7 +225,11 @@ Status Dir::init() {
   const uint32_t ablation_bits = (ablation.one_shadow_map ? 1u : 0u) | (ablation.no_real_only_vpls ? 2u : 0u);
   auto shade_spv = gpu::shader_spirv("dir/shade_vpl.comp");
   if (!shade_spv) return shade_spv.error();
-  auto shade = gpu::create_compute_pipeline(graph.context(), {"dir shade vpls", *shade_spv, {}, sizeof(DirPush), {ablation_bits}});
+  // Glossy VPLs (shade_vpl.comp kGlossy) only in a scene with a glossy virtual material
+  // (SceneGpu::glossy): the lobes cost every pixel every VPL, taken or not, on lavapipe.
+  glossy_ = shared_.scene_gpu->glossy;
+  auto shade = gpu::create_compute_pipeline(graph.context(), {"dir shade vpls", *shade_spv, {}, sizeof(DirPush),
+                                                              {ablation_bits, glossy_ ? 1u : 0u}});
   if (!shade) return shade.error();
   shade_ = gpu::PipelineHandle(graph.context(), std::move(*shade));
   for (auto [shader, out] : {std::pair{"dir/merge_rows.comp", &merge_rows_}, std::pair{"dir/merge_columns.comp", &merge_columns_},
@@ -245,7 +252,8 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   const DirLevel& level = dir_levels()[size_t(info.level)];
   gpu::FrameGraph& graph = *shared_.graph;
   const light::Lighting& lighting = shared_.light_stage->lighting();
-  skipped.push_back("dir glossy VPLs: not built yet (issue 15); every VPL reflects diffusely");
+  if (!glossy_)
+    skipped.push_back("dir glossy VPLs: no glossy virtual material (metallic > 0.1 or roughness < 0.7) in the scene; every VPL reflects diffusely");
   FrameInfo base = info;
   base.level = level.baseline_level;
   set_dir_indirect(*baseline_, nullptr);
@@ -346,7 +354,8 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
                                 (shared_.light_stage->environment_real() ? MRGI_VPL_REAL_PATH : 0));
       for (uint32_t k = 0; k < env_slots; ++k) {
         const light::EnvLight& r = regions[first_region + k];
-        env[k] = {glm::vec4(centre_, flags), glm::vec4(glm::vec3(r.direction), radius_), glm::vec4(glm::vec3(r.irradiance), 0.0f)};
+        env[k] = {glm::vec4(centre_, flags), glm::vec4(glm::vec3(r.direction), radius_), glm::vec4(glm::vec3(r.irradiance), 0.0f),
+                  glm::vec4(0.0f, 0.0f, 1.0f, -1.0f), glm::vec4(0.0f)};
       }
       MRGI_TRY(vpls_->add_copy(graph, "environment", env_vpls_, lamp_vpls + bounce_slots, env_slots));
     }
@@ -359,15 +368,16 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
       if (count == 0) continue;
       const std::string id = std::to_string(i);
       const gi::RsmImages mu = rsm_->images(gi::RsmMap::RealOnly, level.rsm_size);
+      const gi::VplLamp lamp{view.light, glm::vec3(view.colour)};
       if (lamp_reaches_objects(lighting.lights[i])) {
         rsm_->add_pair(graph, id, view, level.rsm_size);
         MRGI_TRY(vpls_->add_sample(graph, id, rsm_->images(gi::RsmMap::WithVirtual, level.rsm_size), mu,
-                                   lighting.lights[i].real, first, count));
+                                   lighting.lights[i].real, lamp, first, count));
       } else {
         // The spot's cone misses the virtual objects: R^rho would be R^mu's copy (issue 15's skip).
         skipped.push_back("dir rsm rho " + id + ": no virtual object in the lamp's cone (R^mu stands for both maps)");
         rsm_->add_real(graph, id, view, level.rsm_size);
-        MRGI_TRY(vpls_->add_sample(graph, id, mu, mu, lighting.lights[i].real, first, count));
+        MRGI_TRY(vpls_->add_sample(graph, id, mu, mu, lighting.lights[i].real, lamp, first, count));
       }
       first += count;
     }

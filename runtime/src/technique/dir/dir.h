@@ -66,12 +66,20 @@
 //     pose and blends it by a confidence from the change of normal and camera distance (the
 //     merge's same-surface test on the reprojected taps) and of the light's luminance
 //     (shaders/dir/temporal.comp), after the merge, at the indirect light's resolution;
-//   - not yet built (it says so in FrameStats::skipped): glossy VPLs.
+//   - glossy VPLs (the paper's Phong D_I/S_I/S_P becomes glTF's GGX metallic-roughness): a VPL
+//     on a glossy virtual surface splits into a cosine emitter and a specular lobe around the
+//     mirror direction of its light (shared/vpl_math.h vpl_intensity; the diffuse part scaled by
+//     1 - F0, brdf()'s 1 - F at normal incidence), at least MRGI_VPL_MIN_ROUGHNESS wide (a VPL
+//     stands for its share of the maps, not a point); virtual pixels reflect VPL light by their
+//     whole BRDF; real surfaces stay diffuse (the paper's real specular is 0). The lobe's
+//     Schlick grazing term takes the incident flux as grey.
 // Ablations (mrgi/runtime.h DirAblation, `mrgi replay --dir-ablation`): one ISM a VPL instead of
 // two, no ir(VPL), one bounce, no environment VPLs, no temporal smoothing; they change the VPL
 // light only (the lamps' direct light keeps baseline's two maps).
 //
 // Skips (each in FrameStats::skipped):
+//   - no glossy virtual material (technique/scene_gpu.h SceneGpu::glossy): no lobes (the shading
+//     and bounce pipelines are compiled without them), every VPL diffuse;
 //   - no virtual object, or no lamp a map can see them from: no maps, VPLs or ISMs (baseline only);
 //   - a spot lamp whose outer cone misses every virtual mesh range's bounding sphere: R^mu only,
 //     read as both maps (R^rho would be its copy);
