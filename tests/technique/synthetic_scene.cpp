@@ -13,7 +13,8 @@ namespace mrgi::test {
 namespace {
 
 // Unit cube x, z in [-0.5, 0.5], y in [0, 1] (resting on y = 0), 24 vertices with face normals.
-void write_cube_gltf(const std::string& folder, const glm::vec3& base, const glm::vec3& emission) {
+void write_cube_gltf(const std::string& folder, const glm::vec3& base, const glm::vec3& emission, float metallic,
+                     float roughness) {
   std::vector<float> pos, nrm;
   std::vector<uint16_t> idx;
   const glm::vec3 normals[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
@@ -44,8 +45,8 @@ void write_cube_gltf(const std::string& folder, const glm::vec3& base, const glm
       {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}, {"NORMAL", 1}}},
                                     {"indices", 2}, {"material", 0}}}}}}},
       {"materials", {{{"pbrMetallicRoughness", {{"baseColorFactor", {base.x, base.y, base.z, 1.0}},
-                                                {"metallicFactor", 0.0},
-                                                {"roughnessFactor", 1.0}}},
+                                                {"metallicFactor", metallic},
+                                                {"roughnessFactor", roughness}}},
                       {"emissiveFactor", {emission.x, emission.y, emission.z}}}}},
       {"buffers", {{{"uri", "cube.bin"}, {"byteLength", 2 * pbytes + ibytes}}}},
       {"bufferViews", {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", pbytes}},
@@ -89,7 +90,7 @@ glm::vec3 Box::normal_at(const glm::vec3& q) const {
 }
 
 SyntheticScene SyntheticScene::create(const std::string& folder, const glm::vec3& emission,
-                                      const glm::vec3& base) {
+                                      const glm::vec3& base, float metallic, float roughness) {
   SyntheticScene s;
   s.intrinsics.width = 64;
   s.intrinsics.height = 48;
@@ -103,7 +104,7 @@ SyntheticScene SyntheticScene::create(const std::string& folder, const glm::vec3
   s.real_box = {{-0.2f, 0.0f, 0.4f}, {0.2f, 0.4f, 0.8f}};
 
   s.virtual_base = base;
-  write_cube_gltf(folder, s.virtual_base, emission);
+  write_cube_gltf(folder, s.virtual_base, emission, metallic, roughness);
   // C1: a virtual box whose shadow falls on open floor; C2: a thin virtual plate floating above
   // the real box, whose shadow covers part of the real box's own shadow (DIR Fig. 5).
   const Placement places[2] = {

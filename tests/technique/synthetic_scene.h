@@ -48,9 +48,11 @@ struct SyntheticScene {
 
   // Writes the glTF cube and the environment image into `folder`.
   // `emission`: the cubes' glTF emissiveFactor (radiance; 0 = none).
-  // `base`: the cubes' glTF baseColorFactor (black: they only block light).
+  // `base`: the cubes' glTF baseColorFactor (black: they only block light); `metallic`,
+  // `roughness`: their glTF factors (the default is diffuse).
   static SyntheticScene create(const std::string& folder, const glm::vec3& emission = glm::vec3(0.0f),
-                               const glm::vec3& base = glm::vec3(0.8f, 0.2f, 0.2f));
+                               const glm::vec3& base = glm::vec3(0.8f, 0.2f, 0.2f), float metallic = 0.0f,
+                               float roughness = 1.0f);
   CameraSetup cameras() const;
 
   // First surface a camera ray through pixel (u, v) hits; `with_virtual` includes the virtual boxes.
