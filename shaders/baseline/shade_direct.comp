@@ -68,6 +68,14 @@ layout(set = 0, binding = 19) uniform sampler3D mu_r;  // V^mu: the two-volume a
 layout(set = 0, binding = 20) uniform sampler3D mu_g;
 layout(set = 0, binding = 21) uniform sampler3D mu_b;
 layout(set = 0, binding = 22, rgba32ui) readonly uniform uimage2D dir_indirect;  // bit 8 only
+// kOneShadowMap (dir's ablation one_shadow_map, mrgi/runtime.h DirAblation): a real lamp's two
+// maps read as the one map of Knecht et al. 2010 (the paper's [4]) would hold them: the nearer
+// caster and its kind (the maps' depths, nearest texel), so a real caster behind a virtual one
+// no longer shadows L_r (the double shadow of the paper's Fig. 5). The depths are read through
+// a plain sampler beside the compare ones.
+layout(constant_id = 1) const bool kOneShadowMap = false;
+layout(set = 0, binding = 23) uniform sampler2DArray shadow_primary_depth;
+layout(set = 0, binding = 24) uniform sampler2DArray shadow_virtual_depth;
 struct LevelConstants {
   vec4 shadow;  // x used map size / allocated size, y used size (texels), z allocated size,
                 // w PCF radius (taps each side of the centre)
@@ -174,6 +182,12 @@ void main() {
     bool real_lamp = L.direction_real.w > 0.5f;
     if (real_lamp) {
       float st_v = L.layers.y >= 0 ? shadow_test(shadow_virtual, L.layers.y, at) : 1.0f;
+      if (kOneShadowMap && L.layers.y >= 0 && at.w >= 0.0f) {
+        bool real_nearer = textureLod(shadow_primary_depth, vec3(at.xy, float(L.layers.x) + at.w), 0.0f).r <=
+                           textureLod(shadow_virtual_depth, vec3(at.xy, float(L.layers.y) + at.w), 0.0f).r;
+        st_primary = real_nearer ? st_primary : 1.0f;  // the real caster behind is lost
+        st_v = real_nearer ? 1.0f : st_v;
+      }
       l_rv += lo * min(st_primary, st_v);   // eq. 1, 3
       l_r += lo * r_p * st_primary;          // eq. 2
     } else {

@@ -165,6 +165,40 @@ TEST(Dir, GlossyCubesGetGlossyVpls) {
   EXPECT_GT(with_vpls, direct * 1.005);
 }
 
+// The one-map ablation (DirAblation::one_shadow_map) in the lamps' direct light: where the
+// virtual plate C2's shadow falls inside the real box's own (the paper's Fig. 5), one map holds
+// only the nearer caster, the plate, so L_r loses the real shadow there and the composite darkens
+// the camera's already dark shadow again: the double shadow. Two maps: the camera's value stays.
+TEST(Dir, OneShadowMapDarkensTheRealShadowTwiceWhereAVirtualOneOverlapsIt) {
+  mrgi::testing::TempDir dir;
+  SyntheticScene scene = SyntheticScene::create(dir.str());
+  DirAblation one;
+  one.one_shadow_map = true;
+  const std::vector<FrameOutput> two_maps = run(scene, "dir", 2, 2, true);
+  const std::vector<FrameOutput> one_map = run(scene, "dir", 2, 2, true, one);
+  ASSERT_EQ(two_maps.size(), 2u);
+  ASSERT_EQ(one_map.size(), 2u);
+  const int w = scene.intrinsics.width, h = scene.intrinsics.height;
+  double both_two = 0.0, both_one = 0.0;
+  int n = 0;
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      const SurfaceHit hit = scene.trace(u, v, true);
+      if (hit.kind == SurfaceKind::Virtual || hit.kind == SurfaceKind::None) continue;
+      if (!scene.blocked_by_real(hit.point) || !scene.blocked_by_virtual(hit.point)) continue;
+      const size_t o = (size_t(v) * w + u) * 4;
+      for (int c = 0; c < 3; ++c) {
+        both_two += lin(two_maps.back().image.data[o + c]);
+        both_one += lin(one_map.back().image.data[o + c]);
+      }
+      ++n;
+    }
+  ASSERT_GT(n, 0) << "the scene has pixels in both shadows (C2 over the real box's shadow)";
+  std::printf("both shadows: %.4f with two maps, %.4f with one (mean linear RGB, %d pixels)\n", both_two / (3.0 * n),
+              both_one / (3.0 * n), n);
+  EXPECT_LT(both_one, 0.8 * both_two) << "one map: the double shadow of Fig. 5";
+}
+
 TEST(Dir, VplsAndIsmsAreReusedOnlyWhileTheInputsStayWithinTolerance) {
   mrgi::testing::TempDir dir;
   check_reuse_within_tolerance(dir.str(), "dir", 3, "dir maps, VPLs and ISMs: reused");

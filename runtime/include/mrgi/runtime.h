@@ -66,9 +66,10 @@ struct DlpvAblation {
 // lamps' direct light is baseline's two shadow maps either way (no_environment_vpls also gives
 // the fast levels' environment regions back to baseline's maps).
 struct DirAblation {
-  // One imperfect shadow map per VPL holding the nearest surface, real or virtual, with a flag
-  // for which (Knecht et al. 2010, the paper's [4]), instead of one each: a real surface behind a
-  // virtual blocker no longer shadows L_r (the double shadow of the paper's Fig. 5).
+  // One shadow map per lamp and one imperfect shadow map per VPL holding the nearest surface,
+  // real or virtual, with a flag for which (Knecht et al. 2010, the paper's [4]), instead of one
+  // each: a real caster behind a virtual one no longer shadows L_r (the double shadow of the
+  // paper's Fig. 5), in the lamps' direct light and in the VPLs' light.
   bool one_shadow_map = false;
   // No ir(VPL): the real surfaces a virtual object hides from the lamp get no VPLs of their own
   // (VPL 3 of Fig. 6), so the real bounce the object blocks is not taken away from L_r (the

@@ -220,7 +220,8 @@ Status Baseline::init() {
   // 8 dir's VPL light.
   for (const uint32_t mode : kShadeModes) {
     auto sp = gpu::create_compute_pipeline(
-        ctx, {"baseline_shade_direct_" + std::to_string(mode), *shade_spv, {}, sizeof(ShadePush), {mode}});
+        ctx, {"baseline_shade_direct_" + std::to_string(mode), *shade_spv, {}, sizeof(ShadePush),
+              {mode, shared_.dir_ablation.one_shadow_map ? 1u : 0u}});
     if (!sp) return sp.error();
     shade_pipelines_[mode] = gpu::PipelineHandle(ctx, std::move(*sp));
   }
@@ -310,9 +311,10 @@ Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped
   (void)s;
   const VkSampler compare = shared_.context->samplers().shadow_compare;
   const VkSampler linear = shared_.context->samplers().linear_clamp;
+  const VkSampler nearest = shared_.context->samplers().nearest_clamp;
   graph.add_shader_pass(
       "shade_direct", gpu::PassKind::Compute, shade_pipeline(),
-      [this, compare, linear](gpu::ShaderPassBuilder& b) {
+      [this, compare, linear, nearest](gpu::ShaderPassBuilder& b) {
         const char* names[9] = {"delta_r", "delta_g", "delta_b", "rho_r", "rho_g", "rho_b", "mu_r", "mu_g", "mu_b"};
         for (int i = 0; i < 9; ++i) {
           const gpu::ImageHandle* set = !bounce_ ? nullptr : i < 3 ? bounce_->delta : i < 6 ? bounce_->rho : bounce_->mu;
@@ -323,6 +325,8 @@ Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped
         b.bind("LightUbo", lights_);
         b.bind_sampled("shadow_primary", shadow_primary_, compare);
         b.bind_sampled("shadow_virtual", shadow_virtual_, compare);
+        b.bind_sampled("shadow_primary_depth", shadow_primary_, nearest);  // kOneShadowMap only
+        b.bind_sampled("shadow_virtual_depth", shadow_virtual_, nearest);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) { shade(cmd, pass); });
   return ok_status();

@@ -73,9 +73,10 @@
 //     stands for its share of the maps, not a point); virtual pixels reflect VPL light by their
 //     whole BRDF; real surfaces stay diffuse (the paper's real specular is 0). The lobe's
 //     Schlick grazing term takes the incident flux as grey.
-// Ablations (mrgi/runtime.h DirAblation, `mrgi replay --dir-ablation`): one ISM a VPL instead of
-// two, no ir(VPL), one bounce, no environment VPLs, no temporal smoothing; they change the VPL
-// light only (the lamps' direct light keeps baseline's two maps).
+// Ablations (mrgi/runtime.h DirAblation, `mrgi replay --dir-ablation`): one shadow map a lamp
+// and one ISM a VPL instead of two (the lamps' direct light too: baseline's shading pass reads its
+// two maps as one, shade_direct.comp kOneShadowMap), no ir(VPL), one bounce, no environment
+// VPLs, no temporal smoothing (these four change the VPL light only).
 //
 // Skips (each in FrameStats::skipped):
 //   - no glossy virtual material (technique/scene_gpu.h SceneGpu::glossy): no lobes (the shading
