@@ -229,8 +229,8 @@ void setup(CLI::App& app) {
       ->delimiter(',')
       ->check(CLI::IsMember(ablation_names(kDlpvAblations)));
   cmd->add_option("--dir-ablation", opts->dir_ablation,
-                  "dir without one of the paper's ideas (mrgi/runtime.h DirAblation): one-shadow-map (one ISM a VPL "
-                  "with the nearest surface and its kind, not one each), no-real-only-vpls (no ir(VPL): the real bounce "
+                  "dir without one of the paper's ideas (mrgi/runtime.h DirAblation): one-shadow-map (one shadow map a "
+                  "lamp and one ISM a VPL with the nearest caster and its kind, not one each), no-real-only-vpls (no ir(VPL): the real bounce "
                   "a virtual object blocks stays in L_r), one-bounce (no bounce light source: the lamps' VPLs only, "
                   "at the levels with multiple bounces), no-environment-vpls (the environment light baseline leaves "
                   "unshadowed stays unshadowed), no-temporal-smoothing (each frame's VPL light alone); comma-separated")
