@@ -39,6 +39,11 @@ struct DeviceSettings {
   // an earlier runtime's data later), so a pass that reads memory nothing wrote this frame
   // changes the output every time instead of once in a while. Also on with MRGI_POISON_MEMORY=1.
   bool poison_memory = false;
+  // Vulkan 1.2 even where the device has 1.3: the instance asks for 1.2 and synchronization2 and
+  // dynamic rendering come from their KHR extensions, the path a 1.2 driver takes (tablets and
+  // headsets often ship one); with `validate`, a 1.3-only call is reported. For testing that path
+  // on a 1.3 device.
+  bool vulkan_1_2 = false;
 };
 
 // Lists the Vulkan devices and marks the one `settings` would pick.

@@ -309,7 +309,7 @@ void ReflectiveShadowMaps::add_map_draw(gpu::FrameGraph& graph, const std::strin
         ri.colorAttachmentCount = 3;
         ri.pColorAttachments = colour;
         ri.pDepthAttachment = &depth;
-        vkCmdBeginRendering(cmd, &ri);
+        ctx.fn().cmd_begin_rendering(cmd, &ri);
         const VkViewport vp{0.0f, 0.0f, float(s), float(s), 0.0f, 1.0f};
         const VkRect2D sc{{0, 0}, {s, s}};
         vkCmdSetViewport(cmd, 0, 1, &vp);
@@ -354,7 +354,7 @@ void ReflectiveShadowMaps::add_map_draw(gpu::FrameGraph& graph, const std::strin
           if (proxies) draw_set(sg->real_proxies, false);
           if (virtuals) draw_set(sg->virtual_objects, true);
         }
-        vkCmdEndRendering(cmd);
+        ctx.fn().cmd_end_rendering(cmd);
       });
 }
 

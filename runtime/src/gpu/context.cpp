@@ -77,11 +77,14 @@ bool device_has_extension(VkPhysicalDevice pd, const char* name) {
 }
 
 // A bare instance for listing devices and the one a Context keeps.
-Expected<VkInstance> create_instance(bool validate, const VkDebugUtilsMessengerCreateInfoEXT* messenger) {
+// api_version: the highest Vulkan version the process uses (1.3, or 1.2 for DeviceSettings::
+// vulkan_1_2).
+Expected<VkInstance> create_instance(bool validate, const VkDebugUtilsMessengerCreateInfoEXT* messenger,
+                                     uint32_t api_version = VK_API_VERSION_1_3) {
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.pApplicationName = "mrgi";
   app.pEngineName = "mrgi";
-  app.apiVersion = VK_API_VERSION_1_3;
+  app.apiVersion = api_version;
   std::vector<const char*> layers, extensions;
   VkValidationFeaturesEXT features{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
   // Synchronization validation checks what the frame graph derives: a missing barrier is a
@@ -231,7 +234,7 @@ Status Context::init(const DeviceSettings& settings) {
                     VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
   mci.pfnUserCallback = debug_callback;
   mci.pUserData = this;
-  auto instance = create_instance(validate_, &mci);
+  auto instance = create_instance(validate_, &mci, settings.vulkan_1_2 ? VK_API_VERSION_1_2 : VK_API_VERSION_1_3);
   if (!instance) return instance.error();
   instance_ = *instance;
   if (validate_) {
@@ -257,7 +260,9 @@ Status Context::init(const DeviceSettings& settings) {
   if (properties_.apiVersion < VK_API_VERSION_1_2)
     return fail(ErrorKind::Device, who + " has Vulkan " + version_string(properties_.apiVersion) +
                                        "; mrgi needs 1.2 or later");
-  const bool is13 = properties_.apiVersion >= VK_API_VERSION_1_3;
+  // The 1.3 entry points only where both the device and the settings allow them.
+  const bool is13 = properties_.apiVersion >= VK_API_VERSION_1_3 && !settings.vulkan_1_2;
+  api_1_3_ = is13;
 
   // Queue: the first family with graphics and compute.
   uint32_t nq = 0;

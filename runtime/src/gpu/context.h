@@ -118,6 +118,8 @@ class Context {
 
   // Validation (DeviceSettings::validate): every warning and error message, in order.
   bool validation_enabled() const { return validate_; }
+  // Whether sync2 and dynamic rendering are core (1.3) or their KHR extensions (1.2 path).
+  bool api_1_3() const { return api_1_3_; }
   // imageAtomicAdd on 32-bit float images and texel buffers (VK_EXT_shader_atomic_float), enabled
   // where the device has it.
   bool image_float_atomic_add() const { return image_float_atomic_add_; }
@@ -175,6 +177,7 @@ class Context {
   DeviceFunctions fn_;
   PFN_vkSetDebugUtilsObjectNameEXT set_object_name_ = nullptr;
   bool validate_ = false;
+  bool api_1_3_ = false;
   bool poison_memory_ = false;  // DeviceSettings::poison_memory
   bool image_float_atomic_add_ = false;
   uint64_t allocated_bytes_ = 0;

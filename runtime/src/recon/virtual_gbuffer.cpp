@@ -198,7 +198,7 @@ void VirtualGBuffer::draw(VkCommandBuffer cmd, gpu::PassContext& pass) {
   ri.colorAttachmentCount = count;
   ri.pColorAttachments = colors;
   ri.pDepthAttachment = &depth;
-  vkCmdBeginRendering(cmd, &ri);
+  pass.context().fn().cmd_begin_rendering(cmd, &ri);
   if (!scene_->virtual_objects.empty()) {
     const VkViewport vp{0.0f, 0.0f, float(e.width), float(e.height), 0.0f, 1.0f};
     const VkRect2D sc = area_;
@@ -209,7 +209,7 @@ void VirtualGBuffer::draw(VkCommandBuffer cmd, gpu::PassContext& pass) {
                        &step);
     scene_->virtual_objects.draw(cmd, pass, &*pipeline_, &*double_sided_pipeline_, &lod_);
   }
-  vkCmdEndRendering(cmd);
+  pass.context().fn().cmd_end_rendering(cmd);
 }
 
 }  // namespace mrgi::recon

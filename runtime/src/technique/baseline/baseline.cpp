@@ -394,7 +394,7 @@ void Baseline::render_faces(VkCommandBuffer cmd, gpu::PassContext& pass,
     ri.renderArea = {{0, 0}, {s, s}};
     ri.layerCount = 1;
     ri.pDepthAttachment = &depth;
-    vkCmdBeginRendering(cmd, &ri);
+    pass.context().fn().cmd_begin_rendering(cmd, &ri);
     const VkViewport vp{0.0f, 0.0f, float(s), float(s), 0.0f, 1.0f};
     const VkRect2D sc{{0, 0}, {s, s}};
     vkCmdSetViewport(cmd, 0, 1, &vp);
@@ -426,7 +426,7 @@ void Baseline::render_faces(VkCommandBuffer cmd, gpu::PassContext& pass,
         sg.virtual_objects.draw(cmd, pass, nullptr, nullptr, lod.focal_px > 0.0f ? &lod : nullptr);
       }
     }
-    vkCmdEndRendering(cmd);
+    pass.context().fn().cmd_end_rendering(cmd);
   }
 }
 
