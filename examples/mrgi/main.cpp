@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <fstream>
 #include "mrgi/runtime.h"
+#include "mrgi/version.h"
 
 namespace mrgi::tool {
 namespace {
@@ -71,7 +72,7 @@ int main(int argc, char** argv) {
   using namespace mrgi::tool;
   CLI::App app{"mrgi: mixed-reality global illumination runtime (Vulkan, differential rendering)"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "mrgi 0.1.0");
+  app.set_version_flag("--version", std::string("mrgi ") + mrgi::version());
   for (auto& [name, setup] : registry()) setup(app);
   try {
     app.parse(argc, argv);
