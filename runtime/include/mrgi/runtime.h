@@ -182,6 +182,11 @@ struct FrameOutput {
   std::optional<LightEstimate> light;
 };
 
+// Thread safety: a Runtime is not thread-safe. Call its methods from one thread at a time
+// (synchronise externally if several threads drive it); process() does its recording and host
+// work on the calling thread, and the Vulkan driver runs the frames on its own threads. Each
+// Runtime owns its own Vulkan instance, device and frame graph; what runtimes share is
+// process-wide: DeviceSettings::keep_freed_memory's malloc setting.
 class Runtime {
  public:
   virtual ~Runtime() = default;
