@@ -178,6 +178,9 @@ void setup(CLI::App& app) {
   cmd->add_option("--device", opts->settings.device.device,
                   "Vulkan device: index or name part (default $MRGI_DEVICE, else lavapipe)");
   cmd->add_flag("--validate", opts->settings.device.validate, "enable Vulkan validation layers (slower)");
+  cmd->add_flag("--vulkan-1-2", opts->settings.device.vulkan_1_2,
+                "use the Vulkan 1.2 path on a 1.3 device (synchronization2 and dynamic rendering from their KHR "
+                "extensions, as a 1.2 driver runs them)");
   cmd->add_flag("--quiet,-q", opts->quiet, "no progress on stderr");
   cmd->callback([opts] { run_bench_command(*opts); });
 }

@@ -49,7 +49,7 @@ struct ReplayOptions {
   std::vector<std::string> dlpv_ablation;
   std::vector<std::string> dir_ablation;
   int frames = 0, width = 0, height = 0;
-  bool validate = false, quiet = false;
+  bool validate = false, quiet = false, vulkan_1_2 = false;
 };
 
 void run_replay(const ReplayOptions& o) {
@@ -63,6 +63,7 @@ void run_replay(const ReplayOptions& o) {
   RuntimeSettings settings;
   settings.device.device = o.device;
   settings.device.validate = o.validate;
+  settings.device.vulkan_1_2 = o.vulkan_1_2;
   settings.technique = o.technique;
   settings.level = level;
   settings.output_width = o.width;
@@ -238,6 +239,9 @@ void setup(CLI::App& app) {
       ->check(CLI::IsMember(ablation_names(kDirAblations)));
   cmd->add_option("--device", opts->device, "Vulkan device: index or name part (default $MRGI_DEVICE, else lavapipe)");
   cmd->add_flag("--validate", opts->validate, "enable Vulkan validation layers");
+  cmd->add_flag("--vulkan-1-2", opts->vulkan_1_2,
+                "use the Vulkan 1.2 path on a 1.3 device (synchronization2 and dynamic rendering from their KHR "
+                "extensions, as a 1.2 driver runs them)");
   cmd->add_flag("--quiet,-q", opts->quiet, "no progress on stderr");
   cmd->callback([opts] { run_replay(*opts); });
 }
