@@ -31,21 +31,7 @@ std::vector<FrameOutput> run(const SyntheticScene& scene, const std::string& tec
   s.dir_ablation = ablation;
   s.technique = technique;
   s.level = level;
-  auto rt = create_runtime(s, scene.cameras(), scene.scene);
-  EXPECT_TRUE(rt.ok()) << rt.error().message;
-  std::vector<FrameOutput> outs;
-  if (!rt.ok()) return outs;
-  for (int k = 0; k < frames; ++k) {
-    auto o = (*rt)->process(scene.frame(k));
-    EXPECT_TRUE(o.ok()) << o.error().message;
-    if (!o.ok()) return outs;
-    for (auto& x : *o) outs.push_back(std::move(x));
-  }
-  auto rest = (*rt)->flush();
-  EXPECT_TRUE(rest.ok()) << rest.error().message;
-  if (rest.ok())
-    for (auto& x : *rest) outs.push_back(std::move(x));
-  return outs;
+  return run_synthetic_frames(scene, s, frames);
 }
 
 // Mean linear light of the pixels the virtual boxes cover.

@@ -4,6 +4,7 @@
 #include <cstring>
 #include <fstream>
 
+#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include "mrgi/image.h"
@@ -225,6 +226,24 @@ InputFrame SyntheticScene::frame(int64_t index) const {
     }
   }
   return f;
+}
+
+std::vector<FrameOutput> run_synthetic_frames(const SyntheticScene& scene, const RuntimeSettings& settings, int frames) {
+  auto rt = create_runtime(settings, scene.cameras(), scene.scene);
+  EXPECT_TRUE(rt.ok()) << rt.error().message;
+  std::vector<FrameOutput> outs;
+  if (!rt.ok()) return outs;
+  for (int k = 0; k < frames; ++k) {
+    auto o = (*rt)->process(scene.frame(k));
+    EXPECT_TRUE(o.ok()) << o.error().message;
+    if (!o.ok()) return outs;
+    for (auto& x : *o) outs.push_back(std::move(x));
+  }
+  auto rest = (*rt)->flush();
+  EXPECT_TRUE(rest.ok()) << rest.error().message;
+  if (rest.ok())
+    for (auto& x : *rest) outs.push_back(std::move(x));
+  return outs;
 }
 
 }  // namespace mrgi::test

@@ -69,4 +69,8 @@ struct SyntheticScene {
   InputFrame frame(int64_t index) const;
 };
 
+// `frames` frames of `scene` through a runtime made with `settings` and flushed: every output, in
+// order (fewer where a call failed, which is reported as a test failure).
+std::vector<FrameOutput> run_synthetic_frames(const SyntheticScene& scene, const RuntimeSettings& settings, int frames);
+
 }  // namespace mrgi::test

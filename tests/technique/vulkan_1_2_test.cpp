@@ -21,21 +21,7 @@ std::vector<FrameOutput> run(const SyntheticScene& scene, const std::string& tec
   s.device.vulkan_1_2 = vulkan_1_2;
   s.technique = technique;
   s.level = 2;
-  auto rt = create_runtime(s, scene.cameras(), scene.scene);
-  EXPECT_TRUE(rt.ok()) << rt.error().message;
-  std::vector<FrameOutput> outs;
-  if (!rt.ok()) return outs;
-  for (int k = 0; k < 2; ++k) {
-    auto o = (*rt)->process(scene.frame(k));
-    EXPECT_TRUE(o.ok()) << o.error().message;
-    if (!o.ok()) return outs;
-    for (auto& x : *o) outs.push_back(std::move(x));
-  }
-  auto rest = (*rt)->flush();
-  EXPECT_TRUE(rest.ok()) << rest.error().message;
-  if (rest.ok())
-    for (auto& x : *rest) outs.push_back(std::move(x));
-  return outs;
+  return run_synthetic_frames(scene, s, 2);
 }
 
 TEST(Vulkan12, EveryPassKindRunsOnTheExtensionPathAndGivesTheSameFrames) {
