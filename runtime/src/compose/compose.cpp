@@ -218,7 +218,8 @@ Status Compose::read(const gpu::FrameGraph& graph, uint32_t slot, ImageRGBA8& im
   const gpu::GpuBuffer& ob = graph.gpu_buffer(output_, slot);
   MRGI_TRY(graph.context().invalidate(ob));
   reuse_or_allocate(image, int(width_), int(height_), false);  // every pixel written below
-  reuse_or_allocate(mask, int(width_), int(height_));   // zero, tiles written below
+  // Every mask byte is written below on a whole-frame readback; a tiled one writes only its tiles.
+  reuse_or_allocate(mask, int(width_), int(height_), slot_host_camera_[slot] != 0);
   const auto* out = static_cast<const uint32_t*>(graph.mapped(output_, slot));
   if (!slot_host_camera_[slot]) {
     unpack_output_words(out, image.data.data(), mask.data.data(), mask.data.size());
