@@ -181,6 +181,9 @@ void setup(CLI::App& app) {
   cmd->add_flag("--vulkan-1-2", opts->settings.device.vulkan_1_2,
                 "use the Vulkan 1.2 path on a 1.3 device (synchronization2 and dynamic rendering from their KHR "
                 "extensions, as a 1.2 driver runs them)");
+  cmd->add_flag("--no-residual-light", [opts](int64_t n) { opts->settings.residual_light = n == 0; },
+                "with declared lamps: light by the lamps alone, without the estimate of the real light they do not "
+                "explain (RuntimeSettings::residual_light; an ablation)");
   cmd->add_flag("--quiet,-q", opts->quiet, "no progress on stderr");
   cmd->callback([opts] { run_bench_command(*opts); });
 }

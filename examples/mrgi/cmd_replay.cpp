@@ -49,7 +49,7 @@ struct ReplayOptions {
   std::vector<std::string> dlpv_ablation;
   std::vector<std::string> dir_ablation;
   int frames = 0, width = 0, height = 0;
-  bool validate = false, quiet = false, vulkan_1_2 = false;
+  bool validate = false, quiet = false, vulkan_1_2 = false, no_residual_light = false;
 };
 
 void run_replay(const ReplayOptions& o) {
@@ -64,6 +64,7 @@ void run_replay(const ReplayOptions& o) {
   settings.device.device = o.device;
   settings.device.validate = o.validate;
   settings.device.vulkan_1_2 = o.vulkan_1_2;
+  settings.residual_light = !o.no_residual_light;
   settings.technique = o.technique;
   settings.level = level;
   settings.output_width = o.width;
@@ -242,6 +243,9 @@ void setup(CLI::App& app) {
   cmd->add_flag("--vulkan-1-2", opts->vulkan_1_2,
                 "use the Vulkan 1.2 path on a 1.3 device (synchronization2 and dynamic rendering from their KHR "
                 "extensions, as a 1.2 driver runs them)");
+  cmd->add_flag("--no-residual-light", opts->no_residual_light,
+                "with declared lamps: light by the lamps alone, without the estimate of the real light they do not "
+                "explain (RuntimeSettings::residual_light; an ablation)");
   cmd->add_flag("--quiet,-q", opts->quiet, "no progress on stderr");
   cmd->callback([opts] { run_replay(*opts); });
 }

@@ -166,7 +166,9 @@ void main() {
 
   // A virtual surface's own emission (glTF emissive) is seen directly; it lights nothing else
   // here (this technique has no indirect light).
-  vec3 l_rv = alb.rgb * ambient_irradiance(ambient_rv, n) * (1.0f / MRGI_PI) +
+  // With V^rho on virtual pixels, not the residual ambient too (light_set.glsl count.y).
+  bool ambient_here = !(kRhoOnVirtual && is_virtual && light_set.count.y != 0);
+  vec3 l_rv = (ambient_here ? alb.rgb * ambient_irradiance(ambient_rv, n) * (1.0f / MRGI_PI) : vec3(0.0f)) +
               (is_virtual && frame.flags.y != 0 ? imageLoad(virtual_emission, pixel).rgb : vec3(0.0f));
   vec3 l_r = r_p * alb.rgb * ambient_irradiance(ambient_r, n) * (1.0f / MRGI_PI);
   int count = min(light_set.count.x, MRGI_MAX_LIGHTS);

@@ -39,7 +39,11 @@ struct AmbientIrradiance {
 // Point lamps use a cube of 6 perspective faces: +X, -X, +Y, -Y, +Z, -Z (major axis of the
 // light-to-point vector picks the face), each a 90 degree frustum.
 struct LightSet {
-  ivec4 count;                                   // x number of lamps
+  // x number of lamps; y 1 when the ambient is the light stage's residual estimate (the real
+  // light the declared lamps do not explain, light/light_stage.h residual_light): a technique
+  // whose volume already carries the real scene's bounce to virtual surfaces (V^rho) leaves it
+  // off them, since the residual holds that bounce too.
+  ivec4 count;
   ShadowLight lights[MRGI_MAX_LIGHTS];
   mat4 face_view_proj[MRGI_MAX_LIGHTS * 6];      // lamp i face f at i * 6 + f; Vulkan clip
   AmbientIrradiance ambient_rv;                  // real + virtual ambient: lights L_rv

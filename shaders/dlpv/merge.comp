@@ -91,8 +91,10 @@ void main() {
 #undef MRGI_SHADE_LAMP
   vec3 l_rv, l_r;
   if (is_virtual) {
-    vec3 e = ambient_irradiance(ambient_rv, n);
-    if (volume.extent.w > 0.5f) e += volume_irradiance(rho_r, rho_g, rho_b, p, n);
+    // With V^rho, not the residual ambient too (light_set.glsl count.y: it holds that bounce).
+    bool rho = volume.extent.w > 0.5f;
+    vec3 e = rho && light_set.count.y != 0 ? vec3(0.0f) : ambient_irradiance(ambient_rv, n);
+    if (rho) e += volume_irradiance(rho_r, rho_g, rho_b, p, n);
     l_rv = lamps + alb.rgb * max(e, vec3(0.0f)) * (1.0f / MRGI_PI) +
            (frame.flags.y != 0 ? imageLoad(virtual_emission, pixel).rgb : vec3(0.0f));
     l_r = vec3(0.0f);

@@ -132,6 +132,12 @@ struct RuntimeSettings {
   // real light is followed with a time constant of this many frames (15: half a second at
   // 30 fps), so noise between frames does not flicker the light. 0 = no filtering. 0..1e6.
   double light_lag_frames = 15.0;
+  // With declared lamps and no environment image: also estimate, from colour and depth, the
+  // real light the lamps do not explain (the room's own interreflection, daylight) and light
+  // both solutions with it as an unshadowed ambient (light/light_stage.h residual_light). The
+  // differential composite divides by the model of the real light, which without it holds the
+  // lamps' direct light only. false: the lamps alone (as before; an ablation).
+  bool residual_light = true;
 };
 
 struct PassTiming {

@@ -20,26 +20,6 @@ void set_rgb(LightDesc& l, const glm::dvec3& rgb) {
   l.color = peak > 0.0 ? glm::vec3(rgb / peak) : glm::vec3(1.0f);
 }
 
-glm::dvec3 light_rgb(const LightDesc& l) { return glm::dvec3(l.color) * double(l.intensity); }
-
-// Irradiance a declared lamp sends to `p` (W/m^2 per channel at normal incidence) and the
-// direction towards it, for the exported estimate.
-glm::dvec3 lamp_at(const LightDesc& l, const glm::dvec3& p, glm::dvec3& to_light) {
-  if (l.type == LightType::Directional) {
-    to_light = -glm::normalize(glm::dvec3(l.direction));
-    return light_rgb(l);
-  }
-  const glm::dvec3 d = glm::dvec3(l.position) - p;
-  const double d2 = std::max(glm::dot(d, d), 1e-6);
-  to_light = d / std::sqrt(d2);
-  double cone = 1.0;
-  if (l.type == LightType::Spot)
-    cone = shader::spot_falloff(float(glm::dot(glm::normalize(glm::dvec3(l.direction)), -to_light)),
-                                std::cos(glm::radians(l.outer_angle_deg)),
-                                std::cos(glm::radians(l.inner_angle_deg)));
-  return light_rgb(l) * (cone / d2);
-}
-
 }  // namespace
 
 const char* source_name(LightSourceKind kind) {
@@ -81,6 +61,8 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
                                                          const SceneDesc& scene, const CameraSetup& cameras) {
   if (settings.shadowed_environment_lights < 0 || settings.shadowed_environment_lights > kMaxStageLights)
     return fail(ErrorKind::BadUsage, "LightStageSettings.shadowed_environment_lights: must be 0..8");
+  if (settings.residual_shading_bands < 1 || settings.residual_shading_bands > 3)
+    return fail(ErrorKind::BadUsage, "LightStageSettings.residual_shading_bands: must be 1..3");
   if (auto check = LightEstimator::create(settings.external_estimator); !check) return check.error();
   auto stage = std::unique_ptr<LightStage>(new LightStage());
   LightStage& s = *stage;
@@ -91,7 +73,13 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
   if (s.declared_ > kMaxStageLights)
     return fail(ErrorKind::BadInput, scene.path + ": lights: " + std::to_string(s.declared_) +
                                          " lamps, at most " + std::to_string(kMaxStageLights));
-  auto estimator = LightEstimator::create(settings.estimator);
+  s.planned_ = scene.environment.present ? LightSourceKind::Environment
+                                         : (s.declared_ > 0 ? LightSourceKind::Declared : LightSourceKind::Probeless);
+  std::vector<LightDesc> real_lamps;
+  for (const LightDesc& l : scene.lights)
+    if (l.real) real_lamps.push_back(l);
+  s.residual_ = s.planned_ == LightSourceKind::Declared && settings.residual_light && !real_lamps.empty();
+  auto estimator = LightEstimator::create(s.residual_ ? settings.residual_estimator : settings.estimator);
   if (!estimator) return estimator.error();
   s.estimator_.emplace(std::move(*estimator));
   const EnvironmentDesc& env = scene.environment;
@@ -107,12 +95,12 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
       s.env_from_file_ = true;
     }
   }
-  s.planned_ = env.present ? LightSourceKind::Environment
-                           : (s.declared_ > 0 ? LightSourceKind::Declared : LightSourceKind::Probeless);
-  if (s.planned_ == LightSourceKind::Probeless) {
-    auto b = ProbelessBuilder::create(settings.probeless, cameras.color, cameras.depth, cameras.depth_scale);
+  if (s.planned_ == LightSourceKind::Probeless || s.residual_) {
+    auto b = ProbelessBuilder::create(s.residual_ ? settings.residual_probeless : settings.probeless,
+                                      cameras.color, cameras.depth, cameras.depth_scale);
     if (!b) return b.error();
     s.probeless_.emplace(std::move(*b));
+    if (s.residual_) s.probeless_->set_known_lamps(real_lamps, settings.estimator.gray_albedo);
   }
   s.max_lights_ = s.declared_ + s.env_lights_ + (s.planned_ == LightSourceKind::Probeless ? 1 : 0);
   s.lighting_.lights.reserve(kMaxStageLights);
@@ -128,7 +116,7 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
   for (const LightDesc& l : scene.lights) {
     if (!l.real) continue;
     glm::dvec3 to_light;
-    const glm::dvec3 e = lamp_at(l, glm::dvec3(settings.focus), to_light);
+    const glm::dvec3 e = lamp_irradiance(l, glm::dvec3(settings.focus), to_light);
     const ShRgb sh = sh_directional_light(to_light, e);
     for (int i = 0; i < kMaxShCoeffs; ++i) s.declared_sh_[size_t(i)] += sh[size_t(i)];
   }
@@ -142,6 +130,8 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
 
 void LightStage::finish_declared() {
   ShRgb all = declared_sh_;
+  if (residual_)
+    for (int i = 0; i < kMaxShCoeffs; ++i) all[size_t(i)] += lighting_.ambient_real[size_t(i)];
   if (lighting_.environment && scene_.environment.real && env_ && env_->valid())
     for (int i = 0; i < kMaxShCoeffs; ++i) all[size_t(i)] += env_->radiance_sh()[size_t(i)];
   LightEstimate& e = lighting_.estimate;
@@ -219,6 +209,20 @@ void LightStage::set_probeless_lighting() {
   ++lighting_.revision;
 }
 
+void LightStage::set_residual_lighting() {
+  // The estimate's first `residual_shading_bands` bands; the mean radiance (band 0) at least
+  // 0: light cannot be negative, and a mean below 0 says the lamps' model already sends more
+  // than the camera saw (its shadows outside the view are not modelled), not that light is
+  // missing.
+  const ShRgb& l = estimator_->filtered();
+  const int kept = settings_.residual_shading_bands * settings_.residual_shading_bands;
+  for (int i = 0; i < kMaxShCoeffs; ++i)
+    lighting_.ambient_real[size_t(i)] = i < kept ? l[size_t(i)] : glm::dvec3(0.0);
+  lighting_.ambient_real[0] = glm::max(lighting_.ambient_real[0], glm::dvec3(0.0));
+  lighting_.ambient_is_residual = true;
+  finish_declared();
+}
+
 void LightStage::use_external_system() {
   external_system_ = true;
   // Checked in create(): cannot fail here.
@@ -228,6 +232,7 @@ void LightStage::use_external_system() {
   lighting_.environment = false;
   max_lights_ = 1;
   probeless_.reset();
+  residual_ = false;
   set_probeless_lighting();
 }
 
@@ -239,6 +244,24 @@ Status LightStage::submit_system(const LightSystem& system, int64_t frame_index,
     return ok_status();  // the estimate keeps its last value: a broken frame is not fatal
   }
   if (planned_ == LightSourceKind::Probeless) set_probeless_lighting();
+  return ok_status();
+}
+
+Status LightStage::add_probeless_parts(const InputFrame& frame, const glm::dmat4& camera_to_world,
+                                       std::vector<std::string>& notes, bool& solved) {
+  // Rows interleaved over `parts` frames; until the first estimate exists the whole system is
+  // built at once, so no frame is lit by the prior.
+  const int parts = probeless_->settings().parts;
+  const bool first = !estimator_->estimate().valid;
+  for (int p = first ? 0 : next_part_; p < (first ? parts : next_part_ + 1); ++p)
+    MRGI_TRY(probeless_->add_part(frame, camera_to_world, cameras_.exposure, p, pending_));
+  next_part_ = first ? 0 : (next_part_ + 1) % parts;
+  solved = next_part_ == 0;
+  if (solved) {
+    auto r = estimator_->update(pending_, frame.index, frame.timestamp);
+    if (!r) notes.push_back("light: " + r.error().message);
+    pending_.clear();
+  }
   return ok_status();
 }
 
@@ -269,18 +292,16 @@ Status LightStage::update(const InputFrame& frame, const glm::dmat4& camera_to_w
     }
   }
   if (planned_ == LightSourceKind::Probeless && !external_system_) {
-    // Rows interleaved over `parts` frames; until the first estimate exists the whole system is
-    // built at once, so no frame is lit by the prior.
-    const int parts = probeless_->settings().parts;
-    const bool first = !estimator_->estimate().valid;
-    for (int p = first ? 0 : next_part_; p < (first ? parts : next_part_ + 1); ++p)
-      MRGI_TRY(probeless_->add_part(frame, camera_to_world, cameras_.exposure, p, pending_));
-    next_part_ = first ? 0 : (next_part_ + 1) % parts;
-    if (next_part_ == 0) {
-      auto r = estimator_->update(pending_, frame.index, frame.timestamp);
-      if (!r) notes.push_back("light: " + r.error().message);
-      pending_.clear();
-      set_probeless_lighting();
+    bool solved = false;
+    MRGI_TRY(add_probeless_parts(frame, camera_to_world, notes, solved));
+    if (solved) set_probeless_lighting();
+  }
+  if (residual_) {
+    bool solved = false;
+    MRGI_TRY(add_probeless_parts(frame, camera_to_world, notes, solved));
+    if (solved) {
+      set_residual_lighting();
+      finish_declared();
     }
   }
   lighting_.estimate.frame_index = planned_ == LightSourceKind::Probeless ? lighting_.estimate.frame_index : frame.index;
@@ -303,7 +324,8 @@ Status LightStage::update(const InputFrame& frame, const glm::dmat4& camera_to_w
                     declared_ > 0 ? " and declared lamps" : "");
       break;
     case LightSourceKind::Declared:
-      std::snprintf(text, sizeof text, "light: %d declared lamp(s) (scene.json)", declared_);
+      std::snprintf(text, sizeof text, "light: %d declared lamp(s) (scene.json)%s", declared_,
+                    residual_ ? " and the residual light estimated from colour and depth" : "");
       break;
     case LightSourceKind::None:
       std::snprintf(text, sizeof text, "light: NONE: no lamp, no environment image yet and no estimate: "

@@ -7,7 +7,11 @@
 //     directional lights, the rest stays as SH ambient;
 //   - neither: the probeless estimate from colour and depth (light::LightEstimator, fed by the
 //     stage's own ProbelessBuilder or by a technique's GPU sums, ssrt's), as one shadowed
-//     dominant directional light plus the rest of the estimate as SH ambient.
+//     dominant directional light plus the rest of the estimate as SH ambient;
+//   - lamps without an environment also get the residual: the light the camera sees that the
+//     lamps' direct light does not explain (the room's own interreflection, daylight through a
+//     window), estimated probelessly from the same rows with the lamps' light taken off each
+//     (ProbelessBuilder::set_known_lamps), as SH ambient (LightStageSettings::residual_light).
 // Declared lamps and an environment add up (a desk lamp in a sunlit room). Each frame's stats
 // carry a note naming the source; a frame lit by nothing says so.
 #pragma once
@@ -67,6 +71,50 @@ struct LightStageSettings {
     s.white_light = false;
     return s;
   }();
+  // With declared lamps and no environment: estimate the residual light (above) and hand it to
+  // the techniques as ambient_real. Why: the differential composite scales a real pixel's change
+  // by the camera's value over the model's L_r (compose.comp), and without the room's own light
+  // L_r holds only what the lamps send directly (plus a technique's few modelled bounces):
+  // where the lamps barely reach, a virtual object's small bounce became a large relative
+  // change, and virtual surfaces missed the room's light altogether. Measured (perf/results/
+  // residual-light.md), RDE all / real / virtual at dir high: corner 0.655 / 1.036 / 0.636 ->
+  // 0.298 / 0.930 / 0.244; on two held-out scenes (perf/heldout/) 0.579 -> 0.350 and 0.194 ->
+  // 0.160. The residual is unshadowed ambient, the same in L_r and L_rv (it cancels in the
+  // delta; a virtual object blocking it is not modelled). It holds the real scene's bounce, so
+  // where a technique already carries that bounce to virtual surfaces through a volume (dlpv's
+  // V^rho) it is left off virtual pixels (Lighting::ambient_is_residual; measured: with both,
+  // dlpv high's virtual RDE on corner 0.432 -> 0.714). dir's VPLs carry some of it too, from
+  // the real surfaces in the influence sphere only, and with the residual on its virtual pixels
+  // every lamp scene measured improved: the double count there is the smaller error.
+  bool residual_light = true;
+  // The residual's sampling: half the probeless source's grid (a low-order ambient needs fewer
+  // samples; a quarter of the cost, about 0.6 ms a frame at 640x480 spread over 8 frames).
+  ProbelessSettings residual_probeless = [] {
+    ProbelessSettings s;
+    s.grid_width = 40;
+    return s;
+  }();
+  // The residual's estimator: the probeless one's, but with the paper's white light (Sec. 5:
+  // the channels solved as one). Why: with a gray-world albedo per channel, a coloured wall
+  // becomes coloured light, and the lamps' light taken off first leaves the walls' colour as
+  // most of what is left.
+  LightEstimatorSettings residual_estimator = [] {
+    LightEstimatorSettings s;
+    s.white_light = true;
+    s.nonnegative_penalty = 10.0;
+    s.relative_regularisation = 1e-3;
+    return s;
+  }();
+  // Bands of the residual estimate the techniques are lit with (1..3; the fit always solves
+  // the estimator's bands, 4, so the directional part of the residual does not bias its mean:
+  // a view of mostly floor lit from above would read a band-0-only fit's mean too high).
+  // 1, the mean radiance only. Why: the directional bands are where the error of the lamps'
+  // model lands (their shadows and spot profile outside the view, which the subtraction cannot
+  // see), and a view's two or three surface orientations constrain them poorly. Measured at
+  // dir / baseline high, RDE all (corner; desk_spot): none 0.655 / 0.709 (0.135 / 0.192);
+  // 4 bands kept 0.720 / 0.755 (0.117 / 0.155); 1 band kept 0.298 / 0.340 (0.123 / 0.172);
+  // a band-0-only fit 0.283 / 0.306 (0.135 / 0.192: its mean is below 0 on desk_spot, clamped).
+  int residual_shading_bands = 1;
   // Where declared lamps are seen from for the exported estimate (LightEstimate: SH and
   // dominant light of the lamps at this point, world metres): the virtual objects' centre.
   glm::vec3 focus{0.0f};
@@ -89,6 +137,9 @@ struct Lighting {
   // Radiance SH (4 bands) of the light not in `lights`: real (lights real and virtual surfaces)
   // and virtual (a virtual environment: lights virtual surfaces only).
   ShRgb ambient_real{}, ambient_virtual{};
+  // ambient_real is the residual estimate (LightStageSettings::residual_light): all of the
+  // real light but the lamps' direct light, the real scene's own bounce included.
+  bool ambient_is_residual = false;
   // Every real light as an estimate (SH, dominant light, confidence), the public form.
   LightEstimate estimate;
   // Bumped whenever `lights` changed (shadow maps are re-planned on a change only).
@@ -130,6 +181,11 @@ class LightStage {
  private:
   LightStage() = default;
   void set_probeless_lighting();
+  void set_residual_lighting();
+  // Feeds this frame's part(s) of the stage's own probeless system; `solved` when a whole
+  // system was solved this frame.
+  Status add_probeless_parts(const InputFrame& frame, const glm::dmat4& camera_to_world,
+                             std::vector<std::string>& notes, bool& solved);
   void set_environment_lighting(bool real);
   void finish_declared();
 
@@ -141,6 +197,7 @@ class LightStage {
   int env_lights_ = 0;              // shadowed environment regions
   int max_lights_ = 0;
   bool external_system_ = false;
+  bool residual_ = false;           // declared lamps with the residual estimate (residual_light)
   std::optional<EnvSampler> env_;
   bool env_from_file_ = false;
   std::optional<ProbelessBuilder> probeless_;

@@ -6,6 +6,7 @@
 
 #include "common/frame_constants.glsl"
 #include "image/srgb.h"
+#include "shared/mrgi_shared.h"
 #include "ssrt/ssrt_math.h"
 
 namespace mrgi::light {
@@ -20,6 +21,28 @@ constexpr int kSaturated = 250;            // 8-bit colour at or above: clipped,
 constexpr float kSameSurface = float(MRGI_DEPTH_EDGE_RELATIVE);
 
 }  // namespace
+
+glm::dvec3 lamp_irradiance(const LightDesc& l, const glm::dvec3& p, glm::dvec3& to_light) {
+  const glm::dvec3 rgb = glm::dvec3(l.color) * double(l.intensity);
+  if (l.type == LightType::Directional) {
+    to_light = -glm::normalize(glm::dvec3(l.direction));
+    return rgb;
+  }
+  const glm::dvec3 d = glm::dvec3(l.position) - p;
+  const double d2 = std::max(glm::dot(d, d), 1e-6);
+  to_light = d / std::sqrt(d2);
+  double cone = 1.0;
+  if (l.type == LightType::Spot)
+    cone = shader::spot_falloff(float(glm::dot(glm::normalize(glm::dvec3(l.direction)), -to_light)),
+                                std::cos(glm::radians(l.outer_angle_deg)),
+                                std::cos(glm::radians(l.inner_angle_deg)));
+  return rgb * (cone / d2);
+}
+
+void ProbelessBuilder::set_known_lamps(const std::vector<LightDesc>& lamps, double albedo) {
+  known_lamps_ = lamps;
+  known_albedo_ = albedo;
+}
 
 Expected<ProbelessBuilder> ProbelessBuilder::create(const ProbelessSettings& s, const Intrinsics& color,
                                                     const Intrinsics& depth, double depth_scale) {
@@ -176,6 +199,24 @@ Status ProbelessBuilder::add_part(const InputFrame& frame, const glm::dmat4& cam
   const float solid_angle = float(4.0 * kPi / settings_.directions);
   const float inv_stride = 1.0f / float(s);
   auto cell = [&](int gx, int gy) -> const glm::vec3& { return position_[size_t(gy) * grid_w_ + gx]; };
+  // Visibility from camera-space point p along camera-space direction w_cam over `reach` metres:
+  // the direction is marched through the depth grid, and a grid surface in front of a step
+  // (within twice the radius: a range check, as the ssrt transfer) occludes it by eq. 7-8's
+  // continuous K; leaving the view ends the search (unknown counts as visible).
+  auto visibility = [&](const glm::vec3& p, const glm::vec3& w_cam, float reach) {
+    float k = 1.0f;
+    for (int step = 1; step <= settings_.march_steps && k > 0.0f; ++step) {
+      const glm::vec3 q = p + w_cam * (reach * float(step) / float(settings_.march_steps));
+      if (!(q.z > 0.0f)) break;
+      const glm::vec2 px = shader::project_pinhole(q, kd) * inv_stride;
+      const int qx = int(std::floor(px.x)), qy = int(std::floor(px.y));
+      if (qx < 0 || qy < 0 || qx >= grid_w_ || qy >= grid_h_) break;
+      const glm::vec3& sp = cell(qx, qy);
+      if (!(sp.z > 0.0f) || sp.z >= q.z - 0.02f * q.z || q.z - sp.z > 2.0f * radius) continue;
+      k = std::min(k, shader::ssrt_visibility_k(p, sp, w_cam, chi_));
+    }
+    return k;
+  };
   // First the part's samples and their colours, so the light's colour can be voted on before
   // any row is added.
   samples_.clear();
@@ -216,35 +257,36 @@ Status ProbelessBuilder::add_part(const InputFrame& frame, const glm::dmat4& cam
     const float weight_row = balance_[size_t(sample.cell)];
     const glm::dvec3 colour = sample.colour;
     {
-      // Transfer with visibility: each direction in front of the surface is marched through the
-      // depth grid; a grid surface in front of a step (within twice the radius: a range check,
-      // as the ssrt transfer) occludes it by eq. 7-8's continuous K.
       const glm::vec3 n = rot * n_cam;
       ShVector t{};
       for (size_t j = 0; j < directions_.size(); ++j) {
         const glm::vec3& w = directions_[j];
         const float nw = glm::dot(n, w);
         if (nw <= 0.0f) continue;
-        const glm::vec3 w_cam = rot_t * w;
-        float k = 1.0f;
-        for (int step = 1; step <= settings_.march_steps && k > 0.0f; ++step) {
-          const glm::vec3 q = p + w_cam * (radius * float(step) / float(settings_.march_steps));
-          if (!(q.z > 0.0f)) break;
-          const glm::vec2 px = shader::project_pinhole(q, kd) * inv_stride;
-          const int qx = int(std::floor(px.x)), qy = int(std::floor(px.y));
-          if (qx < 0 || qy < 0 || qx >= grid_w_ || qy >= grid_h_) break;  // left the view: unknown
-          const glm::vec3& sp = cell(qx, qy);
-          if (!(sp.z > 0.0f) || sp.z >= q.z - 0.02f * q.z || q.z - sp.z > 2.0f * radius) continue;
-          k = std::min(k, shader::ssrt_visibility_k(p, sp, w_cam, chi_));
-        }
-        const float weight = shader::ssrt_transfer_weight(n, w, k, solid_angle);
+        const float weight = shader::ssrt_transfer_weight(n, w, visibility(p, rot_t * w, radius), solid_angle);
         if (weight <= 0.0f) continue;
         for (int i = 0; i < kMaxShCoeffs; ++i) t[size_t(i)] += weight * direction_sh_[j][size_t(i)];
+      }
+      glm::dvec3 known(0.0);
+      if (!known_lamps_.empty()) {
+        const glm::dvec3 world = glm::dvec3(camera_to_world * glm::dvec4(glm::dvec3(p), 1.0));
+        for (const LightDesc& lamp : known_lamps_) {
+          glm::dvec3 to_light;
+          const glm::dvec3 e = lamp_irradiance(lamp, world, to_light);
+          const double cos_n = glm::dot(glm::dvec3(n), to_light);
+          if (cos_n <= 0.0) continue;
+          const double reach = lamp.type == LightType::Directional
+                                   ? double(radius)
+                                   : std::min(double(radius), glm::distance(glm::dvec3(lamp.position), world));
+          const float k = visibility(p, rot_t * glm::vec3(to_light), float(reach));
+          known += e * (cos_n * double(k));
+        }
+        known *= known_albedo_ / kPi;
       }
       // Rows weighted so that every orientation of surface counts alike (balance_normals).
       const float sw = std::sqrt(weight_row);
       for (float& v : t) v *= sw;
-      system.add(t, colour * double(sw));
+      system.add(t, (colour - known) * double(sw));
     }
   }
   return ok_status();

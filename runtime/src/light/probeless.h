@@ -26,6 +26,7 @@
 #include "light/sh_estimator.h"
 #include "mrgi/expected.h"
 #include "mrgi/frame.h"
+#include "mrgi/scene.h"
 
 namespace mrgi::light {
 
@@ -58,6 +59,11 @@ struct ProbelessSettings {
   bool grey_vote = false;
 };
 
+// Irradiance a lamp sends to world point `p` (per channel, at normal incidence: W/m^2 for the
+// scene's units; spot cone and inverse square included, no shadow) and the unit direction
+// towards it.
+glm::dvec3 lamp_irradiance(const LightDesc& l, const glm::dvec3& p, glm::dvec3& to_light);
+
 class ProbelessBuilder {
  public:
   // BadUsage naming the field for settings out of range; BadInput for intrinsics without size
@@ -70,6 +76,13 @@ class ProbelessBuilder {
   // Frames whose images do not have the intrinsics' sizes are refused (BadInput).
   Status add_part(const InputFrame& frame, const glm::dmat4& camera_to_world, double exposure,
                   int part, LightSystem& system);
+  // Light the rows should not explain (the residual estimate, light_stage.h): every later row's
+  // intensity has albedo / pi * E_lamps(x) taken off, E_lamps the lamps' irradiance at the
+  // sample (lamp_irradiance, cosine, and the sample's visibility towards the lamp searched in
+  // the depth grid as for the transfer: a screen-space shadow). `albedo` is the estimator's
+  // gray-world albedo, so that the subtracted light is in the rows' units (I_c = a T l).
+  // An empty list subtracts nothing. Copies the lamps (call at start-up or when they change).
+  void set_known_lamps(const std::vector<LightDesc>& lamps, double albedo);
   const ProbelessSettings& settings() const { return settings_; }
   int grid_width() const { return grid_w_; }
   int grid_height() const { return grid_h_; }
@@ -89,6 +102,8 @@ class ProbelessBuilder {
     glm::dvec3 colour;  // linear, exposure divided out
   };
   std::vector<Sample> samples_;         // this part's, reserved at start-up
+  std::vector<LightDesc> known_lamps_;  // set_known_lamps
+  double known_albedo_ = 0.0;
   static constexpr int kChromaBins = 100;
   std::vector<int> chroma_hist_;        // kChromaBins^2, (r, g) chromaticity
 

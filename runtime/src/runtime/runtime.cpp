@@ -185,6 +185,7 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   light::LightStageSettings ls;
   ls.estimator.lag_frames = settings.light_lag_frames;
   ls.environment.filter_frames = settings.light_lag_frames;
+  ls.residual_light = settings.residual_light;
   if (!scene_gpu_->virtual_objects.empty())
     ls.focus = 0.5f * (scene_gpu_->virtual_objects.bounds_min + scene_gpu_->virtual_objects.bounds_max);
   auto stage = light::LightStage::create(ls, scene_, cameras_);

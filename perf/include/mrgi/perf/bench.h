@@ -46,6 +46,7 @@ struct BenchSettings {
   int floor_per_frame = 2;               // floor pass samples after each measured frame (>= 0)
   int floor_warmup = 3;                  // unmeasured floor frames per scene
   DeviceSettings device;
+  bool residual_light = true;            // RuntimeSettings::residual_light
   ProgressFn progress;                   // optional
 };
 

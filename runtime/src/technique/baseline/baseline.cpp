@@ -364,6 +364,7 @@ Status Baseline::update_lights(int shadowed_estimated) {
   }
   auto* set = static_cast<shader::LightSet*>(shared_.graph->mapped(lights_, shared_.graph->slot()));
   *set = plan_.light_set;
+  set->count.y = lighting.ambient_is_residual ? 1 : 0;
   light::ShRgb real = lighting.ambient_real, both;
   for (int i = 0; i < light::kMaxShCoeffs; ++i) {
     real[size_t(i)] += folded_real_[size_t(i)];

@@ -150,7 +150,7 @@ void Dlpv::write_lights() {
   auto* set = static_cast<shader::LightSet*>(shared_.graph->mapped(lights_, shared_.graph->slot()));
   *set = shader::LightSet{};
   const int n = std::min<int>(int(lighting.lights.size()), MRGI_MAX_LIGHTS);
-  set->count = glm::ivec4(n, 0, 0, 0);
+  set->count = glm::ivec4(n, lighting.ambient_is_residual ? 1 : 0, 0, 0);
   for (int i = 0; i < n; ++i) {
     const LightDesc& l = lighting.lights[size_t(i)];
     shader::ShadowLight& s = set->lights[i];
