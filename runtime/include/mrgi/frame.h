@@ -6,8 +6,7 @@
 #include <optional>
 #include <string>
 
-#include <glm/glm.hpp>
-#include <glm/gtc/quaternion.hpp>
+#include "mrgi/glm_contract.h"
 
 #include "mrgi/image.h"
 

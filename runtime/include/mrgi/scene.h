@@ -5,8 +5,7 @@
 #include <string>
 #include <vector>
 
-#include <glm/glm.hpp>
-#include <glm/gtc/quaternion.hpp>
+#include "mrgi/glm_contract.h"
 
 #include "mrgi/expected.h"
 #include "mrgi/image.h"

@@ -1,0 +1,37 @@
+#!/bin/bash
+# Installs the build into a fresh prefix and builds examples/frames_from_memory on its own against
+# it, twice: with find_package(mrgi) (CMake) and with `pkg-config mrgi` (a plain compiler line);
+# runs both. Fails on any step. Usage: consumer_test.sh BUILD_DIR SOURCE_DIR
+set -euo pipefail
+build=$1
+src=$2
+work=$(mktemp -d "${TMPDIR:-/tmp}/mrgi-install-test.XXXXXX")
+trap 'rm -rf "$work"' EXIT
+prefix=$work/prefix
+cmake --install "$build" --prefix "$prefix" > "$work/install.log"
+# Only the public API is installed: no internal header, no third-party header of mrgi's own.
+test -f "$prefix/include/mrgi/runtime.h"
+test -f "$prefix/include/mrgi/version.h"
+test -f "$prefix/include/mrgi/platform/capture.h"
+if [ -e "$prefix/include/mrgi/json_reader.h" ]; then echo "internal header installed: json_reader.h"; exit 1; fi
+if grep -rlE '#include <(nlohmann|vulkan|Eigen|tiny_gltf|embree)' "$prefix/include"; then
+  echo "a public header includes a third-party header other than GLM"; exit 1
+fi
+test -x "$prefix/bin/mrgi"
+"$prefix/bin/mrgi" --version
+# The installed tool runs from the prefix (RPATH), not from the build tree.
+if ldd "$prefix/bin/mrgi" | grep -F "$build/"; then echo "installed tool links the build tree"; exit 1; fi
+
+sample=$src/data/sample/virtual/0_bunny.glb
+# CMake consumer, outside the source tree.
+cp -r "$src/examples/frames_from_memory" "$work/consumer"
+cmake -S "$work/consumer" -B "$work/consumer-build" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release > "$work/configure.log"
+cmake --build "$work/consumer-build" -j2 > "$work/build.log"
+"$work/consumer-build/frames_from_memory" "$sample" "$work/cmake.ppm"
+# pkg-config consumer.
+export PKG_CONFIG_PATH="$prefix/lib/pkgconfig"
+test "$(pkg-config --modversion mrgi)" = "$(sed -n 's/^project(mrgi VERSION \([0-9.]*\).*/\1/p' "$src/CMakeLists.txt")"
+c++ -std=c++20 -O1 "$work/consumer/main.cpp" -o "$work/pc_consumer" $(pkg-config --cflags --libs mrgi)
+"$work/pc_consumer" "$sample" "$work/pc.ppm"
+cmp "$work/cmake.ppm" "$work/pc.ppm"
+echo "consumer built and ran against $prefix (CMake and pkg-config)"
