@@ -10,4 +10,6 @@ bash scripts/install-deps.sh
 bash scripts/build.sh -DMRGI_WERROR=ON
 export LP_NUM_THREADS="${LP_NUM_THREADS:-2}"
 ctest --test-dir build --output-on-failure --no-tests=error -j"$(nproc)" --timeout 900
+# The build with every optional package left out (configure and the parts it changes).
+bash scripts/check-minimal-build.sh
 [ "${SKIP_SANITIZERS:-0}" = 1 ] || bash scripts/sanitize.sh

@@ -51,6 +51,10 @@ nlohmann::json to_json(const DeviceReport& r) {
     usb.push_back({{"id", hex4(d.vendor) + ":" + hex4(d.product)}, {"bus", d.bus}, {"address", d.address},
                    {"name", d.known->name}, {"product", d.product_name}, {"adapter", d.known->adapter}, {"note", d.known->note}});
   }
+  json adapters = json::array();
+  for (const BuildAdapter& a : build_adapters())
+    adapters.push_back({{"name", a.name}, {"built", a.built}, {"option", a.option}, {"package", a.package}});
+  j["adapters"] = adapters;
   j["usb"] = {{"available", r.usb.available},
               {"status", !r.usb.available ? r.usb.status : sensors == 0 ? "no known sensor among " + std::to_string(r.usb.devices.size()) + " USB devices" : "ok"},
               {"devices_seen", r.usb.devices.size()},
@@ -62,6 +66,12 @@ void print_text(const nlohmann::json& j) {
   auto section = [&](const char* title, const nlohmann::json& s) {
     std::cout << title << ": " << s["status"].get<std::string>() << "\n";
   };
+  std::cout << "adapters in this build:";
+  for (const auto& a : j["adapters"])
+    std::cout << " " << a["name"].get<std::string>()
+              << (a["built"].get<bool>() ? "" : " (left out: " + a["option"].get<std::string>() + "=OFF, needs " +
+                                                  a["package"].get<std::string>() + ")");
+  std::cout << "\n";
   section("OpenNI2", j["openni"]);
   for (const auto& d : j["openni"]["devices"])
     std::cout << "  " << d["uri"].get<std::string>() << "  " << d["vendor"].get<std::string>() << " "

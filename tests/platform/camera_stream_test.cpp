@@ -335,6 +335,18 @@ TEST(UsbDiscovery, KnownIdsAndScanWithoutBusAccess) {
   }
 }
 
+// The tests build only with every adapter (CMakeLists.txt): the list says so, names each
+// adapter's option and package, and `mrgi devices` prints it.
+TEST(BuildAdapters, EveryAdapterIsInTheTestedBuildAndNamesItsOption) {
+  const auto& adapters = build_adapters();
+  ASSERT_EQ(adapters.size(), 5u);
+  for (const BuildAdapter& a : adapters) {
+    EXPECT_TRUE(a.built) << a.name;
+    EXPECT_EQ(std::string(a.option).rfind("MRGI_WITH_", 0), 0u) << a.option;
+    EXPECT_NE(std::string(a.package).find("-dev"), std::string::npos) << a.package;
+  }
+}
+
 TEST(EnvCamera, FrameToRadianceDecodesSRGBAndExposure) {
   ImageRGB8 f(2, 1);
   f.data = {0, 128, 255, 255, 255, 255};

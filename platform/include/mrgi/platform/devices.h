@@ -24,6 +24,17 @@ struct DeviceReport {
   UsbScan usb;
 };
 
+// The input adapters and whether this build has each (CMake's MRGI_WITH_<ADAPTER>: on where
+// the package was found at configure). An adapter left out answers every call with NotFound
+// naming its option and package.
+struct BuildAdapter {
+  const char* name;     // openni2, v4l2, libcamera, usb, apriltag
+  bool built;
+  const char* option;   // the CMake option
+  const char* package;  // the Debian package it needs
+};
+const std::vector<BuildAdapter>& build_adapters();
+
 // Asks every adapter; never fails (each adapter's failure is kept in its status).
 DeviceReport list_devices_all_adapters();
 
