@@ -46,6 +46,15 @@ void run_info(const InfoOptions& o) {
   j["validation"] = o.validate;
 
   if (!o.technique.empty()) {
+    const std::vector<QualityLevelInfo> ladder = take(technique_ladder(o.technique));
+    nlohmann::json levels = nlohmann::json::array();
+    for (size_t i = 0; i < ladder.size(); ++i) {
+      nlohmann::json knobs = nlohmann::json::array();
+      for (const QualityKnob& k : ladder[i].knobs) knobs.push_back({{"name", k.name}, {"value", k.value}, {"unit", k.unit}});
+      levels.push_back({{"index", i}, {"name", ladder[i].name}, {"internal_scale", ladder[i].internal_scale},
+                        {"mesh_error_px", ladder[i].mesh_error_px}, {"knobs", knobs}});
+    }
+    j["ladder"] = {{"technique", o.technique}, {"levels", levels}};
     if (o.width <= 0 || o.height <= 0)
       fail_with(fail(ErrorKind::BadUsage, "--width and --height must be > 0"));
     RuntimeSettings rs;
@@ -81,6 +90,19 @@ void run_info(const InfoOptions& o) {
   }
   std::cout << "(* = the device mrgi uses with this --device / MRGI_DEVICE; validation "
             << (o.validate ? "on" : "off") << ")\n";
+  if (j.contains("ladder")) {
+    std::cout << "ladder of " << o.technique << " (best first; --level takes the index or the name):\n";
+    for (const auto& l : j["ladder"]["levels"]) {
+      std::cout << "  " << l["index"].get<int>() << " " << l["name"].get<std::string>() << ": internal scale "
+                << l["internal_scale"].get<double>() << " of the output";
+      if (l["mesh_error_px"].get<double>() > 0.0)
+        std::cout << ", mesh level of detail " << l["mesh_error_px"].get<double>() << " px";
+      std::cout << "\n";
+      for (const auto& k : l["knobs"])
+        std::cout << "      " << k["name"].get<std::string>() << " = " << k["value"].get<double>() << " ("
+                  << k["unit"].get<std::string>() << ")\n";
+    }
+  }
   if (j.contains("budget")) {
     const auto& b = j["budget"];
     std::cout << "frame memory: " << b["technique"].get<std::string>() << " level " << b["level"].get<int>() << " ("
@@ -94,7 +116,9 @@ void setup(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("info", "Vulkan devices, the one mrgi uses, and a technique's memory budget");
   cmd->add_option("--device", opts->device, "device index or name substring (default: $MRGI_DEVICE, else lavapipe)");
   cmd->add_flag("--validate", opts->validate, "load the Khronos validation layer (fails if it is not installed)");
-  cmd->add_option("--technique", opts->technique, "also state this technique's start-up memory budget");
+  cmd->add_option("--technique", opts->technique,
+                  "also print this technique's quality ladder (every level's knobs with units) and its start-up "
+                  "memory at --level");
   cmd->add_option("--level", opts->level, "quality level: 0 = best, N, a level name, or 'last' = cheapest")->default_val("0");
   cmd->add_option("--width", opts->width, "output width in pixels")->default_val(640);
   cmd->add_option("--height", opts->height, "output height in pixels")->default_val(480);

@@ -236,4 +236,21 @@ Expected<std::unique_ptr<Runtime>> create_runtime(const RuntimeSettings& setting
 std::vector<std::string> technique_names();
 Expected<std::vector<std::string>> technique_levels(const std::string& technique);
 
+// One quality knob of a level: what it sets, its value and its unit ("virtual point lights",
+// "texels per side", ...). `mrgi info --technique NAME` prints the ladder from these.
+struct QualityKnob {
+  std::string name;
+  double value = 0.0;
+  std::string unit;
+};
+struct QualityLevelInfo {
+  std::string name;
+  float internal_scale = 1.0f;   // fraction of the output width and height the level renders at
+  float mesh_error_px = 0.0f;    // the virtual meshes' level of detail (internal pixels; 0 = full)
+  std::vector<QualityKnob> knobs;
+};
+// A technique's ladder, best level first (the levels RuntimeSettings::level and
+// Runtime::set_level index). NotFound for an unknown technique.
+Expected<std::vector<QualityLevelInfo>> technique_ladder(const std::string& technique);
+
 }  // namespace mrgi

@@ -585,6 +585,18 @@ std::vector<std::string> technique_names() {
   return names;
 }
 
+Expected<std::vector<QualityLevelInfo>> technique_ladder(const std::string& technique) {
+  auto entry = technique::find_technique(technique);
+  if (!entry) return entry.error();
+  std::vector<QualityLevelInfo> out;
+  for (const auto& l : (*entry)->ladder()) {
+    QualityLevelInfo info{l.name, l.internal_scale, l.mesh_error_px, {}};
+    for (const auto& k : l.knobs) info.knobs.push_back({k.name, k.value, k.unit});
+    out.push_back(std::move(info));
+  }
+  return out;
+}
+
 Expected<std::vector<std::string>> technique_levels(const std::string& technique) {
   auto entry = technique::find_technique(technique);
   if (!entry) return entry.error();
