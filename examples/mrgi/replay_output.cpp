@@ -1,5 +1,6 @@
 #include "replay_output.h"
 
+#include "mrgi/perf/canvas.h"
 #include "mrgi/perf/stats.h"
 
 #include <algorithm>
@@ -165,21 +166,36 @@ Expected<nlohmann::json> ReplayOutput::finish() {
   }
   MRGI_TRY(write_json(partial_ + "/stats.json", stats_));
   MRGI_TRY(write_json(partial_ + "/summary.json", summary));
-  if (!last_output_.empty()) {
-    const int w = last_output_.width, h = last_output_.height;
-    const int panels = last_reference_.empty() ? 2 : 3;
-    ImageRGB8 sbs(w * panels, h);
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x)
-        for (int c = 0; c < 3; ++c) {
-          sbs.at(x, y)[c] = last_camera_.at(x, y)[c];
-          sbs.at(x + w, y)[c] = last_output_.at(x, y)[c];
-          if (panels == 3) sbs.at(x + 2 * w, y)[c] = last_reference_.at(x, y)[c];
-        }
-    MRGI_TRY(write_png(partial_ + "/side_by_side.png", sbs));
-  }
+  if (!last_output_.empty()) MRGI_TRY(write_png(partial_ + "/side_by_side.png", side_by_side()));
   MRGI_TRY(output_->commit());
   return summary;
+}
+
+// camera | mrgi | reference | |mrgi - reference| x 4, each panel under a label (the last two
+// only when the capture has references), so the picture says what it shows by itself.
+ImageRGB8 ReplayOutput::side_by_side() const {
+  const int w = last_output_.width, h = last_output_.height;
+  const bool ref = !last_reference_.empty() && last_reference_.width == w && last_reference_.height == h;
+  const int panels = ref ? 4 : 2;
+  const float scale = std::max(1.0f, float(w) / 320.0f);
+  const int bar = int(perf::Canvas::text_height(scale) + 8.0f * scale);
+  const char* labels[4] = {"camera", "mrgi", "reference (path traced)", "|mrgi - reference| x 4"};
+  ImageRGB8 panel(w * panels, h + bar);
+  std::fill(panel.data.begin(), panel.data.end(), uint8_t(24));
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) {
+        panel.at(x, y + bar)[c] = last_camera_.at(x, y)[c];
+        panel.at(x + w, y + bar)[c] = last_output_.at(x, y)[c];
+        if (!ref) continue;
+        const int o = last_output_.at(x, y)[c], g = last_reference_.at(x, y)[c];
+        panel.at(x + 2 * w, y + bar)[c] = uint8_t(g);
+        panel.at(x + 3 * w, y + bar)[c] = uint8_t(std::min(255, 4 * std::abs(o - g)));
+      }
+  perf::Canvas labelled(std::move(panel));
+  for (int i = 0; i < panels; ++i)
+    labelled.text(float(i * w) + 4.0f * scale, 4.0f * scale, labels[i], scale, perf::Rgb{235, 235, 235});
+  return labelled.image();
 }
 
 }  // namespace mrgi::tool

@@ -63,6 +63,7 @@ class ReplayOutput {
   bool profiled_ = false;
   Achieved achieved_;
   std::optional<RdeReport> pooled_;
+  ImageRGB8 side_by_side() const;
   ImageRGB8 last_camera_, last_reference_;
   ImageRGBA8 last_output_;
   nlohmann::json last_light_;

@@ -1,4 +1,4 @@
-#include "canvas.h"
+#include "mrgi/perf/canvas.h"
 
 #include <algorithm>
 #include <cmath>

@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <map>
 
-#include "canvas.h"
+#include "mrgi/perf/canvas.h"
 #include "mrgi/perf/pareto.h"
 #include "mrgi/perf/report.h"
 

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "mrgi/image.h"
 #include "test_support.h"
 
 namespace mrgi {
@@ -51,6 +52,36 @@ TEST_F(ToolCommands, DevicesReportsEveryAdapterAndExitsZero) {
   ASSERT_EQ(run(std::string("timeout 60 ") + MRGI_TOOL + " devices > " + dir.file("out.txt") + " 2>&1"), 0);
   const std::string text = slurp(dir.file("out.txt"));
   for (const char* k : {"OpenNI2:", "V4L2:", "libcamera:", "USB sensors:"}) EXPECT_NE(text.find(k), std::string::npos) << text;
+  // Which adapters this build has (the tested build has all five).
+  ASSERT_TRUE(j.contains("adapters"));
+  EXPECT_EQ(j["adapters"].size(), 5u);
+  for (const auto& a : j["adapters"]) EXPECT_TRUE(a["built"].get<bool>()) << a.dump();
+  EXPECT_NE(text.find("adapters in this build: openni2 v4l2 libcamera usb apriltag"), std::string::npos) << text;
+}
+
+// replay's side_by_side.png: four labelled panels (camera | mrgi | reference | difference x 4)
+// on a capture with references, each panel the output's size under a label bar.
+TEST_F(ToolCommands, ReplaySideBySideHasFourLabelledPanels) {
+  test::TempDir dir("side-by-side");
+  const std::string out = dir.file("out");
+  ASSERT_EQ(run(std::string("LP_NUM_THREADS=2 timeout 300 ") + MRGI_TOOL + " replay " + MRGI_SOURCE_DIR +
+                "/data/sample --technique baseline --level last --frames 1 --out " + out + " -q > /dev/null 2> " +
+                dir.file("err.txt")),
+            0)
+      << slurp(dir.file("err.txt"));
+  auto sbs = load_png_rgb8(out + "/side_by_side.png");
+  ASSERT_TRUE(sbs.ok()) << sbs.error().message;
+  auto frame = load_png_rgba8(out + "/frames/000000.png");
+  ASSERT_TRUE(frame.ok()) << frame.error().message;
+  EXPECT_EQ(sbs->width, 4 * frame->width);
+  EXPECT_GT(sbs->height, frame->height);  // the label bar
+  // The label bar holds light text on a dark ground in each panel.
+  for (int p = 0; p < 4; ++p) {
+    int light = 0;
+    for (int y = 0; y < sbs->height - frame->height; ++y)
+      for (int x = p * frame->width; x < p * frame->width + frame->width / 2; ++x) light += sbs->at(x, y)[0] > 200;
+    EXPECT_GT(light, 10) << "panel " << p << " has no label";
+  }
 }
 
 TEST_F(ToolCommands, LiveRendersEveryFrameOfTheOniWithTheDefaultObject) {

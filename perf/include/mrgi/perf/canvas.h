@@ -4,6 +4,7 @@
 #pragma once
 #include <cstdint>
 #include <string>
+#include <utility>
 
 #include "mrgi/image.h"
 
@@ -18,6 +19,8 @@ enum class Marker { Circle, Square, TriangleUp, Diamond, Plus, Cross, TriangleDo
 class Canvas {
  public:
   Canvas(int width, int height, Rgb background);
+  // Draws over an existing picture (labels on a composite).
+  explicit Canvas(ImageRGB8 image) : image_(std::move(image)) {}
   const ImageRGB8& image() const { return image_; }
 
   // Mixes `c` into pixel (x, y) with weight alpha in [0, 1]; outside pixels are ignored.
