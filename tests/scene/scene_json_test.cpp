@@ -97,6 +97,16 @@ TEST(SceneJson, WriteThenReadRoundTrips) {
     EXPECT_EQ(back->lights[i].inner_angle_deg, scene->lights[i].inner_angle_deg);
   }
   EXPECT_EQ(back->environment.image, scene->environment.image);
+  // Keyframed motion round-trips too.
+  SceneDesc moving = *scene;
+  moving.virtual_objects[0].motion = {{0.0, moving.virtual_objects[0].placement}, {0.5, moving.virtual_objects[0].placement}};
+  moving.virtual_objects[0].motion[1].placement.position = glm::vec3(1.0f, 2.0f, 3.0f);
+  ASSERT_TRUE(write_scene_json(f.dir.file("out/moving.json"), moving).ok());
+  auto moved = load_scene_json(f.dir.file("out/moving.json"));
+  ASSERT_TRUE(moved.ok()) << moved.error().message;
+  ASSERT_EQ(moved->virtual_objects[0].motion.size(), 2u);
+  EXPECT_EQ(moved->virtual_objects[0].motion[1].time_s, 0.5);
+  EXPECT_EQ(moved->virtual_objects[0].motion[1].placement.position, glm::vec3(1.0f, 2.0f, 3.0f));
   EXPECT_EQ(back->environment.intensity, scene->environment.intensity);
   EXPECT_EQ(back->real_geometry[0].material.base_color, scene->real_geometry[0].material.base_color);
 }
@@ -152,6 +162,14 @@ INSTANTIATE_TEST_SUITE_P(
                  "virtual_objects[0].gltf", "must be a string"},
         BadScene{R"({"version": 1, "virtual_objects": [{"gltf": "models/none.glb"}]})", ErrorKind::NotFound,
                  "virtual_objects[0].gltf", "does not exist"},
+        BadScene{R"({"version": 1, "virtual_objects": [{"gltf": "models/box.glb", "motion": [{"time": 0.5}, {"time": 0.5}]}]})",
+                 ErrorKind::BadInput, "virtual_objects[0].motion", "increase strictly"},
+        BadScene{R"({"version": 1, "virtual_objects": [{"gltf": "models/box.glb", "motion": [{"position": [0, 0, 0]}]}]})",
+                 ErrorKind::BadInput, "virtual_objects[0].motion[0].time", "required key is missing"},
+        BadScene{R"({"version": 1, "virtual_objects": [{"gltf": "models/box.glb", "motion": [{"time": 0, "scale": -1}]}]})",
+                 ErrorKind::BadInput, "virtual_objects[0].motion[0].scale", "must be positive"},
+        BadScene{R"({"version": 1, "virtual_objects": [{"gltf": "models/box.glb", "motion": [{"time": 0, "speed": 1}]}]})",
+                 ErrorKind::BadInput, "virtual_objects[0].motion[0].speed", "unknown key"},
         BadScene{R"({"version": 1, "virtual_objects": [{"gltf": "models/box.glb", "position": [1, 2]}]})",
                  ErrorKind::BadInput, "virtual_objects[0].position", "array of 3 numbers, got an array of 2"},
         BadScene{R"({"version": 1, "virtual_objects": [{"gltf": "models/box.glb", "position": [1, "a", 2]}]})",

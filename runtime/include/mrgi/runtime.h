@@ -216,6 +216,12 @@ class Runtime {
   virtual Status set_level(int level) = 0;   // the scheduler's knob; never allocates
   // Profiling mode from the next frame on (RuntimeSettings::profile_passes); never allocates.
   virtual Status set_profiling(bool on) = 0;
+  // The virtual objects: scene.json's (SceneDesc::virtual_objects), in its order; the capacity
+  // is fixed at start-up. set_object_placement moves one from the next process() on (an app's
+  // object moving), replacing its scene.json motion from then on; it never allocates. BadUsage
+  // for an index out of range, a non-finite placement or a scale that is not positive.
+  virtual size_t object_count() const = 0;
+  virtual Status set_object_placement(size_t object, const Placement& placement) = 0;
 };
 
 struct CameraSetup {

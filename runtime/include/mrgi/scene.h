@@ -19,10 +19,26 @@ struct Placement {
   glm::mat4 matrix() const;                   // object-to-world
 };
 
-struct VirtualObjectDesc {
-  std::string gltf;  // absolute path (resolved against the scene file's folder when loaded)
+// A keyframe of an object's motion: its placement at `time_s` (seconds, the frames' timestamp
+// clock).
+struct PoseKey {
+  double time_s = 0.0;
   Placement placement;
 };
+
+struct VirtualObjectDesc {
+  std::string gltf;  // absolute path (resolved against the scene file's folder when loaded)
+  Placement placement;  // where it is at start-up (and always, without motion)
+  // Keyframed motion (scene.json "motion"), times strictly increasing: each frame the runtime
+  // places the object at the frame's timestamp, position and scale interpolated linearly,
+  // rotation by slerp, held at the first and last keys outside them. Empty: it stays put (an
+  // app can still move it, Runtime::set_object_placement).
+  std::vector<PoseKey> motion;
+};
+
+// The placement of keyframed `motion` at time t (see VirtualObjectDesc::motion); `motion` must
+// not be empty.
+Placement placement_at(const std::vector<PoseKey>& motion, double t);
 
 enum class LightType { Point, Spot, Directional };
 struct LightDesc {

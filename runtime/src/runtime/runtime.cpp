@@ -75,6 +75,12 @@ class RuntimeImpl final : public Runtime {
   std::vector<std::string> level_names() const override;
   Status set_level(int level) override;
   Status set_profiling(bool on) override { return graph_->set_profiling(on); }
+  size_t object_count() const override { return scene_gpu_->object_count(); }
+  Status set_object_placement(size_t object, const Placement& placement) override {
+    MRGI_TRY(scene_gpu_->set_placement(object, placement));
+    app_placed_[object] = 1;
+    return ok_status();
+  }
 
  private:
   Status check_validation() const;
@@ -111,6 +117,9 @@ class RuntimeImpl final : public Runtime {
   std::vector<FrameOutput> spare_outputs_;  // recycle(): images and masks to fill again
   glm::dmat4 last_pose_{1.0};
   bool have_pose_ = false;
+  // Per virtual object: placed by the app (set_object_placement), whose placement then holds
+  // instead of scene.json's motion.
+  std::vector<uint8_t> app_placed_;
 };
 
 RuntimeImpl::~RuntimeImpl() {
@@ -180,6 +189,7 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   auto sg = technique::SceneGpu::create(*context_, *graph_, scene_);
   if (!sg) return sg.error();
   scene_gpu_ = std::move(*sg);
+  app_placed_.assign(scene_gpu_->object_count(), 0);
   if (!(settings.light_lag_frames >= 0.0 && settings.light_lag_frames <= 1e6))
     return fail(ErrorKind::BadUsage, "RuntimeSettings.light_lag_frames must be 0..1e6 frames");
   light::LightStageSettings ls;
@@ -326,6 +336,14 @@ Expected<SlotRecord*> RuntimeImpl::begin_slot(const InputFrame& frame,
     if (!out) return out.error();
     outputs.push_back(std::move(*out));
   }
+  // The virtual objects where this frame has them: scene.json's motion at its timestamp
+  // (unless the app placed the object), then the slot's vertex copy brought up to date.
+  for (size_t i = 0; i < scene_.virtual_objects.size(); ++i) {
+    const auto& motion = scene_.virtual_objects[i].motion;
+    if (!motion.empty() && !app_placed_[i])
+      MRGI_TRY(scene_gpu_->set_placement(i, placement_at(motion, frame.timestamp)));
+  }
+  scene_gpu_->commit(*graph_);
   SlotRecord& rec = slots_[graph_->slot()];
   rec.used = true;
   rec.priming = false;

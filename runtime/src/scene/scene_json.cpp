@@ -25,6 +25,21 @@ namespace mrgi {
 
 namespace fs = std::filesystem;
 
+Placement placement_at(const std::vector<PoseKey>& motion, double t) {
+  if (t <= motion.front().time_s) return motion.front().placement;
+  if (t >= motion.back().time_s) return motion.back().placement;
+  size_t i = 1;
+  while (motion[i].time_s < t) ++i;
+  const PoseKey& a = motion[i - 1];
+  const PoseKey& b = motion[i];
+  const float f = float((t - a.time_s) / (b.time_s - a.time_s));
+  Placement p;
+  p.position = glm::mix(a.placement.position, b.placement.position, f);
+  p.scale = glm::mix(a.placement.scale, b.placement.scale, f);
+  p.rotation = glm::normalize(glm::slerp(glm::normalize(a.placement.rotation), glm::normalize(b.placement.rotation), f));
+  return p;
+}
+
 glm::mat4 Placement::matrix() const {
   const glm::mat4 t = glm::translate(glm::mat4(1.0f), position);
   const glm::mat4 r = glm::mat4_cast(glm::normalize(rotation));
@@ -87,8 +102,34 @@ Status check_range(const JsonObject& obj, std::string_view key, double v, double
   return ok_status();
 }
 
+template <class T, class F>
+Status read_list(const JsonObject& root, std::string_view key, std::vector<T>* out, F&& read_one) {
+  if (!root.has(key)) return ok_status();
+  auto items = root.objects(key);
+  if (!items) return items.error();
+  for (const JsonObject& item : *items) {
+    auto v = read_one(item);
+    if (!v) return v.error();
+    out->push_back(std::move(*v));
+  }
+  return ok_status();
+}
+
+Expected<PoseKey> read_pose_key(const JsonObject& obj) {
+  MRGI_TRY(obj.only_keys({"time", "position", "rotation", "scale"}));
+  PoseKey key;
+  auto t = obj.number("time");
+  if (!t) return t.error();
+  if (!std::isfinite(*t)) return obj.error("time", "must be a finite number of seconds");
+  key.time_s = *t;
+  auto placement = read_placement(obj);
+  if (!placement) return placement.error();
+  key.placement = *placement;
+  return key;
+}
+
 Expected<VirtualObjectDesc> read_virtual_object(const JsonObject& obj, const fs::path& base) {
-  MRGI_TRY(obj.only_keys({"gltf", "position", "rotation", "scale"}));
+  MRGI_TRY(obj.only_keys({"gltf", "position", "rotation", "scale", "motion"}));
   VirtualObjectDesc desc;
   auto gltf = resolve_existing_file(obj, "gltf", base);
   if (!gltf) return gltf.error();
@@ -96,6 +137,12 @@ Expected<VirtualObjectDesc> read_virtual_object(const JsonObject& obj, const fs:
   auto placement = read_placement(obj);
   if (!placement) return placement.error();
   desc.placement = *placement;
+  MRGI_TRY(read_list(obj, "motion", &desc.motion, [](const JsonObject& o) { return read_pose_key(o); }));
+  for (size_t i = 1; i < desc.motion.size(); ++i)
+    if (!(desc.motion[i].time_s > desc.motion[i - 1].time_s))
+      return obj.error("motion", "key times must increase strictly (key " + std::to_string(i) + " at " +
+                                     std::to_string(desc.motion[i].time_s) + " s after " +
+                                     std::to_string(desc.motion[i - 1].time_s) + " s)");
   return desc;
 }
 
@@ -221,19 +268,6 @@ Expected<RealGeometryDesc> read_real_geometry(const JsonObject& obj, const fs::p
   return desc;
 }
 
-template <class T, class F>
-Status read_list(const JsonObject& root, std::string_view key, std::vector<T>* out, F&& read_one) {
-  if (!root.has(key)) return ok_status();
-  auto items = root.objects(key);
-  if (!items) return items.error();
-  for (const JsonObject& item : *items) {
-    auto v = read_one(item);
-    if (!v) return v.error();
-    out->push_back(std::move(*v));
-  }
-  return ok_status();
-}
-
 std::string relative_to(const std::string& path, const fs::path& folder) {
   std::error_code ec;
   const fs::path abs = fs::absolute(path, ec);
@@ -298,6 +332,14 @@ Status write_scene_json(const std::string& path, const SceneDesc& scene) {
   for (const auto& o : scene.virtual_objects) {
     nlohmann::json e = placement_json(o.placement);
     e["gltf"] = relative_to(o.gltf, folder);
+    if (!o.motion.empty()) {
+      e["motion"] = nlohmann::json::array();
+      for (const PoseKey& k : o.motion) {
+        nlohmann::json key = placement_json(k.placement);
+        key["time"] = k.time_s;
+        e["motion"].push_back(key);
+      }
+    }
     j["virtual_objects"].push_back(e);
   }
   j["lights"] = nlohmann::json::array();

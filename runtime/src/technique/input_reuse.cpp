@@ -36,10 +36,12 @@ void InputReuse::reserve(size_t depth_pixels, double depth_scale) {
   depth_scale_ = depth_scale > 0.0 ? depth_scale : 5000.0;
 }
 
-void InputReuse::set_frame(int level, const glm::dmat4& camera_to_world, const InputFrame* input) {
+void InputReuse::set_frame(int level, const glm::dmat4& camera_to_world, const InputFrame* input,
+                           uint64_t objects_revision) {
   now_ = Source{};
   now_.level = level;
   now_.pose = camera_to_world;
+  now_.objects = objects_revision;
   input_ = input;
 }
 
@@ -67,7 +69,8 @@ bool InputReuse::depth_close() const {
 }
 
 bool InputReuse::close() const {
-  if (!source_.valid || source_.level != now_.level || source_.lamp_count != now_.lamp_count ||
+  if (!source_.valid || source_.level != now_.level || source_.objects != now_.objects ||
+      source_.lamp_count != now_.lamp_count ||
       !pose_close(source_.pose, now_.pose) || !depth_close())
     return false;
   for (size_t i = 0; i < now_.lamp_count; ++i)

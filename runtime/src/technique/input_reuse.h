@@ -7,9 +7,10 @@
 //   - the camera pose within 1 mm and 0.1 degrees;
 //   - the depth frame within 2 mm mean absolute change over the pixels valid in both, with at
 //     most 0.5 % of pixels gaining or losing a depth;
-//   - every lamp within 1 mm, 0.5 degrees (direction and cone) and 1 % of its colour x intensity.
-// The virtual objects are static (uploaded once, technique/scene_gpu.h), so their pose is not
-// compared yet. The depth copy is sized at reserve() (no allocation per frame).
+//   - every lamp within 1 mm, 0.5 degrees (direction and cone) and 1 % of its colour x intensity;
+//   - the virtual objects where they were (SceneGpu::revision: any move counts; an object that
+//     moves, moves every frame, and a tolerance would only delay its light by frames).
+// The depth copy is sized at reserve() (no allocation per frame).
 #pragma once
 #include <array>
 #include <cstdint>
@@ -28,7 +29,8 @@ class InputReuse {
   // `depth_pixels`: the depth camera's width x height; `depth_scale`: its units per metre.
   void reserve(size_t depth_pixels, double depth_scale);
   // This frame's inputs, to compare with the remembered ones (set before close() / remember()).
-  void set_frame(int level, const glm::dmat4& camera_to_world, const InputFrame* input);
+  void set_frame(int level, const glm::dmat4& camera_to_world, const InputFrame* input,
+                 uint64_t objects_revision);
   // The lamps the work is made for this frame (strongest first); at most kMaxLamps are compared.
   void add_lamp(const LightDesc& lamp);
   // Whether the remembered frame's work stands for this one.
@@ -47,6 +49,7 @@ class InputReuse {
     bool valid = false;
     int level = -1;
     glm::dmat4 pose{1.0};
+    uint64_t objects = 0;
     std::array<LightDesc, kMaxLamps> lamps{};
     size_t lamp_count = 0;
   };

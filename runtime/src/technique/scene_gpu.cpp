@@ -1,6 +1,7 @@
 #include "technique/scene_gpu.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include <meshoptimizer.h>
@@ -82,14 +83,21 @@ void append_model(const Model& model, int material_base, MeshData& out, bool lod
   }
 }
 
+// `per_slot_vertices`: the vertex buffer host-visible with a copy per frame slot, written by
+// the caller (the moving virtual objects); else device-local and uploaded here.
 Expected<MeshSet> upload_meshes(gpu::Context& ctx, gpu::FrameGraph& graph, const MeshData& data,
-                                const std::string& name) {
+                                const std::string& name, bool per_slot_vertices) {
   MeshSet set;
   // Never zero-sized (Vulkan forbids it); an empty set simply has no draws.
   const VkDeviceSize vbytes = std::max<VkDeviceSize>(64, data.vertices.size() * sizeof(GpuVertex));
   const VkDeviceSize ibytes = std::max<VkDeviceSize>(64, data.indices.size() * sizeof(uint32_t));
   // Storage too: compute passes read the meshes as lists (gi/ism.h samples points on them).
-  auto vb = graph.create_buffer({name + "_vertices", vbytes}, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT |
+  gpu::BufferDesc vdesc{name + "_vertices", vbytes};
+  if (per_slot_vertices) {
+    vdesc.memory = gpu::MemoryUsage::Upload;
+    vdesc.per_frame_copies = true;
+  }
+  auto vb = graph.create_buffer(vdesc, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT |
                                                               VK_BUFFER_USAGE_TRANSFER_DST_BIT |
                                                               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (!vb) return vb.error();
@@ -98,8 +106,9 @@ Expected<MeshSet> upload_meshes(gpu::Context& ctx, gpu::FrameGraph& graph, const
                                                              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (!ib) return ib.error();
   if (!data.vertices.empty()) {
-    MRGI_TRY(ctx.upload_buffer(graph.gpu_buffer(*vb, 0), data.vertices.data(),
-                               data.vertices.size() * sizeof(GpuVertex)));
+    if (!per_slot_vertices)
+      MRGI_TRY(ctx.upload_buffer(graph.gpu_buffer(*vb, 0), data.vertices.data(),
+                                 data.vertices.size() * sizeof(GpuVertex)));
     MRGI_TRY(ctx.upload_buffer(graph.gpu_buffer(*ib, 0), data.indices.data(),
                                data.indices.size() * sizeof(uint32_t)));
   }
@@ -165,7 +174,8 @@ Expected<std::unique_ptr<SceneGpu>> SceneGpu::create(gpu::Context& context, gpu:
   std::vector<Model> models;  // kept until the textures are resampled
   models.reserve(scene.virtual_objects.size());
   for (const VirtualObjectDesc& obj : scene.virtual_objects) {
-    auto model = load_gltf(obj.gltf, obj.placement);
+    // Model space (the placement is applied per frame, commit()); checked like set_placement.
+    auto model = load_gltf(obj.gltf, Placement{});
     if (!model) return model.error();
     models.push_back(std::move(*model));
   }
@@ -191,18 +201,37 @@ Expected<std::unique_ptr<SceneGpu>> SceneGpu::create(gpu::Context& context, gpu:
       out->glossy = out->glossy || mat.metallic > kGlossyMetallic || mat.roughness < kGlossyRoughness;
     }
     for (const Texture& t : m.textures) textures.push_back(&t.image);
+    ObjectSpan span;
+    span.first_vertex = uint32_t(virtual_data.vertices.size());
+    span.first_draw = virtual_data.draws.size();
     append_model(m, material_base, virtual_data, true);
+    span.vertex_count = uint32_t(virtual_data.vertices.size()) - span.first_vertex;
+    span.draw_count = virtual_data.draws.size() - span.first_draw;
+    span.placement = scene.virtual_objects[out->objects_.size()].placement;
+    out->objects_.push_back(span);
   }
+  for (const DrawRange& d : virtual_data.draws) {
+    std::vector<float> errors;
+    for (const DrawRange::Lod& l : d.lods) errors.push_back(l.error_m);
+    out->local_lod_errors_.push_back(std::move(errors));
+  }
+  out->local_vertices_ = virtual_data.vertices;
   for (const RealGeometryDesc& proxy : scene.real_geometry) {
     auto model = load_gltf(proxy.gltf, proxy.placement);
     if (!model) return model.error();
     append_model(*model, 0, proxy_data, false);
   }
 
-  auto vset = upload_meshes(context, graph, virtual_data, "virtual_objects");
+  for (size_t i = 0; i < out->objects_.size(); ++i)
+    MRGI_TRY(out->set_placement(i, out->objects_[i].placement));  // refuses a bad scene.json pose
+  auto vset = upload_meshes(context, graph, virtual_data, "virtual_objects", true);
   if (!vset) return vset.error();
   out->virtual_objects = std::move(*vset);
-  auto pset = upload_meshes(context, graph, proxy_data, "real_proxies");
+  out->slot_revision_.assign(graph.frames_in_flight(), ~uint64_t(0));
+  out->revision_ = 0;
+  out->bounds_revision_ = ~uint64_t(0);
+  out->commit(graph);  // bounds now; each slot's copy is written the first time it is current
+  auto pset = upload_meshes(context, graph, proxy_data, "real_proxies", false);
   if (!pset) return pset.error();
   out->real_proxies = std::move(*pset);
 
@@ -243,6 +272,82 @@ Expected<std::unique_ptr<SceneGpu>> SceneGpu::create(gpu::Context& context, gpu:
   out->base_color_maps = graph.import_image("base_color_maps", out->texture_array_,
                                             VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, true);
   return out;
+}
+
+Status SceneGpu::set_placement(size_t object, const Placement& p) {
+  if (object >= objects_.size())
+    return fail(ErrorKind::BadUsage, "virtual object " + std::to_string(object) + ": the scene has " +
+                                         std::to_string(objects_.size()) + " (indices from 0)");
+  const glm::vec4 q(p.rotation.x, p.rotation.y, p.rotation.z, p.rotation.w);
+  bool finite = true;
+  for (int i = 0; i < 3; ++i) finite = finite && std::isfinite(p.position[i]) && std::isfinite(p.scale[i]);
+  for (int i = 0; i < 4; ++i) finite = finite && std::isfinite(q[i]);
+  if (!finite || !(glm::length(q) > 1e-6f))
+    return fail(ErrorKind::BadUsage, "virtual object " + std::to_string(object) +
+                                         ": placement must be finite with a non-zero rotation quaternion");
+  if (!(p.scale.x > 0.0f && p.scale.y > 0.0f && p.scale.z > 0.0f))
+    return fail(ErrorKind::BadUsage, "virtual object " + std::to_string(object) + ": scale must be positive");
+  Placement& cur = objects_[object].placement;
+  if (cur.position == p.position && cur.rotation == p.rotation && cur.scale == p.scale) return ok_status();
+  cur = p;
+  ++revision_;
+  return ok_status();
+}
+
+void SceneGpu::write_vertices(GpuVertex* out) const {
+  for (const ObjectSpan& o : objects_) {
+    const glm::mat4 m = o.placement.matrix();
+    const glm::mat3 nm = glm::transpose(glm::inverse(glm::mat3(m)));
+    for (uint32_t i = o.first_vertex; i < o.first_vertex + o.vertex_count; ++i) {
+      const GpuVertex& v = local_vertices_[i];
+      GpuVertex w;
+      w.position = glm::vec3(m * glm::vec4(v.position, 1.0f));
+      const glm::vec3 n = nm * v.normal;
+      const float len = glm::length(n);
+      w.normal = len > 0.0f ? n / len : glm::vec3(0.0f, 1.0f, 0.0f);
+      w.uv = v.uv;
+      out[i] = w;
+    }
+  }
+}
+
+void SceneGpu::update_bounds() {
+  MeshSet& set = virtual_objects;
+  set.bounds_min = glm::vec3(1e30f);
+  set.bounds_max = glm::vec3(-1e30f);
+  for (const ObjectSpan& o : objects_) {
+    const glm::mat4 m = o.placement.matrix();
+    const float grow = std::max({o.placement.scale.x, o.placement.scale.y, o.placement.scale.z});
+    for (size_t d = o.first_draw; d < o.first_draw + o.draw_count; ++d) {
+      DrawRange& range = set.draws[d];
+      range.bounds_min = glm::vec3(1e30f);
+      range.bounds_max = glm::vec3(-1e30f);
+      // The range's vertices (the index list's vertices are a subset of the object's span).
+      const uint32_t first = uint32_t(range.vertex_offset);
+      const uint32_t end = d + 1 < o.first_draw + o.draw_count ? uint32_t(set.draws[d + 1].vertex_offset)
+                                                               : o.first_vertex + o.vertex_count;
+      for (uint32_t i = first; i < end; ++i) {
+        const glm::vec3 p = glm::vec3(m * glm::vec4(local_vertices_[i].position, 1.0f));
+        range.bounds_min = glm::min(range.bounds_min, p);
+        range.bounds_max = glm::max(range.bounds_max, p);
+      }
+      for (size_t l = 0; l < range.lods.size(); ++l) range.lods[l].error_m = local_lod_errors_[d][l] * grow;
+      set.bounds_min = glm::min(set.bounds_min, range.bounds_min);
+      set.bounds_max = glm::max(set.bounds_max, range.bounds_max);
+    }
+  }
+}
+
+void SceneGpu::commit(gpu::FrameGraph& graph) {
+  if (objects_.empty()) return;
+  if (bounds_revision_ != revision_) {
+    update_bounds();
+    bounds_revision_ = revision_;
+  }
+  const uint32_t slot = graph.slot();
+  if (slot >= slot_revision_.size() || slot_revision_[slot] == revision_) return;
+  write_vertices(static_cast<GpuVertex*>(graph.mapped(virtual_objects.vertices, slot)));
+  slot_revision_[slot] = revision_;
 }
 
 SceneGpu::~SceneGpu() {

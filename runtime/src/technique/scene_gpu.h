@@ -1,7 +1,17 @@
-// The scene's triangle meshes on the GPU, uploaded once at start-up: the glTF virtual objects
-// (for the virtual G-buffer and shadow maps) and the real proxy geometry of scene.json (shadow
-// casters in the real-caster maps). One interleaved vertex buffer and one index buffer per set,
-// a material array and one base-colour texture array for the virtual objects.
+// The scene's triangle meshes on the GPU: the glTF virtual objects (for the virtual G-buffer and
+// shadow maps) and the real proxy geometry of scene.json (shadow casters in the real-caster
+// maps). One interleaved vertex buffer and one index buffer per set, a material array and one
+// base-colour texture array for the virtual objects, all made at start-up.
+//
+// Virtual objects move (set_placement: an app's objects, scene.json's keyframed motion): their
+// world-space vertices are rewritten from a model-space copy when a pose changes. The virtual
+// vertex buffer is host-visible with one copy per frame in flight (the frame graph resolves the
+// handle to the current slot's), so a frame still on the GPU keeps the poses it was recorded
+// with and nothing is allocated: commit() rewrites the current slot's copy when it is older
+// than the newest poses. Why world-space vertices rewritten instead of a model matrix per draw:
+// every pass that reads the meshes (G-buffer, shadow maps, RSMs, the ISMs' point sampling, the
+// bounce light source) reads world-space vertices, by vertex fetch and as storage buffers; one
+// rewrite keeps them all right, and a pose changes at most once a frame.
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -81,6 +91,19 @@ class SceneGpu {
 
   MeshSet virtual_objects;
   MeshSet real_proxies;
+
+  // The virtual objects in scene.json's order, their placements, and moving them.
+  size_t object_count() const { return objects_.size(); }
+  const Placement& placement(size_t object) const { return objects_[object].placement; }
+  // Takes effect at the next commit(). BadUsage for an index out of range, a non-finite value
+  // or a scale that is not positive.
+  Status set_placement(size_t object, const Placement& placement);
+  // Before recording a frame: brings the current slot's vertex copy and every range's bounds
+  // (and level-of-detail errors, which scale with the object) to the newest placements.
+  void commit(gpu::FrameGraph& graph);
+  // Bumped by every set_placement that changed a pose: what techniques compare to see that the
+  // virtual objects moved (plans fitted to their bounds).
+  uint64_t revision() const { return revision_; }
   gpu::BufferHandle materials;        // shader::GpuMaterial[] (at least one entry)
   bool emissive = false;              // some virtual material emits (GpuMaterial::emission)
   // Some virtual material is glossy: metallic above kGlossyMetallic or roughness below
@@ -93,7 +116,19 @@ class SceneGpu {
 
  private:
   explicit SceneGpu(gpu::Context& context) : context_(context) {}
+  void write_vertices(GpuVertex* out) const;  // world space at the current placements
+  void update_bounds();
+  struct ObjectSpan {
+    uint32_t first_vertex = 0, vertex_count = 0;
+    size_t first_draw = 0, draw_count = 0;
+    Placement placement;
+  };
   gpu::Context& context_;
+  std::vector<ObjectSpan> objects_;
+  std::vector<GpuVertex> local_vertices_;      // model space (glTF nodes applied), all objects
+  std::vector<std::vector<float>> local_lod_errors_;  // per virtual range, metres in model space
+  std::vector<uint64_t> slot_revision_;        // per frame slot: the poses its vertex copy holds
+  uint64_t revision_ = 0, bounds_revision_ = 0;
   gpu::GpuImage texture_array_;       // owned here, imported into the graph
 };
 

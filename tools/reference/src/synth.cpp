@@ -239,6 +239,11 @@ Expected<SynthReport> synthesize_capture(const SceneDescription& description, co
     const fs::path rel = fs::path("virtual") / (std::to_string(i) + "_" + fs::path(d.virtual_objects[i].gltf).filename().string());
     v.gltf = (staging / rel).string();
     v.placement = scene->virtual_placement(i, 0.0);
+    // A moving object: its placement at every frame's time as keyframes (the runtime
+    // interpolates between them; at the frames themselves they are the path tracer's poses).
+    const auto& mo = d.virtual_objects[i];
+    if (mo.velocity != glm::dvec3(0.0) || mo.angular_velocity_deg != glm::dvec3(0.0))
+      for (int f = 0; f < d.frames; ++f) v.motion.push_back({f / d.fps, scene->virtual_placement(i, f / d.fps)});
     copies.push_back({d.virtual_objects[i].gltf, staging / rel});
     scene_json.virtual_objects.push_back(v);
   }

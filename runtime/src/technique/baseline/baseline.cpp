@@ -79,6 +79,7 @@ class Baseline final : public Technique {
   ShadowPlan plan_;
   Bounds bounds_;
   uint64_t planned_revision_ = ~uint64_t(0);
+  uint64_t planned_objects_ = 0;  // SceneGpu::revision the plan's bounds were taken at
   int planned_shadowed_ = -1;
   std::vector<LightDesc> drawn_;             // the lights with shadow maps this frame
   light::ShRgb folded_real_{}, folded_virtual_{};  // SH of the estimated lights folded into ambient
@@ -334,6 +335,15 @@ Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped
 
 Status Baseline::update_lights(int shadowed_estimated) {
   const light::Lighting& lighting = shared_.light_stage->lighting();
+  const SceneGpu& sg = *shared_.scene_gpu;
+  if (sg.revision() != planned_objects_) {
+    // The virtual objects moved: the maps are fitted to the scene's bounds again.
+    bounds_ = Bounds{};
+    if (!sg.virtual_objects.empty()) bounds_.add(sg.virtual_objects.bounds_min, sg.virtual_objects.bounds_max);
+    if (!sg.real_proxies.empty()) bounds_.add(sg.real_proxies.bounds_min, sg.real_proxies.bounds_max);
+    planned_objects_ = sg.revision();
+    planned_revision_ = ~uint64_t(0);
+  }
   if (lighting.revision != planned_revision_ || shadowed_estimated != planned_shadowed_) {
     // Declared lamps always get their maps; of the estimated lights (environment regions, the
     // probeless dominant light), strongest first, the level's number do, the rest light as SH.

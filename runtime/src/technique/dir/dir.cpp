@@ -265,6 +265,8 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     history_.valid = false;
     return baseline_->record(base, skipped);
   }
+  // The maps follow the objects (their side, radius_, is fixed at start-up: rigid motion keeps it).
+  centre_ = 0.5f * (shared_.scene_gpu->virtual_objects.bounds_max + shared_.scene_gpu->virtual_objects.bounds_min);
   for (size_t i = 0; i < lighting.lights.size() && planned_.size() < level.rsm_lamps; ++i) {
     auto view = gi::rsm_view(lighting.lights[i], centre_, radius_, level.rsm_size);
     if (!view) {
@@ -282,7 +284,7 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   }
   // The VPLs and ISMs in the buffers stand for this frame's while its inputs stay within
   // tolerance of the frame that made them (technique/input_reuse.h): no map, VPL or ISM pass.
-  reuse_.set_frame(info.level, info.camera_to_world, info.input);
+  reuse_.set_frame(info.level, info.camera_to_world, info.input, shared_.scene_gpu->revision());
   for (const auto& [i, view] : planned_) reuse_.add_lamp(lighting.lights[i]);
   // Environment VPLs: the strongest regions of the stage's cut, one directional VPL each.
   const std::vector<light::EnvLight>& regions = shared_.light_stage->environment_regions();

@@ -193,6 +193,9 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   } else {
     MRGI_TRY(delta_->set_cells(graph, level.volume_cells));
     MRGI_TRY(rho_->set_cells(graph, level.volume_cells));
+    // The volumes follow the objects (their side is fixed at start-up: rigid motion keeps it).
+    const SceneGpu& sg = *shared_.scene_gpu;
+    centre_ = 0.5f * (sg.virtual_objects.bounds_max + sg.virtual_objects.bounds_min);
     const gi::LpvGrid grid{centre_ - glm::vec3(0.5f * side_), side_ / float(level.volume_cells)};
     delta_->set_grid(grid);
     rho_->set_grid(grid);
@@ -206,7 +209,7 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     const VkExtent2D g = graph.extent(shared_.real_position);
     const uint32_t stride = std::max(1u, uint32_t(std::ceil(double(std::max(g.width, g.height)) / (level.rsm_size / 2.0))));
     // The real lamps the maps are drawn for this level (strongest first), as the reuse compares them.
-    reuse_.set_frame(info.level, info.camera_to_world, info.input);
+    reuse_.set_frame(info.level, info.camera_to_world, info.input, shared_.scene_gpu->revision());
     for (size_t i = 0, n = 0; i < lighting.lights.size() && n < level.rsm_lamps; ++i)
       if (lighting.lights[i].real) {
         reuse_.add_lamp(lighting.lights[i]);
