@@ -89,6 +89,60 @@ TEST(DynamicScene, AMovedObjectIsDrawnWhereItIsWithoutAllocating) {
   }
 }
 
+SyntheticScene without_object0(SyntheticScene s) {
+  s.virtual_boxes.erase(s.virtual_boxes.begin());
+  return s;
+}
+
+// Removing and adding objects (Runtime::set_object_visible): a removed object is not drawn; with
+// every object removed the frame is the camera's; shown again, it is back where it was.
+TEST(DynamicScene, RemovedObjectsAreNotDrawnAndComeBack) {
+  mrgi::testing::TempDir dir;
+  const SyntheticScene scene = SyntheticScene::create(dir.str());
+  ASSERT_GE(scene.scene.virtual_objects.size(), 2u);
+  const SyntheticScene one_less = without_object0(scene);
+  for (const std::string& technique : technique_names()) {
+    SCOPED_TRACE(technique);
+    RuntimeSettings settings;
+    settings.technique = technique;
+    settings.level = int(technique_levels(technique)->size()) - 1;
+    auto rt = create_runtime(settings, scene.cameras(), scene.scene);
+    ASSERT_TRUE(rt.ok()) << rt.error().message;
+    Runtime& r = **rt;
+    const double memory = r.memory_mib();
+    std::vector<FrameOutput> outs;
+    for (int k = 0; k < 8; ++k) {
+      if (k == 2) ASSERT_TRUE(r.set_object_visible(0, false).ok());
+      if (k == 4)
+        for (size_t i = 1; i < r.object_count(); ++i) ASSERT_TRUE(r.set_object_visible(i, false).ok());
+      if (k == 6)
+        for (size_t i = 0; i < r.object_count(); ++i) ASSERT_TRUE(r.set_object_visible(i, true).ok());
+      auto o = r.process(scene.frame(k));
+      ASSERT_TRUE(o.ok()) << o.error().message;
+      for (auto& x : *o) outs.push_back(std::move(x));
+    }
+    auto rest = r.flush();
+    ASSERT_TRUE(rest.ok()) << rest.error().message;
+    for (auto& x : *rest) outs.push_back(std::move(x));
+    ASSERT_EQ(outs.size(), 8u);
+    for (const FrameOutput& out : outs) {
+      const int64_t k = out.stats.frame_index;
+      if (k < 2 || k >= 6) {
+        EXPECT_GT(mask_iou(out, scene), 0.8) << "frame " << k;
+      } else if (k < 4) {
+        EXPECT_GT(mask_iou(out, one_less), 0.8) << "frame " << k;
+        EXPECT_LT(mask_iou(out, scene), mask_iou(out, one_less)) << "frame " << k;
+      } else {
+        int masked = 0;
+        for (uint8_t m : out.virtual_mask.data) masked += m != 0;
+        EXPECT_EQ(masked, 0) << "frame " << k << ": nothing is shown";
+      }
+    }
+    EXPECT_EQ(r.memory_mib(), memory);
+    EXPECT_EQ(r.set_object_visible(r.object_count(), true).error().kind, ErrorKind::BadUsage);
+  }
+}
+
 // scene.json's keyframed motion: the box at its first key for the frames before the second key's
 // time, then at the last (held past the last key), with the frames' timestamps (30 fps).
 TEST(DynamicScene, KeyframedMotionPlacesTheObjectAtEachFramesTime) {

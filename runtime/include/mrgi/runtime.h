@@ -222,6 +222,10 @@ class Runtime {
   // for an index out of range, a non-finite placement or a scale that is not positive.
   virtual size_t object_count() const = 0;
   virtual Status set_object_placement(size_t object, const Placement& placement) = 0;
+  // Adds (true) or removes (false) object i from the next process() on, within that capacity:
+  // a removed object is not drawn, lit, shadowed or reflected; with none shown, frames are the
+  // camera frame. BadUsage for an index out of range.
+  virtual Status set_object_visible(size_t object, bool visible) = 0;
 };
 
 struct CameraSetup {

@@ -76,6 +76,9 @@ class RuntimeImpl final : public Runtime {
   Status set_level(int level) override;
   Status set_profiling(bool on) override { return graph_->set_profiling(on); }
   size_t object_count() const override { return scene_gpu_->object_count(); }
+  Status set_object_visible(size_t object, bool visible) override {
+    return scene_gpu_->set_visible(object, visible);
+  }
   Status set_object_placement(size_t object, const Placement& placement) override {
     MRGI_TRY(scene_gpu_->set_placement(object, placement));
     app_placed_[object] = 1;
@@ -374,7 +377,7 @@ Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame)
     notes.push_back(have_pose_ ? "pose: none given, previous frame's pose used"
                                : "pose: none given and none before, identity used");
   }
-  const bool has_objects = !scene_gpu_->virtual_objects.empty();
+  const bool has_objects = !scene_gpu_->virtual_objects.empty() && scene_gpu_->any_visible();
   bool affected = has_objects;
   for (const LightDesc& l : scene_.lights) affected = affected || !l.real;  // lights real surfaces
   if (affected && has_objects && settings_.skip_unaffected_frames) {
@@ -447,7 +450,7 @@ Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, 
   write_constants(last_pose_);
   recon_->upload(*graph_, frame);
 
-  const bool has_objects = !scene_gpu_->virtual_objects.empty();
+  const bool has_objects = !scene_gpu_->virtual_objects.empty() && scene_gpu_->any_visible();
   // A frame nothing virtual affects is the camera frame (the lean skeleton above): the
   // reconstruction is not needed for it; its temporal history restarts on the next affected
   // frame (one frame of unfiltered depth).

@@ -224,6 +224,7 @@ Expected<std::unique_ptr<SceneGpu>> SceneGpu::create(gpu::Context& context, gpu:
 
   for (size_t i = 0; i < out->objects_.size(); ++i)
     MRGI_TRY(out->set_placement(i, out->objects_[i].placement));  // refuses a bad scene.json pose
+  out->visible_count_ = out->objects_.size();
   auto vset = upload_meshes(context, graph, virtual_data, "virtual_objects", true);
   if (!vset) return vset.error();
   out->virtual_objects = std::move(*vset);
@@ -294,8 +295,24 @@ Status SceneGpu::set_placement(size_t object, const Placement& p) {
   return ok_status();
 }
 
+Status SceneGpu::set_visible(size_t object, bool visible) {
+  if (object >= objects_.size())
+    return fail(ErrorKind::BadUsage, "virtual object " + std::to_string(object) + ": the scene has " +
+                                         std::to_string(objects_.size()) + " (indices from 0)");
+  if (objects_[object].visible == visible) return ok_status();
+  objects_[object].visible = visible;
+  visible_count_ = visible ? visible_count_ + 1 : visible_count_ - 1;
+  ++revision_;
+  return ok_status();
+}
+
 void SceneGpu::write_vertices(GpuVertex* out) const {
   for (const ObjectSpan& o : objects_) {
+    if (!o.visible) {
+      for (uint32_t i = o.first_vertex; i < o.first_vertex + o.vertex_count; ++i)
+        out[i] = GpuVertex{glm::vec3(0.0f, -kHiddenDepth_m, 0.0f), glm::vec3(0.0f, 1.0f, 0.0f), glm::vec2(0.0f)};
+      continue;
+    }
     const glm::mat4 m = o.placement.matrix();
     const glm::mat3 nm = glm::transpose(glm::inverse(glm::mat3(m)));
     for (uint32_t i = o.first_vertex; i < o.first_vertex + o.vertex_count; ++i) {
@@ -313,9 +330,15 @@ void SceneGpu::write_vertices(GpuVertex* out) const {
 
 void SceneGpu::update_bounds() {
   MeshSet& set = virtual_objects;
+  const glm::vec3 old_min = set.bounds_min, old_max = set.bounds_max;
   set.bounds_min = glm::vec3(1e30f);
   set.bounds_max = glm::vec3(-1e30f);
   for (const ObjectSpan& o : objects_) {
+    if (!o.visible) {
+      for (size_t d = o.first_draw; d < o.first_draw + o.draw_count; ++d)
+        set.draws[d].bounds_min = set.draws[d].bounds_max = glm::vec3(0.0f, -kHiddenDepth_m, 0.0f);
+      continue;
+    }
     const glm::mat4 m = o.placement.matrix();
     const float grow = std::max({o.placement.scale.x, o.placement.scale.y, o.placement.scale.z});
     for (size_t d = o.first_draw; d < o.first_draw + o.draw_count; ++d) {
@@ -335,6 +358,10 @@ void SceneGpu::update_bounds() {
       set.bounds_min = glm::min(set.bounds_min, range.bounds_min);
       set.bounds_max = glm::max(set.bounds_max, range.bounds_max);
     }
+  }
+  if (visible_count_ == 0) {  // nothing shown: the last bounds stay (nothing is drawn by them)
+    set.bounds_min = old_min;
+    set.bounds_max = old_max;
   }
 }
 

@@ -101,9 +101,17 @@ class SceneGpu {
   // Before recording a frame: brings the current slot's vertex copy and every range's bounds
   // (and level-of-detail errors, which scale with the object) to the newest placements.
   void commit(gpu::FrameGraph& graph);
-  // Bumped by every set_placement that changed a pose: what techniques compare to see that the
-  // virtual objects moved (plans fitted to their bounds).
+  // Shows or hides object i from the next commit() on (an app adding and removing its objects
+  // within the scene's capacity). A hidden object's vertices are written 10 km below the scene,
+  // outside every view, map and volume, and its ranges' bounds with them; the set's bounds are
+  // the visible objects'. BadUsage for an index out of range.
+  Status set_visible(size_t object, bool visible);
+  bool visible(size_t object) const { return objects_[object].visible; }
+  bool any_visible() const { return visible_count_ > 0; }
+  // Bumped by every set_placement or set_visible that changed something: what techniques
+  // compare to see that the virtual objects moved (plans fitted to their bounds).
   uint64_t revision() const { return revision_; }
+  static constexpr float kHiddenDepth_m = 1.0e4f;
   gpu::BufferHandle materials;        // shader::GpuMaterial[] (at least one entry)
   bool emissive = false;              // some virtual material emits (GpuMaterial::emission)
   // Some virtual material is glossy: metallic above kGlossyMetallic or roughness below
@@ -122,7 +130,9 @@ class SceneGpu {
     uint32_t first_vertex = 0, vertex_count = 0;
     size_t first_draw = 0, draw_count = 0;
     Placement placement;
+    bool visible = true;
   };
+  size_t visible_count_ = 0;
   gpu::Context& context_;
   std::vector<ObjectSpan> objects_;
   std::vector<GpuVertex> local_vertices_;      // model space (glTF nodes applied), all objects
