@@ -226,6 +226,13 @@ class Runtime {
   // a removed object is not drawn, lit, shadowed or reflected; with none shown, frames are the
   // camera frame. BadUsage for an index out of range.
   virtual Status set_object_visible(size_t object, bool visible) = 0;
+  // The lamps: scene.json's (SceneDesc::lights), in its order, capacity fixed at start-up.
+  // set_lamp changes lamp i from the next process() on: moved, turned, recoloured, dimmed to 0
+  // (off: an app that adds lamps later declares them dark at start-up) or back; its kind (type,
+  // real) stays. Never allocates. BadUsage naming the field for an index out of range or a lamp
+  // scene.json would refuse.
+  virtual size_t lamp_count() const = 0;
+  virtual Status set_lamp(size_t lamp, const LightDesc& desc) = 0;
 };
 
 struct CameraSetup {

@@ -75,10 +75,9 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
                                          " lamps, at most " + std::to_string(kMaxStageLights));
   s.planned_ = scene.environment.present ? LightSourceKind::Environment
                                          : (s.declared_ > 0 ? LightSourceKind::Declared : LightSourceKind::Probeless);
-  std::vector<LightDesc> real_lamps;
   for (const LightDesc& l : scene.lights)
-    if (l.real) real_lamps.push_back(l);
-  s.residual_ = s.planned_ == LightSourceKind::Declared && settings.residual_light && !real_lamps.empty();
+    if (l.real) s.real_lamps_.push_back(l);
+  s.residual_ = s.planned_ == LightSourceKind::Declared && settings.residual_light && !s.real_lamps_.empty();
   auto estimator = LightEstimator::create(s.residual_ ? settings.residual_estimator : settings.estimator);
   if (!estimator) return estimator.error();
   s.estimator_.emplace(std::move(*estimator));
@@ -100,7 +99,7 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
                                       cameras.color, cameras.depth, cameras.depth_scale);
     if (!b) return b.error();
     s.probeless_.emplace(std::move(*b));
-    if (s.residual_) s.probeless_->set_known_lamps(real_lamps, settings.estimator.gray_albedo);
+    if (s.residual_) s.probeless_->set_known_lamps(s.real_lamps_, settings.estimator.gray_albedo);
   }
   s.max_lights_ = s.declared_ + s.env_lights_ + (s.planned_ == LightSourceKind::Probeless ? 1 : 0);
   s.lighting_.lights.reserve(kMaxStageLights);
@@ -112,20 +111,56 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
     s.lighting_.light_sh.push_back(ShRgb{});
     s.lighting_.foldable.push_back(0);
   }
-  // The declared real lamps seen from the focus, for the exported estimate.
-  for (const LightDesc& l : scene.lights) {
-    if (!l.real) continue;
-    glm::dvec3 to_light;
-    const glm::dvec3 e = lamp_irradiance(l, glm::dvec3(settings.focus), to_light);
-    const ShRgb sh = sh_directional_light(to_light, e);
-    for (int i = 0; i < kMaxShCoeffs; ++i) s.declared_sh_[size_t(i)] += sh[size_t(i)];
-  }
+  s.update_declared_sh();
   s.lighting_.source = s.planned_;
   s.lighting_.environment = env.present;
   if (s.planned_ == LightSourceKind::Probeless) s.set_probeless_lighting();
   else if (s.env_from_file_) s.set_environment_lighting(env.real);
   else s.finish_declared();
   return stage;
+}
+
+void LightStage::update_declared_sh() {
+  // The declared real lamps seen from the focus, for the exported estimate.
+  declared_sh_ = ShRgb{};
+  for (const LightDesc& l : scene_.lights) {
+    if (!l.real) continue;
+    glm::dvec3 to_light;
+    const glm::dvec3 e = lamp_irradiance(l, glm::dvec3(settings_.focus), to_light);
+    const ShRgb sh = sh_directional_light(to_light, e);
+    for (int i = 0; i < kMaxShCoeffs; ++i) declared_sh_[size_t(i)] += sh[size_t(i)];
+  }
+}
+
+Status LightStage::set_declared_lamp(size_t i, const LightDesc& lamp) {
+  const std::string where = "lamp " + std::to_string(i);
+  if (i >= size_t(declared_))
+    return fail(ErrorKind::BadUsage, where + ": the scene declares " + std::to_string(declared_) + " (indices from 0)");
+  const LightDesc& was = scene_.lights[i];
+  if (lamp.type != was.type || lamp.real != was.real)
+    return fail(ErrorKind::BadUsage, where + ": type and real cannot change (its shadow maps were laid out for them)");
+  auto finite3 = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+  if (!finite3(lamp.position) || !finite3(lamp.direction) || !finite3(lamp.color) || !std::isfinite(lamp.intensity))
+    return fail(ErrorKind::BadUsage, where + ": position, direction, color and intensity must be finite");
+  if (lamp.type != LightType::Point && !(glm::length(lamp.direction) > 1e-9f))
+    return fail(ErrorKind::BadUsage, where + ".direction: must be non-zero");
+  if (lamp.color.x < 0.0f || lamp.color.y < 0.0f || lamp.color.z < 0.0f || lamp.intensity < 0.0f)
+    return fail(ErrorKind::BadUsage, where + ": color and intensity must be >= 0");
+  if (lamp.type == LightType::Spot &&
+      !(lamp.inner_angle_deg >= 0.0f && lamp.inner_angle_deg <= lamp.outer_angle_deg && lamp.outer_angle_deg <= 90.0f))
+    return fail(ErrorKind::BadUsage, where + ": spot angles must satisfy 0 <= inner_angle_deg <= outer_angle_deg <= 90");
+  LightDesc l = lamp;
+  if (l.type != LightType::Point) l.direction = glm::normalize(l.direction);
+  scene_.lights[i] = l;
+  lighting_.lights[i] = l;
+  size_t r = 0;
+  for (const LightDesc& d : scene_.lights)
+    if (d.real) real_lamps_[r++] = d;
+  if (residual_) probeless_->set_known_lamps(real_lamps_, settings_.estimator.gray_albedo);
+  update_declared_sh();
+  ++lighting_.revision;
+  finish_declared();
+  return ok_status();
 }
 
 void LightStage::finish_declared() {

@@ -167,6 +167,12 @@ class LightStage {
                        int solve_bands, std::vector<std::string>& notes);
 
   const Lighting& lighting() const { return lighting_; }
+  // Declared lamp i (scene.json's order) changes from the next update() on: moved, turned,
+  // recoloured, dimmed to 0 (off) or back. The number of lamps is the scene's (capacity fixed at
+  // start-up: an app that adds lamps later declares them dark). BadUsage naming the field for an
+  // index out of range or a lamp scene.json would refuse; a lamp's kind (real or virtual, point,
+  // spot or directional) cannot change (its shadow maps were laid out for it).
+  Status set_declared_lamp(size_t i, const LightDesc& lamp);
   // Every region of this frame's environment cut (strongest first; empty without an environment
   // or before its first image), for the techniques that light with all of it (dir's environment
   // VPLs); their region_sh add up to the environment's SH. `environment_real()`: scene.json's
@@ -206,6 +212,8 @@ class LightStage {
   int next_part_ = 0;
   Lighting lighting_;
   ShRgb declared_sh_{};             // the declared real lamps seen from the focus (radiance SH)
+  std::vector<LightDesc> real_lamps_;  // the declared real lamps (residual's known light)
+  void update_declared_sh();
   std::vector<glm::dvec3> last_env_directions_;
 };
 

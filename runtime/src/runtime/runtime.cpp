@@ -76,6 +76,12 @@ class RuntimeImpl final : public Runtime {
   Status set_level(int level) override;
   Status set_profiling(bool on) override { return graph_->set_profiling(on); }
   size_t object_count() const override { return scene_gpu_->object_count(); }
+  size_t lamp_count() const override { return scene_.lights.size(); }
+  Status set_lamp(size_t lamp, const LightDesc& desc) override {
+    MRGI_TRY(light_stage_->set_declared_lamp(lamp, desc));
+    scene_.lights[lamp] = light_stage_->lighting().lights[lamp];
+    return ok_status();
+  }
   Status set_object_visible(size_t object, bool visible) override {
     return scene_gpu_->set_visible(object, visible);
   }
