@@ -5,6 +5,8 @@
 // each frame's timestamp.
 #include <gtest/gtest.h>
 
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -33,6 +35,36 @@ double mask_iou(const FrameOutput& out, const SyntheticScene& scene) {
   return either == 0 ? 1.0 : double(both) / double(either);
 }
 
+// A runtime of `technique` at its cheapest level for `scene` (null, with a test failure, when it
+// cannot be made).
+std::unique_ptr<Runtime> cheapest_runtime(const std::string& technique, const SyntheticScene& scene) {
+  RuntimeSettings settings;
+  settings.technique = technique;
+  settings.level = int(technique_levels(technique)->size()) - 1;
+  auto rt = create_runtime(settings, scene.cameras(), scene.scene);
+  EXPECT_TRUE(rt.ok()) << rt.error().message;
+  return rt.ok() ? std::move(*rt) : nullptr;
+}
+
+// `frames` frames of `scene` through `r`, `before(k)` called before frame k is given, flushed:
+// every output in order (fewer where a call failed, reported as a test failure).
+std::vector<FrameOutput> run_frames(Runtime& r, const SyntheticScene& scene, int frames,
+                                    const std::function<void(int)>& before) {
+  std::vector<FrameOutput> outs;
+  for (int k = 0; k < frames; ++k) {
+    before(k);
+    auto o = r.process(scene.frame(k));
+    EXPECT_TRUE(o.ok()) << o.error().message;
+    if (!o.ok()) return outs;
+    for (auto& x : *o) outs.push_back(std::move(x));
+  }
+  auto rest = r.flush();
+  EXPECT_TRUE(rest.ok()) << rest.error().message;
+  if (rest.ok())
+    for (auto& x : *rest) outs.push_back(std::move(x));
+  return outs;
+}
+
 SyntheticScene moved(SyntheticScene s, const glm::vec3& by) {
   s.scene.virtual_objects[0].placement.position += by;
   s.virtual_boxes[0].lo += by;
@@ -48,28 +80,17 @@ TEST(DynamicScene, AMovedObjectIsDrawnWhereItIsWithoutAllocating) {
   const SyntheticScene after = moved(scene, step);
   for (const std::string& technique : technique_names()) {
     SCOPED_TRACE(technique);
-    RuntimeSettings settings;
-    settings.technique = technique;
-    settings.level = int(technique_levels(technique)->size()) - 1;
-    auto rt = create_runtime(settings, scene.cameras(), scene.scene);
-    ASSERT_TRUE(rt.ok()) << rt.error().message;
-    Runtime& r = **rt;
+    auto rt = cheapest_runtime(technique, scene);
+    ASSERT_TRUE(rt);
+    Runtime& r = *rt;
     EXPECT_EQ(r.object_count(), scene.scene.virtual_objects.size());
     const double memory = r.memory_mib();
-    std::vector<FrameOutput> outs;
-    for (int k = 0; k < 6; ++k) {
-      if (k == 3) {
-        Placement p = scene.scene.virtual_objects[0].placement;
-        p.position += step;
-        ASSERT_TRUE(r.set_object_placement(0, p).ok());
-      }
-      auto o = r.process(scene.frame(k));
-      ASSERT_TRUE(o.ok()) << o.error().message;
-      for (auto& x : *o) outs.push_back(std::move(x));
-    }
-    auto rest = r.flush();
-    ASSERT_TRUE(rest.ok()) << rest.error().message;
-    for (auto& x : *rest) outs.push_back(std::move(x));
+    const std::vector<FrameOutput> outs = run_frames(r, scene, 6, [&](int k) {
+      if (k != 3) return;
+      Placement p = scene.scene.virtual_objects[0].placement;
+      p.position += step;
+      EXPECT_TRUE(r.set_object_placement(0, p).ok());
+    });
     ASSERT_EQ(outs.size(), 6u);
     for (const FrameOutput& out : outs) {
       const bool later = out.stats.frame_index >= 3;
@@ -103,27 +124,17 @@ TEST(DynamicScene, RemovedObjectsAreNotDrawnAndComeBack) {
   const SyntheticScene one_less = without_object0(scene);
   for (const std::string& technique : technique_names()) {
     SCOPED_TRACE(technique);
-    RuntimeSettings settings;
-    settings.technique = technique;
-    settings.level = int(technique_levels(technique)->size()) - 1;
-    auto rt = create_runtime(settings, scene.cameras(), scene.scene);
-    ASSERT_TRUE(rt.ok()) << rt.error().message;
-    Runtime& r = **rt;
+    auto rt = cheapest_runtime(technique, scene);
+    ASSERT_TRUE(rt);
+    Runtime& r = *rt;
     const double memory = r.memory_mib();
-    std::vector<FrameOutput> outs;
-    for (int k = 0; k < 8; ++k) {
-      if (k == 2) ASSERT_TRUE(r.set_object_visible(0, false).ok());
+    const std::vector<FrameOutput> outs = run_frames(r, scene, 8, [&](int k) {
+      if (k == 2) EXPECT_TRUE(r.set_object_visible(0, false).ok());
       if (k == 4)
-        for (size_t i = 1; i < r.object_count(); ++i) ASSERT_TRUE(r.set_object_visible(i, false).ok());
+        for (size_t i = 1; i < r.object_count(); ++i) EXPECT_TRUE(r.set_object_visible(i, false).ok());
       if (k == 6)
-        for (size_t i = 0; i < r.object_count(); ++i) ASSERT_TRUE(r.set_object_visible(i, true).ok());
-      auto o = r.process(scene.frame(k));
-      ASSERT_TRUE(o.ok()) << o.error().message;
-      for (auto& x : *o) outs.push_back(std::move(x));
-    }
-    auto rest = r.flush();
-    ASSERT_TRUE(rest.ok()) << rest.error().message;
-    for (auto& x : *rest) outs.push_back(std::move(x));
+        for (size_t i = 0; i < r.object_count(); ++i) EXPECT_TRUE(r.set_object_visible(i, true).ok());
+    });
     ASSERT_EQ(outs.size(), 8u);
     for (const FrameOutput& out : outs) {
       const int64_t k = out.stats.frame_index;
@@ -205,26 +216,16 @@ TEST(DynamicScene, ALampTurnedOffAndOnLightsTheObjectsAccordingly) {
   ASSERT_EQ(scene.scene.lights.size(), 1u);
   for (const std::string& technique : technique_names()) {
     SCOPED_TRACE(technique);
-    RuntimeSettings settings;
-    settings.technique = technique;
-    settings.level = int(technique_levels(technique)->size()) - 1;
-    auto rt = create_runtime(settings, scene.cameras(), scene.scene);
-    ASSERT_TRUE(rt.ok()) << rt.error().message;
-    Runtime& r = **rt;
+    auto rt = cheapest_runtime(technique, scene);
+    ASSERT_TRUE(rt);
+    Runtime& r = *rt;
     ASSERT_EQ(r.lamp_count(), 1u);
     const double memory = r.memory_mib();
-    std::vector<FrameOutput> outs;
-    for (int k = 0; k < 9; ++k) {
+    const std::vector<FrameOutput> outs = run_frames(r, scene, 9, [&](int k) {
       LightDesc lamp = scene.scene.lights[0];
       if (k >= 3 && k < 6) lamp.intensity = 0.0f;
-      ASSERT_TRUE(r.set_lamp(0, lamp).ok());
-      auto o = r.process(scene.frame(k));
-      ASSERT_TRUE(o.ok()) << o.error().message;
-      for (auto& x : *o) outs.push_back(std::move(x));
-    }
-    auto rest = r.flush();
-    ASSERT_TRUE(rest.ok()) << rest.error().message;
-    for (auto& x : *rest) outs.push_back(std::move(x));
+      EXPECT_TRUE(r.set_lamp(0, lamp).ok());
+    });
     ASSERT_EQ(outs.size(), 9u);
     double on = 0.0, off = 0.0, again = 0.0;
     for (const FrameOutput& out : outs) {

@@ -11,16 +11,6 @@ Error apriltag_absent() { return platform_absent::absent("AprilTag", "MRGI_WITH_
 
 struct AprilTagDetector::Impl {};
 
-const char* to_string(TrackingState s) {
-  switch (s) {
-    case TrackingState::NotAcquired: return "not-acquired";
-    case TrackingState::Tracking: return "tracking";
-    case TrackingState::Holding: return "holding";
-    case TrackingState::Lost: return "lost";
-  }
-  return "?";
-}
-
 AprilTagDetector::AprilTagDetector(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 AprilTagDetector::AprilTagDetector(AprilTagDetector&&) noexcept = default;
 AprilTagDetector& AprilTagDetector::operator=(AprilTagDetector&&) noexcept = default;

@@ -146,16 +146,6 @@ const FamilyEntry kFamilies[] = {
 
 }  // namespace
 
-const char* to_string(TrackingState s) {
-  switch (s) {
-    case TrackingState::NotAcquired: return "not-acquired";
-    case TrackingState::Tracking: return "tracking";
-    case TrackingState::Holding: return "holding";
-    case TrackingState::Lost: return "lost";
-  }
-  return "?";
-}
-
 AprilTagDetector::AprilTagDetector(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 AprilTagDetector::AprilTagDetector(AprilTagDetector&&) noexcept = default;
 AprilTagDetector& AprilTagDetector::operator=(AprilTagDetector&&) noexcept = default;
