@@ -129,11 +129,15 @@ TEST(DynamicScene, RemovedObjectsAreNotDrawnAndComeBack) {
     Runtime& r = *rt;
     const double memory = r.memory_mib();
     const std::vector<FrameOutput> outs = run_frames(r, scene, 8, [&](int k) {
-      if (k == 2) EXPECT_TRUE(r.set_object_visible(0, false).ok());
-      if (k == 4)
-        for (size_t i = 1; i < r.object_count(); ++i) EXPECT_TRUE(r.set_object_visible(i, false).ok());
-      if (k == 6)
-        for (size_t i = 0; i < r.object_count(); ++i) EXPECT_TRUE(r.set_object_visible(i, true).ok());
+      if (k == 2) {
+        EXPECT_TRUE(r.set_object_visible(0, false).ok());
+      }
+      for (size_t i = 1; k == 4 && i < r.object_count(); ++i) {
+        EXPECT_TRUE(r.set_object_visible(i, false).ok());
+      }
+      for (size_t i = 0; k == 6 && i < r.object_count(); ++i) {
+        EXPECT_TRUE(r.set_object_visible(i, true).ok());
+      }
     });
     ASSERT_EQ(outs.size(), 8u);
     for (const FrameOutput& out : outs) {

@@ -1,6 +1,8 @@
 // AprilTag tracking left out of this build (MRGI_WITH_APRILTAG=OFF): absent.h. No detector or
 // tracker can be made, so their other members are never reached; they are defined for the link
 // and answer as a tracker that never acquired a pose would.
+#include <algorithm>
+
 #include "absent/absent.h"
 #include "mrgi/platform/apriltag.h"
 
@@ -30,7 +32,11 @@ Expected<AprilTagTracker> AprilTagTracker::create(const AprilTagSettings&, const
                                                   const AprilTagTrackerSettings&) {
   return apriltag_absent();
 }
-TrackingResult AprilTagTracker::track(const ImageRGB8&, double) { return TrackingResult{}; }
+TrackingResult AprilTagTracker::track(const ImageRGB8&, double timestamp) {
+  last_time_ = timestamp;  // as the real tracker keeps it; nothing is ever seen
+  last_seen_ = std::min(last_seen_, timestamp);
+  return TrackingResult{};
+}
 TrackingResult AprilTagTracker::fill_pose(InputFrame& frame) {
   frame.pose.reset();
   return TrackingResult{};
