@@ -311,3 +311,52 @@ TEST(LightStage, EnvCameraFramesLightTheScene) {
   EXPECT_GT(closest, std::cos(10.0 * kDeg));  // 6.7: the centroid of a region holding sky too
 }
 }  // namespace
+
+namespace {
+// A declared lamp changed at run time (LightStage::set_declared_lamp): the frame's lights and
+// the exported estimate follow, the revision moves (maps are re-planned), a lamp scene.json would
+// refuse or whose kind changes is refused; under a technique's own estimate (the probeless
+// source) the lamp is kept but the frame's light is left as it is.
+TEST(LightStage, DeclaredLampsChangeAtRunTime) {
+  using namespace mrgi;
+  using namespace mrgi::light;
+  SceneDesc scene;
+  LightDesc lamp;
+  lamp.position = {0.0f, 2.0f, 0.0f};
+  lamp.intensity = 2.0f;
+  scene.lights.push_back(lamp);
+  LightStageSettings settings;
+  settings.residual_light = false;
+  auto stage = LightStage::create(settings, scene, CameraSetup{});
+  ASSERT_TRUE(stage.ok()) << stage.error().message;
+  LightStage& s = **stage;
+  const uint64_t revision = s.lighting().revision;
+  const double lum_on = luminance(glm::dvec3(s.lighting().estimate.sh_radiance[0][0], s.lighting().estimate.sh_radiance[0][1],
+                                             s.lighting().estimate.sh_radiance[0][2]));
+  LightDesc off = lamp;
+  off.intensity = 0.0f;
+  ASSERT_TRUE(s.set_declared_lamp(0, off).ok());
+  EXPECT_EQ(s.lighting().lights[0].intensity, 0.0f);
+  EXPECT_GT(s.lighting().revision, revision);
+  EXPECT_GT(lum_on, 0.0);
+  EXPECT_EQ(s.lighting().estimate.sh_radiance[0][0], 0.0f);
+  LightDesc bad = lamp;
+  bad.type = LightType::Spot;
+  EXPECT_EQ(s.set_declared_lamp(0, bad).error().kind, ErrorKind::BadUsage);
+  bad = lamp;
+  bad.color.x = -1.0f;
+  EXPECT_EQ(s.set_declared_lamp(0, bad).error().kind, ErrorKind::BadUsage);
+  EXPECT_EQ(s.set_declared_lamp(1, lamp).error().kind, ErrorKind::BadUsage);
+
+  // The probeless source of a technique's own estimate: the lamps light nothing.
+  auto external = LightStage::create(settings, scene, CameraSetup{});
+  ASSERT_TRUE(external.ok());
+  (*external)->use_external_system();
+  const size_t lights = (*external)->lighting().lights.size();
+  const uint64_t ext_revision = (*external)->lighting().revision;
+  ASSERT_TRUE((*external)->set_declared_lamp(0, off).ok());
+  EXPECT_EQ((*external)->lighting().lights.size(), lights);
+  EXPECT_EQ((*external)->lighting().revision, ext_revision);
+  EXPECT_EQ((*external)->declared_lamp(0).intensity, 0.0f);
+}
+}  // namespace

@@ -152,6 +152,9 @@ Status LightStage::set_declared_lamp(size_t i, const LightDesc& lamp) {
   LightDesc l = lamp;
   if (l.type != LightType::Point) l.direction = glm::normalize(l.direction);
   scene_.lights[i] = l;
+  // Under the probeless source (a technique's own estimate, use_external_system) the lamps
+  // light nothing: kept for when they are asked for, the frame's light left as it is.
+  if (planned_ == LightSourceKind::Probeless) return ok_status();
   lighting_.lights[i] = l;
   size_t r = 0;
   for (const LightDesc& d : scene_.lights)

@@ -173,6 +173,8 @@ class LightStage {
   // index out of range or a lamp scene.json would refuse; a lamp's kind (real or virtual, point,
   // spot or directional) cannot change (its shadow maps were laid out for it).
   Status set_declared_lamp(size_t i, const LightDesc& lamp);
+  // Declared lamp i as it is now (the scene's, or the last set_declared_lamp's, normalised).
+  const LightDesc& declared_lamp(size_t i) const { return scene_.lights[i]; }
   // Every region of this frame's environment cut (strongest first; empty without an environment
   // or before its first image), for the techniques that light with all of it (dir's environment
   // VPLs); their region_sh add up to the environment's SH. `environment_real()`: scene.json's

@@ -79,7 +79,7 @@ class RuntimeImpl final : public Runtime {
   size_t lamp_count() const override { return scene_.lights.size(); }
   Status set_lamp(size_t lamp, const LightDesc& desc) override {
     MRGI_TRY(light_stage_->set_declared_lamp(lamp, desc));
-    scene_.lights[lamp] = light_stage_->lighting().lights[lamp];
+    scene_.lights[lamp] = light_stage_->declared_lamp(lamp);
     return ok_status();
   }
   Status set_object_visible(size_t object, bool visible) override {
