@@ -45,7 +45,7 @@ std::vector<std::string> ablation_names(const AblationName<A> (&names)[N]) {
 }
 
 struct ReplayOptions {
-  std::string capture, technique = "baseline", out, level = "0", device, light = "declared";
+  std::string capture, technique = "baseline", out, level = "0", device, light = "declared", video;
   std::vector<std::string> dlpv_ablation;
   std::vector<std::string> dir_ablation;
   int frames = 0, width = 0, height = 0;
@@ -55,6 +55,8 @@ struct ReplayOptions {
 void run_replay(const ReplayOptions& o) {
   if ((o.width == 0) != (o.height == 0)) throw CommandFailure(2, "--width and --height go together");
   const int level = resolve_level(o.technique, o.level);
+  if (!o.video.empty())
+    if (Status st = VideoOutput::check(o.video, o.out); !st.ok()) fail_with(st.error());
   CaptureReader capture = take(CaptureReader::open(o.capture));
   const CaptureInfo& info = capture.info();
   const size_t frames = o.frames > 0 ? std::min<size_t>(size_t(o.frames), capture.frame_count()) : capture.frame_count();
@@ -90,6 +92,11 @@ void run_replay(const ReplayOptions& o) {
   ReplayMeta meta{o.capture, o.technique, level, runtime->level_names()[level], runtime->device().name,
                   runtime->memory_mib(), out_w, out_h};
   ReplayOutput output = take(ReplayOutput::create(o.out, meta));
+  if (!o.video.empty()) {
+    std::vector<double> stamps;
+    for (size_t i = 0; i < frames; ++i) stamps.push_back(capture.entry(i).timestamp);
+    output.set_video(take(VideoOutput::create(o.video, out_w, out_h, capture_fps(stamps))));
+  }
 
   // DESIGN.md: poses come from groundtruth.txt when present, else from AprilTag tracking of the
   // colour frames (capture.json "apriltag"). Without either the runtime keeps the last pose.
@@ -217,6 +224,9 @@ void setup(CLI::App& app) {
   cmd->add_option("--out,-o", opts->out, "output folder (frames/, stats.json, summary.json, side_by_side.png)")->required();
   cmd->add_option("--level,-l", opts->level, "quality level: 0 = best, N, a level name, or 'last' = cheapest")->capture_default_str();
   cmd->add_option("--frames,-n", opts->frames, "replay at most N frames (0 = all)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--video", opts->video,
+                  "also write the composited frames as a clip: FILE.png (animated PNG, lossless) or "
+                  "FILE.mp4/.mkv/.webm (needs ffmpeg on PATH), at the capture's frame rate");
   cmd->add_option("--width", opts->width, "output width in pixels (default: the colour camera's)")->check(CLI::Range(16, 8192));
   cmd->add_option("--height", opts->height, "output height in pixels")->check(CLI::Range(16, 8192));
   cmd->add_option("--light", opts->light,

@@ -85,6 +85,7 @@ Status ReplayOutput::add(const FrameOutput& out, const ImageRGB8& camera, const 
                          const ImageU8* mask, const LightEstimate* light_truth) {
   const size_t i = frame_ms_.size();
   MRGI_TRY(write_png(partial_ + "/frames/" + frame_name(i), out.image));
+  if (video_) MRGI_TRY(video_->add(out.image));
   nlohmann::json s;
   s["frame"] = out.stats.frame_index;
   s["level"] = out.stats.level;
@@ -167,6 +168,7 @@ Expected<nlohmann::json> ReplayOutput::finish() {
   MRGI_TRY(write_json(partial_ + "/stats.json", stats_));
   MRGI_TRY(write_json(partial_ + "/summary.json", summary));
   if (!last_output_.empty()) MRGI_TRY(write_png(partial_ + "/side_by_side.png", side_by_side()));
+  if (video_) MRGI_TRY(video_->finish());
   MRGI_TRY(output_->commit());
   return summary;
 }

@@ -9,7 +9,9 @@
 //                           lp_num_threads, memory_mib, rde {all, real, virtual} with references,
 //                           and light_direction_error_deg {median, worst, frames} when the
 //                           capture has environment images and the technique estimates light
-//   DIR/side_by_side.png    camera | mrgi | reference (or camera | mrgi) of the last frame
+//   DIR/side_by_side.png    camera | mrgi | reference | difference x4 (or camera | mrgi) of the
+//                           last frame, labelled
+// and, with --video FILE, the composited frames as a clip (video_output.h).
 // Everything is written under DIR.partial and renamed over DIR by finish(), so a failed run leaves
 // no half-written output behind.
 #pragma once
@@ -22,6 +24,7 @@
 #include "mrgi/platform/output_dir.h"
 #include "mrgi/metrics.h"
 #include "mrgi/runtime.h"
+#include "video_output.h"
 
 namespace mrgi::tool {
 
@@ -53,9 +56,12 @@ class ReplayOutput {
     std::string what;  // what the interval covers
   };
   void set_achieved(const Achieved& a) { achieved_ = a; }
+  // The composited frames also go to this clip (--video), finished with the rest.
+  void set_video(VideoOutput&& video) { video_.emplace(std::move(video)); }
 
  private:
   std::optional<OutputDir> output_;
+  std::optional<VideoOutput> video_;
   std::string dir_, partial_;
   ReplayMeta meta_;
   nlohmann::json stats_ = nlohmann::json::array();

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <vector>
 
 #if defined(__GNUC__)
@@ -149,6 +151,27 @@ void Canvas::text(float x, float y, const std::string& s, float scale, Rgb c, bo
       fill_rect(x + v0, y - u1, x + v1, y - u0, c);
     }
   }
+}
+
+PlotAxis nice_axis(double data_max) {
+  if (!(data_max > 0.0) || !std::isfinite(data_max)) data_max = 1.0;
+  const double target = data_max * 1.08;
+  const double raw = target / 5.0;
+  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
+  double step = mag;
+  for (double m : {1.0, 2.0, 5.0, 10.0})
+    if (m * mag >= raw) {
+      step = m * mag;
+      break;
+    }
+  return PlotAxis{std::ceil(target / step - 1e-9) * step, step};
+}
+
+std::string tick_label(double v, double step) {
+  char buf[32];
+  const int decimals = step >= 1.0 ? 0 : int(std::ceil(-std::log10(step) - 1e-9));
+  std::snprintf(buf, sizeof buf, "%.*f", std::clamp(decimals, 0, 6), v);
+  return buf;
 }
 
 }  // namespace mrgi::perf

@@ -15,35 +15,8 @@ namespace {
 constexpr int kWidth = 960, kHeight = 640;
 constexpr float kLeft = 90, kRight = 230, kTop = 60, kBottom = 80;  // plot-area margins, px
 
-const Rgb kPalette[] = {{31, 119, 180}, {255, 127, 14}, {44, 160, 44},  {214, 39, 40},
-                        {148, 103, 189}, {140, 86, 75},  {227, 119, 194}, {127, 127, 127}};
 const Marker kMarkers[] = {Marker::Circle, Marker::Square, Marker::TriangleUp, Marker::Diamond,
                            Marker::Plus,   Marker::Cross,  Marker::TriangleDown};
-
-// Axis from 0 to a "nice" maximum with 4..8 ticks of step 1, 2 or 5 x 10^k.
-struct Axis {
-  double max = 1.0, step = 0.2;
-};
-Axis nice_axis(double data_max) {
-  if (!(data_max > 0.0) || !std::isfinite(data_max)) data_max = 1.0;
-  const double target = data_max * 1.08;
-  const double raw = target / 5.0;
-  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
-  double step = mag;
-  for (double m : {1.0, 2.0, 5.0, 10.0})
-    if (m * mag >= raw) {
-      step = m * mag;
-      break;
-    }
-  return Axis{std::ceil(target / step - 1e-9) * step, step};
-}
-
-std::string tick_label(double v, double step) {
-  char buf[32];
-  const int decimals = step >= 1.0 ? 0 : int(std::ceil(-std::log10(step) - 1e-9));
-  std::snprintf(buf, sizeof buf, "%.*f", std::clamp(decimals, 0, 6), v);
-  return buf;
-}
 
 }  // namespace
 
@@ -67,7 +40,7 @@ ImageRGB8 render_pareto_plot(const BenchResult& result) {
   }
   double min_x = max_x;
   for (const ParetoPoint& p : points) min_x = std::min(min_x, p.cost);
-  const Axis ax = nice_axis(max_x), ay = nice_axis(max_y);
+  const PlotAxis ax = nice_axis(max_x), ay = nice_axis(max_y);
   // Frame times of the levels of different techniques span decades (a 100 ms level beside a 10 s
   // one): a linear axis would crowd every cheap level into one corner, so the x axis turns
   // logarithmic when the largest time is over 20 times the smallest.

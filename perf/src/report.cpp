@@ -283,6 +283,7 @@ std::string report_markdown(const BenchResult& r, const CheckReport* check) {
     o << "\n";
   }
 
+  o << "## Where the frame goes\n\n![profiled passes per level, stacked, beside the sustained frame](passes.png)\n\n";
   o << "## Frame time against error\n\n![frame ms against RDE, Pareto front](pareto.png)\n\n";
   o << "Pareto front (suite aggregate, no other level is both faster and more accurate):";
   if (front.empty()) o << " none (no level has a defined RDE)";
@@ -380,6 +381,7 @@ Status write_bench_outputs(const std::string& dir_in, const BenchResult& r, cons
   MRGI_TRY(write_text(partial + "/bench.csv", bench_csv(r)));
   MRGI_TRY(write_text(partial + "/report.md", report_markdown(r, check)));
   MRGI_TRY(write_png(partial + "/pareto.png", render_pareto_plot(r)));
+  MRGI_TRY(write_png(partial + "/passes.png", render_pass_plot(r)));
   return out->commit();
 }
 

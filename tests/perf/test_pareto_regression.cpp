@@ -320,6 +320,38 @@ TEST(Plot, DrawsSeriesFrontAndAxes) {
   EXPECT_LT(blue2, 100u);
 }
 
+// passes.png: each level's bar is its passes stacked to scale (shade: 5 ms at every level, so
+// two bars of equal blue length), with a black tick at the sustained frame (20 and 10 ms).
+TEST(Plot, PassBarsAreToScale) {
+  perf::BenchResult r = constructed_result();
+  for (perf::BenchEntry& e : r.entries) e.passes.push_back({"compose", {4, 2.0 + e.level, 3.0, 1.0, 1.0}});
+  const mrgi::ImageRGB8 img = perf::render_pass_plot(r);
+  ASSERT_EQ(img.width, 1100);
+  // Row through the middle of each bar: count the first colour (the costliest pass: shade,
+  // 5 ms) and the second (compose: 2 ms, then 3 ms).
+  auto count_row = [&](int y, uint8_t r0, uint8_t g0, uint8_t b0) {
+    int n = 0;
+    for (int x = 0; x < 1100 - 290; ++x) n += img.at(x, y)[0] == r0 && img.at(x, y)[1] == g0 && img.at(x, y)[2] == b0;
+    return n;
+  };
+  // Bars start at y = 70 + 10, 22 px high, 32 px apart.
+  const int y0 = 70 + 10 + 11, y1 = y0 + 32;
+  const int shade0 = count_row(y0, 31, 119, 180), shade1 = count_row(y1, 31, 119, 180);
+  const int compose0 = count_row(y0, 255, 127, 14), compose1 = count_row(y1, 255, 127, 14);
+  EXPECT_GT(shade0, 20);
+  EXPECT_NEAR(shade0, shade1, 2);
+  EXPECT_NEAR(double(compose0) / shade0, 2.0 / 5.0, 0.05);
+  EXPECT_NEAR(double(compose1) / shade1, 3.0 / 5.0, 0.05);
+  // The sustained tick lies right of the stack for the 20 ms level (7 ms of passes).
+  int tick_x = -1;
+  for (int x = 1100 - 290; x > 210; --x)
+    if (img.at(x, y0 - 13)[0] == 0 && img.at(x, y0 - 13)[1] == 0 && img.at(x, y0 - 13)[2] == 0) {
+      tick_x = x;
+      break;
+    }
+  EXPECT_GT(tick_x, 210 + (shade0 + compose0) * 2) << "the tick at 20 ms is beyond twice the 7 ms stack";
+}
+
 TEST(Report, CsvAndMarkdownHoldEveryEntry) {
   const perf::BenchResult r = constructed_result();
   const std::string csv = perf::bench_csv(r);

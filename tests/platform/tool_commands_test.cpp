@@ -84,6 +84,49 @@ TEST_F(ToolCommands, ReplaySideBySideHasFourLabelledPanels) {
   }
 }
 
+// replay --video: the composited frames as an animated PNG whose still image is frame 0; names
+// it cannot write are refused before anything runs.
+TEST_F(ToolCommands, ReplayVideoIsAClipOfTheComposites) {
+  test::TempDir dir("video");
+  const std::string out = dir.file("out"), clip = dir.file("clip.png");
+  const std::string replay = std::string("LP_NUM_THREADS=2 timeout 300 ") + MRGI_TOOL + " replay " + MRGI_SOURCE_DIR +
+                             "/data/sample --technique baseline --level last --frames 3 -q --out " + out;
+  ASSERT_EQ(run(replay + " --video " + clip + " > /dev/null 2> " + dir.file("err.txt")), 0) << slurp(dir.file("err.txt"));
+  auto still = load_png_rgb8(clip);
+  ASSERT_TRUE(still.ok()) << still.error().message;
+  auto frame0 = load_png_rgba8(out + "/frames/000000.png");
+  ASSERT_TRUE(frame0.ok());
+  ASSERT_EQ(still->width, frame0->width);
+  int wrong = 0;
+  for (int y = 0; y < still->height; ++y)
+    for (int x = 0; x < still->width; ++x)
+      for (int c = 0; c < 3; ++c) wrong += still->at(x, y)[c] != frame0->at(x, y)[c];
+  EXPECT_EQ(wrong, 0);
+  const std::string bytes = slurp(clip);
+  EXPECT_NE(bytes.find("acTL"), std::string::npos);
+  size_t fdat = 0;
+  for (size_t p = bytes.find("fdAT"); p != std::string::npos; p = bytes.find("fdAT", p + 4)) ++fdat;
+  EXPECT_GE(fdat, 2u) << "frames 1 and 2";
+
+  // Refused with exit 2 and nothing written: an unknown container, a clip inside --out.
+  const std::string out2 = dir.file("out2");
+  const std::string replay2 = std::string("timeout 60 ") + MRGI_TOOL + " replay " + MRGI_SOURCE_DIR +
+                              "/data/sample --frames 1 -q --out " + out2;
+  EXPECT_EQ(run(replay2 + " --video " + dir.file("clip.avi") + " > /dev/null 2> " + dir.file("e1.txt")), 2);
+  EXPECT_NE(slurp(dir.file("e1.txt")).find(".png or .apng"), std::string::npos) << slurp(dir.file("e1.txt"));
+  EXPECT_EQ(run(replay2 + " --video " + out2 + "/clip.png > /dev/null 2> " + dir.file("e2.txt")), 2);
+  EXPECT_NE(slurp(dir.file("e2.txt")).find("inside the --out folder"), std::string::npos) << slurp(dir.file("e2.txt"));
+  EXPECT_FALSE(std::filesystem::exists(out2));
+  if (run("command -v ffmpeg > /dev/null") != 0) {
+    EXPECT_EQ(run(replay2 + " --video " + dir.file("clip.mp4") + " > /dev/null 2> " + dir.file("e3.txt")), 2);
+    EXPECT_NE(slurp(dir.file("e3.txt")).find("Debian package ffmpeg"), std::string::npos) << slurp(dir.file("e3.txt"));
+  } else {  // with ffmpeg present the .mp4 is written
+    EXPECT_EQ(run(replay2 + " --video " + dir.file("clip.mp4") + " > /dev/null 2> " + dir.file("e3.txt")), 0)
+        << slurp(dir.file("e3.txt"));
+    EXPECT_GT(std::filesystem::file_size(dir.file("clip.mp4")), 1000u);
+  }
+}
+
 TEST_F(ToolCommands, LiveRendersEveryFrameOfTheOniWithTheDefaultObject) {
   MRGI_SKIP_WITHOUT_SHARED(kOni);
   test::TempDir dir("live");

@@ -14,6 +14,19 @@ struct Rgb {
   uint8_t r = 0, g = 0, b = 0;
 };
 
+// The plots' colours (matplotlib's tab10 order), for series told apart by colour.
+inline constexpr Rgb kPalette[] = {{31, 119, 180}, {255, 127, 14}, {44, 160, 44},  {214, 39, 40},
+                                   {148, 103, 189}, {140, 86, 75},  {227, 119, 194}, {127, 127, 127},
+                                   {188, 189, 34},  {23, 190, 207}};
+
+// An axis from 0 to a "nice" maximum above data_max (with 8 % room) in 4..8 ticks of step 1, 2
+// or 5 x 10^k; a tick's label with as many decimals as the step needs.
+struct PlotAxis {
+  double max = 1.0, step = 0.2;
+};
+PlotAxis nice_axis(double data_max);
+std::string tick_label(double v, double step);
+
 enum class Marker { Circle, Square, TriangleUp, Diamond, Plus, Cross, TriangleDown };
 
 class Canvas {

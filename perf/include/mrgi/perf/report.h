@@ -23,6 +23,9 @@ std::string bench_csv(const BenchResult& result);
 std::string report_markdown(const BenchResult& result, const CheckReport* check);
 // 960 x 640 plot of the suite aggregates (aggregate_levels), one colour and marker per technique.
 ImageRGB8 render_pareto_plot(const BenchResult& result);
+// 1100 x (bars) plot of each level's profiled passes, stacked, beside its sustained frame
+// (perf/src/pass_plot.cpp says what is drawn).
+ImageRGB8 render_pass_plot(const BenchResult& result);
 
 // Writes the four files. DIR must be absent, empty or an earlier bench output (has bench.json).
 Status write_bench_outputs(const std::string& dir, const BenchResult& result, const CheckReport* check);
