@@ -22,6 +22,7 @@ struct BenchOptions {
   perf::BenchSettings settings;
   std::string out, check, write_baseline;
   std::vector<std::string> sizes;  // --sizes WxH,...: one run per size and a scaling table
+  std::vector<std::string> knobs;  // --knob NAME=VALUE (one technique)
   bool quiet = false;
   int confirm = 1;  // re-runs of an entry whose only finding is its frame time, before failing
 };
@@ -71,6 +72,14 @@ void run_scaling(BenchOptions& o) {
 void run_bench_command(BenchOptions& o) {
   // Before any Vulkan instance exists: lavapipe reads it when the device is created.
   perf::ensure_lp_num_threads();
+  if (!o.knobs.empty()) {
+    if (o.settings.techniques.size() != 1)
+      throw CommandFailure(2, "--knob: name exactly one technique with --techniques (knobs are a technique's own)");
+    if (!o.check.empty() || !o.write_baseline.empty())
+      throw CommandFailure(2, "--knob cannot be combined with --check or --write-baseline (the baseline holds the "
+                              "ladder's own levels)");
+    o.settings.knobs = parse_knobs(o.settings.techniques.front(), o.knobs);
+  }
   if (!o.sizes.empty()) return run_scaling(o);
   std::optional<perf::Baseline> baseline;
   if (!o.check.empty()) baseline = take(perf::load_baseline(o.check));  // fail before hours of work
@@ -184,6 +193,9 @@ void setup(CLI::App& app) {
   cmd->add_flag("--no-residual-light", [opts](int64_t n) { opts->settings.residual_light = n == 0; },
                 "with declared lamps: light by the lamps alone, without the estimate of the real light they do not "
                 "explain (RuntimeSettings::residual_light; an ablation)");
+  cmd->add_option("--knob", opts->knobs,
+                  "set one quality knob of the (one) technique at every level, NAME=VALUE (repeatable; mrgi info "
+                  "--technique T lists them with their spans)");
   cmd->add_flag("--quiet,-q", opts->quiet, "no progress on stderr");
   cmd->callback([opts] { run_bench_command(*opts); });
 }

@@ -16,6 +16,7 @@ struct InfoOptions {
   std::string device;
   bool validate = false;
   std::string technique;
+  std::vector<std::string> knobs;
   std::string level = "0";
   int width = 640;
   int height = 480;
@@ -46,13 +47,16 @@ void run_info(const InfoOptions& o) {
   j["validation"] = o.validate;
 
   if (!o.technique.empty()) {
-    const std::vector<QualityLevelInfo> ladder = take(technique_ladder(o.technique));
+    const std::vector<KnobSetting> knobs = parse_knobs(o.technique, o.knobs);
+    const std::vector<QualityLevelInfo> ladder = take(technique_ladder(o.technique, knobs));
     nlohmann::json levels = nlohmann::json::array();
     for (size_t i = 0; i < ladder.size(); ++i) {
-      nlohmann::json knobs = nlohmann::json::array();
-      for (const QualityKnob& k : ladder[i].knobs) knobs.push_back({{"name", k.name}, {"value", k.value}, {"unit", k.unit}});
+      nlohmann::json knob_list = nlohmann::json::array();
+      for (const QualityKnob& k : ladder[i].knobs)
+        knob_list.push_back({{"name", k.name}, {"value", k.value}, {"unit", k.unit}, {"min", k.min}, {"max", k.max},
+                         {"power_of_two", k.power_of_two}});
       levels.push_back({{"index", i}, {"name", ladder[i].name}, {"internal_scale", ladder[i].internal_scale},
-                        {"mesh_error_px", ladder[i].mesh_error_px}, {"knobs", knobs}});
+                        {"mesh_error_px", ladder[i].mesh_error_px}, {"knobs", knob_list}});
     }
     j["ladder"] = {{"technique", o.technique}, {"levels", levels}};
     if (o.width <= 0 || o.height <= 0)
@@ -61,6 +65,7 @@ void run_info(const InfoOptions& o) {
     rs.device = ds;
     rs.technique = o.technique;
     rs.level = resolve_level(o.technique, o.level);
+    rs.knobs = knobs;
     rs.output_width = o.width;
     rs.output_height = o.height;
     CameraSetup cameras;
@@ -98,9 +103,16 @@ void run_info(const InfoOptions& o) {
       if (l["mesh_error_px"].get<double>() > 0.0)
         std::cout << ", mesh level of detail " << l["mesh_error_px"].get<double>() << " px";
       std::cout << "\n";
-      for (const auto& k : l["knobs"])
+      for (const auto& k : l["knobs"]) {
         std::cout << "      " << k["name"].get<std::string>() << " = " << k["value"].get<double>() << " ("
-                  << k["unit"].get<std::string>() << ")\n";
+                  << k["unit"].get<std::string>();
+        if (k["min"].get<double>() < k["max"].get<double>())
+          std::cout << "; --knob takes " << k["min"].get<double>() << ".." << k["max"].get<double>()
+                    << (k["power_of_two"].get<bool>() ? ", a power of two" : "");
+        else
+          std::cout << "; fixed";
+        std::cout << ")\n";
+      }
     }
   }
   if (j.contains("budget")) {
@@ -119,6 +131,8 @@ void setup(CLI::App& app) {
   cmd->add_option("--technique", opts->technique,
                   "also print this technique's quality ladder (every level's knobs with units) and its start-up "
                   "memory at --level");
+  cmd->add_option("--knob", opts->knobs,
+                  "set one quality knob at every level, NAME=VALUE (repeatable): the ladder and memory with it");
   cmd->add_option("--level", opts->level, "quality level: 0 = best, N, a level name, or 'last' = cheapest")->default_val("0");
   cmd->add_option("--width", opts->width, "output width in pixels")->default_val(640);
   cmd->add_option("--height", opts->height, "output height in pixels")->default_val(480);

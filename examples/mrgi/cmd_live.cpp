@@ -37,6 +37,7 @@ void on_sigint(int) { g_stop = true; }
 
 struct LiveOptions {
   std::string source, technique = "baseline", scene, out, level = "0", device, env, env_model;
+  std::vector<std::string> knobs;
   int frames = 0, timeout_ms = 3000;
   bool quiet = false;
 };
@@ -190,6 +191,7 @@ void run_live(const LiveOptions& o) {
   settings.device.device = o.device;
   settings.technique = o.technique;
   settings.level = level;
+  settings.knobs = parse_knobs(o.technique, o.knobs);
   settings.exposure = info.exposure;
   CameraSetup cameras{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera};
   auto runtime = take(create_runtime(settings, cameras, scene));
@@ -293,6 +295,7 @@ void setup(CLI::App& app) {
   cmd->add_option("--out,-o", o->out, "output folder (frames/, stats.json, summary.json, side_by_side.png); "
                                       "no preview window is implemented, so it is required")->required();
   cmd->add_option("--frames,-n", o->frames, "stop after N frames (0 = until the stream ends or Ctrl-C)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--knob", o->knobs, "set one quality knob at every level, NAME=VALUE (repeatable; mrgi info --technique T lists them with their spans)");
   cmd->add_option("--level,-l", o->level, "quality level: 0 = best, N, a level name, or 'last' = cheapest")->capture_default_str();
   cmd->add_option("--device", o->device, "Vulkan device: index or name part");
   cmd->add_option("--env", o->env, "fisheye environment camera, v4l2:/dev/videoN or libcamera:ID (needs a calibrated model)");

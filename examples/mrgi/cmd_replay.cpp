@@ -48,6 +48,7 @@ struct ReplayOptions {
   std::string capture, technique = "baseline", out, level = "0", device, light = "declared", video;
   std::vector<std::string> dlpv_ablation;
   std::vector<std::string> dir_ablation;
+  std::vector<std::string> knobs;
   int frames = 0, width = 0, height = 0;
   bool validate = false, quiet = false, vulkan_1_2 = false, no_residual_light = false;
 };
@@ -69,6 +70,7 @@ void run_replay(const ReplayOptions& o) {
   settings.residual_light = !o.no_residual_light;
   settings.technique = o.technique;
   settings.level = level;
+  settings.knobs = parse_knobs(o.technique, o.knobs);
   settings.output_width = o.width;
   settings.output_height = o.height;
   settings.exposure = info.exposure;
@@ -224,6 +226,7 @@ void setup(CLI::App& app) {
   cmd->add_option("--out,-o", opts->out, "output folder (frames/, stats.json, summary.json, side_by_side.png)")->required();
   cmd->add_option("--level,-l", opts->level, "quality level: 0 = best, N, a level name, or 'last' = cheapest")->capture_default_str();
   cmd->add_option("--frames,-n", opts->frames, "replay at most N frames (0 = all)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--knob", opts->knobs, "set one quality knob at every level, NAME=VALUE (repeatable; mrgi info --technique T lists them with their spans)");
   cmd->add_option("--video", opts->video,
                   "also write the composited frames as a clip: FILE.png (animated PNG, lossless) or "
                   "FILE.mp4/.mkv/.webm (needs ffmpeg on PATH), at the capture's frame rate");

@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "mrgi/expected.h"
+#include "mrgi/runtime.h"
 
 namespace mrgi::tool {
 
@@ -45,6 +46,10 @@ T take(Expected<T>&& e) {
 // A --level value for `technique`: a number (0 = best), a level name ("fast"), or "last" (the
 // cheapest). Anything else ends the command with exit 2 and the list of levels.
 int resolve_level(const std::string& technique, const std::string& level);
+
+// --knob NAME=VALUE settings (RuntimeSettings::knobs) for `technique`, checked against its
+// ladder; a malformed or refused one ends the command with exit 2 and the knob's span.
+std::vector<KnobSetting> parse_knobs(const std::string& technique, const std::vector<std::string>& given);
 
 // Progress on stderr for long work (one line, rewritten in place when stderr is a terminal).
 void progress(const std::string& what, size_t done, size_t total, double elapsed_s);

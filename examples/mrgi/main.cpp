@@ -57,6 +57,22 @@ int resolve_level(const std::string& technique, const std::string& level) {
   return int(n);
 }
 
+std::vector<KnobSetting> parse_knobs(const std::string& technique, const std::vector<std::string>& given) {
+  std::vector<KnobSetting> knobs;
+  for (const std::string& g : given) {
+    const size_t eq = g.find('=');
+    char* end = nullptr;
+    const double v = eq == std::string::npos ? 0.0 : std::strtod(g.c_str() + eq + 1, &end);
+    if (eq == std::string::npos || eq == 0 || eq + 1 == g.size() || *end != '\0')
+      throw CommandFailure(2, "--knob '" + g + "': expected NAME=VALUE, e.g. --knob vpls=128 (mrgi info --technique " +
+                                  technique + " lists the knobs)");
+    knobs.push_back({g.substr(0, eq), v});
+  }
+  // Refused here, before a capture is opened or a device started, with the knob's span.
+  take(technique_ladder(technique, knobs));
+  return knobs;
+}
+
 void progress(const std::string& what, size_t done, size_t total, double elapsed_s) {
   const double eta = done > 0 ? elapsed_s / double(done) * double(total - done) : 0.0;
   const bool tty = isatty(STDERR_FILENO);

@@ -189,6 +189,7 @@ Expected<RunSamples> run_one(const LoadedScene& l, const std::string& technique,
   RuntimeSettings rs;
   rs.device = s.device;
   rs.residual_light = s.residual_light;
+  rs.knobs = s.knobs;
   rs.frames_in_flight = s.frames_in_flight;
   rs.technique = technique;
   rs.level = level;

@@ -127,6 +127,31 @@ TEST_F(ToolCommands, ReplayVideoIsAClipOfTheComposites) {
   }
 }
 
+// --knob: info prints the ladder with the knob set at every level; replay refuses a knob outside
+// its span with exit 2 before opening anything.
+TEST_F(ToolCommands, KnobsAreSetOneByOneAndRefusedOutsideTheirSpan) {
+  test::TempDir dir("knob");
+  ASSERT_EQ(run(std::string("timeout 60 ") + MRGI_TOOL + " info --technique dir --knob vpls=64 --knob bounce_vpls=8 --json > " +
+                dir.file("info.json") + " 2> " + dir.file("err.txt")),
+            0)
+      << slurp(dir.file("err.txt"));
+  const auto j = nlohmann::json::parse(slurp(dir.file("info.json")));
+  for (const auto& level : j["ladder"]["levels"])
+    for (const auto& k : level["knobs"]) {
+      if (k["name"] == "vpls") EXPECT_EQ(k["value"].get<double>(), 64.0);
+      if (k["name"] == "bounce_vpls") EXPECT_EQ(k["value"].get<double>(), 8.0);
+    }
+  EXPECT_EQ(run(std::string("timeout 60 ") + MRGI_TOOL + " replay " + MRGI_SOURCE_DIR + "/data/sample -t dir --knob vpls=4096 -q --out " +
+                dir.file("out") + " > /dev/null 2> " + dir.file("err2.txt")),
+            2);
+  EXPECT_NE(slurp(dir.file("err2.txt")).find("outside 16..256"), std::string::npos) << slurp(dir.file("err2.txt"));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("out")));
+  EXPECT_EQ(run(std::string("timeout 60 ") + MRGI_TOOL + " replay " + MRGI_SOURCE_DIR + "/data/sample -t dir --knob vpls -q --out " +
+                dir.file("out") + " > /dev/null 2> " + dir.file("err3.txt")),
+            2);
+  EXPECT_NE(slurp(dir.file("err3.txt")).find("NAME=VALUE"), std::string::npos) << slurp(dir.file("err3.txt"));
+}
+
 TEST_F(ToolCommands, LiveRendersEveryFrameOfTheOniWithTheDefaultObject) {
   MRGI_SKIP_WITHOUT_SHARED(kOni);
   test::TempDir dir("live");

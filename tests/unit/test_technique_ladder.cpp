@@ -21,6 +21,9 @@ TEST(TechniqueLadder, EveryTechniqueListsItsLevelsWithUnits) {
       for (const mrgi::QualityKnob& k : l.knobs) {
         EXPECT_FALSE(k.name.empty()) << name << " " << l.name;
         EXPECT_FALSE(k.unit.empty()) << name << " " << l.name << " " << k.name;
+        // The span a knob may be set in is the ladder's own: every level's value lies in it.
+        EXPECT_LE(k.min, k.value) << name << " " << l.name << " " << k.name;
+        EXPECT_GE(k.max, k.value) << name << " " << l.name << " " << k.name;
       }
     }
   }

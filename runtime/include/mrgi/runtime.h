@@ -94,11 +94,24 @@ struct DirAblation {
   }
 };
 
+// One quality knob set by name (technique_ladder lists a technique's knobs, units and spans).
+struct KnobSetting {
+  std::string name;   // e.g. "vpls"
+  double value = 0.0;
+};
+
 // Level "last" in the CLI resolves to technique_level_count(name) - 1.
 struct RuntimeSettings {
   DeviceSettings device;
   std::string technique = "baseline";  // baseline | ssrt | dlpv | dir (later: dvct, specular)
   int level = 0;                       // 0 = the technique's best quality
+  // Quality knobs set one by one (`--knob NAME=VALUE`): each pins that knob of the technique at
+  // every level of its ladder, from start-up (allocations follow the set ladder; a knob does not
+  // change at run time, the level does: Runtime::set_level). A knob takes values in the span its
+  // technique's ladder covers (QualityKnob::min..max; a power of two where it says so): the
+  // values the technique is built and tested for. create_runtime refuses (BadUsage naming the
+  // knob and its span) a knob the technique does not have or a value outside its span.
+  std::vector<KnobSetting> knobs;
   int output_width = 0;                // 0 = the colour camera's width
   int output_height = 0;
   // Camera exposure (linear radiance -> linear camera value) for albedo and the tone curve;
@@ -259,6 +272,8 @@ struct QualityKnob {
   std::string name;
   double value = 0.0;
   std::string unit;
+  double min = 0.0, max = 0.0;   // what RuntimeSettings::knobs may set it to
+  bool power_of_two = false;
 };
 struct QualityLevelInfo {
   std::string name;
@@ -267,7 +282,9 @@ struct QualityLevelInfo {
   std::vector<QualityKnob> knobs;
 };
 // A technique's ladder, best level first (the levels RuntimeSettings::level and
-// Runtime::set_level index). NotFound for an unknown technique.
-Expected<std::vector<QualityLevelInfo>> technique_ladder(const std::string& technique);
+// Runtime::set_level index), with `knobs` applied as RuntimeSettings::knobs would. NotFound for
+// an unknown technique, BadUsage for a knob it refuses.
+Expected<std::vector<QualityLevelInfo>> technique_ladder(const std::string& technique,
+                                                         const std::vector<KnobSetting>& knobs = {});
 
 }  // namespace mrgi

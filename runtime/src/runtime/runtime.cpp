@@ -150,7 +150,9 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   scene_ = scene;
   auto entry = technique::find_technique(settings.technique);
   if (!entry) return entry.error();
-  const std::vector<technique::QualityLevel> ladder = (*entry)->ladder();
+  auto ladder_or = (*entry)->ladder(settings.knobs);
+  if (!ladder_or) return ladder_or.error();
+  const std::vector<technique::QualityLevel> ladder = std::move(*ladder_or);
   if (settings.level < 0 || settings.level >= int(ladder.size()))
     return fail(ErrorKind::BadUsage, "RuntimeSettings.level " + std::to_string(settings.level) +
                                          ": technique '" + settings.technique + "' has levels 0.." +
@@ -240,6 +242,7 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
 
   technique::SharedResources shared;
   shared.context = context_.get();
+  shared.knobs = settings.knobs;
   shared.dlpv_ablation = settings.dlpv_ablation;
   shared.dir_ablation = settings.dir_ablation;
   shared.graph = graph_.get();
@@ -612,13 +615,16 @@ std::vector<std::string> technique_names() {
   return names;
 }
 
-Expected<std::vector<QualityLevelInfo>> technique_ladder(const std::string& technique) {
+Expected<std::vector<QualityLevelInfo>> technique_ladder(const std::string& technique,
+                                                         const std::vector<KnobSetting>& knobs) {
   auto entry = technique::find_technique(technique);
   if (!entry) return entry.error();
+  auto ladder = (*entry)->ladder(knobs);
+  if (!ladder) return ladder.error();
   std::vector<QualityLevelInfo> out;
-  for (const auto& l : (*entry)->ladder()) {
+  for (const auto& l : *ladder) {
     QualityLevelInfo info{l.name, l.internal_scale, l.mesh_error_px, {}};
-    for (const auto& k : l.knobs) info.knobs.push_back({k.name, k.value, k.unit});
+    for (const auto& k : l.knobs) info.knobs.push_back({k.name, k.value, k.unit, k.min, k.max, k.power_of_two});
     out.push_back(std::move(info));
   }
   return out;
@@ -628,7 +634,9 @@ Expected<std::vector<std::string>> technique_levels(const std::string& technique
   auto entry = technique::find_technique(technique);
   if (!entry) return entry.error();
   std::vector<std::string> names;
-  for (const auto& l : (*entry)->ladder()) names.push_back(l.name);
+  auto ladder = (*entry)->ladder({});
+  if (!ladder) return ladder.error();
+  for (const auto& l : *ladder) names.push_back(l.name);
   return names;
 }
 

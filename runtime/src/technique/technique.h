@@ -36,6 +36,9 @@ struct Knob {
   std::string name;   // e.g. "shadow_map_size"
   double value = 0.0;
   std::string unit;   // e.g. "texels per side", "fraction of output width and height"
+  // What RuntimeSettings::knobs may set it to (technique/knobs.h): the ladder's span.
+  double min = 0.0, max = 0.0;
+  bool power_of_two = false;
 };
 
 struct QualityLevel {
@@ -58,6 +61,9 @@ struct SharedResources {
   gpu::Context* context = nullptr;
   DlpvAblation dlpv_ablation;  // RuntimeSettings::dlpv_ablation
   DirAblation dir_ablation;    // RuntimeSettings::dir_ablation
+  // RuntimeSettings::knobs: the technique's create() applies them to its ladder (knobs.h); a
+  // technique that makes another for a part of its frame (dir's baseline) hands on none.
+  std::vector<KnobSetting> knobs;
   gpu::FrameGraph* graph = nullptr;
   const SceneDesc* scene = nullptr;
   const SceneGpu* scene_gpu = nullptr;     // uploaded virtual meshes and real proxies
@@ -182,7 +188,8 @@ class Technique {
 };
 
 using TechniqueFactory = Expected<std::unique_ptr<Technique>> (*)(const SharedResources&);
-using LadderFn = std::vector<QualityLevel> (*)();
+// The ladder with RuntimeSettings::knobs applied (BadUsage for a knob it refuses).
+using LadderFn = Expected<std::vector<QualityLevel>> (*)(const std::vector<KnobSetting>& knobs);
 
 struct TechniqueEntry {
   const char* name;

@@ -47,6 +47,7 @@ struct BenchSettings {
   int floor_warmup = 3;                  // unmeasured floor frames per scene
   DeviceSettings device;
   bool residual_light = true;            // RuntimeSettings::residual_light
+  std::vector<KnobSetting> knobs;        // RuntimeSettings::knobs (one technique only)
   ProgressFn progress;                   // optional
 };
 

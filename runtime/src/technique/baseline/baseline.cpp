@@ -7,6 +7,7 @@
 #include <string>
 
 #include "gpu/pipelines.h"
+#include "technique/knobs.h"
 #include "gpu/shaders.h"
 #include "gpu/vk_check.h"
 #include "light/light_stage.h"
@@ -54,9 +55,22 @@ struct ShadePush {
   VolumeBounce::Constants volume;  // shade_direct.comp's VolumeConstants (kVolumeBounce only)
 };
 
+const KnobField<BaselineLevel> kBaselineKnobs[] = {
+    {"shadow_map_size", "texels per side of each map face", &BaselineLevel::shadow_map_size, true},
+    {"internal_scale", "fraction of the output width and height", &BaselineLevel::internal_scale},
+    {"pcf_radius", "compare taps on each side of the centre tap", &BaselineLevel::pcf_radius},
+    {"caster_cell_shadow_texels", "shadow texels a real caster grid cell spans across the G-buffer's larger side",
+     &BaselineLevel::caster_cell_shadow_texels},
+    {"shadowed_estimated_lights",
+     "of the light stage's estimated lights (environment regions, the probeless dominant light), strongest first, "
+     "how many get shadow maps; the rest light as SH ambient",
+     &BaselineLevel::shadowed_estimated_lights},
+};
+
 class Baseline final : public Technique {
  public:
-  explicit Baseline(const SharedResources& shared) : shared_(shared), ladder_(baseline_ladder()) {}
+  Baseline(const SharedResources& shared, std::vector<BaselineLevel> levels)
+      : shared_(shared), ladder_(ladder_of(levels, baseline_levels(), kBaselineKnobs)), levels_(std::move(levels)) {}
   const std::string& name() const override { return name_; }
   const std::vector<QualityLevel>& levels() const override { return ladder_; }
   Status init();
@@ -72,6 +86,7 @@ class Baseline final : public Technique {
   std::string name_ = "baseline";
   SharedResources shared_;
   std::vector<QualityLevel> ladder_;
+  std::vector<BaselineLevel> levels_;  // baseline_levels() with RuntimeSettings::knobs applied
   // Re-plans the shadow maps when the light stage's lights or the level's number of shadowed
   // estimated lights changed; writes this slot's lights.
   Status update_lights(int shadowed_estimated);
@@ -253,7 +268,7 @@ Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped
   if (info.level < 0 || info.level >= int(ladder_.size()))
     return fail(ErrorKind::BadUsage, "baseline: level " + std::to_string(info.level) +
                                          " outside 0.." + std::to_string(ladder_.size() - 1));
-  const BaselineLevel& level = baseline_levels()[size_t(info.level)];
+  const BaselineLevel& level = levels_[size_t(info.level)];
   shadow_size_ = level.shadow_map_size;
   pcf_radius_ = level.pcf_radius;
   gpu::FrameGraph& graph = *shared_.graph;
@@ -472,27 +487,20 @@ const std::array<BaselineLevel, 4>& baseline_levels() {
   return levels;
 }
 
-std::vector<QualityLevel> baseline_ladder() {
-  std::vector<QualityLevel> out;
-  for (const BaselineLevel& b : baseline_levels()) {
-    QualityLevel l;
-    l.name = b.name;
-    l.internal_scale = b.internal_scale;
-    l.knobs = {{"shadow_map_size", double(b.shadow_map_size), "texels per side of each map face"},
-               {"internal_scale", double(b.internal_scale), "fraction of the output width and height"},
-               {"pcf_radius", double(b.pcf_radius), "compare taps on each side of the centre tap"},
-               {"caster_cell_shadow_texels", b.caster_cell_shadow_texels,
-                "shadow texels a real caster grid cell spans across the G-buffer's larger side"},
-               {"shadowed_estimated_lights", double(b.shadowed_estimated_lights),
-                "of the light stage's estimated lights (environment regions, the probeless dominant "
-                "light), strongest first, how many get shadow maps; the rest light as SH ambient"}};
-    out.push_back(l);
-  }
-  return out;
+Expected<std::vector<BaselineLevel>> baseline_levels(const std::vector<KnobSetting>& knobs) {
+  return apply_knobs<BaselineLevel>("baseline", baseline_levels(), kBaselineKnobs, knobs);
+}
+
+Expected<std::vector<QualityLevel>> baseline_ladder(const std::vector<KnobSetting>& knobs) {
+  auto levels = baseline_levels(knobs);
+  if (!levels) return levels.error();
+  return ladder_of(*levels, baseline_levels(), kBaselineKnobs);
 }
 
 Expected<std::unique_ptr<Technique>> create_baseline(const SharedResources& shared) {
-  auto t = std::make_unique<Baseline>(shared);
+  auto levels = baseline_levels(shared.knobs);
+  if (!levels) return levels.error();
+  auto t = std::make_unique<Baseline>(shared, std::move(*levels));
   MRGI_TRY(t->init());
   return std::unique_ptr<Technique>(std::move(t));
 }

@@ -44,9 +44,10 @@ struct BaselineLevel {
   // 75 ms against 49 and 25 with none).
   int shadowed_estimated_lights;
 };
-const std::array<BaselineLevel, 4>& baseline_levels();
-
-std::vector<QualityLevel> baseline_ladder();
+const std::array<BaselineLevel, 4>& baseline_levels();  // the defaults
+// The defaults with RuntimeSettings::knobs applied (technique/knobs.h; BadUsage for a refused one).
+Expected<std::vector<BaselineLevel>> baseline_levels(const std::vector<KnobSetting>& knobs);
+Expected<std::vector<QualityLevel>> baseline_ladder(const std::vector<KnobSetting>& knobs);
 
 // The bounce light of dlpv's volumes, added in baseline's shading pass
 // (shaders/baseline/shade_direct.comp, kVolumeBounce) instead of a pass of its own.

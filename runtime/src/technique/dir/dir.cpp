@@ -15,6 +15,7 @@
 #include "light/light_stage.h"
 #include "technique/baseline/baseline.h"
 #include "technique/input_reuse.h"
+#include "technique/knobs.h"
 #include "technique/scene_gpu.h"
 
 namespace mrgi::technique {
@@ -30,29 +31,40 @@ const std::array<DirLevel, 5>& dir_levels() {
   return levels;
 }
 
-std::vector<QualityLevel> dir_ladder() {
-  std::vector<QualityLevel> out;
-  for (const DirLevel& l : dir_levels()) {
-    QualityLevel q;
-    q.name = l.name;
-    q.internal_scale = l.internal_scale;
-    q.mesh_error_px = l.mesh_error_px;
-    q.knobs = {{"vpls", double(l.vpls), "virtual point lights"},
-               {"bounce_vpls", double(l.bounce_vpls), "of them, the bounce light source's (0: one bounce)"},
-               {"env_vpls", double(l.env_vpls), "of them, at most this many environment regions' (directional VPLs)"},
-               {"ism_size", double(l.ism_size), "texels per side of each VPL's imperfect shadow maps"},
-               {"points_per_vpl", double(l.points_per_vpl), "points splatted into each of a VPL's two maps"},
-               {"rsm_size", double(l.rsm_size), "texels per side of each reflective shadow map"},
-               {"rsm_lamps", double(l.rsm_lamps), "lamps, strongest first, whose maps spawn VPLs"},
-               {"interleave", double(l.interleave), "side of the interleaved-sampling block (pixels)"},
-               {"indirect_divisor", double(l.indirect_divisor), "G-buffer pixels per side of an indirect-light texel"},
-               {"internal_scale", double(l.internal_scale), "fraction of the output width and height"},
-               {"mesh_error_px", double(l.mesh_error_px), "largest projected error of the virtual meshes' level of detail (internal pixels)"},
-               {"shadowed_env", double(l.shadowed_env), "environment regions baseline shadows with maps (-1: its level's)"},
-               {"baseline_level", double(l.baseline_level), "baseline's level for the direct light"}};
-    out.push_back(q);
-  }
-  return out;
+namespace {
+const KnobField<DirLevel> kDirKnobs[] = {
+    {"vpls", "virtual point lights", &DirLevel::vpls},
+    {"bounce_vpls", "of them, the bounce light source's (0: one bounce)", &DirLevel::bounce_vpls},
+    {"env_vpls", "of them, at most this many environment regions' (directional VPLs)", &DirLevel::env_vpls},
+    {"ism_size", "texels per side of each VPL's imperfect shadow maps", &DirLevel::ism_size, true},
+    {"points_per_vpl", "points splatted into each of a VPL's two maps", &DirLevel::points_per_vpl},
+    {"rsm_size", "texels per side of each reflective shadow map", &DirLevel::rsm_size, true},
+    {"rsm_lamps", "lamps, strongest first, whose maps spawn VPLs", &DirLevel::rsm_lamps},
+    {"interleave", "side of the interleaved-sampling block (pixels)", &DirLevel::interleave},
+    {"indirect_divisor", "G-buffer pixels per side of an indirect-light texel", &DirLevel::indirect_divisor, true},
+    {"internal_scale", "fraction of the output width and height", &DirLevel::internal_scale},
+    {"mesh_error_px", "largest projected error of the virtual meshes' level of detail (internal pixels)",
+     &DirLevel::mesh_error_px},
+    {"shadowed_env", "environment regions baseline shadows with maps (-1: its level's)", &DirLevel::shadowed_env},
+    {"baseline_level", "baseline's level for the direct light", &DirLevel::baseline_level},
+};
+}  // namespace
+
+Expected<std::vector<DirLevel>> dir_levels(const std::vector<KnobSetting>& knobs) {
+  auto levels = apply_knobs<DirLevel>("dir", dir_levels(), kDirKnobs, knobs);
+  if (!levels) return levels;
+  for (const DirLevel& l : *levels)
+    if (l.bounce_vpls >= l.vpls)  // the lamps keep at least one slot
+      return fail(ErrorKind::BadUsage, std::string("dir level ") + l.name + ": bounce_vpls " +
+                                           std::to_string(l.bounce_vpls) + " must be below vpls " +
+                                           std::to_string(l.vpls) + " (the lamps keep at least one VPL)");
+  return levels;
+}
+
+Expected<std::vector<QualityLevel>> dir_ladder(const std::vector<KnobSetting>& knobs) {
+  auto levels = dir_levels(knobs);
+  if (!levels) return levels.error();
+  return ladder_of(*levels, dir_levels(), kDirKnobs);
 }
 
 namespace {
@@ -91,7 +103,8 @@ struct TemporalPush {
 
 class Dir final : public Technique {
  public:
-  explicit Dir(const SharedResources& shared) : shared_(shared), ladder_(dir_ladder()) {}
+  Dir(const SharedResources& shared, std::vector<DirLevel> levels)
+      : shared_(shared), ladder_(ladder_of(levels, dir_levels(), kDirKnobs)), levels_(std::move(levels)) {}
   const std::string& name() const override { return name_; }
   const std::vector<QualityLevel>& levels() const override { return ladder_; }
   Status init();
@@ -101,6 +114,7 @@ class Dir final : public Technique {
   std::string name_ = "dir";
   SharedResources shared_;
   std::vector<QualityLevel> ladder_;
+  std::vector<DirLevel> levels_;  // dir_levels() with RuntimeSettings::knobs applied
   std::optional<gi::ReflectiveShadowMaps> rsm_;
   std::optional<gi::VplSampler> vpls_;
   std::optional<gi::ImperfectShadowMaps> ism_;
@@ -145,7 +159,7 @@ Status Dir::init() {
   if (!shared_.light_stage) return fail(ErrorKind::Internal, "dir: no light stage");
   has_virtual_ = !sg.virtual_objects.empty();
   uint32_t top_vpls = 1, top_ism = 8, top_rsm = 16, top_lamps = 1, top_bounce = 0;
-  for (const DirLevel& l : dir_levels()) {
+  for (const DirLevel& l : levels_) {
     top_vpls = std::max(top_vpls, l.vpls);
     top_bounce = std::max(top_bounce, l.bounce_vpls);
     top_ism = std::max(top_ism, l.ism_size);
@@ -239,17 +253,19 @@ Status Dir::init() {
     *out = std::move(*p);
   }
   reuse_.reserve(size_t(shared_.depth_intrinsics.width) * size_t(shared_.depth_intrinsics.height), shared_.depth_scale);
-  auto base = create_baseline(shared_);
+  SharedResources for_baseline = shared_;
+  for_baseline.knobs.clear();  // dir's knobs (baseline_level picks baseline's level)
+  auto base = create_baseline(for_baseline);
   if (!base) return base.error();
   baseline_ = std::move(*base);
   return ok_status();
 }
 
 Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
-  if (info.level < 0 || info.level >= int(dir_levels().size()))
+  if (info.level < 0 || info.level >= int(levels_.size()))
     return fail(ErrorKind::BadUsage, "dir: level " + std::to_string(info.level) + " outside 0.." +
-                                         std::to_string(dir_levels().size() - 1));
-  const DirLevel& level = dir_levels()[size_t(info.level)];
+                                         std::to_string(levels_.size() - 1));
+  const DirLevel& level = levels_[size_t(info.level)];
   gpu::FrameGraph& graph = *shared_.graph;
   const light::Lighting& lighting = shared_.light_stage->lighting();
   if (!glossy_)
@@ -475,7 +491,9 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
 }  // namespace
 
 Expected<std::unique_ptr<Technique>> create_dir(const SharedResources& shared) {
-  auto t = std::make_unique<Dir>(shared);
+  auto levels = dir_levels(shared.knobs);
+  if (!levels) return levels.error();
+  auto t = std::make_unique<Dir>(shared, std::move(*levels));
   MRGI_TRY(t->init());
   return std::unique_ptr<Technique>(std::move(t));
 }

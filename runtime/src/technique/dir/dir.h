@@ -120,9 +120,10 @@ struct DirLevel {
   int shadowed_env;         // environment regions baseline shadows with maps (-1: its level's)
   int baseline_level;       // baseline's level for the direct light
 };
-const std::array<DirLevel, 5>& dir_levels();
-
-std::vector<QualityLevel> dir_ladder();
+const std::array<DirLevel, 5>& dir_levels();  // the defaults
+// The defaults with RuntimeSettings::knobs applied (technique/knobs.h; BadUsage for a refused one).
+Expected<std::vector<DirLevel>> dir_levels(const std::vector<KnobSetting>& knobs);
+Expected<std::vector<QualityLevel>> dir_ladder(const std::vector<KnobSetting>& knobs);
 Expected<std::unique_ptr<Technique>> create_dir(const SharedResources& shared);
 
 }  // namespace mrgi::technique

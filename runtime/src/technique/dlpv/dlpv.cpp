@@ -12,6 +12,7 @@
 #include "light/light_stage.h"
 #include "technique/baseline/baseline.h"
 #include "technique/input_reuse.h"
+#include "technique/knobs.h"
 #include "technique/scene_gpu.h"
 
 namespace mrgi::technique {
@@ -27,24 +28,28 @@ const std::array<DlpvLevel, 5>& dlpv_levels() {
   return levels;
 }
 
-std::vector<QualityLevel> dlpv_ladder() {
-  std::vector<QualityLevel> out;
-  for (const DlpvLevel& l : dlpv_levels()) {
-    QualityLevel q;
-    q.name = l.name;
-    q.internal_scale = l.internal_scale;
-    q.knobs = {{"volume_cells", double(l.volume_cells), "cells per side of each volume"},
-               {"steps", double(l.steps), "propagation steps"},
-               {"rsm_size", double(l.rsm_size), "texels per side of each reflective shadow map"},
-               {"rsm_lamps", double(l.rsm_lamps), "real lamps, strongest first, with a map pair"},
-               {"rho_volume", l.rho_volume ? 1.0 : 0.0, "1: V^rho propagated for the virtual pixels"},
-               {"internal_scale", double(l.internal_scale), "fraction of the output width and height"},
-               {"antiradiance_shadows", l.antiradiance_shadows ? 1.0 : 0.0,
-                "1: shadows as the volume's antiradiance (Algorithm 1); 0: baseline's shadow maps"},
-               {"baseline_level", double(l.baseline_level), "baseline's level for the shadow maps"}};
-    out.push_back(q);
-  }
-  return out;
+namespace {
+const KnobField<DlpvLevel> kDlpvKnobs[] = {
+    {"volume_cells", "cells per side of each volume", &DlpvLevel::volume_cells, true},
+    {"steps", "propagation steps", &DlpvLevel::steps},
+    {"rsm_size", "texels per side of each reflective shadow map", &DlpvLevel::rsm_size, true},
+    {"rsm_lamps", "real lamps, strongest first, with a map pair", &DlpvLevel::rsm_lamps},
+    {"rho_volume", "1: V^rho propagated for the virtual pixels", &DlpvLevel::rho_volume},
+    {"internal_scale", "fraction of the output width and height", &DlpvLevel::internal_scale},
+    {"antiradiance_shadows", "1: shadows as the volume's antiradiance (Algorithm 1); 0: baseline's shadow maps",
+     &DlpvLevel::antiradiance_shadows},
+    {"baseline_level", "baseline's level for the shadow maps", &DlpvLevel::baseline_level},
+};
+}  // namespace
+
+Expected<std::vector<DlpvLevel>> dlpv_levels(const std::vector<KnobSetting>& knobs) {
+  return apply_knobs<DlpvLevel>("dlpv", dlpv_levels(), kDlpvKnobs, knobs);
+}
+
+Expected<std::vector<QualityLevel>> dlpv_ladder(const std::vector<KnobSetting>& knobs) {
+  auto levels = dlpv_levels(knobs);
+  if (!levels) return levels.error();
+  return ladder_of(*levels, dlpv_levels(), kDlpvKnobs);
 }
 
 namespace {
@@ -60,7 +65,8 @@ constexpr float kMinVolumeSide = 0.25f;
 
 class Dlpv final : public Technique {
  public:
-  explicit Dlpv(const SharedResources& shared) : shared_(shared), ladder_(dlpv_ladder()) {}
+  Dlpv(const SharedResources& shared, std::vector<DlpvLevel> levels)
+      : shared_(shared), ladder_(ladder_of(levels, dlpv_levels(), kDlpvKnobs)), levels_(std::move(levels)) {}
   const std::string& name() const override { return name_; }
   const std::vector<QualityLevel>& levels() const override { return ladder_; }
   Status init();
@@ -72,6 +78,7 @@ class Dlpv final : public Technique {
   std::string name_ = "dlpv";
   SharedResources shared_;
   std::vector<QualityLevel> ladder_;
+  std::vector<DlpvLevel> levels_;  // dlpv_levels() with RuntimeSettings::knobs applied
   gpu::BufferHandle lights_;  // shader::LightSet, one per frame slot
   std::optional<gi::ReflectiveShadowMaps> rsm_;
   std::optional<gi::LightPropagationVolume> delta_, rho_;
@@ -99,7 +106,7 @@ Status Dlpv::init() {
     const glm::vec3 size = sg.virtual_objects.bounds_max - sg.virtual_objects.bounds_min;
     centre_ = 0.5f * (sg.virtual_objects.bounds_max + sg.virtual_objects.bounds_min);
     side_ = std::max(kMinVolumeSide, 2.0f * std::max({size.x, size.y, size.z}));
-    for (const DlpvLevel& l : dlpv_levels()) {
+    for (const DlpvLevel& l : levels_) {
       top_cells = std::max(top_cells, l.volume_cells);
       top_rsm = std::max(top_rsm, l.rsm_size);
     }
@@ -139,7 +146,9 @@ Status Dlpv::init() {
   if (!merge) return merge.error();
   merge_ = std::move(*merge);
   reuse_.reserve(size_t(shared_.depth_intrinsics.width) * size_t(shared_.depth_intrinsics.height), shared_.depth_scale);
-  auto base = create_baseline(shared_);
+  SharedResources for_baseline = shared_;
+  for_baseline.knobs.clear();  // dlpv's knobs (baseline_level picks baseline's level)
+  auto base = create_baseline(for_baseline);
   if (!base) return base.error();
   baseline_ = std::move(*base);
   return ok_status();
@@ -173,10 +182,10 @@ void Dlpv::write_lights() {
 }
 
 Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
-  if (info.level < 0 || info.level >= int(dlpv_levels().size()))
+  if (info.level < 0 || info.level >= int(levels_.size()))
     return fail(ErrorKind::BadUsage, "dlpv: level " + std::to_string(info.level) + " outside 0.." +
-                                         std::to_string(dlpv_levels().size() - 1));
-  const DlpvLevel& level = dlpv_levels()[size_t(info.level)];
+                                         std::to_string(levels_.size() - 1));
+  const DlpvLevel& level = levels_[size_t(info.level)];
   gpu::FrameGraph& graph = *shared_.graph;
   const bool antiradiance = level.antiradiance_shadows;
   const bool two = mu_.has_value();  // DlpvAblation::two_volumes
@@ -332,7 +341,9 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
 }  // namespace
 
 Expected<std::unique_ptr<Technique>> create_dlpv(const SharedResources& shared) {
-  auto t = std::make_unique<Dlpv>(shared);
+  auto levels = dlpv_levels(shared.knobs);
+  if (!levels) return levels.error();
+  auto t = std::make_unique<Dlpv>(shared, std::move(*levels));
   MRGI_TRY(t->init());
   return std::unique_ptr<Technique>(std::move(t));
 }

@@ -83,9 +83,10 @@ struct DlpvLevel {
   bool antiradiance_shadows;
   int baseline_level;      // baseline's level for the shadow maps (when not antiradiance)
 };
-const std::array<DlpvLevel, 5>& dlpv_levels();
-
-std::vector<QualityLevel> dlpv_ladder();
+const std::array<DlpvLevel, 5>& dlpv_levels();  // the defaults
+// The defaults with RuntimeSettings::knobs applied (technique/knobs.h; BadUsage for a refused one).
+Expected<std::vector<DlpvLevel>> dlpv_levels(const std::vector<KnobSetting>& knobs);
+Expected<std::vector<QualityLevel>> dlpv_ladder(const std::vector<KnobSetting>& knobs);
 Expected<std::unique_ptr<Technique>> create_dlpv(const SharedResources& shared);
 
 }  // namespace mrgi::technique

@@ -250,7 +250,7 @@ Status Ssrt::record_geometry(const FrameInfo& info, std::vector<std::string>& sk
   if (info.level < 0 || info.level >= int(ladder_.size()))
     return fail(ErrorKind::BadUsage, "ssrt: level " + std::to_string(info.level) + " outside 0.." +
                                          std::to_string(ladder_.size() - 1));
-  const SsrtLevel& level = ssrt_levels()[size_t(info.level)];
+  const SsrtLevel& level = levels_[size_t(info.level)];
   level_ = info.level;
   step_ = level.subsample;
   directions_ = level.directions;
@@ -484,36 +484,20 @@ const std::array<SsrtLevel, 4>& ssrt_levels() {
   return levels;
 }
 
-std::vector<QualityLevel> ssrt_ladder() {
-  std::vector<QualityLevel> out;
-  for (const SsrtLevel& v : ssrt_levels()) {
-    QualityLevel l;
-    l.name = v.name;
-    l.internal_scale = v.internal_scale;
-    l.mesh_error_px = v.mesh_error_px;
-    l.knobs = {{"subsample", double(v.subsample), "pixels per cell side (transfer computed once per cell)"},
-               {"directions", double(v.directions), "visibility directions per pixel (per 2x2 jitter set)"},
-               {"sh_bands", double(v.sh_bands), "SH bands of transfer and estimated light"},
-               {"internal_scale", double(v.internal_scale), "fraction of the output width and height"},
-               {"volume_resolution", double(v.volume_resolution), "TSDF voxels per side of the 2 m workspace cube"},
-               {"aux_resolution", double(v.aux_resolution), "texels per side of each auxiliary orthographic buffer"},
-               {"final_filter", v.final_filter ? 1.0 : 0.0, "1 = the third median pass (eq. 5) on, 0 = off"},
-               {"geometry_step", double(v.geometry_step),
-                "internal pixels per texel side of the volume ray cast, depth filters and their "
-                "G-buffer"},
-               {"occluder_step", double(v.occluder_step),
-                "internal pixels per texel side of the occluder G-buffer the transfer's samples "
-                "read (virtual surface, albedos; occluders.comp)"},
-               {"mesh_error_px", double(v.mesh_error_px),
-                "projected error of the virtual meshes' level of detail, internal pixels "
-                "(0 = full detail)"}};
-    out.push_back(l);
-  }
-  return out;
+Expected<std::vector<SsrtLevel>> ssrt_levels(const std::vector<KnobSetting>& knobs) {
+  return apply_knobs<SsrtLevel>("ssrt", ssrt_levels(), ssrt_detail::kSsrtKnobs, knobs);
+}
+
+Expected<std::vector<QualityLevel>> ssrt_ladder(const std::vector<KnobSetting>& knobs) {
+  auto levels = ssrt_levels(knobs);
+  if (!levels) return levels.error();
+  return ladder_of(*levels, ssrt_levels(), ssrt_detail::kSsrtKnobs);
 }
 
 Expected<std::unique_ptr<Technique>> create_ssrt(const SharedResources& shared) {
-  auto t = std::make_unique<ssrt_detail::Ssrt>(shared);
+  auto levels = ssrt_levels(shared.knobs);
+  if (!levels) return levels.error();
+  auto t = std::make_unique<ssrt_detail::Ssrt>(shared, std::move(*levels));
   MRGI_TRY(t->init());
   return std::unique_ptr<Technique>(std::move(t));
 }

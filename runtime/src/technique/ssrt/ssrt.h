@@ -140,9 +140,10 @@ struct SsrtLevel {
   // 4.3 ms, RDE 0.8280 -> 0.8283).
   float mesh_error_px;
 };
-const std::array<SsrtLevel, 4>& ssrt_levels();
-
-std::vector<QualityLevel> ssrt_ladder();
+const std::array<SsrtLevel, 4>& ssrt_levels();  // the defaults
+// The defaults with RuntimeSettings::knobs applied (technique/knobs.h; BadUsage for a refused one).
+Expected<std::vector<SsrtLevel>> ssrt_levels(const std::vector<KnobSetting>& knobs);
+Expected<std::vector<QualityLevel>> ssrt_ladder(const std::vector<KnobSetting>& knobs);
 Expected<std::unique_ptr<Technique>> create_ssrt(const SharedResources& shared);
 // The light estimate of an ssrt technique (nullptr when `t` is not one).
 const LightEstimate* ssrt_light_estimate(const Technique& t);

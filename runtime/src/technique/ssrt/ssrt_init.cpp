@@ -11,7 +11,7 @@ Status Ssrt::init() {
   ssrt::VolumeSettings vs;
   vs.max_resolution = 1;
   vs.max_aux_resolution = 1;
-  for (const SsrtLevel& l : ssrt_levels()) {
+  for (const SsrtLevel& l : levels_) {
     vs.max_resolution = std::max(vs.max_resolution, l.volume_resolution);
     vs.max_aux_resolution = std::max(vs.max_aux_resolution, l.aux_resolution);
   }
@@ -49,7 +49,7 @@ Status Ssrt::init() {
   // a uniform buffer with vector inserts but a storage buffer lane by lane in a branchy loop
   // (14 % of the transfer's sample loop).
   std::vector<glm::vec4> directions;
-  for (const SsrtLevel& l : ssrt_levels()) {
+  for (const SsrtLevel& l : levels_) {
     auto sets = ssrt::make_sample_sets({l.directions, kSampleSeed});
     if (!sets) return sets.error();
     sample_base_.push_back(uint32_t(directions.size()));
@@ -143,7 +143,7 @@ Status Ssrt::init() {
   // One blur per window radius the ladder uses, the radius a constant (upsample_blur.comp).
   auto blur_spv = gpu::shader_spirv("ssrt/upsample_blur.comp");
   if (!blur_spv) return blur_spv.error();
-  for (const SsrtLevel& level : ssrt_levels()) {
+  for (const SsrtLevel& level : levels_) {
     const int step = int(level.subsample);
     if (step <= 1) continue;
     const int r = blur_radius_cells(step);

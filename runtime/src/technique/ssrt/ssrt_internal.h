@@ -22,8 +22,28 @@
 #include "technique/ssrt/volume.h"
 
 #include "technique/ssrt/ssrt.h"
+#include "technique/knobs.h"
 
 namespace mrgi::technique::ssrt_detail {
+
+// The ladder's knobs (technique/knobs.h), one entry per field of SsrtLevel.
+inline const KnobField<SsrtLevel> kSsrtKnobs[] = {
+    {"subsample", "pixels per cell side (transfer computed once per cell)", &SsrtLevel::subsample, true},
+    {"directions", "visibility directions per pixel (per 2x2 jitter set)", &SsrtLevel::directions, true},
+    {"sh_bands", "SH bands of transfer and estimated light", &SsrtLevel::sh_bands},
+    {"internal_scale", "fraction of the output width and height", &SsrtLevel::internal_scale},
+    {"volume_resolution", "TSDF voxels per side of the 2 m workspace cube", &SsrtLevel::volume_resolution, true},
+    {"aux_resolution", "texels per side of each auxiliary orthographic buffer", &SsrtLevel::aux_resolution, true},
+    {"final_filter", "1 = the third median pass (eq. 5) on, 0 = off", &SsrtLevel::final_filter},
+    {"geometry_step", "internal pixels per texel side of the volume ray cast, depth filters and their G-buffer",
+     &SsrtLevel::geometry_step, true},
+    {"occluder_step",
+     "internal pixels per texel side of the occluder G-buffer the transfer's samples read (virtual surface, "
+     "albedos; occluders.comp)",
+     &SsrtLevel::occluder_step, true},
+    {"mesh_error_px", "projected error of the virtual meshes' level of detail, internal pixels (0 = full detail)",
+     &SsrtLevel::mesh_error_px},
+};
 
 constexpr uint32_t kCoarseLayers = 7;
 constexpr uint32_t kReduceEntries = 192;       // per partial sum, see light_reduce.comp
@@ -85,7 +105,8 @@ struct ShadePush {
 
 class Ssrt final : public Technique {
  public:
-  explicit Ssrt(const SharedResources& shared) : shared_(shared), ladder_(ssrt_ladder()) {}
+  Ssrt(const SharedResources& shared, std::vector<SsrtLevel> levels)
+      : shared_(shared), ladder_(ladder_of(levels, ssrt_levels(), kSsrtKnobs)), levels_(std::move(levels)) {}
   const std::string& name() const override { return name_; }
   const std::vector<QualityLevel>& levels() const override { return ladder_; }
   Status init();
@@ -135,6 +156,7 @@ class Ssrt final : public Technique {
   std::string name_ = "ssrt";
   SharedResources shared_;
   std::vector<QualityLevel> ladder_;
+  std::vector<SsrtLevel> levels_;  // ssrt_levels() with RuntimeSettings::knobs applied
   // The light stage's estimator, which this technique's sums feed.
   const light::LightEstimator& estimator() const { return shared_.light_stage->estimator(); }
   std::optional<ssrt::Volume> volume_;
