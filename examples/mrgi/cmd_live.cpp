@@ -36,7 +36,8 @@ std::atomic<bool> g_stop{false};
 void on_sigint(int) { g_stop = true; }
 
 struct LiveOptions {
-  std::string source, technique = "baseline", scene, out, level = "0", device, env, env_model;
+  std::string source, technique = "baseline", scene, out, level = "auto", device, env, env_model;
+  double budget_ms = 1000.0 / 30.0;
   std::vector<std::string> knobs;
   int frames = 0, timeout_ms = 3000;
   bool quiet = false;
@@ -155,7 +156,7 @@ struct TempFolder {
 };
 
 void run_live(const LiveOptions& o) {
-  const int level = resolve_level(o.technique, o.level);
+  const int level = resolve_level(o.technique, o.level, true);
   SourceOptions so;
   so.env = o.env;
   if (!o.env.empty()) {
@@ -191,12 +192,14 @@ void run_live(const LiveOptions& o) {
   settings.device.device = o.device;
   settings.technique = o.technique;
   settings.level = level;
+  settings.frame_budget_ms = o.budget_ms;
   settings.knobs = parse_knobs(o.technique, o.knobs);
   settings.exposure = info.exposure;
   CameraSetup cameras{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera};
   auto runtime = take(create_runtime(settings, cameras, scene));
   const int out_w = info.color.width, out_h = info.color.height;
-  ReplayMeta meta{source->name(), o.technique, level, runtime->level_names()[size_t(level)], runtime->device().name,
+  ReplayMeta meta{source->name(), o.technique, level,
+                  level == kAutoLevel ? "auto" : runtime->level_names()[size_t(level)], runtime->device().name,
                   runtime->memory_mib(), out_w, out_h};
   ReplayOutput output = take(ReplayOutput::create(o.out, meta));
 
@@ -296,7 +299,13 @@ void setup(CLI::App& app) {
                                       "no preview window is implemented, so it is required")->required();
   cmd->add_option("--frames,-n", o->frames, "stop after N frames (0 = until the stream ends or Ctrl-C)")->check(CLI::NonNegativeNumber);
   cmd->add_option("--knob", o->knobs, "set one quality knob at every level, NAME=VALUE (repeatable; mrgi info --technique T lists them with their spans)");
-  cmd->add_option("--level,-l", o->level, "quality level: 0 = best, N, a level name, or 'last' = cheapest")->capture_default_str();
+  cmd->add_option("--level,-l", o->level,
+                  "quality level: 'auto' = the scheduler chooses the level and internal resolution every frame to "
+                  "hold --budget-ms; or fixed: 0 = best, N, a level name, or 'last' = cheapest")
+      ->capture_default_str();
+  cmd->add_option("--budget-ms", o->budget_ms, "frame budget the scheduler holds, ms (--level auto)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 1e6));
   cmd->add_option("--device", o->device, "Vulkan device: index or name part");
   cmd->add_option("--env", o->env, "fisheye environment camera, v4l2:/dev/videoN or libcamera:ID (needs a calibrated model)");
   cmd->add_option("--env-model", o->env_model, "capture.json whose env_camera (fisheye equidistant) and exposure calibrate --env");

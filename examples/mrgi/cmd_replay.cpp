@@ -45,7 +45,8 @@ std::vector<std::string> ablation_names(const AblationName<A> (&names)[N]) {
 }
 
 struct ReplayOptions {
-  std::string capture, technique = "baseline", out, level = "0", device, light = "declared", video;
+  std::string capture, technique = "baseline", out, level = "auto", device, light = "declared", video;
+  double budget_ms = 1000.0 / 30.0;
   std::vector<std::string> dlpv_ablation;
   std::vector<std::string> dir_ablation;
   std::vector<std::string> knobs;
@@ -55,7 +56,7 @@ struct ReplayOptions {
 
 void run_replay(const ReplayOptions& o) {
   if ((o.width == 0) != (o.height == 0)) throw CommandFailure(2, "--width and --height go together");
-  const int level = resolve_level(o.technique, o.level);
+  const int level = resolve_level(o.technique, o.level, true);
   if (!o.video.empty())
     if (Status st = VideoOutput::check(o.video, o.out); !st.ok()) fail_with(st.error());
   CaptureReader capture = take(CaptureReader::open(o.capture));
@@ -70,6 +71,7 @@ void run_replay(const ReplayOptions& o) {
   settings.residual_light = !o.no_residual_light;
   settings.technique = o.technique;
   settings.level = level;
+  settings.frame_budget_ms = o.budget_ms;
   settings.knobs = parse_knobs(o.technique, o.knobs);
   settings.output_width = o.width;
   settings.output_height = o.height;
@@ -91,7 +93,8 @@ void run_replay(const ReplayOptions& o) {
   auto runtime = take(create_runtime(settings, cameras, scene));
 
   const int out_w = o.width ? o.width : info.color.width, out_h = o.height ? o.height : info.color.height;
-  ReplayMeta meta{o.capture, o.technique, level, runtime->level_names()[level], runtime->device().name,
+  ReplayMeta meta{o.capture, o.technique, level, level == kAutoLevel ? "auto" : runtime->level_names()[size_t(level)],
+                  runtime->device().name,
                   runtime->memory_mib(), out_w, out_h};
   ReplayOutput output = take(ReplayOutput::create(o.out, meta));
   if (!o.video.empty()) {
@@ -224,7 +227,13 @@ void setup(CLI::App& app) {
     return s;
   }())->capture_default_str();
   cmd->add_option("--out,-o", opts->out, "output folder (frames/, stats.json, summary.json, side_by_side.png)")->required();
-  cmd->add_option("--level,-l", opts->level, "quality level: 0 = best, N, a level name, or 'last' = cheapest")->capture_default_str();
+  cmd->add_option("--level,-l", opts->level,
+                  "quality level: 'auto' = the scheduler chooses the level and internal resolution every frame to "
+                  "hold --budget-ms; or fixed: 0 = best, N, a level name, or 'last' = cheapest")
+      ->capture_default_str();
+  cmd->add_option("--budget-ms", opts->budget_ms, "frame budget the scheduler holds, ms (--level auto)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 1e6));
   cmd->add_option("--frames,-n", opts->frames, "replay at most N frames (0 = all)")->check(CLI::NonNegativeNumber);
   cmd->add_option("--knob", opts->knobs, "set one quality knob at every level, NAME=VALUE (repeatable; mrgi info --technique T lists them with their spans)");
   cmd->add_option("--video", opts->video,

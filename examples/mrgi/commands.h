@@ -45,7 +45,8 @@ T take(Expected<T>&& e) {
 
 // A --level value for `technique`: a number (0 = best), a level name ("fast"), or "last" (the
 // cheapest). Anything else ends the command with exit 2 and the list of levels.
-int resolve_level(const std::string& technique, const std::string& level);
+// allow_auto: "auto" is kAutoLevel (the scheduler chooses; replay and live).
+int resolve_level(const std::string& technique, const std::string& level, bool allow_auto = false);
 
 // --knob NAME=VALUE settings (RuntimeSettings::knobs) for `technique`, checked against its
 // ladder; a malformed or refused one ends the command with exit 2 and the knob's span.

@@ -41,9 +41,13 @@ void fail_with(const Error& error) {
   throw CommandFailure(exit_code_for(error.kind), std::string(to_string(error.kind)) + ": " + error.message);
 }
 
-int resolve_level(const std::string& technique, const std::string& level) {
+int resolve_level(const std::string& technique, const std::string& level, bool allow_auto) {
   auto levels = take(technique_levels(technique));
   if (level == "last") return int(levels.size()) - 1;
+  if (level == "auto") {
+    if (!allow_auto) throw CommandFailure(2, "--level auto: this command runs one fixed level (a number, a name, or 'last')");
+    return kAutoLevel;
+  }
   for (size_t i = 0; i < levels.size(); ++i)
     if (levels[i] == level) return int(i);
   char* end = nullptr;
@@ -52,7 +56,8 @@ int resolve_level(const std::string& technique, const std::string& level) {
     std::string names;
     for (size_t i = 0; i < levels.size(); ++i) names += (i ? ", " : "") + std::to_string(i) + "=" + levels[i];
     throw CommandFailure(2, "--level '" + level + "': technique '" + technique + "' has levels " + names +
-                                " (a number, a name, or 'last')");
+                                (allow_auto ? " (a number, a name, 'last', or 'auto': the scheduler chooses)"
+                                            : " (a number, a name, or 'last')"));
   }
   return int(n);
 }

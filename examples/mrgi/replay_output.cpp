@@ -89,6 +89,11 @@ Status ReplayOutput::add(const FrameOutput& out, const ImageRGB8& camera, const 
   nlohmann::json s;
   s["frame"] = out.stats.frame_index;
   s["level"] = out.stats.level;
+  s["internal_scale"] = out.stats.internal_scale;
+  s["cost_ms"] = out.stats.cost_ms;
+  s["predicted_ms"] = out.stats.predicted_ms;
+  s["budget_ms"] = out.stats.budget_ms;
+  s["scheduled"] = out.stats.scheduled;
   s["gpu_total_ms"] = out.stats.gpu_total_ms;
   s["record_ms"] = out.stats.record_ms;
   s["light_ms"] = out.stats.light_ms;
@@ -121,6 +126,9 @@ Status ReplayOutput::add(const FrameOutput& out, const ImageRGB8& camera, const 
   }
   stats_.push_back(std::move(s));
   frame_ms_.push_back(out.stats.gpu_total_ms);
+  cost_ms_.push_back(out.stats.cost_ms);
+  levels_.push_back(out.stats.level);
+  budget_ms_ = out.stats.budget_ms;
   profiled_ = profiled_ || out.stats.profiled;
   last_camera_ = camera;
   last_output_ = out.image;
@@ -141,6 +149,26 @@ Expected<nlohmann::json> ReplayOutput::finish() {
                            {"fps", double(achieved_.frames) / achieved_.seconds},
                            {"ms_per_frame", 1000.0 * achieved_.seconds / double(achieved_.frames)},
                            {"is", achieved_.what}};
+  }
+  if (!cost_ms_.empty()) {
+    // What the scheduler held: every frame's cost (device + own host work) against the budget,
+    // the level it ran at and how often the level changed.
+    size_t within = 0, switches = 0;
+    nlohmann::json per_level = nlohmann::json::object();
+    for (size_t i = 0; i < cost_ms_.size(); ++i) {
+      within += cost_ms_[i] <= budget_ms_;
+      if (i > 0 && levels_[i] != levels_[i - 1]) ++switches;
+      const std::string k = std::to_string(levels_[i]);
+      per_level[k] = per_level.value(k, 0) + 1;
+    }
+    summary["budget"] = {{"budget_ms", budget_ms_},
+                         {"frames_within", within},
+                         {"share_within", double(within) / double(cost_ms_.size())},
+                         {"median_cost_ms", perf::percentile(cost_ms_, 50)},
+                         {"p95_cost_ms", perf::percentile(cost_ms_, 95)},
+                         {"level_switches", switches},
+                         {"frames_per_level", per_level},
+                         {"cost_is", "device time + the frame's own host work (a CPU device), or the larger (a GPU)"}};
   }
   summary["technique"] = meta_.technique;
   summary["level"] = meta_.level;

@@ -1,11 +1,13 @@
 // What `mrgi replay` and `mrgi live` write to --out DIR:
 //   DIR/frames/NNNNNN.png   composited RGBA8 frames
-//   DIR/stats.json          per frame: each pass's ms, total ms, record ms, level, skipped passes,
+//   DIR/stats.json          per frame: each pass's ms, total ms, record ms, level, internal scale,
+//                           cost, predicted cost and budget (the scheduler's view), skipped passes,
 //                           notes (a priming run, a missing pose), the frame's error figures
 //                           when a reference exists, and the estimated light (ssrt) when the
 //                           technique estimates one
 //   DIR/summary.json        frames, median_frame_ms, p95_frame_ms, achieved {fps, ms_per_frame},
-//                           technique, level, device,
+//                           technique, level, device, budget {share_within, level_switches,
+//                           frames_per_level, median and p95 cost},
 //                           lp_num_threads, memory_mib, rde {all, real, virtual} with references,
 //                           and light_direction_error_deg {median, worst, frames} when the
 //                           capture has environment images and the technique estimates light
@@ -66,6 +68,9 @@ class ReplayOutput {
   ReplayMeta meta_;
   nlohmann::json stats_ = nlohmann::json::array();
   std::vector<double> frame_ms_;
+  std::vector<double> cost_ms_;   // FrameStats::cost_ms
+  std::vector<int> levels_;
+  double budget_ms_ = 0.0;
   bool profiled_ = false;
   Achieved achieved_;
   std::optional<RdeReport> pooled_;

@@ -138,8 +138,12 @@ TEST_F(ToolCommands, KnobsAreSetOneByOneAndRefusedOutsideTheirSpan) {
   const auto j = nlohmann::json::parse(slurp(dir.file("info.json")));
   for (const auto& level : j["ladder"]["levels"])
     for (const auto& k : level["knobs"]) {
-      if (k["name"] == "vpls") EXPECT_EQ(k["value"].get<double>(), 64.0);
-      if (k["name"] == "bounce_vpls") EXPECT_EQ(k["value"].get<double>(), 8.0);
+      if (k["name"] == "vpls") {
+        EXPECT_EQ(k["value"].get<double>(), 64.0);
+      }
+      if (k["name"] == "bounce_vpls") {
+        EXPECT_EQ(k["value"].get<double>(), 8.0);
+      }
     }
   EXPECT_EQ(run(std::string("timeout 60 ") + MRGI_TOOL + " replay " + MRGI_SOURCE_DIR + "/data/sample -t dir --knob vpls=4096 -q --out " +
                 dir.file("out") + " > /dev/null 2> " + dir.file("err2.txt")),

@@ -40,7 +40,9 @@ TEST(KnobSweep, EveryKnobRendersAtBothEndsOfItsSpan) {
         ASSERT_TRUE(set.ok()) << set.error().message;
         for (const QualityLevelInfo& l : *set)
           for (const QualityKnob& k : l.knobs)
-            if (k.name == knob.name) EXPECT_EQ(k.value, value) << l.name;
+            if (k.name == knob.name) {
+              EXPECT_EQ(k.value, value) << l.name;
+            }
         const std::vector<FrameOutput> outs = test::run_synthetic_frames(scene, s, 3);
         ASSERT_EQ(outs.size(), 3u);
         size_t virtual_pixels = 0;

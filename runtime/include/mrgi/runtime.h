@@ -94,6 +94,24 @@ struct DirAblation {
   }
 };
 
+// The frame-budget scheduler's constants (scheduler/scheduler.h says how it decides). The
+// defaults are the anchors' where they give one (Filament's dynamic resolution controller,
+// Unreal's dynamic resolution and scalability), measured on the load test otherwise
+// (perf/results/scheduler/).
+struct SchedulerSettings {
+  double headroom = 0.10;          // target = budget x (1 - headroom) (Unreal: 10 %)
+  int window_frames = 9;           // frames in the median cost the controller reads (1..64)
+  double dead_band_below = 0.01;   // no change while the median is within target x [1 - this,
+  double dead_band_above = 0.05;   //   1 + this] (Filament: -1 % / +5 %)
+  double scale_gain = 0.6;         // fraction of the model's scale correction taken per frame (0, 1]
+  float min_scale = 0.6f;          // internal-resolution factor inside a level: [min_scale, 1]
+  float upgrade_min_scale = 0.85f; // a better level is taken only if it fits at this scale or more
+  int min_frames_between_changes = 30;  // level changes at most once a second at 30 fps
+  int emergency_frames = 3;        // this many consecutive frames over
+  double emergency_factor = 1.25;  //   this x the budget drop a level at once
+};
+inline constexpr int kAutoLevel = -1;
+
 // One quality knob set by name (technique_ladder lists a technique's knobs, units and spans).
 struct KnobSetting {
   std::string name;   // e.g. "vpls"
@@ -104,7 +122,18 @@ struct KnobSetting {
 struct RuntimeSettings {
   DeviceSettings device;
   std::string technique = "baseline";  // baseline | ssrt | dlpv | dir (later: dvct, specular)
-  int level = 0;                       // 0 = the technique's best quality
+  // The quality level: kAutoLevel (the default) lets the scheduler choose it and the internal
+  // resolution inside it every frame to hold frame_budget_ms; 0.. fixes it (0 = the technique's
+  // best quality; the budget is then only reported, FrameStats::predicted_ms).
+  int level = kAutoLevel;
+  // The frame budget, ms per frame (default: 30 fps). A frame's cost is what it takes of the
+  // device and of the host: on a CPU device (lavapipe) the two share the cores, so their sum;
+  // on a GPU the larger (FrameStats::cost_ms).
+  double frame_budget_ms = 1000.0 / 30.0;
+  SchedulerSettings scheduler;
+  // The scheduler's cost priors, ms per level at full internal resolution (best level first):
+  // a bench's figures for this device (`mrgi bench` bench.json). Empty: the built-in table.
+  std::vector<double> level_costs_ms;
   // Quality knobs set one by one (`--knob NAME=VALUE`): each pins that knob of the technique at
   // every level of its ladder, from start-up (allocations follow the set ladder; a knob does not
   // change at run time, the level does: Runtime::set_level). A knob takes values in the span its
@@ -184,6 +213,15 @@ struct FrameStats {
   // probeless system's part and solve) on the calling thread, ms; inside record_ms and host_ms.
   double light_ms = 0.0;
   int level = 0;
+  // The internal resolution this frame ran at, as a fraction of the output's side (the level's
+  // internal scale x the scheduler's factor).
+  float internal_scale = 1.0f;
+  // What the frame cost, ms: device time (first to last timestamp; profiled: the passes' sum)
+  // plus host_ms on a CPU device, the larger of the two on a GPU. What the scheduler reads.
+  double cost_ms = 0.0;
+  double predicted_ms = 0.0;  // the scheduler's prediction of cost_ms when it chose this frame's quality
+  double budget_ms = 0.0;     // RuntimeSettings::frame_budget_ms when the frame was recorded
+  bool scheduled = false;     // the level and scale were the scheduler's (kAutoLevel)
   std::vector<std::string> skipped;    // passes culled or skipped this frame, with reason
   // Conditions worth knowing about this frame, e.g. "pose: none given, previous pose used".
   std::vector<std::string> notes;
@@ -226,7 +264,11 @@ class Runtime {
   virtual double memory_mib() const = 0;      // everything allocated at start-up, MiB
   virtual int level_count() const = 0;
   virtual std::vector<std::string> level_names() const = 0;
-  virtual Status set_level(int level) = 0;   // the scheduler's knob; never allocates
+  // Fixes the level from the next frame on (kAutoLevel: the scheduler chooses again). Never
+  // allocates. BadUsage outside kAutoLevel, 0..level_count()-1.
+  virtual Status set_level(int level) = 0;
+  // The frame budget from the next frame on (ms, > 0); BadUsage otherwise.
+  virtual Status set_frame_budget_ms(double budget_ms) = 0;
   // Profiling mode from the next frame on (RuntimeSettings::profile_passes); never allocates.
   virtual Status set_profiling(bool on) = 0;
   // The virtual objects: scene.json's (SceneDesc::virtual_objects), in its order; the capacity

@@ -3,6 +3,7 @@
 // level. process() uploads a frame, records this frame's passes, submits, and returns the frames
 // that completed (pipelined over frames_in_flight slots).
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <ctime>
 #include <cstdio>
@@ -19,6 +20,7 @@
 #include "mrgi/runtime.h"
 #include "recon/reconstruction.h"
 #include "recon/virtual_gbuffer.h"
+#include "scheduler/scheduler.h"
 #include "runtime/camera_math.h"
 #include "runtime/influence.h"
 #include "technique/scene_gpu.h"
@@ -50,7 +52,14 @@ struct SlotRecord {
   bool used = false;
   int64_t frame_index = 0;
   int level = 0;
+  float internal_scale = 1.0f;  // the level's internal scale x the scheduler's factor
+  double predicted_ms = 0.0;    // the scheduler's prediction for this frame
+  bool scheduled = false;
+  bool technique_ran = false;
   double record_ms = 0.0;
+  // Host work for this frame in process(): checks, recording, upload, submission, without the
+  // wait for an earlier frame's slot (which is that frame's device time, not this frame's work).
+  double host_work_ms = 0.0;
   bool priming = false;  // a technique's priming run of this frame: its output is dropped
   // Nothing virtual in view and the output has the camera's size: the output is the camera
   // frame, converted on the host from this slot's colour upload when the frame completes.
@@ -74,6 +83,7 @@ class RuntimeImpl final : public Runtime {
   int level_count() const override { return int(technique_->levels().size()); }
   std::vector<std::string> level_names() const override;
   Status set_level(int level) override;
+  Status set_frame_budget_ms(double budget_ms) override;
   Status set_profiling(bool on) override { return graph_->set_profiling(on); }
   size_t object_count() const override { return scene_gpu_->object_count(); }
   size_t lamp_count() const override { return scene_.lights.size(); }
@@ -110,7 +120,9 @@ class RuntimeImpl final : public Runtime {
   CameraSetup cameras_;
   SceneDesc scene_;
   int output_w_ = 0, output_h_ = 0;
-  int level_ = 0;
+  int level_ = 0;       // the fixed level, or the scheduler's choice when auto_level_
+  bool auto_level_ = false;
+  std::optional<sched::Scheduler> scheduler_;  // made at start-up whatever the level (no allocation later)
   // Declared in creation order; destroyed in reverse (the device outlives everything on it).
   std::unique_ptr<gpu::Context> context_;
   std::unique_ptr<gpu::FrameGraph> graph_;
@@ -143,6 +155,36 @@ RuntimeImpl::~RuntimeImpl() {
   context_.reset();
 }
 
+// The budget and the scheduler's constants, each checked with its field's name and rule.
+Status check_scheduler_settings(const RuntimeSettings& rs, size_t levels) {
+  auto bad = [](const std::string& field, const std::string& rule) {
+    return fail(ErrorKind::BadUsage, "RuntimeSettings." + field + ": " + rule);
+  };
+  if (!std::isfinite(rs.frame_budget_ms) || rs.frame_budget_ms <= 0.0 || rs.frame_budget_ms > 1e6)
+    return bad("frame_budget_ms", "must be in (0, 1e6] ms");
+  const SchedulerSettings& s = rs.scheduler;
+  if (!(s.headroom >= 0.0 && s.headroom < 0.9)) return bad("scheduler.headroom", "must be in [0, 0.9)");
+  if (s.window_frames < 1 || s.window_frames > 64) return bad("scheduler.window_frames", "must be 1..64");
+  if (!(s.dead_band_below >= 0.0 && s.dead_band_below < 1.0) || !(s.dead_band_above >= 0.0 && s.dead_band_above < 1.0))
+    return bad("scheduler.dead_band_below/above", "must be in [0, 1)");
+  if (!(s.scale_gain > 0.0 && s.scale_gain <= 1.0)) return bad("scheduler.scale_gain", "must be in (0, 1]");
+  if (!(s.min_scale >= 0.25f && s.min_scale <= 1.0f)) return bad("scheduler.min_scale", "must be in [0.25, 1]");
+  if (!(s.upgrade_min_scale >= s.min_scale && s.upgrade_min_scale <= 1.0f))
+    return bad("scheduler.upgrade_min_scale", "must be in [min_scale, 1]");
+  if (s.min_frames_between_changes < 0 || s.min_frames_between_changes > 100000)
+    return bad("scheduler.min_frames_between_changes", "must be 0..100000");
+  if (s.emergency_frames < 1 || s.emergency_frames > 1000) return bad("scheduler.emergency_frames", "must be 1..1000");
+  if (!(s.emergency_factor >= 1.0 && s.emergency_factor <= 100.0)) return bad("scheduler.emergency_factor", "must be in [1, 100]");
+  if (!rs.level_costs_ms.empty()) {
+    if (rs.level_costs_ms.size() != levels)
+      return bad("level_costs_ms", "has " + std::to_string(rs.level_costs_ms.size()) + " costs for a ladder of " +
+                                       std::to_string(levels) + " levels");
+    for (double c : rs.level_costs_ms)
+      if (!std::isfinite(c) || c <= 0.0) return bad("level_costs_ms", "every cost must be a positive number of ms");
+  }
+  return ok_status();
+}
+
 Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cameras,
                          const SceneDesc& scene) {
   settings_ = settings;
@@ -153,10 +195,11 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   auto ladder_or = (*entry)->ladder(settings.knobs);
   if (!ladder_or) return ladder_or.error();
   const std::vector<technique::QualityLevel> ladder = std::move(*ladder_or);
-  if (settings.level < 0 || settings.level >= int(ladder.size()))
+  if (settings.level != kAutoLevel && (settings.level < 0 || settings.level >= int(ladder.size())))
     return fail(ErrorKind::BadUsage, "RuntimeSettings.level " + std::to_string(settings.level) +
                                          ": technique '" + settings.technique + "' has levels 0.." +
-                                         std::to_string(ladder.size() - 1));
+                                         std::to_string(ladder.size() - 1) + " (or kAutoLevel)");
+  MRGI_TRY(check_scheduler_settings(settings, ladder.size()));
   if (settings.frames_in_flight < 1 || settings.frames_in_flight > 3)
     return fail(ErrorKind::BadUsage, "RuntimeSettings.frames_in_flight " +
                                          std::to_string(settings.frames_in_flight) + ": must be 1..3");
@@ -180,7 +223,21 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   if (settings.exposure > 0.0) cameras_.exposure = settings.exposure;
   output_w_ = settings.output_width ? settings.output_width : c.width;
   output_h_ = settings.output_height ? settings.output_height : c.height;
-  level_ = settings.level;
+  auto_level_ = settings.level == kAutoLevel;
+  {
+    std::vector<double> prior = settings.level_costs_ms.empty()
+                                    ? sched::builtin_level_costs(settings.technique, int(ladder.size()))
+                                    : settings.level_costs_ms;
+    // Start at the best level the priors say fits the budget at full resolution.
+    int start = int(ladder.size()) - 1;
+    for (int l = 0; l < int(prior.size()); ++l)
+      if (prior[size_t(l)] <= settings.frame_budget_ms * (1.0 - settings.scheduler.headroom)) {
+        start = l;
+        break;
+      }
+    scheduler_.emplace(settings.scheduler, settings.frame_budget_ms, std::move(prior), auto_level_ ? start : settings.level);
+  }
+  level_ = auto_level_ ? scheduler_->choice().level : settings.level;
 
   auto ctx = gpu::Context::create(settings.device);
   if (!ctx) return ctx.error();
@@ -361,7 +418,11 @@ Expected<SlotRecord*> RuntimeImpl::begin_slot(const InputFrame& frame,
   rec.priming = false;
   rec.camera_copy = false;
   rec.frame_index = frame.index;
+  if (auto_level_) level_ = scheduler_->choice().level;
   rec.level = level_;
+  rec.scheduled = auto_level_;
+  rec.predicted_ms = auto_level_ ? scheduler_->choice().predicted_ms : scheduler_->predict(level_, 1.0f);
+  rec.technique_ran = false;
   rec.skipped.clear();
   rec.notes.clear();
   rec.light_ms = 0.0;
@@ -371,10 +432,13 @@ Expected<SlotRecord*> RuntimeImpl::begin_slot(const InputFrame& frame,
 Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame) {
   const auto t0 = std::chrono::steady_clock::now();
   MRGI_TRY(check_frame(frame));
+  const double check_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   std::vector<FrameOutput> outputs;
+  // begin_slot waits for the slot's earlier frame and collects it: that frame's time.
   auto slot = begin_slot(frame, outputs);
   if (!slot) return slot.error();
   SlotRecord* rec = *slot;
+  const auto t_work = std::chrono::steady_clock::now();
 
   // A frame without a pose keeps the last known one (identity before any): the output is then
   // only right for a camera that did not move; the stats say so.
@@ -407,7 +471,9 @@ Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame)
   }
   rec->notes.insert(rec->notes.end(), notes.begin(), notes.end());
   MRGI_TRY(record_and_submit(frame, *rec, affected));
-  rec->record_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  const auto t1 = std::chrono::steady_clock::now();
+  rec->record_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+  rec->host_work_ms = std::max(0.0, check_ms) + std::chrono::duration<double, std::milli>(t1 - t_work).count();
   return outputs;
 }
 
@@ -455,7 +521,10 @@ Status RuntimeImpl::prime(const InputFrame& frame, SlotRecord& rec,
 // compose's camera-copy pipeline resamples it (2-3 ms). Recon and the technique are not added.
 Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, bool affected) {
   const technique::QualityLevel& level = technique_->levels()[size_t(level_)];
-  MRGI_TRY(graph_->set_render_scale(level.internal_scale));
+  const float factor = auto_level_ ? scheduler_->choice().scale : 1.0f;
+  rec.internal_scale = level.internal_scale * factor;
+  MRGI_TRY(graph_->set_render_scale(rec.internal_scale));
+  rec.technique_ran = affected;
   write_constants(last_pose_);
   recon_->upload(*graph_, frame);
 
@@ -562,6 +631,15 @@ Expected<FrameOutput> RuntimeImpl::collect(const gpu::FrameTimings& timings) {
   out.stats.completed_s = timings.completed_s;
   out.stats.host_ms = std::max(0.0, rec.record_ms - (timings.profiled ? timings.total_ms : 0.0)) + readback_ms;
   out.stats.level = rec.level;
+  out.stats.internal_scale = rec.internal_scale;
+  out.stats.budget_ms = scheduler_->budget_ms();
+  out.stats.predicted_ms = rec.predicted_ms;
+  out.stats.scheduled = rec.scheduled;
+  // The frame's cost: its device time and its own host work (the readback included); on a CPU
+  // device they take turns on the same cores, on a GPU they overlap.
+  const double host_work = rec.host_work_ms + readback_ms;
+  out.stats.cost_ms = context_->info().type == "cpu" ? timings.total_ms + host_work : std::max(timings.total_ms, host_work);
+  if (!rec.priming) scheduler_->observe(rec.level, rec.level < int(technique_->levels().size()) ? rec.internal_scale / std::max(1e-6f, technique_->levels()[size_t(rec.level)].internal_scale) : 1.0f, out.stats.cost_ms, rec.technique_ran && !timings.profiled);
   out.stats.light_ms = rec.light_ms;
   out.stats.skipped = rec.skipped;
   for (const std::string& c : timings.culled) out.stats.skipped.push_back(c + ": culled (nothing reads it)");
@@ -590,7 +668,19 @@ std::vector<std::string> RuntimeImpl::level_names() const {
   return names;
 }
 
+Status RuntimeImpl::set_frame_budget_ms(double budget_ms) {
+  if (!std::isfinite(budget_ms) || budget_ms <= 0.0 || budget_ms > 1e6)
+    return fail(ErrorKind::BadUsage, "set_frame_budget_ms(" + std::to_string(budget_ms) + "): must be in (0, 1e6] ms");
+  scheduler_->set_budget_ms(budget_ms);
+  return ok_status();
+}
+
 Status RuntimeImpl::set_level(int level) {
+  if (level == kAutoLevel) {
+    auto_level_ = true;
+    return ok_status();
+  }
+  auto_level_ = false;
   if (level < 0 || level >= level_count())
     return fail(ErrorKind::BadUsage, "set_level(" + std::to_string(level) + "): technique '" +
                                          technique_->name() + "' has levels 0.." +

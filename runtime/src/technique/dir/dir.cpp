@@ -135,6 +135,7 @@ class Dir final : public Technique {
     int level = -1;
     int image = 0;
     glm::dmat4 camera_to_world{1.0};
+    uint32_t width = 0, height = 0;  // the smoothed light's size
   } history_;
   std::unique_ptr<Technique> baseline_;
   bool glossy_ = false;  // glossy VPLs: the scene has a glossy virtual material (SceneGpu::glossy)
@@ -457,9 +458,11 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
           gpu::dispatch_2d(cmd, *merge_columns, &push, sizeof push, low.width, low.height);
         });
   } else {
-    // The previous frame's smoothed light is the history while it was made at this level (the
-    // same grid and intrinsics); the pose may differ (reprojected).
-    const bool have = history_.valid && history_.level == info.level;
+    // The previous frame's smoothed light is the history while it was made at this level and
+    // internal resolution (the same grid and intrinsics: the scheduler moves the resolution
+    // inside a level); the pose may differ (reprojected).
+    const bool have = history_.valid && history_.level == info.level && history_.width == low.width &&
+                      history_.height == low.height;
     const int read = history_.image, write = 1 - history_.image;
     const glm::dmat4 previous = history_.camera_to_world;
     const TemporalPush tp{glm::mat4(glm::inverse(previous)), glm::vec4(glm::vec3(previous[3]), have ? 1.0f : 0.0f),
@@ -480,8 +483,9 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
         [temporal, tp, low](VkCommandBuffer cmd, gpu::PassContext&) {
           gpu::dispatch_2d(cmd, *temporal, &tp, sizeof tp, low.width, low.height);
         });
-    if (!have) skipped.push_back("dir temporal smoothing: no history at this level yet (the frame's own light)");
-    history_ = {true, info.level, write, info.camera_to_world};
+    if (!have)
+      skipped.push_back("dir temporal smoothing: no history at this level and resolution yet (the frame's own light)");
+    history_ = {true, info.level, write, info.camera_to_world, low.width, low.height};
     to_add.merged = smoothed_[write];
   }
   set_dir_indirect(*baseline_, &to_add);
