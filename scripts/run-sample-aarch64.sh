@@ -3,7 +3,8 @@
 # sysroot, LP_NUM_THREADS=2) and compares its frames with the native build's, pixel by pixel.
 # Builds either when missing (scripts/build-aarch64.sh, scripts/build.sh). Writes
 # out/aarch64/ (the qemu run) and out/native/ (the native one); exits 1 if a frame differs.
-# Extra arguments go to both replays (default: --technique baseline).
+# Extra arguments go to both replays (default: --technique baseline --level high; a fixed level:
+# under --level auto each build would choose by its own speed, and qemu is slower).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SYSROOT="${MRGI_SYSROOT:-$PWD/build-aarch64-sysroot}"
@@ -12,7 +13,7 @@ SYSROOT="${MRGI_SYSROOT:-$PWD/build-aarch64-sysroot}"
 command -v qemu-aarch64-static > /dev/null || { echo "qemu-aarch64-static not found: apt-get install qemu-user-static" >&2; exit 1; }
 export LP_NUM_THREADS="${LP_NUM_THREADS:-2}"
 args=("$@")
-[ ${#args[@]} -gt 0 ] || args=(--technique baseline)
+[ ${#args[@]} -gt 0 ] || args=(--technique baseline --level high)
 icd="$SYSROOT/usr/share/vulkan/icd.d/lvp_icd.aarch64.json"
 echo "run-sample-aarch64: native replay"
 ./build/bin/mrgi replay data/sample "${args[@]}" --out out/native -q > /dev/null

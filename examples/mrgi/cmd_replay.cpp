@@ -56,7 +56,9 @@ struct ReplayOptions {
 
 void run_replay(const ReplayOptions& o) {
   if ((o.width == 0) != (o.height == 0)) throw CommandFailure(2, "--width and --height go together");
-  const int level = resolve_level(o.technique, o.level, true);
+  if (o.technique == "auto" && o.level != "auto")
+    throw CommandFailure(2, "--technique auto: the level is the scheduler's (--level auto)");
+  const int level = o.technique == "auto" ? kAutoLevel : resolve_level(o.technique, o.level, true);
   if (!o.video.empty())
     if (Status st = VideoOutput::check(o.video, o.out); !st.ok()) fail_with(st.error());
   CaptureReader capture = take(CaptureReader::open(o.capture));
@@ -72,7 +74,9 @@ void run_replay(const ReplayOptions& o) {
   settings.technique = o.technique;
   settings.level = level;
   settings.frame_budget_ms = o.budget_ms;
-  settings.knobs = parse_knobs(o.technique, o.knobs);
+  if (o.technique == "auto" && !o.knobs.empty())
+    throw CommandFailure(2, "--knob: name a technique (knobs are a technique's own), not --technique auto");
+  if (!o.knobs.empty()) settings.knobs = parse_knobs(o.technique, o.knobs);
   settings.output_width = o.width;
   settings.output_height = o.height;
   settings.exposure = info.exposure;
@@ -93,7 +97,7 @@ void run_replay(const ReplayOptions& o) {
   auto runtime = take(create_runtime(settings, cameras, scene));
 
   const int out_w = o.width ? o.width : info.color.width, out_h = o.height ? o.height : info.color.height;
-  ReplayMeta meta{o.capture, o.technique, level, level == kAutoLevel ? "auto" : runtime->level_names()[size_t(level)],
+  ReplayMeta meta{o.capture, runtime->technique(), level, level == kAutoLevel ? "auto" : runtime->level_names()[size_t(level)],
                   runtime->device().name,
                   runtime->memory_mib(), out_w, out_h};
   ReplayOutput output = take(ReplayOutput::create(o.out, meta));
@@ -224,7 +228,7 @@ void setup(CLI::App& app) {
   cmd->add_option("--technique,-t", opts->technique, "technique: " + [] {
     std::string s;
     for (auto& n : technique_names()) s += (s.empty() ? "" : ", ") + n;
-    return s;
+    return s + ", or auto (chosen for the scene and the budget; the first frame's notes say why)";
   }())->capture_default_str();
   cmd->add_option("--out,-o", opts->out, "output folder (frames/, stats.json, summary.json, side_by_side.png)")->required();
   cmd->add_option("--level,-l", opts->level,

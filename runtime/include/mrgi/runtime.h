@@ -112,6 +112,16 @@ struct SchedulerSettings {
 };
 inline constexpr int kAutoLevel = -1;
 
+// `technique = "auto"`: the technique is chosen at start-up by choose_technique (below), then the
+// scheduler moves inside it. One row of the table it chooses by: a technique level's sustained
+// frame time and its error against the reference, as `mrgi bench` measures them (bench.json's
+// suite aggregate) for the device at hand.
+struct TechniqueFigure {
+  std::string technique;
+  int level = 0;
+  double ms = 0.0;   // sustained ms per frame
+  double rde = 0.0;  // RDE over all pixels (0 = the reference)
+};
 // One quality knob set by name (technique_ladder lists a technique's knobs, units and spans).
 struct KnobSetting {
   std::string name;   // e.g. "vpls"
@@ -121,7 +131,10 @@ struct KnobSetting {
 // Level "last" in the CLI resolves to technique_level_count(name) - 1.
 struct RuntimeSettings {
   DeviceSettings device;
-  std::string technique = "baseline";  // baseline | ssrt | dlpv | dir (later: dvct, specular)
+  // baseline | ssrt | dlpv | dir, or "auto": chosen at start-up for the scene and the budget by
+  // choose_technique (with technique_table), Runtime::technique() says which.
+  std::string technique = "baseline";
+  std::vector<TechniqueFigure> technique_table;  // for "auto"; empty: the built-in table
   // The quality level: kAutoLevel (the default) lets the scheduler choose it and the internal
   // resolution inside it every frame to hold frame_budget_ms; 0.. fixes it (0 = the technique's
   // best quality; the budget is then only reported, FrameStats::predicted_ms).
@@ -261,6 +274,7 @@ class Runtime {
   // renderer needs). Frames of another size are dropped; at most frames_in_flight + 1 are kept.
   virtual void recycle(FrameOutput&& done) = 0;
   virtual const DeviceInfo& device() const = 0;
+  virtual const std::string& technique() const = 0;  // the technique running (auto: the chosen one)
   virtual double memory_mib() const = 0;      // everything allocated at start-up, MiB
   virtual int level_count() const = 0;
   virtual std::vector<std::string> level_names() const = 0;
@@ -303,6 +317,21 @@ struct CameraSetup {
 Expected<std::unique_ptr<Runtime>> create_runtime(const RuntimeSettings& settings,
                                                   const CameraSetup& cameras,
                                                   const SceneDesc& scene);
+
+struct TechniqueChoice {
+  std::string technique;
+  std::string reason;  // what was left out and why, and the figures the choice rests on
+};
+// The technique for `scene` under `budget_ms`: techniques the scene cannot use are left out (no
+// lamp: the RSM-based dlpv and dir, whose bounce starts at the lamps' maps; a glossy virtual
+// material: ssrt, whose transfer is diffuse only); of the rest, the one whose most accurate level
+// that fits the budget (less the scheduler's headroom) has the lowest RDE; where none fits, the
+// one with the fastest level. `table`: a bench's figures for this device; empty: the built-in
+// table (lavapipe x2, 640x480, scheduler/technique_choice.cpp). BadInput where the scene's glTF
+// cannot be read (its materials say whether it is glossy).
+Expected<TechniqueChoice> choose_technique(const SceneDesc& scene, double budget_ms,
+                                           const std::vector<TechniqueFigure>& table = {},
+                                           double headroom = SchedulerSettings{}.headroom);
 
 // Names of the registered techniques and their level names (best first).
 std::vector<std::string> technique_names();

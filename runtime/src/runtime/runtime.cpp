@@ -79,6 +79,7 @@ class RuntimeImpl final : public Runtime {
   Expected<std::vector<FrameOutput>> flush() override;
   void recycle(FrameOutput&& done) override;
   const DeviceInfo& device() const override { return context_->info(); }
+  const std::string& technique() const override { return technique_name_; }
   double memory_mib() const override { return context_->memory_mib(); }
   int level_count() const override { return int(technique_->levels().size()); }
   std::vector<std::string> level_names() const override;
@@ -119,6 +120,8 @@ class RuntimeImpl final : public Runtime {
   RuntimeSettings settings_;
   CameraSetup cameras_;
   SceneDesc scene_;
+  std::string technique_name_;  // the technique running (auto: the chosen one)
+  std::string choice_reason_;   // why, for technique "auto"
   int output_w_ = 0, output_h_ = 0;
   int level_ = 0;       // the fixed level, or the scheduler's choice when auto_level_
   bool auto_level_ = false;
@@ -190,16 +193,36 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   settings_ = settings;
   cameras_ = cameras;
   scene_ = scene;
-  auto entry = technique::find_technique(settings.technique);
+  technique_name_ = settings.technique;
+  if (settings.technique == "auto") {
+    for (const TechniqueFigure& f : settings.technique_table)
+      if (!std::isfinite(f.ms) || f.ms <= 0.0 || !std::isfinite(f.rde) || f.rde < 0.0)
+        return fail(ErrorKind::BadUsage, "RuntimeSettings.technique_table: " + f.technique + " level " +
+                                             std::to_string(f.level) + ": ms must be > 0 and rde >= 0");
+    auto choice = choose_technique(scene, settings.frame_budget_ms, settings.technique_table, settings.scheduler.headroom);
+    if (!choice) return choice.error();
+    technique_name_ = choice->technique;
+    choice_reason_ = choice->reason;
+    settings_.technique = technique_name_;
+    // The chosen technique's own figures are the scheduler's priors.
+    if (settings_.level_costs_ms.empty() && !settings.technique_table.empty()) {
+      auto names = technique_levels(technique_name_);
+      std::vector<double> costs(names ? names->size() : 0, 0.0);
+      for (const TechniqueFigure& f : settings.technique_table)
+        if (f.technique == technique_name_ && f.level >= 0 && size_t(f.level) < costs.size()) costs[size_t(f.level)] = f.ms;
+      if (std::all_of(costs.begin(), costs.end(), [](double c) { return c > 0.0; })) settings_.level_costs_ms = costs;
+    }
+  }
+  auto entry = technique::find_technique(technique_name_);
   if (!entry) return entry.error();
   auto ladder_or = (*entry)->ladder(settings.knobs);
   if (!ladder_or) return ladder_or.error();
   const std::vector<technique::QualityLevel> ladder = std::move(*ladder_or);
   if (settings.level != kAutoLevel && (settings.level < 0 || settings.level >= int(ladder.size())))
     return fail(ErrorKind::BadUsage, "RuntimeSettings.level " + std::to_string(settings.level) +
-                                         ": technique '" + settings.technique + "' has levels 0.." +
+                                         ": technique '" + settings_.technique + "' has levels 0.." +
                                          std::to_string(ladder.size() - 1) + " (or kAutoLevel)");
-  MRGI_TRY(check_scheduler_settings(settings, ladder.size()));
+  MRGI_TRY(check_scheduler_settings(settings_, ladder.size()));
   if (settings.frames_in_flight < 1 || settings.frames_in_flight > 3)
     return fail(ErrorKind::BadUsage, "RuntimeSettings.frames_in_flight " +
                                          std::to_string(settings.frames_in_flight) + ": must be 1..3");
@@ -225,9 +248,9 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   output_h_ = settings.output_height ? settings.output_height : c.height;
   auto_level_ = settings.level == kAutoLevel;
   {
-    std::vector<double> prior = settings.level_costs_ms.empty()
-                                    ? sched::builtin_level_costs(settings.technique, int(ladder.size()))
-                                    : settings.level_costs_ms;
+    std::vector<double> prior = settings_.level_costs_ms.empty()
+                                    ? sched::builtin_level_costs(settings_.technique, int(ladder.size()))
+                                    : settings_.level_costs_ms;
     // Start at the best level the priors say fits the budget at full resolution.
     int start = int(ladder.size()) - 1;
     for (int l = 0; l < int(prior.size()); ++l)
@@ -468,6 +491,10 @@ Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame)
     if (!slot) return slot.error();
     rec = *slot;
     notes.push_back(note);
+  }
+  if (!choice_reason_.empty()) {  // technique "auto": the first frame says what was chosen and why
+    notes.push_back("technique: auto: " + choice_reason_);
+    choice_reason_.clear();
   }
   rec->notes.insert(rec->notes.end(), notes.begin(), notes.end());
   MRGI_TRY(record_and_submit(frame, *rec, affected));
