@@ -156,7 +156,11 @@ struct TempFolder {
 };
 
 void run_live(const LiveOptions& o) {
-  const int level = resolve_level(o.technique, o.level, true);
+  if (o.technique == "auto" && o.level != "auto")
+    throw CommandFailure(2, "--technique auto: the level is the scheduler's (--level auto)");
+  if (o.technique == "auto" && !o.knobs.empty())
+    throw CommandFailure(2, "--knob: name a technique (knobs are a technique's own), not --technique auto");
+  const int level = o.technique == "auto" ? kAutoLevel : resolve_level(o.technique, o.level, true);
   SourceOptions so;
   so.env = o.env;
   if (!o.env.empty()) {
@@ -193,12 +197,12 @@ void run_live(const LiveOptions& o) {
   settings.technique = o.technique;
   settings.level = level;
   settings.frame_budget_ms = o.budget_ms;
-  settings.knobs = parse_knobs(o.technique, o.knobs);
+  if (!o.knobs.empty()) settings.knobs = parse_knobs(o.technique, o.knobs);
   settings.exposure = info.exposure;
   CameraSetup cameras{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera};
   auto runtime = take(create_runtime(settings, cameras, scene));
   const int out_w = info.color.width, out_h = info.color.height;
-  ReplayMeta meta{source->name(), o.technique, level,
+  ReplayMeta meta{source->name(), runtime->technique(), level,
                   level == kAutoLevel ? "auto" : runtime->level_names()[size_t(level)], runtime->device().name,
                   runtime->memory_mib(), out_w, out_h};
   ReplayOutput output = take(ReplayOutput::create(o.out, meta));
@@ -293,7 +297,9 @@ void setup(CLI::App& app) {
   auto o = std::make_shared<LiveOptions>();
   CLI::App* cmd = app.add_subcommand("live", "Run a live source through a technique and write frames, stats and a summary");
   cmd->add_option("source", o->source, "openni:, openni:FILE.oni, v4l2:/dev/videoN, libcamera:ID, or a capture folder")->required();
-  cmd->add_option("--technique,-t", o->technique, "technique")->capture_default_str();
+  cmd->add_option("--technique,-t", o->technique,
+                  "technique (mrgi info lists them), or auto: chosen for the scene and the budget")
+      ->capture_default_str();
   cmd->add_option("--scene", o->scene, "scene.json (default: a 15 cm box in front of the camera, one real light)");
   cmd->add_option("--out,-o", o->out, "output folder (frames/, stats.json, summary.json, side_by_side.png); "
                                       "no preview window is implemented, so it is required")->required();
