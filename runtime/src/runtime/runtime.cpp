@@ -115,7 +115,7 @@ class RuntimeImpl final : public Runtime {
   // The technique's priming run (Technique::wants_priming_run): this frame run once, waited
   // for, its output dropped; the frames still in flight before it are collected into `outputs`.
   Status prime(const InputFrame& frame, SlotRecord& rec, std::vector<FrameOutput>& outputs,
-               std::string& note);
+               std::string& note, bool for_estimate);
 
   RuntimeSettings settings_;
   CameraSetup cameras_;
@@ -125,6 +125,7 @@ class RuntimeImpl final : public Runtime {
   int output_w_ = 0, output_h_ = 0;
   int level_ = 0;       // the fixed level, or the scheduler's choice when auto_level_
   bool auto_level_ = false;
+  bool warmed_up_ = false;  // the first frame's warm-up run is done (process)
   std::optional<sched::Scheduler> scheduler_;  // made at start-up whatever the level (no allocation later)
   // Declared in creation order; destroyed in reverse (the device outlives everything on it).
   std::unique_ptr<gpu::Context> context_;
@@ -461,7 +462,7 @@ Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame)
   auto slot = begin_slot(frame, outputs);
   if (!slot) return slot.error();
   SlotRecord* rec = *slot;
-  const auto t_work = std::chrono::steady_clock::now();
+  auto t_work = std::chrono::steady_clock::now();
 
   // A frame without a pose keeps the last known one (identity before any): the output is then
   // only right for a camera that did not move; the stats say so.
@@ -484,12 +485,22 @@ Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame)
     q.camera = cameras_.color;
     affected = runtime::virtual_influence_in_view(q, scene_.lights);
   }
-  if (affected && technique_->wants_priming_run()) {
+  // The first frame that runs the technique is run twice, the first run's output dropped, when
+  // the technique wants an estimate from the frames themselves (ssrt) or the scheduler chooses
+  // the quality: a CPU driver compiles each pipeline's variant at its first use (lavapipe: the
+  // virtual G-buffer's draw 145 ms on the sample's first frame, 6-8 ms after), which the first
+  // frame would otherwise pay beyond any budget. The repeat sees the same inputs, so the
+  // temporal filters and reuse caches are where one run of the frame would leave them, nearly.
+  const bool warm_up = auto_level_ && !warmed_up_;
+  const bool for_estimate = affected && technique_->wants_priming_run();
+  if (affected && (for_estimate || warm_up)) {
     std::string note;
-    MRGI_TRY(prime(frame, *rec, outputs, note));
+    warmed_up_ = true;
+    MRGI_TRY(prime(frame, *rec, outputs, note, for_estimate));
     slot = begin_slot(frame, outputs);
     if (!slot) return slot.error();
     rec = *slot;
+    t_work = std::chrono::steady_clock::now();  // the priming run is not this frame's own work
     notes.push_back(note);
   }
   if (!choice_reason_.empty()) {  // technique "auto": the first frame says what was chosen and why
@@ -505,7 +516,7 @@ Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame)
 }
 
 Status RuntimeImpl::prime(const InputFrame& frame, SlotRecord& rec,
-                          std::vector<FrameOutput>& outputs, std::string& note) {
+                          std::vector<FrameOutput>& outputs, std::string& note, bool for_estimate) {
   rec.priming = true;
   MRGI_TRY(record_and_submit(frame, rec, true));
   auto all = graph_->flush();
@@ -525,8 +536,9 @@ Status RuntimeImpl::prime(const InputFrame& frame, SlotRecord& rec,
   technique_->frames_completed();
   char ms[32];
   std::snprintf(ms, sizeof ms, "%.2f", prime_ms);
-  note = "technique: frame run twice, the first run (" + std::string(ms) +
-         " ms GPU, output dropped) primes " + technique_->name() + "'s estimate from this frame";
+  note = "technique: frame run twice, the first run (" + std::string(ms) + " ms GPU, output dropped) " +
+         (for_estimate ? "primes " + technique_->name() + "'s estimate from this frame"
+                                          : std::string("warms the driver up (its first use of each pipeline)"));
   return ok_status();
 }
 

@@ -69,7 +69,7 @@ class Scheduler {
 
  private:
   static constexpr int kMaxWindow = 64;
-  static constexpr int kWarmupFrames = 3;
+  static constexpr int kWarmupFrames = 1;  // the runtime primes its first frame (runtime.cpp)
   void change_level(int level);
   double normalised_median() const;
   SchedulerSettings s_;
