@@ -107,6 +107,24 @@ TEST(SceneJson, WriteThenReadRoundTrips) {
   ASSERT_EQ(moved->virtual_objects[0].motion.size(), 2u);
   EXPECT_EQ(moved->virtual_objects[0].motion[1].time_s, 0.5);
   EXPECT_EQ(moved->virtual_objects[0].motion[1].placement.position, glm::vec3(1.0f, 2.0f, 3.0f));
+  // And a lamp's: position, direction and intensity per key; lamp_at interpolates them.
+  SceneDesc lit = *scene;
+  ASSERT_EQ(lit.lights[0].type, LightType::Point);
+  LampKey k0{0.0, glm::vec3(0.0f, 2.0f, 0.0f), glm::vec3(0.0f, -1.0f, 0.0f), 1.0f};
+  LampKey k1{1.0, glm::vec3(1.0f, 2.0f, 0.0f), glm::vec3(0.0f, -1.0f, 0.0f), 0.0f};
+  lit.lights[0].motion = {k0, k1};
+  ASSERT_TRUE(write_scene_json(f.dir.file("out/lit.json"), lit).ok());
+  auto lit_back = load_scene_json(f.dir.file("out/lit.json"));
+  ASSERT_TRUE(lit_back.ok()) << lit_back.error().message;
+  ASSERT_EQ(lit_back->lights[0].motion.size(), 2u);
+  EXPECT_EQ(lit_back->lights[0].motion[1].position, glm::vec3(1.0f, 2.0f, 0.0f));
+  EXPECT_EQ(lit_back->lights[0].motion[1].intensity, 0.0f);
+  const LightDesc mid = lamp_at(lit_back->lights[0], 0.25);
+  EXPECT_NEAR(mid.position.x, 0.25f, 1e-6f);
+  EXPECT_NEAR(mid.intensity, 0.75f, 1e-6f);
+  EXPECT_TRUE(mid.motion.empty());
+  EXPECT_EQ(lamp_at(lit_back->lights[0], -5.0).position, k0.position);  // held outside the keys
+  EXPECT_EQ(lamp_at(lit_back->lights[0], 9.0).intensity, 0.0f);
   EXPECT_EQ(back->environment.intensity, scene->environment.intensity);
   EXPECT_EQ(back->real_geometry[0].material.base_color, scene->real_geometry[0].material.base_color);
 }
@@ -168,6 +186,14 @@ INSTANTIATE_TEST_SUITE_P(
                  ErrorKind::BadInput, "virtual_objects[0].motion[0].time", "required key is missing"},
         BadScene{R"({"version": 1, "virtual_objects": [{"gltf": "models/box.glb", "motion": [{"time": 0, "scale": -1}]}]})",
                  ErrorKind::BadInput, "virtual_objects[0].motion[0].scale", "must be positive"},
+        BadScene{R"({"version": 1, "lights": [{"type": "point", "real": true, "position": [0, 1, 0], "motion": [{"time": 1}, {"time": 0}]}]})",
+                 ErrorKind::BadInput, "lights[0].motion", "increase strictly"},
+        BadScene{R"({"version": 1, "lights": [{"type": "point", "real": true, "position": [0, 1, 0], "motion": [{"time": 0, "direction": [0, -1, 0]}]}]})",
+                 ErrorKind::BadInput, "lights[0].motion[0].direction", "point light has no direction"},
+        BadScene{R"({"version": 1, "lights": [{"type": "spot", "real": true, "position": [0, 1, 0], "direction": [0, -1, 0], "motion": [{"time": 0, "direction": [0, 0, 0]}]}]})",
+                 ErrorKind::BadInput, "lights[0].motion[0].direction", "non-zero"},
+        BadScene{R"({"version": 1, "lights": [{"type": "point", "real": true, "position": [0, 1, 0], "motion": [{"time": 0, "intensity": -2}]}]})",
+                 ErrorKind::BadInput, "lights[0].motion[0].intensity", ">= 0"},
         BadScene{R"({"version": 1, "virtual_objects": [{"gltf": "models/box.glb", "motion": [{"time": 0, "speed": 1}]}]})",
                  ErrorKind::BadInput, "virtual_objects[0].motion[0].speed", "unknown key"},
         BadScene{R"({"version": 1, "virtual_objects": [{"gltf": "models/box.glb", "position": [1, 2]}]})",

@@ -41,6 +41,15 @@ struct VirtualObjectDesc {
 Placement placement_at(const std::vector<PoseKey>& motion, double t);
 
 enum class LightType { Point, Spot, Directional };
+// A keyframe of a lamp's motion (scene.json lights[].motion): where it is, where it points and
+// how bright it is at `time_s` (the frames' timestamp clock).
+struct LampKey {
+  double time_s = 0.0;
+  glm::vec3 position{0.0f};                 // point, spot
+  glm::vec3 direction{0.0f, -1.0f, 0.0f};   // spot, directional (unit)
+  float intensity = 1.0f;                   // 0: off
+};
+
 struct LightDesc {
   LightType type = LightType::Point;
   bool real = true;                   // a real lamp (in the camera image) or a virtual one
@@ -50,7 +59,16 @@ struct LightDesc {
   float intensity = 1.0f;             // W/sr (point/spot) or W/m^2 (directional), per channel
   float inner_angle_deg = 30.0f;      // spot: full intensity inside this half-angle
   float outer_angle_deg = 45.0f;      // spot: zero outside this half-angle
+  // Keyframed motion, times strictly increasing: each frame the runtime sets the lamp to the
+  // frame's timestamp, position and intensity interpolated linearly, direction by the
+  // normalised linear mix, held at the first and last keys outside them. Empty: it stays
+  // (an app can still change it, Runtime::set_lamp, which stops the motion).
+  std::vector<LampKey> motion;
 };
+
+// `lamp` as its motion has it at time t (without the motion: no allocation); `lamp.motion` must
+// not be empty.
+LightDesc lamp_at(const LightDesc& lamp, double t);
 
 struct EnvironmentDesc {
   bool present = false;

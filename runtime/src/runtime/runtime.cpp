@@ -90,7 +90,8 @@ class RuntimeImpl final : public Runtime {
   size_t lamp_count() const override { return scene_.lights.size(); }
   Status set_lamp(size_t lamp, const LightDesc& desc) override {
     MRGI_TRY(light_stage_->set_declared_lamp(lamp, desc));
-    scene_.lights[lamp] = light_stage_->declared_lamp(lamp);
+    app_lamp_[lamp] = 1;  // the app's from now on: scene.json's motion stops
+    keep_lamp(lamp);
     return ok_status();
   }
   Status set_object_visible(size_t object, bool visible) override {
@@ -145,6 +146,19 @@ class RuntimeImpl final : public Runtime {
   // Per virtual object: placed by the app (set_object_placement), whose placement then holds
   // instead of scene.json's motion.
   std::vector<uint8_t> app_placed_;
+  std::vector<uint8_t> app_lamp_;  // lamps the app set (Runtime::set_lamp): their motion no longer applies
+  // scene_.lights[i] takes the light stage's lamp i (what the influence test reads), field by
+  // field: its motion keys stay, and nothing is allocated.
+  void keep_lamp(size_t i) {
+    const LightDesc& now = light_stage_->declared_lamp(i);
+    LightDesc& l = scene_.lights[i];
+    l.position = now.position;
+    l.direction = now.direction;
+    l.color = now.color;
+    l.intensity = now.intensity;
+    l.inner_angle_deg = now.inner_angle_deg;
+    l.outer_angle_deg = now.outer_angle_deg;
+  }
 };
 
 RuntimeImpl::~RuntimeImpl() {
@@ -282,6 +296,7 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   if (!sg) return sg.error();
   scene_gpu_ = std::move(*sg);
   app_placed_.assign(scene_gpu_->object_count(), 0);
+  app_lamp_.assign(scene_.lights.size(), 0);
   if (!(settings.light_lag_frames >= 0.0 && settings.light_lag_frames <= 1e6))
     return fail(ErrorKind::BadUsage, "RuntimeSettings.light_lag_frames must be 0..1e6 frames");
   light::LightStageSettings ls;
@@ -436,6 +451,12 @@ Expected<SlotRecord*> RuntimeImpl::begin_slot(const InputFrame& frame,
     if (!motion.empty() && !app_placed_[i])
       MRGI_TRY(scene_gpu_->set_placement(i, placement_at(motion, frame.timestamp)));
   }
+  // The lamps where scene.json's motion has them at this frame's timestamp.
+  for (size_t i = 0; i < scene_.lights.size(); ++i)
+    if (!scene_.lights[i].motion.empty() && !app_lamp_[i]) {
+      MRGI_TRY(light_stage_->set_declared_lamp(i, lamp_at(scene_.lights[i], frame.timestamp)));
+      keep_lamp(i);
+    }
   scene_gpu_->commit(*graph_);
   SlotRecord& rec = slots_[graph_->slot()];
   rec.used = true;

@@ -40,6 +40,26 @@ Placement placement_at(const std::vector<PoseKey>& motion, double t) {
   return p;
 }
 
+LightDesc lamp_at(const LightDesc& lamp, double t) {
+  const std::vector<LampKey>& m = lamp.motion;
+  size_t i = 1;
+  while (i < m.size() && m[i].time_s < t) ++i;
+  const LampKey& a = t <= m.front().time_s ? m.front() : t >= m.back().time_s ? m.back() : m[i - 1];
+  const LampKey& b = t <= m.front().time_s ? m.front() : t >= m.back().time_s ? m.back() : m[i];
+  const float f = b.time_s > a.time_s ? float((t - a.time_s) / (b.time_s - a.time_s)) : 0.0f;
+  LightDesc out;  // field by field: the motion is not copied
+  out.type = lamp.type;
+  out.real = lamp.real;
+  out.color = lamp.color;
+  out.inner_angle_deg = lamp.inner_angle_deg;
+  out.outer_angle_deg = lamp.outer_angle_deg;
+  out.position = glm::mix(a.position, b.position, f);
+  const glm::vec3 d = glm::mix(a.direction, b.direction, f);
+  out.direction = glm::length(d) > 1e-6f ? glm::normalize(d) : a.direction;
+  out.intensity = glm::mix(a.intensity, b.intensity, f);
+  return out;
+}
+
 glm::mat4 Placement::matrix() const {
   const glm::mat4 t = glm::translate(glm::mat4(1.0f), position);
   const glm::mat4 r = glm::mat4_cast(glm::normalize(rotation));
@@ -146,9 +166,37 @@ Expected<VirtualObjectDesc> read_virtual_object(const JsonObject& obj, const fs:
   return desc;
 }
 
+// A lamp's keyframe: "time", and any of "position", "direction", "intensity" (the lamp's own
+// where a key leaves one out).
+Expected<LampKey> read_lamp_key(const JsonObject& obj, const LightDesc& lamp) {
+  MRGI_TRY(obj.only_keys({"time", "position", "direction", "intensity"}));
+  LampKey key;
+  auto t = obj.number("time");
+  if (!t) return t.error();
+  if (!std::isfinite(*t)) return obj.error("time", "must be a finite number of seconds");
+  key.time_s = *t;
+  if (lamp.type == LightType::Directional && obj.has("position"))
+    return obj.error("position", "a directional light has no position (remove the key)");
+  if (lamp.type == LightType::Point && obj.has("direction"))
+    return obj.error("direction", "a point light has no direction (remove the key)");
+  auto pos = obj.vec3("position", glm::dvec3(lamp.position));
+  if (!pos) return pos.error();
+  key.position = glm::vec3(*pos);
+  auto dir = obj.vec3("direction", glm::dvec3(lamp.direction));
+  if (!dir) return dir.error();
+  const double len = glm::length(*dir);
+  if (!(len > 1e-9)) return obj.error("direction", "must be non-zero");
+  key.direction = glm::vec3(*dir / len);
+  auto intensity = obj.number("intensity", double(lamp.intensity));
+  if (!intensity) return intensity.error();
+  if (!(*intensity >= 0.0) || !std::isfinite(*intensity)) return obj.error("intensity", "must be a finite number >= 0");
+  key.intensity = float(*intensity);
+  return key;
+}
+
 Expected<LightDesc> read_light(const JsonObject& obj) {
   MRGI_TRY(obj.only_keys({"type", "real", "position", "direction", "color", "intensity",
-                          "inner_angle_deg", "outer_angle_deg"}));
+                          "inner_angle_deg", "outer_angle_deg", "motion"}));
   LightDesc light;
   auto type = obj.string("type");
   if (!type) return type.error();
@@ -207,6 +255,12 @@ Expected<LightDesc> read_light(const JsonObject& obj) {
     for (std::string_view key : {"inner_angle_deg", "outer_angle_deg"})
       if (obj.has(key)) return obj.error(key, "cone angles apply to spot lights only");
   }
+  MRGI_TRY(read_list(obj, "motion", &light.motion, [&](const JsonObject& o) { return read_lamp_key(o, light); }));
+  for (size_t i = 1; i < light.motion.size(); ++i)
+    if (!(light.motion[i].time_s > light.motion[i - 1].time_s))
+      return obj.error("motion", "key times must increase strictly (key " + std::to_string(i) + " at " +
+                                     std::to_string(light.motion[i].time_s) + " s after " +
+                                     std::to_string(light.motion[i - 1].time_s) + " s)");
   return light;
 }
 
@@ -354,6 +408,17 @@ Status write_scene_json(const std::string& path, const SceneDesc& scene) {
     if (l.type == LightType::Spot) {
       e["inner_angle_deg"] = l.inner_angle_deg;
       e["outer_angle_deg"] = l.outer_angle_deg;
+    }
+    if (!l.motion.empty()) {
+      e["motion"] = nlohmann::json::array();
+      for (const LampKey& k : l.motion) {
+        nlohmann::json key;
+        key["time"] = k.time_s;
+        if (l.type != LightType::Directional) key["position"] = {k.position.x, k.position.y, k.position.z};
+        if (l.type != LightType::Point) key["direction"] = {k.direction.x, k.direction.y, k.direction.z};
+        key["intensity"] = k.intensity;
+        e["motion"].push_back(key);
+      }
     }
     j["lights"].push_back(e);
   }
