@@ -183,6 +183,7 @@ Status check_scheduler_settings(const RuntimeSettings& rs, size_t levels) {
   const SchedulerSettings& s = rs.scheduler;
   if (!(s.headroom >= 0.0 && s.headroom < 0.9)) return bad("scheduler.headroom", "must be in [0, 0.9)");
   if (s.window_frames < 1 || s.window_frames > 64) return bad("scheduler.window_frames", "must be 1..64");
+  if (!(s.quantile >= 0.0 && s.quantile <= 1.0)) return bad("scheduler.quantile", "must be in [0, 1]");
   if (!(s.dead_band_below >= 0.0 && s.dead_band_below < 1.0) || !(s.dead_band_above >= 0.0 && s.dead_band_above < 1.0))
     return bad("scheduler.dead_band_below/above", "must be in [0, 1)");
   if (!(s.scale_gain > 0.0 && s.scale_gain <= 1.0)) return bad("scheduler.scale_gain", "must be in (0, 1]");

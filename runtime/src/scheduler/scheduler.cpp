@@ -40,12 +40,12 @@ double Scheduler::predict(int level, float scale) const {
   return c * scale_factor(scale);
 }
 
-double Scheduler::normalised_median() const {
+double Scheduler::normalised_quantile(double q) const {
   std::array<double, kMaxWindow> v{};
   std::copy(window_.begin(), window_.begin() + window_count_, v.begin());
-  auto mid = v.begin() + window_count_ / 2;
-  std::nth_element(v.begin(), mid, v.begin() + window_count_);
-  return *mid;
+  const int k = std::clamp(int(std::floor(q * double(window_count_ - 1) + 0.5)), 0, window_count_ - 1);
+  std::nth_element(v.begin(), v.begin() + k, v.begin() + window_count_);
+  return v[size_t(k)];
 }
 
 void Scheduler::change_level(int level) {
@@ -87,7 +87,7 @@ void Scheduler::observe(int level, float scale, double cost_ms, bool technique_r
   // constant of about 8 frames; the first median taken as it is).
   if (window_count_ >= std::min(3, s_.window_frames)) {
     double& m = model_[size_t(level)];
-    const double med = normalised_median();
+    const double med = normalised_quantile(0.5);
     m = m <= 0.0 ? med : m + 0.12 * (med - m);
   }
 
@@ -109,7 +109,8 @@ void Scheduler::observe(int level, float scale, double cost_ms, bool technique_r
   }
   if (window_count_ < std::min(3, s_.window_frames)) return;
 
-  const double median_norm = normalised_median();
+  // The controlled signal: the window's quantile (SchedulerSettings::quantile), at full scale.
+  const double median_norm = normalised_quantile(s_.quantile);
   const double current = median_norm * scale_factor(choice_.scale);
   const bool may_change_level = frames_ - changed_at_ >= s_.min_frames_between_changes;
   const bool in_band = current >= target * (1.0 - s_.dead_band_below) && current <= target * (1.0 + s_.dead_band_above);

@@ -5,9 +5,11 @@
 // and is unit-tested on simulated cost traces (tests/unit/test_scheduler.cpp).
 //
 // How it decides (constants in mrgi/runtime.h SchedulerSettings, with where each comes from):
-//   - the signal is the median cost of the last `window_frames` frames at the current level (a
-//     median, as Filament's dynamic-resolution controller, so one spike moves nothing), each
-//     frame's cost normalised to full internal resolution with the cost model below;
+//   - the signal is a high quantile (`quantile`, 0.8) of the cost of the last `window_frames`
+//     frames at the current level (an order statistic, as Filament's median, so a spike or two
+//     move nothing; higher than the median because a CPU device's frame times scatter), each
+//     frame's cost normalised to full internal resolution with the cost model below; the
+//     model learns each level's cost from the window's median;
 //   - the target is the budget less `headroom` (Unreal's 10 %); inside a dead band around it
 //     (Filament's -1 % / +5 %) nothing changes;
 //   - internal resolution is the continuous knob inside a level: a damped step of the scale
@@ -71,7 +73,7 @@ class Scheduler {
   static constexpr int kMaxWindow = 64;
   static constexpr int kWarmupFrames = 1;  // the runtime primes its first frame (runtime.cpp)
   void change_level(int level);
-  double normalised_median() const;
+  double normalised_quantile(double q) const;  // of the window (normalised to full scale)
   SchedulerSettings s_;
   double budget_ms_;
   std::vector<double> prior_;     // per level, ms at scale 1
