@@ -20,7 +20,11 @@ Scheduler::Scheduler(const SchedulerSettings& settings, double budget_ms, std::v
   cooldown_.assign(prior_.size(), 0);
   left_at_.assign(prior_.size(), -1000000);
   choice_.level = std::clamp(start_level, 0, int(prior_.size()) - 1);
-  choice_.scale = 1.0f;
+  // A cautious start: nothing has been measured on this device and scene, so the first frames
+  // aim at three quarters of the target by the priors; the controller raises the resolution as
+  // soon as its window shows room (the 8-frame sample otherwise spent its first frames over).
+  const double target = budget_ms_ * (1.0 - s_.headroom);
+  choice_.scale = std::clamp(scale_for_factor(0.75 * target / std::max(1e-6, predict(choice_.level, 1.0f))), s_.min_scale, 1.0f);
   choice_.predicted_ms = predict(choice_.level, choice_.scale);
 }
 
@@ -89,6 +93,12 @@ void Scheduler::observe(int level, float scale, double cost_ms, bool technique_r
     double& m = model_[size_t(level)];
     const double med = normalised_quantile(0.5);
     m = m <= 0.0 ? med : m + 0.12 * (med - m);
+    // What was learned of the other levels goes stale (it was measured under another load):
+    // each drifts toward the current level's cost scaled by the priors' ratio, with a time
+    // constant of about 50 frames, so a level left under a load it could not meet is tried
+    // again once the load has gone (load test: level 3 held after the load ended).
+    for (size_t o = 0; o < model_.size(); ++o)
+      if (o != size_t(level) && model_[o] > 0.0) model_[o] += 0.02 * (m * prior_[o] / prior_[size_t(level)] - model_[o]);
   }
 
   const double target = budget_ms_ * (1.0 - s_.headroom);
