@@ -1,5 +1,6 @@
 #include "mrgi/perf/regression.h"
 
+#include <sstream>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -308,6 +309,70 @@ std::string CheckReport::summary() const {
   for (const auto& m : missing_in_baseline) s += "  in this run, not in the baseline: " + m + "\n";
   for (const auto& n : notes) s += "  note: " + n + "\n";
   return s;
+}
+
+namespace {
+std::string xml_escape(const std::string& t) {
+  std::string o;
+  for (char c : t) {
+    switch (c) {
+      case '&': o += "&amp;"; break;
+      case '<': o += "&lt;"; break;
+      case '>': o += "&gt;"; break;
+      case '"': o += "&quot;"; break;
+      default: o += c;
+    }
+  }
+  return o;
+}
+}  // namespace
+
+std::string junit_xml(const BenchResult& result, const CheckReport& report) {
+  // One test case per run entry (its findings name it first: "scene/technique/level: ..."),
+  // one for the run-wide pass rule and one for the run as a whole (settings, missing entries).
+  struct Case {
+    std::string name;
+    std::vector<std::string> failures;
+  };
+  std::vector<Case> cases;
+  for (const BenchEntry& e : result.entries) cases.push_back({key_text(e.scene, e.technique, e.level_name), {}});
+  Case passes{"passes (whole run)", {}}, run{"run", {}};
+  for (const std::string& v : report.violations) {
+    bool placed = false;
+    for (Case& c : cases)
+      if (v.compare(0, c.name.size() + 1, c.name + ":") == 0) {
+        c.failures.push_back(v);
+        placed = true;
+        break;
+      }
+    if (placed) continue;
+    (v.rfind("pass ", 0) == 0 ? passes : run).failures.push_back(v);
+  }
+  if (!report.subset_run)
+    for (const std::string& m : report.missing_in_run) run.failures.push_back("missing in the run: " + m);
+  if (report.compared == 0) run.failures.push_back("nothing compared: no run entry has a baseline entry");
+  cases.push_back(passes);
+  cases.push_back(run);
+  size_t failed = 0;
+  for (const Case& c : cases) failed += c.failures.empty() ? 0 : 1;
+  std::ostringstream o;
+  o << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+  o << "<testsuites name=\"mrgi bench --check\" tests=\"" << cases.size() << "\" failures=\"" << failed << "\">\n";
+  o << "  <testsuite name=\"mrgi.bench.regression\" tests=\"" << cases.size() << "\" failures=\"" << failed << "\">\n";
+  for (const Case& c : cases) {
+    o << "    <testcase classname=\"mrgi.bench\" name=\"" << xml_escape(c.name) << "\"";
+    if (c.failures.empty()) {
+      o << "/>\n";
+      continue;
+    }
+    o << ">\n";
+    for (const std::string& f : c.failures)
+      o << "      <failure message=\"" << xml_escape(f) << "\">" << xml_escape(f) << "</failure>\n";
+    o << "    </testcase>\n";
+  }
+  for (const std::string& n : report.notes) o << "    <system-out>" << xml_escape(n) << "</system-out>\n";
+  o << "  </testsuite>\n</testsuites>\n";
+  return o.str();
 }
 
 }  // namespace mrgi::perf

@@ -382,6 +382,7 @@ Status write_bench_outputs(const std::string& dir_in, const BenchResult& r, cons
   MRGI_TRY(write_text(partial + "/report.md", report_markdown(r, check)));
   MRGI_TRY(write_png(partial + "/pareto.png", render_pareto_plot(r)));
   MRGI_TRY(write_png(partial + "/passes.png", render_pass_plot(r)));
+  if (check) MRGI_TRY(write_text(partial + "/junit.xml", junit_xml(r, *check)));
   return out->commit();
 }
 

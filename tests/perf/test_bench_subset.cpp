@@ -122,6 +122,11 @@ void check_outputs(const perf::BenchResult& r) {
   const std::string md((std::istreambuf_iterator<char>(mf)), std::istreambuf_iterator<char>());
   EXPECT_NE(md.find("## baseline"), std::string::npos);
   EXPECT_NE(md.find("regression check PASSED"), std::string::npos);
+  // The check as JUnit XML beside the report, and the pass chart.
+  std::ifstream junit_file(out + "/junit.xml");
+  const std::string junit((std::istreambuf_iterator<char>(junit_file)), std::istreambuf_iterator<char>());
+  EXPECT_NE(junit.find("<testsuite name=\"mrgi.bench.regression\""), std::string::npos) << junit;
+  EXPECT_TRUE(fs::exists(out + "/passes.png"));
   auto png = mrgi::load_png_rgb8(out + "/pareto.png");
   ASSERT_TRUE(png.ok()) << png.error().message;
   EXPECT_EQ(png->width, 960);

@@ -95,6 +95,25 @@ TEST(Regression, PassesAgainstItself) {
   EXPECT_TRUE(rep.missing_in_baseline.empty());
 }
 
+// junit.xml: one test case per entry, the finding a <failure> of the entry it names; a clean
+// check has no failure.
+TEST(Regression, JunitXmlPutsEachFindingOnItsEntry) {
+  const perf::BenchResult r = constructed_result();
+  perf::Baseline b = perf::make_baseline(r);
+  const std::string clean = perf::junit_xml(r, perf::check_against(r, b));
+  EXPECT_NE(clean.find("<testsuites name=\"mrgi bench --check\" tests=\"6\" failures=\"0\">"), std::string::npos) << clean;
+  EXPECT_EQ(clean.find("<failure"), std::string::npos);
+  b.entries[1].ratio_to_floor /= 2.0;
+  const std::string xml = perf::junit_xml(r, perf::check_against(r, b));
+  EXPECT_NE(xml.find("failures=\"1\""), std::string::npos) << xml;
+  const size_t c = xml.find("name=\"desk/baseline/low\">");
+  ASSERT_NE(c, std::string::npos) << xml;
+  const size_t f = xml.find("<failure message=\"desk/baseline/low: sustained frame time ratio", c);
+  EXPECT_NE(f, std::string::npos) << xml;
+  EXPECT_LT(f, xml.find("</testcase>", c));
+  EXPECT_NE(xml.find("name=\"desk/baseline/high\"/>"), std::string::npos) << xml;
+}
+
 TEST(Regression, RatioGrowthBeyondToleranceFails) {
   const perf::BenchResult r = constructed_result();
   perf::Baseline b = perf::make_baseline(r);

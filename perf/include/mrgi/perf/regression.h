@@ -84,4 +84,9 @@ struct CheckReport {
 
 CheckReport check_against(const BenchResult& result, const Baseline& baseline);
 
+// The check as JUnit XML (junit.xml beside the report), for CI systems that show test results:
+// a test case per run entry, one for the run-wide pass rule, one for the run itself; each finding
+// a <failure> of the case it names.
+std::string junit_xml(const BenchResult& result, const CheckReport& report);
+
 }  // namespace mrgi::perf
