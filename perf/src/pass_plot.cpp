@@ -13,10 +13,11 @@
 #include "mrgi/perf/report.h"
 
 namespace mrgi::perf {
+// Names of their own: the unity build (MRGI_UNITY_LIBS) puts this file beside pareto_plot.cpp.
 namespace {
 
-constexpr int kWidth = 1100;
-constexpr float kLeft = 210, kRight = 290, kTop = 70, kBottom = 80, kBar = 22, kGap = 10;
+constexpr int kBarsWidth = 1100;
+constexpr float kBarsLeft = 210, kBarsRight = 290, kBarsTop = 70, kBarsBottom = 80, kBarHeight = 22, kBarGap = 10;
 constexpr size_t kColouredPasses = 9;
 constexpr double kBudgetMs = 1000.0 / 30.0;
 
@@ -58,9 +59,9 @@ std::vector<LevelBar> level_bars(const BenchResult& r) {
 ImageRGB8 render_pass_plot(const BenchResult& result) {
   const Rgb white{255, 255, 255}, black{0, 0, 0}, grid{225, 225, 225}, dark{70, 70, 70}, other{190, 190, 190};
   const std::vector<LevelBar> bars = level_bars(result);
-  const int height = int(kTop + kBottom + std::max<size_t>(1, bars.size()) * (kBar + kGap) + kGap);
-  Canvas cv(kWidth, height, white);
-  const float px0 = kLeft, px1 = kWidth - kRight, py0 = kTop, py1 = float(height) - kBottom;
+  const int height = int(kBarsTop + kBarsBottom + std::max<size_t>(1, bars.size()) * (kBarHeight + kBarGap) + kBarGap);
+  Canvas cv(kBarsWidth, height, white);
+  const float px0 = kBarsLeft, px1 = kBarsWidth - kBarsRight, py0 = kBarsTop, py1 = float(height) - kBarsBottom;
 
   // The costliest passes over the run get colours, in order of total time.
   std::map<std::string, double> total;
@@ -92,19 +93,19 @@ ImageRGB8 render_pass_plot(const BenchResult& result) {
   cv.line(bx, py0 - 6, bx, py1, 1.5f, {200, 0, 0}, 8.0f);
   cv.text(bx + 4, py0 - 16, "33.3 ms", 1.5f, {200, 0, 0});
 
-  float y = py0 + kGap;
+  float y = py0 + kBarGap;
   for (const LevelBar& b : bars) {
-    cv.text(px0 - 10 - Canvas::text_width(b.label, 1.5f), y + kBar / 2 - Canvas::text_height(1.5f) / 2, b.label,
+    cv.text(px0 - 10 - Canvas::text_width(b.label, 1.5f), y + kBarHeight / 2 - Canvas::text_height(1.5f) / 2, b.label,
             1.5f, black);
     double x = 0.0;
     for (const auto& [name, ms] : b.passes) {
       auto it = colour.find(name);
-      cv.fill_rect(sx(x), y, sx(x + ms), y + kBar, it == colour.end() ? other : it->second);
+      cv.fill_rect(sx(x), y, sx(x + ms), y + kBarHeight, it == colour.end() ? other : it->second);
       x += ms;
     }
     const float tx = sx(b.sustained_ms);
-    cv.fill_rect(tx - 1.5f, y - 4, tx + 1.5f, y + kBar + 4, black);
-    y += kBar + kGap;
+    cv.fill_rect(tx - 1.5f, y - 4, tx + 1.5f, y + kBarHeight + 4, black);
+    y += kBarHeight + kBarGap;
   }
   if (bars.empty()) {
     const std::string msg = "no levels in this run";
