@@ -53,6 +53,7 @@ struct SlotRecord {
   int64_t frame_index = 0;
   int level = 0;
   float internal_scale = 1.0f;  // the level's internal scale x the scheduler's factor
+  float scale_factor = 1.0f;    // the scheduler's factor alone
   double predicted_ms = 0.0;    // the scheduler's prediction for this frame
   bool scheduled = false;
   bool technique_ran = false;
@@ -127,6 +128,7 @@ class RuntimeImpl final : public Runtime {
   int level_ = 0;       // the fixed level, or the scheduler's choice when auto_level_
   bool auto_level_ = false;
   bool warmed_up_ = false;  // the first frame's warm-up run is done (process)
+  bool cpu_device_ = false;  // a CPU device (lavapipe): host and device work share the cores
   std::optional<sched::Scheduler> scheduler_;  // made at start-up whatever the level (no allocation later)
   // Declared in creation order; destroyed in reverse (the device outlives everything on it).
   std::unique_ptr<gpu::Context> context_;
@@ -281,6 +283,7 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   auto ctx = gpu::Context::create(settings.device);
   if (!ctx) return ctx.error();
   context_ = std::move(*ctx);
+  cpu_device_ = context_->info().type == "cpu";
   gpu::FrameGraphSettings gs;
   gs.max_output_width = uint32_t(output_w_);
   gs.max_output_height = uint32_t(output_h_);
@@ -582,8 +585,8 @@ Status RuntimeImpl::prime(const InputFrame& frame, SlotRecord& rec,
 // compose's camera-copy pipeline resamples it (2-3 ms). Recon and the technique are not added.
 Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, bool affected) {
   const technique::QualityLevel& level = technique_->levels()[size_t(level_)];
-  const float factor = auto_level_ ? scheduler_->choice().scale : 1.0f;
-  rec.internal_scale = level.internal_scale * factor;
+  rec.scale_factor = auto_level_ ? scheduler_->choice().scale : 1.0f;
+  rec.internal_scale = level.internal_scale * rec.scale_factor;
   MRGI_TRY(graph_->set_render_scale(rec.internal_scale));
   rec.technique_ran = affected;
   write_constants(last_pose_);
@@ -699,8 +702,8 @@ Expected<FrameOutput> RuntimeImpl::collect(const gpu::FrameTimings& timings) {
   // The frame's cost: its device time and its own host work (the readback included); on a CPU
   // device they take turns on the same cores, on a GPU they overlap.
   const double host_work = rec.host_work_ms + readback_ms;
-  out.stats.cost_ms = context_->info().type == "cpu" ? timings.total_ms + host_work : std::max(timings.total_ms, host_work);
-  if (!rec.priming) scheduler_->observe(rec.level, rec.level < int(technique_->levels().size()) ? rec.internal_scale / std::max(1e-6f, technique_->levels()[size_t(rec.level)].internal_scale) : 1.0f, out.stats.cost_ms, rec.technique_ran && !timings.profiled);
+  out.stats.cost_ms = cpu_device_ ? timings.total_ms + host_work : std::max(timings.total_ms, host_work);
+  if (!rec.priming) scheduler_->observe(rec.level, rec.scale_factor, out.stats.cost_ms, rec.technique_ran && !timings.profiled);
   out.stats.light_ms = rec.light_ms;
   out.stats.skipped = rec.skipped;
   for (const std::string& c : timings.culled) out.stats.skipped.push_back(c + ": culled (nothing reads it)");
