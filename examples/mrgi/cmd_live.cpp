@@ -36,9 +36,8 @@ std::atomic<bool> g_stop{false};
 void on_sigint(int) { g_stop = true; }
 
 struct LiveOptions {
-  std::string source, technique = "baseline", scene, out, level = "auto", device, env, env_model;
-  double budget_ms = 1000.0 / 30.0;
-  std::vector<std::string> knobs;
+  std::string source, scene, out, device, env, env_model;
+  QualityOptions quality;
   int frames = 0, timeout_ms = 3000;
   bool quiet = false;
 };
@@ -156,11 +155,9 @@ struct TempFolder {
 };
 
 void run_live(const LiveOptions& o) {
-  if (o.technique == "auto" && o.level != "auto")
-    throw CommandFailure(2, "--technique auto: the level is the scheduler's (--level auto)");
-  if (o.technique == "auto" && !o.knobs.empty())
-    throw CommandFailure(2, "--knob: name a technique (knobs are a technique's own), not --technique auto");
-  const int level = o.technique == "auto" ? kAutoLevel : resolve_level(o.technique, o.level, true);
+  RuntimeSettings settings;
+  o.quality.apply(settings);  // before the source is opened: a bad level or knob ends here
+  const int level = settings.level;
   SourceOptions so;
   so.env = o.env;
   if (!o.env.empty()) {
@@ -192,12 +189,7 @@ void run_live(const LiveOptions& o) {
     scene = default_scene(glb, central_depth_m(*first, info.depth_scale));
   }
 
-  RuntimeSettings settings;
   settings.device.device = o.device;
-  settings.technique = o.technique;
-  settings.level = level;
-  settings.frame_budget_ms = o.budget_ms;
-  if (!o.knobs.empty()) settings.knobs = parse_knobs(o.technique, o.knobs);
   settings.exposure = info.exposure;
   CameraSetup cameras{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera};
   auto runtime = take(create_runtime(settings, cameras, scene));
@@ -229,7 +221,7 @@ void run_live(const LiveOptions& o) {
           encoded.put(std::move(f->output));
           ++written;
           if (!o.quiet)
-            progress("live " + o.technique, written, o.frames > 0 ? size_t(o.frames) : written,
+            progress("live " + o.quality.technique, written, o.frames > 0 ? size_t(o.frames) : written,
                      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
         }
       },
@@ -297,21 +289,11 @@ void setup(CLI::App& app) {
   auto o = std::make_shared<LiveOptions>();
   CLI::App* cmd = app.add_subcommand("live", "Run a live source through a technique and write frames, stats and a summary");
   cmd->add_option("source", o->source, "openni:, openni:FILE.oni, v4l2:/dev/videoN, libcamera:ID, or a capture folder")->required();
-  cmd->add_option("--technique,-t", o->technique,
-                  "technique (mrgi info lists them), or auto: chosen for the scene and the budget")
-      ->capture_default_str();
+  o->quality.add(*cmd);
   cmd->add_option("--scene", o->scene, "scene.json (default: a 15 cm box in front of the camera, one real light)");
   cmd->add_option("--out,-o", o->out, "output folder (frames/, stats.json, summary.json, side_by_side.png); "
                                       "no preview window is implemented, so it is required")->required();
   cmd->add_option("--frames,-n", o->frames, "stop after N frames (0 = until the stream ends or Ctrl-C)")->check(CLI::NonNegativeNumber);
-  cmd->add_option("--knob", o->knobs, "set one quality knob at every level, NAME=VALUE (repeatable; mrgi info --technique T lists them with their spans)");
-  cmd->add_option("--level,-l", o->level,
-                  "quality level: 'auto' = the scheduler chooses the level and internal resolution every frame to "
-                  "hold --budget-ms; or fixed: 0 = best, N, a level name, or 'last' = cheapest")
-      ->capture_default_str();
-  cmd->add_option("--budget-ms", o->budget_ms, "frame budget the scheduler holds, ms (--level auto)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.1, 1e6));
   cmd->add_option("--device", o->device, "Vulkan device: index or name part");
   cmd->add_option("--env", o->env, "fisheye environment camera, v4l2:/dev/videoN or libcamera:ID (needs a calibrated model)");
   cmd->add_option("--env-model", o->env_model, "capture.json whose env_camera (fisheye equidistant) and exposure calibrate --env");

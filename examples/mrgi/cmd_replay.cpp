@@ -45,20 +45,19 @@ std::vector<std::string> ablation_names(const AblationName<A> (&names)[N]) {
 }
 
 struct ReplayOptions {
-  std::string capture, technique = "baseline", out, level = "auto", device, light = "declared", video;
-  double budget_ms = 1000.0 / 30.0;
+  std::string capture, out, device, light = "declared", video;
+  QualityOptions quality;
   std::vector<std::string> dlpv_ablation;
   std::vector<std::string> dir_ablation;
-  std::vector<std::string> knobs;
   int frames = 0, width = 0, height = 0;
   bool validate = false, quiet = false, vulkan_1_2 = false, no_residual_light = false;
 };
 
 void run_replay(const ReplayOptions& o) {
   if ((o.width == 0) != (o.height == 0)) throw CommandFailure(2, "--width and --height go together");
-  if (o.technique == "auto" && o.level != "auto")
-    throw CommandFailure(2, "--technique auto: the level is the scheduler's (--level auto)");
-  const int level = o.technique == "auto" ? kAutoLevel : resolve_level(o.technique, o.level, true);
+  RuntimeSettings settings;
+  o.quality.apply(settings);  // before any file is opened: a bad level or knob ends here
+  const int level = settings.level;
   if (!o.video.empty())
     if (Status st = VideoOutput::check(o.video, o.out); !st.ok()) fail_with(st.error());
   CaptureReader capture = take(CaptureReader::open(o.capture));
@@ -66,25 +65,18 @@ void run_replay(const ReplayOptions& o) {
   const size_t frames = o.frames > 0 ? std::min<size_t>(size_t(o.frames), capture.frame_count()) : capture.frame_count();
   if (frames == 0) throw CommandFailure(1, o.capture + ": capture has no frames");
 
-  RuntimeSettings settings;
   settings.device.device = o.device;
   settings.device.validate = o.validate;
   settings.device.vulkan_1_2 = o.vulkan_1_2;
   settings.residual_light = !o.no_residual_light;
-  settings.technique = o.technique;
-  settings.level = level;
-  settings.frame_budget_ms = o.budget_ms;
-  if (o.technique == "auto" && !o.knobs.empty())
-    throw CommandFailure(2, "--knob: name a technique (knobs are a technique's own), not --technique auto");
-  if (!o.knobs.empty()) settings.knobs = parse_knobs(o.technique, o.knobs);
   settings.output_width = o.width;
   settings.output_height = o.height;
   settings.exposure = info.exposure;
   set_ablations(o.dlpv_ablation, kDlpvAblations, settings.dlpv_ablation);
-  if (settings.dlpv_ablation.any() && o.technique != "dlpv")
+  if (settings.dlpv_ablation.any() && o.quality.technique != "dlpv")
     throw CommandFailure(2, "--dlpv-ablation: only for --technique dlpv");
   set_ablations(o.dir_ablation, kDirAblations, settings.dir_ablation);
-  if (settings.dir_ablation.any() && o.technique != "dir")
+  if (settings.dir_ablation.any() && o.quality.technique != "dir")
     throw CommandFailure(2, "--dir-ablation: only for --technique dir");
   CameraSetup cameras{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera};
   SceneDesc scene = capture.scene() ? *capture.scene() : SceneDesc{};
@@ -166,7 +158,7 @@ void run_replay(const ReplayOptions& o) {
           encoded.put(std::move(f->output));
           ++written;
           if (!o.quiet)
-            progress("replay " + o.technique, written, frames,
+            progress("replay " + o.quality.technique, written, frames,
                      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
         }
       },
@@ -225,21 +217,9 @@ void setup(CLI::App& app) {
   auto opts = std::make_shared<ReplayOptions>();
   CLI::App* cmd = app.add_subcommand("replay", "Replay a capture (format v1) through a technique and write frames, stats and a summary");
   cmd->add_option("capture", opts->capture, "capture folder (capture format v1, TUM RGB-D compatible)")->required();
-  cmd->add_option("--technique,-t", opts->technique, "technique: " + [] {
-    std::string s;
-    for (auto& n : technique_names()) s += (s.empty() ? "" : ", ") + n;
-    return s + ", or auto (chosen for the scene and the budget; the first frame's notes say why)";
-  }())->capture_default_str();
+  opts->quality.add(*cmd);
   cmd->add_option("--out,-o", opts->out, "output folder (frames/, stats.json, summary.json, side_by_side.png)")->required();
-  cmd->add_option("--level,-l", opts->level,
-                  "quality level: 'auto' = the scheduler chooses the level and internal resolution every frame to "
-                  "hold --budget-ms; or fixed: 0 = best, N, a level name, or 'last' = cheapest")
-      ->capture_default_str();
-  cmd->add_option("--budget-ms", opts->budget_ms, "frame budget the scheduler holds, ms (--level auto)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.1, 1e6));
   cmd->add_option("--frames,-n", opts->frames, "replay at most N frames (0 = all)")->check(CLI::NonNegativeNumber);
-  cmd->add_option("--knob", opts->knobs, "set one quality knob at every level, NAME=VALUE (repeatable; mrgi info --technique T lists them with their spans)");
   cmd->add_option("--video", opts->video,
                   "also write the composited frames as a clip: FILE.png (animated PNG, lossless) or "
                   "FILE.mp4/.mkv/.webm (needs ffmpeg on PATH), at the capture's frame rate");

@@ -52,6 +52,17 @@ int resolve_level(const std::string& technique, const std::string& level, bool a
 // ladder; a malformed or refused one ends the command with exit 2 and the knob's span.
 std::vector<KnobSetting> parse_knobs(const std::string& technique, const std::vector<std::string>& given);
 
+// The quality options replay and live share: --technique (a name or auto), --level (auto or
+// fixed), --budget-ms, --knob. add() declares them; apply() checks them together (exit 2 for a
+// combination that cannot be: auto with a fixed level or knobs) and fills the settings.
+struct QualityOptions {
+  std::string technique = "baseline", level = "auto";
+  double budget_ms = 1000.0 / 30.0;
+  std::vector<std::string> knobs;
+  void add(CLI::App& cmd);
+  void apply(RuntimeSettings& settings) const;  // technique, level, frame_budget_ms, knobs
+};
+
 // Progress on stderr for long work (one line, rewritten in place when stderr is a terminal).
 void progress(const std::string& what, size_t done, size_t total, double elapsed_s);
 

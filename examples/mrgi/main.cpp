@@ -78,6 +78,35 @@ std::vector<KnobSetting> parse_knobs(const std::string& technique, const std::ve
   return knobs;
 }
 
+void QualityOptions::add(CLI::App& cmd) {
+  cmd.add_option("--technique,-t", technique, "technique: " + [] {
+    std::string s;
+    for (auto& n : technique_names()) s += (s.empty() ? "" : ", ") + n;
+    return s + ", or auto (chosen for the scene and the budget; the first frame's notes say why)";
+  }())->capture_default_str();
+  cmd.add_option("--level,-l", level,
+                 "quality level: 'auto' = the scheduler chooses the level and internal resolution every frame to "
+                 "hold --budget-ms; or fixed: 0 = best, N, a level name, or 'last' = cheapest")
+      ->capture_default_str();
+  cmd.add_option("--budget-ms", budget_ms, "frame budget the scheduler holds, ms (--level auto)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 1e6));
+  cmd.add_option("--knob", knobs,
+                 "set one quality knob at every level, NAME=VALUE (repeatable; mrgi info --technique T lists them "
+                 "with their spans)");
+}
+
+void QualityOptions::apply(RuntimeSettings& settings) const {
+  if (technique == "auto" && level != "auto")
+    throw CommandFailure(2, "--technique auto: the level is the scheduler's (--level auto)");
+  if (technique == "auto" && !knobs.empty())
+    throw CommandFailure(2, "--knob: name a technique (knobs are a technique's own), not --technique auto");
+  settings.technique = technique;
+  settings.level = technique == "auto" ? kAutoLevel : resolve_level(technique, level, true);
+  settings.frame_budget_ms = budget_ms;
+  if (!knobs.empty()) settings.knobs = parse_knobs(technique, knobs);
+}
+
 void progress(const std::string& what, size_t done, size_t total, double elapsed_s) {
   const double eta = done > 0 ? elapsed_s / double(done) * double(total - done) : 0.0;
   const bool tty = isatty(STDERR_FILENO);
