@@ -129,6 +129,30 @@ TEST_F(ToolCommands, ReplayVideoIsAClipOfTheComposites) {
 
 // --knob: info prints the ladder with the knob set at every level; replay refuses a knob outside
 // its span with exit 2 before opening anything.
+// The two I/O modes of replay run the same frames: preloaded (chunks decoded ahead, the runtime
+// flushed at each chunk's end, outputs handed back through recycle) writes the same pixels as
+// overlapped (stage threads).
+TEST_F(ToolCommands, ReplayPreloadedWritesTheFramesOverlappedWrites) {
+  test::TempDir dir("io");
+  const std::string replay = std::string("LP_NUM_THREADS=2 timeout 300 ") + MRGI_TOOL + " replay " + MRGI_SOURCE_DIR +
+                             "/data/sample --technique baseline --level last --frames 5 -q";
+  ASSERT_EQ(run(replay + " --io overlapped --out " + dir.file("a") + " > /dev/null 2> " + dir.file("e1.txt")), 0)
+      << slurp(dir.file("e1.txt"));
+  ASSERT_EQ(run(replay + " --io preloaded --preload-frames 2 --out " + dir.file("b") + " > " + dir.file("b.json") +
+                " 2> " + dir.file("e2.txt")),
+            0)
+      << slurp(dir.file("e2.txt"));
+  EXPECT_NE(slurp(dir.file("b.json")).find("decode a chunk of frames"), std::string::npos);
+  for (int i = 0; i < 5; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/frames/%06d.png", i);
+    auto a = load_png_rgba8(dir.file("a") + name);
+    auto b = load_png_rgba8(dir.file("b") + name);
+    ASSERT_TRUE(a.ok() && b.ok()) << name;
+    EXPECT_TRUE(a->data == b->data) << "frame " << i << " differs between the I/O modes";
+  }
+}
+
 TEST_F(ToolCommands, KnobsAreSetOneByOneAndRefusedOutsideTheirSpan) {
   test::TempDir dir("knob");
   ASSERT_EQ(run(std::string("timeout 60 ") + MRGI_TOOL + " info --technique dir --knob vpls=64 --knob bounce_vpls=8 --json > " +

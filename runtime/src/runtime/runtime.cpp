@@ -521,10 +521,15 @@ Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame)
   if (affected && (for_estimate || warm_up)) {
     std::string note;
     warmed_up_ = true;
-    MRGI_TRY(prime(frame, *rec, outputs, note, for_estimate));
-    slot = begin_slot(frame, outputs);
-    if (!slot) return slot.error();
-    rec = *slot;
+    // A scheduler's warm-up runs once in every slot: a slot's own buffers (uploads, readbacks)
+    // are first touched by its first frame, which a CPU driver pays in page faults.
+    const int runs = warm_up ? std::max(1, settings_.frames_in_flight) : 1;
+    for (int r = 0; r < runs; ++r) {
+      MRGI_TRY(prime(frame, *rec, outputs, note, for_estimate));
+      slot = begin_slot(frame, outputs);
+      if (!slot) return slot.error();
+      rec = *slot;
+    }
     t_work = std::chrono::steady_clock::now();  // the priming run is not this frame's own work
     notes.push_back(note);
   }
