@@ -189,11 +189,13 @@ Status check_scheduler_settings(const RuntimeSettings& rs, size_t levels) {
   if (!(s.dead_band_below >= 0.0 && s.dead_band_below < 1.0) || !(s.dead_band_above >= 0.0 && s.dead_band_above < 1.0))
     return bad("scheduler.dead_band_below/above", "must be in [0, 1)");
   if (!(s.scale_gain > 0.0 && s.scale_gain <= 1.0)) return bad("scheduler.scale_gain", "must be in (0, 1]");
+  if (!(s.scale_gain_up > 0.0 && s.scale_gain_up <= 1.0)) return bad("scheduler.scale_gain_up", "must be in (0, 1]");
   if (!(s.min_scale >= 0.25f && s.min_scale <= 1.0f)) return bad("scheduler.min_scale", "must be in [0.25, 1]");
   if (!(s.upgrade_min_scale >= s.min_scale && s.upgrade_min_scale <= 1.0f))
     return bad("scheduler.upgrade_min_scale", "must be in [min_scale, 1]");
   if (s.min_frames_between_changes < 0 || s.min_frames_between_changes > 100000)
     return bad("scheduler.min_frames_between_changes", "must be 0..100000");
+  if (s.step_frames < 1 || s.step_frames > 1000) return bad("scheduler.step_frames", "must be 1..1000");
   if (s.emergency_frames < 1 || s.emergency_frames > 1000) return bad("scheduler.emergency_frames", "must be 1..1000");
   if (!(s.emergency_factor >= 1.0 && s.emergency_factor <= 100.0)) return bad("scheduler.emergency_factor", "must be in [1, 100]");
   if (!rs.level_costs_ms.empty()) {

@@ -47,8 +47,14 @@ double Scheduler::predict(int level, float scale) const {
 double Scheduler::normalised_quantile(double q) const {
   std::array<double, kMaxWindow> v{};
   std::copy(window_.begin(), window_.begin() + window_count_, v.begin());
-  const int k = std::clamp(int(std::floor(q * double(window_count_ - 1) + 0.5)), 0, window_count_ - 1);
-  std::nth_element(v.begin(), v.begin() + k, v.begin() + window_count_);
+  std::sort(v.begin(), v.begin() + window_count_);
+  // Spikes are left out: a frame over kSpikeFactor x the window's median is the device's hiccup
+  // (a page fault storm, a preempted thread), which no resolution would have fitted; a step in
+  // the load moves the median within half a window and the step rule (observe) before that.
+  const double median = v[size_t(window_count_ / 2)];
+  int n = window_count_;
+  while (n > 1 && v[size_t(n - 1)] > kSpikeFactor * median) --n;
+  const int k = std::clamp(int(std::floor(q * double(n - 1) + 0.5)), 0, n - 1);
   return v[size_t(k)];
 }
 
@@ -71,6 +77,7 @@ void Scheduler::change_level(int level) {
   window_count_ = 0;
   window_next_ = 0;
   over_ = 0;
+  over_budget_ = 0;
   ++level_changes_;
 }
 
@@ -117,6 +124,14 @@ void Scheduler::observe(int level, float scale, double cost_ms, bool technique_r
     choice_.predicted_ms = predict(choice_.level, choice_.scale);
     return;
   }
+  // A step up in the load: the scale follows at once, without waiting for the window.
+  over_budget_ = cost_ms > budget_ms_ ? over_budget_ + 1 : 0;
+  if (over_budget_ >= s_.step_frames && choice_.scale > s_.min_scale) {
+    choice_.scale = s_.min_scale;
+    choice_.predicted_ms = predict(choice_.level, choice_.scale);
+    over_budget_ = 0;
+    return;
+  }
   if (window_count_ < std::min(3, s_.window_frames)) return;
 
   // The controlled signal: the window's quantile (SchedulerSettings::quantile), at full scale.
@@ -126,7 +141,9 @@ void Scheduler::observe(int level, float scale, double cost_ms, bool technique_r
   const bool in_band = current >= target * (1.0 - s_.dead_band_below) && current <= target * (1.0 + s_.dead_band_above);
 
   // Over the budget even at the smallest scale: a cheaper level.
-  if (current > target * (1.0 + s_.dead_band_above) && median_norm * scale_factor(s_.min_scale) > target &&
+  // Judged on a lower quantile than the scale's (the window's upper quarter may be spikes no
+  // level fixes; a level lost for them is a second of worse quality each time).
+  if (current > target * (1.0 + s_.dead_band_above) && normalised_quantile(0.75) * scale_factor(s_.min_scale) > target &&
       choice_.level < last && may_change_level) {
     change_level(choice_.level + 1);
     choice_.scale = std::clamp(scale_for_factor(target / std::max(1e-6, predict(choice_.level, 1.0f))), s_.min_scale, 1.0f);
@@ -148,7 +165,8 @@ void Scheduler::observe(int level, float scale, double cost_ms, bool technique_r
   }
   // Inside the level: the scale, a damped step toward the one the model says meets the target.
   if (!in_band) {
-    const double want = scale_factor(choice_.scale) * std::pow(target / std::max(1e-6, current), s_.scale_gain);
+    const double ratio = target / std::max(1e-6, current);
+    const double want = scale_factor(choice_.scale) * std::pow(ratio, ratio < 1.0 ? s_.scale_gain : s_.scale_gain_up);
     choice_.scale = std::clamp(scale_for_factor(want), s_.min_scale, 1.0f);
     // Snap to full resolution within a percent: the upgrade test asks for full scale.
     if (choice_.scale > 0.99f) choice_.scale = 1.0f;

@@ -5,9 +5,10 @@
 // and is unit-tested on simulated cost traces (tests/unit/test_scheduler.cpp).
 //
 // How it decides (constants in mrgi/runtime.h SchedulerSettings, with where each comes from):
-//   - the signal is a high quantile (`quantile`, 0.8) of the cost of the last `window_frames`
-//     frames at the current level (an order statistic, as Filament's median, so a spike or two
-//     move nothing; higher than the median because a CPU device's frame times scatter), each
+//   - the signal is a high quantile (`quantile`, 0.95) of the cost of the last `window_frames`
+//     frames at the current level, spikes over twice the median left out (an order statistic,
+//     as Filament's median, so a spike moves nothing; higher than the median because a CPU
+//     device's frame times scatter), each
 //     frame's cost normalised to full internal resolution with the cost model below; the
 //     model learns each level's cost from the window's median;
 //   - the target is the budget less `headroom` (Unreal's 10 %); inside a dead band around it
@@ -16,8 +17,10 @@
 //     toward the one the model says meets the target (Filament: a PI controller on the scale;
 //     here the model's answer is the proportional part and the damping keeps a noisy median
 //     from stepping it far), between `min_scale` and 1;
+//   - a step in the load (`step_frames` frames in a row over the budget) drops the scale to
+//     `min_scale` at once, without waiting for the window; it climbs back at `scale_gain_up`;
 //   - a level changes only when the scale cannot absorb the error: down when even `min_scale`
-//     misses the target, up when the better level is predicted to fit at a scale of at least
+//     misses the target (by the window's 0.75 quantile), up when the better level is predicted to fit at a scale of at least
 //     `upgrade_min_scale`; never more often than `min_frames_between_changes` (Unreal's minimum
 //     frames between changes), except that `emergency_frames` consecutive frames over
 //     `emergency_factor` x the budget drop a level at once (Unreal's limit on consecutive
@@ -71,6 +74,7 @@ class Scheduler {
 
  private:
   static constexpr int kMaxWindow = 64;
+  static constexpr double kSpikeFactor = 2.0;  // normalised_quantile: a spike is over this x the median
   static constexpr int kWarmupFrames = 1;  // the runtime primes its first frame (runtime.cpp)
   void change_level(int level);
   double normalised_quantile(double q) const;  // of the window (normalised to full scale)
@@ -83,6 +87,7 @@ class Scheduler {
   std::array<double, kMaxWindow> window_{};  // normalised costs at the current level
   int window_count_ = 0, window_next_ = 0;
   int over_ = 0;                  // consecutive frames over the emergency line
+  int over_budget_ = 0;           // consecutive frames over the budget
   int64_t frames_ = 0, changed_at_ = -1000000;
   int upgraded_to_ = -1;          // the last upgrade's level and when it was taken
   int64_t upgraded_at_ = -1000000;
