@@ -283,8 +283,10 @@ class Runtime {
   // Processes one frame. Frames are pipelined: the output returned belongs to the frame given
   // frames_in_flight-1 calls earlier; flush() drains the rest at the end of a stream. Once per
   // runtime, a technique that estimates from the frames themselves (ssrt's light) has its first
-  // frame run twice, waiting for the first run, so that frame is lit by its own estimate; that
-  // call returns the frames still in flight at once, and the frame's stats note the extra run.
+  // frame run twice, waiting for the first run, so that frame is lit by its own estimate; with
+  // the level on kAutoLevel the first frame is also run once in every frame slot first (the
+  // driver's first use of pipelines and slot memory would otherwise be charged to the budget).
+  // That call returns the frames still in flight at once, and the frame's stats note the runs.
   virtual Expected<std::vector<FrameOutput>> process(const InputFrame& frame) = 0;
   virtual Expected<std::vector<FrameOutput>> flush() = 0;
   // Hands a delivered frame back once the caller is done with it: a later process() or flush()

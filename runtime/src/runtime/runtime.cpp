@@ -116,8 +116,7 @@ class RuntimeImpl final : public Runtime {
   Status record_and_submit(const InputFrame& frame, SlotRecord& rec, bool affected);
   // The technique's priming run (Technique::wants_priming_run): this frame run once, waited
   // for, its output dropped; the frames still in flight before it are collected into `outputs`.
-  Status prime(const InputFrame& frame, SlotRecord& rec, std::vector<FrameOutput>& outputs,
-               std::string& note, bool for_estimate);
+  Status prime(const InputFrame& frame, SlotRecord& rec, std::vector<FrameOutput>& outputs, double& prime_ms);
 
   RuntimeSettings settings_;
   CameraSetup cameras_;
@@ -526,12 +525,23 @@ Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame)
     // A scheduler's warm-up runs once in every slot: a slot's own buffers (uploads, readbacks)
     // are first touched by its first frame, which a CPU driver pays in page faults.
     const int runs = warm_up ? std::max(1, settings_.frames_in_flight) : 1;
+    double prime_ms = 0.0;
     for (int r = 0; r < runs; ++r) {
-      MRGI_TRY(prime(frame, *rec, outputs, note, for_estimate));
+      double ms = 0.0;
+      MRGI_TRY(prime(frame, *rec, outputs, ms));
+      prime_ms += ms;
       slot = begin_slot(frame, outputs);
       if (!slot) return slot.error();
       rec = *slot;
     }
+    char ms[32];
+    std::snprintf(ms, sizeof ms, "%.2f", prime_ms);
+    note = "technique: frame run " + std::to_string(runs + 1) + " times, the first " +
+           (runs == 1 ? std::string("run") : std::to_string(runs) + " runs") + " (" + ms + " ms GPU, output dropped) " +
+           (for_estimate ? "prime" : "warm") +
+           (runs == 1 ? "s " : " ") +
+           (for_estimate ? technique_->name() + "'s estimate from this frame"
+                         : std::string("the driver up (its first use of each pipeline and of each frame slot's memory)"));
     t_work = std::chrono::steady_clock::now();  // the priming run is not this frame's own work
     notes.push_back(note);
   }
@@ -547,13 +557,12 @@ Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame)
   return outputs;
 }
 
-Status RuntimeImpl::prime(const InputFrame& frame, SlotRecord& rec,
-                          std::vector<FrameOutput>& outputs, std::string& note, bool for_estimate) {
+Status RuntimeImpl::prime(const InputFrame& frame, SlotRecord& rec, std::vector<FrameOutput>& outputs,
+                          double& prime_ms) {
   rec.priming = true;
   MRGI_TRY(record_and_submit(frame, rec, true));
   auto all = graph_->flush();
   if (!all) return all.error();
-  double prime_ms = 0.0;
   for (const gpu::FrameTimings& t : *all) {
     if (slots_[t.slot].priming) {
       slots_[t.slot].used = false;
@@ -566,11 +575,6 @@ Status RuntimeImpl::prime(const InputFrame& frame, SlotRecord& rec,
     outputs.push_back(std::move(*out));
   }
   technique_->frames_completed();
-  char ms[32];
-  std::snprintf(ms, sizeof ms, "%.2f", prime_ms);
-  note = "technique: frame run twice, the first run (" + std::string(ms) + " ms GPU, output dropped) " +
-         (for_estimate ? "primes " + technique_->name() + "'s estimate from this frame"
-                                          : std::string("warms the driver up (its first use of each pipeline)"));
   return ok_status();
 }
 
