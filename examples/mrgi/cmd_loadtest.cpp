@@ -1,4 +1,5 @@
 // mrgi loadtest: the scheduler under a changing load (mrgi/perf/load_test.h), report and plot.
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -22,8 +23,12 @@ struct LoadTestOptions {
 void run_loadtest(LoadTestOptions& o) {
   perf::ensure_lp_num_threads();
   o.settings.oracle = !o.no_oracle;
-  if (!o.quiet) o.settings.progress = [](const std::string& what, size_t done, size_t total, double) {
-    if (done % 30 == 0 || done == total) progress(what, done, total, 0.0);
+  // Each run (the scheduled one, then one per fixed level for the oracle) has its own clock.
+  auto t0 = std::chrono::steady_clock::now();
+  if (!o.quiet) o.settings.progress = [t0](const std::string& what, size_t done, size_t total, double) mutable {
+    if (done == 1) t0 = std::chrono::steady_clock::now();
+    if (done % 30 == 0 || done == total)
+      progress(what, done, total, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   };
   perf::LoadTestResult r = take(perf::run_load_test(o.settings));
   OutputDir out = take(OutputDir::begin(o.out, "--out"));
