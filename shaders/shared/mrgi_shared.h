@@ -18,11 +18,15 @@
 #include <glm/gtc/packing.hpp>
 namespace mrgi::shader {
 using glm::abs;
+using glm::acos;
+using glm::atan;
 using glm::clamp;
 using glm::cos;
 using glm::dot;
 using glm::isinf;
 using glm::isnan;
+using glm::length;
+using glm::log2;
 using glm::mat3;
 using glm::max;
 using glm::min;
@@ -33,6 +37,7 @@ using glm::pow;
 using glm::sin;
 using glm::smoothstep;
 using glm::sqrt;
+using glm::tan;
 using glm::transpose;
 using glm::unpackSnorm2x16;
 using glm::vec2;
