@@ -68,16 +68,22 @@ MRGI_FN vec4 vct_accumulate(vec4 acc, vec3 light, float occlusion) {
 }
 
 // "The occlusion value is thereby adapted with the normal that is stored in the volume"
-// (Sec. 3.1). A voxel stores the mean of its surfaces' unit normals: a length near 1 is one flat
-// surface, near 0 surfaces facing every way. A flat surface crossing a cone's footprint covers
-// the fraction |n . dir| of the footprint's cross-section (a plane seen edge-on hides nothing);
-// surfaces facing every way cover it whatever the direction. So the occlusion a cone reads is
-// occlusion x mix(1, |n . dir|, |n_mean|), never below `floor` (a surface exactly edge-on still
-// has thickness: a voxel's worth of reconstruction noise).
-MRGI_FN float vct_directional_occlusion(float occlusion, vec3 mean_normal, vec3 dir, float floor_fraction) {
-  const float coherence = min(length(mean_normal), 1.0f);
-  const float facing = coherence > 1e-4f ? abs(dot(mean_normal, dir)) / coherence : 1.0f;
-  return occlusion * max(mix(1.0f, facing, coherence), floor_fraction);
+// (Sec. 3.1). A visibility voxel stores (n, o): o the fraction of it holding geometry, n the mean
+// of its surfaces' unit normals times o (premultiplied, so the mip chain's plain mean keeps both
+// right: gi/volume_downsample.comp). |n| / o near 1 is one flat surface, near 0 surfaces facing
+// every way. A flat surface crossing a cone's footprint covers the fraction |n . dir| of the
+// footprint's cross-section (a plane seen edge-on hides nothing); surfaces facing every way cover
+// it whatever the direction. So the occlusion a cone reads is o x mix(1, |n^ . dir|, |n| / o),
+// never below `floor_fraction` x o (a surface exactly edge-on still has thickness: a voxel's
+// worth of reconstruction noise).
+MRGI_FN float vct_directional_occlusion(vec4 normal_occlusion, vec3 dir, float floor_fraction) {
+  const float o = clamp(normal_occlusion.w, 0.0f, 1.0f);
+  if (o <= 0.0f) return 0.0f;
+  const vec3 n = vec3(normal_occlusion.x, normal_occlusion.y, normal_occlusion.z);
+  const float len = length(n);
+  const float coherence = min(len / o, 1.0f);
+  const float facing = len > 1e-6f ? abs(dot(n, dir)) / len : 1.0f;
+  return o * max(mix(1.0f, facing, coherence), floor_fraction);
 }
 
 // The diffuse cone set: VCT_DIFFUSE_MAX cones at most, `count` used (1, 5 or 9 and more): one

@@ -72,19 +72,29 @@ TEST(VctMath, ThePrintedFormulaWouldFadeLightInEmptySpace) {
 }
 
 TEST(VctMath, OcclusionFollowsTheStoredNormal) {
-  const vec3 up(0.0f, 0.0f, 1.0f);
-  // One flat surface: full occlusion head-on, the floor edge-on, |cos| between.
-  EXPECT_FLOAT_EQ(vct_directional_occlusion(1.0f, up, up, 0.1f), 1.0f);
-  EXPECT_FLOAT_EQ(vct_directional_occlusion(1.0f, up, vec3(1.0f, 0.0f, 0.0f), 0.1f), 0.1f);
+  const vec3 up(0.0f, 0.0f, 1.0f), side(1.0f, 0.0f, 0.0f);
+  const vec4 flat(0.0f, 0.0f, 1.0f, 1.0f);  // one flat surface filling the voxel
+  // Full occlusion head-on, the floor edge-on, |cos| between.
+  EXPECT_FLOAT_EQ(vct_directional_occlusion(flat, up, 0.1f), 1.0f);
+  EXPECT_FLOAT_EQ(vct_directional_occlusion(flat, side, 0.1f), 0.1f);
   const vec3 d = normalize(vec3(1.0f, 0.0f, 1.0f));
-  EXPECT_NEAR(vct_directional_occlusion(0.8f, up, d, 0.1f), 0.8f * std::sqrt(0.5f), 1e-6f);
+  EXPECT_NEAR(vct_directional_occlusion(flat, d, 0.1f), std::sqrt(0.5f), 1e-6f);
   // Either side of the surface hides the same.
-  EXPECT_FLOAT_EQ(vct_directional_occlusion(1.0f, -up, d, 0.1f), vct_directional_occlusion(1.0f, up, d, 0.1f));
+  EXPECT_FLOAT_EQ(vct_directional_occlusion(vec4(0.0f, 0.0f, -1.0f, 1.0f), d, 0.1f),
+                  vct_directional_occlusion(flat, d, 0.1f));
   // Surfaces facing every way (mean normal 0): the same from every direction.
-  EXPECT_FLOAT_EQ(vct_directional_occlusion(0.6f, vec3(0.0f), d, 0.1f), 0.6f);
-  // Half coherent: between the two.
-  const float half = vct_directional_occlusion(1.0f, 0.5f * up, vec3(1.0f, 0.0f, 0.0f), 0.1f);
-  EXPECT_FLOAT_EQ(half, 0.5f);
+  EXPECT_FLOAT_EQ(vct_directional_occlusion(vec4(0.0f, 0.0f, 0.0f, 0.6f), d, 0.1f), 0.6f);
+  // A coarser level's mean over 8 cells, 2 of them the flat surface (premultiplied: n 2/8, o
+  // 2/8): still one coherent surface, a quarter of the footprint.
+  EXPECT_FLOAT_EQ(vct_directional_occlusion(vec4(0.0f, 0.0f, 0.25f, 0.25f), up, 0.1f), 0.25f);
+  EXPECT_FLOAT_EQ(vct_directional_occlusion(vec4(0.0f, 0.0f, 0.25f, 0.25f), side, 0.1f), 0.025f);
+  // Two perpendicular surfaces (a mean normal of length 0.707): between the two cases.
+  const vec4 corner(0.5f, 0.0f, 0.5f, 1.0f);
+  const float seen = vct_directional_occlusion(corner, side, 0.1f);
+  EXPECT_GT(seen, 0.5f);
+  EXPECT_LT(seen, 1.0f);
+  // Empty: nothing, whatever the normal says.
+  EXPECT_EQ(vct_directional_occlusion(vec4(0.3f, 0.0f, 0.0f, 0.0f), d, 0.1f), 0.0f);
 }
 
 TEST(VctMath, DiffuseConesIntegrateTheCosineOverTheHemisphere) {
