@@ -19,12 +19,6 @@ struct GridConstants {
 layout(push_constant) uniform Grid { GridConstants params_block; };
 GridConstants params;
 
-bool continuous(float a, float b, float c) {
-  float zmin = min(a, min(b, c));
-  float zmax = max(a, max(b, c));
-  return zmin > 0.0f && (zmax - zmin) <= MRGI_DEPTH_EDGE_RELATIVE * zmin;
-}
-
 void main() {
   params = params_block;  // MRGI_UNIFORM_COPIES
   ivec2 q = ivec2(gl_GlobalInvocationID.xy);
@@ -38,7 +32,7 @@ void main() {
   uint row = uint(params.grid.x);
   uint i00 = uint(q.y) * row + uint(q.x), i10 = i00 + 1u, i01 = i00 + row, i11 = i01 + 1u;
   uint base = (uint(q.y) * uint(cells.x) + uint(q.x)) * 6u;
-  bool a = continuous(z00, z10, z01), b = continuous(z10, z11, z01);
+  bool a = mrgi_one_surface(z00, z10, z01), b = mrgi_one_surface(z10, z11, z01);
   indices[base + 0u] = i00;
   indices[base + 1u] = a ? i10 : i00;
   indices[base + 2u] = a ? i01 : i00;

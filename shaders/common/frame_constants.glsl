@@ -29,6 +29,15 @@ using glm::vec4;
 // Depth discontinuity rule used by normals and the real caster mesh: two neighbouring depths
 // belong to one surface when |z_a - z_b| <= MRGI_DEPTH_EDGE_RELATIVE * min(z_a, z_b).
 #define MRGI_DEPTH_EDGE_RELATIVE 0.05
+// Three depths (a triangle of G-buffer pixels) are one surface: all valid, and their spread
+// within the rule above (the real caster mesh, the voxelisation of the real scene).
+#ifndef __cplusplus
+bool mrgi_one_surface(float a, float b, float c) {
+  float zmin = min(a, min(b, c));
+  float zmax = max(a, max(b, c));
+  return zmin > 0.0f && (zmax - zmin) <= MRGI_DEPTH_EDGE_RELATIVE * zmin;
+}
+#endif
 
 // Sizes are pixels; k vectors are pinhole intrinsics (fx, fy, cx, cy) in pixels, OpenCV
 // convention (mrgi_shared.h project_pinhole / unproject_pinhole).
