@@ -23,6 +23,7 @@ using glm::atan;
 using glm::clamp;
 using glm::cos;
 using glm::dot;
+using glm::exp2;
 using glm::isinf;
 using glm::isnan;
 using glm::length;

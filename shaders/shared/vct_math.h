@@ -71,19 +71,45 @@ MRGI_FN vec4 vct_accumulate(vec4 acc, vec3 light, float occlusion) {
 // (Sec. 3.1). A visibility voxel stores (n, o): o the fraction of it holding geometry, n the mean
 // of its surfaces' unit normals times o (premultiplied, so the mip chain's plain mean keeps both
 // right: gi/volume_downsample.comp). |n| / o near 1 is one flat surface, near 0 surfaces facing
-// every way. A flat surface crossing a cone's footprint covers the fraction |n . dir| of the
-// footprint's cross-section (a plane seen edge-on hides nothing); surfaces facing every way cover
-// it whatever the direction. So the occlusion a cone reads is o x mix(1, |n^ . dir|, |n| / o),
-// never below `floor_fraction` x o (a surface exactly edge-on still has thickness: a voxel's
-// worth of reconstruction noise).
-MRGI_FN float vct_directional_occlusion(vec4 normal_occlusion, vec3 dir, float floor_fraction) {
+// every way. Two adaptations, both by how coherent the surfaces are:
+//   - coverage: at mip level `lod` a voxel spans 2^lod finest voxels a side, and a flat surface
+//     crossing it fills only one finest voxel in 2^lod of each column, so o = 2^-lod for a
+//     surface that covers the whole footprint. Its coverage is min(1, o 2^lod); surfaces facing
+//     every way (clutter filling the voxel) cover o. Without this a one-voxel wall would be half
+//     transparent at level 1, a quarter at level 2: light through real geometry, which Sec. 3.2's
+//     separate visibility volumes are there to prevent;
+//   - direction: a small flat patch covers the fraction |n . dir| of the footprint's
+//     cross-section (edge-on it hides nothing), clutter the same from every side.
+// So: coverage x mix(1, |n^ . dir|, coherence), the direction factor never below
+// `floor_fraction` (a surface exactly edge-on still has thickness: reconstruction noise).
+MRGI_FN float vct_directional_occlusion(vec4 normal_occlusion, vec3 dir, float floor_fraction, float lod) {
   const float o = clamp(normal_occlusion.w, 0.0f, 1.0f);
   if (o <= 0.0f) return 0.0f;
   const vec3 n = vec3(normal_occlusion.x, normal_occlusion.y, normal_occlusion.z);
   const float len = length(n);
   const float coherence = min(len / o, 1.0f);
   const float facing = len > 1e-6f ? abs(dot(n, dir)) / len : 1.0f;
-  return o * max(mix(1.0f, facing, coherence), floor_fraction);
+  const float coverage = mix(o, min(1.0f, o * exp2(lod)), coherence);
+  return coverage * max(mix(1.0f, facing, coherence), floor_fraction);
+}
+
+// What one cone sample adds (vct_accumulate's light and occlusion) from the two volumes' values
+// at its footprint: `light` the light volume's rgb (radiance x coverage, gi/voxel_light.h),
+// `visibility` the visibility volume's (mean normal x occupancy, occupancy), both read at mip
+// level `lod`. The light is radiance x occupancy, so the light seen is the radiance times the
+// coverage the occlusion says (vct_directional_occlusion), and a coherent surface seen from behind sends nothing towards the cone (its
+// light leaves its front; a thin real surface's back is another surface the reconstruction did
+// not see). rgb: light, a: occlusion.
+MRGI_FN vec4 vct_sample(vec3 light, vec4 visibility, vec3 dir, float floor_fraction, float lod) {
+  const float o = clamp(visibility.w, 0.0f, 1.0f);
+  const float occ = vct_directional_occlusion(visibility, dir, floor_fraction, lod);
+  if (o <= 0.0f) return vec4(0.0f);
+  const vec3 n = vec3(visibility.x, visibility.y, visibility.z);
+  const float coherence = min(length(n) / o, 1.0f);
+  // -dir points from the sample back to the cone's apex: a front face has n . -dir > 0.
+  const float front = dot(n, dir) < 0.0f ? 1.0f : 1.0f - coherence;
+  const float seen = occ / o * front;
+  return vec4(light.x * seen, light.y * seen, light.z * seen, occ);
 }
 
 // The diffuse cone set: VCT_DIFFUSE_MAX cones at most, `count` used (1, 5 or 9 and more): one

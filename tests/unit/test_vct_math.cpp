@@ -75,26 +75,55 @@ TEST(VctMath, OcclusionFollowsTheStoredNormal) {
   const vec3 up(0.0f, 0.0f, 1.0f), side(1.0f, 0.0f, 0.0f);
   const vec4 flat(0.0f, 0.0f, 1.0f, 1.0f);  // one flat surface filling the voxel
   // Full occlusion head-on, the floor edge-on, |cos| between.
-  EXPECT_FLOAT_EQ(vct_directional_occlusion(flat, up, 0.1f), 1.0f);
-  EXPECT_FLOAT_EQ(vct_directional_occlusion(flat, side, 0.1f), 0.1f);
+  EXPECT_FLOAT_EQ(vct_directional_occlusion(flat, up, 0.1f, 0.0f), 1.0f);
+  EXPECT_FLOAT_EQ(vct_directional_occlusion(flat, side, 0.1f, 0.0f), 0.1f);
   const vec3 d = normalize(vec3(1.0f, 0.0f, 1.0f));
-  EXPECT_NEAR(vct_directional_occlusion(flat, d, 0.1f), std::sqrt(0.5f), 1e-6f);
+  EXPECT_NEAR(vct_directional_occlusion(flat, d, 0.1f, 0.0f), std::sqrt(0.5f), 1e-6f);
   // Either side of the surface hides the same.
-  EXPECT_FLOAT_EQ(vct_directional_occlusion(vec4(0.0f, 0.0f, -1.0f, 1.0f), d, 0.1f),
-                  vct_directional_occlusion(flat, d, 0.1f));
+  EXPECT_FLOAT_EQ(vct_directional_occlusion(vec4(0.0f, 0.0f, -1.0f, 1.0f), d, 0.1f, 0.0f),
+                  vct_directional_occlusion(flat, d, 0.1f, 0.0f));
   // Surfaces facing every way (mean normal 0): the same from every direction.
-  EXPECT_FLOAT_EQ(vct_directional_occlusion(vec4(0.0f, 0.0f, 0.0f, 0.6f), d, 0.1f), 0.6f);
-  // A coarser level's mean over 8 cells, 2 of them the flat surface (premultiplied: n 2/8, o
-  // 2/8): still one coherent surface, a quarter of the footprint.
-  EXPECT_FLOAT_EQ(vct_directional_occlusion(vec4(0.0f, 0.0f, 0.25f, 0.25f), up, 0.1f), 0.25f);
-  EXPECT_FLOAT_EQ(vct_directional_occlusion(vec4(0.0f, 0.0f, 0.25f, 0.25f), side, 0.1f), 0.025f);
+  EXPECT_FLOAT_EQ(vct_directional_occlusion(vec4(0.0f, 0.0f, 0.0f, 0.6f), d, 0.1f, 0.0f), 0.6f);
+  // Level 1 over a one-voxel floor spanning the cell: 4 of its 8 sub-voxels (premultiplied: n
+  // 4/8, o 4/8), one coherent surface covering the footprint: opaque head-on, as at level 0.
+  EXPECT_FLOAT_EQ(vct_directional_occlusion(vec4(0.0f, 0.0f, 0.5f, 0.5f), up, 0.1f, 1.0f), 1.0f);
+  EXPECT_FLOAT_EQ(vct_directional_occlusion(vec4(0.0f, 0.0f, 0.5f, 0.5f), side, 0.1f, 1.0f), 0.1f);
+  // Level 2 over a floor covering half the cell's columns (8 of 64 sub-voxels): half covered.
+  EXPECT_FLOAT_EQ(vct_directional_occlusion(vec4(0.0f, 0.0f, 0.125f, 0.125f), up, 0.1f, 2.0f), 0.5f);
+  // Clutter (no coherent normal) at level 1 covers its occupancy, not more.
+  EXPECT_FLOAT_EQ(vct_directional_occlusion(vec4(0.0f, 0.0f, 0.0f, 0.5f), up, 0.1f, 1.0f), 0.5f);
   // Two perpendicular surfaces (a mean normal of length 0.707): between the two cases.
   const vec4 corner(0.5f, 0.0f, 0.5f, 1.0f);
-  const float seen = vct_directional_occlusion(corner, side, 0.1f);
+  const float seen = vct_directional_occlusion(corner, side, 0.1f, 0.0f);
   EXPECT_GT(seen, 0.5f);
   EXPECT_LT(seen, 1.0f);
   // Empty: nothing, whatever the normal says.
-  EXPECT_EQ(vct_directional_occlusion(vec4(0.3f, 0.0f, 0.0f, 0.0f), d, 0.1f), 0.0f);
+  EXPECT_EQ(vct_directional_occlusion(vec4(0.3f, 0.0f, 0.0f, 0.0f), d, 0.1f, 0.0f), 0.0f);
+}
+
+TEST(VctMath, ASampleSeesAFrontFaceByItsProjectedCoverageAndNoBackFace) {
+  const vec4 wall(0.0f, 0.0f, 1.0f, 1.0f);  // a wall facing +z filling the voxel
+  const vec3 radiance(2.0f, 4.0f, 6.0f);
+  // Looking at its front (the cone travels -z): all of its light, fully occluded.
+  vec4 s = vct_sample(radiance, wall, vec3(0.0f, 0.0f, -1.0f), 0.1f, 0.0f);
+  EXPECT_FLOAT_EQ(s.x, 2.0f);
+  EXPECT_FLOAT_EQ(s.w, 1.0f);
+  // At 60 degrees: half the coverage, half the light (radiance per projected area unchanged:
+  // light and occlusion shrink together, so a cone stopped by it reads the radiance).
+  const vec3 oblique = normalize(vec3(std::sqrt(3.0f), 0.0f, -1.0f));
+  s = vct_sample(radiance, wall, oblique, 0.1f, 0.0f);
+  EXPECT_NEAR(s.w, 0.5f, 1e-5f);
+  EXPECT_NEAR(s.y, 2.0f, 1e-5f);
+  // From behind: it occludes, it sends nothing.
+  s = vct_sample(radiance, wall, vec3(0.0f, 0.0f, 1.0f), 0.1f, 0.0f);
+  EXPECT_FLOAT_EQ(s.w, 1.0f);
+  EXPECT_FLOAT_EQ(s.x, 0.0f);
+  // Surfaces facing every way: their light whatever the direction.
+  s = vct_sample(radiance, vec4(0.0f, 0.0f, 0.0f, 0.5f), vec3(0.0f, 0.0f, 1.0f), 0.1f, 0.0f);
+  EXPECT_FLOAT_EQ(s.x, 2.0f);
+  EXPECT_FLOAT_EQ(s.w, 0.5f);
+  // Empty: nothing.
+  EXPECT_EQ(vct_sample(radiance, vec4(0.0f), vec3(0.0f, 0.0f, 1.0f), 0.1f, 0.0f), vec4(0.0f));
 }
 
 TEST(VctMath, DiffuseConesIntegrateTheCosineOverTheHemisphere) {
