@@ -7,12 +7,12 @@
 namespace mrgi::gi {
 namespace {
 
-struct InjectPush {
+struct VoxelInjectPush {
   glm::vec4 region;
   glm::ivec4 sizes;  // cells, map width, height
   glm::vec4 sign;
 };
-struct ResolvePush {
+struct VoxelLightResolvePush {
   glm::ivec4 cells;
   glm::vec4 scale;
 };
@@ -48,7 +48,7 @@ Expected<VoxelLight> VoxelLight::create(gpu::FrameGraph& graph, const VoxelLight
   auto spv = gpu::shader_spirv("gi/voxel_inject.comp");
   if (!spv) return spv.error();
   for (uint32_t pair = 0; pair < 2; ++pair) {  // voxel_inject.comp's kDeltaPair: one pipeline each
-    auto p = gpu::create_compute_pipeline(ctx, {s.name + " inject " + std::to_string(pair), *spv, {}, sizeof(InjectPush), {pair}});
+    auto p = gpu::create_compute_pipeline(ctx, {s.name + " inject " + std::to_string(pair), *spv, {}, sizeof(VoxelInjectPush), {pair}});
     if (!p) return p.error();
     v.inject_[pair] = gpu::PipelineHandle(ctx, std::move(*p));
   }
@@ -80,7 +80,7 @@ void VoxelLight::add_inject(gpu::FrameGraph& graph, const std::string& label, co
   const RsmImages o = other ? *other : rsm;  // without a pair the map stands in (never read)
   const gpu::Pipeline* pipe = &*inject_[other ? 1 : 0];
   const gpu::BufferHandle sums = sums_;
-  const InjectPush push{glm::vec4(region_.origin, region_.voxel_size),
+  const VoxelInjectPush push{glm::vec4(region_.origin, region_.voxel_size),
                         glm::ivec4(int(cells()), int(rsm.width), int(rsm.height), 0), glm::vec4(sign, 0.0f, 0.0f, 0.0f)};
   graph.add_shader_pass(
       settings_.name + " inject " + label, gpu::PassKind::Compute, *pipe,
@@ -102,7 +102,7 @@ void VoxelLight::add_resolve(gpu::FrameGraph& graph) const {
   const gpu::ImageHandle image = volume_->image(0);
   const uint32_t n = cells();
   const float s = region_.voxel_size;
-  const ResolvePush push{glm::ivec4(int(n), 0, 0, 0), glm::vec4(1.0f / (std::numbers::pi_v<float> * s * s), 0.0f, 0.0f, 0.0f)};
+  const VoxelLightResolvePush push{glm::ivec4(int(n), 0, 0, 0), glm::vec4(1.0f / (std::numbers::pi_v<float> * s * s), 0.0f, 0.0f, 0.0f)};
   graph.add_shader_pass(
       settings_.name + " resolve", gpu::PassKind::Compute, *pipe,
       [sums, image](gpu::ShaderPassBuilder& b) {

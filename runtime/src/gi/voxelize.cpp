@@ -3,15 +3,15 @@
 namespace mrgi::gi {
 namespace {
 
-struct MeshPush {
+struct VoxelizeMeshPush {
   glm::vec4 region;
   glm::ivec4 range;  // cells, first index, triangles, vertex offset
 };
-struct DepthPush {
+struct VoxelizeDepthPush {
   glm::vec4 region;
   glm::ivec4 sizes;  // cells, width, height
 };
-struct ResolvePush {
+struct VoxelizeResolvePush {
   glm::ivec4 cells;
 };
 
@@ -90,7 +90,7 @@ void Voxelizer::add_mesh(gpu::FrameGraph& graph, const std::string& label, gpu::
         for (const TriangleRange& r : ranges) {
           const uint32_t triangles = r.index_count / 3;
           if (triangles == 0) continue;
-          const MeshPush push{region, glm::ivec4(n, int(r.first_index), int(triangles), r.vertex_offset)};
+          const VoxelizeMeshPush push{region, glm::ivec4(n, int(r.first_index), int(triangles), r.vertex_offset)};
           gpu::push_and_dispatch(cmd, *pipe, &push, sizeof push, {(triangles + 63) / 64, 1, 1});
         }
       });
@@ -100,7 +100,7 @@ void Voxelizer::add_depth_surface(gpu::FrameGraph& graph, const std::string& lab
                                   gpu::ImageHandle normal, uint32_t width, uint32_t height) const {
   const gpu::Pipeline* pipe = &*depth_;
   const gpu::BufferHandle sums = sums_;
-  const DepthPush push{glm::vec4(region_.origin, region_.voxel_size), glm::ivec4(int(cells()), int(width), int(height), 0)};
+  const VoxelizeDepthPush push{glm::vec4(region_.origin, region_.voxel_size), glm::ivec4(int(cells()), int(width), int(height), 0)};
   graph.add_shader_pass(
       settings_.name + " voxelize " + label, gpu::PassKind::Compute, *pipe,
       [position, normal, sums](gpu::ShaderPassBuilder& b) {
@@ -118,7 +118,7 @@ void Voxelizer::add_resolve(gpu::FrameGraph& graph) const {
   const gpu::BufferHandle sums = sums_;
   const gpu::ImageHandle image = volume_->image(0);
   const uint32_t n = cells();
-  const ResolvePush push{glm::ivec4(int(n), 0, 0, 0)};
+  const VoxelizeResolvePush push{glm::ivec4(int(n), 0, 0, 0)};
   graph.add_shader_pass(
       settings_.name + " resolve", gpu::PassKind::Compute, *pipe,
       [sums, image](gpu::ShaderPassBuilder& b) {
