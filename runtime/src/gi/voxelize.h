@@ -11,6 +11,7 @@
 // shaders/gi/voxelize_splat.glsl (why sampling, and its limits). Everything is allocated at
 // create() for `resolution`; set_cells() picks the used size of a cheaper level.
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -36,6 +37,17 @@ struct VoxelRegion {
   glm::vec3 origin{0.0f};
   float voxel_size = 0.01f;
 };
+
+// The region of Sec. 3.4: "the double sized bounding box of the virtual object", as a cube (the
+// volumes are cubes of cells() voxels) around the box's centre whose side is twice the box's
+// longest side, never under `min_side` metres (a flat or tiny object still gets a region its
+// neighbourhood fits in).
+inline VoxelRegion doubled_box_region(glm::vec3 box_min, glm::vec3 box_max, uint32_t cells, float min_side) {
+  const glm::vec3 extent = glm::max(box_max - box_min, glm::vec3(0.0f));
+  const float side = std::max(2.0f * std::max(extent.x, std::max(extent.y, extent.z)), min_side);
+  const glm::vec3 centre = 0.5f * (box_min + box_max);
+  return {centre - glm::vec3(0.5f * side), side / float(std::max(cells, 1u))};
+}
 
 // One indexed triangle range of a mesh whose vertices are technique/scene_gpu.h GpuVertex (world
 // position, normal, uv: 8 floats) in a storage buffer, with 32-bit indices.
