@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "gi/voxel_light.h"
+#include "volume_readback.h"
 #include "vulkan/vk_test_util.h"
 
 namespace {
@@ -43,11 +44,7 @@ struct Rig {
     EXPECT_TRUE(v.ok()) << v.error().message;
     light.emplace(std::move(*v));
     light->set_region({glm::vec3(0.0f), kVoxel});
-    gpu::BufferDesc bd;
-    bd.name = "light readback";
-    bd.size = VkDeviceSize(kN) * kN * kN * 8 * 2;
-    bd.memory = gpu::MemoryUsage::Readback;
-    readback = *graph->create_buffer(bd, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    readback = test::make_volume_readback(*graph, kN);
   }
 
   gi::RsmImages map(const std::string& name, const std::vector<Texel>& texels) {
@@ -74,41 +71,14 @@ struct Rig {
 
   // One frame; returns levels 0 and 1 (rgb).
   std::vector<std::vector<glm::vec3>> run(const std::function<void()>& add) {
-    EXPECT_TRUE(graph->begin_frame().ok());
-    light->add_clear(*graph);
-    add();
-    light->add_resolve(*graph);
-    const gpu::ImageHandle image = light->volume().image(0);
-    graph->add_pass(
-        "copy light", gpu::PassKind::Transfer,
-        [&](gpu::PassBuilder& b) {
-          b.read(image, gpu::Access::TransferSrc);
-          b.write(readback, gpu::Access::TransferDst);
-        },
-        [this, image](VkCommandBuffer cmd, gpu::PassContext& p) {
-          VkBufferImageCopy r[2]{};
-          for (uint32_t level = 0; level < 2; ++level) {
-            const uint32_t n = kN >> level;
-            r[level].bufferOffset = level == 0 ? 0 : VkDeviceSize(kN) * kN * kN * 8;
-            r[level].imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, level, 0, 1};
-            r[level].imageExtent = {n, n, n};
-          }
-          vkCmdCopyImageToBuffer(cmd, p.image(image), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, p.buffer(readback), 2, r);
-        });
-    graph->mark_output(readback);
-    Status s = graph->compile();
-    EXPECT_TRUE(s.ok()) << s.error().message;
-    EXPECT_TRUE(graph->submit().ok());
-    EXPECT_TRUE(graph->flush().ok());
-    const auto* h = static_cast<const uint16_t*>(graph->mapped(readback, 0));
+    const auto levels = test::run_and_read_volume(*graph, light->volume().image(0), readback, kN, [&] {
+      light->add_clear(*graph);
+      add();
+      light->add_resolve(*graph);
+    });
     std::vector<std::vector<glm::vec3>> out(2);
-    for (uint32_t level = 0; level < 2; ++level) {
-      const uint32_t n = kN >> level;
-      const uint16_t* l = h + (level == 0 ? 0 : size_t(kN) * kN * kN * 4);
-      for (size_t i = 0; i < size_t(n) * n * n; ++i)
-        out[level].push_back(glm::vec3(glm::unpackHalf1x16(l[4 * i]), glm::unpackHalf1x16(l[4 * i + 1]),
-                                       glm::unpackHalf1x16(l[4 * i + 2])));
-    }
+    for (size_t l = 0; l < 2; ++l)
+      for (const glm::vec4& v : levels[l]) out[l].push_back(glm::vec3(v));
     return out;
   }
 };

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "gi/voxelize.h"
+#include "volume_readback.h"
 #include "vulkan/vk_test_util.h"
 
 namespace {
@@ -41,11 +42,7 @@ struct Rig {
     EXPECT_TRUE(v.ok()) << v.error().message;
     vox.emplace(std::move(*v));
     vox->set_region({glm::vec3(0.0f), kVoxel});
-    gpu::BufferDesc bd;
-    bd.name = "voxel readback";
-    bd.size = VkDeviceSize(kN) * kN * kN * 8 * 2;  // level 0 and level 1, RGBA16F
-    bd.memory = gpu::MemoryUsage::Readback;
-    readback = *graph->create_buffer(bd, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    readback = test::make_volume_readback(*graph, kN);
   }
 
   gpu::BufferHandle buffer(const std::string& name, const void* data, size_t bytes) {
@@ -60,42 +57,11 @@ struct Rig {
 
   // One frame: what `add` records between clear and resolve; returns levels 0 and 1 as RGBA.
   std::vector<std::vector<glm::vec4>> run(const std::function<void()>& add) {
-    EXPECT_TRUE(graph->begin_frame().ok());
-    vox->add_clear(*graph);
-    add();
-    vox->add_resolve(*graph);
-    const gpu::ImageHandle image = vox->volume().image(0);
-    graph->add_pass(
-        "copy volume", gpu::PassKind::Transfer,
-        [&](gpu::PassBuilder& b) {
-          b.read(image, gpu::Access::TransferSrc);
-          b.write(readback, gpu::Access::TransferDst);
-        },
-        [this, image](VkCommandBuffer cmd, gpu::PassContext& p) {
-          VkBufferImageCopy r[2]{};
-          for (uint32_t level = 0; level < 2; ++level) {
-            const uint32_t n = kN >> level;
-            r[level].bufferOffset = level == 0 ? 0 : VkDeviceSize(kN) * kN * kN * 8;
-            r[level].imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, level, 0, 1};
-            r[level].imageExtent = {n, n, n};
-          }
-          vkCmdCopyImageToBuffer(cmd, p.image(image), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, p.buffer(readback), 2, r);
-        });
-    graph->mark_output(readback);
-    Status s = graph->compile();
-    EXPECT_TRUE(s.ok()) << s.error().message;
-    EXPECT_TRUE(graph->submit().ok());
-    EXPECT_TRUE(graph->flush().ok());
-    const auto* halfs = static_cast<const uint16_t*>(graph->mapped(readback, 0));
-    std::vector<std::vector<glm::vec4>> out(2);
-    for (uint32_t level = 0; level < 2; ++level) {
-      const uint32_t n = kN >> level;
-      const uint16_t* h = halfs + (level == 0 ? 0 : size_t(kN) * kN * kN * 4);
-      for (size_t i = 0; i < size_t(n) * n * n; ++i)
-        out[level].push_back(glm::vec4(glm::unpackHalf1x16(h[4 * i]), glm::unpackHalf1x16(h[4 * i + 1]),
-                                       glm::unpackHalf1x16(h[4 * i + 2]), glm::unpackHalf1x16(h[4 * i + 3])));
-    }
-    return out;
+    return test::run_and_read_volume(*graph, vox->volume().image(0), readback, kN, [&] {
+      vox->add_clear(*graph);
+      add();
+      vox->add_resolve(*graph);
+    });
   }
 };
 
