@@ -10,6 +10,7 @@
 
 #include "gi/voxel_light.h"
 #include "gi/voxelize.h"
+#include "volume_readback.h"
 #include "vulkan/vk_test_util.h"
 
 namespace {
@@ -34,12 +35,8 @@ struct Cone {
 };
 
 std::vector<glm::vec4> trace(gpu::Context& ctx, const std::vector<Cone>& cones) {
-  gpu::FrameGraphSettings fs;
-  fs.max_output_width = fs.max_output_height = 16;
-  fs.frames_in_flight = 1;
-  auto g = gpu::FrameGraph::create(ctx, fs);
-  EXPECT_TRUE(g.ok());
-  gpu::FrameGraph& graph = **g;
+  auto owned = test::make_block_graph(ctx);
+  gpu::FrameGraph& graph = *owned;
   gi::VoxelizeSettings vs;
   vs.name = "wall visibility";
   vs.resolution = kN;

@@ -31,12 +31,7 @@ struct Rig {
   gpu::BufferHandle readback;
 
   explicit Rig(gpu::Context& ctx) {
-    gpu::FrameGraphSettings fs;
-    fs.max_output_width = fs.max_output_height = 16;
-    fs.frames_in_flight = 1;
-    auto g = gpu::FrameGraph::create(ctx, fs);
-    EXPECT_TRUE(g.ok());
-    graph = std::move(*g);
+    graph = test::make_block_graph(ctx);
     gi::VoxelLightSettings s;
     s.name = "test light";
     s.resolution = kN;

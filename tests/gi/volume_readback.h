@@ -6,11 +6,23 @@
 #include <gtest/gtest.h>
 
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "gpu/frame_graph.h"
 
 namespace mrgi::test {
+
+// A frame graph for a block test: one frame in flight, a 16 x 16 output (the blocks' images are
+// sized absolutely).
+inline std::unique_ptr<gpu::FrameGraph> make_block_graph(gpu::Context& ctx) {
+  gpu::FrameGraphSettings fs;
+  fs.max_output_width = fs.max_output_height = 16;
+  fs.frames_in_flight = 1;
+  auto g = gpu::FrameGraph::create(ctx, fs);
+  EXPECT_TRUE(g.ok()) << (g.ok() ? "" : g.error().message);
+  return g.ok() ? std::move(*g) : nullptr;
+}
 
 // Readback space for levels 0 and 1 of an RGBA16F volume of n^3 cells.
 inline gpu::BufferHandle make_volume_readback(gpu::FrameGraph& graph, uint32_t n) {
