@@ -314,7 +314,7 @@ void setup(CLI::App& app) {
                   "beside the frames (the default with a fixed level: faster on many cores)")
       ->check(CLI::IsMember({"preloaded", "overlapped"}));
   cmd->add_option("--preload-frames", opts->preload_frames,
-                  "--io preloaded: frames decoded ahead at a time (default: as many as fit in 512 MiB, about 64 "
+                  "--io preloaded: frames decoded ahead at a time (default: as many as fit in 512 MiB, about 130 "
                   "at 640x480)")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--quiet,-q", opts->quiet, "no progress on stderr");
