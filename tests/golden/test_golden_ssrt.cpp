@@ -82,7 +82,7 @@ TEST(GoldenSsrt, FirstFrameIsPrimedOnceAndEveryFrameGivesOneOutput) {
     for (size_t i = 0; i < outs.size(); ++i) {
       EXPECT_EQ(outs[i].stats.frame_index, int64_t(i)) << technique;
       for (const std::string& n : outs[i].stats.notes)
-        if (n.find("primes") != std::string::npos) ++primed;
+        if (n.find("primed") != std::string::npos) ++primed;
     }
     const bool ssrt = std::string(technique) == "ssrt";
     EXPECT_EQ(primed, ssrt ? 1 : 0) << technique;

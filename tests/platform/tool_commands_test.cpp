@@ -214,10 +214,10 @@ TEST_F(ToolCommands, LiveSsrtOnTheKinectRecordingEstimatesLightFromTheFirstFrame
     EXPECT_TRUE(f["light"]["valid"].get<bool>()) << "frame " << f["frame"];
     for (const auto& c : f["light"]["sh_radiance"])
       for (const auto& v : c) EXPECT_TRUE(v.is_number()) << "a non-finite coefficient is written as null";
-    for (const auto& n : f["notes"]) primed += n.get<std::string>().find("primes") != std::string::npos;
+    for (const auto& n : f["notes"]) primed += n.get<std::string>().find("primed") != std::string::npos;
   }
   EXPECT_EQ(primed, 1);
-  EXPECT_NE(stats[0]["notes"].dump().find("primes"), std::string::npos) << "frame 0 is the primed one";
+  EXPECT_NE(stats[0]["notes"].dump().find("primed"), std::string::npos) << "frame 0 is the primed one";
 }
 
 TEST_F(ToolCommands, RecordedCaptureReplays) {

@@ -174,39 +174,6 @@ RuntimeImpl::~RuntimeImpl() {
   context_.reset();
 }
 
-// The budget and the scheduler's constants, each checked with its field's name and rule.
-Status check_scheduler_settings(const RuntimeSettings& rs, size_t levels) {
-  auto bad = [](const std::string& field, const std::string& rule) {
-    return fail(ErrorKind::BadUsage, "RuntimeSettings." + field + ": " + rule);
-  };
-  if (!std::isfinite(rs.frame_budget_ms) || rs.frame_budget_ms <= 0.0 || rs.frame_budget_ms > 1e6)
-    return bad("frame_budget_ms", "must be in (0, 1e6] ms");
-  const SchedulerSettings& s = rs.scheduler;
-  if (!(s.headroom >= 0.0 && s.headroom < 0.9)) return bad("scheduler.headroom", "must be in [0, 0.9)");
-  if (s.window_frames < 1 || s.window_frames > 64) return bad("scheduler.window_frames", "must be 1..64");
-  if (!(s.quantile >= 0.0 && s.quantile <= 1.0)) return bad("scheduler.quantile", "must be in [0, 1]");
-  if (!(s.dead_band_below >= 0.0 && s.dead_band_below < 1.0) || !(s.dead_band_above >= 0.0 && s.dead_band_above < 1.0))
-    return bad("scheduler.dead_band_below/above", "must be in [0, 1)");
-  if (!(s.scale_gain > 0.0 && s.scale_gain <= 1.0)) return bad("scheduler.scale_gain", "must be in (0, 1]");
-  if (!(s.scale_gain_up > 0.0 && s.scale_gain_up <= 1.0)) return bad("scheduler.scale_gain_up", "must be in (0, 1]");
-  if (!(s.min_scale >= 0.25f && s.min_scale <= 1.0f)) return bad("scheduler.min_scale", "must be in [0.25, 1]");
-  if (!(s.upgrade_min_scale >= s.min_scale && s.upgrade_min_scale <= 1.0f))
-    return bad("scheduler.upgrade_min_scale", "must be in [min_scale, 1]");
-  if (s.min_frames_between_changes < 0 || s.min_frames_between_changes > 100000)
-    return bad("scheduler.min_frames_between_changes", "must be 0..100000");
-  if (s.step_frames < 1 || s.step_frames > 1000) return bad("scheduler.step_frames", "must be 1..1000");
-  if (s.emergency_frames < 1 || s.emergency_frames > 1000) return bad("scheduler.emergency_frames", "must be 1..1000");
-  if (!(s.emergency_factor >= 1.0 && s.emergency_factor <= 100.0)) return bad("scheduler.emergency_factor", "must be in [1, 100]");
-  if (!rs.level_costs_ms.empty()) {
-    if (rs.level_costs_ms.size() != levels)
-      return bad("level_costs_ms", "has " + std::to_string(rs.level_costs_ms.size()) + " costs for a ladder of " +
-                                       std::to_string(levels) + " levels");
-    for (double c : rs.level_costs_ms)
-      if (!std::isfinite(c) || c <= 0.0) return bad("level_costs_ms", "every cost must be a positive number of ms");
-  }
-  return ok_status();
-}
-
 Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cameras,
                          const SceneDesc& scene) {
   settings_ = settings;
@@ -241,7 +208,7 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
     return fail(ErrorKind::BadUsage, "RuntimeSettings.level " + std::to_string(settings.level) +
                                          ": technique '" + settings_.technique + "' has levels 0.." +
                                          std::to_string(ladder.size() - 1) + " (or kAutoLevel)");
-  MRGI_TRY(check_scheduler_settings(settings_, ladder.size()));
+  MRGI_TRY(sched::check_settings(settings_, ladder.size()));
   if (settings.frames_in_flight < 1 || settings.frames_in_flight > 3)
     return fail(ErrorKind::BadUsage, "RuntimeSettings.frames_in_flight " +
                                          std::to_string(settings.frames_in_flight) + ": must be 1..3");
@@ -536,12 +503,10 @@ Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame)
     }
     char ms[32];
     std::snprintf(ms, sizeof ms, "%.2f", prime_ms);
-    note = "technique: frame run " + std::to_string(runs + 1) + " times, the first " +
-           (runs == 1 ? std::string("run") : std::to_string(runs) + " runs") + " (" + ms + " ms GPU, output dropped) " +
-           (for_estimate ? "prime" : "warm") +
-           (runs == 1 ? "s " : " ") +
-           (for_estimate ? technique_->name() + "'s estimate from this frame"
-                         : std::string("the driver up (its first use of each pipeline and of each frame slot's memory)"));
+    note = "technique: frame run " + std::to_string(runs + 1) + " times, the first " + std::to_string(runs) +
+           " run(s) (" + ms + " ms GPU, output dropped) " +
+           (for_estimate ? "primed " + technique_->name() + "'s estimate from this frame"
+                         : std::string("warmed the driver up (its first use of each pipeline and of each frame slot's memory)"));
     t_work = std::chrono::steady_clock::now();  // the priming run is not this frame's own work
     notes.push_back(note);
   }

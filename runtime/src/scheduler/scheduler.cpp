@@ -2,8 +2,42 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace mrgi::sched {
+
+// The budget and the scheduler's constants, each checked with its field's name and rule.
+Status check_settings(const RuntimeSettings& rs, size_t levels) {
+  auto bad = [](const std::string& field, const std::string& rule) {
+    return fail(ErrorKind::BadUsage, "RuntimeSettings." + field + ": " + rule);
+  };
+  if (!std::isfinite(rs.frame_budget_ms) || rs.frame_budget_ms <= 0.0 || rs.frame_budget_ms > 1e6)
+    return bad("frame_budget_ms", "must be in (0, 1e6] ms");
+  const SchedulerSettings& s = rs.scheduler;
+  if (!(s.headroom >= 0.0 && s.headroom < 0.9)) return bad("scheduler.headroom", "must be in [0, 0.9)");
+  if (s.window_frames < 1 || s.window_frames > 64) return bad("scheduler.window_frames", "must be 1..64");
+  if (!(s.quantile >= 0.0 && s.quantile <= 1.0)) return bad("scheduler.quantile", "must be in [0, 1]");
+  if (!(s.dead_band_below >= 0.0 && s.dead_band_below < 1.0) || !(s.dead_band_above >= 0.0 && s.dead_band_above < 1.0))
+    return bad("scheduler.dead_band_below/above", "must be in [0, 1)");
+  if (!(s.scale_gain > 0.0 && s.scale_gain <= 1.0)) return bad("scheduler.scale_gain", "must be in (0, 1]");
+  if (!(s.scale_gain_up > 0.0 && s.scale_gain_up <= 1.0)) return bad("scheduler.scale_gain_up", "must be in (0, 1]");
+  if (!(s.min_scale >= 0.25f && s.min_scale <= 1.0f)) return bad("scheduler.min_scale", "must be in [0.25, 1]");
+  if (!(s.upgrade_min_scale >= s.min_scale && s.upgrade_min_scale <= 1.0f))
+    return bad("scheduler.upgrade_min_scale", "must be in [min_scale, 1]");
+  if (s.min_frames_between_changes < 0 || s.min_frames_between_changes > 100000)
+    return bad("scheduler.min_frames_between_changes", "must be 0..100000");
+  if (s.step_frames < 1 || s.step_frames > 1000) return bad("scheduler.step_frames", "must be 1..1000");
+  if (s.emergency_frames < 1 || s.emergency_frames > 1000) return bad("scheduler.emergency_frames", "must be 1..1000");
+  if (!(s.emergency_factor >= 1.0 && s.emergency_factor <= 100.0)) return bad("scheduler.emergency_factor", "must be in [1, 100]");
+  if (!rs.level_costs_ms.empty()) {
+    if (rs.level_costs_ms.size() != levels)
+      return bad("level_costs_ms", "has " + std::to_string(rs.level_costs_ms.size()) + " costs for a ladder of " +
+                                       std::to_string(levels) + " levels");
+    for (double c : rs.level_costs_ms)
+      if (!std::isfinite(c) || c <= 0.0) return bad("level_costs_ms", "every cost must be a positive number of ms");
+  }
+  return ok_status();
+}
 
 float Scheduler::scale_for_factor(double factor) {
   const double s2 = (factor - kFixedFraction) / (1.0 - kFixedFraction);

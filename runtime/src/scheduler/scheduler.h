@@ -95,6 +95,10 @@ class Scheduler {
   Choice choice_;
 };
 
+// The frame budget and RuntimeSettings::scheduler's constants (and level_costs_ms against a
+// ladder of `levels`), each refused as BadUsage naming its field and rule.
+Status check_settings(const RuntimeSettings& settings, size_t levels);
+
 // Relative cost priors of a technique's ladder (ms at 640x480 on lavapipe x2 from the bench,
 // perf/results/scheduler/README.md), best level first; equal steps where none is known.
 std::vector<double> builtin_level_costs(const std::string& technique, int levels);
