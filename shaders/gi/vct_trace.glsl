@@ -1,46 +1,91 @@
-// Cone tracing through a voxel light volume and its visibility volume (dvct; the math is
-// shaders/shared/vct_math.h, unit-tested on the CPU): samples along the cone at footprints that
-// touch (vct_next_distance), each read at the mip level of its footprint from both volumes
-// (trilinear within a level), composited front to back until the cone is occluded, leaves the
-// volume or reaches `max_distance`. Needs shared/vct_math.h included first.
+// Cone tracing through dvct's four volumes (delta-voxel-cone-tracing.md Sec. 3.2; the math is
+// shaders/shared/vct_math.h, unit-tested on the CPU): the light volume (every surface, the
+// virtual objects included), the delta light volume (with the objects minus without), and one
+// visibility volume each for the real scene and the virtual objects. Samples along the cone at
+// footprints that touch (vct_next_distance) times `step_scale`, each read at the mip level of its
+// footprint from every volume it needs (trilinear within a level), composited front to back
+// until the cone is occluded, leaves the volume or reaches `max_distance`. Needs
+// shared/vct_math.h included first.
+//
+// Two accumulations in one march (the same samples, the same footprints):
+//   - "with" the objects: the light volume through both visibility volumes (what a virtual
+//     pixel sees, and a real one once the objects are there);
+//   - "without" them (VCT_WITHOUT): light volume minus delta volume (= the scene-only light
+//     the paper subtracts) through the scene's visibility alone.
+// A real pixel's change is with - without. The paper relights real pixels from the delta volume
+// through both visibility volumes; that holds the objects' bounce and the light they block at
+// its source (their shadow on the scene), but not the scene light they hide from the pixel (a
+// real wall's bounce, or its reflection in a real mirror, behind the object): with - without
+// holds all three and equals the paper's term where the objects hide nothing. A shadow cone
+// (no VCT_LIGHT) reads the visibility volumes only: trans_with against trans_without is the
+// objects' shadow where the scene does not already shadow (no double shadow, Sec. 3.2).
 
 struct VctVolume {
-  vec3 origin;       // the volumes' min corner (m)
-  float voxel_size;  // m
-  float cells;       // voxels per side (used)
-  float max_lod;     // the coarsest mip level holding data
+  vec3 origin;            // the volumes' min corner (m)
+  float voxel_size;       // m
+  float cells;            // voxels per side (used)
+  float max_lod;          // the coarsest mip level holding data
   float occlusion_floor;  // vct_directional_occlusion's floor_fraction
+  float step_scale;       // vct_step: the fraction of the touching-footprint step taken
 };
 
-// Light (rgb) and occlusion (a) a cone gathers. `origin` (m) should already sit a voxel off the
-// surface it starts from (the caller knows the normal); `aperture` the full aperture (radians);
-// `max_distance` metres.
-vec4 vct_trace(sampler3D light_volume, sampler3D visibility_volume, VctVolume v, vec3 origin, vec3 dir,
-               float aperture, float max_distance) {
+struct VctResult {
+  vec3 light_with;      // light gathered with the objects (rgb)
+  float trans_with;     // the cone's transmittance through both visibility volumes
+  vec3 light_without;   // the scene-only light through the scene's visibility (VCT_WITHOUT)
+  float trans_without;  // the transmittance through the scene's visibility alone (VCT_WITHOUT)
+};
+
+const int VCT_LIGHT = 1;    // gather light (else: occlusion only, a shadow cone)
+const int VCT_WITHOUT = 2;  // also the accumulation without the objects
+
+VctResult vct_trace_cone(sampler3D light_volume, sampler3D delta_volume, sampler3D scene_visibility,
+                         sampler3D object_visibility, VctVolume v, vec3 origin, vec3 dir, float aperture,
+                         float max_distance, int flags) {
+  const bool want_light = (flags & VCT_LIGHT) != 0, want_without = (flags & VCT_WITHOUT) != 0;
   const float ratio = vct_diameter_ratio(aperture);
-  const float min_diameter = 0.5;                  // voxels
+  const float min_diameter = 0.5f;                        // voxels
   const vec3 start = (origin - v.origin) / v.voxel_size;  // voxel units
   const float limit = max_distance / v.voxel_size;
-  vec4 acc = vec4(0.0);
-  float d = 1.0;
+  VctResult r;
+  r.light_with = vec3(0.0f);
+  r.light_without = vec3(0.0f);
+  r.trans_with = 1.0f;
+  r.trans_without = 1.0f;
+  float d = 1.0f;
   bool entered = false;  // a cone from outside the region (a real pixel beyond it) may enter it
-  for (int step = 0; step < 256 && d < limit && acc.w < 0.99; ++step) {
+  for (int step = 0; step < 512 && d < limit; ++step) {
+    if (r.trans_with < 0.01f && (!want_without || r.trans_without < 0.01f)) break;
     const vec3 p = start + d * dir;
-    const bool inside = all(greaterThanEqual(p, vec3(0.0))) && all(lessThanEqual(p, vec3(v.cells)));
+    const float next = vct_step(ratio, d, min_diameter, v.step_scale);
+    const bool inside = all(greaterThanEqual(p, vec3(0.0f))) && all(lessThanEqual(p, vec3(v.cells)));
     if (!inside) {
       if (entered) break;  // left it: nothing more to gather (the sampler would repeat the edge)
-      d = vct_next_distance(ratio, d, min_diameter);
+      d = next;
       continue;
     }
     entered = true;
-    const float diameter = vct_diameter(ratio, d, min_diameter);
-    const float lod = vct_lod(diameter, v.max_lod);
+    const float lod = vct_lod(vct_diameter(ratio, d, min_diameter), v.max_lod);
     const vec3 uvw = p / v.cells;
-    const vec3 light = textureLod(light_volume, uvw, lod).rgb;
-    const vec4 visibility = textureLod(visibility_volume, uvw, lod);
-    const vec4 s = vct_sample(light, visibility, dir, v.occlusion_floor, lod);
-    acc = vct_accumulate(acc, vec3(s.x, s.y, s.z), s.w);
-    d = vct_next_distance(ratio, d, min_diameter);
+    const vec4 vis_s = textureLod(scene_visibility, uvw, lod);
+    const vec4 vis_o = textureLod(object_visibility, uvw, lod);
+    const float a_s = vct_opacity_for_step(vct_directional_occlusion(vis_s, dir, v.occlusion_floor, lod), v.step_scale);
+    const float a_o = vct_opacity_for_step(vct_directional_occlusion(vis_o, dir, v.occlusion_floor, lod), v.step_scale);
+    const float a_with = 1.0f - (1.0f - a_s) * (1.0f - a_o);
+    if (want_light) {
+      const vec3 light = textureLod(light_volume, uvw, lod).rgb;
+      const vec4 both = vec4(vis_s.xyz + vis_o.xyz, min(vis_s.w + vis_o.w, 1.0f));
+      const vec4 s = vct_sample(light, both, dir, v.occlusion_floor, lod);
+      r.light_with += vct_light_for_step(s, v.step_scale) * r.trans_with;
+      if (want_without) {
+        const vec3 scene_light = light - textureLod(delta_volume, uvw, lod).rgb;
+        const vec4 t = vct_sample(scene_light, vis_s, dir, v.occlusion_floor, lod);
+        r.light_without += vct_light_for_step(t, v.step_scale) * r.trans_without;
+      }
+    }
+    r.trans_with *= 1.0f - a_with;
+    r.trans_without *= 1.0f - a_s;
+    d = next;
   }
-  return acc;
+  return r;
 }

@@ -170,4 +170,23 @@ TEST(VctMath, SpecularApertureFollowsRoughness) {
   EXPECT_FLOAT_EQ(vct_specular_aperture(1.0f, min_aperture), 2.0f * std::atan(0.5f * VCT_MAX_DIAMETER_RATIO));
 }
 
+TEST(VctMath, ShorterStepsKeepTheTransmittanceOfTheSameDepth) {
+  const float ratio = vct_diameter_ratio(1.0f);
+  // step_scale 1 is the paper's step; 0.5 goes half as far.
+  EXPECT_FLOAT_EQ(vct_step(ratio, 4.0f, 0.5f, 1.0f), vct_next_distance(ratio, 4.0f, 0.5f));
+  EXPECT_FLOAT_EQ(vct_step(ratio, 4.0f, 0.5f, 0.5f) - 4.0f, 0.5f * (vct_next_distance(ratio, 4.0f, 0.5f) - 4.0f));
+  // Two half steps through the same medium let through what one full step does.
+  for (float a : {0.0f, 0.1f, 0.5f, 0.9f}) {
+    const float half = vct_opacity_for_step(a, 0.5f);
+    EXPECT_NEAR((1.0f - half) * (1.0f - half), 1.0f - a, 1e-5f) << a;
+    EXPECT_FLOAT_EQ(vct_opacity_for_step(a, 1.0f), a);
+  }
+  EXPECT_FLOAT_EQ(vct_opacity_for_step(1.0f, 0.5f), 1.0f) << "opaque stays opaque";
+  // The light scales with the occlusion, so their ratio (the voxel's radiance) is kept.
+  const vec4 s(0.2f, 0.4f, 0.6f, 0.5f);
+  const vec3 l = vct_light_for_step(s, 0.5f);
+  EXPECT_NEAR(l.x / vct_opacity_for_step(0.5f, 0.5f), 0.2f / 0.5f, 1e-5f);
+  EXPECT_EQ(vct_light_for_step(vec4(0.0f), 0.5f), vec3(0.0f));
+}
+
 }  // namespace
