@@ -24,6 +24,9 @@ struct VctVolume {
   vec3 origin;            // the volumes' min corner (m)
   float voxel_size;       // m
   float cells;            // voxels per side (used)
+  float texture_cells;    // voxels per side allocated: a cheaper level's volume is a corner of
+                          // each mip level (gi/volume.h set_divisor), so texture coordinates
+                          // divide by this
   float max_lod;          // the coarsest mip level holding data
   float occlusion_floor;  // vct_directional_occlusion's floor_fraction
   float step_scale;       // vct_step: the fraction of the touching-footprint step taken
@@ -52,21 +55,21 @@ VctResult vct_trace_cone(sampler3D light_volume, sampler3D delta_volume, sampler
   r.light_without = vec3(0.0f);
   r.trans_with = 1.0f;
   r.trans_without = 1.0f;
-  float d = 1.0f;
-  bool entered = false;  // a cone from outside the region (a real pixel beyond it) may enter it
-  for (int step = 0; step < 512 && d < limit; ++step) {
+  // The march runs where the ray is inside the region: a cone from outside it (a real pixel
+  // beyond it, a shadow cone towards a lamp) starts where it enters, with the footprint it has
+  // there, and nothing is read after it leaves (the sampler would repeat the edge).
+  const vec3 inv = 1.0f / (abs(dir) + 1e-12f) * sign(dir + 1e-30f);
+  const vec3 t_a = (vec3(0.0f) - start) * inv, t_b = (vec3(v.cells) - start) * inv;
+  const vec3 t_lo = min(t_a, t_b), t_hi = max(t_a, t_b);
+  const float enter = max(max(t_lo.x, t_lo.y), t_lo.z), leave = min(min(t_hi.x, t_hi.y), t_hi.z);
+  float d = max(1.0f, enter);
+  const float end = min(limit, leave);
+  for (int step = 0; step < 512 && d < end; ++step) {
     if (r.trans_with < 0.01f && (!want_without || r.trans_without < 0.01f)) break;
     const vec3 p = start + d * dir;
     const float next = vct_step(ratio, d, min_diameter, v.step_scale);
-    const bool inside = all(greaterThanEqual(p, vec3(0.0f))) && all(lessThanEqual(p, vec3(v.cells)));
-    if (!inside) {
-      if (entered) break;  // left it: nothing more to gather (the sampler would repeat the edge)
-      d = next;
-      continue;
-    }
-    entered = true;
     const float lod = vct_lod(vct_diameter(ratio, d, min_diameter), v.max_lod);
-    const vec3 uvw = p / v.cells;
+    const vec3 uvw = p / v.texture_cells;
     const vec4 vis_s = textureLod(scene_visibility, uvw, lod);
     const vec4 vis_o = textureLod(object_visibility, uvw, lod);
     const float a_s = vct_opacity_for_step(vct_directional_occlusion(vis_s, dir, v.occlusion_floor, lod), v.step_scale);

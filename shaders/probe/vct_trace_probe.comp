@@ -29,6 +29,7 @@ void main() {
   v.origin = volume.xyz;
   v.voxel_size = volume.w;
   v.cells = sizes.x;
+  v.texture_cells = sizes.x;
   v.max_lod = sizes.y;
   v.occlusion_floor = sizes.z;
   v.step_scale = sizes.w;

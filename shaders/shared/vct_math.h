@@ -196,6 +196,19 @@ MRGI_FN float vct_specular_aperture(float roughness, float min_aperture) {
   return clamp(2.0f * half_angle, min_aperture, 2.0f * atan(0.5f * VCT_MAX_DIAMETER_RATIO));
 }
 
+// What a specular cone's radiance is weighted by: the GGX lobe's directional albedo for
+// reflectance f0 at n.v and roughness, from Karis' analytic fit of the split-sum table
+// ("Physically based shading on mobile", 2014), so a cone's mean radiance times this is the
+// reflected radiance without a lookup table bound in every shading pass. In [0, 1] per channel
+// for f0 in [0, 1].
+MRGI_FN vec3 vct_specular_weight(vec3 f0, float roughness, float n_dot_v) {
+  const float r = clamp(roughness, 0.0f, 1.0f);
+  const vec4 rr = vec4(-1.0f, -0.0275f, -0.572f, 0.022f) * r + vec4(1.0f, 0.0425f, 1.04f, -0.04f);
+  const float a004 = min(rr.x * rr.x, exp2(-9.28f * max(n_dot_v, 0.0f))) * rr.x + rr.y;
+  const float scale = -1.04f * a004 + rr.z, bias = 1.04f * a004 + rr.w;
+  return clamp(f0 * scale + vec3(bias), vec3(0.0f), vec3(1.0f));
+}
+
 #ifdef __cplusplus
 }  // namespace mrgi::shader
 #undef MRGI_FN

@@ -189,4 +189,19 @@ TEST(VctMath, ShorterStepsKeepTheTransmittanceOfTheSameDepth) {
   EXPECT_EQ(vct_light_for_step(vec4(0.0f), 0.5f), vec3(0.0f));
 }
 
+TEST(VctMath, SpecularWeightIsTheLobesDirectionalAlbedo) {
+  // A smooth dielectric seen head-on reflects about its f0; a mirror-like metal its colour;
+  // grazing angles reflect more (Fresnel); rough surfaces less at grazing than smooth ones.
+  EXPECT_NEAR(vct_specular_weight(vec3(0.04f), 0.0f, 1.0f).x, 0.04f, 0.01f);
+  EXPECT_NEAR(vct_specular_weight(vec3(0.9f), 0.0f, 1.0f).x, 0.9f, 0.05f);
+  EXPECT_GT(vct_specular_weight(vec3(0.04f), 0.0f, 0.05f).x, vct_specular_weight(vec3(0.04f), 0.0f, 1.0f).x);
+  EXPECT_LT(vct_specular_weight(vec3(0.04f), 1.0f, 0.1f).x, vct_specular_weight(vec3(0.04f), 0.0f, 0.1f).x);
+  for (float r = 0.0f; r <= 1.0f; r += 0.25f)
+    for (float nv = 0.0f; nv <= 1.0f; nv += 0.25f) {
+      const vec3 w = vct_specular_weight(vec3(0.5f), r, nv);
+      EXPECT_GE(w.x, 0.0f);
+      EXPECT_LE(w.x, 1.0f);
+    }
+}
+
 }  // namespace

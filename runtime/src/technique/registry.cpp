@@ -3,6 +3,7 @@
 #include "technique/baseline/baseline.h"
 #include "technique/dir/dir.h"
 #include "technique/dlpv/dlpv.h"
+#include "technique/dvct/dvct.h"
 #include "technique/ssrt/ssrt.h"
 #include "technique/technique.h"
 
@@ -16,6 +17,7 @@ const std::vector<TechniqueEntry>& registered_techniques() {
       {"ssrt", &ssrt_ladder, &create_ssrt},
       {"dlpv", &dlpv_ladder, &create_dlpv},
       {"dir", &dir_ladder, &create_dir},
+      {"dvct", &dvct_ladder, &create_dvct},
   };
   return entries;
 }
@@ -28,7 +30,6 @@ Expected<const TechniqueEntry*> find_technique(const std::string& name) {
   }
   // Techniques of DESIGN.md that are not built yet say so by name instead of "unknown".
   static const std::pair<const char*, const char*> planned[] = {
-      {"dvct", "Delta Voxel Cone Tracing"},
       {"specular", "mirrors, glass and caustics inside DIR"},
   };
   for (const auto& [planned_name, what] : planned)

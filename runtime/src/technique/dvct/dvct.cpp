@@ -1,0 +1,369 @@
+#include "technique/dvct/dvct.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "dvct/dvct_params.glsl"
+#include "gi/rsm.h"
+#include "gi/voxel_light.h"
+#include "gi/voxelize.h"
+#include "gpu/pipelines.h"
+#include "gpu/shaders.h"
+#include "light/light_stage.h"
+#include "technique/baseline/baseline.h"
+#include "technique/input_reuse.h"
+#include "technique/knobs.h"
+#include "technique/light_set_writer.h"
+#include "technique/scene_gpu.h"
+
+namespace mrgi::technique {
+
+const std::array<DvctLevel, 5>& dvct_levels() {
+  static const std::array<DvctLevel, 5> levels = {{
+      {"paper", 128, 9, true, 512, 4, 1, 1.0f, true, 0, 0.1f, 0.5f},
+      {"high", 64, 9, true, 512, 4, 2, 1.0f, false, 0, 0.1f, 0.5f},
+      {"medium", 64, 5, true, 256, 2, 4, 1.0f, false, 1, 0.1f, 0.5f},
+      {"fast", 32, 5, false, 128, 1, 4, 0.5f, false, 3, 0.1f, 0.5f},
+      {"fastest", 16, 3, false, 64, 1, 4, 0.5f, false, 3, 0.1f, 0.5f},
+  }};
+  return levels;
+}
+
+namespace {
+const KnobField<DvctLevel> kDvctKnobs[] = {
+    {"volume_cells", "voxels per side of each volume", &DvctLevel::volume_cells, true},
+    {"diffuse_cones", "cones in the diffuse set", &DvctLevel::diffuse_cones},
+    {"specular_cone", "1: a specular cone at glossy pixels", &DvctLevel::specular_cone},
+    {"rsm_size", "texels per side of each reflective shadow map", &DvctLevel::rsm_size, true},
+    {"rsm_lamps", "real lamps, strongest first, injected through a map pair", &DvctLevel::rsm_lamps},
+    {"trace_divisor", "G-buffer pixels per traced pixel, each side", &DvctLevel::trace_divisor},
+    {"internal_scale", "fraction of the output width and height", &DvctLevel::internal_scale},
+    {"shadow_cones", "1: direct light through shadow cones (paper); 0: baseline's shadow maps",
+     &DvctLevel::shadow_cones},
+    {"baseline_level", "baseline's level for the shadow maps", &DvctLevel::baseline_level},
+    {"shadow_aperture", "full aperture of a shadow cone, radians", &DvctLevel::shadow_aperture},
+    {"step_scale", "fraction of the touching-footprint step the cones take", &DvctLevel::step_scale},
+};
+
+// The region's side is never under this (metres): a flat or tiny object still gets room for its
+// shadow and bounce (as dlpv's volume).
+constexpr float kMinRegionSide = 0.25f;
+// Pixels at and above this roughness trace no specular cone: the diffuse cones hold that light
+// (SceneGpu::kGlossyRoughness, the same line the scene's glossy flag draws).
+constexpr float kSpecularRoughnessLimit = SceneGpu::kGlossyRoughness;
+// The narrowest specular cone (radians): a mirror reads the volume at its finest level anyway.
+constexpr float kMinSpecularAperture = 0.05f;
+// vct_directional_occlusion's floor for a surface seen edge-on (reconstruction noise).
+constexpr float kOcclusionFloor = 0.1f;
+
+}  // namespace
+
+Expected<std::vector<DvctLevel>> dvct_levels(const std::vector<KnobSetting>& knobs) {
+  auto levels = apply_knobs<DvctLevel>("dvct", dvct_levels(), kDvctKnobs, knobs);
+  if (!levels) return levels;
+  for (const DvctLevel& l : *levels) {
+    if (l.shadow_cones && l.trace_divisor != 1)
+      return fail(ErrorKind::BadUsage, std::string("dvct level '") + l.name +
+                                           "': shadow_cones=1 shades every pixel with cones (trace_divisor must be 1)");
+    if (l.diffuse_cones < 1) return fail(ErrorKind::BadUsage, std::string("dvct level '") + l.name + "': diffuse_cones must be >= 1");
+  }
+  return levels;
+}
+
+Expected<std::vector<QualityLevel>> dvct_ladder(const std::vector<KnobSetting>& knobs) {
+  auto levels = dvct_levels(knobs);
+  if (!levels) return levels.error();
+  return ladder_of(*levels, dvct_levels(), kDvctKnobs);
+}
+
+namespace {
+
+class Dvct final : public Technique {
+ public:
+  Dvct(const SharedResources& shared, std::vector<DvctLevel> levels)
+      : shared_(shared), ladder_(ladder_of(levels, dvct_levels(), kDvctKnobs)), levels_(std::move(levels)) {}
+  const std::string& name() const override { return name_; }
+  const std::vector<QualityLevel>& levels() const override { return ladder_; }
+  Status init();
+  Status record(const FrameInfo& info, std::vector<std::string>& skipped) override;
+
+ private:
+  // The shading pipeline for (diffuse cones, specular cone), made at start-up for every level.
+  using Variant = std::pair<uint32_t, bool>;
+  Status record_volumes(const DvctLevel& level, const FrameInfo& info, std::vector<std::string>& skipped);
+  void add_cone_pass(const DvctLevel& level, const shader::DvctParams& params);
+
+  std::string name_ = "dvct";
+  SharedResources shared_;
+  std::vector<QualityLevel> ladder_;
+  std::vector<DvctLevel> levels_;
+  gpu::BufferHandle lights_;  // shader::LightSet, one per frame slot (the paper level's shading)
+  std::optional<gi::ReflectiveShadowMaps> rsm_;
+  std::optional<gi::Voxelizer> scene_visibility_, object_visibility_;
+  std::optional<gi::VoxelLight> light_, delta_;
+  std::map<Variant, gpu::PipelineHandle> indirect_, shade_;
+  gpu::ImageHandle indirect_image_;  // RGBA32UI, dir/indirect_pack.glsl
+  std::unique_ptr<Technique> baseline_;
+  InputReuse reuse_;
+  bool has_virtual_ = false, glossy_ = false;
+};
+
+Status Dvct::init() {
+  gpu::FrameGraph& graph = *shared_.graph;
+  const gpu::Context& ctx = *shared_.context;
+  const SceneGpu& sg = *shared_.scene_gpu;
+  if (!shared_.light_stage) return fail(ErrorKind::Internal, "dvct: no light stage");
+  auto lights = graph.create_buffer({"dvct_lights", sizeof(shader::LightSet), gpu::MemoryUsage::Upload, true},
+                                    VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  if (!lights) return lights.error();
+  lights_ = *lights;
+  has_virtual_ = !sg.virtual_objects.empty();
+  glossy_ = sg.glossy;
+  // Without virtual objects the volumes are the smallest allowed, allocated only so the shading
+  // passes bind images of the kinds they declare (mode.y 0: they read none of them).
+  uint32_t cells = 2, rsm_size = 16;
+  if (has_virtual_)
+    for (const DvctLevel& l : levels_) {
+      cells = std::max(cells, l.volume_cells);
+      rsm_size = std::max(rsm_size, l.rsm_size);
+    }
+  auto visibility = [&](const char* name) -> Status {
+    gi::VoxelizeSettings s;
+    s.name = name;
+    s.resolution = cells;
+    auto v = gi::Voxelizer::create(graph, s);
+    if (!v) return v.error();
+    (std::string(name) == "dvct scene" ? scene_visibility_ : object_visibility_).emplace(std::move(*v));
+    return ok_status();
+  };
+  MRGI_TRY(visibility("dvct scene"));
+  MRGI_TRY(visibility("dvct objects"));
+  for (int k = 0; k < 2; ++k) {
+    gi::VoxelLightSettings s;
+    s.name = k == 0 ? "dvct light" : "dvct delta";
+    s.resolution = cells;
+    auto v = gi::VoxelLight::create(graph, s);
+    if (!v) return v.error();
+    (k == 0 ? light_ : delta_).emplace(std::move(*v));
+  }
+  if (has_virtual_) {
+    gi::RsmSettings rs;
+    rs.name = "dvct rsm";
+    rs.size = rsm_size;
+    auto rsm = gi::ReflectiveShadowMaps::create(graph, sg, {shared_.real_position, shared_.real_normal, shared_.real_albedo}, rs);
+    if (!rsm) return rsm.error();
+    rsm_.emplace(std::move(*rsm));
+  }
+  for (const DvctLevel& l : levels_) {
+    const Variant key{l.diffuse_cones, l.specular_cone};
+    auto& table = l.shadow_cones ? shade_ : indirect_;
+    if (table.count(key)) continue;
+    const char* shader = l.shadow_cones ? "dvct/shade.comp" : "dvct/indirect.comp";
+    auto spv = gpu::shader_spirv(shader);
+    if (!spv) return spv.error();
+    auto p = gpu::create_compute_pipeline(
+        ctx, {std::string("dvct_") + (l.shadow_cones ? "shade_" : "indirect_") + std::to_string(l.diffuse_cones) +
+                  (l.specular_cone ? "_specular" : ""),
+              *spv, {}, sizeof(shader::DvctParams), {l.diffuse_cones, l.specular_cone ? 1u : 0u}});
+    if (!p) return p.error();
+    table.emplace(key, gpu::PipelineHandle(ctx, std::move(*p)));
+  }
+  gpu::ImageDesc d;
+  d.name = "dvct indirect";
+  d.format = VK_FORMAT_R32G32B32A32_UINT;
+  auto indirect = graph.create_image(d, VK_IMAGE_USAGE_STORAGE_BIT);
+  if (!indirect) return indirect.error();
+  indirect_image_ = *indirect;
+  reuse_.reserve(size_t(shared_.depth_intrinsics.width) * size_t(shared_.depth_intrinsics.height), shared_.depth_scale);
+  SharedResources for_baseline = shared_;
+  for_baseline.knobs.clear();  // dvct's knobs (baseline_level picks baseline's level)
+  auto base = create_baseline(for_baseline);
+  if (!base) return base.error();
+  baseline_ = std::move(*base);
+  return ok_status();
+}
+
+// The four volumes for this frame: voxelised and injected, or kept from the frame that made them.
+Status Dvct::record_volumes(const DvctLevel& level, const FrameInfo& info, std::vector<std::string>& skipped) {
+  gpu::FrameGraph& graph = *shared_.graph;
+  const SceneGpu& sg = *shared_.scene_gpu;
+  MRGI_TRY(scene_visibility_->set_cells(graph, level.volume_cells));
+  MRGI_TRY(object_visibility_->set_cells(graph, level.volume_cells));
+  MRGI_TRY(light_->set_cells(graph, level.volume_cells));
+  MRGI_TRY(delta_->set_cells(graph, level.volume_cells));
+  const gi::VoxelRegion region =
+      gi::doubled_box_region(sg.virtual_objects.bounds_min, sg.virtual_objects.bounds_max, level.volume_cells, kMinRegionSide);
+  scene_visibility_->set_region(region);
+  object_visibility_->set_region(region);
+  light_->set_region(region);
+  delta_->set_region(region);
+
+  const light::Lighting& lighting = shared_.light_stage->lighting();
+  reuse_.set_frame(info.level, info.camera_to_world, info.input, sg.revision());
+  for (size_t i = 0, n = 0; i < lighting.lights.size() && n < level.rsm_lamps; ++i)
+    if (lighting.lights[i].real) {
+      reuse_.add_lamp(lighting.lights[i]);
+      ++n;
+    }
+  if (reuse_.close()) {
+    skipped.push_back("dvct voxelisation and injection: reused (level, pose, depth, lamps and objects within tolerance of the frame that made them)");
+    return ok_status();
+  }
+  reuse_.remember();
+  // Visibility: the real scene as the reconstruction sees it plus its proxy meshes; the objects.
+  const VkExtent2D g = graph.extent(shared_.real_position);
+  scene_visibility_->add_clear(graph);
+  scene_visibility_->add_depth_surface(graph, "reconstruction", shared_.real_position, shared_.real_normal, g.width, g.height);
+  auto ranges = [](const MeshSet& set) {
+    std::vector<gi::TriangleRange> out;
+    for (const DrawRange& r : set.draws) out.push_back({r.first_index, r.index_count, r.vertex_offset});
+    return out;
+  };
+  if (!sg.real_proxies.empty())
+    scene_visibility_->add_mesh(graph, "proxies", sg.real_proxies.vertices, sg.real_proxies.indices, ranges(sg.real_proxies));
+  scene_visibility_->add_resolve(graph);
+  object_visibility_->add_clear(graph);
+  object_visibility_->add_mesh(graph, "objects", sg.virtual_objects.vertices, sg.virtual_objects.indices, ranges(sg.virtual_objects));
+  object_visibility_->add_resolve(graph);
+
+  // Light: each real lamp's map pair (strongest first), R^rho into the light volume, the pair
+  // into the delta volume.
+  light_->add_clear(graph);
+  delta_->add_clear(graph);
+  const float side = region.voxel_size * float(level.volume_cells);
+  const glm::vec3 centre = region.origin + glm::vec3(0.5f * side);
+  const float radius = 0.5f * side * std::sqrt(3.0f);
+  // The real grid at about two points a map texel across the G-buffer's larger side (as dlpv).
+  const uint32_t stride = std::max(1u, uint32_t(std::ceil(double(std::max(g.width, g.height)) / (level.rsm_size / 2.0))));
+  bool grid_added = false;
+  uint32_t lamps = 0;
+  for (size_t i = 0; i < lighting.lights.size() && lamps < level.rsm_lamps; ++i) {
+    const LightDesc& lamp = lighting.lights[i];
+    if (!lamp.real) continue;
+    auto view = gi::rsm_view(lamp, centre, radius, level.rsm_size);
+    if (!view) {
+      skipped.push_back("dvct rsm (light " + std::to_string(i) + "): " + view.error().message);
+      continue;
+    }
+    if (!grid_added) {
+      rsm_->add_grid(graph, stride);
+      grid_added = true;
+    }
+    const std::string id = std::to_string(i);
+    const gi::RsmImages rho = rsm_->images(gi::RsmMap::WithVirtual, level.rsm_size);
+    const gi::RsmImages mu = rsm_->images(gi::RsmMap::RealOnly, level.rsm_size);
+    rsm_->add_pair(graph, id, *view, level.rsm_size);
+    light_->add_inject(graph, id, rho, 1.0f);
+    delta_->add_inject(graph, id, rho, 1.0f, &mu);
+    ++lamps;
+  }
+  if (lamps == 0)
+    skipped.push_back("dvct injection: no real light to inject (no lamp, environment region or estimate); the cones still shade");
+  light_->add_resolve(graph);
+  delta_->add_resolve(graph);
+  return ok_status();
+}
+
+void Dvct::add_cone_pass(const DvctLevel& level, const shader::DvctParams& params) {
+  gpu::FrameGraph& graph = *shared_.graph;
+  const Variant key{level.diffuse_cones, level.specular_cone};
+  const gpu::Pipeline* pipe = level.shadow_cones ? &*shade_.at(key) : &*indirect_.at(key);
+  const SharedResources& r = shared_;
+  const VkSampler linear = shared_.context->samplers().linear_clamp;
+  const gpu::ImageHandle light = light_->volume().image(0), delta = delta_->volume().image(0);
+  const gpu::ImageHandle scene = scene_visibility_->volume().image(0), object = object_visibility_->volume().image(0);
+  const bool full = level.shadow_cones;
+  const gpu::ImageHandle indirect = indirect_image_;
+  const gpu::BufferHandle lights = lights_;
+  const uint32_t divisor = std::max(1u, level.trace_divisor);
+  graph.add_shader_pass(
+      full ? "dvct shade" : "dvct cones", gpu::PassKind::Compute, *pipe,
+      [&, full, indirect, lights](gpu::ShaderPassBuilder& b) {
+        if (full) {
+          bind_shading_gbuffers(b, r);
+        } else {
+          bind_gbuffer_reads(b, r);
+          b.bind("indirect", indirect);
+        }
+        b.bind("LightUbo", lights);
+        b.bind_sampled("light_volume", light, linear);
+        b.bind_sampled("delta_volume", delta, linear);
+        b.bind_sampled("scene_visibility", scene, linear);
+        b.bind_sampled("object_visibility", object, linear);
+      },
+      [pipe, params, lit = r.lit_rv, divisor](VkCommandBuffer cmd, gpu::PassContext& p) {
+        const VkExtent2D e = p.extent(lit);
+        const uint32_t w = (e.width + divisor - 1) / divisor, h = (e.height + divisor - 1) / divisor;
+        gpu::push_and_dispatch(cmd, *pipe, &params, sizeof params, {(w + 7) / 8, (h + 7) / 8, 1});
+      });
+}
+
+Status Dvct::record(const FrameInfo& info, std::vector<std::string>& skipped) {
+  if (info.level < 0 || info.level >= int(levels_.size()))
+    return fail(ErrorKind::BadUsage, "dvct: level " + std::to_string(info.level) + " outside 0.." +
+                                         std::to_string(levels_.size() - 1));
+  const DvctLevel& level = levels_[size_t(info.level)];
+  gpu::FrameGraph& graph = *shared_.graph;
+  auto* set = static_cast<shader::LightSet*>(graph.mapped(lights_, graph.slot()));
+  write_unshadowed_light_set(shared_.light_stage->lighting(), *set);
+  shader::DvctParams params{};
+  const bool volumes = has_virtual_ && shared_.scene_gpu->any_visible();
+  if (volumes) {
+    MRGI_TRY(record_volumes(level, info, skipped));
+    const gi::VoxelRegion& region = light_->region();
+    params.volume = glm::vec4(region.origin, region.voxel_size);
+    params.trace = glm::vec4(float(level.volume_cells), float(light_->volume().used_levels() - 1), kOcclusionFloor,
+                             level.step_scale);
+    params.cones = glm::vec4(level.shadow_aperture, kMinSpecularAperture,
+                             region.voxel_size * float(level.volume_cells) * std::sqrt(3.0f), kSpecularRoughnessLimit);
+    params.texture = glm::vec4(float(light_->volume().settings().resolution), 0.0f, 0.0f, 0.0f);
+    params.mode = glm::ivec4(int(std::max(1u, level.trace_divisor)), 1, 0, 0);
+  } else {
+    reuse_.forget();
+    skipped.push_back("dvct volumes and cones: no virtual object in the scene (nothing changes the real scene's light)");
+    params.volume = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+    params.trace = glm::vec4(2.0f, 0.0f, kOcclusionFloor, level.step_scale);
+    params.texture = glm::vec4(2.0f, 0.0f, 0.0f, 0.0f);
+    params.mode = glm::ivec4(int(std::max(1u, level.trace_divisor)), 0, 0, 0);
+  }
+  const bool specular = level.specular_cone && glossy_;
+  if (!level.specular_cone)
+    skipped.push_back("dvct specular cone: level '" + std::string(level.name) + "' traces none");
+  else if (!glossy_)
+    skipped.push_back("dvct specular cone: no glossy material in the scene (virtual: metallic > 0.1 or roughness < 0.7; real: no glossy hint)");
+  // Without a glossy material the specular cone would return at once; the roughness limit 0
+  // says so to the shader without another pipeline.
+  if (!specular) params.cones.w = 0.0f;
+  if (level.shadow_cones) {
+    add_cone_pass(level, params);
+    return ok_status();
+  }
+  FrameInfo base = info;
+  base.level = level.baseline_level;
+  if (!volumes) {
+    set_dir_indirect(*baseline_, nullptr);
+    return baseline_->record(base, skipped);
+  }
+  add_cone_pass(level, params);
+  DirIndirect add;
+  add.merged = indirect_image_;
+  add.divisor = int(std::max(1u, level.trace_divisor));
+  set_dir_indirect(*baseline_, &add);
+  return baseline_->record(base, skipped);
+}
+
+}  // namespace
+
+Expected<std::unique_ptr<Technique>> create_dvct(const SharedResources& shared) {
+  auto levels = dvct_levels(shared.knobs);
+  if (!levels) return levels.error();
+  auto t = std::make_unique<Dvct>(shared, std::move(*levels));
+  MRGI_TRY(t->init());
+  return std::unique_ptr<Technique>(std::move(t));
+}
+
+}  // namespace mrgi::technique

@@ -1,0 +1,75 @@
+// The `dvct` technique: Delta Voxel Cone Tracing (Thoener & Kuijper, "Delta global illumination
+// for mixed reality", ../shared/papers/delta-voxel-cone-tracing.md). Four volumes over the
+// region of Sec. 3.4 (the virtual objects' bounding box doubled, gi/voxelize.h
+// doubled_box_region): the light volume (reflective shadow maps with the objects, +1), the delta
+// light volume (the pair: with the objects +1, without -1, negative light allowed), and one
+// visibility volume each for the real scene (the reconstruction's G-buffer as a surface, and the
+// scene's proxy meshes) and for the virtual objects (their meshes), all with mip chains
+// (gi/voxel_light.h, gi/voxelize.h). Pixels gather light through cones
+// (shaders/gi/vct_trace.glsl, math in shaders/shared/vct_math.h): a diffuse set over the
+// hemisphere, one specular cone whose aperture follows roughness, one shadow cone per lamp.
+//
+// Quality ladder (best first; DvctLevel below, with units):
+//   level    volume  diffuse  specular  RSM    lamps  traced at   internal  direct light
+//   paper    128^3   9        yes       512^2  4      every px    1.0       shadow cones (Sec. 3.5)
+//   high      64^3   9        yes       512^2  4      1 in 2x2    1.0       baseline high's maps
+//   medium    64^3   5        yes       256^2  2      1 in 4x4    1.0       baseline medium's
+//   fast      32^3   5        no        128^2  1      1 in 4x4    0.5       baseline lowest's
+//   fastest   16^3   3        no         64^2  1      1 in 4x4    0.5       baseline lowest's
+// "paper" shades every pixel with cones alone (shaders/dvct/shade.comp). The others trace the
+// cones at one pixel in a block (shaders/dvct/indirect.comp) into dir's packed indirect image,
+// which baseline's shading pass up-samples by surface and adds as it lights the pixel with
+// shadow maps (the reduced-resolution shading with geometry-aware up-sampling of the fast path;
+// the shadow maps are sharper than a 64^3 volume's shadow cones and cost less on a CPU device).
+//
+// Where mrgi differs from the paper and why:
+//   - real pixels take with - without: the light volume through both visibility volumes minus
+//     (light - delta) through the scene's alone (vct_trace.glsl says why: it also holds the scene
+//     light the objects hide from the pixel, and their reflection in a real glossy surface);
+//   - the accumulation is the emission-absorption form of Crassin et al., not the printed one
+//     (vct_math.h vct_accumulate, tested), and the cones step at half the touching footprints
+//     with opacity correction (vct_step: the paper's step aliases on one-voxel surfaces, measured
+//     in tests/gi/test_vct_trace.cpp);
+//   - the environment the light stage does not turn into lamps (its SH ambient) lights through
+//     the diffuse cones' open part: a virtual object shades the ambient on the real scene and on
+//     itself (the paper's environment is injected only as the lamps its RSMs see).
+//
+// Skips (each in FrameStats::skipped):
+//   - no virtual object: no volumes, no cones (the solutions are baseline's, or the paper
+//     level's lamps and ambient unshadowed by any object);
+//   - the volumes are reused, with nothing voxelised, drawn or injected, while what made them
+//     stays within technique/input_reuse.h's tolerances (pose, depth, lamps, objects);
+//   - no specular cone at levels without it, or with no glossy material in the scene (virtual:
+//     SceneGpu::glossy; real: none yet).
+#pragma once
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "technique/technique.h"
+
+namespace mrgi::technique {
+
+struct DvctLevel {
+  const char* name;
+  uint32_t volume_cells;   // voxels per side of each of the four volumes
+  uint32_t diffuse_cones;  // cones in the diffuse set (vct_math.h vct_diffuse_cone)
+  bool specular_cone;      // one specular cone at glossy pixels
+  uint32_t rsm_size;       // texels per side of each reflective shadow map
+  uint32_t rsm_lamps;      // real lamps (strongest first) injected through a map pair
+  uint32_t trace_divisor;  // G-buffer pixels per traced pixel, each side (1: every pixel)
+  float internal_scale;    // fraction of the output width and height
+  // true: the paper's shading, direct light through shadow cones (shaders/dvct/shade.comp,
+  // needs trace_divisor 1); false: baseline's shadow-mapped direct light at baseline_level,
+  // the cones' light added in its shading pass.
+  bool shadow_cones;
+  int baseline_level;
+  float shadow_aperture;   // full aperture of a shadow cone, radians (the penumbra's spread)
+  float step_scale;        // fraction of the touching-footprint step the cones take (vct_step)
+};
+const std::array<DvctLevel, 5>& dvct_levels();  // the defaults
+Expected<std::vector<DvctLevel>> dvct_levels(const std::vector<KnobSetting>& knobs);
+Expected<std::vector<QualityLevel>> dvct_ladder(const std::vector<KnobSetting>& knobs);
+Expected<std::unique_ptr<Technique>> create_dvct(const SharedResources& shared);
+
+}  // namespace mrgi::technique

@@ -1,0 +1,89 @@
+// dvct's per-pixel cone sets (delta-voxel-cone-tracing.md Sec. 3.1, 3.3), shared by indirect.comp
+// (the levels that light directly with baseline's shadow maps) and shade.comp (the paper's
+// level, shadow cones too). Needs, declared before it: shared/mrgi_shared.h, shared/vct_math.h,
+// gi/vct_trace.glsl, common/light_set.glsl, common/surface_shading.glsl, the samplers
+// light_volume, delta_volume, scene_visibility, object_visibility, `DvctParams params`,
+// `AmbientIrradiance ambient_rv`, and the specialisation constants kDiffuseCones (cones in the
+// diffuse set, 0 none) and kSpecular (the specular cone compiled in).
+#ifndef MRGI_DVCT_CONE_SHADING_GLSL
+#define MRGI_DVCT_CONE_SHADING_GLSL
+
+VctVolume dvct_volume() {
+  VctVolume v;
+  v.origin = params.volume.xyz;
+  v.voxel_size = params.volume.w;
+  v.cells = params.trace.x;
+  v.texture_cells = params.texture.x;
+  v.max_lod = params.trace.y;
+  v.occlusion_floor = params.trace.z;
+  v.step_scale = params.trace.w;
+  return v;
+}
+
+// Whether p is within `margin` metres of the region (the volumes' cube).
+bool dvct_near_region(vec3 p, float margin) {
+  vec3 lo = params.volume.xyz - vec3(margin), hi = params.volume.xyz + vec3(params.volume.w * params.trace.x + margin);
+  return all(greaterThanEqual(p, lo)) && all(lessThanEqual(p, hi));
+}
+
+// A cone's apex: one voxel off the surface along its normal, so the surface's own voxel does not
+// occlude the cones leaving it (vct_trace_cone's first sample is a voxel further).
+vec3 dvct_apex(vec3 p, vec3 n) { return p + n * params.volume.w; }
+
+// The cosine-weighted sums of the diffuse cone set around n: irradiance with and without the
+// objects (rgb), and the fraction of the cosine-weighted hemisphere left open with and without.
+struct DvctGather {
+  vec3 with, without;
+  float open_with, open_without;
+};
+
+DvctGather dvct_diffuse(vec3 p, vec3 n, int flags) {
+  DvctGather g;
+  g.with = vec3(0.0f);
+  g.without = vec3(0.0f);
+  g.open_with = 0.0f;
+  g.open_without = 0.0f;
+  const VctVolume v = dvct_volume();
+  const vec3 t = abs(n.z) < 0.999f ? normalize(cross(vec3(0.0f, 0.0f, 1.0f), n)) : vec3(1.0f, 0.0f, 0.0f);
+  const vec3 b = cross(n, t);
+  const vec3 apex = dvct_apex(p, n);
+  for (int i = 0; i < kDiffuseCones; ++i) {
+    const VctCone c = vct_diffuse_cone(i, kDiffuseCones);
+    const vec3 dir = normalize(t * c.dir.x + b * c.dir.y + n * c.dir.z);
+    const VctResult r = vct_trace_cone(light_volume, delta_volume, scene_visibility, object_visibility, v, apex, dir,
+                                       c.aperture, params.cones.z, flags);
+    g.with += c.weight * r.light_with;
+    g.without += c.weight * r.light_without;
+    g.open_with += c.weight * (1.0f / MRGI_PI) * r.trans_with;
+    g.open_without += c.weight * (1.0f / MRGI_PI) * r.trans_without;
+  }
+  return g;
+}
+
+// The specular cone around v's mirror direction: reflected radiance with and without the objects
+// (the cone's light plus the ambient's radiance where the cone leaves the region open, both
+// times the lobe's directional albedo vct_specular_weight).
+struct DvctSpecular {
+  vec3 with, without;
+};
+
+DvctSpecular dvct_specular(vec3 p, vec3 n, vec3 view, vec3 f0, float roughness, int flags) {
+  DvctSpecular s;
+  s.with = vec3(0.0f);
+  s.without = vec3(0.0f);
+  const float nv = dot(n, view);
+  if (!kSpecular || roughness >= params.cones.w || nv <= 0.0f) return s;
+  const vec3 refl = reflect(-view, n);
+  const VctResult r = vct_trace_cone(light_volume, delta_volume, scene_visibility, object_visibility, dvct_volume(),
+                                     dvct_apex(p, n), refl, vct_specular_aperture(roughness, params.cones.y),
+                                     params.cones.z, flags);
+  // The ambient seen along the mirror direction: its irradiance there over pi (a radiance the
+  // SH bands 0..2 hold only smoothly, the same light the diffuse term uses).
+  const vec3 env = ambient_irradiance(ambient_rv, refl) * (1.0f / MRGI_PI);
+  const vec3 w = vct_specular_weight(f0, roughness, nv);
+  s.with = w * (r.light_with + env * r.trans_with);
+  s.without = w * (r.light_without + env * r.trans_without);
+  return s;
+}
+
+#endif  // MRGI_DVCT_CONE_SHADING_GLSL

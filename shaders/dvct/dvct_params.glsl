@@ -1,0 +1,29 @@
+// Push constants of dvct's shading passes (technique/dvct/dvct.h), shared by indirect.comp and
+// shade.comp and by the C++ that fills them (like frame_constants.glsl).
+#ifndef MRGI_DVCT_PARAMS_GLSL
+#define MRGI_DVCT_PARAMS_GLSL
+#ifdef __cplusplus
+#include <glm/glm.hpp>
+namespace mrgi::shader {
+using glm::ivec4;
+using glm::vec4;
+#endif
+
+struct DvctParams {
+  vec4 volume;   // xyz: the volumes' min corner (m); w: voxel size (m)
+  vec4 trace;    // x: voxels per side used; y: the coarsest mip level; z: occlusion floor
+                 // (vct_directional_occlusion); w: step scale (vct_step)
+  vec4 cones;    // x: shadow cone aperture (rad); y: narrowest specular cone (rad); z: the
+                 // diffuse and specular cones' reach (m); w: roughness at and above which no
+                 // specular cone is traced (the diffuse cones hold that light)
+  ivec4 mode;    // x: G-buffer pixels per indirect texel (indirect.comp); y: 1 the volumes hold
+                 // this frame's light (0: no virtual object or lamp: nothing changes); z, w unused
+  vec4 texture;  // x: voxels per side allocated (a cheaper level uses a corner of each mip
+                 // level: texture coordinates divide by this); y, z, w unused
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(DvctParams) == 80, "std430 push constant mirror");
+}  // namespace mrgi::shader
+#endif
+#endif  // MRGI_DVCT_PARAMS_GLSL
