@@ -38,7 +38,7 @@ class VoxelLight {
   void set_region(const VoxelRegion& region) { region_ = region; }
   const VoxelRegion& region() const { return region_; }
 
-  void add_clear(gpu::FrameGraph& graph) const;
+  void add_clear(gpu::FrameGraph& graph);
   // `rsm`'s texels with `sign`; with `other`, the pair: `rsm` with sign and `other` with -sign
   // where the two differ (voxel_inject.comp). One pass, "<name> inject <label>".
   void add_inject(gpu::FrameGraph& graph, const std::string& label, const RsmImages& rsm, float sign,
@@ -52,6 +52,7 @@ class VoxelLight {
   VoxelLightSettings settings_;
   VoxelRegion region_;
   std::optional<VoxelVolume> volume_;
+  uint32_t cleared_cells_ = 0;  // the used size the images were last cleared for (0: never)
   gpu::BufferHandle sums_;  // 3 floats a cell: flux rgb (W)
   gpu::PipelineHandle inject_[2], resolve_;  // inject_[1]: the delta pair
 };

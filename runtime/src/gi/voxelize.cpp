@@ -64,7 +64,14 @@ Status Voxelizer::set_cells(gpu::FrameGraph& graph, uint32_t cells) {
   return volume_->set_divisor(graph, settings_.resolution / cells);
 }
 
-void Voxelizer::add_clear(gpu::FrameGraph& graph) const {
+void Voxelizer::add_clear(gpu::FrameGraph& graph) {
+  // The images once whenever the used size changes: resolve writes the used corner of each
+  // level every frame, and a cone's trilinear read at the corner's edge reaches half a voxel
+  // past it, where a larger level's (or a former runtime's) values would otherwise still be.
+  if (cleared_cells_ != cells()) {
+    volume_->add_clear(graph);
+    cleared_cells_ = cells();
+  }
   const gpu::BufferHandle sums = sums_;
   const VkDeviceSize bytes = VkDeviceSize(cells()) * cells() * cells() * 4 * sizeof(float);
   graph.add_pass(

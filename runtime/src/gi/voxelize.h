@@ -69,7 +69,7 @@ class Voxelizer {
   void set_region(const VoxelRegion& region) { region_ = region; }
   const VoxelRegion& region() const { return region_; }
 
-  void add_clear(gpu::FrameGraph& graph) const;
+  void add_clear(gpu::FrameGraph& graph);
   // The triangles of `ranges` (one pass, "<name> voxelize <label>"). The buffers must have
   // storage usage (the scene's meshes do).
   void add_mesh(gpu::FrameGraph& graph, const std::string& label, gpu::BufferHandle vertices,
@@ -88,6 +88,7 @@ class Voxelizer {
   VoxelizeSettings settings_;
   VoxelRegion region_;
   std::optional<VoxelVolume> volume_;
+  uint32_t cleared_cells_ = 0;  // the used size the images were last cleared for (0: never)
   gpu::BufferHandle sums_;  // 4 floats a cell: normal x area (xyz), area (voxel^2)
   gpu::PipelineHandle mesh_, depth_, resolve_;
 };
