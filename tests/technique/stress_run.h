@@ -26,6 +26,9 @@ struct StressVariant {
   const char* name;
   glm::vec3 base;                 // the virtual objects' base colour (black: they reflect nothing)
   void (*edit)(SyntheticScene&);  // the variant's change to the scene
+  float metallic = 0.0f, roughness = 1.0f;  // the virtual objects' glTF factors
+  const char* knob = nullptr;               // a quality knob set for the run (RuntimeSettings::knobs)
+  double knob_value = 0.0;
 };
 
 struct StressOutcome {
@@ -46,11 +49,12 @@ inline double stress_mean_light(const FrameOutput& o) {
 // Fatal failures (a frame refused) return early: the caller checks HasFatalFailure().
 inline void run_stress(const StressVariant& v, const std::string& folder, const std::string& technique, int level,
                        const std::string& reuse_note, int n, StressOutcome& out) {
-  SyntheticScene scene = SyntheticScene::create(folder, glm::vec3(0.0f), v.base);
+  SyntheticScene scene = SyntheticScene::create(folder, glm::vec3(0.0f), v.base, v.metallic, v.roughness);
   v.edit(scene);
   RuntimeSettings s;
   s.technique = technique;
   s.level = level;
+  if (v.knob) s.knobs = {{v.knob, v.knob_value}};
   auto rt = create_runtime(s, scene.cameras(), scene.scene);
   ASSERT_TRUE(rt.ok()) << rt.error().message;
   InputFrame frames[2] = {scene.frame(0), scene.frame(1)};

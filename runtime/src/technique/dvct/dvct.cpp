@@ -40,7 +40,7 @@ const KnobField<DvctLevel> kDvctKnobs[] = {
     {"specular_cone", "1: a specular cone at glossy pixels", &DvctLevel::specular_cone},
     {"rsm_size", "texels per side of each reflective shadow map", &DvctLevel::rsm_size, true},
     {"rsm_lamps", "real lamps, strongest first, injected through a map pair", &DvctLevel::rsm_lamps},
-    {"trace_divisor", "G-buffer pixels per traced pixel, each side", &DvctLevel::trace_divisor},
+    {"trace_divisor", "G-buffer pixels per traced pixel, each side (levels without shadow cones; with them every pixel)", &DvctLevel::trace_divisor},
     {"internal_scale", "fraction of the output width and height", &DvctLevel::internal_scale},
     {"shadow_cones", "1: direct light through shadow cones (paper); 0: baseline's shadow maps",
      &DvctLevel::shadow_cones},
@@ -66,9 +66,6 @@ Expected<std::vector<DvctLevel>> dvct_levels(const std::vector<KnobSetting>& kno
   auto levels = apply_knobs<DvctLevel>("dvct", dvct_levels(), kDvctKnobs, knobs);
   if (!levels) return levels;
   for (const DvctLevel& l : *levels) {
-    if (l.shadow_cones && l.trace_divisor != 1)
-      return fail(ErrorKind::BadUsage, std::string("dvct level '") + l.name +
-                                           "': shadow_cones=1 shades every pixel with cones (trace_divisor must be 1)");
     if (l.diffuse_cones < 1) return fail(ErrorKind::BadUsage, std::string("dvct level '") + l.name + "': diffuse_cones must be >= 1");
   }
   return levels;

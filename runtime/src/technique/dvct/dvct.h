@@ -57,10 +57,11 @@ struct DvctLevel {
   bool specular_cone;      // one specular cone at glossy pixels
   uint32_t rsm_size;       // texels per side of each reflective shadow map
   uint32_t rsm_lamps;      // real lamps (strongest first) injected through a map pair
-  uint32_t trace_divisor;  // G-buffer pixels per traced pixel, each side (1: every pixel)
+  uint32_t trace_divisor;  // G-buffer pixels per traced pixel, each side (1: every pixel); a
+                           // level with shadow cones traces every pixel whatever this says
   float internal_scale;    // fraction of the output width and height
-  // true: the paper's shading, direct light through shadow cones (shaders/dvct/shade.comp,
-  // needs trace_divisor 1); false: baseline's shadow-mapped direct light at baseline_level,
+  // true: the paper's shading, direct light through shadow cones at every pixel
+  // (shaders/dvct/shade.comp); false: baseline's shadow-mapped direct light at baseline_level,
   // the cones' light added in its shading pass.
   bool shadow_cones;
   int baseline_level;
