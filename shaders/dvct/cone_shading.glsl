@@ -31,18 +31,16 @@ bool dvct_near_region(vec3 p, float margin) {
 vec3 dvct_apex(vec3 p, vec3 n) { return p + n * params.volume.w; }
 
 // The cosine-weighted sums of the diffuse cone set around n: irradiance with and without the
-// objects (rgb), and the fraction of the cosine-weighted hemisphere left open with and without.
+// objects (rgb). The ambient (the light stage's SH) is not shaded by the cones: technique/dvct/dvct.h
+// says what that was measured to cost.
 struct DvctGather {
   vec3 with, without;
-  float open_with, open_without;
 };
 
 DvctGather dvct_diffuse(vec3 p, vec3 n, int flags) {
   DvctGather g;
   g.with = vec3(0.0f);
   g.without = vec3(0.0f);
-  g.open_with = 0.0f;
-  g.open_without = 0.0f;
   const VctVolume v = dvct_volume();
   const vec3 t = abs(n.z) < 0.999f ? normalize(cross(vec3(0.0f, 0.0f, 1.0f), n)) : vec3(1.0f, 0.0f, 0.0f);
   const vec3 b = cross(n, t);
@@ -54,8 +52,6 @@ DvctGather dvct_diffuse(vec3 p, vec3 n, int flags) {
                                        c.aperture, params.cones.z, flags);
     g.with += c.weight * r.light_with;
     g.without += c.weight * r.light_without;
-    g.open_with += c.weight * (1.0f / MRGI_PI) * r.trans_with;
-    g.open_without += c.weight * (1.0f / MRGI_PI) * r.trans_without;
   }
   return g;
 }

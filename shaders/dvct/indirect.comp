@@ -5,16 +5,13 @@
 // baseline's shading pass up-samples by surface and adds to both solutions
 // (shade_direct.comp kDirIndirect). What it adds on top of baseline's direct light and ambient:
 //   real pixel near the region:
-//     L_rv += albedo / pi (E_with + E_amb_rv(n) (open_with - open_without)) + S_with
-//     L_r  += albedo / pi  E_without                                      + S_without
-//   (E: the diffuse cones' irradiance, with the objects from the light volume through both
-//   visibility volumes, without them from light - delta through the scene's; open: the cosine-
-//   weighted part of the hemisphere the cones leave open, so the objects shade the ambient;
-//   S: the specular cone, real surfaces with a glossy hint only)
+//     L_rv += albedo / pi E_with    + S_with
+//     L_r  += albedo / pi E_without + S_without
 //   virtual pixel:
-//     L_rv += base (1 - metallic) / pi E_with + base / pi E_amb_rv(n) (open_with - 1) + S_with
-//   (baseline's pass adds base / pi E_amb_rv(n) unoccluded: the second term takes off what the
-//   cones find blocked, by the real scene and by the objects themselves).
+//     L_rv += base (1 - metallic) / pi E_with + S_with
+//   (E: the diffuse cones' irradiance, with the objects from the light volume through both
+//   visibility volumes, without them from light - delta through the scene's; S: the specular
+//   cone, real surfaces with a glossy hint only; baseline's pass adds the ambient unshadowed).
 // Real pixels farther than a quarter of the region's side from it keep both solutions as
 // baseline makes them: the paper's region is where the objects' influence is (Sec. 3.4).
 #extension GL_GOOGLE_include_directive : require
@@ -82,12 +79,11 @@ void main() {
   if (params.mode.y != 0 && (is_virtual || dvct_near_region(p, 0.25f * side))) {
     if (is_virtual) {
       const DvctGather d = dvct_diffuse(p, n, VCT_LIGHT);
-      rv = alb.rgb * (1.0f - alb.a) * (1.0f / MRGI_PI) * d.with +
-           alb.rgb * (1.0f / MRGI_PI) * ambient_irradiance(ambient_rv, n) * (d.open_with - 1.0f);
+      rv = alb.rgb * (1.0f - alb.a) * (1.0f / MRGI_PI) * d.with;
       rv += dvct_specular(p, n, view, mix(vec3(0.04f), alb.rgb, alb.a), nrm.w, VCT_LIGHT).with;
     } else {
       const DvctGather d = dvct_diffuse(p, n, VCT_LIGHT | VCT_WITHOUT);
-      rv = alb.rgb * (1.0f / MRGI_PI) * (d.with + ambient_irradiance(ambient_rv, n) * (d.open_with - d.open_without));
+      rv = alb.rgb * (1.0f / MRGI_PI) * d.with;
       r = alb.rgb * (1.0f / MRGI_PI) * d.without;
       const DvctSpecular s = dvct_specular(p, n, view, vec3(0.04f), 1.0f, VCT_LIGHT | VCT_WITHOUT);
       rv += s.with;

@@ -2,13 +2,12 @@
 // dvct's paper level (technique/dvct/dvct.h): every pixel shaded by cones alone, direct light
 // included, as delta-voxel-cone-tracing.md Sec. 3.3 and 3.5 do it:
 //   real pixel:    L_r  = Lambert x lamp x T_without + albedo / pi (E_amb_r(n) + E_without)
-//                  L_rv = Lambert x lamp x T_with + albedo / pi (E_amb_rv(n) (1 + open_with -
-//                         open_without) + E_with)
-//   virtual pixel: L_rv = BRDF x lamp x T_with + base (1 - metallic) / pi (E_amb_rv(n) open_with
-//                         + E_with) + S_with + emission
+//                  L_rv = Lambert x lamp x T_with + albedo / pi (E_amb_rv(n) + E_with)
+//   virtual pixel: L_rv = BRDF x lamp x T_with + base (1 - metallic) / pi (E_amb_rv(n) + E_with)
+//                         + S_with + emission
 // T: a shadow cone to each lamp (Sec. 3.5), through both visibility volumes (with) or the scene's
 // alone (without), so a real surface the scene already shadows is not shadowed twice (Sec. 3.2);
-// a real pixel's lamp term is the real lamps' only in L_r. E, open, S as dvct/indirect.comp says.
+// a real pixel's lamp term is the real lamps' only in L_r. E, S as dvct/indirect.comp says.
 // Real pixels away from the region: the cones find nothing there but the shadow cones may cross
 // it (a long shadow), so only the diffuse set is left out.
 #extension GL_GOOGLE_include_directive : require
@@ -99,26 +98,25 @@ void main() {
   if (is_virtual) {
     DvctGather d;
     d.with = vec3(0.0f);
-    d.open_with = 1.0f;
     if (volumes) d = dvct_diffuse(p, n, VCT_LIGHT);
-    l_rv += alb.rgb * (1.0f - alb.a) * (1.0f / MRGI_PI) * (ambient_irradiance(ambient_rv, n) * d.open_with + d.with);
+    l_rv += alb.rgb * (1.0f - alb.a) * (1.0f / MRGI_PI) * (ambient_irradiance(ambient_rv, n) + d.with);
     if (volumes) l_rv += dvct_specular(p, n, view, mix(vec3(0.04f), alb.rgb, alb.a), nrm.w, VCT_LIGHT).with;
     if (frame.flags.y != 0) l_rv += imageLoad(virtual_emission, pixel).rgb;
   } else {
     const vec3 amb_rv = ambient_irradiance(ambient_rv, n), amb_r = ambient_irradiance(ambient_r, n);
     l_r += alb.rgb * (1.0f / MRGI_PI) * amb_r;
+    l_rv += alb.rgb * (1.0f / MRGI_PI) * amb_rv;
     if (volumes && dvct_near_region(p, 0.25f * side)) {
       const DvctGather d = dvct_diffuse(p, n, VCT_LIGHT | VCT_WITHOUT);
-      l_rv += alb.rgb * (1.0f / MRGI_PI) * (amb_rv * (1.0f + d.open_with - d.open_without) + d.with);
+      l_rv += alb.rgb * (1.0f / MRGI_PI) * d.with;
       l_r += alb.rgb * (1.0f / MRGI_PI) * d.without;
       const DvctSpecular s = dvct_specular(p, n, view, vec3(0.04f), 1.0f, VCT_LIGHT | VCT_WITHOUT);
       l_rv += s.with;
       l_r += s.without;
-    } else {
-      l_rv += alb.rgb * (1.0f / MRGI_PI) * amb_rv;
     }
   }
   // Half floats end at 65504: clamp so no Inf reaches compose.
   imageStore(lit_rv, pixel, vec4(clamp(sanitize(l_rv), vec3(0.0f), vec3(60000.0f)), 1.0f));
   imageStore(lit_r, pixel, vec4(clamp(sanitize(l_r), vec3(0.0f), vec3(60000.0f)), 1.0f));
 }
+

@@ -43,7 +43,7 @@ class VoxelLight {
   // where the two differ (voxel_inject.comp). One pass, "<name> inject <label>".
   void add_inject(gpu::FrameGraph& graph, const std::string& label, const RsmImages& rsm, float sign,
                   const RsmImages* other = nullptr) const;
-  void add_resolve(gpu::FrameGraph& graph) const;
+  void add_resolve(gpu::FrameGraph& graph);
   // RGBA16F, every mip level: rgb radiance x coverage (W / (sr m^2)), a unused.
   const VoxelVolume& volume() const { return *volume_; }
 
@@ -53,6 +53,7 @@ class VoxelLight {
   VoxelRegion region_;
   std::optional<VoxelVolume> volume_;
   uint32_t cleared_cells_ = 0;  // the used size the images were last cleared for (0: never)
+  bool clear_pending_ = false;  // this frame recorded that clear (add_resolve keeps it)
   gpu::BufferHandle sums_;  // 3 floats a cell: flux rgb (W)
   gpu::PipelineHandle inject_[2], resolve_;  // inject_[1]: the delta pair
 };

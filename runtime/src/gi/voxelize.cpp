@@ -71,6 +71,7 @@ void Voxelizer::add_clear(gpu::FrameGraph& graph) {
   if (cleared_cells_ != cells()) {
     volume_->add_clear(graph);
     cleared_cells_ = cells();
+    clear_pending_ = true;
   }
   const gpu::BufferHandle sums = sums_;
   const VkDeviceSize bytes = VkDeviceSize(cells()) * cells() * cells() * 4 * sizeof(float);
@@ -120,7 +121,7 @@ void Voxelizer::add_depth_surface(gpu::FrameGraph& graph, const std::string& lab
       });
 }
 
-void Voxelizer::add_resolve(gpu::FrameGraph& graph) const {
+void Voxelizer::add_resolve(gpu::FrameGraph& graph) {
   const gpu::Pipeline* pipe = &*resolve_;
   const gpu::BufferHandle sums = sums_;
   const gpu::ImageHandle image = volume_->image(0);
@@ -128,14 +129,19 @@ void Voxelizer::add_resolve(gpu::FrameGraph& graph) const {
   const VoxelizeResolvePush push{glm::ivec4(int(n), 0, 0, 0)};
   graph.add_shader_pass(
       settings_.name + " resolve", gpu::PassKind::Compute, *pipe,
-      [sums, image](gpu::ShaderPassBuilder& b) {
+      [sums, image, keep = clear_pending_, levels = volume_->allocated_levels()](gpu::ShaderPassBuilder& b) {
         b.bind("cells", sums);
         b.bind("visibility", image, 0);
+        // The resolve and the mip chain write the used corner of each level: the clear of the
+        // whole image is read where they do not write, which the graph is told here (else it
+        // culls the clear as overwritten).
+        if (keep && levels > 1) b.uses().read(image, gpu::Access::StorageRead, 1, levels - 1);
       },
       [pipe, push, n](VkCommandBuffer cmd, gpu::PassContext&) {
         gpu::push_and_dispatch(cmd, *pipe, &push, sizeof push, {(n + 3) / 4, (n + 3) / 4, (n + 3) / 4});
       });
   volume_->add_mip_chain(graph);
+  clear_pending_ = false;
 }
 
 }  // namespace mrgi::gi

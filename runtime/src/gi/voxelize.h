@@ -79,7 +79,7 @@ class Voxelizer {
   void add_depth_surface(gpu::FrameGraph& graph, const std::string& label, gpu::ImageHandle position,
                          gpu::ImageHandle normal, uint32_t width, uint32_t height) const;
   // The finest level from the sums, then the mip chain.
-  void add_resolve(gpu::FrameGraph& graph) const;
+  void add_resolve(gpu::FrameGraph& graph);
   // RGBA16F, every mip level: xyz the mean normal x occupancy, w the occlusion.
   const VoxelVolume& volume() const { return *volume_; }
 
@@ -89,6 +89,7 @@ class Voxelizer {
   VoxelRegion region_;
   std::optional<VoxelVolume> volume_;
   uint32_t cleared_cells_ = 0;  // the used size the images were last cleared for (0: never)
+  bool clear_pending_ = false;  // this frame recorded that clear (add_resolve keeps it)
   gpu::BufferHandle sums_;  // 4 floats a cell: normal x area (xyz), area (voxel^2)
   gpu::PipelineHandle mesh_, depth_, resolve_;
 };

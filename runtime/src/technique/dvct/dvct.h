@@ -30,9 +30,15 @@
 //     (vct_math.h vct_accumulate, tested), and the cones step at half the touching footprints
 //     with opacity correction (vct_step: the paper's step aliases on one-voxel surfaces, measured
 //     in tests/gi/test_vct_trace.cpp);
-//   - the environment the light stage does not turn into lamps (its SH ambient) lights through
-//     the diffuse cones' open part: a virtual object shades the ambient on the real scene and on
-//     itself (the paper's environment is injected only as the lamps its RSMs see).
+//   - the ambient (the light stage's SH: the residual estimate, or an environment's light beyond
+//     its lamps) lights every pixel unshadowed, as in baseline; the paper has no such term (its
+//     environment is injected only as the lamps its RSMs see). Shading it by the diffuse cones
+//     (each cone's ambient radiance times its transmittance with the objects minus without)
+//     made RDE worse on every suite scene it was tried on, at the high level (session 23:
+//     corner real 0.885 -> 1.026, env_fisheye virtual 0.291 -> 0.437, moving real 0.410 ->
+//     0.461, desk_spot equal): the cones over-occlude near a surface (its own voxels at coarse
+//     mip levels, and vct_directional_occlusion's coverage rule, which treats a compact object
+//     as a wall across the footprint), so the objects' occlusion of the ambient is left out.
 //
 // Skips (each in FrameStats::skipped):
 //   - no virtual object: no volumes, no cones (the solutions are baseline's, or the paper
