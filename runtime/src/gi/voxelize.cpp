@@ -105,10 +105,13 @@ void Voxelizer::add_mesh(gpu::FrameGraph& graph, const std::string& label, gpu::
 }
 
 void Voxelizer::add_depth_surface(gpu::FrameGraph& graph, const std::string& label, gpu::ImageHandle position,
-                                  gpu::ImageHandle normal, uint32_t width, uint32_t height) const {
+                                  gpu::ImageHandle normal, uint32_t width, uint32_t height, uint32_t stride) const {
   const gpu::Pipeline* pipe = &*depth_;
   const gpu::BufferHandle sums = sums_;
-  const VoxelizeDepthPush push{glm::vec4(region_.origin, region_.voxel_size), glm::ivec4(int(cells()), int(width), int(height), 0)};
+  stride = std::max(stride, 1u);
+  const VoxelizeDepthPush push{glm::vec4(region_.origin, region_.voxel_size),
+                               glm::ivec4(int(cells()), int(width), int(height), int(stride))};
+  const uint32_t quads_x = (std::max(width, 2u) - 2) / stride + 1, quads_y = (std::max(height, 2u) - 2) / stride + 1;
   graph.add_shader_pass(
       settings_.name + " voxelize " + label, gpu::PassKind::Compute, *pipe,
       [position, normal, sums](gpu::ShaderPassBuilder& b) {
@@ -116,8 +119,8 @@ void Voxelizer::add_depth_surface(gpu::FrameGraph& graph, const std::string& lab
         b.bind("real_normal", normal);
         b.bind("cells", sums);
       },
-      [pipe, push, width, height](VkCommandBuffer cmd, gpu::PassContext&) {
-        gpu::push_and_dispatch(cmd, *pipe, &push, sizeof push, {(width + 7) / 8, (height + 7) / 8, 1});
+      [pipe, push, quads_x, quads_y](VkCommandBuffer cmd, gpu::PassContext&) {
+        gpu::push_and_dispatch(cmd, *pipe, &push, sizeof push, {(quads_x + 7) / 8, (quads_y + 7) / 8, 1});
       });
 }
 

@@ -76,8 +76,11 @@ class Voxelizer {
                 gpu::BufferHandle indices, const std::vector<TriangleRange>& ranges) const;
   // The real scene as the G-buffer holds it: `position` RGBA32F (xyz world, w depth, 0 invalid),
   // `normal` RGBA16F, `width` x `height` used pixels.
+  // `stride`: G-buffer pixels between grid points (1: every pixel). The splat samples every
+  // triangle at half a voxel whatever its size, so a stride only drops grid points a voxel does
+  // not resolve (and depth edges finer than it).
   void add_depth_surface(gpu::FrameGraph& graph, const std::string& label, gpu::ImageHandle position,
-                         gpu::ImageHandle normal, uint32_t width, uint32_t height) const;
+                         gpu::ImageHandle normal, uint32_t width, uint32_t height, uint32_t stride = 1) const;
   // The finest level from the sums, then the mip chain.
   void add_resolve(gpu::FrameGraph& graph);
   // RGBA16F, every mip level: xyz the mean normal x occupancy, w the occlusion.

@@ -27,8 +27,8 @@ const std::array<DvctLevel, 5>& dvct_levels() {
       {"paper", 128, 9, true, 512, 4, 1, 1.0f, true, 0, 0.03f, 0.5f},
       {"high", 64, 9, true, 512, 4, 2, 1.0f, false, 0, 0.1f, 0.5f},
       {"medium", 64, 5, true, 256, 2, 4, 1.0f, false, 1, 0.1f, 0.5f},
-      {"fast", 32, 5, false, 128, 1, 4, 0.5f, false, 3, 0.1f, 0.5f},
-      {"fastest", 16, 3, false, 64, 1, 4, 0.5f, false, 3, 0.1f, 0.5f},
+      {"fast", 32, 3, false, 64, 1, 4, 0.5f, false, 3, 0.1f, 0.5f},
+      {"fastest", 16, 1, false, 64, 1, 4, 0.5f, false, 3, 0.1f, 0.5f},
   }};
   return levels;
 }
@@ -106,6 +106,11 @@ class Dvct final : public Technique {
   gpu::ImageHandle indirect_image_;  // RGBA32UI, dir/indirect_pack.glsl
   std::unique_ptr<Technique> baseline_;
   InputReuse reuse_;
+  struct ObjectSource {
+    bool valid = false;
+    uint64_t revision = 0;  // SceneGpu::revision() it was voxelised at
+    uint32_t cells = 0;
+  } object_source_;  // what the object visibility volume holds
   bool has_virtual_ = false, glossy_ = false;
 };
 
@@ -214,7 +219,17 @@ Status Dvct::record_volumes(const DvctLevel& level, const FrameInfo& info, std::
   // Visibility: the real scene as the reconstruction sees it plus its proxy meshes; the objects.
   const VkExtent2D g = graph.extent(shared_.real_position);
   scene_visibility_->add_clear(graph);
-  scene_visibility_->add_depth_surface(graph, "reconstruction", shared_.real_position, shared_.real_normal, g.width, g.height);
+  // The reconstruction's grid at about two points a voxel where the region is nearest the camera
+  // (a G-buffer pixel spans depth / fx there; farther surfaces have larger pixels): at a coarse
+  // level most pixels would splat into a voxel their neighbours already fill.
+  const glm::vec3 camera(info.camera_to_world[3]);
+  const float side_m = region.voxel_size * float(level.volume_cells);
+  const float nearest = std::max(0.05f, glm::length(camera - (region.origin + glm::vec3(0.5f * side_m))) - 0.5f * side_m * std::sqrt(3.0f));
+  const double fx = shared_.color_intrinsics.fx * double(g.width) / double(std::max(shared_.color_intrinsics.width, 1));
+  const float pixel_m = nearest / float(std::max(fx, 1.0));
+  const uint32_t grid_stride = std::clamp(uint32_t(0.5f * region.voxel_size / pixel_m), 1u, 8u);
+  scene_visibility_->add_depth_surface(graph, "reconstruction", shared_.real_position, shared_.real_normal, g.width,
+                                       g.height, grid_stride);
   auto ranges = [](const MeshSet& set) {
     std::vector<gi::TriangleRange> out;
     for (const DrawRange& r : set.draws) out.push_back({r.first_index, r.index_count, r.vertex_offset});
@@ -223,9 +238,16 @@ Status Dvct::record_volumes(const DvctLevel& level, const FrameInfo& info, std::
   if (!sg.real_proxies.empty())
     scene_visibility_->add_mesh(graph, "proxies", sg.real_proxies.vertices, sg.real_proxies.indices, ranges(sg.real_proxies));
   scene_visibility_->add_resolve(graph);
-  object_visibility_->add_clear(graph);
-  object_visibility_->add_mesh(graph, "objects", sg.virtual_objects.vertices, sg.virtual_objects.indices, ranges(sg.virtual_objects));
-  object_visibility_->add_resolve(graph);
+  // The objects' visibility depends on their meshes and poses alone (the region follows their
+  // bounds): kept while they have not moved and the level's size is the same.
+  if (object_source_.revision == sg.revision() && object_source_.cells == level.volume_cells && object_source_.valid) {
+    skipped.push_back("dvct object visibility: reused (the objects have not moved since it was voxelised)");
+  } else {
+    object_visibility_->add_clear(graph);
+    object_visibility_->add_mesh(graph, "objects", sg.virtual_objects.vertices, sg.virtual_objects.indices, ranges(sg.virtual_objects));
+    object_visibility_->add_resolve(graph);
+    object_source_ = {true, sg.revision(), level.volume_cells};
+  }
 
   // Light: each real lamp's map pair (strongest first), R^rho into the light volume, the pair
   // into the delta volume.
