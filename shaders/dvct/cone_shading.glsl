@@ -3,6 +3,7 @@
 // level, shadow cones too). Needs, declared before it: shared/mrgi_shared.h, shared/vct_math.h,
 // gi/vct_trace.glsl, common/light_set.glsl, common/surface_shading.glsl, the samplers
 // light_volume, delta_volume, scene_visibility, object_visibility, `DvctParams params`,
+// `DvctRealMaterials real_materials`,
 // `AmbientIrradiance ambient_rv`, and the specialisation constants kDiffuseCones (cones in the
 // diffuse set, 0 none) and kSpecular (the specular cone compiled in).
 #ifndef MRGI_DVCT_CONE_SHADING_GLSL
@@ -24,6 +25,17 @@ VctVolume dvct_volume() {
 bool dvct_near_region(vec3 p, float margin) {
   vec3 lo = params.volume.xyz - vec3(margin), hi = params.volume.xyz + vec3(params.volume.w * params.trace.x + margin);
   return all(greaterThanEqual(p, lo)) && all(lessThanEqual(p, hi));
+}
+
+// A real surface's (roughness, metallic) at p: the first real material region holding it, else a
+// rough dielectric (Lambert), what every real pixel is without hints.
+vec2 dvct_real_material(vec3 p) {
+  const int n = min(real_materials.count.x, DVCT_MAX_REAL_MATERIALS);
+  for (int i = 0; i < n; ++i) {
+    const vec4 lo = real_materials.min_roughness[i], hi = real_materials.max_metallic[i];
+    if (all(greaterThanEqual(p, lo.xyz)) && all(lessThanEqual(p, hi.xyz))) return vec2(lo.w, hi.w);
+  }
+  return vec2(1.0f, 0.0f);
 }
 
 // A cone's apex: one voxel off the surface along its normal, so the surface's own voxel does not

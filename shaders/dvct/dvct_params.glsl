@@ -22,6 +22,15 @@ struct DvctParams {
                  // level: texture coordinates divide by this); y, z, w unused
 };
 
+// The real material regions (scene.json real_materials, mrgi/scene.h RealMaterialRegion): a real
+// pixel whose position is in box i takes its roughness and metallic; the first box wins.
+#define DVCT_MAX_REAL_MATERIALS 16
+struct DvctRealMaterials {
+  ivec4 count;                                      // x: boxes in use
+  vec4 min_roughness[DVCT_MAX_REAL_MATERIALS];      // xyz: box min (m); w: roughness
+  vec4 max_metallic[DVCT_MAX_REAL_MATERIALS];       // xyz: box max (m); w: metallic
+};
+
 #ifdef __cplusplus
 static_assert(sizeof(DvctParams) == 80, "std430 push constant mirror");
 }  // namespace mrgi::shader

@@ -40,6 +40,7 @@ layout(set = 0, binding = 9) uniform sampler3D delta_volume;
 layout(set = 0, binding = 10) uniform sampler3D scene_visibility;
 layout(set = 0, binding = 11) uniform sampler3D object_visibility;
 layout(set = 0, binding = 12, rgba32ui) writeonly uniform uimage2D indirect;
+layout(std140, set = 0, binding = 13) uniform RealMaterialUbo { DvctRealMaterials real_materials; };
 layout(push_constant) uniform Params { DvctParams params_block; };
 DvctParams params;
 layout(constant_id = 0) const int kDiffuseCones = 9;
@@ -85,7 +86,8 @@ void main() {
       const DvctGather d = dvct_diffuse(p, n, VCT_LIGHT | VCT_WITHOUT);
       rv = alb.rgb * (1.0f / MRGI_PI) * d.with;
       r = alb.rgb * (1.0f / MRGI_PI) * d.without;
-      const DvctSpecular s = dvct_specular(p, n, view, vec3(0.04f), 1.0f, VCT_LIGHT | VCT_WITHOUT);
+      const vec2 rm = dvct_real_material(p);
+      const DvctSpecular s = dvct_specular(p, n, view, mix(vec3(0.04f), alb.rgb, rm.y), rm.x, VCT_LIGHT | VCT_WITHOUT);
       rv += s.with;
       r += s.without;
     }

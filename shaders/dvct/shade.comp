@@ -37,6 +37,7 @@ layout(set = 0, binding = 11) uniform sampler3D scene_visibility;
 layout(set = 0, binding = 12) uniform sampler3D object_visibility;
 layout(set = 0, binding = 13, rgba16f) writeonly uniform image2D lit_rv;
 layout(set = 0, binding = 14, rgba16f) writeonly uniform image2D lit_r;
+layout(std140, set = 0, binding = 15) uniform RealMaterialUbo { DvctRealMaterials real_materials; };
 layout(push_constant) uniform Params { DvctParams params_block; };
 DvctParams params;
 layout(constant_id = 0) const int kDiffuseCones = 9;
@@ -110,7 +111,8 @@ void main() {
       const DvctGather d = dvct_diffuse(p, n, VCT_LIGHT | VCT_WITHOUT);
       l_rv += alb.rgb * (1.0f / MRGI_PI) * d.with;
       l_r += alb.rgb * (1.0f / MRGI_PI) * d.without;
-      const DvctSpecular s = dvct_specular(p, n, view, vec3(0.04f), 1.0f, VCT_LIGHT | VCT_WITHOUT);
+      const vec2 rm = dvct_real_material(p);
+      const DvctSpecular s = dvct_specular(p, n, view, mix(vec3(0.04f), alb.rgb, rm.y), rm.x, VCT_LIGHT | VCT_WITHOUT);
       l_rv += s.with;
       l_r += s.without;
     }

@@ -42,6 +42,9 @@ const char* kFullScene = R"({
   "real_geometry": [
     {"gltf": "models/box.glb", "scale": [2, 1, 3],
      "material": {"base_color": [0.5, 0.4, 0.3], "roughness": 0.7, "metallic": 0}}
+  ],
+  "real_materials": [
+    {"min": [-0.7, 0.7, -0.1], "max": [0.7, 0.76, 0.7], "roughness": 0.2, "metallic": 0.1}
   ]
 })";
 
@@ -72,6 +75,10 @@ TEST(SceneJson, ParsesEveryKey) {
   EXPECT_TRUE(scene->real_geometry[0].has_material_hint);
   EXPECT_EQ(scene->real_geometry[0].placement.scale, glm::vec3(2, 1, 3));
   EXPECT_FLOAT_EQ(scene->real_geometry[0].material.roughness, 0.7f);
+  ASSERT_EQ(scene->real_materials.size(), 1u);
+  EXPECT_EQ(scene->real_materials[0].min, glm::vec3(-0.7f, 0.7f, -0.1f));
+  EXPECT_FLOAT_EQ(scene->real_materials[0].roughness, 0.2f);
+  EXPECT_FLOAT_EQ(scene->real_materials[0].metallic, 0.1f);
 }
 
 TEST(SceneJson, WriteThenReadRoundTrips) {
@@ -127,6 +134,9 @@ TEST(SceneJson, WriteThenReadRoundTrips) {
   EXPECT_EQ(lamp_at(lit_back->lights[0], 9.0).intensity, 0.0f);
   EXPECT_EQ(back->environment.intensity, scene->environment.intensity);
   EXPECT_EQ(back->real_geometry[0].material.base_color, scene->real_geometry[0].material.base_color);
+  ASSERT_EQ(back->real_materials.size(), 1u);
+  EXPECT_EQ(back->real_materials[0].max, scene->real_materials[0].max);
+  EXPECT_EQ(back->real_materials[0].roughness, scene->real_materials[0].roughness);
 }
 
 TEST(SceneJson, DefaultsForOptionalKeys) {
@@ -196,6 +206,12 @@ INSTANTIATE_TEST_SUITE_P(
                  ErrorKind::BadInput, "lights[0].motion[0].intensity", ">= 0"},
         BadScene{R"({"version": 1, "virtual_objects": [{"gltf": "models/box.glb", "motion": [{"time": 0, "speed": 1}]}]})",
                  ErrorKind::BadInput, "virtual_objects[0].motion[0].speed", "unknown key"},
+        BadScene{R"({"version": 1, "real_materials": [{"min": [0, 0, 0], "max": [1, -1, 1]}]})", ErrorKind::BadInput,
+                 "max", "must be >= min"},
+        BadScene{R"({"version": 1, "real_materials": [{"min": [0, 0, 0], "max": [1, 1, 1], "roughness": 2}]})",
+                 ErrorKind::BadInput, "roughness", "must be in [0.000000, 1.000000]"},
+        BadScene{R"({"version": 1, "real_materials": [{"max": [1, 1, 1]}]})", ErrorKind::BadInput, "min",
+                 "required key is missing"},
         BadScene{R"({"version": 1, "virtual_objects": [{"gltf": "models/box.glb", "position": [1, 2]}]})",
                  ErrorKind::BadInput, "virtual_objects[0].position", "array of 3 numbers, got an array of 2"},
         BadScene{R"({"version": 1, "virtual_objects": [{"gltf": "models/box.glb", "position": [1, "a", 2]}]})",

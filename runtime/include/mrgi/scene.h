@@ -93,12 +93,24 @@ struct RealGeometryDesc {
   MaterialHint material;
 };
 
+// A region of the real scene whose surfaces have a known material (scene.json real_materials):
+// the real pixels whose reconstructed positions fall in the axis-aligned box [min, max] (world,
+// metres) take its roughness and metallic (their colour stays the camera's estimate). The first
+// region holding a point wins; real pixels in none are rough dielectrics (Lambert), as before.
+// What a technique with glossy real light transport reads (dvct's specular cone on real pixels).
+struct RealMaterialRegion {
+  glm::vec3 min{0.0f}, max{0.0f};
+  float roughness = 1.0f;  // GGX, perceptual (alpha = roughness^2)
+  float metallic = 0.0f;
+};
+
 struct SceneDesc {
   std::string path;  // the scene.json it was read from (for messages)
   std::vector<VirtualObjectDesc> virtual_objects;
   std::vector<LightDesc> lights;
   EnvironmentDesc environment;
   std::vector<RealGeometryDesc> real_geometry;
+  std::vector<RealMaterialRegion> real_materials;
 };
 
 // Parses and validates scene.json. Unknown keys, wrong types, non-unit quaternions, NaNs,

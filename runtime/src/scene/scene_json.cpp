@@ -10,6 +10,8 @@
 //                     intensity >= 0 (default 1), rotation [x,y,z,w]}
 //   real_geometry    [{gltf (required), position, rotation, scale,
 //                      material {base_color [3] in [0,1], roughness, metallic in [0,1]}}]
+//   real_materials   [{min [3], max [3] (required, world metres, min <= max per axis),
+//                      roughness (default 1), metallic (default 0), both in [0,1]}]
 // A key that has no meaning for a light's type (a directional light's position, a point light's
 // cone angles) is refused rather than ignored: it is almost always a mistake in the type.
 #include <cmath>
@@ -322,6 +324,28 @@ Expected<RealGeometryDesc> read_real_geometry(const JsonObject& obj, const fs::p
   return desc;
 }
 
+Expected<RealMaterialRegion> read_real_material(const JsonObject& obj) {
+  MRGI_TRY(obj.only_keys({"min", "max", "roughness", "metallic"}));
+  RealMaterialRegion r;
+  auto lo = obj.vec3("min");
+  if (!lo) return lo.error();
+  auto hi = obj.vec3("max");
+  if (!hi) return hi.error();
+  for (int c = 0; c < 3; ++c)
+    if (!((*lo)[c] <= (*hi)[c])) return obj.error("max", "must be >= min on every axis (an axis-aligned box)");
+  auto roughness = obj.number("roughness", 1.0);
+  if (!roughness) return roughness.error();
+  MRGI_TRY(check_range(obj, "roughness", *roughness, 0.0, 1.0));
+  auto metallic = obj.number("metallic", 0.0);
+  if (!metallic) return metallic.error();
+  MRGI_TRY(check_range(obj, "metallic", *metallic, 0.0, 1.0));
+  r.min = glm::vec3(*lo);
+  r.max = glm::vec3(*hi);
+  r.roughness = float(*roughness);
+  r.metallic = float(*metallic);
+  return r;
+}
+
 std::string relative_to(const std::string& path, const fs::path& folder) {
   std::error_code ec;
   const fs::path abs = fs::absolute(path, ec);
@@ -354,7 +378,7 @@ Expected<SceneDesc> load_scene_json(const std::string& path) {
   if (!json) return json.error();
   auto root = JsonObject::from(*json, path, "");
   if (!root) return root.error();
-  MRGI_TRY(root->only_keys({"version", "virtual_objects", "lights", "environment", "real_geometry"}));
+  MRGI_TRY(root->only_keys({"version", "virtual_objects", "lights", "environment", "real_geometry", "real_materials"}));
   auto version = root->integer("version");
   if (!version) return version.error();
   if (*version != kSceneVersion)
@@ -375,6 +399,8 @@ Expected<SceneDesc> load_scene_json(const std::string& path) {
   }
   MRGI_TRY(read_list(*root, "real_geometry", &scene.real_geometry,
                      [&](const JsonObject& o) { return read_real_geometry(o, base); }));
+  MRGI_TRY(read_list(*root, "real_materials", &scene.real_materials,
+                     [](const JsonObject& o) { return read_real_material(o); }));
   return scene;
 }
 
@@ -443,6 +469,14 @@ Status write_scene_json(const std::string& path, const SceneDesc& scene) {
                        {"metallic", m.metallic}};
     }
     j["real_geometry"].push_back(e);
+  }
+  if (!scene.real_materials.empty()) {
+    j["real_materials"] = nlohmann::json::array();
+    for (const RealMaterialRegion& r : scene.real_materials)
+      j["real_materials"].push_back({{"min", {r.min.x, r.min.y, r.min.z}},
+                                     {"max", {r.max.x, r.max.y, r.max.z}},
+                                     {"roughness", r.roughness},
+                                     {"metallic", r.metallic}});
   }
   return write_text_file(path, j.dump(2) + "\n");
 }

@@ -260,6 +260,31 @@ Expected<SynthReport> synthesize_capture(const SceneDescription& description, co
     ld.outer_angle_deg = float(l.outer_angle_deg);
     scene_json.lights.push_back(ld);
   }
+  // The real surfaces that are not diffuse, as scene.json's real material regions (the material
+  // hint a runtime gets for them): each generated shape's world bounding box, 1 cm larger on
+  // every side (the reconstruction's positions scatter about the surface).
+  for (const RealObjectDesc& o : d.real_objects) {
+    if (!o.material || o.shape == ShapeKind::Gltf) continue;
+    const RefMaterial& m = *o.material;
+    if (m.type != MaterialType::Glossy && m.type != MaterialType::Mirror) continue;
+    glm::dvec3 half = o.shape == ShapeKind::Plane ? glm::dvec3(0.5 * o.size.x, 0.0, 0.5 * o.size.y)
+                      : o.shape == ShapeKind::Box ? 0.5 * o.size
+                                                  : glm::dvec3(o.radius);
+    half *= o.scale;
+    glm::dvec3 lo(1e30), hi(-1e30);
+    for (int k = 0; k < 8; ++k) {
+      const glm::dvec3 corner((k & 1) ? half.x : -half.x, (k & 2) ? half.y : -half.y, (k & 4) ? half.z : -half.z);
+      const glm::dvec3 w = o.position + o.rotation * corner;
+      lo = glm::min(lo, w);
+      hi = glm::max(hi, w);
+    }
+    RealMaterialRegion r;
+    r.min = glm::vec3(lo - glm::dvec3(0.01));
+    r.max = glm::vec3(hi + glm::dvec3(0.01));
+    r.roughness = m.type == MaterialType::Mirror ? 0.0f : m.roughness;
+    r.metallic = m.type == MaterialType::Mirror ? 1.0f : m.metallic;
+    scene_json.real_materials.push_back(r);
+  }
   ImageRGBF env_copy;
   if (d.environment.present) {
     EnvironmentDesc& e = scene_json.environment;

@@ -99,6 +99,8 @@ class Dvct final : public Technique {
   std::vector<QualityLevel> ladder_;
   std::vector<DvctLevel> levels_;
   gpu::BufferHandle lights_;  // shader::LightSet, one per frame slot (the paper level's shading)
+  gpu::BufferHandle real_materials_;  // shader::DvctRealMaterials, one per frame slot
+  shader::DvctRealMaterials real_material_table_{};  // scene.json's regions, as the shaders read them
   std::optional<gi::ReflectiveShadowMaps> rsm_;
   std::optional<gi::Voxelizer> scene_visibility_, object_visibility_;
   std::optional<gi::VoxelLight> light_, delta_;
@@ -125,6 +127,21 @@ Status Dvct::init() {
   lights_ = *lights;
   has_virtual_ = !sg.virtual_objects.empty();
   glossy_ = sg.glossy;
+  // The real material regions: a real surface with a glossy hint gets the specular cone too.
+  const std::vector<RealMaterialRegion>& regions = shared_.scene->real_materials;
+  if (regions.size() > DVCT_MAX_REAL_MATERIALS)
+    return fail(ErrorKind::BadInput, shared_.scene->path + ": real_materials: " + std::to_string(regions.size()) +
+                                         " regions; dvct reads at most " + std::to_string(DVCT_MAX_REAL_MATERIALS));
+  real_material_table_.count = glm::ivec4(int(regions.size()), 0, 0, 0);
+  for (size_t i = 0; i < regions.size(); ++i) {
+    real_material_table_.min_roughness[i] = glm::vec4(regions[i].min, regions[i].roughness);
+    real_material_table_.max_metallic[i] = glm::vec4(regions[i].max, regions[i].metallic);
+    glossy_ |= regions[i].roughness < SceneGpu::kGlossyRoughness || regions[i].metallic > SceneGpu::kGlossyMetallic;
+  }
+  auto materials = graph.create_buffer({"dvct_real_materials", sizeof(shader::DvctRealMaterials), gpu::MemoryUsage::Upload, true},
+                                       VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  if (!materials) return materials.error();
+  real_materials_ = *materials;
   // Without virtual objects the volumes are the smallest allowed, allocated only so the shading
   // passes bind images of the kinds they declare (mode.y 0: they read none of them).
   uint32_t cells = 2, rsm_size = 16;
@@ -297,11 +314,11 @@ void Dvct::add_cone_pass(const DvctLevel& level, const shader::DvctParams& param
   const gpu::ImageHandle scene = scene_visibility_->volume().image(0), object = object_visibility_->volume().image(0);
   const bool full = level.shadow_cones;
   const gpu::ImageHandle indirect = indirect_image_;
-  const gpu::BufferHandle lights = lights_;
+  const gpu::BufferHandle lights = lights_, materials = real_materials_;
   const uint32_t divisor = std::max(1u, level.trace_divisor);
   graph.add_shader_pass(
       full ? "dvct shade" : "dvct cones", gpu::PassKind::Compute, *pipe,
-      [&, full, indirect, lights](gpu::ShaderPassBuilder& b) {
+      [&, full, indirect, lights, materials](gpu::ShaderPassBuilder& b) {
         if (full) {
           bind_shading_gbuffers(b, r);
         } else {
@@ -309,6 +326,7 @@ void Dvct::add_cone_pass(const DvctLevel& level, const shader::DvctParams& param
           b.bind("indirect", indirect);
         }
         b.bind("LightUbo", lights);
+        b.bind("RealMaterialUbo", materials);
         b.bind_sampled("light_volume", light, linear);
         b.bind_sampled("delta_volume", delta, linear);
         b.bind_sampled("scene_visibility", scene, linear);
@@ -329,6 +347,7 @@ Status Dvct::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   gpu::FrameGraph& graph = *shared_.graph;
   auto* set = static_cast<shader::LightSet*>(graph.mapped(lights_, graph.slot()));
   write_unshadowed_light_set(shared_.light_stage->lighting(), *set);
+  *static_cast<shader::DvctRealMaterials*>(graph.mapped(real_materials_, graph.slot())) = real_material_table_;
   shader::DvctParams params{};
   const bool volumes = has_virtual_ && shared_.scene_gpu->any_visible();
   if (volumes) {
@@ -353,7 +372,7 @@ Status Dvct::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   if (!level.specular_cone)
     skipped.push_back("dvct specular cone: level '" + std::string(level.name) + "' traces none");
   else if (!glossy_)
-    skipped.push_back("dvct specular cone: no glossy material in the scene (virtual: metallic > 0.1 or roughness < 0.7; real: no glossy hint)");
+    skipped.push_back("dvct specular cone: no glossy material in the scene (virtual: metallic > 0.1 or roughness < 0.7; real: no such scene.json real_materials region)");
   // Without a glossy material the specular cone would return at once; the roughness limit 0
   // says so to the shader without another pipeline.
   if (!specular) params.cones.w = 0.0f;

@@ -50,7 +50,14 @@
 //   - the reconstruction is voxelised from a grid of about two points a voxel where the region
 //     is nearest the camera (Voxelizer::add_depth_surface's stride), not from every pixel;
 //   - no specular cone at levels without it, or with no glossy material in the scene (virtual:
-//     SceneGpu::glossy; real: none yet).
+//     SceneGpu::glossy; real: a scene.json real_materials region with roughness under 0.7 or
+//     metallic over 0.1), and at pixels rougher than that.
+//
+// Real materials: scene.json's real_materials regions (mrgi/scene.h RealMaterialRegion) give the
+// real pixels inside them a roughness and metallic (the colour stays the camera's estimate); a
+// glossy real surface then traces the specular cone too, with and without the objects, so it
+// reflects them (and their shadow) and loses the reflection of what they hide. `mrgi synth`
+// writes a region for every glossy or mirror real shape it renders.
 #pragma once
 #include <array>
 #include <memory>
