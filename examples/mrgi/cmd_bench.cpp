@@ -23,6 +23,7 @@ struct BenchOptions {
   std::string out, check, write_baseline;
   std::vector<std::string> sizes;  // --sizes WxH,...: one run per size and a scaling table
   std::vector<std::string> knobs;  // --knob NAME=VALUE (one technique)
+  std::vector<std::string> sweeps;  // --sweep NAME=V1,V2,... (one technique)
   bool quiet = false;
   int confirm = 1;  // re-runs of an entry whose only finding is its frame time, before failing
 };
@@ -79,6 +80,30 @@ void run_bench_command(BenchOptions& o) {
       throw CommandFailure(2, "--knob cannot be combined with --check or --write-baseline (the baseline holds the "
                               "ladder's own levels)");
     o.settings.knobs = parse_knobs(o.settings.techniques.front(), o.knobs);
+  }
+  if (!o.sweeps.empty()) {
+    if (o.settings.techniques.size() != 1)
+      throw CommandFailure(2, "--sweep: name exactly one technique with --techniques (knobs are a technique's own)");
+    if (!o.check.empty() || !o.write_baseline.empty() || !o.sizes.empty())
+      throw CommandFailure(2, "--sweep cannot be combined with --check, --write-baseline or --sizes");
+    for (const std::string& g : o.sweeps) {
+      const size_t eq = g.find('=');
+      std::vector<double> values;
+      bool ok = eq != std::string::npos && eq > 0 && eq + 1 < g.size();
+      for (size_t at = eq + 1; ok && at <= g.size();) {
+        const size_t comma = std::min(g.find(',', at), g.size());
+        const std::string item = g.substr(at, comma - at);
+        char* end = nullptr;
+        const double v = std::strtod(item.c_str(), &end);
+        ok = !item.empty() && *end == '\0';
+        values.push_back(v);
+        at = comma + 1;
+      }
+      if (!ok)
+        throw CommandFailure(2, "--sweep '" + g + "': expected NAME=V1,V2,..., e.g. --sweep volume_cells=16,32,64 (mrgi info "
+                                "--technique " + o.settings.techniques.front() + " lists the knobs)");
+      o.settings.sweeps.push_back({g.substr(0, eq), values});
+    }
   }
   if (!o.sizes.empty()) return run_scaling(o);
   std::optional<perf::Baseline> baseline;
@@ -193,6 +218,9 @@ void setup(CLI::App& app) {
   cmd->add_flag("--no-residual-light", [opts](int64_t n) { opts->settings.residual_light = n == 0; },
                 "with declared lamps: light by the lamps alone, without the estimate of the real light they do not "
                 "explain (RuntimeSettings::residual_light; an ablation)");
+  cmd->add_option("--sweep", opts->sweeps,
+                 "run every combination of a knob's values at every chosen level, NAME=V1,V2,... (repeatable: the "
+                 "product; one technique; entries are named by level and values)");
   cmd->add_option("--knob", opts->knobs,
                   "set one quality knob of the (one) technique at every level, NAME=VALUE (repeatable; mrgi info "
                   "--technique T lists them with their spans)");

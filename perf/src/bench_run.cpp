@@ -16,6 +16,7 @@
 #include "mrgi/perf/suite.h"
 #include "mrgi/platform/capture.h"
 #include "loaded_scene.h"
+#include "technique/knobs.h"
 
 #ifndef MRGI_PERF_SOURCE_DIR
 #define MRGI_PERF_SOURCE_DIR ""
@@ -347,6 +348,35 @@ Expected<BenchResult> run_bench(const BenchSettings& s) {
   progress.total = scenes->size() * runs_per_scene * size_t(s.warmup + s.frames + s.profile_frames);
   const auto t0 = std::chrono::steady_clock::now();
 
+  // The sweep's combinations (one, empty, without a sweep), each the knobs it adds and its label.
+  struct Combination {
+    std::vector<KnobSetting> knobs;
+    std::string label;
+  };
+  std::vector<Combination> combinations(1);
+  for (const auto& [name, values] : s.sweeps) {
+    if (values.empty()) return fail(ErrorKind::BadUsage, "--sweep " + name + ": no values");
+    std::vector<Combination> next;
+    for (const Combination& c : combinations)
+      for (double v : values) {
+        Combination d = c;
+        d.knobs.push_back({name, v});
+        d.label += " " + name + "=" + technique::knob_number(v);
+        next.push_back(std::move(d));
+      }
+    combinations = std::move(next);
+  }
+  if (!s.sweeps.empty()) {
+    progress.total *= combinations.size();
+    for (const auto& [t, levels] : plan)
+      for (const Combination& c : combinations) {
+        std::vector<KnobSetting> knobs = s.knobs;
+        knobs.insert(knobs.end(), c.knobs.begin(), c.knobs.end());
+        auto ladder = technique_ladder(t, knobs);  // refused before any scene runs
+        if (!ladder.ok()) return fail(ladder.error().kind, "--sweep" + c.label + ": " + ladder.error().message);
+      }
+  }
+
   std::vector<double> all_floor;
   for (const SuiteScene& sc : *scenes) {
     auto loaded = load_scene(sc);
@@ -357,13 +387,20 @@ Expected<BenchResult> run_bench(const BenchSettings& s) {
     auto floor = gpu::FloorTimer::create(ctx, uint32_t(w), uint32_t(h), uint32_t(s.floor_warmup));
     if (!floor.ok()) return fail(floor.error().kind, "floor pass (scene '" + sc.name + "'): " + floor.error().message);
     for (const auto& [t, levels] : plan)
+      for (size_t ci = 0; ci < combinations.size(); ++ci)
       for (int level : levels) {
         // Floor samples before each run and between its frames: machine load drifts, and a
         // scene's ratios should divide by floor times taken alongside its own.
         auto st = floor->sample(uint32_t(s.floor_frames), floor_ms);
         if (!st.ok()) return fail(st.error().kind, "floor pass (scene '" + sc.name + "'): " + st.error().message);
-        auto run = run_one(*loaded, t, level, s, result.device, *floor, floor_ms);
+        BenchSettings with = s;
+        with.knobs.insert(with.knobs.end(), combinations[ci].knobs.begin(), combinations[ci].knobs.end());
+        auto run = run_one(*loaded, t, level, with, result.device, *floor, floor_ms);
         if (!run.ok()) return run.error();
+        if (!s.sweeps.empty()) {
+          run->entry.level_name += combinations[ci].label;
+          run->entry.level += 1000 * int(ci + 1);
+        }
         runs.push_back(std::move(run).value());
         progress.step(sc.name + " " + t + " " + runs.back().entry.level_name,
                       size_t(s.warmup + s.frames + s.profile_frames));

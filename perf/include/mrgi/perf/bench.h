@@ -48,6 +48,11 @@ struct BenchSettings {
   DeviceSettings device;
   bool residual_light = true;            // RuntimeSettings::residual_light
   std::vector<KnobSetting> knobs;        // RuntimeSettings::knobs (one technique only)
+  // Knob sweeps (one technique only): every combination of the values is run at every chosen
+  // level, on top of `knobs`; an entry's level_name then names its values ("high volume_cells=32
+  // diffuse_cones=5") and its level is 1000 x (combination + 1) + the level index, so the
+  // report, the aggregate and the plot keep the combinations apart. Empty: no sweep.
+  std::vector<std::pair<std::string, std::vector<double>>> sweeps;
   ProgressFn progress;                   // optional
 };
 
