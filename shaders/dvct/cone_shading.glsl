@@ -82,9 +82,14 @@ DvctSpecular dvct_specular(vec3 p, vec3 n, vec3 view, vec3 f0, float roughness, 
   const float nv = dot(n, view);
   if (!kSpecular || roughness >= params.cones.w || nv <= 0.0f) return s;
   const vec3 refl = reflect(-view, n);
+  // A glancing mirror direction runs along the surface it leaves, inside that surface's own voxels
+  // (trilinear reads spread it over a voxel either side): the cone starts where its axis is two
+  // voxels above the surface (at most 8 voxels along it), so a glossy table at the camera's
+  // glancing angle is not occluded by itself before the reflected object.
+  const float lift = 2.0f / max(dot(refl, n), 0.25f) - 1.0f;
   const VctResult r = vct_trace_cone(light_volume, delta_volume, scene_visibility, object_visibility, dvct_volume(),
-                                     dvct_apex(p, n), refl, vct_specular_aperture(roughness, params.cones.y),
-                                     params.cones.z, flags);
+                                     dvct_apex(p, n) + refl * (lift * params.volume.w),
+                                     refl, vct_specular_aperture(roughness, params.cones.y), params.cones.z, flags);
   // The ambient seen along the mirror direction: its irradiance there over pi (a radiance the
   // SH bands 0..2 hold only smoothly, the same light the diffuse term uses).
   const vec3 env = ambient_irradiance(ambient_rv, refl) * (1.0f / MRGI_PI);
