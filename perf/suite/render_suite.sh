@@ -17,7 +17,7 @@ set -euo pipefail
 MRGI="${MRGI:-./build/bin/mrgi}"
 STAGE=out/suite-render
 names=("$@")
-if [ ${#names[@]} -eq 0 ]; then names=(desk_spot corner glass_mirror env_fisheye out_of_view moving); fi
+if [ ${#names[@]} -eq 0 ]; then names=(desk_spot corner glass_mirror env_fisheye out_of_view moving glossy_table); fi
 mkdir -p "$STAGE"
 for n in "${names[@]}"; do
   if [ ! -d "$STAGE/$n" ]; then

@@ -27,7 +27,7 @@ const std::array<DvctLevel, 5>& dvct_levels() {
       {"paper", 128, 9, true, 512, 4, 1, 1.0f, true, 0, 0.03f, 0.5f},
       {"high", 64, 9, true, 512, 4, 2, 1.0f, false, 0, 0.1f, 0.5f},
       {"medium", 64, 5, true, 256, 2, 4, 1.0f, false, 1, 0.1f, 0.5f},
-      {"fast", 32, 3, false, 64, 1, 4, 0.5f, false, 3, 0.1f, 0.5f},
+      {"fast", 16, 3, false, 64, 1, 4, 0.5f, false, 3, 0.1f, 0.5f},
       {"fastest", 16, 1, false, 64, 1, 4, 0.5f, false, 3, 0.1f, 0.5f},
   }};
   return levels;

@@ -14,7 +14,7 @@
 //   paper    128^3   9        yes       512^2  4      every px    1.0       shadow cones (Sec. 3.5)
 //   high      64^3   9        yes       512^2  4      1 in 2x2    1.0       baseline high's maps
 //   medium    64^3   5        yes       256^2  2      1 in 4x4    1.0       baseline medium's
-//   fast      32^3   3        no         64^2  1      1 in 4x4    0.5       baseline lowest's
+//   fast      16^3   3        no         64^2  1      1 in 4x4    0.5       baseline lowest's
 //   fastest   16^3   1        no         64^2  1      1 in 4x4    0.5       baseline lowest's
 // "paper" shades every pixel with cones alone (shaders/dvct/shade.comp). The others trace the
 // cones at one pixel in a block (shaders/dvct/indirect.comp) into dir's packed indirect image,
