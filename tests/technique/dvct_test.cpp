@@ -250,6 +250,32 @@ TEST(Dvct, AGlossyRealRegionReflectsTheBoxes) {
   EXPECT_GT(g.x, g.y + 0.001) << "the red boxes' reflection";
 }
 
+// The specular-cone skip (dvct.h "Skips"): a glossy real region outside the camera's view
+// compiles the cone out ("no glossy material in view") and the frame is the one the same scene
+// without the region gives, bit for bit (no glossy pixel: nothing the cone would have added).
+TEST(Dvct, AGlossyRegionOutOfViewTracesNoSpecularCone) {
+  mrgi::testing::TempDir dir;
+  SyntheticScene plain = SyntheticScene::create(dir.str());
+  SyntheticScene away = plain;
+  RealMaterialRegion far;
+  far.min = glm::vec3(49.0f, -0.02f, -1.0f);
+  far.max = glm::vec3(51.0f, 0.02f, 1.0f);
+  far.roughness = 0.1f;
+  away.scene.real_materials = {far};
+  auto run = [&](const SyntheticScene& scene) {
+    RuntimeSettings s;
+    s.technique = "dvct";
+    s.level = 2;
+    s.device.validate = true;
+    return run_synthetic_frames(scene, s, 3);
+  };
+  const std::vector<FrameOutput> with = run(away), without = run(plain);
+  ASSERT_EQ(with.size(), 3u);
+  ASSERT_EQ(without.size(), 3u);
+  EXPECT_TRUE(has_note(with.back(), "dvct specular cone: no glossy material in view"));
+  EXPECT_TRUE(with.back().image.data == without.back().image.data);
+}
+
 // Stress (issue 18): 1,000 frames at the fast level (32^3; the glossy variants with its specular
 // cone turned on by knob), each rebuilding its volumes (the depth alternates by 1 cm, beyond the
 // reuse tolerance): an object larger than the scene (the region, twice its size, holds the whole

@@ -92,7 +92,7 @@ class Dvct final : public Technique {
   // The shading pipeline for (diffuse cones, specular cone), made at start-up for every level.
   using Variant = std::pair<uint32_t, bool>;
   Status record_volumes(const DvctLevel& level, const FrameInfo& info, std::vector<std::string>& skipped);
-  void add_cone_pass(const DvctLevel& level, const shader::DvctParams& params);
+  void add_cone_pass(const DvctLevel& level, const shader::DvctParams& params, bool specular);
 
   std::string name_ = "dvct";
   SharedResources shared_;
@@ -114,6 +114,8 @@ class Dvct final : public Technique {
     uint32_t cells = 0;
   } object_source_;  // what the object visibility volume holds
   bool has_virtual_ = false, glossy_ = false;
+  std::vector<RealMaterialRegion> glossy_regions_;  // the real material regions the specular cone is for
+  bool glossy_in_view(const FrameInfo& info) const;
 };
 
 Status Dvct::init() {
@@ -136,8 +138,10 @@ Status Dvct::init() {
   for (size_t i = 0; i < regions.size(); ++i) {
     real_material_table_.min_roughness[i] = glm::vec4(regions[i].min, regions[i].roughness);
     real_material_table_.max_metallic[i] = glm::vec4(regions[i].max, regions[i].metallic);
-    glossy_ |= regions[i].roughness < SceneGpu::kGlossyRoughness || regions[i].metallic > SceneGpu::kGlossyMetallic;
+    if (regions[i].roughness < SceneGpu::kGlossyRoughness || regions[i].metallic > SceneGpu::kGlossyMetallic)
+      glossy_regions_.push_back(regions[i]);
   }
+  glossy_ |= !glossy_regions_.empty();
   auto materials = graph.create_buffer({"dvct_real_materials", sizeof(shader::DvctRealMaterials), gpu::MemoryUsage::Upload, true},
                                        VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   if (!materials) return materials.error();
@@ -177,20 +181,23 @@ Status Dvct::init() {
     if (!rsm) return rsm.error();
     rsm_.emplace(std::move(*rsm));
   }
-  for (const DvctLevel& l : levels_) {
-    const Variant key{l.diffuse_cones, l.specular_cone};
-    auto& table = l.shadow_cones ? shade_ : indirect_;
-    if (table.count(key)) continue;
-    const char* shader = l.shadow_cones ? "dvct/shade.comp" : "dvct/indirect.comp";
-    auto spv = gpu::shader_spirv(shader);
-    if (!spv) return spv.error();
-    auto p = gpu::create_compute_pipeline(
-        ctx, {std::string("dvct_") + (l.shadow_cones ? "shade_" : "indirect_") + std::to_string(l.diffuse_cones) +
-                  (l.specular_cone ? "_specular" : ""),
-              *spv, {}, sizeof(shader::DvctParams), {l.diffuse_cones, l.specular_cone ? 1u : 0u}});
-    if (!p) return p.error();
-    table.emplace(key, gpu::PipelineHandle(ctx, std::move(*p)));
-  }
+  // A level with the specular cone also gets the variant without it, for frames with no glossy
+  // material in view: lavapipe runs every path of a shader, so it is compiled out, not skipped.
+  for (const DvctLevel& l : levels_)
+    for (const bool specular : {l.specular_cone, false}) {
+      const Variant key{l.diffuse_cones, specular};
+      auto& table = l.shadow_cones ? shade_ : indirect_;
+      if (table.count(key)) continue;
+      const char* shader = l.shadow_cones ? "dvct/shade.comp" : "dvct/indirect.comp";
+      auto spv = gpu::shader_spirv(shader);
+      if (!spv) return spv.error();
+      auto p = gpu::create_compute_pipeline(
+          ctx, {std::string("dvct_") + (l.shadow_cones ? "shade_" : "indirect_") + std::to_string(l.diffuse_cones) +
+                    (specular ? "_specular" : ""),
+                *spv, {}, sizeof(shader::DvctParams), {l.diffuse_cones, specular ? 1u : 0u}});
+      if (!p) return p.error();
+      table.emplace(key, gpu::PipelineHandle(ctx, std::move(*p)));
+    }
   gpu::ImageDesc d;
   d.name = "dvct indirect";
   d.format = VK_FORMAT_R32G32B32A32_UINT;
@@ -304,9 +311,36 @@ Status Dvct::record_volumes(const DvctLevel& level, const FrameInfo& info, std::
   return ok_status();
 }
 
-void Dvct::add_cone_pass(const DvctLevel& level, const shader::DvctParams& params) {
+// Whether this frame shows a glossy surface: the objects' box (with a glossy virtual material) or
+// a glossy real region's box not wholly outside the colour camera's frustum (tested plane by plane
+// on its corners: conservative, a box beside a frustum corner may count as in view).
+bool Dvct::glossy_in_view(const FrameInfo& info) const {
+  const glm::dmat4 to_camera = glm::inverse(info.camera_to_world);
+  const Intrinsics& k = shared_.color_intrinsics;
+  auto box_in_view = [&](const glm::vec3& lo, const glm::vec3& hi) {
+    int outside[5] = {0, 0, 0, 0, 0};  // behind, left, right, above, below
+    for (int c = 0; c < 8; ++c) {
+      const glm::dvec3 w((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
+      const glm::dvec3 p(to_camera * glm::dvec4(w, 1.0));  // OpenCV camera: x right, y down, z forward
+      outside[0] += p.z < 1e-3;
+      outside[1] += p.x < -p.z * k.cx / k.fx;
+      outside[2] += p.x > p.z * (k.width - k.cx) / k.fx;
+      outside[3] += p.y < -p.z * k.cy / k.fy;
+      outside[4] += p.y > p.z * (k.height - k.cy) / k.fy;
+    }
+    return std::count(std::begin(outside), std::end(outside), 8) == 0;
+  };
+  const SceneGpu& sg = *shared_.scene_gpu;
+  if (sg.glossy && info.virtual_objects_present && box_in_view(sg.virtual_objects.bounds_min, sg.virtual_objects.bounds_max))
+    return true;
+  for (const RealMaterialRegion& r : glossy_regions_)
+    if (box_in_view(r.min, r.max)) return true;
+  return false;
+}
+
+void Dvct::add_cone_pass(const DvctLevel& level, const shader::DvctParams& params, bool specular) {
   gpu::FrameGraph& graph = *shared_.graph;
-  const Variant key{level.diffuse_cones, level.specular_cone};
+  const Variant key{level.diffuse_cones, specular};
   const gpu::Pipeline* pipe = level.shadow_cones ? &*shade_.at(key) : &*indirect_.at(key);
   const SharedResources& r = shared_;
   const VkSampler linear = shared_.context->samplers().linear_clamp;
@@ -368,16 +402,15 @@ Status Dvct::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     params.texture = glm::vec4(2.0f, 0.0f, 0.0f, 0.0f);
     params.mode = glm::ivec4(int(std::max(1u, level.trace_divisor)), 0, 0, 0);
   }
-  const bool specular = level.specular_cone && glossy_;
+  const bool specular = level.specular_cone && glossy_ && glossy_in_view(info);
   if (!level.specular_cone)
     skipped.push_back("dvct specular cone: level '" + std::string(level.name) + "' traces none");
   else if (!glossy_)
     skipped.push_back("dvct specular cone: no glossy material in the scene (virtual: metallic > 0.1 or roughness < 0.7; real: no such scene.json real_materials region)");
-  // Without a glossy material the specular cone would return at once; the roughness limit 0
-  // says so to the shader without another pipeline.
-  if (!specular) params.cones.w = 0.0f;
+  else if (!specular)
+    skipped.push_back("dvct specular cone: no glossy material in view (compiled out this frame)");
   if (level.shadow_cones) {
-    add_cone_pass(level, params);
+    add_cone_pass(level, params, specular);
     return ok_status();
   }
   FrameInfo base = info;
@@ -386,7 +419,7 @@ Status Dvct::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     set_dir_indirect(*baseline_, nullptr);
     return baseline_->record(base, skipped);
   }
-  add_cone_pass(level, params);
+  add_cone_pass(level, params, specular);
   DirIndirect add;
   add.merged = indirect_image_;
   add.divisor = int(std::max(1u, level.trace_divisor));

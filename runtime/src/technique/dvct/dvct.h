@@ -49,9 +49,12 @@
 //     the same level: it depends on nothing else (1.5 ms a frame at fast on desk_spot's bunny);
 //   - the reconstruction is voxelised from a grid of about two points a voxel where the region
 //     is nearest the camera (Voxelizer::add_depth_surface's stride), not from every pixel;
-//   - no specular cone at levels without it, or with no glossy material in the scene (virtual:
-//     SceneGpu::glossy; real: a scene.json real_materials region with roughness under 0.7 or
-//     metallic over 0.1), and at pixels rougher than that.
+//   - no specular cone at levels without it, or with no glossy material in view (virtual:
+//     SceneGpu::glossy and the objects' box in the camera's frustum; real: a scene.json
+//     real_materials region with roughness under 0.7 or metallic over 0.1 whose box is): the
+//     shading pass's variant without it runs (compiled out, not branched around), and the frame
+//     is the same bit for bit (tests/technique/dvct_test.cpp); pixels rougher than that trace
+//     none either way.
 //
 // Real materials: scene.json's real_materials regions (mrgi/scene.h RealMaterialRegion) give the
 // real pixels inside them a roughness and metallic (the colour stays the camera's estimate); a
