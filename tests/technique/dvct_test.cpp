@@ -219,26 +219,34 @@ TEST(Dvct, GlossyBoxesGetTheSpecularCone) {
   EXPECT_GT(std::abs(a.virtual_mean - b.virtual_mean), 1e-3);
 }
 
+// `scene` with one glossy real region (roughness 0.1) over [lo, hi].
+SyntheticScene with_glossy_region(const SyntheticScene& scene, const glm::vec3& lo, const glm::vec3& hi) {
+  SyntheticScene out = scene;
+  RealMaterialRegion r;
+  r.min = lo;
+  r.max = hi;
+  r.roughness = 0.1f;
+  out.scene.real_materials = {r};
+  return out;
+}
+
+// Three frames at the medium level (the specular cone), validation on.
+std::vector<FrameOutput> run_medium(const SyntheticScene& scene) {
+  RuntimeSettings s;
+  s.technique = "dvct";
+  s.level = 2;
+  s.device.validate = true;
+  return run_synthetic_frames(scene, s, 3);
+}
+
 // A real material region (scene.json real_materials) makes the real floor glossy: the specular
 // cone then runs on its pixels (no "specular cone" note although the boxes are diffuse) and the
 // floor near the red boxes reflects them: it gains red over the same scene without the region.
 TEST(Dvct, AGlossyRealRegionReflectsTheBoxes) {
   mrgi::testing::TempDir dir;
-  SyntheticScene plain = SyntheticScene::create(dir.str());
-  SyntheticScene glossy = plain;
-  RealMaterialRegion floor;
-  floor.min = glm::vec3(-5.0f, -0.02f, -5.0f);
-  floor.max = glm::vec3(5.0f, 0.02f, 5.0f);
-  floor.roughness = 0.1f;
-  glossy.scene.real_materials = {floor};
-  auto run = [&](const SyntheticScene& scene) {
-    RuntimeSettings s;
-    s.technique = "dvct";
-    s.level = 2;
-    s.device.validate = true;
-    return run_synthetic_frames(scene, s, 3);
-  };
-  const std::vector<FrameOutput> with = run(glossy), without = run(plain);
+  const SyntheticScene plain = SyntheticScene::create(dir.str());
+  const SyntheticScene glossy = with_glossy_region(plain, glm::vec3(-5.0f, -0.02f, -5.0f), glm::vec3(5.0f, 0.02f, 5.0f));
+  const std::vector<FrameOutput> with = run_medium(glossy), without = run_medium(plain);
   ASSERT_EQ(with.size(), 3u);
   ASSERT_EQ(without.size(), 3u);
   EXPECT_FALSE(has_note(with.back(), "dvct specular cone"));
@@ -255,28 +263,16 @@ TEST(Dvct, AGlossyRealRegionReflectsTheBoxes) {
 // without the region gives, bit for bit (no glossy pixel: nothing the cone would have added).
 TEST(Dvct, AGlossyRegionOutOfViewTracesNoSpecularCone) {
   mrgi::testing::TempDir dir;
-  SyntheticScene plain = SyntheticScene::create(dir.str());
-  SyntheticScene away = plain;
-  RealMaterialRegion far;
-  far.min = glm::vec3(49.0f, -0.02f, -1.0f);
-  far.max = glm::vec3(51.0f, 0.02f, 1.0f);
-  far.roughness = 0.1f;
-  away.scene.real_materials = {far};
-  auto run = [&](const SyntheticScene& scene) {
-    RuntimeSettings s;
-    s.technique = "dvct";
-    s.level = 2;
-    s.device.validate = true;
-    return run_synthetic_frames(scene, s, 3);
-  };
-  const std::vector<FrameOutput> with = run(away), without = run(plain);
+  const SyntheticScene plain = SyntheticScene::create(dir.str());
+  const SyntheticScene away = with_glossy_region(plain, glm::vec3(49.0f, -0.02f, -1.0f), glm::vec3(51.0f, 0.02f, 1.0f));
+  const std::vector<FrameOutput> with = run_medium(away), without = run_medium(plain);
   ASSERT_EQ(with.size(), 3u);
   ASSERT_EQ(without.size(), 3u);
   EXPECT_TRUE(has_note(with.back(), "dvct specular cone: no glossy material in view"));
   EXPECT_TRUE(with.back().image.data == without.back().image.data);
 }
 
-// Stress (issue 18): 1,000 frames at the fast level (32^3; the glossy variants with its specular
+// Stress (issue 18): 1,000 frames at the fast level (16^3; the glossy variants with its specular
 // cone turned on by knob), each rebuilding its volumes (the depth alternates by 1 cm, beyond the
 // reuse tolerance): an object larger than the scene (the region, twice its size, holds the whole
 // real scene coarsely), an empty volume (one box 1 m above the floor, in view, with no real
