@@ -80,6 +80,28 @@ void VoxelVolume::add_clear(gpu::FrameGraph& graph) const {
       });
 }
 
+Status VoxelVolume::set_cells(gpu::FrameGraph& graph, uint32_t cells, const std::string& what) {
+  if (cells < 2 || cells > settings_.resolution || settings_.resolution % cells != 0)
+    return fail(ErrorKind::BadUsage, what + " '" + settings_.name + "': " + std::to_string(cells) +
+                                         " cells per side: must divide the allocated " +
+                                         std::to_string(settings_.resolution) + " and be at least 2");
+  return set_divisor(graph, settings_.resolution / cells);
+}
+
+void VoxelVolume::add_clear_if_resized(gpu::FrameGraph& graph) {
+  if (cleared_cells_ == cells()) return;
+  add_clear(graph);
+  cleared_cells_ = cells();
+  clear_pending_ = true;
+}
+
+void VoxelVolume::keep_cleared_margin(gpu::ShaderPassBuilder& b) {
+  if (!clear_pending_) return;
+  clear_pending_ = false;
+  if (levels_ > 1)
+    for (uint32_t i = 0; i < settings_.images; ++i) b.uses().read(images_[i], gpu::Access::StorageRead, 1, levels_ - 1);
+}
+
 void VoxelVolume::add_mip_chain(gpu::FrameGraph& graph) const {
   const uint32_t levels = used_levels();
   for (uint32_t m = 1; m < levels; ++m) {

@@ -45,8 +45,19 @@ class VoxelVolume {
   uint32_t image_count() const { return settings_.images; }
   const VolumeSettings& settings() const { return settings_; }
 
+  // set_divisor for `cells` per side (the voxel blocks' unit): BadUsage naming `what` unless it
+  // divides the allocated resolution and is at least 2.
+  Status set_cells(gpu::FrameGraph& graph, uint32_t cells, const std::string& what);
   // A transfer pass setting every image, every level, to zero.
   void add_clear(gpu::FrameGraph& graph) const;
+  // For a volume whose passes write only the used corner of each level (the voxel blocks'
+  // resolve and mip chain): add_clear() whenever the used size changed since the last one (a
+  // cone's trilinear read at the corner's edge reaches half a voxel past it, where a larger
+  // level's, or a former runtime's, values would otherwise still be). keep_cleared_margin() in
+  // the frame's first pass that writes the corner then declares that it reads the levels it writes
+  // in part, so the graph does not cull the clear as overwritten.
+  void add_clear_if_resized(gpu::FrameGraph& graph);
+  void keep_cleared_margin(gpu::ShaderPassBuilder& b);
   // Passes building levels 1..used_levels()-1 of every image from level 0 (a no-op without a chain).
   void add_mip_chain(gpu::FrameGraph& graph) const;
 
@@ -55,6 +66,8 @@ class VoxelVolume {
   VolumeSettings settings_;
   uint32_t levels_ = 1;
   uint32_t divisor_ = 1;
+  uint32_t cleared_cells_ = 0;  // the used size the images were last cleared for (0: never)
+  bool clear_pending_ = false;  // add_clear_if_resized cleared this frame, not yet kept
   std::array<gpu::ImageHandle, 4> images_{};
   gpu::PipelineHandle downsample_;
 };

@@ -52,8 +52,6 @@ class VoxelLight {
   VoxelLightSettings settings_;
   VoxelRegion region_;
   std::optional<VoxelVolume> volume_;
-  uint32_t cleared_cells_ = 0;  // the used size the images were last cleared for (0: never)
-  bool clear_pending_ = false;  // this frame recorded that clear (add_resolve keeps it)
   gpu::BufferHandle sums_;  // 3 floats a cell: flux rgb (W)
   gpu::PipelineHandle inject_[2], resolve_;  // inject_[1]: the delta pair
 };

@@ -57,22 +57,11 @@ Expected<Voxelizer> Voxelizer::create(gpu::FrameGraph& graph, const VoxelizeSett
 }
 
 Status Voxelizer::set_cells(gpu::FrameGraph& graph, uint32_t cells) {
-  if (cells < 2 || cells > settings_.resolution || settings_.resolution % cells != 0)
-    return fail(ErrorKind::BadUsage, "voxeliser '" + settings_.name + "': " + std::to_string(cells) +
-                                         " cells per side: must divide the allocated " +
-                                         std::to_string(settings_.resolution) + " and be at least 2");
-  return volume_->set_divisor(graph, settings_.resolution / cells);
+  return volume_->set_cells(graph, cells, "voxeliser");
 }
 
 void Voxelizer::add_clear(gpu::FrameGraph& graph) {
-  // The images once whenever the used size changes: resolve writes the used corner of each
-  // level every frame, and a cone's trilinear read at the corner's edge reaches half a voxel
-  // past it, where a larger level's (or a former runtime's) values would otherwise still be.
-  if (cleared_cells_ != cells()) {
-    volume_->add_clear(graph);
-    cleared_cells_ = cells();
-    clear_pending_ = true;
-  }
+  volume_->add_clear_if_resized(graph);  // resolve writes the used corner of each level
   const gpu::BufferHandle sums = sums_;
   const VkDeviceSize bytes = VkDeviceSize(cells()) * cells() * cells() * 4 * sizeof(float);
   graph.add_pass(
@@ -132,19 +121,15 @@ void Voxelizer::add_resolve(gpu::FrameGraph& graph) {
   const VoxelizeResolvePush push{glm::ivec4(int(n), 0, 0, 0)};
   graph.add_shader_pass(
       settings_.name + " resolve", gpu::PassKind::Compute, *pipe,
-      [sums, image, keep = clear_pending_, levels = volume_->allocated_levels()](gpu::ShaderPassBuilder& b) {
+      [this, sums, image](gpu::ShaderPassBuilder& b) {
         b.bind("cells", sums);
         b.bind("visibility", image, 0);
-        // The resolve and the mip chain write the used corner of each level: the clear of the
-        // whole image is read where they do not write, which the graph is told here (else it
-        // culls the clear as overwritten).
-        if (keep && levels > 1) b.uses().read(image, gpu::Access::StorageRead, 1, levels - 1);
+        volume_->keep_cleared_margin(b);
       },
       [pipe, push, n](VkCommandBuffer cmd, gpu::PassContext&) {
         gpu::push_and_dispatch(cmd, *pipe, &push, sizeof push, {(n + 3) / 4, (n + 3) / 4, (n + 3) / 4});
       });
   volume_->add_mip_chain(graph);
-  clear_pending_ = false;
 }
 
 }  // namespace mrgi::gi

@@ -91,8 +91,6 @@ class Voxelizer {
   VoxelizeSettings settings_;
   VoxelRegion region_;
   std::optional<VoxelVolume> volume_;
-  uint32_t cleared_cells_ = 0;  // the used size the images were last cleared for (0: never)
-  bool clear_pending_ = false;  // this frame recorded that clear (add_resolve keeps it)
   gpu::BufferHandle sums_;  // 4 floats a cell: normal x area (xyz), area (voxel^2)
   gpu::PipelineHandle mesh_, depth_, resolve_;
 };
