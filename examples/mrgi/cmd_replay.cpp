@@ -30,6 +30,10 @@ constexpr AblationName<DirAblation> kDirAblations[] = {{"one-shadow-map", &DirAb
                                                        {"one-bounce", &DirAblation::one_bounce},
                                                        {"no-environment-vpls", &DirAblation::no_environment_vpls},
                                                        {"no-temporal-smoothing", &DirAblation::no_temporal_smoothing}};
+constexpr AblationName<SpecularAblation> kSpecularAblations[] = {
+    {"off", &SpecularAblation::off},
+    {"no-back-projection", &SpecularAblation::no_back_projection},
+    {"no-depth-test", &SpecularAblation::no_depth_test}};
 
 template <typename A, size_t N>
 void set_ablations(const std::vector<std::string>& given, const AblationName<A> (&names)[N], A& out) {
@@ -50,6 +54,7 @@ struct ReplayOptions {
   QualityOptions quality;
   std::vector<std::string> dlpv_ablation;
   std::vector<std::string> dir_ablation;
+  std::vector<std::string> specular_ablation;
   int frames = 0, width = 0, height = 0, preload_frames = 0;
   bool validate = false, quiet = false, vulkan_1_2 = false, no_residual_light = false;
 };
@@ -79,6 +84,7 @@ void run_replay(const ReplayOptions& o) {
   set_ablations(o.dir_ablation, kDirAblations, settings.dir_ablation);
   if (settings.dir_ablation.any() && o.quality.technique != "dir")
     throw CommandFailure(2, "--dir-ablation: only for --technique dir");
+  set_ablations(o.specular_ablation, kSpecularAblations, settings.specular_ablation);
   CameraSetup cameras{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera};
   SceneDesc scene = capture.scene() ? *capture.scene() : SceneDesc{};
   // The env intensity stays known for the truth of the direction error (env frames).
@@ -291,6 +297,13 @@ void setup(CLI::App& app) {
                   "surfaces' VPLs only, not the virtual objects' own); comma-separated")
       ->delimiter(',')
       ->check(CLI::IsMember(ablation_names(kDlpvAblations)));
+  cmd->add_option("--specular-ablation", opts->specular_ablation,
+                  "mirrors and glass without one of the paper's ideas (mrgi/runtime.h SpecularAblation), any "
+                  "technique: off (shaded by the technique as any material), no-back-projection (real surfaces in "
+                  "a mirror or through glass show their rendered light, not the camera's colour), no-depth-test "
+                  "(the camera's colour is taken without the depth validity test); comma-separated")
+      ->delimiter(',')
+      ->check(CLI::IsMember(ablation_names(kSpecularAblations)));
   cmd->add_option("--dir-ablation", opts->dir_ablation,
                   "dir without one of the paper's ideas (mrgi/runtime.h DirAblation): one-shadow-map (one shadow map a "
                   "lamp and one ISM a VPL with the nearest caster and its kind, not one each), no-real-only-vpls (no ir(VPL): the real bounce "

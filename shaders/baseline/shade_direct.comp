@@ -85,54 +85,7 @@ layout(push_constant) uniform Level { LevelConstants level_block; VolumeConstant
 LevelConstants level;
 
 
-const float kNormalOffsetTexels = 1.5f;  // shadow lookup moved along the normal, in texels
-
-int cube_face(vec3 d) {
-  vec3 a = abs(d);
-  if (a.x >= a.y && a.x >= a.z) return d.x >= 0.0f ? 0 : 1;
-  if (a.y >= a.z) return d.y >= 0.0f ? 2 : 3;
-  return d.z >= 0.0f ? 4 : 5;
-}
-
-// Where p (moved along n by kNormalOffsetTexels) falls in lamp `light`'s maps: the map
-// coordinates in the used corner (xy), the depth (z) and the face (w; 0 unless a point lamp's
-// cube), or w = -1 outside the frustum (lit). Once a lamp for both of its maps: they share
-// the projection (the matrix is a per-pixel gather from the uniform buffer on lavapipe).
-vec4 shadow_coord(int light, ShadowLight L, vec3 p, vec3 n) {
-  int type = int(L.position_type.w);
-  int face = 0;
-  float texel_world;
-  if (type == MRGI_LIGHT_DIRECTIONAL) {
-    texel_world = L.cone.w / level.shadow.y;
-  } else {
-    vec3 d = p - L.position_type.xyz;
-    if (L.layers.z == 6) face = cube_face(d);
-    texel_world = L.cone.z * length(d) / level.shadow.y;
-  }
-  vec3 q = p + n * (kNormalOffsetTexels * texel_world);
-  vec4 clip = light_set.face_view_proj[light * 6 + face] * vec4(q, 1.0f);
-  if (!(clip.w > 0.0f)) return vec4(0.0f, 0.0f, 0.0f, -1.0f);
-  vec3 ndc = clip.xyz / clip.w;
-  if (any(greaterThan(abs(ndc.xy), vec2(1.0f))) || ndc.z > 1.0f || ndc.z < 0.0f) return vec4(0.0f, 0.0f, 0.0f, -1.0f);
-  return vec4((ndc.xy * 0.5f + 0.5f) * level.shadow.x, ndc.z, float(face));
-}
-
-// Fraction of the lamp seen through one map at c (shadow_coord; 1 lit, 0 shadowed), PCF over
-// (2r+1)^2 bilinear compare taps.
-float shadow_test(sampler2DArrayShadow map, int first_layer, vec4 c) {
-  if (c.w < 0.0f) return 1.0f;
-  float texel = 1.0f / level.shadow.z;
-  vec2 lo = vec2(0.5f * texel), hi = vec2(level.shadow.x - 0.5f * texel);
-  int r = int(level.shadow.w);
-  float sum = 0.0f;
-  for (int j = -r; j <= r; ++j) {
-    for (int i = -r; i <= r; ++i) {
-      vec2 t = clamp(c.xy + vec2(i, j) * texel, lo, hi);
-      sum += texture(map, vec4(t, float(first_layer) + c.w, c.z));
-    }
-  }
-  return sum / float((2 * r + 1) * (2 * r + 1));
-}
+#include "common/shadowed_lamps.glsl"
 
 void main() {
   frame = frame_ubo; level = level_block;  // MRGI_UNIFORM_COPIES
@@ -171,31 +124,7 @@ void main() {
   vec3 l_rv = (ambient_here ? alb.rgb * ambient_irradiance(ambient_rv, n) * (1.0f / MRGI_PI) : vec3(0.0f)) +
               (is_virtual && frame.flags.y != 0 ? imageLoad(virtual_emission, pixel).rgb : vec3(0.0f));
   vec3 l_r = r_p * alb.rgb * ambient_irradiance(ambient_r, n) * (1.0f / MRGI_PI);
-  int count = min(light_set.count.x, MRGI_MAX_LIGHTS);
-  for (int i = 0; i < count; ++i) {
-    ShadowLight L = light_set.lights[i];
-    vec3 wi;
-    vec3 irradiance_rgb = light_incident(L, p, wi);
-    float nl = dot(n, wi);
-    if (nl <= 0.0f || all(equal(irradiance_rgb, vec3(0.0f)))) continue;
-    vec3 lo = brdf(n, v, wi, alb.rgb, alb.a, roughness, is_virtual) * irradiance_rgb * nl;
-    vec4 at = shadow_coord(i, L, p, n);
-    float st_primary = shadow_test(shadow_primary, L.layers.x, at);
-    bool real_lamp = L.direction_real.w > 0.5f;
-    if (real_lamp) {
-      float st_v = L.layers.y >= 0 ? shadow_test(shadow_virtual, L.layers.y, at) : 1.0f;
-      if (kOneShadowMap && L.layers.y >= 0 && at.w >= 0.0f) {
-        bool real_nearer = textureLod(shadow_primary_depth, vec3(at.xy, float(L.layers.x) + at.w), 0.0f).r <=
-                           textureLod(shadow_virtual_depth, vec3(at.xy, float(L.layers.y) + at.w), 0.0f).r;
-        st_primary = real_nearer ? st_primary : 1.0f;  // the real caster behind is lost
-        st_v = real_nearer ? 1.0f : st_v;
-      }
-      l_rv += lo * min(st_primary, st_v);   // eq. 1, 3
-      l_r += lo * r_p * st_primary;          // eq. 2
-    } else {
-      l_rv += lo * st_primary;               // the virtual lamp's map holds every caster
-    }
-  }
+  add_shadowed_lamps(p, n, v, alb.rgb, alb.a, roughness, is_virtual, r_p, level.shadow, kOneShadowMap, l_rv, l_r);
   if (kVolumeBounce != 0) {
     if (is_virtual) {
       if (kRhoOnVirtual && volume.extent.w > 0.5f)

@@ -23,7 +23,10 @@ layout(location = 6) flat in vec4 in_emission;
 layout(location = 7) flat in vec4 in_k;
 layout(location = 8) flat in vec4 in_camera;    // xyz camera centre (world), w behind-real tolerance
 layout(location = 9) flat in mat3x4 in_to_camera;
-layout(location = 0) out vec4 out_position;  // xyz world, w = 1 (virtual coverage mask)
+layout(location = 12) flat in float in_coverage;  // 1, or 2 + material of a specular one
+layout(location = 0) out vec4 out_position;  // xyz world, w coverage: 1, or 2 + the material index
+                                             // of a reflective or refractive material (readers
+                                             // test w > 0.5 for virtual, w > 1.5 for specular)
 layout(location = 1) out vec4 out_normal;    // xyz unit, w roughness
 layout(location = 2) out vec4 out_albedo;    // rgb linear base colour, w metallic
 layout(location = 3) out vec4 out_emission;  // rgb emitted radiance (glTF emissive), w 0
@@ -54,7 +57,7 @@ void main() {
   // A double-sided material seen from behind (single-sided ones are culled), or a flipped
   // normal: shade the side the camera sees.
   if (dot(n, in_camera.xyz - in_world) < 0.0f) n = -n;
-  out_position = vec4(in_world, 1.0f);
+  out_position = vec4(in_world, in_coverage);
   out_normal = vec4(n, clamp(in_material.y, 0.02f, 1.0f));
   out_albedo = vec4(clamp(base.rgb, vec3(0.0f), vec3(1.0f)), clamp(in_material.x, 0.0f, 1.0f));
   // Half floats end at 65504 (a material's emission is finite and non-negative on upload).

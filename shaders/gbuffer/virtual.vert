@@ -27,6 +27,9 @@ layout(location = 6) flat out vec4 out_emission;
 layout(location = 7) flat out vec4 out_k;           // frame.internal_k
 layout(location = 8) flat out vec4 out_camera;      // xyz frame.camera_world, w frame.camera.z
 layout(location = 9) flat out mat3x4 out_to_camera; // rows of frame.world_to_camera (x, y, z)
+// The position's w (virtual.frag): 1, or 2 + the material's index for a reflective or refractive
+// one (shared/specular_math.h specular_kind), which the specular stage reads its material from.
+layout(location = 12) flat out float out_coverage;
 
 void main() {
   out_world = in_position;
@@ -38,6 +41,7 @@ void main() {
   out_base_color = m.base_color_factor;
   out_material = vec4(m.params.xyz, float(max(draw.real_step, 1)));
   out_emission = m.emission;
+  out_coverage = m.specular.x != 0.0f ? 2.0f + float(max(draw.material, 0)) : 1.0f;
   out_k = frame.internal_k;
   out_camera = vec4(frame.camera_world.xyz, frame.camera.z);
   out_to_camera = transpose(mat4x3(frame.world_to_camera));

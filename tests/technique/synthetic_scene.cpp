@@ -15,7 +15,7 @@ namespace {
 
 // Unit cube x, z in [-0.5, 0.5], y in [0, 1] (resting on y = 0), 24 vertices with face normals.
 void write_cube_gltf(const std::string& folder, const glm::vec3& base, const glm::vec3& emission, float metallic,
-                     float roughness) {
+                     float roughness, float transmission) {
   std::vector<float> pos, nrm;
   std::vector<uint16_t> idx;
   const glm::vec3 normals[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
@@ -32,6 +32,8 @@ void write_cube_gltf(const std::string& folder, const glm::vec3& base, const glm
     idx.insert(idx.end(), {first, uint16_t(first + 1), uint16_t(first + 2), first,
                            uint16_t(first + 2), uint16_t(first + 3)});
   }
+  nlohmann::json extensions = nlohmann::json::object();
+  if (transmission > 0.0f) extensions["KHR_materials_transmission"] = {{"transmissionFactor", transmission}};
   std::ofstream bin(folder + "/cube.bin", std::ios::binary);
   bin.write(reinterpret_cast<const char*>(pos.data()), std::streamsize(pos.size() * 4));
   bin.write(reinterpret_cast<const char*>(nrm.data()), std::streamsize(nrm.size() * 4));
@@ -48,7 +50,8 @@ void write_cube_gltf(const std::string& folder, const glm::vec3& base, const glm
       {"materials", {{{"pbrMetallicRoughness", {{"baseColorFactor", {base.x, base.y, base.z, 1.0}},
                                                 {"metallicFactor", metallic},
                                                 {"roughnessFactor", roughness}}},
-                      {"emissiveFactor", {emission.x, emission.y, emission.z}}}}},
+                      {"emissiveFactor", {emission.x, emission.y, emission.z}},
+                      {"extensions", extensions}}}},
       {"buffers", {{{"uri", "cube.bin"}, {"byteLength", 2 * pbytes + ibytes}}}},
       {"bufferViews", {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", pbytes}},
                        {{"buffer", 0}, {"byteOffset", pbytes}, {"byteLength", pbytes}},
@@ -91,7 +94,7 @@ glm::vec3 Box::normal_at(const glm::vec3& q) const {
 }
 
 SyntheticScene SyntheticScene::create(const std::string& folder, const glm::vec3& emission,
-                                      const glm::vec3& base, float metallic, float roughness) {
+                                      const glm::vec3& base, float metallic, float roughness, float transmission) {
   SyntheticScene s;
   s.intrinsics.width = 64;
   s.intrinsics.height = 48;
@@ -105,7 +108,7 @@ SyntheticScene SyntheticScene::create(const std::string& folder, const glm::vec3
   s.real_box = {{-0.2f, 0.0f, 0.4f}, {0.2f, 0.4f, 0.8f}};
 
   s.virtual_base = base;
-  write_cube_gltf(folder, s.virtual_base, emission, metallic, roughness);
+  write_cube_gltf(folder, s.virtual_base, emission, metallic, roughness, transmission);
   // C1: a virtual box whose shadow falls on open floor; C2: a thin virtual plate floating above
   // the real box, whose shadow covers part of the real box's own shadow (DIR Fig. 5).
   const Placement places[2] = {

@@ -49,10 +49,11 @@ struct SyntheticScene {
   // Writes the glTF cube and the environment image into `folder`.
   // `emission`: the cubes' glTF emissiveFactor (radiance; 0 = none).
   // `base`: the cubes' glTF baseColorFactor (black: they only block light); `metallic`,
-  // `roughness`: their glTF factors (the default is diffuse).
+  // `roughness`: their glTF factors (the default is diffuse); `transmission`: their
+  // KHR_materials_transmission factor (> 0: glass).
   static SyntheticScene create(const std::string& folder, const glm::vec3& emission = glm::vec3(0.0f),
                                const glm::vec3& base = glm::vec3(0.8f, 0.2f, 0.2f), float metallic = 0.0f,
-                               float roughness = 1.0f);
+                               float roughness = 1.0f, float transmission = 0.0f);
   CameraSetup cameras() const;
 
   // First surface a camera ray through pixel (u, v) hits; `with_virtual` includes the virtual boxes.

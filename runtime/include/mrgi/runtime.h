@@ -94,6 +94,21 @@ struct DirAblation {
   }
 };
 
+// Reflective and refractive virtual objects (Knecht et al. 2013) without one of the paper's
+// ideas, for ablation images; every technique (the specular stage runs after any of them).
+struct SpecularAblation {
+  // Off: mirrors and glass are shaded by the technique like any material (its diffuse and
+  // glossy light), as before the stage existed.
+  bool off = false;
+  // No back-projection (Sec. 4.1.2): every real surface seen in a mirror or through glass shows
+  // its rendered light, not the camera's colour.
+  bool no_back_projection = false;
+  // No depth validity test (Sec. 4.1.3): a back-projected hit takes the camera's colour even
+  // where the camera sees another surface there.
+  bool no_depth_test = false;
+  bool any() const { return off || no_back_projection || no_depth_test; }
+};
+
 // The frame-budget scheduler's constants (scheduler/scheduler.h says how it decides). The
 // defaults are the anchors' where they give one (Filament's dynamic resolution controller,
 // Unreal's dynamic resolution and scalability), measured on the load test otherwise
@@ -198,6 +213,7 @@ struct RuntimeSettings {
   bool compose_tiles = true;
   DlpvAblation dlpv_ablation;  // the `dlpv` technique only; defaults: the paper's method
   DirAblation dir_ablation;    // the `dir` technique only; defaults: the paper's method
+  SpecularAblation specular_ablation;  // every technique; defaults: the paper's method
   // Profiling mode (also Runtime::set_profiling): each pass of a frame submitted on its own and
   // waited for, timed by the host clock, so FrameStats::passes add up to the frame. Frames then
   // do not overlap: use it to see where the time goes (bench, scheduler cost model), not to run.

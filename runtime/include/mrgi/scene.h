@@ -126,7 +126,12 @@ struct Material {
   float metallic = 1.0f;         // glTF defaults
   float roughness = 1.0f;
   float transmission = 0.0f;     // KHR_materials_transmission
-  float ior = 1.5f;              // KHR_materials_ior
+  float ior = 1.5f;              // KHR_materials_ior, [1, 4]
+  // KHR_materials_volume: light inside a transmissive material keeps attenuation_color after
+  // attenuation_distance metres (Beer's law); distance 0 = no absorption (the extension's
+  // infinite default).
+  glm::vec3 attenuation_color{1.0f};
+  float attenuation_distance = 0.0f;
   glm::vec3 emissive{0.0f};      // emitted radiance: emissiveFactor x KHR_materials_emissive_strength
   int emissive_texture = -1;     // index into Model::textures (sRGB, multiplies `emissive`), -1 = none
   bool double_sided = false;

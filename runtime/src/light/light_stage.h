@@ -181,6 +181,13 @@ class LightStage {
   // environment.real.
   const std::vector<EnvLight>& environment_regions() const;
   bool environment_real() const { return scene_.environment.real; }
+  // This frame's filtered environment grid (EnvSampler: world-space equirectangular radiance),
+  // nullptr without an environment image or before its first one; for what sees the
+  // environment itself (mirrors and glass, specular/). Its width is environment_grid_width().
+  const EnvSampler* environment_grid() const {
+    return lighting_.environment && env_ && env_->valid() ? &*env_ : nullptr;
+  }
+  int environment_grid_width() const { return settings_.environment.grid_width; }
   const LightEstimator& estimator() const { return *estimator_; }
   // The largest number of shadowed lights any frame can have (for shadow map allocation).
   int max_lights() const { return max_lights_; }

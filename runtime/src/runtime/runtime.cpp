@@ -25,6 +25,7 @@
 #include "runtime/influence.h"
 #include "technique/scene_gpu.h"
 #include "technique/technique.h"
+#include "specular/specular.h"
 
 namespace mrgi {
 namespace {
@@ -139,6 +140,9 @@ class RuntimeImpl final : public Runtime {
   gpu::BufferHandle frame_constants_;
   gpu::ImageHandle lit_rv_, lit_r_;
   std::unique_ptr<technique::Technique> technique_;
+  // Mirrors and glass (specular/specular.h); null when no virtual material is specular.
+  std::unique_ptr<specular::SpecularStage> specular_;
+  shader::FrameConstants constants_{};  // this frame's, as write_constants wrote them
   std::optional<compose::Compose> compose_;
   std::vector<SlotRecord> slots_;
   std::vector<FrameOutput> spare_outputs_;  // recycle(): images and masks to fill again
@@ -165,6 +169,7 @@ class RuntimeImpl final : public Runtime {
 RuntimeImpl::~RuntimeImpl() {
   if (context_ && context_->device() != VK_NULL_HANDLE) vkDeviceWaitIdle(context_->device());
   compose_.reset();
+  specular_.reset();
   technique_.reset();
   light_stage_.reset();
   virtual_gbuffer_.reset();
@@ -328,7 +333,9 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   shared.lit_rv = lit_rv_;
   shared.lit_r = lit_r_;
   shared.compose_honours_tiles = true;  // record(): compose uses Technique::compose_tiles()
-  if (settings.fuse_compose && compose_->fusable()) {
+  // A technique that composes its own tiles would do so before the specular stage writes the
+  // mirrors' and glass's pixels: with a specular material in the scene the runtime composes.
+  if (settings.fuse_compose && compose_->fusable() && !(scene_gpu_->specular && !settings.specular_ablation.off)) {
     shared.composed_output = compose_->output();
   }
   shared.compose_eps = compose_->settings().eps;
@@ -342,6 +349,14 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   auto tech = (*entry)->create(shared);
   if (!tech) return tech.error();
   technique_ = std::move(*tech);
+  if (!settings.specular_ablation.off) {
+    specular::SpecularSettings ss;
+    ss.back_projection = !settings.specular_ablation.no_back_projection;
+    ss.depth_test = !settings.specular_ablation.no_depth_test;
+    auto spec = specular::SpecularStage::create(shared, ss);
+    if (!spec) return spec.error();
+    specular_ = std::move(*spec);
+  }
 
   slots_.resize(size_t(settings.frames_in_flight));
   for (SlotRecord& s : slots_) {
@@ -405,6 +420,7 @@ void RuntimeImpl::write_constants(const glm::dmat4& camera_to_world) {
   f.flags = glm::ivec4(same_intrinsics(cameras_.color, cameras_.depth) ? 1 : 0,
                        virtual_gbuffer_->emission().valid() ? 1 : 0, 0, 0);
   *fc = f;
+  constants_ = f;
 }
 
 Expected<SlotRecord*> RuntimeImpl::begin_slot(const InputFrame& frame,
@@ -604,6 +620,7 @@ Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, 
                              own ? *own : technique::RealGeometry{recon_->position(), recon_->position(), 1},
                              level.mesh_error_px);
     MRGI_TRY(technique_->record(info, rec.skipped));
+    if (specular_) MRGI_TRY(specular_->record(constants_, *technique_, level_, rec.skipped));
   } else {
     rec.skipped.push_back(has_objects ? "technique: no virtual object or its shadow in view"
                                       : "technique: no virtual object and no virtual lamp in the scene");

@@ -242,6 +242,17 @@ double extension_number(const tinygltf::ExtensionMap& ext, const char* name, con
   return v.IsNumber() ? v.GetNumberAsDouble() : fallback;
 }
 
+// Element `index` of a numeric array in an extension, or `fallback`.
+double extension_number_at(const tinygltf::ExtensionMap& ext, const char* name, const char* key, int index,
+                           double fallback) {
+  auto it = ext.find(name);
+  if (it == ext.end() || !it->second.Has(key)) return fallback;
+  const auto& v = it->second.Get(key);
+  if (!v.IsArray() || index >= int(v.ArrayLen())) return fallback;
+  const auto& e = v.Get(index);
+  return e.IsNumber() ? e.GetNumberAsDouble() : fallback;
+}
+
 Status convert_materials(LoadContext& ctx) {
   for (size_t i = 0; i < ctx.gltf.materials.size(); ++i) {
     const auto& g = ctx.gltf.materials[i];
@@ -264,6 +275,23 @@ Status convert_materials(LoadContext& ctx) {
     mat.double_sided = g.doubleSided;
     mat.transmission = float(extension_number(g.extensions, "KHR_materials_transmission", "transmissionFactor", 0.0));
     mat.ior = float(extension_number(g.extensions, "KHR_materials_ior", "ior", 1.5));
+    for (int c = 0; c < 3; ++c)
+      mat.attenuation_color[c] = float(extension_number_at(g.extensions, "KHR_materials_volume", "attenuationColor", c, 1.0));
+    mat.attenuation_distance =
+        float(extension_number(g.extensions, "KHR_materials_volume", "attenuationDistance", 0.0));
+    const std::string label = "material " + std::to_string(i) + (g.name.empty() ? "" : " '" + g.name + "'");
+    if (!(mat.transmission >= 0.0f && mat.transmission <= 1.0f))
+      return fail(ErrorKind::BadInput, ctx.path + ": " + label +
+                                           ": KHR_materials_transmission.transmissionFactor must be in [0, 1]");
+    if (!(mat.ior >= 1.0f && mat.ior <= 4.0f))
+      return fail(ErrorKind::BadInput, ctx.path + ": " + label + ": KHR_materials_ior.ior must be in [1, 4]");
+    if (!(mat.attenuation_distance >= 0.0f) || !std::isfinite(mat.attenuation_distance))
+      return fail(ErrorKind::BadInput, ctx.path + ": " + label +
+                                           ": KHR_materials_volume.attenuationDistance must be a positive number");
+    for (int c = 0; c < 3; ++c)
+      if (!(mat.attenuation_color[c] >= 0.0f && mat.attenuation_color[c] <= 1.0f))
+        return fail(ErrorKind::BadInput, ctx.path + ": " + label +
+                                             ": KHR_materials_volume.attenuationColor must be in [0, 1]");
     ctx.out->materials.push_back(mat);
   }
   return ok_status();

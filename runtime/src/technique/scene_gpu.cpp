@@ -11,6 +11,7 @@
 #include <stb/stb_image_resize.h>
 
 #include "common/scene_materials.glsl"
+#include "shared/specular_math.h"
 #include "gpu/vk_check.h"
 
 namespace mrgi::technique {
@@ -180,7 +181,9 @@ Expected<std::unique_ptr<SceneGpu>> SceneGpu::create(gpu::Context& context, gpu:
     models.push_back(std::move(*model));
   }
   // Material 0 is the glTF default material (white, metallic 1, roughness 1 per the spec).
-  materials.push_back({glm::vec4(1.0f), glm::vec4(1.0f, 1.0f, -1.0f, 0.0f), glm::vec4(0.0f)});
+  materials.push_back({glm::vec4(1.0f), glm::vec4(1.0f, 1.0f, -1.0f, 0.0f), glm::vec4(0.0f),
+                       glm::vec4(0.0f, 1.5f, 0.0f, 0.0f), glm::vec4(1.0f)});
+  out->material_specular_kind.push_back(0);
   for (const Model& m : models) {
     const int material_base = int(materials.size());
     const int texture_base = int(textures.size());
@@ -193,9 +196,14 @@ Expected<std::unique_ptr<SceneGpu>> SceneGpu::create(gpu::Context& context, gpu:
                                            mat.emissive_texture < int(m.textures.size())
                                        ? float(texture_base + mat.emissive_texture)
                                        : -1.0f;
+      const int kind = shader::specular_kind(mat.metallic, mat.roughness, mat.transmission);
       materials.push_back({mat.base_color_factor,
                            glm::vec4(mat.metallic, mat.roughness, layer, 0.0f),
-                           glm::vec4(glm::max(mat.emissive, glm::vec3(0.0f)), emissive_layer)});
+                           glm::vec4(glm::max(mat.emissive, glm::vec3(0.0f)), emissive_layer),
+                           glm::vec4(float(kind), mat.ior, mat.attenuation_distance, mat.transmission),
+                           glm::vec4(mat.attenuation_color, 0.0f)});
+      out->specular = out->specular || kind != shader::SPECULAR_NONE;
+      out->material_specular_kind.push_back(kind);
       const glm::vec3 e = materials.back().emission;
       out->emissive = out->emissive || e.x > 0.0f || e.y > 0.0f || e.z > 0.0f;
       out->glossy = out->glossy || mat.metallic > kGlossyMetallic || mat.roughness < kGlossyRoughness;
@@ -379,6 +387,17 @@ void SceneGpu::commit(gpu::FrameGraph& graph) {
 
 SceneGpu::~SceneGpu() {
   context_.destroy(texture_array_);
+}
+
+int SceneGpu::object_specular_kinds(size_t object) const {
+  int kinds = 0;
+  const ObjectSpan& o = objects_[object];
+  for (size_t d = o.first_draw; d < o.first_draw + o.draw_count; ++d) {
+    const int m = virtual_objects.draws[d].material;
+    const int kind = m >= 0 && size_t(m) < material_specular_kind.size() ? material_specular_kind[size_t(m)] : 0;
+    if (kind != 0) kinds |= 1 << kind;
+  }
+  return kinds;
 }
 
 }  // namespace mrgi::technique

@@ -121,6 +121,16 @@ class SceneGpu {
   bool glossy = false;
   static constexpr float kGlossyMetallic = 0.1f, kGlossyRoughness = 0.7f;
   gpu::ImageHandle base_color_maps;   // R8G8B8A8_SRGB array (at least one white layer)
+  // Per material (the index DrawRange::material holds): shared/specular_math.h specular_kind.
+  std::vector<int> material_specular_kind;
+  bool specular = false;  // some virtual material reflects or refracts (specular_kind)
+  // Object i's ranges in virtual_objects.draws: [first, first + count).
+  struct DrawSpan {
+    size_t first = 0, count = 0;
+  };
+  DrawSpan object_draws(size_t object) const { return {objects_[object].first_draw, objects_[object].draw_count}; }
+  // Whether one of object i's ranges has a specular material, and of which kinds (bit 1 << kind).
+  int object_specular_kinds(size_t object) const;
 
  private:
   explicit SceneGpu(gpu::Context& context) : context_(context) {}

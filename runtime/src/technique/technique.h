@@ -185,6 +185,17 @@ class Technique {
     bool composed = false;
   };
   virtual ComposeTiles compose_tiles() const { return {}; }
+  // After record(): the direct light this frame's shading applied with shadow maps, for a stage
+  // that lights points of its own the same way (specular/: what mirrors and glass show): the
+  // light set (shaders/common/light_set.glsl, its layers index the maps) and baseline's map pair
+  // (sampler2DArrayShadow), `shadow` as shade_direct.comp's LevelConstants::shadow. nullopt: this
+  // frame's shading drew no shadow maps (the stage then lights its points unshadowed).
+  struct DirectLight {
+    gpu::BufferHandle light_set;
+    gpu::ImageHandle shadow_primary, shadow_virtual;
+    glm::vec4 shadow{0.0f};
+  };
+  virtual std::optional<DirectLight> direct_light() const { return std::nullopt; }
 };
 
 using TechniqueFactory = Expected<std::unique_ptr<Technique>> (*)(const SharedResources&);

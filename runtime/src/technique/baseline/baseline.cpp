@@ -77,11 +77,19 @@ class Baseline final : public Technique {
   Status record(const FrameInfo& info, std::vector<std::string>& skipped) override;
   void set_volume_bounce(const VolumeBounce* bounce) { bounce_ = bounce ? std::optional<VolumeBounce>(*bounce) : std::nullopt; }
   void set_dir_indirect(const DirIndirect* indirect) { dir_ = indirect ? std::optional<DirIndirect>(*indirect) : std::nullopt; }
+  std::optional<DirectLight> direct_light() const override {
+    return DirectLight{lights_, shadow_primary_, shadow_virtual_, shadow_constants()};
+  }
 
  private:
   void render_faces(VkCommandBuffer cmd, gpu::PassContext& pass, const std::vector<ShadowFace>& faces,
                     const std::vector<VkImageView>& layer_views);
   void shade(VkCommandBuffer cmd, gpu::PassContext& pass);
+  // shade_direct.comp's LevelConstants::shadow at this frame's level.
+  glm::vec4 shadow_constants() const {
+    return glm::vec4(float(shadow_size_) / float(kTopShadowSize), float(shadow_size_), float(kTopShadowSize),
+                     float(pcf_radius_));
+  }
 
   std::string name_ = "baseline";
   SharedResources shared_;
@@ -459,8 +467,7 @@ void Baseline::render_faces(VkCommandBuffer cmd, gpu::PassContext& pass,
 void Baseline::shade(VkCommandBuffer cmd, gpu::PassContext& pass) {
   const SharedResources& r = shared_;
   ShadePush pc{};
-  pc.shadow = glm::vec4(float(shadow_size_) / float(kTopShadowSize), float(shadow_size_),
-                        float(kTopShadowSize), float(pcf_radius_));
+  pc.shadow = shadow_constants();
   if (bounce_) pc.volume = bounce_->constants;
   if (dir_) pc.volume.mode.y = dir_->divisor;
   const VkExtent2D e = pass.extent(r.lit_rv);

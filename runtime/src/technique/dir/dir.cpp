@@ -138,6 +138,14 @@ class Dir final : public Technique {
     uint32_t width = 0, height = 0;  // the smoothed light's size
   } history_;
   std::unique_ptr<Technique> baseline_;
+  bool baseline_recorded_ = false;  // this frame's record() recorded baseline's passes
+  Status record_baseline(const FrameInfo& base, std::vector<std::string>& skipped) {
+    baseline_recorded_ = true;
+    return baseline_->record(base, skipped);
+  }
+  std::optional<DirectLight> direct_light() const override {
+    return baseline_recorded_ ? baseline_->direct_light() : std::nullopt;
+  }
   bool glossy_ = false;  // glossy VPLs: the scene has a glossy virtual material (SceneGpu::glossy)
   // This frame's lamps with VPLs (light index, view); reserved at init (no allocation per frame).
   std::vector<std::pair<size_t, gi::RsmView>> planned_;
@@ -263,6 +271,7 @@ Status Dir::init() {
 }
 
 Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
+  baseline_recorded_ = false;
   if (info.level < 0 || info.level >= int(levels_.size()))
     return fail(ErrorKind::BadUsage, "dir: level " + std::to_string(info.level) + " outside 0.." +
                                          std::to_string(levels_.size() - 1));
@@ -280,7 +289,7 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     reuse_.forget();
     made_.valid = false;
     history_.valid = false;
-    return baseline_->record(base, skipped);
+    return record_baseline(base, skipped);
   }
   // The maps follow the objects (their side, radius_, is fixed at start-up: rigid motion keeps it).
   centre_ = 0.5f * (shared_.scene_gpu->virtual_objects.bounds_max + shared_.scene_gpu->virtual_objects.bounds_min);
@@ -297,7 +306,7 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     reuse_.forget();
     made_.valid = false;
     history_.valid = false;
-    return baseline_->record(base, skipped);
+    return record_baseline(base, skipped);
   }
   // The VPLs and ISMs in the buffers stand for this frame's while its inputs stay within
   // tolerance of the frame that made them (technique/input_reuse.h): no map, VPL or ISM pass.
@@ -489,7 +498,7 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     to_add.merged = smoothed_[write];
   }
   set_dir_indirect(*baseline_, &to_add);
-  return baseline_->record(base, skipped);
+  return record_baseline(base, skipped);
 }
 
 }  // namespace

@@ -86,6 +86,14 @@ class Dlpv final : public Technique {
   std::optional<gi::LightPropagationVolume> mu_;  // DlpvAblation::two_volumes only
   gpu::PipelineHandle merge_;
   std::unique_ptr<Technique> baseline_;  // direct light with shadow maps (not antiradiance levels)
+  bool baseline_recorded_ = false;  // this frame's record() recorded baseline's passes
+  Status record_baseline(const FrameInfo& base, std::vector<std::string>& skipped) {
+    baseline_recorded_ = true;
+    return baseline_->record(base, skipped);
+  }
+  std::optional<DirectLight> direct_light() const override {
+    return baseline_recorded_ ? baseline_->direct_light() : std::nullopt;
+  }
   InputReuse reuse_;                    // what the volumes in the images were made from
   bool source_delta_ = false, source_rho_ = false;  // which volumes that frame made
   bool has_virtual_ = false;
@@ -161,6 +169,7 @@ void Dlpv::write_lights() {
 }
 
 Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
+  baseline_recorded_ = false;
   if (info.level < 0 || info.level >= int(levels_.size()))
     return fail(ErrorKind::BadUsage, "dlpv: level " + std::to_string(info.level) + " outside 0.." +
                                          std::to_string(levels_.size() - 1));
@@ -296,7 +305,7 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
                          two ? mu_->accumulated(2) : dvol[2]},
                         {push.grid, push.extent, glm::ivec4(two ? 1 : 0, 0, 0, 0)}};
     set_volume_bounce(*baseline_, bounce_present ? &bounce : nullptr);
-    return baseline_->record(base, skipped);
+    return record_baseline(base, skipped);
   }
   graph.add_shader_pass(
       "dlpv merge", gpu::PassKind::Compute, *merge_,

@@ -107,6 +107,14 @@ class Dvct final : public Technique {
   std::map<Variant, gpu::PipelineHandle> indirect_, shade_;
   gpu::ImageHandle indirect_image_;  // RGBA32UI, dir/indirect_pack.glsl
   std::unique_ptr<Technique> baseline_;
+  bool baseline_recorded_ = false;  // this frame's record() recorded baseline's passes
+  Status record_baseline(const FrameInfo& base, std::vector<std::string>& skipped) {
+    baseline_recorded_ = true;
+    return baseline_->record(base, skipped);
+  }
+  std::optional<DirectLight> direct_light() const override {
+    return baseline_recorded_ ? baseline_->direct_light() : std::nullopt;
+  }
   InputReuse reuse_;
   struct ObjectSource {
     bool valid = false;
@@ -374,6 +382,7 @@ void Dvct::add_cone_pass(const DvctLevel& level, const shader::DvctParams& param
 }
 
 Status Dvct::record(const FrameInfo& info, std::vector<std::string>& skipped) {
+  baseline_recorded_ = false;
   if (info.level < 0 || info.level >= int(levels_.size()))
     return fail(ErrorKind::BadUsage, "dvct: level " + std::to_string(info.level) + " outside 0.." +
                                          std::to_string(levels_.size() - 1));
@@ -417,14 +426,14 @@ Status Dvct::record(const FrameInfo& info, std::vector<std::string>& skipped) {
   base.level = level.baseline_level;
   if (!volumes) {
     set_dir_indirect(*baseline_, nullptr);
-    return baseline_->record(base, skipped);
+    return record_baseline(base, skipped);
   }
   add_cone_pass(level, params, specular);
   DirIndirect add;
   add.merged = indirect_image_;
   add.divisor = int(std::max(1u, level.trace_divisor));
   set_dir_indirect(*baseline_, &add);
-  return baseline_->record(base, skipped);
+  return record_baseline(base, skipped);
 }
 
 }  // namespace

@@ -1,0 +1,596 @@
+#include "specular/specular.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "common/light_set.glsl"
+#include "gpu/shaders.h"
+#include "light/env_sampler.h"
+#include "light/light_stage.h"
+#include "shared/specular_math.h"
+#include "specular/specular_params.glsl"
+#include "technique/light_set_writer.h"
+#include "technique/scene_gpu.h"
+#include "technique/screen_bounds.h"
+
+namespace mrgi::specular {
+namespace {
+
+constexpr VkFormat kPositionFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+constexpr VkFormat kImpostorNormalFormat = VK_FORMAT_R8G8B8A8_SNORM;
+constexpr VkFormat kImpostorAlbedoFormat = VK_FORMAT_R8G8B8A8_UNORM;
+constexpr VkFormat kBackNormalFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
+// What the impostors see: nearer than this is inside the object, farther is environment.
+constexpr float kImpostorNear_m = 0.01f, kImpostorFar_m = 50.0f;
+
+// gi/rsm_grid.vert and gi/rsm_mesh.vert's push block (gi/rsm.cpp RsmPush).
+struct DrawPush {
+  glm::mat4 view_proj;
+  glm::vec4 light;
+  glm::vec4 colour;
+  glm::vec4 axis;
+  glm::ivec4 misc;
+};
+static_assert(sizeof(DrawPush) == 128, "the guaranteed push-constant size");
+
+// Face f of a cube around `centre`: Vulkan clip coordinates whose x / w and y / w are
+// shared/specular_math.h's face coordinates (dot(d, right) / dot(d, forward), the same with down).
+glm::mat4 face_view_proj(const glm::vec3& centre, int face) {
+  const glm::vec3 r = shader::specular_face_right(face), d = shader::specular_face_down(face),
+                  f = shader::specular_face_forward(face);
+  const float n = kImpostorNear_m, far = kImpostorFar_m;
+  const float a = far / (far - n), b = -far * n / (far - n);
+  // Rows: x = r . (p - c), y = d . (p - c), z = a (f . (p - c)) + b, w = f . (p - c).
+  glm::mat4 m(0.0f);
+  for (int c = 0; c < 3; ++c) {
+    m[c][0] = r[c];
+    m[c][1] = d[c];
+    m[c][2] = a * f[c];
+    m[c][3] = f[c];
+  }
+  m[3][0] = -glm::dot(r, centre);
+  m[3][1] = -glm::dot(d, centre);
+  m[3][2] = -a * glm::dot(f, centre) + b;
+  m[3][3] = -glm::dot(f, centre);
+  return m;
+}
+
+struct ObjectInView {
+  size_t object = 0;
+  glm::vec3 lo{0.0f}, hi{0.0f};
+  float distance = 0.0f;
+  bool refractive = false;
+};
+
+struct ImpostorSet {
+  glm::vec3 centre{0.0f};
+  float radius = 0.0f;
+  std::vector<size_t> objects;  // not drawn into their own set
+};
+
+}  // namespace
+
+const std::array<SpecularLevel, 3>& specular_levels() {
+  static const std::array<SpecularLevel, 3> levels = {{
+      {"paper", 512, 4, 24, 4, 16},
+      {"high", 256, 2, 16, 3, 12},
+      {"fast", 128, 1, 10, 2, 8},
+  }};
+  return levels;
+}
+
+const SpecularLevel& specular_level_for(int technique_level, int technique_levels) {
+  const auto& l = specular_levels();
+  if (technique_level <= 0) return l[0];
+  if (technique_level >= technique_levels - 2) return l[2];
+  return l[1];
+}
+
+struct SpecularStage::Impl {
+  technique::SharedResources shared;
+  SpecularSettings settings;
+  gpu::ImageHandle impostor_position, impostor_normal, impostor_albedo, impostor_depth;
+  gpu::ImageHandle back_position, back_normal, back_depth;
+  gpu::ImageHandle no_shadow;
+  gpu::BufferHandle grid_indices, constants, own_lights;
+  gpu::BufferHandle env_grid;  // the light stage's environment grid, copied each frame
+  int env_width = 0;           // its width in cells
+  gpu::PipelineHandle indices_pipeline, grid_pipeline, mesh_pipeline, back_pipeline, trace_pipeline;
+  VkExtent2D grid_points{0, 0};
+  uint32_t grid_stride = 1;
+  glm::mat4 world_to_clip{1.0f};  // this frame's camera (the back faces' draw)
+
+  Status init();
+  void add_grid(gpu::FrameGraph& graph, uint32_t face);
+  void add_impostors(gpu::FrameGraph& graph, const ImpostorSet& set, const glm::ivec2& origin, uint32_t face,
+                     bool first, const std::string& label);
+  void add_back_faces(gpu::FrameGraph& graph, const std::vector<ObjectInView>& objects);
+};
+
+Status SpecularStage::Impl::init() {
+  gpu::FrameGraph& graph = *shared.graph;
+  const gpu::Context& ctx = *shared.context;
+  const uint32_t face = settings.max_impostor_face;
+  const int sets = std::clamp(settings.max_sets, 1, MRGI_SPECULAR_MAX_SETS);
+  settings.max_sets = sets;
+  const VkImageUsageFlags colour = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_STORAGE_BIT;
+  auto atlas = [&](const char* name, VkFormat f, VkImageUsageFlags usage) -> Expected<gpu::ImageHandle> {
+    gpu::ImageDesc d;
+    d.name = name;
+    d.format = f;
+    d.size_mode = gpu::SizeMode::Absolute;
+    d.width = 3 * face;
+    d.height = 2 * face * uint32_t(sets);
+    return graph.create_image(d, usage);
+  };
+  auto p = atlas("specular impostor position", kPositionFormat, colour);
+  if (!p) return p.error();
+  impostor_position = *p;
+  auto n = atlas("specular impostor normal", kImpostorNormalFormat, colour);
+  if (!n) return n.error();
+  impostor_normal = *n;
+  auto a = atlas("specular impostor albedo", kImpostorAlbedoFormat, colour);
+  if (!a) return a.error();
+  impostor_albedo = *a;
+  auto dz = atlas("specular impostor depth", kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
+  if (!dz) return dz.error();
+  impostor_depth = *dz;
+  auto screen = [&](const char* name, VkFormat f, VkImageUsageFlags usage) -> Expected<gpu::ImageHandle> {
+    gpu::ImageDesc d;
+    d.name = name;
+    d.format = f;  // OutputRelative, following the render scale: the internal resolution
+    return graph.create_image(d, usage);
+  };
+  auto bp = screen("specular back position", kPositionFormat, colour);
+  if (!bp) return bp.error();
+  back_position = *bp;
+  auto bn = screen("specular back normal", kBackNormalFormat, colour);
+  if (!bn) return bn.error();
+  back_normal = *bn;
+  auto bd = screen("specular back depth", kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
+  if (!bd) return bd.error();
+  back_depth = *bd;
+  gpu::ImageDesc ns;
+  ns.name = "specular no shadow map";
+  ns.format = kDepthFormat;
+  ns.size_mode = gpu::SizeMode::Absolute;
+  ns.width = ns.height = 1;
+  ns.array_view = true;
+  auto nsi = graph.create_image(ns, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
+  if (!nsi) return nsi.error();
+  no_shadow = *nsi;
+
+  const VkExtent2D g = graph.allocated_extent(shared.real_position);
+  const VkDeviceSize cells = VkDeviceSize(std::max(1u, g.width - 1)) * std::max(1u, g.height - 1);
+  auto ib = graph.create_buffer({"specular grid indices", cells * 6 * 4},
+                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
+  if (!ib) return ib.error();
+  grid_indices = *ib;
+  auto cb = graph.create_buffer({"specular constants", sizeof(shader::SpecularConstants), gpu::MemoryUsage::Upload, true},
+                                VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  if (!cb) return cb.error();
+  constants = *cb;
+  auto lb = graph.create_buffer({"specular lights", sizeof(shader::LightSet), gpu::MemoryUsage::Upload, true},
+                                VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  if (!lb) return lb.error();
+  own_lights = *lb;
+  env_width = shared.light_stage ? shared.light_stage->environment_grid_width() : 0;
+  const VkDeviceSize env_cells = VkDeviceSize(std::max(env_width, 2)) * VkDeviceSize(std::max(env_width, 2) / 2);
+  auto eb = graph.create_buffer({"specular environment grid", env_cells * sizeof(glm::vec4), gpu::MemoryUsage::Upload, true},
+                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  if (!eb) return eb.error();
+  env_grid = *eb;
+
+  auto ip = gpu::load_compute_pipeline(ctx, "baseline/shadow_caster_indices.comp", {});
+  if (!ip) return ip.error();
+  indices_pipeline = std::move(*ip);
+  auto tp = gpu::load_compute_pipeline(ctx, "specular/trace.comp", {});
+  if (!tp) return tp.error();
+  trace_pipeline = std::move(*tp);
+  auto impostor_fs = gpu::shader_spirv("specular/impostor.frag");
+  if (!impostor_fs) return impostor_fs.error();
+  auto back_fs = gpu::shader_spirv("specular/backface.frag");
+  if (!back_fs) return back_fs.error();
+  auto grid_vs = gpu::shader_spirv("gi/rsm_grid.vert");
+  if (!grid_vs) return grid_vs.error();
+  auto mesh_vs = gpu::shader_spirv("gi/rsm_mesh.vert");
+  if (!mesh_vs) return mesh_vs.error();
+  gpu::GraphicsPipelineDesc pd;
+  pd.name = "specular impostor grid";
+  pd.vertex_spirv = *grid_vs;
+  pd.fragment_spirv = *impostor_fs;
+  pd.color_formats = {kPositionFormat, kImpostorNormalFormat, kImpostorAlbedoFormat};
+  pd.depth_format = kDepthFormat;
+  pd.cull_mode = VK_CULL_MODE_NONE;
+  auto gp = gpu::create_graphics_pipeline(ctx, pd);
+  if (!gp) return gp.error();
+  grid_pipeline = gpu::PipelineHandle(ctx, std::move(*gp));
+  MRGI_TRY(gpu::require_bindings(*grid_pipeline, pd.name, {"real_position", "real_normal", "real_albedo", "base_color_maps"}));
+  pd.name = "specular impostor mesh";
+  pd.vertex_spirv = *mesh_vs;
+  pd.vertex_strides = {sizeof(technique::GpuVertex)};
+  pd.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
+                   {1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12},
+                   {2, 0, VK_FORMAT_R32G32_SFLOAT, 24}};
+  auto mp = gpu::create_graphics_pipeline(ctx, pd);
+  if (!mp) return mp.error();
+  mesh_pipeline = gpu::PipelineHandle(ctx, std::move(*mp));
+  MRGI_TRY(gpu::require_bindings(*mesh_pipeline, pd.name, {"Materials", "base_color_maps"}));
+  pd.name = "specular back faces";
+  pd.fragment_spirv = *back_fs;
+  pd.color_formats = {kPositionFormat, kBackNormalFormat};
+  pd.cull_mode = VK_CULL_MODE_FRONT_BIT;
+  auto bpp = gpu::create_graphics_pipeline(ctx, pd);
+  if (!bpp) return bpp.error();
+  back_pipeline = gpu::PipelineHandle(ctx, std::move(*bpp));
+  MRGI_TRY(gpu::require_bindings(*back_pipeline, pd.name, {"Materials"}));
+  return ok_status();
+}
+
+void SpecularStage::Impl::add_grid(gpu::FrameGraph& graph, uint32_t face) {
+  const VkExtent2D g = graph.extent(shared.real_position);
+  // About two grid points per impostor texel across the real G-buffer's larger side (the
+  // impostor's 90 degrees see about as much as the camera's view).
+  const uint32_t side = std::max(g.width, g.height);
+  grid_stride = std::max(1u, (side + face / 2 - 1) / std::max(1u, face / 2));
+  grid_points = {(g.width - 1) / grid_stride + 1, (g.height - 1) / grid_stride + 1};
+  const VkExtent2D points = grid_points;
+  const uint32_t st = grid_stride;
+  const gpu::Pipeline* pipe = &*indices_pipeline;
+  const VkSampler nearest = shared.context->samplers().nearest_clamp;
+  graph.add_shader_pass(
+      "specular impostor grid", gpu::PassKind::Compute, *indices_pipeline,
+      [this, nearest](gpu::ShaderPassBuilder& b) {
+        b.bind_sampled("real_position", shared.real_position, nearest);
+        b.bind("Indices", grid_indices);
+      },
+      [pipe, points, st](VkCommandBuffer cmd, gpu::PassContext&) {
+        const glm::ivec4 push(int(points.width), int(points.height), int(st), 0);
+        gpu::push_and_dispatch(cmd, *pipe, &push, sizeof push, {(points.width - 1 + 7) / 8, (points.height - 1 + 7) / 8, 1});
+      });
+}
+
+void SpecularStage::Impl::add_impostors(gpu::FrameGraph& graph, const ImpostorSet& set, const glm::ivec2& origin,
+                                        uint32_t face, bool first, const std::string& label) {
+  const technique::SceneGpu* sg = shared.scene_gpu;
+  const bool grid = grid_points.width > 1 && grid_points.height > 1;
+  const uint32_t grid_index_count = grid ? (grid_points.width - 1) * (grid_points.height - 1) * 6 : 0;
+  std::vector<bool> excluded(sg->virtual_objects.draws.size(), false);
+  for (size_t o : set.objects) {
+    const technique::SceneGpu::DrawSpan span = sg->object_draws(o);
+    for (size_t d = span.first; d < span.first + span.count; ++d) excluded[d] = true;
+  }
+  const Impl* self = this;
+  const gpu::Access colour_access = first ? gpu::Access::ColorAttachmentWrite : gpu::Access::ColorAttachmentReadWrite;
+  const gpu::Access depth_access = first ? gpu::Access::DepthAttachmentWrite : gpu::Access::DepthAttachmentReadWrite;
+  const technique::RealGeometry real{shared.real_position, shared.real_normal, 1};
+  const glm::vec3 centre = set.centre;
+  const glm::ivec4 misc(int(grid_stride), -1, int(0xff808080u), int(grid_points.width));
+  graph.add_pass(
+      label, gpu::PassKind::Graphics,
+      [=](gpu::PassBuilder& b) {
+        if (grid_index_count > 0) {
+          b.read(self->shared.real_position, gpu::Access::Sampled);
+          b.read(self->shared.real_normal, gpu::Access::Sampled);
+          b.read(self->shared.real_albedo, gpu::Access::Sampled);
+          b.read(self->grid_indices, gpu::Access::IndexBuffer);
+        }
+        if (!sg->real_proxies.empty()) {
+          b.read(sg->real_proxies.vertices, gpu::Access::VertexBuffer);
+          b.read(sg->real_proxies.indices, gpu::Access::IndexBuffer);
+        }
+        b.read(sg->virtual_objects.vertices, gpu::Access::VertexBuffer);
+        b.read(sg->virtual_objects.indices, gpu::Access::IndexBuffer);
+        b.read(sg->materials, gpu::Access::StorageRead);
+        b.read(sg->base_color_maps, gpu::Access::Sampled);
+        b.write(self->impostor_position, colour_access);
+        b.write(self->impostor_normal, colour_access);
+        b.write(self->impostor_albedo, colour_access);
+        b.write(self->impostor_depth, depth_access);
+      },
+      [=](VkCommandBuffer cmd, gpu::PassContext& p) {
+        const gpu::Context& ctx = p.context();
+        VkRenderingAttachmentInfo colour[3];
+        const gpu::ImageHandle targets[3] = {self->impostor_position, self->impostor_normal, self->impostor_albedo};
+        for (int i = 0; i < 3; ++i) {
+          colour[i] = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+          colour[i].imageView = p.view(targets[i]);
+          colour[i].imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+          colour[i].loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;  // the render area: this set's block
+          colour[i].storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+          colour[i].clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
+        }
+        VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+        depth.imageView = p.view(self->impostor_depth);
+        depth.imageLayout = gpu::access_info(gpu::PassKind::Graphics, depth_access, true, true).layout;
+        depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+        depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+        depth.clearValue.depthStencil = {1.0f, 0};
+        VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+        ri.renderArea = {{origin.x, origin.y}, {3 * face, 2 * face}};
+        ri.layerCount = 1;
+        ri.colorAttachmentCount = 3;
+        ri.pColorAttachments = colour;
+        ri.pDepthAttachment = &depth;
+        ctx.fn().cmd_begin_rendering(cmd, &ri);
+        const VkSampler linear = ctx.samplers().linear_repeat, nearest = ctx.samplers().nearest_clamp;
+        const gpu::Pipeline* gp = &*self->grid_pipeline;
+        const gpu::Pipeline* mp = &*self->mesh_pipeline;
+        for (int f = 0; f < 6; ++f) {
+          const int fx = origin.x + int(face) * (f % 3), fy = origin.y + int(face) * (f / 3);
+          const VkViewport vp{float(fx), float(fy), float(face), float(face), 0.0f, 1.0f};
+          const VkRect2D sc{{fx, fy}, {face, face}};
+          vkCmdSetViewport(cmd, 0, 1, &vp);
+          vkCmdSetScissor(cmd, 0, 1, &sc);
+          DrawPush push{face_view_proj(centre, f), glm::vec4(centre, 1.0f), glm::vec4(1.0f, 1.0f, 1.0f, -2.0f),
+                        glm::vec4(shader::specular_face_forward(f), 1.0f), misc};
+          if (grid_index_count > 0) {
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, gp->pipeline);
+            const gpu::ShaderInterface& gi = gp->interface;
+            gpu::DescriptorPush()
+                .sampled_image(gi.find("real_position")->binding, p.view(real.position), nearest)
+                .sampled_image(gi.find("real_normal")->binding, p.view(self->shared.real_normal), nearest)
+                .sampled_image(gi.find("real_albedo")->binding, p.view(self->shared.real_albedo), nearest)
+                .sampled_image(gi.find("base_color_maps")->binding, p.view(sg->base_color_maps), linear)
+                .push(ctx, cmd, *gp);
+            vkCmdPushConstants(cmd, gp->layout, gp->stages, 0, sizeof push, &push);
+            vkCmdBindIndexBuffer(cmd, p.buffer(self->grid_indices), 0, VK_INDEX_TYPE_UINT32);
+            vkCmdDrawIndexed(cmd, grid_index_count, 1, 0, 0, 0);
+          }
+          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mp->pipeline);
+          const gpu::ShaderInterface& mi = mp->interface;
+          gpu::DescriptorPush()
+              .storage_buffer(mi.find("Materials")->binding, p.buffer(sg->materials))
+              .sampled_image(mi.find("base_color_maps")->binding, p.view(sg->base_color_maps), linear)
+              .push(ctx, cmd, *mp);
+          auto draw_set = [&](const technique::MeshSet& set, bool materials) {
+            VkBuffer vb = p.buffer(set.vertices);
+            VkDeviceSize offset = 0;
+            vkCmdBindVertexBuffers(cmd, 0, 1, &vb, &offset);
+            vkCmdBindIndexBuffer(cmd, p.buffer(set.indices), 0, VK_INDEX_TYPE_UINT32);
+            for (size_t i = 0; i < set.draws.size(); ++i) {
+              const technique::DrawRange& d = set.draws[i];
+              if (materials && excluded[i]) continue;
+              push.misc.y = materials ? d.material : -1;
+              vkCmdPushConstants(cmd, mp->layout, mp->stages, 0, sizeof push, &push);
+              vkCmdDrawIndexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0);
+            }
+          };
+          if (!sg->real_proxies.empty()) draw_set(sg->real_proxies, false);
+          draw_set(sg->virtual_objects, true);
+        }
+        ctx.fn().cmd_end_rendering(cmd);
+      });
+}
+
+void SpecularStage::Impl::add_back_faces(gpu::FrameGraph& graph, const std::vector<ObjectInView>& objects) {
+  const technique::SceneGpu* sg = shared.scene_gpu;
+  std::vector<size_t> draws;
+  for (const ObjectInView& o : objects) {
+    if (!o.refractive) continue;
+    const technique::SceneGpu::DrawSpan span = sg->object_draws(o.object);
+    for (size_t d = span.first; d < span.first + span.count; ++d) {
+      const int m = sg->virtual_objects.draws[d].material;
+      if (m >= 0 && size_t(m) < sg->material_specular_kind.size() &&
+          sg->material_specular_kind[size_t(m)] == shader::SPECULAR_REFRACTIVE)
+        draws.push_back(d);
+    }
+  }
+  const Impl* self = this;
+  graph.add_pass(
+      "specular back faces", gpu::PassKind::Graphics,
+      [=](gpu::PassBuilder& b) {
+        b.read(sg->virtual_objects.vertices, gpu::Access::VertexBuffer);
+        b.read(sg->virtual_objects.indices, gpu::Access::IndexBuffer);
+        b.read(sg->materials, gpu::Access::StorageRead);
+        b.write(self->back_position, gpu::Access::ColorAttachmentWrite);
+        b.write(self->back_normal, gpu::Access::ColorAttachmentWrite);
+        b.write(self->back_depth, gpu::Access::DepthAttachmentWrite);
+      },
+      [=](VkCommandBuffer cmd, gpu::PassContext& p) {
+        const gpu::Context& ctx = p.context();
+        const VkExtent2D e = p.extent(self->back_position);
+        VkRenderingAttachmentInfo colour[2];
+        const gpu::ImageHandle targets[2] = {self->back_position, self->back_normal};
+        for (int i = 0; i < 2; ++i) {
+          colour[i] = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+          colour[i].imageView = p.view(targets[i]);
+          colour[i].imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+          colour[i].loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+          colour[i].storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+          colour[i].clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
+        }
+        VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+        depth.imageView = p.view(self->back_depth);
+        depth.imageLayout = gpu::access_info(gpu::PassKind::Graphics, gpu::Access::DepthAttachmentWrite, true, true).layout;
+        depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+        depth.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+        depth.clearValue.depthStencil = {1.0f, 0};
+        VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+        ri.renderArea = {{0, 0}, e};
+        ri.layerCount = 1;
+        ri.colorAttachmentCount = 2;
+        ri.pColorAttachments = colour;
+        ri.pDepthAttachment = &depth;
+        ctx.fn().cmd_begin_rendering(cmd, &ri);
+        const VkViewport vp{0.0f, 0.0f, float(e.width), float(e.height), 0.0f, 1.0f};
+        const VkRect2D sc{{0, 0}, e};
+        vkCmdSetViewport(cmd, 0, 1, &vp);
+        vkCmdSetScissor(cmd, 0, 1, &sc);
+        const gpu::Pipeline* bp = &*self->back_pipeline;
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, bp->pipeline);
+        gpu::DescriptorPush().storage_buffer(bp->interface.find("Materials")->binding, p.buffer(sg->materials)).push(ctx, cmd, *bp);
+        DrawPush push{self->world_to_clip, glm::vec4(0.0f), glm::vec4(0.0f), glm::vec4(0.0f), glm::ivec4(1, -1, 0, 0)};
+        vkCmdPushConstants(cmd, bp->layout, bp->stages, 0, sizeof push, &push);
+        VkBuffer vb = p.buffer(sg->virtual_objects.vertices);
+        VkDeviceSize offset = 0;
+        vkCmdBindVertexBuffers(cmd, 0, 1, &vb, &offset);
+        vkCmdBindIndexBuffer(cmd, p.buffer(sg->virtual_objects.indices), 0, VK_INDEX_TYPE_UINT32);
+        for (size_t i : draws) {
+          const technique::DrawRange& d = sg->virtual_objects.draws[i];
+          vkCmdDrawIndexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0);
+        }
+        ctx.fn().cmd_end_rendering(cmd);
+      });
+}
+
+SpecularStage::SpecularStage(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+SpecularStage::~SpecularStage() = default;
+
+Expected<std::unique_ptr<SpecularStage>> SpecularStage::create(const technique::SharedResources& shared,
+                                                               const SpecularSettings& settings) {
+  if (!shared.scene_gpu || !shared.scene_gpu->specular) return std::unique_ptr<SpecularStage>();
+  if (settings.max_impostor_face < 16 || settings.max_impostor_face > 2048)
+    return fail(ErrorKind::BadUsage, "SpecularSettings.max_impostor_face: must be 16..2048 texels");
+  if (!(settings.depth_tolerance > 0.0f && settings.depth_tolerance < 1.0f))
+    return fail(ErrorKind::BadUsage, "SpecularSettings.depth_tolerance: must be in (0, 1)");
+  auto impl = std::make_unique<Impl>();
+  impl->shared = shared;
+  impl->settings = settings;
+  MRGI_TRY(impl->init());
+  return std::unique_ptr<SpecularStage>(new SpecularStage(std::move(impl)));
+}
+
+Status SpecularStage::record(const shader::FrameConstants& fc, const technique::Technique& technique,
+                             int technique_level, std::vector<std::string>& skipped) {
+  Impl& m = *impl_;
+  const technique::SceneGpu& sg = *m.shared.scene_gpu;
+  gpu::FrameGraph& graph = *m.shared.graph;
+  std::vector<ObjectInView> in_view;
+  for (size_t o = 0; o < sg.object_count(); ++o) {
+    if (!sg.visible(o)) continue;
+    const int kinds = sg.object_specular_kinds(o);
+    if (kinds == 0) continue;
+    const technique::SceneGpu::DrawSpan span = sg.object_draws(o);
+    if (span.count == 0) continue;
+    ObjectInView v;
+    v.object = o;
+    v.lo = glm::vec3(1e30f);
+    v.hi = glm::vec3(-1e30f);
+    for (size_t d = span.first; d < span.first + span.count; ++d) {
+      v.lo = glm::min(v.lo, sg.virtual_objects.draws[d].bounds_min);
+      v.hi = glm::max(v.hi, sg.virtual_objects.draws[d].bounds_max);
+    }
+    if (!technique::project_box(fc, v.lo, v.hi).visible) continue;
+    v.distance = glm::distance(0.5f * (v.lo + v.hi), glm::vec3(fc.camera_world));
+    v.refractive = (kinds & (1 << shader::SPECULAR_REFRACTIVE)) != 0;
+    in_view.push_back(v);
+  }
+  if (in_view.empty()) {
+    skipped.push_back("specular: no reflective or refractive object in view");
+    return ok_status();
+  }
+  std::sort(in_view.begin(), in_view.end(), [](const ObjectInView& a, const ObjectInView& b) { return a.distance < b.distance; });
+  const SpecularLevel& level = specular_level_for(technique_level, int(technique.levels().size()));
+  const uint32_t face = std::min(level.impostor_face, m.settings.max_impostor_face);
+  const int set_count = std::clamp(std::min(level.own_sets, m.settings.max_sets), 1, int(in_view.size()));
+  std::vector<ImpostorSet> sets(static_cast<size_t>(set_count));
+  for (size_t i = 0; i < in_view.size(); ++i) {
+    ImpostorSet& s = sets[std::min(i, size_t(set_count - 1))];
+    s.objects.push_back(in_view[i].object);
+  }
+  for (ImpostorSet& s : sets) {
+    glm::vec3 lo(1e30f), hi(-1e30f);
+    for (size_t o : s.objects)
+      for (const ObjectInView& v : in_view)
+        if (v.object == o) {
+          lo = glm::min(lo, v.lo);
+          hi = glm::max(hi, v.hi);
+        }
+    s.centre = 0.5f * (lo + hi);
+    s.radius = 0.5f * glm::length(hi - lo);
+  }
+
+  // This frame's constants.
+  auto* c = static_cast<shader::SpecularConstants*>(graph.mapped(m.constants, graph.slot()));
+  *c = shader::SpecularConstants{};
+  c->counts = glm::ivec4(set_count, level.search_steps, level.refine_steps, level.back_face_steps);
+  c->params = glm::vec4(m.settings.depth_tolerance, m.shared.compose_eps, m.shared.compose_alpha_max,
+                        m.settings.back_projection ? 1.0f : 0.0f);
+  for (int i = 0; i < set_count; ++i) {
+    c->sets[i].centre = glm::vec4(sets[size_t(i)].centre, sets[size_t(i)].radius);
+    c->sets[i].atlas = glm::ivec4(0, int(2 * face) * i, int(face), 0);
+  }
+  const light::Lighting& lighting = m.shared.light_stage->lighting();
+  for (int k = 0; k < 16; ++k) {
+    glm::dvec3 e = lighting.ambient_real[size_t(k)] + lighting.ambient_virtual[size_t(k)];
+    for (size_t l = 0; l < lighting.lights.size(); ++l)
+      if (l < lighting.foldable.size() && lighting.foldable[l] != 0 && l < lighting.light_sh.size())
+        e += lighting.light_sh[l][size_t(k)];
+    c->env_sh[k] = glm::vec4(glm::vec3(e), 0.0f);
+  }
+  const std::optional<technique::Technique::DirectLight> direct = technique.direct_light();
+  gpu::BufferHandle light_set = m.own_lights;
+  gpu::ImageHandle shadow_primary = m.no_shadow, shadow_virtual = m.no_shadow;
+  if (direct) {
+    light_set = direct->light_set;
+    shadow_primary = direct->shadow_primary;
+    shadow_virtual = direct->shadow_virtual;
+    c->shadow = direct->shadow;
+  } else {
+    auto* set = static_cast<shader::LightSet*>(graph.mapped(m.own_lights, graph.slot()));
+    technique::write_unshadowed_light_set(lighting, *set);
+    c->shadow = glm::vec4(1.0f, 1.0f, 1.0f, 0.0f);
+    skipped.push_back("specular: the technique drew no shadow maps this frame: mirrors and glass show lamps' light unshadowed");
+  }
+  int env_width = 0;
+  if (const light::EnvSampler* env = m.shared.light_stage->environment_grid();
+      env && env->settings().grid_width == m.env_width) {
+    env_width = m.env_width;
+    auto* cells = static_cast<glm::vec4*>(graph.mapped(m.env_grid, graph.slot()));
+    for (int y = 0; y < env->grid_height(); ++y)
+      for (int x = 0; x < env_width; ++x) cells[size_t(y) * size_t(env_width) + size_t(x)] = glm::vec4(glm::vec3(env->cell_radiance(x, y)), 0.0f);
+  }
+  c->flags = glm::ivec4(direct ? 1 : 0, m.settings.depth_test ? 1 : 0, env_width, 0);
+
+  m.world_to_clip = fc.world_to_clip;
+  m.add_grid(graph, face);
+  for (int i = 0; i < set_count; ++i)
+    m.add_impostors(graph, sets[size_t(i)], glm::ivec2(0, int(2 * face) * i), face, i == 0,
+                    "specular impostors " + std::to_string(i));
+  bool refractive = false;
+  for (const ObjectInView& v : in_view) refractive = refractive || v.refractive;
+  if (refractive) m.add_back_faces(graph, in_view);
+  else skipped.push_back("specular back faces: no refractive object in view");
+
+  const VkSampler compare = m.shared.context->samplers().shadow_compare;
+  const VkSampler nearest = m.shared.context->samplers().nearest_clamp;
+  Impl* self = &m;
+  graph.add_shader_pass(
+      "specular trace", gpu::PassKind::Compute, *m.trace_pipeline,
+      [=](gpu::ShaderPassBuilder& b) {
+        const technique::SharedResources& r = self->shared;
+        b.bind("FrameUbo", r.frame_constants);
+        b.bind("LightUbo", light_set);
+        b.bind("SpecularUbo", self->constants);
+        b.bind("Materials", r.scene_gpu->materials);
+        b.bind("real_position", r.real_position);
+        b.bind("virtual_position", r.virtual_position);
+        b.bind("virtual_normal", r.virtual_normal);
+        b.bind("virtual_albedo", r.virtual_albedo);
+        b.bind("back_position", self->back_position);
+        b.bind("back_normal", self->back_normal);
+        b.bind("impostor_position", self->impostor_position);
+        b.bind("impostor_normal", self->impostor_normal);
+        b.bind("impostor_albedo", self->impostor_albedo);
+        b.bind_sampled("shadow_primary", shadow_primary, compare);
+        b.bind_sampled("shadow_virtual", shadow_virtual, compare);
+        b.bind_sampled("shadow_primary_depth", shadow_primary, nearest);
+        b.bind_sampled("shadow_virtual_depth", shadow_virtual, nearest);
+        b.bind("color_words", r.color_upload);
+        b.bind("EnvGrid", self->env_grid);
+        b.bind_over("lit_rv", r.lit_rv);
+        b.bind_over("lit_r", r.lit_r);
+      },
+      [self](VkCommandBuffer cmd, gpu::PassContext& p) {
+        const VkExtent2D e = p.extent(self->shared.lit_rv);
+        gpu::push_and_dispatch(cmd, *self->trace_pipeline, nullptr, 0, {(e.width + 7) / 8, (e.height + 7) / 8, 1});
+      });
+  return ok_status();
+}
+
+}  // namespace mrgi::specular

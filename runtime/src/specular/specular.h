@@ -1,0 +1,94 @@
+// Reflective and refractive virtual objects (Knecht et al. 2013, "Reflective and refractive
+// objects for mixed reality", ../shared/papers/reflective-refractive-caustics-dir.md), a stage of
+// the runtime after the technique's shading and before compose, so a mirror or a glass object is
+// specular whichever technique lights the diffuse scene (dir, the paper's base, or baseline, dlpv,
+// dvct, ssrt).
+//
+// Per frame, where a reflective or refractive object is in view (shared/specular_math.h
+// specular_kind: smooth metal, transmissive materials):
+//   specular impostor grid      the real scene's grid over the real G-buffer (baseline's caster
+//                               index list at the impostors' resolution)
+//   specular impostors <s>      per set: six 90 degree faces drawn from the set's centre (the real
+//                               grid, the proxies, the other virtual objects): world position,
+//                               normal, albedo, real or virtual (shaders/specular/impostor.frag)
+//   specular back faces         the refractive objects' back faces from the camera (Wyman 2005)
+//   specular trace              per specular pixel: the reflected and refracted rays' hits,
+//                               their light with and without the virtual objects, back-projection
+//                               into the camera frame and the composite of eq. 6-11
+//                               (shaders/specular/trace.comp), into lit_rv
+//
+// Deviations from the paper, and why:
+//   - Impostors: Popescu et al. give each surrounding object its own billboard. Here the
+//     surrounding scene is mostly one surface that encloses the object (the reconstructed table
+//     under it, the wall behind), which no billboard can hold, so a set's impostor is the six
+//     faces of a cube around its centre (distance impostors, Szirmay-Kalos et al. 2005), searched
+//     by the same iterative refinement; one layer, so a surface hidden from the centre behind a
+//     nearer one is missing (the search then passes behind the nearer one's silhouette).
+//   - Each hit is shaded by the lamps (with the technique's shadow maps where it drew them) and
+//     the SH ambient; dir's VPLs do not light the hits yet, and a virtual hit is Lambertian.
+//   - L_env: the environment's radiance from the light stage's SH (4 bands), not the fish-eye
+//     image itself: the stage keeps no environment texture on the GPU.
+//   - Eq. 9's validity is per path (specular_math.h specular_compose says why).
+//   Caustics (Sec. 4.2) are not built yet: a spot lamp through glass lights nothing behind it
+//   beyond what the technique's shadow maps let through (none: glass casts a full shadow).
+#pragma once
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "common/frame_constants.glsl"
+#include "gpu/frame_graph.h"
+#include "gpu/pipelines.h"
+#include "mrgi/expected.h"
+#include "technique/technique.h"
+
+namespace mrgi::specular {
+
+// One level of the stage's ladder. Units: texels per impostor face side; steps per ray.
+struct SpecularLevel {
+  const char* name;
+  uint32_t impostor_face;  // texels per side of each of a set's six faces
+  // Sets with their own centre: the first own_sets specular objects in view (nearest the camera
+  // first) get one each, the rest share the last one, drawn around all of them.
+  int own_sets;
+  int search_steps;        // linear search steps along a ray through the impostors
+  int refine_steps;        // secant refinements of a bracketed crossing
+  int back_face_steps;     // search steps for the refracted ray's exit in the back faces
+};
+// paper (512^2 impostors, a set per object), high, fast (128^2, one set for all objects).
+const std::array<SpecularLevel, 3>& specular_levels();
+// The stage's level for a technique's level: the technique's first level gets the paper's
+// settings, its last two the fast ones, the others high.
+const SpecularLevel& specular_level_for(int technique_level, int technique_levels);
+
+// Ablations (RuntimeSettings knobs of the same names would go here once the runtime exposes
+// them; the bench's images are made with these).
+struct SpecularSettings {
+  bool back_projection = true;  // false: every hit shows its rendered light (no camera colour)
+  bool depth_test = true;       // false: a back-projection is trusted without the depth test
+  uint32_t max_impostor_face = 512;  // allocated texels per face side (the largest level)
+  int max_sets = 2;                  // allocated impostor sets
+  // Fraction of the depth within which a back-projected hit must meet the real G-buffer's depth
+  // (sensor noise and the impostor's texel size).
+  float depth_tolerance = 0.04f;
+};
+
+class SpecularStage {
+ public:
+  // nullptr (no error) when no virtual material is specular: nothing is allocated.
+  static Expected<std::unique_ptr<SpecularStage>> create(const technique::SharedResources& shared,
+                                                         const SpecularSettings& settings);
+  ~SpecularStage();
+  // After the technique's record(): records the passes above for this frame, or appends
+  // "specular: <reason>" to `skipped`. `fc` is this frame's FrameConstants.
+  Status record(const shader::FrameConstants& fc, const technique::Technique& technique, int technique_level,
+                std::vector<std::string>& skipped);
+
+ private:
+  struct Impl;
+  explicit SpecularStage(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace mrgi::specular

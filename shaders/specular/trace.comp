@@ -1,0 +1,329 @@
+#version 460
+// Reflective and refractive virtual objects in DIR (Knecht et al. 2013, Sec. 4.1 and 5.1), one
+// pass at the internal resolution over the pixels whose virtual material is specular
+// (virtual_position.w >= 2: 2 + its material index, gbuffer/virtual.frag):
+//   1. GBuf_refl: the mirror direction's ray searched against the set's impostors (a linear
+//      search along the ray, then secant refinement: the iterative refinement of Popescu et al.
+//      2006 on distance impostors);
+//      GBuf_refr: two-sided refraction (Wyman 2005): Snell at the front face, the exit point found
+//      along the refracted ray in the back faces' buffer (a search instead of Wyman's
+//      interpolated distance estimate: exact where the buffer holds the exit, and no per-vertex
+//      precomputation), Snell at the back face, then the impostor search as for the reflection.
+//      The G-buffers are this pass's registers: each hit is shaded where it is found (its
+//      position, normal, albedo and real/virtual flag are what Sec. 5.1 stores).
+//   2. L'_rv and L'_r (eq. 3-5): each hit lit by the lamps with baseline's shadow-map pair (a
+//      real lamp's light on a real hit in L'_r too, common/shadowed_lamps.glsl) and by the SH
+//      ambient, times the Fresnel factors and the transmittance colour (eq. 9).
+//   3. Back-projection (eq. 6-11, Sec. 4.1.3): a real hit seen by the camera (inside the view,
+//      its depth within the tolerance of the real G-buffer's there) takes the camera's colour;
+//      the rendered light where the test fails or the hit is outside the view; the environment
+//      (L_env) where a ray meets nothing modelled; composited by shared/specular_math.h
+//      specular_compose. The result is written to lit_rv as radiance (compose shows a virtual
+//      pixel's TM(L_rv)), lit_r 0.
+// Virtual hits are lit as Lambertian surfaces of their base colour (the impostors keep no
+// metallic or roughness), and a specular object seen in another's impostor is its base colour:
+// the paper's one reflection or refraction per path (its Sec. 6).
+#extension GL_GOOGLE_include_directive : require
+#include "shared/mrgi_shared.h"
+#include "shared/specular_math.h"
+#include "common/frame_constants.glsl"
+#include "common/light_set.glsl"
+#include "common/scene_materials.glsl"
+#include "common/surface_shading.glsl"
+#include "specular/specular_params.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
+FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
+layout(std140, set = 0, binding = 1) uniform LightUbo { LightSet light_set; };
+layout(std140, set = 0, binding = 2) uniform SpecularUbo { SpecularConstants specular; };
+layout(std430, set = 0, binding = 3) readonly buffer Materials { GpuMaterial materials[]; };
+layout(set = 0, binding = 4, rgba32f) readonly uniform image2D real_position;
+layout(set = 0, binding = 5, rgba32f) readonly uniform image2D virtual_position;
+layout(set = 0, binding = 6, rgba16f) readonly uniform image2D virtual_normal;
+layout(set = 0, binding = 7, rgba16f) readonly uniform image2D virtual_albedo;
+layout(set = 0, binding = 8, rgba32f) readonly uniform image2D back_position;
+layout(set = 0, binding = 9, rgba16f) readonly uniform image2D back_normal;
+layout(set = 0, binding = 10, rgba32f) readonly uniform image2D impostor_position;
+layout(set = 0, binding = 11, rgba16f) readonly uniform image2D impostor_normal;
+layout(set = 0, binding = 12, rgba16f) readonly uniform image2D impostor_albedo;
+layout(set = 0, binding = 13) uniform sampler2DArrayShadow shadow_primary;
+layout(set = 0, binding = 14) uniform sampler2DArrayShadow shadow_virtual;
+layout(set = 0, binding = 15) uniform sampler2DArray shadow_primary_depth;  // one-map ablation only
+layout(set = 0, binding = 16) uniform sampler2DArray shadow_virtual_depth;
+layout(set = 0, binding = 17, r32ui) readonly uniform uimageBuffer color_words;
+layout(set = 0, binding = 18, rgba16f) writeonly uniform image2D lit_rv;
+layout(set = 0, binding = 19, rgba16f) writeonly uniform image2D lit_r;
+// The light stage's environment grid (light/env_sampler.h: world-space equirectangular cells
+// of filtered radiance, u = 0.5 + atan2(x, -z) / 2 pi, v = acos(y) / pi), flags.z cells wide.
+layout(std430, set = 0, binding = 20) readonly buffer EnvGrid { vec4 env_cells[]; };
+
+#define MRGI_UPLOAD_COLOR_ONLY
+#include "common/upload_gather.glsl"
+#include "common/shadowed_lamps.glsl"
+
+// ---- impostors ------------------------------------------------------------------------------
+
+// The atlas texel of set s in direction d from its centre.
+ivec2 impostor_texel(SpecularSet s, vec3 d) {
+  vec3 f = specular_cube_face(d);
+  int face = int(f.z);
+  int size = s.atlas.z;
+  ivec2 block = ivec2(face - 3 * (face / 3), face / 3);
+  return s.atlas.xy + block * size + clamp(ivec2(f.xy * float(size)), ivec2(0), ivec2(size - 1));
+}
+
+// Distance from the centre of the impostor surface in the direction of x (1e30: none there).
+float impostor_distance(SpecularSet s, vec3 x) {
+  vec4 p = imageLoad(impostor_position, impostor_texel(s, x - s.centre.xyz));
+  return p.w > 0.5f ? distance(p.xyz, s.centre.xyz) : 1e30f;
+}
+
+// f(t) = |x(t) - c| - impostor distance: < 0 in front of the surface, >= 0 behind it.
+float impostor_gap(SpecularSet s, vec3 o, vec3 d, float t) {
+  vec3 x = o + d * t;
+  return distance(x, s.centre.xyz) - impostor_distance(s, x);
+}
+
+struct Hit {
+  bool found;
+  vec3 position, normal, albedo;
+  bool real;
+};
+
+// The first crossing of the ray o + t d (t > 0) with set s's impostor surface. Linear search at
+// t_k = r u_k / (1 - u_k), u_k uniform up to the impostors' far plane (dense within r of the
+// object, where nearby surfaces bend the reflection most, and reaching a far wall in the last
+// steps), then secant steps on the bracketing interval. A crossing where the gap jumps by more
+// than a step's worth is the silhouette of a nearer surface the ray passes behind (the
+// single-layer impostor's missing back side), not a hit: the search goes on.
+const float kImpostorFar_m = 50.0f;  // specular.cpp's far plane
+Hit trace_impostor(SpecularSet s, vec3 o, vec3 d) {
+  Hit h;
+  h.found = false;
+  int n = max(specular.counts.y, 1);
+  // The search's scale: the object's size, at least a quarter metre (the table it stands on and
+  // the things beside it are that near).
+  float r = max(s.centre.w, 0.25f);
+  float u_max = kImpostorFar_m / (r + kImpostorFar_m);
+  float t_prev = 0.0f;
+  float f_prev = impostor_gap(s, o, d, 1e-4f);
+  float t_hit = -1.0f;
+  if (f_prev >= 0.0f && f_prev < 0.5f * r) {
+    t_hit = 1e-4f;  // the ray starts at or under the surface (an object resting on it)
+  } else {
+    for (int k = 1; k <= n; ++k) {
+      float u = u_max * float(k) / float(n);
+      float t = r * u / (1.0f - u);
+      float f = impostor_gap(s, o, d, t);
+      if (f_prev < 0.0f && f >= 0.0f) {
+        float ta = t_prev, fa = f_prev, tb = t, fb = f;
+        for (int i = 0; i < specular.counts.z; ++i) {
+          float tm = ta + (tb - ta) * clamp(-fa / max(fb - fa, 1e-9f), 0.05f, 0.95f);
+          float fm = impostor_gap(s, o, d, tm);
+          if (fm < 0.0f) { ta = tm; fa = fm; } else { tb = tm; fb = fm; }
+        }
+        // A real crossing closes the gap: both ends near the surface relative to the step.
+        float step_len = tb - ta;
+        if (fb - fa <= 4.0f * step_len + 0.02f * tb) {
+          t_hit = tb;
+          break;
+        }
+      }
+      t_prev = t;
+      f_prev = f;
+    }
+  }
+  if (t_hit < 0.0f) return h;
+  ivec2 texel = impostor_texel(s, o + d * t_hit - s.centre.xyz);
+  vec4 p = imageLoad(impostor_position, texel);
+  if (!(p.w > 0.5f)) return h;
+  h.found = true;
+  h.position = p.xyz;
+  h.normal = normalize(imageLoad(impostor_normal, texel).xyz);
+  if (dot(h.normal, d) > 0.0f) h.normal = -h.normal;  // the side the ray meets
+  h.albedo = imageLoad(impostor_albedo, texel).rgb;
+  h.real = p.w < 1.5f;
+  return h;
+}
+
+// ---- shading and back-projection --------------------------------------------------------------
+
+// The hit's light with and without the virtual objects (eq. 3-5): lamps (shadowed when the
+// technique drew maps) and the SH ambient; L_r only on real hits.
+void shade_hit(Hit h, vec3 d, out vec3 l_rv, out vec3 l_r) {
+  float r_p = h.real ? 1.0f : 0.0f;
+  l_rv = h.albedo * ambient_irradiance(light_set.ambient_rv, h.normal) * (1.0f / MRGI_PI);
+  l_r = r_p * h.albedo * ambient_irradiance(light_set.ambient_r, h.normal) * (1.0f / MRGI_PI);
+  add_shadowed_lamps(h.position, h.normal, -d, h.albedo, 0.0f, 1.0f, false, r_p, specular.shadow, false, l_rv, l_r);
+}
+
+// CI(x) of eq. 8-10 where the depth validity test of Sec. 4.1.3 passes: rgb linear camera
+// colour, w 1; w 0 outside the view or where the camera sees another surface there.
+vec4 back_project(vec3 x) {
+  vec3 c = (frame.world_to_camera * vec4(x, 1.0f)).xyz;
+  if (!(c.z > 1e-3f)) return vec4(0.0f);
+  vec2 ip = project_pinhole(c, frame.internal_k);
+  ivec2 used = frame.internal_output_size.xy;
+  if (any(lessThan(ip, vec2(0.0f))) || any(greaterThanEqual(ip, vec2(used)))) return vec4(0.0f);
+  if (specular.flags.y != 0) {
+    float depth = imageLoad(real_position, ivec2(ip)).w;
+    if (!(depth > 0.0f) || abs(depth - c.z) > specular.params.x * c.z) return vec4(0.0f);
+  }
+  vec2 cp = project_pinhole(c, frame.color_k);
+  ivec2 size = frame.color_depth_size.xy;
+  ivec2 q = clamp(ivec2(cp), ivec2(0), size - 1);
+  return vec4(srgb_decode(vec3(color_rgb8(uint(q.y * size.x + q.x))) / 255.0f), 1.0f);
+}
+
+vec3 env_cell(int x, int y, int w) {
+  x = x - w * int(floor(float(x) / float(w)));  // wraps around in longitude
+  y = clamp(y, 0, w / 2 - 1);
+  return env_cells[y * w + x].rgb;
+}
+
+// L_env of Sec. 4.1.3: the environment's radiance along d, bilinear in the grid (the SH where
+// the stage has no grid: a light estimate without an environment image).
+vec3 environment_radiance(vec3 d) {
+  d = normalize(d);
+  int w = specular.flags.z;
+  if (w > 0) {
+    vec2 uv = vec2(0.5f + atan(d.x, -d.z) / (2.0f * MRGI_PI), acos(clamp(d.y, -1.0f, 1.0f)) / MRGI_PI);
+    vec2 c = uv * vec2(float(w), float(w / 2)) - 0.5f;
+    ivec2 c0 = ivec2(floor(c));
+    vec2 f = c - vec2(c0);
+    return mix(mix(env_cell(c0.x, c0.y, w), env_cell(c0.x + 1, c0.y, w), f.x),
+               mix(env_cell(c0.x, c0.y + 1, w), env_cell(c0.x + 1, c0.y + 1, w), f.x), f.y);
+  }
+  SH16 y = sh_basis16(d);
+  vec3 sum = vec3(0.0f);
+  for (int i = 0; i < 16; ++i) sum += specular.env_sh[i].rgb * sh_get(y, i);
+  return max(sum, vec3(0.0f));
+}
+
+// One path's terms of specular_compose (shared/specular_math.h), weight w, in camera units.
+struct PathSum {
+  vec3 rv, r, camera, env;
+};
+void add_path(inout PathSum sum, vec3 w, Hit h, vec3 d, float exposure) {
+  if (all(lessThanEqual(w, vec3(0.0f)))) return;
+  if (!h.found) {
+    sum.env += w * environment_radiance(d) * exposure;
+    return;
+  }
+  vec3 l_rv, l_r;
+  shade_hit(h, d, l_rv, l_r);
+  vec3 tm_rv = clamp(l_rv * exposure, vec3(0.0f), vec3(1.0f));
+  vec3 tm_r = clamp(l_r * exposure, vec3(0.0f), vec3(1.0f));
+  sum.rv += w * tm_rv;
+  sum.r += w * tm_r;
+  if (h.real) {
+    vec4 ci = specular.params.w > 0.5f ? back_project(h.position) : vec4(0.0f);
+    sum.camera += w * (ci.w > 0.5f ? ci.rgb : tm_r);  // eq. 9: L'_r where v() fails
+  }
+}
+
+int nearest_set(vec3 p) {
+  int best = 0;
+  float best_d = 1e30f;
+  for (int i = 0; i < specular.counts.x; ++i) {
+    float d = distance(p, specular.sets[i].centre.xyz) - specular.sets[i].centre.w;
+    if (d < best_d) { best_d = d; best = i; }
+  }
+  return best;
+}
+
+void main() {
+  frame = frame_ubo;  // MRGI_UNIFORM_COPIES
+  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 used = frame.internal_output_size.xy;
+  if (any(greaterThanEqual(pixel, used))) return;
+  vec4 vpos = imageLoad(virtual_position, pixel);
+  if (!(vpos.w > 1.5f)) return;  // not a specular virtual pixel: the technique's shading stands
+  GpuMaterial m = materials[int(vpos.w + 0.5f) - 2];
+  vec3 p = vpos.xyz;
+  vec3 n = normalize(imageLoad(virtual_normal, pixel).xyz);
+  vec4 alb = imageLoad(virtual_albedo, pixel);
+  vec3 view = normalize(p - frame.camera_world.xyz);  // camera to surface
+  if (dot(n, view) > 0.0f) n = -n;
+  float cos_v = max(-dot(view, n), 0.0f);
+  float exposure = frame.camera.y;
+  SpecularSet s = specular.sets[nearest_set(p)];
+  PathSum sum;
+  sum.rv = vec3(0.0f); sum.r = vec3(0.0f); sum.camera = vec3(0.0f); sum.env = vec3(0.0f);
+
+  // GBuf_refl: the mirror direction.
+  vec3 refl = mirror_direction(view, n);
+  int kind = int(m.specular.x + 0.5f);
+  vec3 eta1;
+  vec3 eta2 = vec3(0.0f);
+  if (kind == SPECULAR_REFRACTIVE) {
+    float ior = max(m.specular.y, 1.0f);
+    float f1 = fresnel_dielectric(cos_v, 1.0f / ior);
+    eta1 = vec3(f1);
+    // GBuf_refr: Snell at the front face, the exit in the back faces' buffer, Snell there.
+    vec4 t1 = refract_or_reflect(view, n, 1.0f / ior);
+    vec3 exit_p = p;
+    vec3 exit_d = view;  // no back face (an open or one-sided surface): a thin sheet, straight on
+    vec4 back = imageLoad(back_position, pixel);
+    if (back.w > 0.5f && t1.w > 0.5f) {
+      float d_v = distance(back.xyz, p);
+      int steps = max(specular.counts.w, 1);
+      float t_lo = 0.0f, t_hi = -1.0f;
+      vec3 exit_n = imageLoad(back_normal, pixel).xyz;
+      exit_p = back.xyz;
+      for (int k = 1; k <= steps; ++k) {
+        float t = 2.0f * d_v * float(k) / float(steps);
+        vec3 x = p + t1.xyz * t;
+        vec3 c = (frame.world_to_camera * vec4(x, 1.0f)).xyz;
+        vec2 ip = project_pinhole(c, frame.internal_k);
+        if (!(c.z > 0.0f) || any(lessThan(ip, vec2(0.0f))) || any(greaterThanEqual(ip, vec2(used)))) break;
+        vec4 b = imageLoad(back_position, ivec2(ip));
+        if (!(b.w > 0.5f)) { t_hi = t; break; }  // left the object's silhouette
+        float back_depth = (frame.world_to_camera * vec4(b.xyz, 1.0f)).z;
+        if (c.z >= back_depth) { t_hi = t; break; }
+        t_lo = t;
+      }
+      if (t_hi > 0.0f) {
+        for (int i = 0; i < 4; ++i) {  // bisection to the back face
+          float t = 0.5f * (t_lo + t_hi);
+          vec3 x = p + t1.xyz * t;
+          vec3 c = (frame.world_to_camera * vec4(x, 1.0f)).xyz;
+          vec2 ip = project_pinhole(c, frame.internal_k);
+          vec4 b = imageLoad(back_position, clamp(ivec2(ip), ivec2(0), used - 1));
+          bool behind = !(b.w > 0.5f) || c.z >= (frame.world_to_camera * vec4(b.xyz, 1.0f)).z;
+          if (behind) t_hi = t; else t_lo = t;
+        }
+        vec3 x = p + t1.xyz * t_hi;
+        vec2 ip = project_pinhole((frame.world_to_camera * vec4(x, 1.0f)).xyz, frame.internal_k);
+        ivec2 q = clamp(ivec2(ip), ivec2(0), used - 1);
+        vec4 b = imageLoad(back_position, q);
+        exit_p = b.w > 0.5f ? b.xyz : x;
+        if (b.w > 0.5f) exit_n = imageLoad(back_normal, q).xyz;
+      }
+      exit_n = normalize(exit_n);
+      if (dot(exit_n, t1.xyz) < 0.0f) exit_n = -exit_n;  // outward, along the ray
+      vec4 t2 = refract_or_reflect(t1.xyz, -exit_n, ior);
+      // Under total internal reflection the light stays inside; it is followed along the
+      // internal mirror direction from the exit point (one bounce, no further search).
+      exit_d = t2.xyz;
+      float f2 = t2.w > 0.5f ? fresnel_dielectric(max(dot(t1.xyz, exit_n), 0.0f), ior) : 0.0f;
+      eta2 = vec3((1.0f - f1) * (1.0f - f2));
+    } else {
+      eta2 = vec3(1.0f - f1);
+    }
+    eta2 *= transmittance_colour(alb.rgb, m.attenuation.rgb, m.specular.z, distance(p, exit_p)) *
+            clamp(m.specular.w, 0.0f, 1.0f);
+    Hit refr = trace_impostor(s, exit_p + exit_d * 1e-3f, exit_d);
+    add_path(sum, eta2, refr, exit_d, exposure);
+  } else {
+    eta1 = fresnel_metal(mix(vec3(0.04f), alb.rgb, alb.a), cos_v);
+  }
+  Hit h1 = trace_impostor(s, p + refl * 1e-3f, refl);
+  add_path(sum, eta1, h1, refl, exposure);
+
+  vec3 final_linear = specular_compose(sum.rv, sum.r, sum.camera, sum.env, specular.params.y, specular.params.z);
+  vec3 radiance = finite3(final_linear) / max(exposure, 1e-6f);
+  imageStore(lit_rv, pixel, vec4(clamp(radiance, vec3(0.0f), vec3(60000.0f)), 1.0f));
+  imageStore(lit_r, pixel, vec4(0.0f, 0.0f, 0.0f, 1.0f));
+}

@@ -1,0 +1,105 @@
+// The specular stage's math (shaders/shared/specular_math.h) on the CPU: what shaders/specular/
+// trace.comp runs for mirrors and glass.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "bsdf.h"
+#include "shared/specular_math.h"
+
+namespace {
+using namespace mrgi::shader;
+
+TEST(SpecularMath, KindsFollowTheMaterial) {
+  EXPECT_EQ(specular_kind(0.0f, 0.0f, 1.0f), SPECULAR_REFRACTIVE);
+  EXPECT_EQ(specular_kind(0.0f, 0.5f, 0.3f), SPECULAR_REFRACTIVE);
+  EXPECT_EQ(specular_kind(1.0f, 0.0f, 0.0f), SPECULAR_REFLECTIVE);
+  EXPECT_EQ(specular_kind(1.0f, 0.1f, 0.0f), SPECULAR_REFLECTIVE);
+  EXPECT_EQ(specular_kind(1.0f, 0.3f, 0.0f), SPECULAR_NONE);   // brushed metal: glossy, not an image
+  EXPECT_EQ(specular_kind(0.0f, 0.0f, 0.0f), SPECULAR_NONE);   // smooth plastic: 4 % reflection
+  EXPECT_EQ(specular_kind(1.0f, 1.0f, 0.0f), SPECULAR_NONE);   // glTF's default material
+}
+
+TEST(SpecularMath, DielectricFresnelMatchesTheReferenceRenderer) {
+  // The path tracer's smooth dielectric (tools/reference/src/bsdf.h) is the ground truth the
+  // suite's glass is rendered with: the same reflectance at every angle, both ways through.
+  for (float eta : {1.0f / 1.5f, 1.5f, 1.0f / 1.33f}) {
+    for (float c = 0.02f; c <= 1.0f; c += 0.07f) {
+      float cos_t = 0.0f;
+      const float reference = mrgi::reference::bsdf_detail::fresnel_dielectric(c, eta, &cos_t);
+      EXPECT_NEAR(fresnel_dielectric(c, eta), reference, 1e-5f) << "eta " << eta << " cos " << c;
+    }
+  }
+  EXPECT_NEAR(fresnel_dielectric(1.0f, 1.0f / 1.5f), 0.04f, 1e-4f);  // ((n - 1) / (n + 1))^2
+  EXPECT_FLOAT_EQ(fresnel_dielectric(0.1f, 1.5f), 1.0f);            // total internal reflection
+}
+
+TEST(SpecularMath, SnellBendsTowardsTheNormalEnteringGlass) {
+  const vec3 n(0.0f, 0.0f, 1.0f);
+  const float s = std::sin(0.6f);
+  const vec3 d = normalize(vec3(s, 0.0f, -std::cos(0.6f)));
+  const vec4 t = refract_or_reflect(d, n, 1.0f / 1.5f);
+  ASSERT_GT(t.w, 0.5f);
+  EXPECT_NEAR(t.x, s / 1.5f, 1e-5f);  // sin(theta_t) = sin(theta_i) / n
+  EXPECT_LT(t.z, 0.0f);               // through the surface
+  EXPECT_NEAR(length(vec3(t)), 1.0f, 1e-5f);
+  // Leaving the glass past the critical angle (41.8 degrees): reflected back inside.
+  const vec3 steep = normalize(vec3(std::sin(0.9f), 0.0f, std::cos(0.9f)));
+  const vec4 tir = refract_or_reflect(steep, -n, 1.5f);
+  EXPECT_EQ(tir.w, 0.0f);
+  EXPECT_NEAR(tir.z, -steep.z, 1e-5f);
+  // A slab with parallel faces: the ray leaves in the direction it came.
+  const vec4 out = refract_or_reflect(vec3(t), n, 1.5f);  // the far face, its normal against the ray
+  ASSERT_GT(out.w, 0.5f);
+  EXPECT_NEAR(out.x, d.x, 1e-5f);
+  EXPECT_NEAR(out.z, d.z, 1e-5f);
+}
+
+TEST(SpecularMath, TransmittanceTintsAtBothInterfacesAndAbsorbsWithDistance) {
+  const vec3 base(0.5f, 1.0f, 1.0f);
+  EXPECT_NEAR(transmittance_colour(base, vec3(1.0f), 0.0f, 3.0f).x, 0.25f, 1e-6f);
+  // Beer: the attenuation colour after attenuation_distance, its square after twice that.
+  const vec3 a = transmittance_colour(vec3(1.0f), vec3(0.5f, 0.8f, 1.0f), 0.1f, 0.2f);
+  EXPECT_NEAR(a.x, 0.25f, 1e-5f);
+  EXPECT_NEAR(a.y, 0.64f, 1e-5f);
+  EXPECT_NEAR(a.z, 1.0f, 1e-6f);
+}
+
+TEST(SpecularMath, ComposeKeepsTheCameraWhereNothingVirtualChangesThePath) {
+  const float eps = 1e-3f, alpha_max = 10.0f;
+  // A real hit lit the same with and without the objects: the camera's colour as it is.
+  const vec3 camera(0.3f, 0.2f, 0.1f);
+  const vec3 l(0.25f, 0.25f, 0.25f);
+  vec3 out = specular_compose(l, l, camera, vec3(0.0f), eps, alpha_max);
+  EXPECT_NEAR(out.x, 0.3f, 1e-6f);
+  EXPECT_NEAR(out.z, 0.1f, 1e-6f);
+  // Half the light with the objects (a virtual shadow on the hit): half the camera's colour.
+  out = specular_compose(0.5f * l, l, camera, vec3(0.0f), eps, alpha_max);
+  EXPECT_NEAR(out.x, 0.15f, 1e-6f);
+  // Every back-projection failed (camera = L'_r): the rendered L'_rv, plus the environment.
+  out = specular_compose(vec3(0.4f), l, l, vec3(0.1f), eps, alpha_max);
+  EXPECT_NEAR(out.y, 0.5f, 1e-6f);
+  // A virtual hit only (L'_r = 0, no camera term): its rendered light.
+  out = specular_compose(vec3(0.2f, 0.3f, 0.4f), vec3(0.0f), vec3(0.0f), vec3(0.0f), eps, alpha_max);
+  EXPECT_NEAR(out.z, 0.4f, 1e-6f);
+}
+
+TEST(SpecularMath, CubeFacesCoverEveryDirectionOnce) {
+  // The face a direction falls on, and its coordinates, agree with the face's own axes: the
+  // centre of face f looks along its forward axis; the image's x grows along right, y along down.
+  for (int f = 0; f < 6; ++f) {
+    const vec3 fwd = specular_face_forward(f), r = specular_face_right(f), dn = specular_face_down(f);
+    EXPECT_NEAR(dot(glm::cross(r, dn), fwd), 1.0f, 1e-6f) << "face " << f << " is right-handed";
+    const vec3 c = specular_cube_face(fwd);
+    EXPECT_EQ(int(c.z), f);
+    EXPECT_NEAR(c.x, 0.5f, 1e-6f);
+    EXPECT_NEAR(c.y, 0.5f, 1e-6f);
+    const vec3 right_edge = specular_cube_face(normalize(fwd + 0.99f * r));
+    EXPECT_EQ(int(right_edge.z), f);
+    EXPECT_NEAR(right_edge.x, 0.995f, 1e-4f);
+    const vec3 bottom = specular_cube_face(normalize(fwd + 0.5f * dn));
+    EXPECT_NEAR(bottom.y, 0.75f, 1e-5f);
+  }
+}
+
+}  // namespace
