@@ -87,6 +87,7 @@ float impostor_gap(SpecularSet s, vec3 o, vec3 d, float t) {
 
 struct Hit {
   bool found;
+  float t;  // along the ray
   vec3 position, normal, albedo;
   bool real;
 };
@@ -123,9 +124,14 @@ Hit trace_impostor(SpecularSet s, vec3 o, vec3 d) {
           float fm = impostor_gap(s, o, d, tm);
           if (fm < 0.0f) { ta = tm; fa = fm; } else { tb = tm; fb = fm; }
         }
-        // A real crossing closes the gap: both ends near the surface relative to the step.
-        float step_len = tb - ta;
-        if (fb - fa <= 4.0f * step_len + 0.02f * tb) {
+        // A crossing of the surface has the impostor's point on the ray, within its texel's size
+        // and what is left of the bracket; at a silhouette the point is on the nearer surface,
+        // off the ray that passed behind it.
+        vec3 q = imageLoad(impostor_position, impostor_texel(s, o + d * tb - s.centre.xyz)).xyz;
+        vec3 oq = q - o;
+        float off_ray = length(oq - d * dot(oq, d));
+        float texel_m = 2.0f * distance(q, s.centre.xyz) / float(s.atlas.z);
+        if (off_ray <= 2.0f * texel_m + (tb - ta)) {
           t_hit = tb;
           break;
         }
@@ -138,6 +144,7 @@ Hit trace_impostor(SpecularSet s, vec3 o, vec3 d) {
   ivec2 texel = impostor_texel(s, o + d * t_hit - s.centre.xyz);
   vec4 p = imageLoad(impostor_position, texel);
   if (!(p.w > 0.5f)) return h;
+  h.t = t_hit;
   h.found = true;
   h.position = p.xyz;
   h.normal = normalize(imageLoad(impostor_normal, texel).xyz);
@@ -233,11 +240,15 @@ int nearest_set(vec3 p) {
   return best;
 }
 
+// The specular objects' pixel bounds this frame (specular.cpp: their boxes projected): only
+// those pixels are dispatched.
+layout(push_constant) uniform Region { ivec4 region; };  // xy first pixel, zw size
+
 void main() {
   frame = frame_ubo;  // MRGI_UNIFORM_COPIES
-  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 pixel = region.xy + ivec2(gl_GlobalInvocationID.xy);
   ivec2 used = frame.internal_output_size.xy;
-  if (any(greaterThanEqual(pixel, used))) return;
+  if (any(greaterThanEqual(pixel, used)) || any(greaterThanEqual(ivec2(gl_GlobalInvocationID.xy), region.zw))) return;
   vec4 vpos = imageLoad(virtual_position, pixel);
   if (!(vpos.w > 1.5f)) return;  // not a specular virtual pixel: the technique's shading stands
   GpuMaterial m = materials[int(vpos.w + 0.5f) - 2];

@@ -76,9 +76,9 @@ struct ImpostorSet {
 
 const std::array<SpecularLevel, 3>& specular_levels() {
   static const std::array<SpecularLevel, 3> levels = {{
-      {"paper", 512, 4, 24, 4, 16},
-      {"high", 256, 2, 16, 3, 12},
-      {"fast", 128, 1, 10, 2, 8},
+      {"paper", 512, 4, 24, 4, 16, 1},
+      {"high", 256, 2, 16, 3, 12, 1},
+      {"fast", 96, 2, 10, 2, 8, 2},
   }};
   return levels;
 }
@@ -96,18 +96,34 @@ struct SpecularStage::Impl {
   gpu::ImageHandle impostor_position, impostor_normal, impostor_albedo, impostor_depth;
   gpu::ImageHandle back_position, back_normal, back_depth;
   gpu::ImageHandle no_shadow;
-  gpu::BufferHandle grid_indices, constants, own_lights;
+  gpu::BufferHandle constants, own_lights;
+  // Per set: the real grid's triangles of each cube face (impostor_cells.comp) and the six
+  // indexed indirect draws; capacity: indices a face can hold (every triangle of the finest grid).
+  std::vector<gpu::BufferHandle> face_indices, face_draws;
+  uint32_t face_capacity = 0;
   gpu::BufferHandle env_grid;  // the light stage's environment grid, copied each frame
   int env_width = 0;           // its width in cells
-  gpu::PipelineHandle indices_pipeline, grid_pipeline, mesh_pipeline, back_pipeline, trace_pipeline;
+  gpu::PipelineHandle cells_pipeline, grid_pipeline, mesh_pipeline, back_pipeline, trace_pipeline;
   VkExtent2D grid_points{0, 0};
   uint32_t grid_stride = 1;
   glm::mat4 world_to_clip{1.0f};  // this frame's camera (the back faces' draw)
+  // What each set's block of the atlas holds: drawn at frame `frame` around `centre` for
+  // `objects` at face size `face` (a set is redrawn when any of them changed or it is
+  // refresh_period frames old).
+  struct DrawnSet {
+    int64_t frame = -1000000;
+    glm::vec3 centre{0.0f};
+    std::vector<size_t> objects;
+    uint32_t face = 0;
+    uint64_t revision = 0;
+  };
+  std::vector<DrawnSet> drawn;
+  int64_t frame = 0;
 
   Status init();
-  void add_grid(gpu::FrameGraph& graph, uint32_t face);
-  void add_impostors(gpu::FrameGraph& graph, const ImpostorSet& set, const glm::ivec2& origin, uint32_t face,
-                     bool first, const std::string& label);
+  void set_grid(gpu::FrameGraph& graph, uint32_t face);
+  void add_impostors(gpu::FrameGraph& graph, const ImpostorSet& set, int index, const glm::ivec2& origin,
+                     uint32_t face, bool first);
   void add_back_faces(gpu::FrameGraph& graph, const std::vector<ObjectInView>& objects);
 };
 
@@ -125,6 +141,7 @@ Status SpecularStage::Impl::init() {
     d.size_mode = gpu::SizeMode::Absolute;
     d.width = 3 * face;
     d.height = 2 * face * uint32_t(sets);
+    d.history = true;  // a set not redrawn this frame (SpecularLevel::refresh_period) is read as it was
     return graph.create_image(d, usage);
   };
   auto p = atlas("specular impostor position", kPositionFormat, colour);
@@ -164,12 +181,22 @@ Status SpecularStage::Impl::init() {
   if (!nsi) return nsi.error();
   no_shadow = *nsi;
 
+  // The finest grid any level draws: a point per texel of the largest face (set_grid).
   const VkExtent2D g = graph.allocated_extent(shared.real_position);
-  const VkDeviceSize cells = VkDeviceSize(std::max(1u, g.width - 1)) * std::max(1u, g.height - 1);
-  auto ib = graph.create_buffer({"specular grid indices", cells * 6 * 4},
-                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
-  if (!ib) return ib.error();
-  grid_indices = *ib;
+  const uint32_t finest = std::max(1u, (std::max(g.width, g.height) + face - 1) / face);
+  const uint64_t cells = uint64_t((g.width - 1) / finest) * uint64_t((g.height - 1) / finest);
+  face_capacity = uint32_t(std::max<uint64_t>(3, cells * 6));
+  for (int i = 0; i < sets; ++i) {
+    auto fi = graph.create_buffer({"specular face indices " + std::to_string(i), VkDeviceSize(face_capacity) * 6 * 4},
+                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
+    if (!fi) return fi.error();
+    face_indices.push_back(*fi);
+    auto fd = graph.create_buffer({"specular face draws " + std::to_string(i), 6 * 20},
+                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
+                                      VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    if (!fd) return fd.error();
+    face_draws.push_back(*fd);
+  }
   auto cb = graph.create_buffer({"specular constants", sizeof(shader::SpecularConstants), gpu::MemoryUsage::Upload, true},
                                 VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   if (!cb) return cb.error();
@@ -185,9 +212,9 @@ Status SpecularStage::Impl::init() {
   if (!eb) return eb.error();
   env_grid = *eb;
 
-  auto ip = gpu::load_compute_pipeline(ctx, "baseline/shadow_caster_indices.comp", {});
+  auto ip = gpu::load_compute_pipeline(ctx, "specular/impostor_cells.comp", {});
   if (!ip) return ip.error();
-  indices_pipeline = std::move(*ip);
+  cells_pipeline = std::move(*ip);
   auto tp = gpu::load_compute_pipeline(ctx, "specular/trace.comp", {});
   if (!tp) return tp.error();
   trace_pipeline = std::move(*tp);
@@ -231,34 +258,50 @@ Status SpecularStage::Impl::init() {
   return ok_status();
 }
 
-void SpecularStage::Impl::add_grid(gpu::FrameGraph& graph, uint32_t face) {
+void SpecularStage::Impl::set_grid(gpu::FrameGraph& graph, uint32_t face) {
   const VkExtent2D g = graph.extent(shared.real_position);
-  // About two grid points per impostor texel across the real G-buffer's larger side (the
-  // impostor's 90 degrees see about as much as the camera's view).
+  // At least one grid point per impostor texel across the real G-buffer's larger side (a face's
+  // 90 degrees see about as much as the camera's view). Coarser grids lose the small real
+  // objects near the mirror or glass: the grid drops its cells across a depth edge, and a 5
+  // pixel cell is the whole top of a 16-pixel box (glass_mirror at half resolution: a stride of
+  // 5 instead of 3 took the glass's RDE from 0.50 to 0.77).
   const uint32_t side = std::max(g.width, g.height);
-  grid_stride = std::max(1u, (side + face / 2 - 1) / std::max(1u, face / 2));
+  grid_stride = std::max(1u, (side + face - 1) / std::max(1u, face));
   grid_points = {(g.width - 1) / grid_stride + 1, (g.height - 1) / grid_stride + 1};
-  const VkExtent2D points = grid_points;
-  const uint32_t st = grid_stride;
-  const gpu::Pipeline* pipe = &*indices_pipeline;
-  const VkSampler nearest = shared.context->samplers().nearest_clamp;
-  graph.add_shader_pass(
-      "specular impostor grid", gpu::PassKind::Compute, *indices_pipeline,
-      [this, nearest](gpu::ShaderPassBuilder& b) {
-        b.bind_sampled("real_position", shared.real_position, nearest);
-        b.bind("Indices", grid_indices);
-      },
-      [pipe, points, st](VkCommandBuffer cmd, gpu::PassContext&) {
-        const glm::ivec4 push(int(points.width), int(points.height), int(st), 0);
-        gpu::push_and_dispatch(cmd, *pipe, &push, sizeof push, {(points.width - 1 + 7) / 8, (points.height - 1 + 7) / 8, 1});
-      });
 }
 
-void SpecularStage::Impl::add_impostors(gpu::FrameGraph& graph, const ImpostorSet& set, const glm::ivec2& origin,
-                                        uint32_t face, bool first, const std::string& label) {
+void SpecularStage::Impl::add_impostors(gpu::FrameGraph& graph, const ImpostorSet& set, int index,
+                                        const glm::ivec2& origin, uint32_t face, bool first) {
   const technique::SceneGpu* sg = shared.scene_gpu;
-  const bool grid = grid_points.width > 1 && grid_points.height > 1;
-  const uint32_t grid_index_count = grid ? (grid_points.width - 1) * (grid_points.height - 1) * 6 : 0;
+  const std::string id = std::to_string(index);
+  const bool grid = grid_points.width > 1 && grid_points.height > 1 &&
+                    uint64_t(grid_points.width - 1) * (grid_points.height - 1) * 6 <= face_capacity;
+  const gpu::BufferHandle indices = face_indices[size_t(index)], draws = face_draws[size_t(index)];
+  if (grid) {
+    // The real grid's triangles of each face, seen from this set's centre.
+    graph.add_pass("specular impostor cells reset " + id, gpu::PassKind::Transfer,
+                   [draws](gpu::PassBuilder& b) { b.write(draws, gpu::Access::TransferDst); },
+                   [draws](VkCommandBuffer cmd, gpu::PassContext& p) { vkCmdFillBuffer(cmd, p.buffer(draws), 0, 6 * 20, 0); });
+    const VkSampler nearest = shared.context->samplers().nearest_clamp;
+    const gpu::Pipeline* pipe = &*cells_pipeline;
+    struct CellsPush {
+      glm::ivec4 grid;
+      glm::vec4 centre;
+    } push{glm::ivec4(int(grid_points.width), int(grid_points.height), int(grid_stride), int(face_capacity)),
+           glm::vec4(set.centre, 0.0f)};
+    const VkExtent2D points = grid_points;
+    graph.add_shader_pass(
+        "specular impostor cells " + id, gpu::PassKind::Compute, *cells_pipeline,
+        [this, nearest, indices, draws](gpu::ShaderPassBuilder& b) {
+          b.bind_sampled("real_position", shared.real_position, nearest);
+          b.bind("FaceIndices", indices);
+          b.bind_over("FaceDraws", draws);
+        },
+        [pipe, push, points](VkCommandBuffer cmd, gpu::PassContext&) {
+          gpu::push_and_dispatch(cmd, *pipe, &push, sizeof push, {(points.width - 1 + 7) / 8, (points.height - 1 + 7) / 8, 1});
+        });
+  }
+  const std::string label = "specular impostors " + id;
   std::vector<bool> excluded(sg->virtual_objects.draws.size(), false);
   for (size_t o : set.objects) {
     const technique::SceneGpu::DrawSpan span = sg->object_draws(o);
@@ -273,11 +316,12 @@ void SpecularStage::Impl::add_impostors(gpu::FrameGraph& graph, const ImpostorSe
   graph.add_pass(
       label, gpu::PassKind::Graphics,
       [=](gpu::PassBuilder& b) {
-        if (grid_index_count > 0) {
+        if (grid) {
           b.read(self->shared.real_position, gpu::Access::Sampled);
           b.read(self->shared.real_normal, gpu::Access::Sampled);
           b.read(self->shared.real_albedo, gpu::Access::Sampled);
-          b.read(self->grid_indices, gpu::Access::IndexBuffer);
+          b.read(indices, gpu::Access::IndexBuffer);
+          b.read(draws, gpu::Access::IndirectRead);
         }
         if (!sg->real_proxies.empty()) {
           b.read(sg->real_proxies.vertices, gpu::Access::VertexBuffer);
@@ -328,7 +372,7 @@ void SpecularStage::Impl::add_impostors(gpu::FrameGraph& graph, const ImpostorSe
           vkCmdSetScissor(cmd, 0, 1, &sc);
           DrawPush push{face_view_proj(centre, f), glm::vec4(centre, 1.0f), glm::vec4(1.0f, 1.0f, 1.0f, -2.0f),
                         glm::vec4(shader::specular_face_forward(f), 1.0f), misc};
-          if (grid_index_count > 0) {
+          if (grid) {
             vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, gp->pipeline);
             const gpu::ShaderInterface& gi = gp->interface;
             gpu::DescriptorPush()
@@ -338,8 +382,8 @@ void SpecularStage::Impl::add_impostors(gpu::FrameGraph& graph, const ImpostorSe
                 .sampled_image(gi.find("base_color_maps")->binding, p.view(sg->base_color_maps), linear)
                 .push(ctx, cmd, *gp);
             vkCmdPushConstants(cmd, gp->layout, gp->stages, 0, sizeof push, &push);
-            vkCmdBindIndexBuffer(cmd, p.buffer(self->grid_indices), 0, VK_INDEX_TYPE_UINT32);
-            vkCmdDrawIndexed(cmd, grid_index_count, 1, 0, 0, 0);
+            vkCmdBindIndexBuffer(cmd, p.buffer(indices), 0, VK_INDEX_TYPE_UINT32);
+            vkCmdDrawIndexedIndirect(cmd, p.buffer(draws), VkDeviceSize(f) * 20, 1, 20);
           }
           vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mp->pipeline);
           const gpu::ShaderInterface& mi = mp->interface;
@@ -480,6 +524,14 @@ Status SpecularStage::record(const shader::FrameConstants& fc, const technique::
     v.refractive = (kinds & (1 << shader::SPECULAR_REFRACTIVE)) != 0;
     in_view.push_back(v);
   }
+  glm::vec2 lo_px(1e30f), hi_px(-1e30f);
+  bool behind = false;
+  for (const ObjectInView& v : in_view) {
+    const technique::ScreenBounds b = technique::project_box(fc, v.lo, v.hi);
+    behind = behind || b.behind;
+    lo_px = glm::min(lo_px, b.min);
+    hi_px = glm::max(hi_px, b.max);
+  }
   if (in_view.empty()) {
     skipped.push_back("specular: no reflective or refractive object in view");
     return ok_status();
@@ -548,10 +600,35 @@ Status SpecularStage::record(const shader::FrameConstants& fc, const technique::
   c->flags = glm::ivec4(direct ? 1 : 0, m.settings.depth_test ? 1 : 0, env_width, 0);
 
   m.world_to_clip = fc.world_to_clip;
-  m.add_grid(graph, face);
-  for (int i = 0; i < set_count; ++i)
-    m.add_impostors(graph, sets[size_t(i)], glm::ivec2(0, int(2 * face) * i), face, i == 0,
-                    "specular impostors " + std::to_string(i));
+  m.set_grid(graph, face);
+  // Redraw the sets whose content changed; of the rest, the oldest one if it is refresh_period
+  // frames old (at most one stale set is refreshed a frame: the fast level spreads the sets over
+  // frames).
+  m.drawn.resize(size_t(m.settings.max_sets));
+  ++m.frame;
+  std::vector<bool> redraw(size_t(set_count), false);
+  int oldest = -1;
+  for (int i = 0; i < set_count; ++i) {
+    const Impl::DrawnSet& d = m.drawn[size_t(i)];
+    const ImpostorSet& s = sets[size_t(i)];
+    const bool changed = d.objects != s.objects || d.face != face || d.revision != sg.revision() ||
+                         glm::any(glm::greaterThan(glm::abs(d.centre - s.centre), glm::vec3(1e-5f)));
+    if (changed || level.refresh_period <= 1) redraw[size_t(i)] = true;
+    else if (m.frame - d.frame >= level.refresh_period && (oldest < 0 || d.frame < m.drawn[size_t(oldest)].frame)) oldest = i;
+  }
+  if (oldest >= 0) redraw[size_t(oldest)] = true;
+  bool first = true;
+  for (int i = 0; i < set_count; ++i) {
+    if (!redraw[size_t(i)]) {
+      skipped.push_back("specular impostors " + std::to_string(i) + ": drawn " +
+                        std::to_string(m.frame - m.drawn[size_t(i)].frame) + " frame(s) ago (refresh period " +
+                        std::to_string(level.refresh_period) + ")");
+      continue;
+    }
+    m.add_impostors(graph, sets[size_t(i)], i, glm::ivec2(0, int(2 * face) * i), face, first);
+    first = false;
+    m.drawn[size_t(i)] = {m.frame, sets[size_t(i)].centre, sets[size_t(i)].objects, face, sg.revision()};
+  }
   bool refractive = false;
   for (const ObjectInView& v : in_view) refractive = refractive || v.refractive;
   if (refractive) m.add_back_faces(graph, in_view);
@@ -559,6 +636,15 @@ Status SpecularStage::record(const shader::FrameConstants& fc, const technique::
 
   const VkSampler compare = m.shared.context->samplers().shadow_compare;
   const VkSampler nearest = m.shared.context->samplers().nearest_clamp;
+  // The dispatch covers the objects' projected boxes (all of the image when a corner is behind
+  // the camera).
+  const glm::ivec2 size(fc.internal_output_size.x, fc.internal_output_size.y);
+  glm::ivec2 r0(0), r1 = size;
+  if (!behind) {
+    r0 = glm::clamp(glm::ivec2(glm::floor(lo_px)) - 1, glm::ivec2(0), size);
+    r1 = glm::clamp(glm::ivec2(glm::ceil(hi_px)) + 2, glm::ivec2(0), size);
+  }
+  const glm::ivec4 region(r0, glm::max(r1 - r0, glm::ivec2(0)));
   Impl* self = &m;
   graph.add_shader_pass(
       "specular trace", gpu::PassKind::Compute, *m.trace_pipeline,
@@ -586,9 +672,9 @@ Status SpecularStage::record(const shader::FrameConstants& fc, const technique::
         b.bind_over("lit_rv", r.lit_rv);
         b.bind_over("lit_r", r.lit_r);
       },
-      [self](VkCommandBuffer cmd, gpu::PassContext& p) {
-        const VkExtent2D e = p.extent(self->shared.lit_rv);
-        gpu::push_and_dispatch(cmd, *self->trace_pipeline, nullptr, 0, {(e.width + 7) / 8, (e.height + 7) / 8, 1});
+      [self, region](VkCommandBuffer cmd, gpu::PassContext&) {
+        gpu::push_and_dispatch(cmd, *self->trace_pipeline, &region, sizeof region,
+                               {(uint32_t(region.z) + 7) / 8, (uint32_t(region.w) + 7) / 8, 1});
       });
   return ok_status();
 }

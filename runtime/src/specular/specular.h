@@ -55,8 +55,13 @@ struct SpecularLevel {
   int search_steps;        // linear search steps along a ray through the impostors
   int refine_steps;        // secant refinements of a bracketed crossing
   int back_face_steps;     // search steps for the refracted ray's exit in the back faces
+  // Frames between redraws of a set whose objects did not move (1: every frame). The impostors
+  // are world-space surfaces, so a set a frame old differs only by what the camera newly sees
+  // of the real scene; at 2, two sets cost one set's drawing a frame.
+  int refresh_period;
 };
-// paper (512^2 impostors, a set per object), high, fast (128^2, one set for all objects).
+// paper (512^2 impostors, a set per object up to four), high (256^2, two sets), fast (96^2, two
+// sets, each redrawn every other frame).
 const std::array<SpecularLevel, 3>& specular_levels();
 // The stage's level for a technique's level: the technique's first level gets the paper's
 // settings, its last two the fast ones, the others high.
