@@ -62,97 +62,7 @@ layout(std430, set = 0, binding = 20) readonly buffer EnvGrid { vec4 env_cells[]
 #include "common/upload_gather.glsl"
 #include "common/shadowed_lamps.glsl"
 
-// ---- impostors ------------------------------------------------------------------------------
-
-// The atlas texel of set s in direction d from its centre.
-ivec2 impostor_texel(SpecularSet s, vec3 d) {
-  vec3 f = specular_cube_face(d);
-  int face = int(f.z);
-  int size = s.atlas.z;
-  ivec2 block = ivec2(face - 3 * (face / 3), face / 3);
-  return s.atlas.xy + block * size + clamp(ivec2(f.xy * float(size)), ivec2(0), ivec2(size - 1));
-}
-
-// Distance from the centre of the impostor surface in the direction of x (1e30: none there).
-float impostor_distance(SpecularSet s, vec3 x) {
-  vec4 p = imageLoad(impostor_position, impostor_texel(s, x - s.centre.xyz));
-  return p.w > 0.5f ? distance(p.xyz, s.centre.xyz) : 1e30f;
-}
-
-// f(t) = |x(t) - c| - impostor distance: < 0 in front of the surface, >= 0 behind it.
-float impostor_gap(SpecularSet s, vec3 o, vec3 d, float t) {
-  vec3 x = o + d * t;
-  return distance(x, s.centre.xyz) - impostor_distance(s, x);
-}
-
-struct Hit {
-  bool found;
-  float t;  // along the ray
-  vec3 position, normal, albedo;
-  bool real;
-};
-
-// The first crossing of the ray o + t d (t > 0) with set s's impostor surface. Linear search at
-// t_k = r u_k / (1 - u_k), u_k uniform up to the impostors' far plane (dense within r of the
-// object, where nearby surfaces bend the reflection most, and reaching a far wall in the last
-// steps), then secant steps on the bracketing interval. A crossing where the gap jumps by more
-// than a step's worth is the silhouette of a nearer surface the ray passes behind (the
-// single-layer impostor's missing back side), not a hit: the search goes on.
-const float kImpostorFar_m = 50.0f;  // specular.cpp's far plane
-Hit trace_impostor(SpecularSet s, vec3 o, vec3 d) {
-  Hit h;
-  h.found = false;
-  int n = max(specular.counts.y, 1);
-  // The search's scale: the object's size, at least a quarter metre (the table it stands on and
-  // the things beside it are that near).
-  float r = max(s.centre.w, 0.25f);
-  float u_max = kImpostorFar_m / (r + kImpostorFar_m);
-  float t_prev = 0.0f;
-  float f_prev = impostor_gap(s, o, d, 1e-4f);
-  float t_hit = -1.0f;
-  if (f_prev >= 0.0f && f_prev < 0.5f * r) {
-    t_hit = 1e-4f;  // the ray starts at or under the surface (an object resting on it)
-  } else {
-    for (int k = 1; k <= n; ++k) {
-      float u = u_max * float(k) / float(n);
-      float t = r * u / (1.0f - u);
-      float f = impostor_gap(s, o, d, t);
-      if (f_prev < 0.0f && f >= 0.0f) {
-        float ta = t_prev, fa = f_prev, tb = t, fb = f;
-        for (int i = 0; i < specular.counts.z; ++i) {
-          float tm = ta + (tb - ta) * clamp(-fa / max(fb - fa, 1e-9f), 0.05f, 0.95f);
-          float fm = impostor_gap(s, o, d, tm);
-          if (fm < 0.0f) { ta = tm; fa = fm; } else { tb = tm; fb = fm; }
-        }
-        // A crossing of the surface has the impostor's point on the ray, within its texel's size
-        // and what is left of the bracket; at a silhouette the point is on the nearer surface,
-        // off the ray that passed behind it.
-        vec3 q = imageLoad(impostor_position, impostor_texel(s, o + d * tb - s.centre.xyz)).xyz;
-        vec3 oq = q - o;
-        float off_ray = length(oq - d * dot(oq, d));
-        float texel_m = 2.0f * distance(q, s.centre.xyz) / float(s.atlas.z);
-        if (off_ray <= 2.0f * texel_m + (tb - ta)) {
-          t_hit = tb;
-          break;
-        }
-      }
-      t_prev = t;
-      f_prev = f;
-    }
-  }
-  if (t_hit < 0.0f) return h;
-  ivec2 texel = impostor_texel(s, o + d * t_hit - s.centre.xyz);
-  vec4 p = imageLoad(impostor_position, texel);
-  if (!(p.w > 0.5f)) return h;
-  h.t = t_hit;
-  h.found = true;
-  h.position = p.xyz;
-  h.normal = normalize(imageLoad(impostor_normal, texel).xyz);
-  if (dot(h.normal, d) > 0.0f) h.normal = -h.normal;  // the side the ray meets
-  h.albedo = imageLoad(impostor_albedo, texel).rgb;
-  h.real = p.w < 1.5f;
-  return h;
-}
+#include "specular/impostor_trace.glsl"
 
 // ---- shading and back-projection --------------------------------------------------------------
 
@@ -273,56 +183,9 @@ void main() {
     float f1 = fresnel_dielectric(cos_v, 1.0f / ior);
     eta1 = vec3(f1);
     // GBuf_refr: Snell at the front face, the exit in the back faces' buffer, Snell there.
-    vec4 t1 = refract_or_reflect(view, n, 1.0f / ior);
-    vec3 exit_p = p;
-    vec3 exit_d = view;  // no back face (an open or one-sided surface): a thin sheet, straight on
-    vec4 back = imageLoad(back_position, pixel);
-    if (back.w > 0.5f && t1.w > 0.5f) {
-      float d_v = distance(back.xyz, p);
-      int steps = max(specular.counts.w, 1);
-      float t_lo = 0.0f, t_hi = -1.0f;
-      vec3 exit_n = imageLoad(back_normal, pixel).xyz;
-      exit_p = back.xyz;
-      for (int k = 1; k <= steps; ++k) {
-        float t = 2.0f * d_v * float(k) / float(steps);
-        vec3 x = p + t1.xyz * t;
-        vec3 c = (frame.world_to_camera * vec4(x, 1.0f)).xyz;
-        vec2 ip = project_pinhole(c, frame.internal_k);
-        if (!(c.z > 0.0f) || any(lessThan(ip, vec2(0.0f))) || any(greaterThanEqual(ip, vec2(used)))) break;
-        vec4 b = imageLoad(back_position, ivec2(ip));
-        if (!(b.w > 0.5f)) { t_hi = t; break; }  // left the object's silhouette
-        float back_depth = (frame.world_to_camera * vec4(b.xyz, 1.0f)).z;
-        if (c.z >= back_depth) { t_hi = t; break; }
-        t_lo = t;
-      }
-      if (t_hi > 0.0f) {
-        for (int i = 0; i < 4; ++i) {  // bisection to the back face
-          float t = 0.5f * (t_lo + t_hi);
-          vec3 x = p + t1.xyz * t;
-          vec3 c = (frame.world_to_camera * vec4(x, 1.0f)).xyz;
-          vec2 ip = project_pinhole(c, frame.internal_k);
-          vec4 b = imageLoad(back_position, clamp(ivec2(ip), ivec2(0), used - 1));
-          bool behind = !(b.w > 0.5f) || c.z >= (frame.world_to_camera * vec4(b.xyz, 1.0f)).z;
-          if (behind) t_hi = t; else t_lo = t;
-        }
-        vec3 x = p + t1.xyz * t_hi;
-        vec2 ip = project_pinhole((frame.world_to_camera * vec4(x, 1.0f)).xyz, frame.internal_k);
-        ivec2 q = clamp(ivec2(ip), ivec2(0), used - 1);
-        vec4 b = imageLoad(back_position, q);
-        exit_p = b.w > 0.5f ? b.xyz : x;
-        if (b.w > 0.5f) exit_n = imageLoad(back_normal, q).xyz;
-      }
-      exit_n = normalize(exit_n);
-      if (dot(exit_n, t1.xyz) < 0.0f) exit_n = -exit_n;  // outward, along the ray
-      vec4 t2 = refract_or_reflect(t1.xyz, -exit_n, ior);
-      // Under total internal reflection the light stays inside; it is followed along the
-      // internal mirror direction from the exit point (one bounce, no further search).
-      exit_d = t2.xyz;
-      float f2 = t2.w > 0.5f ? fresnel_dielectric(max(dot(t1.xyz, exit_n), 0.0f), ior) : 0.0f;
-      eta2 = vec3((1.0f - f1) * (1.0f - f2));
-    } else {
-      eta2 = vec3(1.0f - f1);
-    }
+    Refraction r = refract_through(p, view, n, ior, frame.world_to_clip, used);
+    vec3 exit_p = r.exit_p, exit_d = r.exit_d;
+    eta2 = vec3(r.transmission);
     eta2 *= transmittance_colour(alb.rgb, m.attenuation.rgb, m.specular.z, distance(p, exit_p)) *
             clamp(m.specular.w, 0.0f, 1.0f);
     Hit refr = trace_impostor(s, exit_p + exit_d * 1e-3f, exit_d);
