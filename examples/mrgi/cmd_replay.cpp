@@ -33,7 +33,8 @@ constexpr AblationName<DirAblation> kDirAblations[] = {{"one-shadow-map", &DirAb
 constexpr AblationName<SpecularAblation> kSpecularAblations[] = {
     {"off", &SpecularAblation::off},
     {"no-back-projection", &SpecularAblation::no_back_projection},
-    {"no-depth-test", &SpecularAblation::no_depth_test}};
+    {"no-depth-test", &SpecularAblation::no_depth_test},
+    {"no-caustics", &SpecularAblation::no_caustics}};
 
 template <typename A, size_t N>
 void set_ablations(const std::vector<std::string>& given, const AblationName<A> (&names)[N], A& out) {
@@ -301,7 +302,8 @@ void setup(CLI::App& app) {
                   "mirrors and glass without one of the paper's ideas (mrgi/runtime.h SpecularAblation), any "
                   "technique: off (shaded by the technique as any material), no-back-projection (real surfaces in "
                   "a mirror or through glass show their rendered light, not the camera's colour), no-depth-test "
-                  "(the camera's colour is taken without the depth validity test); comma-separated")
+                  "(the camera's colour is taken without the depth validity test), no-caustics (spot lamps make no caustics "
+                  "through mirrors and glass); comma-separated")
       ->delimiter(',')
       ->check(CLI::IsMember(ablation_names(kSpecularAblations)));
   cmd->add_option("--dir-ablation", opts->dir_ablation,

@@ -26,7 +26,7 @@ struct SpecularConstants {
   vec4 shadow;   // baseline's LevelConstants::shadow for the direct light's maps
   ivec4 flags;   // x 1: lamps lit with shadow maps; y 1: depth validity test on (0: ablation);
                  // z the environment grid's width in cells (EnvGrid, height z / 2; 0: none, the
-                 // environment is env_sh)
+                 // environment is env_sh); w 1: the caustic buffer holds this frame's caustics
   vec4 env_sh[16];  // rgb: the environment's radiance, SH bands 0..3 (shared/mrgi_shared.h basis)
   SpecularSet sets[MRGI_SPECULAR_MAX_SETS];
 };

@@ -45,8 +45,8 @@ layout(set = 0, binding = 7, rgba16f) readonly uniform image2D virtual_albedo;
 layout(set = 0, binding = 8, rgba32f) readonly uniform image2D back_position;
 layout(set = 0, binding = 9, rgba16f) readonly uniform image2D back_normal;
 layout(set = 0, binding = 10, rgba32f) readonly uniform image2D impostor_position;
-layout(set = 0, binding = 11, rgba16f) readonly uniform image2D impostor_normal;
-layout(set = 0, binding = 12, rgba16f) readonly uniform image2D impostor_albedo;
+layout(set = 0, binding = 11, rgba8_snorm) readonly uniform image2D impostor_normal;
+layout(set = 0, binding = 12, rgba8) readonly uniform image2D impostor_albedo;
 layout(set = 0, binding = 13) uniform sampler2DArrayShadow shadow_primary;
 layout(set = 0, binding = 14) uniform sampler2DArrayShadow shadow_virtual;
 layout(set = 0, binding = 15) uniform sampler2DArray shadow_primary_depth;  // one-map ablation only
@@ -57,6 +57,9 @@ layout(set = 0, binding = 19, rgba16f) writeonly uniform image2D lit_r;
 // The light stage's environment grid (light/env_sampler.h: world-space equirectangular cells
 // of filtered radiance, u = 0.5 + atan2(x, -z) / 2 pi, v = acos(y) / pi), flags.z cells wide.
 layout(std430, set = 0, binding = 20) readonly buffer EnvGrid { vec4 env_cells[]; };
+// The spot lamps' caustics on the surfaces the camera sees (caustics.h; flags.w 1 when written
+// this frame): rgb irradiance.
+layout(set = 0, binding = 21, rgba16f) readonly uniform image2D caustics;
 
 #define MRGI_UPLOAD_COLOR_ONLY
 #include "common/upload_gather.glsl"
@@ -101,6 +104,22 @@ vec3 env_cell(int x, int y, int w) {
 
 // L_env of Sec. 4.1.3: the environment's radiance along d, bilinear in the grid (the SH where
 // the stage has no grid: a light estimate without an environment image).
+// The caustic irradiance on x where the camera sees x (the caustic buffer holds the surfaces in
+// view: a hit hidden from the camera or outside the view gets none, the paper's Sec. 5.2
+// reading of CBuf through GBuf_refl and GBuf_refr).
+vec3 caustic_at(vec3 x) {
+  vec3 c = (frame.world_to_camera * vec4(x, 1.0f)).xyz;
+  if (!(c.z > 1e-3f)) return vec3(0.0f);
+  vec2 ip = project_pinhole(c, frame.internal_k);
+  ivec2 used = frame.internal_output_size.xy;
+  if (any(lessThan(ip, vec2(0.0f))) || any(greaterThanEqual(ip, vec2(used)))) return vec3(0.0f);
+  ivec2 q = ivec2(ip);
+  vec4 v = imageLoad(virtual_position, q);
+  float depth = v.w > 0.5f ? (frame.world_to_camera * vec4(v.xyz, 1.0f)).z : imageLoad(real_position, q).w;
+  if (!(depth > 0.0f) || abs(depth - c.z) > specular.params.x * c.z) return vec3(0.0f);
+  return max(imageLoad(caustics, q).rgb, vec3(0.0f));
+}
+
 vec3 environment_radiance(vec3 d) {
   d = normalize(d);
   int w = specular.flags.z;
@@ -130,6 +149,7 @@ void add_path(inout PathSum sum, vec3 w, Hit h, vec3 d, float exposure) {
   }
   vec3 l_rv, l_r;
   shade_hit(h, d, l_rv, l_r);
+  if (specular.flags.w != 0) l_rv += h.albedo * caustic_at(h.position) * (1.0f / MRGI_PI);
   vec3 tm_rv = clamp(l_rv * exposure, vec3(0.0f), vec3(1.0f));
   vec3 tm_r = clamp(l_r * exposure, vec3(0.0f), vec3(1.0f));
   sum.rv += w * tm_rv;

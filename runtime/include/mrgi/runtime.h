@@ -106,7 +106,9 @@ struct SpecularAblation {
   // No depth validity test (Sec. 4.1.3): a back-projected hit takes the camera's colour even
   // where the camera sees another surface there.
   bool no_depth_test = false;
-  bool any() const { return off || no_back_projection || no_depth_test; }
+  // No caustics (Sec. 4.2): a spot lamp's light through a mirror or glass lights nothing.
+  bool no_caustics = false;
+  bool any() const { return off || no_back_projection || no_depth_test || no_caustics; }
 };
 
 // The frame-budget scheduler's constants (scheduler/scheduler.h says how it decides). The

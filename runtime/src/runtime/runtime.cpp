@@ -353,6 +353,7 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
     specular::SpecularSettings ss;
     ss.back_projection = !settings.specular_ablation.no_back_projection;
     ss.depth_test = !settings.specular_ablation.no_depth_test;
+    ss.caustics = !settings.specular_ablation.no_caustics;
     auto spec = specular::SpecularStage::create(shared, ss);
     if (!spec) return spec.error();
     specular_ = std::move(*spec);
@@ -636,9 +637,14 @@ Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, 
                               virtual_gbuffer_->position(), !affected};
     if (affected) {
       const technique::Technique::ComposeTiles tiles = technique_->compose_tiles();
-      ci.tile_args = tiles.args;
-      ci.tile_list = tiles.list;
-      ci.tiles_composed = tiles.composed;
+      // Caustics land where the technique's tiles may not reach: then every pixel is composed.
+      if (!(specular_ && specular_->lights_outside_tiles())) {
+        ci.tile_args = tiles.args;
+        ci.tile_list = tiles.list;
+        ci.tiles_composed = tiles.composed;
+      } else {
+        rec.skipped.push_back("compose tiles: caustics may light pixels outside them, every pixel composed");
+      }
     }
     compose_->record(*graph_, ci);
   }

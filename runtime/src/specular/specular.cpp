@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include <glm/glm.hpp>
@@ -11,6 +12,8 @@
 #include "light/env_sampler.h"
 #include "light/light_stage.h"
 #include "shared/specular_math.h"
+#include "specular/caustics.h"
+#include "specular/mesh_raster.h"
 #include "specular/specular_params.glsl"
 #include "technique/light_set_writer.h"
 #include "technique/scene_gpu.h"
@@ -76,9 +79,9 @@ struct ImpostorSet {
 
 const std::array<SpecularLevel, 3>& specular_levels() {
   static const std::array<SpecularLevel, 3> levels = {{
-      {"paper", 512, 4, 24, 4, 16, 1},
-      {"high", 256, 2, 16, 3, 12, 1},
-      {"fast", 96, 2, 10, 2, 8, 2},
+      {"paper", 512, 4, 24, 4, 16, 1, 512},
+      {"high", 256, 2, 16, 3, 12, 1, 256},
+      {"fast", 96, 2, 10, 2, 8, 2, 0},
   }};
   return levels;
 }
@@ -103,7 +106,9 @@ struct SpecularStage::Impl {
   uint32_t face_capacity = 0;
   gpu::BufferHandle env_grid;  // the light stage's environment grid, copied each frame
   int env_width = 0;           // its width in cells
-  gpu::PipelineHandle cells_pipeline, grid_pipeline, mesh_pipeline, back_pipeline, trace_pipeline;
+  gpu::PipelineHandle cells_pipeline, grid_pipeline, mesh_pipeline, back_pipeline, trace_pipeline, apply_pipeline;
+  std::optional<Caustics> caustics;  // null with SpecularSettings::caustics off
+  bool caustics_recorded = false;    // this frame's record() splatted caustics
   VkExtent2D grid_points{0, 0};
   uint32_t grid_stride = 1;
   glm::mat4 world_to_clip{1.0f};  // this frame's camera (the back faces' draw)
@@ -255,6 +260,14 @@ Status SpecularStage::Impl::init() {
   if (!bpp) return bpp.error();
   back_pipeline = gpu::PipelineHandle(ctx, std::move(*bpp));
   MRGI_TRY(gpu::require_bindings(*back_pipeline, pd.name, {"Materials"}));
+  if (settings.caustics) {
+    auto c = Caustics::create(shared, settings.max_caustic_map, *back_pipeline);
+    if (!c) return c.error();
+    caustics.emplace(std::move(*c));
+    auto ap = gpu::load_compute_pipeline(ctx, "specular/caustic_apply.comp", {});
+    if (!ap) return ap.error();
+    apply_pipeline = std::move(*ap);
+  }
   return ok_status();
 }
 
@@ -412,74 +425,17 @@ void SpecularStage::Impl::add_impostors(gpu::FrameGraph& graph, const ImpostorSe
 }
 
 void SpecularStage::Impl::add_back_faces(gpu::FrameGraph& graph, const std::vector<ObjectInView>& objects) {
-  const technique::SceneGpu* sg = shared.scene_gpu;
-  std::vector<size_t> draws;
-  for (const ObjectInView& o : objects) {
-    if (!o.refractive) continue;
-    const technique::SceneGpu::DrawSpan span = sg->object_draws(o.object);
-    for (size_t d = span.first; d < span.first + span.count; ++d) {
-      const int m = sg->virtual_objects.draws[d].material;
-      if (m >= 0 && size_t(m) < sg->material_specular_kind.size() &&
-          sg->material_specular_kind[size_t(m)] == shader::SPECULAR_REFRACTIVE)
-        draws.push_back(d);
-    }
-  }
-  const Impl* self = this;
-  graph.add_pass(
-      "specular back faces", gpu::PassKind::Graphics,
-      [=](gpu::PassBuilder& b) {
-        b.read(sg->virtual_objects.vertices, gpu::Access::VertexBuffer);
-        b.read(sg->virtual_objects.indices, gpu::Access::IndexBuffer);
-        b.read(sg->materials, gpu::Access::StorageRead);
-        b.write(self->back_position, gpu::Access::ColorAttachmentWrite);
-        b.write(self->back_normal, gpu::Access::ColorAttachmentWrite);
-        b.write(self->back_depth, gpu::Access::DepthAttachmentWrite);
-      },
-      [=](VkCommandBuffer cmd, gpu::PassContext& p) {
-        const gpu::Context& ctx = p.context();
-        const VkExtent2D e = p.extent(self->back_position);
-        VkRenderingAttachmentInfo colour[2];
-        const gpu::ImageHandle targets[2] = {self->back_position, self->back_normal};
-        for (int i = 0; i < 2; ++i) {
-          colour[i] = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-          colour[i].imageView = p.view(targets[i]);
-          colour[i].imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-          colour[i].loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-          colour[i].storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-          colour[i].clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
-        }
-        VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-        depth.imageView = p.view(self->back_depth);
-        depth.imageLayout = gpu::access_info(gpu::PassKind::Graphics, gpu::Access::DepthAttachmentWrite, true, true).layout;
-        depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-        depth.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
-        depth.clearValue.depthStencil = {1.0f, 0};
-        VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-        ri.renderArea = {{0, 0}, e};
-        ri.layerCount = 1;
-        ri.colorAttachmentCount = 2;
-        ri.pColorAttachments = colour;
-        ri.pDepthAttachment = &depth;
-        ctx.fn().cmd_begin_rendering(cmd, &ri);
-        const VkViewport vp{0.0f, 0.0f, float(e.width), float(e.height), 0.0f, 1.0f};
-        const VkRect2D sc{{0, 0}, e};
-        vkCmdSetViewport(cmd, 0, 1, &vp);
-        vkCmdSetScissor(cmd, 0, 1, &sc);
-        const gpu::Pipeline* bp = &*self->back_pipeline;
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, bp->pipeline);
-        gpu::DescriptorPush().storage_buffer(bp->interface.find("Materials")->binding, p.buffer(sg->materials)).push(ctx, cmd, *bp);
-        DrawPush push{self->world_to_clip, glm::vec4(0.0f), glm::vec4(0.0f), glm::vec4(0.0f), glm::ivec4(1, -1, 0, 0)};
-        vkCmdPushConstants(cmd, bp->layout, bp->stages, 0, sizeof push, &push);
-        VkBuffer vb = p.buffer(sg->virtual_objects.vertices);
-        VkDeviceSize offset = 0;
-        vkCmdBindVertexBuffers(cmd, 0, 1, &vb, &offset);
-        vkCmdBindIndexBuffer(cmd, p.buffer(sg->virtual_objects.indices), 0, VK_INDEX_TYPE_UINT32);
-        for (size_t i : draws) {
-          const technique::DrawRange& d = sg->virtual_objects.draws[i];
-          vkCmdDrawIndexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0);
-        }
-        ctx.fn().cmd_end_rendering(cmd);
-      });
+  std::vector<size_t> refractive;
+  for (const ObjectInView& o : objects)
+    if (o.refractive) refractive.push_back(o.object);
+  MeshRaster r;
+  r.name = "specular back faces";
+  r.pipeline = &*back_pipeline;
+  r.colour = {back_position, back_normal};
+  r.depth = back_depth;
+  r.push.view_proj = world_to_clip;
+  r.draws = specular_draws(*shared.scene_gpu, refractive, 1 << shader::SPECULAR_REFRACTIVE);
+  add_mesh_raster(graph, *shared.scene_gpu, r);
 }
 
 SpecularStage::SpecularStage(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -532,6 +488,7 @@ Status SpecularStage::record(const shader::FrameConstants& fc, const technique::
     lo_px = glm::min(lo_px, b.min);
     hi_px = glm::max(hi_px, b.max);
   }
+  m.caustics_recorded = false;
   if (in_view.empty()) {
     skipped.push_back("specular: no reflective or refractive object in view");
     return ok_status();
@@ -634,6 +591,24 @@ Status SpecularStage::record(const shader::FrameConstants& fc, const technique::
   if (refractive) m.add_back_faces(graph, in_view);
   else skipped.push_back("specular back faces: no refractive object in view");
 
+  bool caustics = false;
+  if (m.caustics && level.caustic_map > 0) {
+    std::vector<size_t> objects;
+    glm::vec3 lo(1e30f), hi(-1e30f);
+    for (const ObjectInView& v : in_view) {
+      objects.push_back(v.object);
+      lo = glm::min(lo, v.lo);
+      hi = glm::max(hi, v.hi);
+    }
+    caustics = m.caustics->record(graph, {m.constants, m.impostor_position, m.impostor_normal, m.impostor_albedo},
+                                  lighting.lights, objects, 0.5f * (lo + hi), 0.5f * glm::length(hi - lo),
+                                  level.caustic_map, skipped);
+  } else {
+    skipped.push_back(m.caustics ? "specular caustics: off at this level" : "specular caustics: off (ablation)");
+  }
+  c->flags.w = caustics ? 1 : 0;
+  m.caustics_recorded = caustics;
+  const gpu::ImageHandle caustic_buffer = m.caustics ? m.caustics->buffer() : m.back_position;
   const VkSampler compare = m.shared.context->samplers().shadow_compare;
   const VkSampler nearest = m.shared.context->samplers().nearest_clamp;
   // The dispatch covers the objects' projected boxes (all of the image when a corner is behind
@@ -669,6 +644,7 @@ Status SpecularStage::record(const shader::FrameConstants& fc, const technique::
         b.bind_sampled("shadow_virtual_depth", shadow_virtual, nearest);
         b.bind("color_words", r.color_upload);
         b.bind("EnvGrid", self->env_grid);
+        b.bind("caustics", caustic_buffer);
         b.bind_over("lit_rv", r.lit_rv);
         b.bind_over("lit_r", r.lit_r);
       },
@@ -676,7 +652,27 @@ Status SpecularStage::record(const shader::FrameConstants& fc, const technique::
         gpu::push_and_dispatch(cmd, *self->trace_pipeline, &region, sizeof region,
                                {(uint32_t(region.z) + 7) / 8, (uint32_t(region.w) + 7) / 8, 1});
       });
+  if (caustics) {
+    graph.add_shader_pass(
+        "specular caustic apply", gpu::PassKind::Compute, *m.apply_pipeline,
+        [self, caustic_buffer](gpu::ShaderPassBuilder& b) {
+          const technique::SharedResources& r = self->shared;
+          b.bind("FrameUbo", r.frame_constants);
+          b.bind("caustics", caustic_buffer);
+          b.bind("real_position", r.real_position);
+          b.bind("real_albedo", r.real_albedo);
+          b.bind("virtual_position", r.virtual_position);
+          b.bind("virtual_albedo", r.virtual_albedo);
+          b.bind_over("lit_rv", r.lit_rv);
+        },
+        [self](VkCommandBuffer cmd, gpu::PassContext& p) {
+          const VkExtent2D e = p.extent(self->shared.lit_rv);
+          gpu::push_and_dispatch(cmd, *self->apply_pipeline, nullptr, 0, {(e.width + 7) / 8, (e.height + 7) / 8, 1});
+        });
+  }
   return ok_status();
 }
+
+bool SpecularStage::lights_outside_tiles() const { return impl_->caustics_recorded; }
 
 }  // namespace mrgi::specular

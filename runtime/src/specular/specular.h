@@ -29,8 +29,9 @@
 //   - L_env: the environment's radiance from the light stage's SH (4 bands), not the fish-eye
 //     image itself: the stage keeps no environment texture on the GPU.
 //   - Eq. 9's validity is per path (specular_math.h specular_compose says why).
-//   Caustics (Sec. 4.2) are not built yet: a spot lamp through glass lights nothing behind it
-//   beyond what the technique's shadow maps let through (none: glass casts a full shadow).
+//   - Caustics (Sec. 4.2, caustics.h) add to L_rv; the technique's shadow maps hold the glass as
+//     an opaque caster, so the light it lets through is the caustic's alone. Caustic VPLs
+//     (Sec. 4.2.2: dir's VPLs moved to where the caustics land) are not built yet.
 #pragma once
 #include <array>
 #include <memory>
@@ -59,9 +60,11 @@ struct SpecularLevel {
   // are world-space surfaces, so a set a frame old differs only by what the camera newly sees
   // of the real scene; at 2, two sets cost one set's drawing a frame.
   int refresh_period;
+  uint32_t caustic_map;    // texels per side of each spot lamp's photon maps (0: no caustics)
 };
-// paper (512^2 impostors, a set per object up to four), high (256^2, two sets), fast (96^2, two
-// sets, each redrawn every other frame).
+// paper (512^2 impostors, a set per object up to four, 512^2 caustic maps), high (256^2, two
+// sets, 256^2 caustic maps), fast (96^2, two sets, each redrawn every other frame, no caustics:
+// at 64^2 they cost 3.9 ms and took glass_mirror's fastest dir frame from 30 to 36 ms).
 const std::array<SpecularLevel, 3>& specular_levels();
 // The stage's level for a technique's level: the technique's first level gets the paper's
 // settings, its last two the fast ones, the others high.
@@ -77,6 +80,8 @@ struct SpecularSettings {
   // Fraction of the depth within which a back-projected hit must meet the real G-buffer's depth
   // (sensor noise and the impostor's texel size).
   float depth_tolerance = 0.04f;
+  bool caustics = true;                 // false: no caustic maps (the ablation no-caustics)
+  uint32_t max_caustic_map = 512;       // allocated texels per side of the photon maps
 };
 
 class SpecularStage {
@@ -89,6 +94,9 @@ class SpecularStage {
   // "specular: <reason>" to `skipped`. `fc` is this frame's FrameConstants.
   Status record(const shader::FrameConstants& fc, const technique::Technique& technique, int technique_level,
                 std::vector<std::string>& skipped);
+  // After record(): this frame's caustics may have lit pixels outside the technique's compose
+  // tiles (Technique::compose_tiles): the frame must be composed everywhere.
+  bool lights_outside_tiles() const;
 
  private:
   struct Impl;

@@ -1,0 +1,261 @@
+#include "specular/caustics.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "gi/rsm.h"
+#include "gpu/shaders.h"
+#include "shared/specular_math.h"
+#include "specular/mesh_raster.h"
+#include "technique/scene_gpu.h"
+
+namespace mrgi::specular {
+namespace {
+
+constexpr VkFormat kPositionFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+constexpr VkFormat kNormalFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+constexpr VkFormat kCausticFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
+constexpr VkDeviceSize kPhotonBytes = 48;  // photons.comp's Photon
+
+// photons.comp's push block.
+struct PhotonPush {
+  glm::mat4 view_proj;
+  glm::vec4 position;   // xyz lamp; w map size
+  glm::vec4 intensity;  // rgb W/sr; w 2 tan(half field of view)
+  glm::vec4 axis;       // xyz spot direction; w cos inner
+  glm::vec4 cone;       // x cos outer; yzw the map's axis
+};
+static_assert(sizeof(PhotonPush) == 128, "the guaranteed push-constant size");
+
+glm::vec3 any_up(const glm::vec3& forward) {
+  return std::abs(forward.y) > 0.9f ? glm::vec3(1.0f, 0.0f, 0.0f) : glm::vec3(0.0f, 1.0f, 0.0f);
+}
+
+}  // namespace
+
+Expected<Caustics> Caustics::create(const technique::SharedResources& shared, uint32_t max_map_size,
+                                    const gpu::Pipeline& back_faces) {
+  if (max_map_size < 16 || max_map_size > 2048) return fail(ErrorKind::BadUsage, "caustic map size: must be 16..2048 texels");
+  Caustics c;
+  c.shared_ = shared;
+  c.max_map_ = max_map_size;
+  c.back_faces_ = &back_faces;
+  gpu::FrameGraph& graph = *shared.graph;
+  const gpu::Context& ctx = *shared.context;
+  const VkImageUsageFlags colour = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_STORAGE_BIT;
+  auto map = [&](const char* name, VkFormat f, VkImageUsageFlags usage) -> Expected<gpu::ImageHandle> {
+    gpu::ImageDesc d;
+    d.name = name;
+    d.format = f;
+    d.size_mode = gpu::SizeMode::Absolute;
+    d.width = d.height = max_map_size;
+    return graph.create_image(d, usage);
+  };
+  auto p = map("specular photon position", kPositionFormat, colour);
+  if (!p) return p.error();
+  c.position_ = *p;
+  auto n = map("specular photon normal", kNormalFormat, colour);
+  if (!n) return n.error();
+  c.normal_ = *n;
+  auto bp = map("specular photon back position", kPositionFormat, colour);
+  if (!bp) return bp.error();
+  c.back_position_ = *bp;
+  auto bn = map("specular photon back normal", kNormalFormat, colour);
+  if (!bn) return bn.error();
+  c.back_normal_ = *bn;
+  auto d = map("specular photon depth", kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
+  if (!d) return d.error();
+  c.depth_ = *d;
+  gpu::ImageDesc cd;
+  cd.name = "specular caustics";
+  cd.format = kCausticFormat;  // OutputRelative, following the render scale
+  auto cb = graph.create_image(cd, colour);
+  if (!cb) return cb.error();
+  c.caustics_ = *cb;
+  auto pb = graph.create_buffer({"specular photons", VkDeviceSize(max_map_size) * max_map_size * 2 * kPhotonBytes},
+                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  if (!pb) return pb.error();
+  c.photons_ = *pb;
+  auto lb = graph.create_buffer({"specular photon list", VkDeviceSize(max_map_size) * max_map_size * 2 * 4},
+                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  if (!lb) return lb.error();
+  c.photon_list_ = *lb;
+  auto db = graph.create_buffer({"specular photon draw", 16},
+                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
+                                    VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  if (!db) return db.error();
+  c.photon_draw_ = *db;
+
+  auto pp = gpu::load_compute_pipeline(ctx, "specular/photons.comp", {});
+  if (!pp) return pp.error();
+  c.photon_pipeline_ = std::move(*pp);
+  auto mesh_vs = gpu::shader_spirv("gi/rsm_mesh.vert");
+  if (!mesh_vs) return mesh_vs.error();
+  auto surface_fs = gpu::shader_spirv("specular/photon_surface.frag");
+  if (!surface_fs) return surface_fs.error();
+  gpu::GraphicsPipelineDesc pd;
+  pd.name = "specular photon surfaces";
+  pd.vertex_spirv = *mesh_vs;
+  pd.fragment_spirv = *surface_fs;
+  pd.vertex_strides = {sizeof(technique::GpuVertex)};
+  pd.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
+                   {1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12},
+                   {2, 0, VK_FORMAT_R32G32_SFLOAT, 24}};
+  pd.color_formats = {kPositionFormat, kNormalFormat};
+  pd.depth_format = kDepthFormat;
+  pd.cull_mode = VK_CULL_MODE_BACK_BIT;
+  auto sp = gpu::create_graphics_pipeline(ctx, pd);
+  if (!sp) return sp.error();
+  c.surface_pipeline_ = gpu::PipelineHandle(ctx, std::move(*sp));
+  MRGI_TRY(gpu::require_bindings(*c.surface_pipeline_, pd.name, {"Materials"}));
+  auto splat_vs = gpu::shader_spirv("specular/caustic_splat.vert");
+  if (!splat_vs) return splat_vs.error();
+  auto splat_fs = gpu::shader_spirv("specular/caustic_splat.frag");
+  if (!splat_fs) return splat_fs.error();
+  gpu::GraphicsPipelineDesc sd;
+  sd.name = "specular caustic splat";
+  sd.vertex_spirv = *splat_vs;
+  sd.fragment_spirv = *splat_fs;
+  sd.color_formats = {kCausticFormat};
+  sd.depth_test = false;
+  sd.depth_write = false;
+  sd.cull_mode = VK_CULL_MODE_NONE;
+  sd.additive_blend = true;
+  auto spl = gpu::create_graphics_pipeline(ctx, sd);
+  if (!spl) return spl.error();
+  c.splat_pipeline_ = gpu::PipelineHandle(ctx, std::move(*spl));
+  return c;
+}
+
+bool Caustics::record(gpu::FrameGraph& graph, const Impostors& imp, const std::vector<LightDesc>& lamps,
+                      const std::vector<size_t>& objects, const glm::vec3& centre, float radius, uint32_t map_size,
+                      std::vector<std::string>& skipped) {
+  const technique::SceneGpu& sg = *shared_.scene_gpu;
+  const uint32_t size = std::min(map_size, max_map_);
+  // The strongest spot lamps whose cone meets the objects' sphere and that are outside it.
+  std::vector<const LightDesc*> chosen;
+  for (const LightDesc& l : lamps) {
+    if (l.type != LightType::Spot || !(l.intensity > 0.0f)) continue;
+    if (glm::distance(l.position, centre) <= 1.05f * radius || !gi::lamp_reaches_sphere(l, centre, radius)) continue;
+    chosen.push_back(&l);
+  }
+  std::sort(chosen.begin(), chosen.end(), [](const LightDesc* a, const LightDesc* b) {
+    return glm::dot(a->color, glm::vec3(1.0f)) * a->intensity > glm::dot(b->color, glm::vec3(1.0f)) * b->intensity;
+  });
+  if (chosen.size() > size_t(kMaxLamps)) {
+    skipped.push_back("specular caustics: " + std::to_string(chosen.size() - size_t(kMaxLamps)) +
+                      " weaker spot lamp(s) beyond the " + std::to_string(kMaxLamps) + " with caustic maps");
+    chosen.resize(size_t(kMaxLamps));
+  }
+  if (chosen.empty()) {
+    skipped.push_back("specular caustics: no spot lamp's cone holds a reflective or refractive object");
+    return false;
+  }
+  const std::vector<size_t> front = specular_draws(sg, objects, (1 << shader::SPECULAR_REFLECTIVE) | (1 << shader::SPECULAR_REFRACTIVE));
+  const std::vector<size_t> back = specular_draws(sg, objects, 1 << shader::SPECULAR_REFRACTIVE);
+  // Quads between 1.5 pixels and a fortieth of the image's width (caustic_splat.vert sizes each
+  // by its photon's spacing; larger ones cost more in overdraw than the smoothness they add).
+  const VkExtent2D internal = graph.extent(shared_.lit_rv);
+  const float quad_min_px = 1.5f, quad_max_px = std::max(4.0f, float(internal.width) / 40.0f);
+  for (size_t li = 0; li < chosen.size(); ++li) {
+    const LightDesc& lamp = *chosen[li];
+    const std::string id = std::to_string(li);
+    const glm::vec3 to = centre - lamp.position;
+    const float dist = glm::length(to);
+    const glm::vec3 axis = to / dist;
+    const float half = std::asin(std::min(radius / dist, 0.97f));
+    const glm::mat4 view_proj = glm::perspective(2.0f * half, 1.0f, 0.01f, dist + radius) *
+                                glm::lookAt(lamp.position, centre, any_up(axis));
+    MeshRaster r;
+    r.name = "specular photon surfaces " + id;
+    r.pipeline = &*surface_pipeline_;
+    r.colour = {position_, normal_};
+    r.depth = depth_;
+    r.extent = {size, size};
+    r.push.view_proj = view_proj;
+    r.push.light = glm::vec4(lamp.position, 1.0f);
+    r.draws = front;
+    add_mesh_raster(graph, sg, r);
+    if (!back.empty()) {
+      r.name = "specular photon back faces " + id;
+      r.pipeline = back_faces_;
+      r.colour = {back_position_, back_normal_};
+      r.draws = back;
+      add_mesh_raster(graph, sg, r);
+    }
+    const glm::vec3 dir = glm::normalize(lamp.direction);
+    const PhotonPush push{view_proj, glm::vec4(lamp.position, float(size)),
+                          glm::vec4(lamp.color * lamp.intensity, 2.0f * std::tan(half)),
+                          glm::vec4(dir, std::cos(glm::radians(lamp.inner_angle_deg))),
+                          glm::vec4(std::cos(glm::radians(lamp.outer_angle_deg)), axis)};
+    const gpu::BufferHandle draw = photon_draw_;
+    graph.add_pass("specular photons reset " + id, gpu::PassKind::Transfer,
+                   [draw](gpu::PassBuilder& b) { b.write(draw, gpu::Access::TransferDst); },
+                   [draw](VkCommandBuffer cmd, gpu::PassContext& p) { vkCmdFillBuffer(cmd, p.buffer(draw), 0, 16, 0); });
+    const gpu::Pipeline* pp = &*photon_pipeline_;
+    const bool has_back = !back.empty();
+    graph.add_shader_pass(
+        "specular photons " + id, gpu::PassKind::Compute, *photon_pipeline_,
+        [this, imp, has_back](gpu::ShaderPassBuilder& b) {
+          b.bind("SpecularUbo", imp.constants);
+          b.bind("Materials", shared_.scene_gpu->materials);
+          b.bind("photon_position", position_);
+          b.bind("photon_normal", normal_);
+          // Without a refractive object the back faces are never read: the front ones stand in.
+          b.bind("back_position", has_back ? back_position_ : position_);
+          b.bind("back_normal", has_back ? back_normal_ : normal_);
+          b.bind("impostor_position", imp.position);
+          b.bind("impostor_normal", imp.normal);
+          b.bind("impostor_albedo", imp.albedo);
+          b.bind("Photons", photons_);
+          b.bind("PhotonList", photon_list_);
+          b.bind_over("PhotonDraw", photon_draw_);
+        },
+        [pp, push, size](VkCommandBuffer cmd, gpu::PassContext&) {
+          gpu::push_and_dispatch(cmd, *pp, &push, sizeof push, {(size + 7) / 8, (size + 7) / 8, 1});
+        });
+    const bool first = li == 0;
+    const gpu::Pipeline* splat = &*splat_pipeline_;
+    const glm::vec4 splat_push(quad_min_px, float(size), quad_max_px, 0.0f);
+    graph.add_shader_pass(
+        "specular caustic splat " + id, gpu::PassKind::Graphics, *splat_pipeline_,
+        [this, first](gpu::ShaderPassBuilder& b) {
+          b.bind("FrameUbo", shared_.frame_constants);
+          b.bind("Photons", photons_);
+          b.bind("PhotonList", photon_list_);
+          b.uses().read(photon_draw_, gpu::Access::IndirectRead);
+          b.bind("real_position", shared_.real_position);
+          b.bind("virtual_position", shared_.virtual_position);
+          b.uses().write(caustics_, first ? gpu::Access::ColorAttachmentWrite : gpu::Access::ColorAttachmentReadWrite);
+        },
+        [this, splat, splat_push, first](VkCommandBuffer cmd, gpu::PassContext& p) {
+          const gpu::Context& ctx = p.context();
+          const VkExtent2D e = p.extent(caustics_);
+          VkRenderingAttachmentInfo colour{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+          colour.imageView = p.view(caustics_);
+          colour.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+          colour.loadOp = first ? VK_ATTACHMENT_LOAD_OP_CLEAR : VK_ATTACHMENT_LOAD_OP_LOAD;
+          colour.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+          colour.clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
+          VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+          ri.renderArea = {{0, 0}, e};
+          ri.layerCount = 1;
+          ri.colorAttachmentCount = 1;
+          ri.pColorAttachments = &colour;
+          ctx.fn().cmd_begin_rendering(cmd, &ri);
+          const VkViewport vp{0.0f, 0.0f, float(e.width), float(e.height), 0.0f, 1.0f};
+          const VkRect2D sc{{0, 0}, e};
+          vkCmdSetViewport(cmd, 0, 1, &vp);
+          vkCmdSetScissor(cmd, 0, 1, &sc);
+          vkCmdPushConstants(cmd, splat->layout, splat->stages, 0, sizeof splat_push, &splat_push);
+          vkCmdDrawIndirect(cmd, p.buffer(photon_draw_), 0, 1, 16);
+          ctx.fn().cmd_end_rendering(cmd);
+        });
+  }
+  return true;
+}
+
+}  // namespace mrgi::specular

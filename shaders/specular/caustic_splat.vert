@@ -1,0 +1,57 @@
+#version 460
+// Caustic photons splatted as quads into the caustic buffer CBuf at the camera's internal
+// resolution (caustics-DIR paper Sec. 5.2; Wyman and Davis 2006, quad sizes after Wyman 2008):
+// six vertices a photon that landed (photons.comp lists them), a quad of `quad_px` pixels around where it landed, each of its pixels
+// given E = flux / (the quad's area on the surface), so the buffer holds irradiance and the
+// photons' energy is kept whatever the quad size. Photons that landed nowhere are dropped
+// outside the clip volume.
+#extension GL_GOOGLE_include_directive : require
+#include "common/frame_constants.glsl"
+
+layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
+struct Photon {
+  vec4 position;  // xyz world hit; w 0 none, 1 real, 2 virtual
+  vec4 flux;      // rgb W
+  vec4 normal;
+};
+layout(std430, set = 0, binding = 1) readonly buffer Photons { Photon photons[]; };
+layout(std430, set = 0, binding = 4) readonly buffer PhotonList { uint photon_list[]; };  // photons.comp
+layout(push_constant) uniform Splat { vec4 splat; };  // x smallest quad side (internal pixels),
+                                                     // y photon map size (texels), z largest side
+layout(location = 0) flat out vec4 out_irradiance;   // rgb W/m^2; w the photon's camera depth
+
+// Where the neighbouring texel's photon of the same kind landed, or the photon's own place.
+vec3 neighbour(int index, ivec2 step, vec3 own) {
+  int size = int(splat.y);
+  int i = index / 2, kind = index - 2 * i;
+  ivec2 t = ivec2(i % size, i / size) + step;
+  if (any(greaterThanEqual(t, ivec2(size)))) return own;
+  Photon n = photons[2 * (t.y * size + t.x) + kind];
+  return n.position.w > 0.5f ? n.position.xyz : own;
+}
+
+void main() {
+  int index = int(photon_list[gl_VertexIndex / 6]);
+  Photon ph = photons[index];
+  int corner = gl_VertexIndex % 6;
+  gl_Position = vec4(2.0f, 2.0f, 2.0f, 1.0f);  // outside: dropped
+  out_irradiance = vec4(0.0f);
+  if (!(ph.position.w > 0.5f)) return;
+  vec3 c = (frame.world_to_camera * vec4(ph.position.xyz, 1.0f)).xyz;
+  if (!(c.z > 1e-3f)) return;
+  vec3 to_camera = normalize(frame.camera_world.xyz - ph.position.xyz);
+  float cos_view = max(abs(dot(normalize(ph.normal.xyz), to_camera)), 0.1f);
+  float px_m = c.z / frame.internal_k.x;  // a pixel's side on a surface facing the camera
+  // The quad covers the photon's share of the surface: the distance to where the neighbouring
+  // texels' photons landed (a ray differential: small where the object focuses the light, the
+  // caustic's sharp core; large where it spreads it, whose few photons would otherwise be dots).
+  vec3 p = ph.position.xyz;
+  float spacing = max(distance(neighbour(index, ivec2(1, 0), p), p), distance(neighbour(index, ivec2(0, 1), p), p));
+  float side = clamp(spacing / px_m, splat.x, splat.z);
+  float area = side * side * px_m * px_m / cos_view;
+  out_irradiance = vec4(ph.flux.rgb / area, c.z);
+  vec4 clip = frame.world_to_clip * vec4(ph.position.xyz, 1.0f);
+  const vec2 offsets[6] = vec2[6](vec2(-1, -1), vec2(1, -1), vec2(1, 1), vec2(-1, -1), vec2(1, 1), vec2(-1, 1));
+  vec2 ndc_per_px = 2.0f / vec2(frame.internal_output_size.xy);
+  gl_Position = clip + vec4(offsets[corner] * 0.5f * side * ndc_per_px * clip.w, 0.0f, 0.0f);
+}
