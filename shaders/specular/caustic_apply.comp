@@ -22,7 +22,8 @@ void main() {
   vec4 e = imageLoad(caustics, pixel);
   if (!(e.a > 0.0f)) return;
   vec4 v = imageLoad(virtual_position, pixel);
-  if (v.w > 1.5f) return;  // a mirror or glass pixel: its hits took their caustics
+  if (v.w > 1.5f) return;  // a mirror or glass pixel: its hits took their caustics (the real
+                           // surface's under it are read through it, trace.comp)
   vec3 albedo;
   if (v.w > 0.5f) {
     vec4 a = imageLoad(virtual_albedo, pixel);

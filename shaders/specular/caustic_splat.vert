@@ -19,6 +19,7 @@ layout(std430, set = 0, binding = 4) readonly buffer PhotonList { uint photon_li
 layout(push_constant) uniform Splat { vec4 splat; };  // x smallest quad side (internal pixels),
                                                      // y photon map size (texels), z largest side
 layout(location = 0) flat out vec4 out_irradiance;   // rgb W/m^2; w the photon's camera depth
+layout(location = 1) flat out float out_real;        // 1: it landed on a real surface
 
 // Where the neighbouring texel's photon of the same kind landed, or the photon's own place.
 vec3 neighbour(int index, ivec2 step, vec3 own) {
@@ -50,6 +51,7 @@ void main() {
   float side = clamp(spacing / px_m, splat.x, splat.z);
   float area = side * side * px_m * px_m / cos_view;
   out_irradiance = vec4(ph.flux.rgb / area, c.z);
+  out_real = ph.position.w < 1.5f ? 1.0f : 0.0f;
   vec4 clip = frame.world_to_clip * vec4(ph.position.xyz, 1.0f);
   const vec2 offsets[6] = vec2[6](vec2(-1, -1), vec2(1, -1), vec2(1, 1), vec2(-1, -1), vec2(1, 1), vec2(-1, 1));
   vec2 ndc_per_px = 2.0f / vec2(frame.internal_output_size.xy);

@@ -104,10 +104,11 @@ vec3 env_cell(int x, int y, int w) {
 
 // L_env of Sec. 4.1.3: the environment's radiance along d, bilinear in the grid (the SH where
 // the stage has no grid: a light estimate without an environment image).
-// The caustic irradiance on x where the camera sees x (the caustic buffer holds the surfaces in
-// view: a hit hidden from the camera or outside the view gets none, the paper's Sec. 5.2
-// reading of CBuf through GBuf_refl and GBuf_refr).
-vec3 caustic_at(vec3 x) {
+// The caustic irradiance on x (a real or a virtual surface) where the camera sees it, or sees it
+// through a mirror or glass (the caustic buffer holds those: caustic_splat.frag); a hit outside
+// the view or hidden behind something else gets none (the paper's Sec. 5.2 reading of CBuf
+// through GBuf_refl and GBuf_refr).
+vec3 caustic_at(vec3 x, bool real) {
   vec3 c = (frame.world_to_camera * vec4(x, 1.0f)).xyz;
   if (!(c.z > 1e-3f)) return vec3(0.0f);
   vec2 ip = project_pinhole(c, frame.internal_k);
@@ -115,7 +116,8 @@ vec3 caustic_at(vec3 x) {
   if (any(lessThan(ip, vec2(0.0f))) || any(greaterThanEqual(ip, vec2(used)))) return vec3(0.0f);
   ivec2 q = ivec2(ip);
   vec4 v = imageLoad(virtual_position, q);
-  float depth = v.w > 0.5f ? (frame.world_to_camera * vec4(v.xyz, 1.0f)).z : imageLoad(real_position, q).w;
+  if (real && v.w > 0.5f && v.w < 1.5f) return vec3(0.0f);  // covered by a diffuse virtual object
+  float depth = real ? imageLoad(real_position, q).w : (v.w > 0.5f ? (frame.world_to_camera * vec4(v.xyz, 1.0f)).z : 0.0f);
   if (!(depth > 0.0f) || abs(depth - c.z) > specular.params.x * c.z) return vec3(0.0f);
   return max(imageLoad(caustics, q).rgb, vec3(0.0f));
 }
@@ -149,7 +151,7 @@ void add_path(inout PathSum sum, vec3 w, Hit h, vec3 d, float exposure) {
   }
   vec3 l_rv, l_r;
   shade_hit(h, d, l_rv, l_r);
-  if (specular.flags.w != 0) l_rv += h.albedo * caustic_at(h.position) * (1.0f / MRGI_PI);
+  if (specular.flags.w != 0) l_rv += h.albedo * caustic_at(h.position, h.real) * (1.0f / MRGI_PI);
   vec3 tm_rv = clamp(l_rv * exposure, vec3(0.0f), vec3(1.0f));
   vec3 tm_r = clamp(l_r * exposure, vec3(0.0f), vec3(1.0f));
   sum.rv += w * tm_rv;
