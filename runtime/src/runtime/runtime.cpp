@@ -589,7 +589,9 @@ Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, 
   // A frame nothing virtual affects is the camera frame (the lean skeleton above): the
   // reconstruction is not needed for it; its temporal history restarts on the next affected
   // frame (one frame of unfiltered depth).
-  const bool recon_used = technique_->uses_reconstruction();
+  // The specular stage's impostors and back-projection read the reconstruction's G-buffer, so it
+  // runs for a technique without one (ssrt) when a mirror or glass object is in the scene.
+  const bool recon_used = technique_->uses_reconstruction() || specular_ != nullptr;
   if (affected && recon_used) {
     recon_->record(*graph_, frame_constants_);
   } else {

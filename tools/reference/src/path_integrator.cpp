@@ -366,4 +366,127 @@ size_t Integrator::render_pixel(int x, int y, RenderOutput& out) const {
   return dropped;
 }
 
+size_t Integrator::trace_light_paths(size_t light_index, uint64_t first, uint64_t count, uint64_t count_total,
+                                     bool combined, std::vector<double>& accum) const {
+  const RefLight& light = scene_.lights[light_index];
+  if (light.type == RefLightType::Directional || (light.is_virtual && !combined) || camera_.model != RefCamera::Model::Pinhole)
+    return 0;
+  // The cone of directions from the lamp that holds every delta-material mesh (paths whose first
+  // vertex is not delta are the pixel estimator's: leaving them out of the emission keeps the
+  // estimate unbiased and puts every photon where it counts).
+  glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+  bool any = false;
+  for (int part = 0; part < (combined ? 2 : 1); ++part)
+    for (const RefMesh& m : part == 0 ? scene_.real_meshes : scene_.virtual_meshes) {
+      const MaterialType t = scene_.materials[m.material].type;
+      if (t != MaterialType::Mirror && t != MaterialType::Glass) continue;
+      for (const glm::vec3& p : m.positions) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+        any = true;
+      }
+    }
+  if (!any) return 0;
+  const glm::vec3 centre = 0.5f * (lo + hi);
+  const float radius = 0.5f * glm::length(hi - lo);
+  const glm::vec3 to = centre - light.position;
+  const float dist = glm::length(to);
+  const glm::vec3 axis = dist > 0.0f ? to / dist : glm::vec3(0.0f, -1.0f, 0.0f);
+  const float cos_max = dist > radius ? std::sqrt(std::max(0.0f, 1.0f - radius * radius / (dist * dist))) : -1.0f;
+  const float cone_sr = 2.0f * kPi * (1.0f - cos_max);
+  const Frame3 cone_frame(axis);
+  const Intrinsics& k = camera_.pinhole;
+  const int w = k.width, h = k.height;
+  const glm::mat3 world_to_cam = glm::transpose(cam_rot_);
+  const uint64_t light_key = hash_key(hash_key(frame_key_, 0x6C74ull), light_index);
+  size_t dropped = 0;
+  for (uint64_t i = first; i < first + count; ++i) {
+    const SampleRng rng{hash_key(light_key, i)};
+    const glm::vec2 u = rng.uniform2(dims::kPixelJitter);
+    const float cos_t = 1.0f - u.x * (1.0f - cos_max), sin_t = std::sqrt(std::max(0.0f, 1.0f - cos_t * cos_t));
+    const float phi = 2.0f * kPi * u.y;
+    glm::vec3 d = glm::normalize(cone_frame.to_world(glm::vec3(sin_t * std::cos(phi), sin_t * std::sin(phi), cos_t)));
+    glm::vec3 power = light.intensity * (cone_sr / float(count_total));
+    if (light.type == RefLightType::Spot)
+      power *= spot_falloff(glm::dot(d, glm::normalize(light.direction)), light.cos_outer, light.cos_inner);
+    if (max_component(power) <= 0.0f) continue;
+    glm::vec3 o = light.position;
+    bool after_delta = false;
+    for (int bounce = 0; bounce <= settings_.max_depth; ++bounce) {
+      const Hit hit = intersect(o, d, kInf, combined);
+      if (!hit.found) break;
+      const SurfacePoint s = surface(hit, o, d);
+      const ShadingPoint sp = shading(s);
+      if (bounce == 0 && !sp.is_delta()) break;  // the pixel estimator's path
+      const glm::vec3 wi = -d;                    // towards where the light came from
+      const bool front = glm::dot(s.ng, wi) >= 0.0f;
+      const glm::vec3 n_facing = front ? s.ng : -s.ng;
+      const glm::vec3 ns_facing = front ? s.ns : -s.ns;
+      if (!sp.is_delta() && after_delta) {
+        // Connect to the camera: pixel j gets power f cos_o / (d^2 Omega_j), Omega_j the pixel's
+        // solid angle cos^3 / (fx fy) (a box filter over the pixel, as the jittered camera rays).
+        const glm::vec3 to_cam = cam_pos_ - s.p;
+        const float d2 = glm::dot(to_cam, to_cam);
+        const glm::vec3 wo = to_cam / std::sqrt(d2);
+        const glm::vec3 c = world_to_cam * (-to_cam);
+        if (c.z > 0.0f && glm::dot(wo, n_facing) > 0.0f) {
+          const double px = k.fx * c.x / c.z + k.cx, py = k.fy * c.y / c.z + k.cy;
+          const int x = int(std::floor(px + 0.5)), y = int(std::floor(py + 0.5));
+          if (x >= 0 && y >= 0 && x < w && y < h) {
+            const Frame3 frame(ns_facing);
+            float pdf;
+            const glm::vec3 f = bsdf_eval_local(sp, frame.to_local(wo), frame.to_local(wi), &pdf);
+            const float cos_c = c.z / std::sqrt(d2);
+            const float cos_o = std::max(glm::dot(frame.to_local(wo), glm::vec3(0.0f, 0.0f, 1.0f)), 0.0f);
+            const float omega = cos_c * cos_c * cos_c / float(k.fx * k.fy);
+            const glm::vec3 value = power * f * cos_o / (d2 * omega);
+            bool unused = false;
+            if (max_component(value) > 0.0f &&
+                !occluded(s.p + n_facing * ray_epsilon(s.p), wo, std::sqrt(d2) * (1.0f - 1e-4f), combined, &unused)) {
+              if (!finite3(value)) {
+                ++dropped;
+              } else {
+                const size_t at = (size_t(y) * size_t(w) + size_t(x)) * 3;
+                for (int ch = 0; ch < 3; ++ch) accum[at + size_t(ch)] += double(value[ch]);
+              }
+            }
+          }
+        }
+      }
+      BsdfSample bs;
+      glm::vec3 n_next;
+      if (sp.type == MaterialType::Glass) {
+        const Frame3 frame(s.ns);
+        if (!bsdf_sample_local(sp, frame.to_local(wi), rng.uniform(dims::at(bounce, dims::kBsdfLobe)),
+                               rng.uniform2(dims::at(bounce, dims::kBsdfDir)), bs))
+          break;
+        bs.wi = glm::normalize(frame.to_world(bs.wi));
+        n_next = glm::dot(bs.wi, s.ng) >= 0.0f ? s.ng : -s.ng;
+      } else {
+        const Frame3 frame(ns_facing);
+        if (!bsdf_sample_local(sp, frame.to_local(wi), rng.uniform(dims::at(bounce, dims::kBsdfLobe)),
+                               rng.uniform2(dims::at(bounce, dims::kBsdfDir)), bs))
+          break;
+        bs.wi = glm::normalize(frame.to_world(bs.wi));
+        if (glm::dot(bs.wi, n_facing) <= 0.0f) break;
+        n_next = n_facing;
+      }
+      // Sampling from the light side with the BSDF's own (camera-side) sampler: the materials'
+      // weights f |cos| / pdf hold both ways for the delta lobes and the Lambertian base; the
+      // glossy lobe's are not exactly adjoint (a small bias in caustics' further bounces only).
+      power *= bs.weight;
+      if (!finite3(power) || max_component(power) <= 0.0f) break;
+      after_delta = after_delta || sp.is_delta();
+      o = s.p + n_next * ray_epsilon(s.p);
+      d = bs.wi;
+      if (bounce + 1 >= settings_.rr_depth) {
+        const float q = std::min(0.95f, max_component(bs.weight));
+        if (rng.uniform(dims::at(bounce, dims::kRoulette)) >= q) break;
+        power /= q;
+      }
+    }
+  }
+  return dropped;
+}
+
 }  // namespace mrgi::reference

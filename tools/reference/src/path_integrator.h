@@ -55,6 +55,13 @@ class Integrator {
   Integrator(const PathTracer::Impl& scene, const RefCamera& camera, const RenderSettings& settings);
   // Renders pixel (x, y) into `out` (all spp samples); returns the number of dropped samples.
   size_t render_pixel(int x, int y, RenderOutput& out) const;
+  // Light tracing of the paths the pixel estimator cannot sample (path_tracer.h): photons
+  // [first, first + count) of `count_total` from delta lamp `light` towards the scene's delta
+  // materials, followed through the specular vertices right after the lamp and connected to the
+  // pinhole camera at every non-delta vertex after them; their radiance is added to `accum`
+  // (w x h x 3, the pixels' mean radiance). `combined`: the real + virtual scene, else the real one.
+  size_t trace_light_paths(size_t light, uint64_t first, uint64_t count, uint64_t count_total, bool combined,
+                           std::vector<double>& accum) const;
 
  private:
   bool camera_ray(double px, double py, glm::vec3* origin, glm::vec3* dir, glm::vec3* dir_cam) const;

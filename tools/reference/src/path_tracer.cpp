@@ -178,6 +178,34 @@ Expected<RenderOutput> PathTracer::render(const RefCamera& camera, const RenderS
     }
   }
   for (std::thread& t : threads) t.join();
+
+  // Light tracing (path_tracer.h): each thread takes chunks of photons and keeps its own sums.
+  if (camera.model == RefCamera::Model::Pinhole && !impl_->lights.empty()) {
+    const uint64_t n = settings.light_paths > 0 ? settings.light_paths : uint64_t(settings.spp) * uint64_t(w) * uint64_t(h) / 4;
+    constexpr uint64_t kChunk = 4096;
+    for (int part = 0; part < (settings.real_only ? 1 : 2); ++part) {
+      const bool combined = part == 1;
+      std::vector<std::vector<double>> sums(size_t(thread_count), std::vector<double>(size_t(w) * size_t(h) * 3, 0.0));
+      for (size_t light = 0; light < impl_->lights.size(); ++light) {
+        std::atomic<uint64_t> next_chunk{0};
+        std::vector<std::thread> tracers;
+        for (int i = 0; i < thread_count; ++i)
+          tracers.emplace_back([&, i] {
+            size_t local = 0;
+            for (uint64_t c = next_chunk++; c * kChunk < n; c = next_chunk++)
+              local += integrator.trace_light_paths(light, c * kChunk, std::min(kChunk, n - c * kChunk), n, combined, sums[size_t(i)]);
+            dropped += local;
+          });
+        for (std::thread& t : tracers) t.join();
+      }
+      ImageRGBF& image = combined ? out.combined : out.real;
+      for (size_t j = 0; j < image.data.size(); ++j) {
+        double add = 0.0;
+        for (const auto& s : sums) add += s[j];
+        image.data[j] += float(add);
+      }
+    }
+  }
   out.dropped_samples = dropped.load();
   return out;
 }

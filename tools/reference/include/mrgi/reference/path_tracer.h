@@ -14,7 +14,12 @@
 // every non-specular vertex, multiple importance sampling (balance heuristic) between BSDF
 // sampling and light sampling for area lamps and the environment, Russian roulette after
 // `rr_depth` bounces. Delta lamps seen only through delta BSDFs (caustics of a point lamp through
-// glass) cannot be sampled by this estimator and are missing, as in every unidirectional tracer.
+// glass) cannot be sampled by this estimator; a light tracer adds them for pinhole cameras:
+// photons from each point or spot lamp towards the delta-material meshes, followed through the
+// delta vertices after the lamp and connected to the camera at every non-delta vertex after
+// those (L S+ (D|S)* E paths, which the pixel estimator never forms: its next-event estimation
+// needs a non-delta vertex next to the lamp). Directional lamps' caustics and those seen by the
+// environment cameras are still missing.
 //
 // Materials (radiometric conventions: radiance in W/(m^2 sr) per linear RGB channel):
 //   Diffuse  Lambertian, f = albedo / pi.
@@ -115,6 +120,9 @@ struct RenderSettings {
   uint64_t frame = 0;
   int threads = 0;         // worker threads over 16x16 tiles; 0 = hardware concurrency
   bool real_only = false;  // render only L_r (env camera): `combined` is left empty
+  // Light-traced paths per delta lamp per frame (pinhole cameras): the caustics the pixel
+  // estimator cannot sample; 0 = spp x pixels / 4.
+  uint64_t light_paths = 0;
   // Called from the calling thread about every 0.5 s with (tiles done, tiles total).
   std::function<void(size_t, size_t)> progress;
 };
