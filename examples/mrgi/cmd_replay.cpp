@@ -29,7 +29,8 @@ constexpr AblationName<DirAblation> kDirAblations[] = {{"one-shadow-map", &DirAb
                                                        {"no-real-only-vpls", &DirAblation::no_real_only_vpls},
                                                        {"one-bounce", &DirAblation::one_bounce},
                                                        {"no-environment-vpls", &DirAblation::no_environment_vpls},
-                                                       {"no-temporal-smoothing", &DirAblation::no_temporal_smoothing}};
+                                                       {"no-temporal-smoothing", &DirAblation::no_temporal_smoothing},
+                                                       {"no-caustic-vpls", &DirAblation::no_caustic_vpls}};
 constexpr AblationName<SpecularAblation> kSpecularAblations[] = {
     {"off", &SpecularAblation::off},
     {"no-back-projection", &SpecularAblation::no_back_projection},
@@ -311,7 +312,8 @@ void setup(CLI::App& app) {
                   "lamp and one ISM a VPL with the nearest caster and its kind, not one each), no-real-only-vpls (no ir(VPL): the real bounce "
                   "a virtual object blocks stays in L_r), one-bounce (no bounce light source: the lamps' VPLs only, "
                   "at the levels with multiple bounces), no-environment-vpls (the environment light baseline leaves "
-                  "unshadowed stays unshadowed), no-temporal-smoothing (each frame's VPL light alone); comma-separated")
+                  "unshadowed stays unshadowed), no-temporal-smoothing (each frame's VPL light alone), no-caustic-vpls (VPLs drawn "
+                  "on mirrors and glass stay there instead of moving to where their light lands); comma-separated")
       ->delimiter(',')
       ->check(CLI::IsMember(ablation_names(kDirAblations)));
   cmd->add_option("--device", opts->device, "Vulkan device: index or name part (default $MRGI_DEVICE, else lavapipe)");

@@ -28,13 +28,59 @@ layout(set = 0, binding = 4, rgba32f) uniform readonly image2D mu_position;
 layout(set = 0, binding = 5, rgba16f) uniform readonly image2D mu_normal;
 layout(set = 0, binding = 6, rgba32f) uniform readonly image2D mu_flux;
 layout(std430, set = 0, binding = 7) writeonly buffer Vpls { Vpl vpls[]; };
+// The lamp's caustic photons (gi/vpl.h VplCaustics; caustic.x 0: none, never read).
+#include "specular/photon.glsl"
+layout(std430, set = 0, binding = 8) readonly buffer Photons { Photon photons[]; };
 layout(push_constant) uniform Params {
   ivec4 slots;  // x: first slot; y: slots of this pair; z: the pyramid's top level (used side
                 // 2^z); w: 1 real lamp, 0 virtual
   vec4 lamp;    // the maps' lamp (gi/rsm.h RsmView::light): xyz its position (w > 0) or the
                 // direction its light travels (w < 0)
   vec4 colour;  // rgb its colour x intensity (what the maps' flux alpha is per unit of)
+  mat4 caustic_view_proj;  // the photon map's view
+  ivec4 caustic;           // x the photon map's side (0: no caustic VPLs)
 } params;
+
+// Caustic VPLs (caustics-DIR paper Sec. 4.2.2): a VPL on a texel of a mirror or glass object
+// (its photon-map texel's point on the object is this texel's point) moves to where one of that
+// texel's photons landed: the reflected or the refracted one, by a Halton value when both did
+// (then with twice the flux: each is taken every second time), the only one otherwise; none: no
+// VPL (its light left the scene). Its flux: the texel's incident light x the path's weight
+// (Fresnel, transmittance: the photon's flux over what its texel emitted) x the albedo where it
+// landed, over the probability of drawing the texel. It lights L_rv only: a virtual object is on
+// its path. Returns false where the texel is not on such an object.
+bool caustic_vpl(vec4 pos, vec4 flux, float weight, uint h, inout Vpl v) {
+  int size = params.caustic.x;
+  if (size <= 0 || !(pos.w > 1.5f)) return false;
+  vec4 clip = params.caustic_view_proj * vec4(pos.xyz, 1.0f);
+  if (!(clip.w > 0.0f)) return false;
+  vec2 t = (clip.xy / clip.w * 0.5f + 0.5f) * float(size);
+  if (any(lessThan(t, vec2(0.0f))) || any(greaterThanEqual(t, vec2(float(size))))) return false;
+  ivec2 texel = ivec2(t);
+  int i = texel.y * size + texel.x;
+  Photon a = photons[2 * i], b = photons[2 * i + 1];
+  // The same surface point: within a few photon-map texels (the maps see the object from the
+  // same lamp at different resolutions).
+  float tolerance = 0.02f * distance(pos.xyz, params.lamp.xyz) + 0.005f;
+  if (!(a.origin.w > 0.5f) || distance(a.origin.xyz, pos.xyz) > tolerance) return false;
+  bool va = a.position.w > 0.5f, vb = b.position.w > 0.5f;
+  v.flux = vec4(0.0f);
+  v.position = vec4(0.0f);
+  if (!va && !vb) return true;
+  bool take_a = va && (!vb || halton(h, 7u) < 0.5f);
+  Photon p = take_a ? a : b;
+  float share = (va && vb) ? 2.0f : 1.0f;
+  vec3 path = p.flux.rgb / max(params.colour.rgb * p.flux.w, vec3(1e-30f));
+  vec3 incident = max(flux.a, 0.0f) * params.colour.rgb;
+  vec3 f = incident * path * p.albedo.rgb * share / weight;
+  bool finite = all(lessThan(f, vec3(3.0e38f)));
+  v.position = vec4(p.position.xyz, float(MRGI_VPL_VALID));
+  v.normal = vec4(normalize(p.normal.xyz), 0.0f);
+  v.flux = vec4(finite ? max(f, vec3(0.0f)) : vec3(0.0f), 0.0f);
+  v.lobe = vec4(0.0f, 0.0f, 1.0f, -1.0f);
+  v.specular = vec4(0.0f);
+  return true;
+}
 layout(constant_id = 0) const bool kGlossy = false;
 
 void main() {
@@ -80,7 +126,9 @@ void main() {
       flux = imageLoad(mu_flux, at);
     }
     float weight = p * p_map * float(params.slots.y);
-    if (pos.w > 0.5f && weight > 0.0f) {
+    if (pos.w > 0.5f && weight > 0.0f && caustic_vpl(pos, flux, weight, h, v)) {
+      // moved off the mirror or glass (or dropped)
+    } else if (pos.w > 0.5f && weight > 0.0f) {
       int flags = MRGI_VPL_VALID;
       if (!use_virtual && real_lamp) {
         flags |= MRGI_VPL_REAL_PATH;

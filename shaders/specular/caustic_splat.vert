@@ -9,11 +9,7 @@
 #include "common/frame_constants.glsl"
 
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
-struct Photon {
-  vec4 position;  // xyz world hit; w 0 none, 1 real, 2 virtual
-  vec4 flux;      // rgb W
-  vec4 normal;
-};
+#include "specular/photon.glsl"
 layout(std430, set = 0, binding = 1) readonly buffer Photons { Photon photons[]; };
 layout(std430, set = 0, binding = 4) readonly buffer PhotonList { uint photon_list[]; };  // photons.comp
 layout(push_constant) uniform Splat { vec4 splat; };  // x smallest quad side (internal pixels),

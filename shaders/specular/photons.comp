@@ -10,6 +10,7 @@
 #include "shared/mrgi_shared.h"
 #include "shared/specular_math.h"
 #include "common/scene_materials.glsl"
+#include "specular/photon.glsl"
 #include "specular/specular_params.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -22,11 +23,6 @@ layout(set = 0, binding = 5, rgba16f) readonly uniform image2D back_normal;
 layout(set = 0, binding = 6, rgba32f) readonly uniform image2D impostor_position;
 layout(set = 0, binding = 7, rgba8_snorm) readonly uniform image2D impostor_normal;
 layout(set = 0, binding = 8, rgba8) readonly uniform image2D impostor_albedo;
-struct Photon {
-  vec4 position;  // xyz world hit; w 0 none, 1 on a real surface, 2 on a virtual one
-  vec4 flux;      // rgb W
-  vec4 normal;    // xyz the surface's, facing the photon's origin
-};
 layout(std430, set = 0, binding = 9) writeonly buffer Photons { Photon photons[]; };
 // The photons that landed somewhere, listed for the splat's indirect draw (six vertices each;
 // vertex_count reset to 0 before this pass).
@@ -54,11 +50,15 @@ int nearest_set(vec3 p) {
   return best;
 }
 
-void store(uint i, Hit h, vec3 flux) {
+// origin: the texel's point on the object (w 1), or w 0 where the texel sees none; emitted: the
+// lamp's light the texel stands for, per unit of its colour.
+void store(uint i, Hit h, vec3 flux, vec4 origin, float emitted) {
   bool ok = h.found && any(greaterThan(flux, vec3(0.0f)));
   photons[i].position = vec4(h.position, ok ? (h.real ? 1.0f : 2.0f) : 0.0f);
-  photons[i].flux = vec4(ok ? flux : vec3(0.0f), 0.0f);
+  photons[i].flux = vec4(ok ? flux : vec3(0.0f), emitted);
   photons[i].normal = vec4(ok ? h.normal : vec3(0.0f, 1.0f, 0.0f), 0.0f);
+  photons[i].albedo = vec4(ok ? h.albedo : vec3(0.0f), 0.0f);
+  photons[i].origin = origin;
   if (ok) photon_list[atomicAdd(photon_draw.vertex_count, 6u) / 6u] = i;
 }
 
@@ -72,8 +72,8 @@ void main() {
   none.found = false;
   vec4 pos = imageLoad(photon_position, texel);
   if (!(pos.w > 1.5f)) {
-    store(2u * index, none, vec3(0.0f));
-    store(2u * index + 1u, none, vec3(0.0f));
+    store(2u * index, none, vec3(0.0f), vec4(0.0f), 0.0f);
+    store(2u * index + 1u, none, vec3(0.0f), vec4(0.0f), 0.0f);
     return;
   }
   GpuMaterial m = materials[int(pos.w + 0.5f) - 2];
@@ -84,8 +84,9 @@ void main() {
   // The texel's solid angle: (2 tan(half) / size)^2 cos^3 of its angle from the map's axis.
   float c_axis = max(dot(d, cone.yzw), 1e-3f);
   float texel_angle = intensity.w / float(size);
-  vec3 flux = intensity.rgb * spot_falloff(dot(d, axis.xyz), cone.x, axis.w) * texel_angle * texel_angle *
-              c_axis * c_axis * c_axis;
+  float emitted = spot_falloff(dot(d, axis.xyz), cone.x, axis.w) * texel_angle * texel_angle * c_axis * c_axis * c_axis;
+  vec3 flux = intensity.rgb * emitted;
+  vec4 origin = vec4(p, 1.0f);
   float cos_i = max(-dot(d, n), 0.0f);
   SpecularSet s = specular.sets[nearest_set(p)];
   int kind = int(m.specular.x + 0.5f);
@@ -98,10 +99,10 @@ void main() {
     // The base colour is m's factor: the photon map holds no texture coordinates.
     vec3 t = r.transmission * transmittance_colour(m.base_color_factor.rgb, m.attenuation.rgb, m.specular.z,
                                                    distance(p, r.exit_p)) * clamp(m.specular.w, 0.0f, 1.0f);
-    store(2u * index + 1u, trace_impostor(s, r.exit_p + r.exit_d * 1e-3f, r.exit_d), flux * t);
+    store(2u * index + 1u, trace_impostor(s, r.exit_p + r.exit_d * 1e-3f, r.exit_d), flux * t, origin, emitted);
   } else {
     eta1 = fresnel_metal(mix(vec3(0.04f), m.base_color_factor.rgb, m.params.x), cos_i);
-    store(2u * index + 1u, none, vec3(0.0f));
+    store(2u * index + 1u, none, vec3(0.0f), origin, emitted);
   }
-  store(2u * index, trace_impostor(s, p + refl * 1e-3f, refl), flux * eta1);
+  store(2u * index, trace_impostor(s, p + refl * 1e-3f, refl), flux * eta1, origin, emitted);
 }

@@ -174,6 +174,50 @@ TEST(PathTracer, LightTracingAddsTheCausticOfAPointLampInAMirror) {
   }
 }
 
+// A clear glass sphere above a floor under a point lamp: the light it bends still reaches the
+// floor (the pixel estimator alone leaves its shadow black but for the sky): over the floor the
+// camera sees, the power with the sphere is the power without it less what the sphere reflects
+// away and what lands outside the view (a few percent: the focus is under the sphere).
+TEST(PathTracer, LightTracingKeepsTheLightAGlassSphereBends) {
+  RefScene scene;
+  RefMaterial floor_m;
+  floor_m.base_color = glm::vec3(0.6f);
+  scene.materials.push_back(floor_m);
+  RefMaterial glass;
+  glass.type = MaterialType::Glass;
+  glass.base_color = glm::vec3(1.0f);
+  glass.ior = 1.5f;
+  scene.materials.push_back(glass);
+  scene.meshes.push_back(make_plane({20.0f, 20.0f}, glm::mat4(1.0f)));
+  RefMesh sphere = make_sphere(0.25f, 64, glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 0.6f, 0.0f)));
+  sphere.material = 1;
+  sphere.is_virtual = true;
+  scene.meshes.push_back(sphere);
+  RefLight lamp;
+  lamp.position = {0.0f, 2.0f, 0.0f};
+  lamp.intensity = glm::vec3(5.0f);
+  scene.lights.push_back(lamp);
+  const RefCamera cam = small_camera(48, 48, 0.6, mrgi::test::opencv_look_at({0, 3.0, 0.001}, {0, 0, 0}, {0, 0, -1}));
+  auto tracer = PathTracer::create(scene);
+  ASSERT_TRUE(tracer.ok());
+  RenderSettings s;
+  s.spp = 8;
+  s.max_depth = 8;
+  s.rr_depth = 64;
+  s.threads = 2;
+  s.light_paths = 4000000;
+  auto out = (*tracer)->render(cam, s);
+  ASSERT_TRUE(out.ok());
+  double with = 0.0, without = 0.0;
+  for (size_t i = 0; i < out->real.pixel_count(); ++i) {
+    if (out->virtual_mask.data[i] != 0) continue;  // the floor, where the sphere does not hide it
+    with += out->combined.data[3 * i + 1];
+    without += out->real.data[3 * i + 1];
+  }
+  EXPECT_GT(with, 0.85 * without) << "the light through the glass is lost";
+  EXPECT_LT(with, 1.0 * without);
+}
+
 // Spot lamp: full intensity inside the inner cone, none outside the outer cone.
 TEST(PathTracer, SpotConeLimitsLight) {
   RefScene scene;

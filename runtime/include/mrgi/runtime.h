@@ -89,8 +89,12 @@ struct DirAblation {
   // No temporal smoothing of the VPL light (the paper's [4]: blending the previous frame's by a
   // confidence from normal, position and illumination change): each frame's VPLs alone.
   bool no_temporal_smoothing = false;
+  // No caustic VPLs (caustics-DIR paper Sec. 4.2.2): a VPL drawn on a mirror or glass object
+  // stays there as on any surface instead of moving to where its light lands.
+  bool no_caustic_vpls = false;
   bool any() const {
-    return one_shadow_map || no_real_only_vpls || one_bounce || no_environment_vpls || no_temporal_smoothing;
+    return one_shadow_map || no_real_only_vpls || one_bounce || no_environment_vpls || no_temporal_smoothing ||
+           no_caustic_vpls;
   }
 };
 

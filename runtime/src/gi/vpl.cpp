@@ -1,5 +1,7 @@
 #include "gi/vpl.h"
 
+#include "specular/photon.glsl"
+
 #include <bit>
 #include <string>
 
@@ -39,6 +41,9 @@ Expected<VplSampler> VplSampler::create(gpu::FrameGraph& graph, const VplSetting
                                         VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
   if (!buffer) return buffer.error();
   v.vpls_ = *buffer;
+  auto none = graph.create_buffer({s.name + " no photons", sizeof(shader::Photon)}, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  if (!none) return none.error();
+  v.no_photons_ = *none;
   const gpu::Context& ctx = graph.context();
   auto ip = gpu::load_compute_pipeline(ctx, "gi/vpl_importance.comp", {});
   if (!ip) return ip.error();
@@ -86,7 +91,8 @@ Status VplSampler::add_copy(gpu::FrameGraph& graph, const std::string& id, gpu::
 }
 
 Status VplSampler::add_sample(gpu::FrameGraph& graph, const std::string& id, const RsmImages& rho, const RsmImages& mu,
-                              bool real_lamp, const VplLamp& lamp, uint32_t first, uint32_t count) {
+                              bool real_lamp, const VplLamp& lamp, uint32_t first, uint32_t count,
+                              const VplCaustics* caustics) {
   const uint32_t side = rho.width;
   if (rho.height != side || mu.width != side || mu.height != side || !std::has_single_bit(side) || side > settings_.map_size)
     return fail(ErrorKind::BadUsage, "vpl '" + settings_.name + "': the maps must be square, equal, a power of two and at most " +
@@ -133,7 +139,12 @@ Status VplSampler::add_sample(gpu::FrameGraph& graph, const std::string& id, con
   struct {
     glm::ivec4 slots;
     glm::vec4 lamp, colour;
-  } const push{glm::ivec4(int(first), int(count), int(top), real_lamp ? 1 : 0), lamp.light, glm::vec4(lamp.colour, 0.0f)};
+    glm::mat4 caustic_view_proj;
+    glm::ivec4 caustic;  // x photon map side (0: no caustics)
+  } const push{glm::ivec4(int(first), int(count), int(top), real_lamp ? 1 : 0), lamp.light, glm::vec4(lamp.colour, 0.0f),
+               caustics ? caustics->view_proj : glm::mat4(1.0f), glm::ivec4(caustics ? int(caustics->size) : 0, 0, 0, 0)};
+  static_assert(sizeof(push) == 128, "the guaranteed push-constant size");
+  const gpu::BufferHandle photons = caustics ? caustics->photons : no_photons_;
   const VkSampler nearest = graph.context().samplers().nearest_clamp;
   graph.add_shader_pass(
       settings_.name + " sample " + id, gpu::PassKind::Compute, *sample_,
@@ -146,6 +157,7 @@ Status VplSampler::add_sample(gpu::FrameGraph& graph, const std::string& id, con
         b.bind("mu_normal", mu.normal);
         b.bind("mu_flux", mu.flux);
         b.bind_over("Vpls", vpls);  // other pairs' slots and the clear stay
+        b.bind("Photons", photons);
       },
       [sp, push, count](VkCommandBuffer cmd, gpu::PassContext&) {
         gpu::push_and_dispatch(cmd, *sp, &push, sizeof push, {(count + 63) / 64, 1, 1});

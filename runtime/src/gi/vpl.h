@@ -14,6 +14,8 @@
 #include <cstdint>
 #include <string>
 
+#include <glm/glm.hpp>
+
 #include "gi/light_propagation.h"
 #include "gpu/frame_graph.h"
 #include "gpu/pipelines.h"
@@ -42,6 +44,17 @@ struct VplLamp {
   glm::vec3 colour{1.0f};
 };
 
+// Caustic VPLs (caustics-DIR paper Sec. 4.2.2): the lamp's photons (specular/caustics.h, two a
+// photon-map texel: the reflected and the refracted one), so a VPL drawn on a mirror or glass
+// texel moves to where one of its texel's photons landed (a Halton choice when both did, its
+// flux then doubled), with that path's Fresnel and transmittance weight and the albedo there;
+// a texel whose photons both left the scene gives no VPL.
+struct VplCaustics {
+  gpu::BufferHandle photons;   // shader::Photon[2 * size * size]
+  glm::mat4 view_proj{1.0f};   // the photon map's view
+  uint32_t size = 0;           // its side (texels)
+};
+
 class VplSampler {
  public:
   // BadUsage naming the field for settings out of range.
@@ -53,8 +66,10 @@ class VplSampler {
   // square, a power of two <= map_size) of a real lamp (`real_lamp`: both maps and the path
   // flags of Sec. 3.3; else R^rho's texels as one map, as the paper's virtual spot light).
   // Passes "<name> importance <id>", "<name> pyramid <id> <level>", "<name> sample <id>".
+  // `caustics`: this lamp's photons (nullptr: VPLs stay on mirrors and glass as on any surface).
   Status add_sample(gpu::FrameGraph& graph, const std::string& id, const RsmImages& rho, const RsmImages& mu,
-                    bool real_lamp, const VplLamp& lamp, uint32_t first, uint32_t count);
+                    bool real_lamp, const VplLamp& lamp, uint32_t first, uint32_t count,
+                    const VplCaustics* caustics = nullptr);
 
   // Slots [first, first + count) from `source` (shader::Vpl[count], the bounce light source's);
   // the other slots keep what they hold. Pass "<name> copy <id>".
@@ -70,6 +85,7 @@ class VplSampler {
   uint32_t levels_ = 1;
   gpu::ImageHandle pyramid_;
   gpu::BufferHandle vpls_;
+  gpu::BufferHandle no_photons_;  // bound when a pair has no caustics (never read)
   gpu::PipelineHandle importance_, downsample_, sample_, copy_;
 };
 

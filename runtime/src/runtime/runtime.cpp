@@ -622,8 +622,12 @@ Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, 
     virtual_gbuffer_->record(*graph_, frame_constants_,
                              own ? *own : technique::RealGeometry{recon_->position(), recon_->position(), 1},
                              level.mesh_error_px);
+    if (specular_) {
+      MRGI_TRY(specular_->prepare(constants_, level_, int(technique_->levels().size()), rec.skipped));
+      info.caustics = specular_->caustic_photons();
+    }
     MRGI_TRY(technique_->record(info, rec.skipped));
-    if (specular_) MRGI_TRY(specular_->record(constants_, *technique_, level_, rec.skipped));
+    if (specular_) MRGI_TRY(specular_->finish(*technique_, rec.skipped));
   } else {
     rec.skipped.push_back(has_objects ? "technique: no virtual object or its shadow in view"
                                       : "technique: no virtual object and no virtual lamp in the scene");

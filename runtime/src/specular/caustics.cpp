@@ -8,6 +8,7 @@
 #include "gi/rsm.h"
 #include "gpu/shaders.h"
 #include "shared/specular_math.h"
+#include "specular/photon.glsl"
 #include "specular/mesh_raster.h"
 #include "technique/scene_gpu.h"
 
@@ -18,7 +19,7 @@ constexpr VkFormat kPositionFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 constexpr VkFormat kNormalFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kCausticFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
-constexpr VkDeviceSize kPhotonBytes = 48;  // photons.comp's Photon
+constexpr VkDeviceSize kPhotonBytes = sizeof(shader::Photon);
 
 // photons.comp's push block.
 struct PhotonPush {
@@ -75,10 +76,12 @@ Expected<Caustics> Caustics::create(const technique::SharedResources& shared, ui
   auto cb = graph.create_image(cd, colour);
   if (!cb) return cb.error();
   c.caustics_ = *cb;
-  auto pb = graph.create_buffer({"specular photons", VkDeviceSize(max_map_size) * max_map_size * 2 * kPhotonBytes},
-                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-  if (!pb) return pb.error();
-  c.photons_ = *pb;
+  for (int l = 0; l < kMaxLamps; ++l) {
+    auto pb = graph.create_buffer({"specular photons " + std::to_string(l), VkDeviceSize(max_map_size) * max_map_size * 2 * kPhotonBytes},
+                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    if (!pb) return pb.error();
+    c.photons_[l] = *pb;
+  }
   auto lb = graph.create_buffer({"specular photon list", VkDeviceSize(max_map_size) * max_map_size * 2 * 4},
                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (!lb) return lb.error();
@@ -135,6 +138,7 @@ bool Caustics::record(gpu::FrameGraph& graph, const Impostors& imp, const std::v
                       std::vector<std::string>& skipped) {
   const technique::SceneGpu& sg = *shared_.scene_gpu;
   const uint32_t size = std::min(map_size, max_map_);
+  recorded_.lamps.clear();
   // The strongest spot lamps whose cone meets the objects' sphere and that are outside it.
   std::vector<const LightDesc*> chosen;
   for (const LightDesc& l : lamps) {
@@ -191,7 +195,8 @@ bool Caustics::record(gpu::FrameGraph& graph, const Impostors& imp, const std::v
                           glm::vec4(lamp.color * lamp.intensity, 2.0f * std::tan(half)),
                           glm::vec4(dir, std::cos(glm::radians(lamp.inner_angle_deg))),
                           glm::vec4(std::cos(glm::radians(lamp.outer_angle_deg)), axis)};
-    const gpu::BufferHandle draw = photon_draw_;
+    const gpu::BufferHandle draw = photon_draw_, photons = photons_[li];
+    recorded_.lamps.push_back({lamp.position, view_proj, size, photons});
     graph.add_pass("specular photons reset " + id, gpu::PassKind::Transfer,
                    [draw](gpu::PassBuilder& b) { b.write(draw, gpu::Access::TransferDst); },
                    [draw](VkCommandBuffer cmd, gpu::PassContext& p) { vkCmdFillBuffer(cmd, p.buffer(draw), 0, 16, 0); });
@@ -199,7 +204,7 @@ bool Caustics::record(gpu::FrameGraph& graph, const Impostors& imp, const std::v
     const bool has_back = !back.empty();
     graph.add_shader_pass(
         "specular photons " + id, gpu::PassKind::Compute, *photon_pipeline_,
-        [this, imp, has_back](gpu::ShaderPassBuilder& b) {
+        [this, imp, has_back, photons](gpu::ShaderPassBuilder& b) {
           b.bind("SpecularUbo", imp.constants);
           b.bind("Materials", shared_.scene_gpu->materials);
           b.bind("photon_position", position_);
@@ -210,7 +215,7 @@ bool Caustics::record(gpu::FrameGraph& graph, const Impostors& imp, const std::v
           b.bind("impostor_position", imp.position);
           b.bind("impostor_normal", imp.normal);
           b.bind("impostor_albedo", imp.albedo);
-          b.bind("Photons", photons_);
+          b.bind("Photons", photons);
           b.bind("PhotonList", photon_list_);
           b.bind_over("PhotonDraw", photon_draw_);
         },
@@ -222,9 +227,9 @@ bool Caustics::record(gpu::FrameGraph& graph, const Impostors& imp, const std::v
     const glm::vec4 splat_push(quad_min_px, float(size), quad_max_px, 0.0f);
     graph.add_shader_pass(
         "specular caustic splat " + id, gpu::PassKind::Graphics, *splat_pipeline_,
-        [this, first](gpu::ShaderPassBuilder& b) {
+        [this, first, photons](gpu::ShaderPassBuilder& b) {
           b.bind("FrameUbo", shared_.frame_constants);
-          b.bind("Photons", photons_);
+          b.bind("Photons", photons);
           b.bind("PhotonList", photon_list_);
           b.uses().read(photon_draw_, gpu::Access::IndirectRead);
           b.bind("real_position", shared_.real_position);

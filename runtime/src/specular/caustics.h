@@ -48,6 +48,8 @@ class Caustics {
   // The caustic buffer (RGBA16F, internal resolution): rgb irradiance (W/m^2) on the surface
   // each pixel shows, a the number of photons.
   gpu::ImageHandle buffer() const { return caustics_; }
+  // This frame's photons per lamp (after record()).
+  const technique::CausticPhotons& photons() const { return recorded_; }
 
  private:
   Caustics() = default;
@@ -55,7 +57,8 @@ class Caustics {
   uint32_t max_map_ = 0;
   const gpu::Pipeline* back_faces_ = nullptr;
   gpu::ImageHandle position_, normal_, back_position_, back_normal_, depth_, caustics_;
-  gpu::BufferHandle photons_, photon_list_, photon_draw_;
+  gpu::BufferHandle photons_[kMaxLamps], photon_list_, photon_draw_;
+  technique::CausticPhotons recorded_;  // this frame's lamps
   gpu::PipelineHandle surface_pipeline_, photon_pipeline_, splat_pipeline_;
 };
 

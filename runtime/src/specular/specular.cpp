@@ -108,7 +108,10 @@ struct SpecularStage::Impl {
   int env_width = 0;           // its width in cells
   gpu::PipelineHandle cells_pipeline, grid_pipeline, mesh_pipeline, back_pipeline, trace_pipeline, apply_pipeline;
   std::optional<Caustics> caustics;  // null with SpecularSettings::caustics off
-  bool caustics_recorded = false;    // this frame's record() splatted caustics
+  bool caustics_recorded = false;    // this frame's prepare() splatted caustics
+  bool active = false;               // prepare() found something to do this frame
+  glm::ivec4 region{0};              // the trace's dispatch: first pixel, size
+  technique::CausticPhotons photons; // this frame's, for the technique
   VkExtent2D grid_points{0, 0};
   uint32_t grid_stride = 1;
   glm::mat4 world_to_clip{1.0f};  // this frame's camera (the back faces' draw)
@@ -455,9 +458,11 @@ Expected<std::unique_ptr<SpecularStage>> SpecularStage::create(const technique::
   return std::unique_ptr<SpecularStage>(new SpecularStage(std::move(impl)));
 }
 
-Status SpecularStage::record(const shader::FrameConstants& fc, const technique::Technique& technique,
-                             int technique_level, std::vector<std::string>& skipped) {
+Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_level, int technique_levels,
+                              std::vector<std::string>& skipped) {
   Impl& m = *impl_;
+  m.active = false;
+  m.photons = technique::CausticPhotons{};
   const technique::SceneGpu& sg = *m.shared.scene_gpu;
   gpu::FrameGraph& graph = *m.shared.graph;
   std::vector<ObjectInView> in_view;
@@ -494,7 +499,7 @@ Status SpecularStage::record(const shader::FrameConstants& fc, const technique::
     return ok_status();
   }
   std::sort(in_view.begin(), in_view.end(), [](const ObjectInView& a, const ObjectInView& b) { return a.distance < b.distance; });
-  const SpecularLevel& level = specular_level_for(technique_level, int(technique.levels().size()));
+  const SpecularLevel& level = specular_level_for(technique_level, technique_levels);
   const uint32_t face = std::min(level.impostor_face, m.settings.max_impostor_face);
   const int set_count = std::clamp(std::min(level.own_sets, m.settings.max_sets), 1, int(in_view.size()));
   std::vector<ImpostorSet> sets(static_cast<size_t>(set_count));
@@ -532,20 +537,6 @@ Status SpecularStage::record(const shader::FrameConstants& fc, const technique::
         e += lighting.light_sh[l][size_t(k)];
     c->env_sh[k] = glm::vec4(glm::vec3(e), 0.0f);
   }
-  const std::optional<technique::Technique::DirectLight> direct = technique.direct_light();
-  gpu::BufferHandle light_set = m.own_lights;
-  gpu::ImageHandle shadow_primary = m.no_shadow, shadow_virtual = m.no_shadow;
-  if (direct) {
-    light_set = direct->light_set;
-    shadow_primary = direct->shadow_primary;
-    shadow_virtual = direct->shadow_virtual;
-    c->shadow = direct->shadow;
-  } else {
-    auto* set = static_cast<shader::LightSet*>(graph.mapped(m.own_lights, graph.slot()));
-    technique::write_unshadowed_light_set(lighting, *set);
-    c->shadow = glm::vec4(1.0f, 1.0f, 1.0f, 0.0f);
-    skipped.push_back("specular: the technique drew no shadow maps this frame: mirrors and glass show lamps' light unshadowed");
-  }
   int env_width = 0;
   if (const light::EnvSampler* env = m.shared.light_stage->environment_grid();
       env && env->settings().grid_width == m.env_width) {
@@ -554,7 +545,7 @@ Status SpecularStage::record(const shader::FrameConstants& fc, const technique::
     for (int y = 0; y < env->grid_height(); ++y)
       for (int x = 0; x < env_width; ++x) cells[size_t(y) * size_t(env_width) + size_t(x)] = glm::vec4(glm::vec3(env->cell_radiance(x, y)), 0.0f);
   }
-  c->flags = glm::ivec4(direct ? 1 : 0, m.settings.depth_test ? 1 : 0, env_width, 0);
+  c->flags = glm::ivec4(0, m.settings.depth_test ? 1 : 0, env_width, 0);  // x: finish()
 
   m.world_to_clip = fc.world_to_clip;
   m.set_grid(graph, face);
@@ -608,18 +599,46 @@ Status SpecularStage::record(const shader::FrameConstants& fc, const technique::
   }
   c->flags.w = caustics ? 1 : 0;
   m.caustics_recorded = caustics;
-  const gpu::ImageHandle caustic_buffer = m.caustics ? m.caustics->buffer() : m.back_position;
-  const VkSampler compare = m.shared.context->samplers().shadow_compare;
-  const VkSampler nearest = m.shared.context->samplers().nearest_clamp;
-  // The dispatch covers the objects' projected boxes (all of the image when a corner is behind
-  // the camera).
+  if (caustics) m.photons = m.caustics->photons();
+  // The trace's dispatch covers the objects' projected boxes (all of the image when a corner is
+  // behind the camera).
   const glm::ivec2 size(fc.internal_output_size.x, fc.internal_output_size.y);
   glm::ivec2 r0(0), r1 = size;
   if (!behind) {
     r0 = glm::clamp(glm::ivec2(glm::floor(lo_px)) - 1, glm::ivec2(0), size);
     r1 = glm::clamp(glm::ivec2(glm::ceil(hi_px)) + 2, glm::ivec2(0), size);
   }
-  const glm::ivec4 region(r0, glm::max(r1 - r0, glm::ivec2(0)));
+  m.region = glm::ivec4(r0, glm::max(r1 - r0, glm::ivec2(0)));
+  m.active = true;
+  return ok_status();
+}
+
+Status SpecularStage::finish(const technique::Technique& technique, std::vector<std::string>& skipped) {
+  Impl& m = *impl_;
+  if (!m.active) return ok_status();
+  gpu::FrameGraph& graph = *m.shared.graph;
+  const light::Lighting& lighting = m.shared.light_stage->lighting();
+  auto* c = static_cast<shader::SpecularConstants*>(graph.mapped(m.constants, graph.slot()));
+  const std::optional<technique::Technique::DirectLight> direct = technique.direct_light();
+  gpu::BufferHandle light_set = m.own_lights;
+  gpu::ImageHandle shadow_primary = m.no_shadow, shadow_virtual = m.no_shadow;
+  if (direct) {
+    light_set = direct->light_set;
+    shadow_primary = direct->shadow_primary;
+    shadow_virtual = direct->shadow_virtual;
+    c->shadow = direct->shadow;
+  } else {
+    auto* set = static_cast<shader::LightSet*>(graph.mapped(m.own_lights, graph.slot()));
+    technique::write_unshadowed_light_set(lighting, *set);
+    c->shadow = glm::vec4(1.0f, 1.0f, 1.0f, 0.0f);
+    skipped.push_back("specular: the technique drew no shadow maps this frame: mirrors and glass show lamps' light unshadowed");
+  }
+  c->flags.x = direct ? 1 : 0;
+  const bool caustics = m.caustics_recorded;
+  const gpu::ImageHandle caustic_buffer = m.caustics ? m.caustics->buffer() : m.back_position;
+  const VkSampler compare = m.shared.context->samplers().shadow_compare;
+  const VkSampler nearest = m.shared.context->samplers().nearest_clamp;
+  const glm::ivec4 region = m.region;
   Impl* self = &m;
   graph.add_shader_pass(
       "specular trace", gpu::PassKind::Compute, *m.trace_pipeline,
@@ -674,5 +693,9 @@ Status SpecularStage::record(const shader::FrameConstants& fc, const technique::
 }
 
 bool SpecularStage::lights_outside_tiles() const { return impl_->caustics_recorded; }
+
+const technique::CausticPhotons* SpecularStage::caustic_photons() const {
+  return impl_->photons.lamps.empty() ? nullptr : &impl_->photons;
+}
 
 }  // namespace mrgi::specular

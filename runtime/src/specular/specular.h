@@ -90,10 +90,17 @@ class SpecularStage {
   static Expected<std::unique_ptr<SpecularStage>> create(const technique::SharedResources& shared,
                                                          const SpecularSettings& settings);
   ~SpecularStage();
-  // After the technique's record(): records the passes above for this frame, or appends
-  // "specular: <reason>" to `skipped`. `fc` is this frame's FrameConstants.
-  Status record(const shader::FrameConstants& fc, const technique::Technique& technique, int technique_level,
-                std::vector<std::string>& skipped);
+  // Before the technique's record(): records this frame's impostors, back faces and caustics
+  // (their photons are what a technique reads to move its VPLs off mirrors and glass:
+  // caustic_photons()), or appends "specular: <reason>" to `skipped`. `fc` is this frame's
+  // FrameConstants; the technique's level picks the stage's (specular_level_for).
+  Status prepare(const shader::FrameConstants& fc, int technique_level, int technique_levels,
+                 std::vector<std::string>& skipped);
+  // This frame's caustic photons (after prepare; nullptr: none).
+  const technique::CausticPhotons* caustic_photons() const;
+  // After the technique's record(): the mirrors' and glass's pixels (specular trace) and the
+  // caustics on the diffuse ones, over the technique's solutions.
+  Status finish(const technique::Technique& technique, std::vector<std::string>& skipped);
   // After record(): this frame's caustics may have lit pixels outside the technique's compose
   // tiles (Technique::compose_tiles): the frame must be composed everywhere.
   bool lights_outside_tiles() const;

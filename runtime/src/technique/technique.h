@@ -133,6 +133,20 @@ struct RealGeometry {
   uint32_t step = 1;
 };
 
+// This frame's caustic photons (specular/caustics.h): per spot lamp with a caustic map, the
+// photons its texels sent off the mirrors and glass (two a texel: reflected, refracted) and the
+// map's view, for a technique that moves the VPLs its maps put on those objects to where their
+// light lands (dir: the caustics-DIR paper's Sec. 4.2.2).
+struct CausticPhotons {
+  struct Lamp {
+    glm::vec3 position{0.0f};    // the lamp's
+    glm::mat4 view_proj{1.0f};   // the photon map's view (Vulkan clip)
+    uint32_t size = 0;           // its side (texels)
+    gpu::BufferHandle photons;   // caustics.h Photon[2 * size * size]
+  };
+  std::vector<Lamp> lamps;
+};
+
 // What record() needs to know about the current frame.
 struct FrameInfo {
   int64_t frame_index = 0;
@@ -140,6 +154,7 @@ struct FrameInfo {
   bool virtual_objects_present = false;
   glm::dmat4 camera_to_world{1.0};   // this frame's pose (the previous one when none was given)
   const InputFrame* input = nullptr; // the host copy of this frame's images (valid during record)
+  const CausticPhotons* caustics = nullptr;  // this frame's, written before record(); or none
 };
 
 class Technique {

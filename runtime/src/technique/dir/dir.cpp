@@ -399,8 +399,14 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
       const gi::VplLamp lamp{view.light, glm::vec3(view.colour)};
       if (lamp_reaches_objects(lighting.lights[i])) {
         rsm_->add_pair(graph, id, view, level.rsm_size);
+        // Caustic VPLs (caustics-DIR Sec. 4.2.2): this lamp's photons, when the specular stage
+        // made a caustic map for it this frame.
+        std::optional<gi::VplCaustics> caustic;
+        if (info.caustics && !shared_.dir_ablation.no_caustic_vpls)
+          for (const CausticPhotons::Lamp& c : info.caustics->lamps)
+            if (glm::distance(c.position, lighting.lights[i].position) < 1e-4f) caustic = gi::VplCaustics{c.photons, c.view_proj, c.size};
         MRGI_TRY(vpls_->add_sample(graph, id, rsm_->images(gi::RsmMap::WithVirtual, level.rsm_size), mu,
-                                   lighting.lights[i].real, lamp, first, count));
+                                   lighting.lights[i].real, lamp, first, count, caustic ? &*caustic : nullptr));
       } else {
         // The spot's cone misses the virtual objects: R^rho would be R^mu's copy (issue 15's skip).
         skipped.push_back("dir rsm rho " + id + ": no virtual object in the lamp's cone (R^mu stands for both maps)");
