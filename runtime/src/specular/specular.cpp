@@ -81,7 +81,7 @@ const std::array<SpecularLevel, 3>& specular_levels() {
   static const std::array<SpecularLevel, 3> levels = {{
       {"paper", 512, 4, 24, 4, 16, 1, 512},
       {"high", 256, 2, 16, 3, 12, 1, 256},
-      {"fast", 96, 2, 10, 2, 8, 2, 0},
+      {"fast", 96, 2, 10, 2, 8, 4, 0},
   }};
   return levels;
 }

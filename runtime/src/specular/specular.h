@@ -58,13 +58,14 @@ struct SpecularLevel {
   int back_face_steps;     // search steps for the refracted ray's exit in the back faces
   // Frames between redraws of a set whose objects did not move (1: every frame). The impostors
   // are world-space surfaces, so a set a frame old differs only by what the camera newly sees
-  // of the real scene; at 2, two sets cost one set's drawing a frame.
+  // of the real scene; at 4, two sets cost half a set's drawing a frame.
   int refresh_period;
   uint32_t caustic_map;    // texels per side of each spot lamp's photon maps (0: no caustics)
 };
 // paper (512^2 impostors, a set per object up to four, 512^2 caustic maps), high (256^2, two
-// sets, 256^2 caustic maps), fast (96^2, two sets, each redrawn every other frame, no caustics:
-// at 64^2 they cost 3.9 ms and took glass_mirror's fastest dir frame from 30 to 36 ms).
+// sets, 256^2 caustic maps), fast (96^2, two sets, each redrawn every fourth frame while its
+// objects stay put, no caustics: at 64^2 they cost 3.9 ms and took glass_mirror's fastest dir
+// frame from 30 to 36 ms).
 const std::array<SpecularLevel, 3>& specular_levels();
 // The stage's level for a technique's level: the technique's first level gets the paper's
 // settings, its last two the fast ones, the others high.
