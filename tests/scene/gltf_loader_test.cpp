@@ -114,7 +114,10 @@ TEST(GltfLoader, CornellBoxMeshesAndIor) {
 struct TinyGltf {
   TempDir dir;
   std::string path;
-  explicit TinyGltf(const std::string& mode = "4") {
+  // `extensions`: the material's extensions object.
+  explicit TinyGltf(const std::string& mode = "4",
+                    const std::string& extensions = R"({"KHR_materials_transmission": {"transmissionFactor": 0.95},
+                                "KHR_materials_ior": {"ior": 1.33}})") {
     // Positions with a 16-byte stride (4 bytes of padding after each vec3).
     const float data[] = {0, 0, 0, -1, 1, 0, 0, -1, 0, 1, 0, -1};
     std::ofstream(dir.file("tri.bin"), std::ios::binary)
@@ -132,8 +135,7 @@ struct TinyGltf {
   "materials": [{"name": "glass", "pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.95, 1, 1],
                  "metallicFactor": 0, "roughnessFactor": 0.05},
                  "emissiveFactor": [0.1, 0.2, 0.3],
-                 "extensions": {"KHR_materials_transmission": {"transmissionFactor": 0.95},
-                                "KHR_materials_ior": {"ior": 1.33}}}],
+                 "extensions": )" + extensions + R"(}],
   "buffers": [{"uri": "tri.bin", "byteLength": 48}],
   "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48, "byteStride": 16}],
   "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
@@ -164,6 +166,35 @@ TEST(GltfLoader, TinyFileWithTransmissionTrsAndFlatNormals) {
   EXPECT_FALSE(mat.double_sided);
   expect_vec3_near(model->bounds_min, {0, 1, -2}, 1e-5f);
   expect_vec3_near(model->bounds_max, {0, 3, 0}, 1e-5f);
+}
+
+TEST(GltfLoader, VolumeAttenuationIsReadAndBadTransmissionValuesAreRefused) {
+  {
+    TinyGltf f("4", R"({"KHR_materials_transmission": {"transmissionFactor": 1},
+                        "KHR_materials_volume": {"attenuationColor": [0.5, 0.8, 1.0], "attenuationDistance": 0.2}})");
+    auto model = load_gltf(f.path, Placement{});
+    ASSERT_TRUE(model.ok()) << model.error().message;
+    expect_vec3_near(model->materials[0].attenuation_color, {0.5f, 0.8f, 1.0f}, 1e-6f);
+    EXPECT_NEAR(model->materials[0].attenuation_distance, 0.2f, 1e-6f);
+    EXPECT_NEAR(model->materials[0].ior, 1.5f, 1e-6f);  // KHR_materials_ior's default
+  }
+  {
+    TinyGltf f("4", R"({"KHR_materials_ior": {"ior": 0.5}})");
+    EXPECT_ERROR(load_gltf(f.path, Placement{}), BadInput, "tri.gltf", "material 0 'glass'", "KHR_materials_ior.ior",
+                 "[1, 4]");
+  }
+  {
+    TinyGltf f("4", R"({"KHR_materials_transmission": {"transmissionFactor": 1.5}})");
+    EXPECT_ERROR(load_gltf(f.path, Placement{}), BadInput, "tri.gltf", "transmissionFactor", "[0, 1]");
+  }
+  {
+    TinyGltf f("4", R"({"KHR_materials_volume": {"attenuationDistance": -1}})");
+    EXPECT_ERROR(load_gltf(f.path, Placement{}), BadInput, "tri.gltf", "attenuationDistance", "positive");
+  }
+  {
+    TinyGltf f("4", R"({"KHR_materials_volume": {"attenuationColor": [2, 0, 0]}})");
+    EXPECT_ERROR(load_gltf(f.path, Placement{}), BadInput, "tri.gltf", "attenuationColor", "[0, 1]");
+  }
 }
 
 TEST(GltfLoader, MirroringPlacementKeepsFrontFaces) {
