@@ -16,15 +16,6 @@ constexpr VkFormat kNormalFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kFluxFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 
-struct RsmPush {
-  glm::mat4 view_proj;
-  glm::vec4 light;
-  glm::vec4 colour;
-  glm::vec4 axis;
-  glm::ivec4 misc;
-};
-static_assert(sizeof(RsmPush) == 128, "the guaranteed push-constant size");
-
 glm::vec3 any_up(const glm::vec3& forward) {
   return std::abs(forward.y) > 0.9f ? glm::vec3(1.0f, 0.0f, 0.0f) : glm::vec3(0.0f, 1.0f, 0.0f);
 }
@@ -314,48 +305,71 @@ void ReflectiveShadowMaps::add_map_draw(gpu::FrameGraph& graph, const std::strin
         const VkRect2D sc{{0, 0}, {s, s}};
         vkCmdSetViewport(cmd, 0, 1, &vp);
         vkCmdSetScissor(cmd, 0, 1, &sc);
-        const VkSampler linear = ctx.samplers().linear_repeat, nearest = ctx.samplers().nearest_clamp;
-        if (grid_indices > 0) {
-          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, grid_pipe->pipeline);
-          const gpu::ShaderInterface& gi = grid_pipe->interface;
-          gpu::DescriptorPush()
-              .sampled_image(gi.find("real_position")->binding, p.view(real.position), nearest)
-              .sampled_image(gi.find("real_normal")->binding, p.view(real.normal), nearest)
-              .sampled_image(gi.find("real_albedo")->binding, p.view(real.albedo), nearest)
-              .sampled_image(gi.find("base_color_maps")->binding, p.view(sg->base_color_maps), linear)
-              .push(ctx, cmd, *grid_pipe);
-          vkCmdPushConstants(cmd, grid_pipe->layout, grid_pipe->stages, 0, sizeof push, &push);
-          vkCmdBindIndexBuffer(cmd, p.buffer(indices), 0, VK_INDEX_TYPE_UINT32);
-          vkCmdDrawIndexed(cmd, grid_indices, 1, 0, 0, 0);
-        }
-        if (proxies || virtuals) {
-          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mesh_pipe->pipeline);
-          const gpu::ShaderInterface& mi = mesh_pipe->interface;
-          gpu::DescriptorPush()
-              .storage_buffer(mi.find("Materials")->binding, p.buffer(sg->materials))
-              .sampled_image(mi.find("base_color_maps")->binding, p.view(sg->base_color_maps), linear)
-              .push(ctx, cmd, *mesh_pipe);
-          auto draw_set = [&](const technique::MeshSet& set, bool materials) {
-            VkBuffer vb = p.buffer(set.vertices);
-            VkDeviceSize offset = 0;
-            vkCmdBindVertexBuffers(cmd, 0, 1, &vb, &offset);
-            vkCmdBindIndexBuffer(cmd, p.buffer(set.indices), 0, VK_INDEX_TYPE_UINT32);
-            for (const technique::DrawRange& d : set.draws) {
-              // Proxies: their scene.json material hint is not on the GPU yet: mid grey.
-              push.misc.y = materials ? d.material : -1;
-              push.misc.z = materials ? 0 : int(0xff808080u);
-              vkCmdPushConstants(cmd, mesh_pipe->layout, mesh_pipe->stages, 0, sizeof push, &push);
-              const technique::DrawRange::Lod& l =
-                  d.lods.empty() ? technique::DrawRange::Lod{d.first_index, d.index_count, 0.0f}
-                                 : d.lods[technique::MeshSet::select_lod(d, lod)];
-              vkCmdDrawIndexed(cmd, l.index_count, 1, l.first_index, d.vertex_offset, 0);
-            }
-          };
-          if (proxies) draw_set(sg->real_proxies, false);
-          if (virtuals) draw_set(sg->virtual_objects, true);
-        }
+        RsmGeometryDraw g;
+        g.grid_pipeline = grid_indices > 0 ? grid_pipe : nullptr;
+        g.mesh_pipeline = mesh_pipe;
+        g.real = real;
+        g.grid_indices = indices;
+        g.grid_index_count = grid_indices;
+        g.proxies = proxies;
+        g.virtuals = virtuals;
+        g.lod = &lod;
+        draw_rsm_geometry(cmd, p, *sg, g, push);
         ctx.fn().cmd_end_rendering(cmd);
       });
+}
+
+void draw_rsm_geometry(VkCommandBuffer cmd, gpu::PassContext& p, const technique::SceneGpu& scene,
+                       const RsmGeometryDraw& d, RsmPush push) {
+  const gpu::Context& ctx = p.context();
+  const VkSampler linear = ctx.samplers().linear_repeat, nearest = ctx.samplers().nearest_clamp;
+  if (d.grid_pipeline) {
+    const gpu::Pipeline* gp = d.grid_pipeline;
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, gp->pipeline);
+    const gpu::ShaderInterface& gi = gp->interface;
+    gpu::DescriptorPush()
+        .sampled_image(gi.find("real_position")->binding, p.view(d.real.position), nearest)
+        .sampled_image(gi.find("real_normal")->binding, p.view(d.real.normal), nearest)
+        .sampled_image(gi.find("real_albedo")->binding, p.view(d.real.albedo), nearest)
+        .sampled_image(gi.find("base_color_maps")->binding, p.view(scene.base_color_maps), linear)
+        .push(ctx, cmd, *gp);
+    vkCmdPushConstants(cmd, gp->layout, gp->stages, 0, sizeof push, &push);
+    vkCmdBindIndexBuffer(cmd, p.buffer(d.grid_indices), 0, VK_INDEX_TYPE_UINT32);
+    if (d.grid_indirect.valid())
+      vkCmdDrawIndexedIndirect(cmd, p.buffer(d.grid_indirect), d.grid_indirect_offset, 1, 20);
+    else
+      vkCmdDrawIndexed(cmd, d.grid_index_count, 1, 0, 0, 0);
+  }
+  const bool proxies = d.proxies && !scene.real_proxies.empty();
+  const bool virtuals = d.virtuals && !scene.virtual_objects.empty();
+  if (!d.mesh_pipeline || !(proxies || virtuals)) return;
+  const gpu::Pipeline* mp = d.mesh_pipeline;
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mp->pipeline);
+  const gpu::ShaderInterface& mi = mp->interface;
+  gpu::DescriptorPush()
+      .storage_buffer(mi.find("Materials")->binding, p.buffer(scene.materials))
+      .sampled_image(mi.find("base_color_maps")->binding, p.view(scene.base_color_maps), linear)
+      .push(ctx, cmd, *mp);
+  auto draw_set = [&](const technique::MeshSet& set, bool materials) {
+    VkBuffer vb = p.buffer(set.vertices);
+    VkDeviceSize offset = 0;
+    vkCmdBindVertexBuffers(cmd, 0, 1, &vb, &offset);
+    vkCmdBindIndexBuffer(cmd, p.buffer(set.indices), 0, VK_INDEX_TYPE_UINT32);
+    for (size_t i = 0; i < set.draws.size(); ++i) {
+      if (materials && d.skip_virtual && i < d.skip_virtual->size() && (*d.skip_virtual)[i]) continue;
+      const technique::DrawRange& r = set.draws[i];
+      // Proxies: their scene.json material hint is not on the GPU yet: mid grey.
+      push.misc.y = materials ? r.material : -1;
+      push.misc.z = materials ? 0 : int(0xff808080u);
+      vkCmdPushConstants(cmd, mp->layout, mp->stages, 0, sizeof push, &push);
+      const technique::DrawRange::Lod l =
+          r.lods.empty() || !d.lod ? technique::DrawRange::Lod{r.first_index, r.index_count, 0.0f}
+                                   : r.lods[technique::MeshSet::select_lod(r, *d.lod)];
+      vkCmdDrawIndexed(cmd, l.index_count, 1, l.first_index, r.vertex_offset, 0);
+    }
+  };
+  if (proxies) draw_set(scene.real_proxies, false);
+  if (virtuals) draw_set(scene.virtual_objects, true);
 }
 
 }  // namespace mrgi::gi

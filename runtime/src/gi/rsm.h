@@ -10,6 +10,7 @@
 #pragma once
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -53,6 +54,36 @@ Expected<RsmView> rsm_view(const LightDesc& lamp, const glm::vec3& centre, float
 bool lamp_reaches_sphere(const LightDesc& lamp, const glm::vec3& centre, float radius);
 
 enum class RsmMap : uint8_t { WithVirtual, RealOnly };
+
+// The push block of gi/rsm_grid.vert and gi/rsm_mesh.vert (and the fragment shaders drawn with
+// them: gi/rsm.frag, the specular stage's impostor, back-face and photon-surface shaders).
+struct RsmPush {
+  glm::mat4 view_proj{1.0f};
+  glm::vec4 light{0.0f};
+  glm::vec4 colour{0.0f};
+  glm::vec4 axis{0.0f};
+  glm::ivec4 misc{1, -1, 0, 0};  // x grid stride; y the draw's material (-1: proxy); z a proxy's hint colour; w grid points per row
+};
+static_assert(sizeof(RsmPush) == 128, "the guaranteed push-constant size");
+
+// The scene as the RSM vertex shaders draw it, inside a render pass that is begun, with its
+// viewport set: the real grid over the real G-buffer (an index list drawn directly, or from an
+// indexed indirect command), the proxies (their material hint: mid grey) and the virtual meshes
+// with their materials, at `lod` (else full detail), leaving out the virtual ranges `skip` marks.
+struct RsmGeometryDraw {
+  const gpu::Pipeline* grid_pipeline = nullptr;  // null: no real grid
+  const gpu::Pipeline* mesh_pipeline = nullptr;  // null: no meshes
+  RealGBuffer real;
+  gpu::BufferHandle grid_indices;
+  uint32_t grid_index_count = 0;               // a direct draw of this many indices, or
+  gpu::BufferHandle grid_indirect;             // valid: one VkDrawIndexedIndirectCommand at
+  VkDeviceSize grid_indirect_offset = 0;       // this offset
+  bool proxies = true, virtuals = true;
+  const std::vector<bool>* skip_virtual = nullptr;
+  const technique::LodView* lod = nullptr;
+};
+void draw_rsm_geometry(VkCommandBuffer cmd, gpu::PassContext& p, const technique::SceneGpu& scene,
+                       const RsmGeometryDraw& draw, RsmPush push);
 
 class ReflectiveShadowMaps {
  public:

@@ -49,7 +49,7 @@ void add_mesh_raster(gpu::FrameGraph& graph, const technique::SceneGpu& scene, c
         VkDeviceSize offset = 0;
         vkCmdBindVertexBuffers(cmd, 0, 1, &vb, &offset);
         vkCmdBindIndexBuffer(cmd, p.buffer(sg->virtual_objects.indices), 0, VK_INDEX_TYPE_UINT32);
-        MeshDrawPush push = r.push;
+        gi::RsmPush push = r.push;
         for (size_t i : r.draws) {
           const technique::DrawRange& d = sg->virtual_objects.draws[i];
           push.misc.y = d.material;

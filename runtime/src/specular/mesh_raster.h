@@ -8,21 +8,12 @@
 
 #include <glm/glm.hpp>
 
+#include "gi/rsm.h"
 #include "gpu/frame_graph.h"
 #include "gpu/pipelines.h"
 #include "technique/scene_gpu.h"
 
 namespace mrgi::specular {
-
-// gi/rsm_mesh.vert's push block.
-struct MeshDrawPush {
-  glm::mat4 view_proj{1.0f};
-  glm::vec4 light{0.0f};  // xyz: the viewpoint (fragment shaders face normals towards it)
-  glm::vec4 colour{0.0f};
-  glm::vec4 axis{0.0f};
-  glm::ivec4 misc{1, -1, 0, 0};  // y: the draw's material (set per range)
-};
-static_assert(sizeof(MeshDrawPush) == 128, "the guaranteed push-constant size");
 
 struct MeshRaster {
   std::string name;
@@ -30,7 +21,7 @@ struct MeshRaster {
   std::vector<gpu::ImageHandle> colour;     // cleared to 0
   gpu::ImageHandle depth;                   // cleared to 1
   VkExtent2D extent{0, 0};                  // {0, 0}: the first colour target's used extent
-  MeshDrawPush push;
+  gi::RsmPush push;  // misc.y is set per range
   std::vector<size_t> draws;                // indices into scene.virtual_objects.draws
 };
 

@@ -8,6 +8,7 @@
 #include <glm/glm.hpp>
 
 #include "common/light_set.glsl"
+#include "gi/rsm.h"
 #include "gpu/shaders.h"
 #include "light/env_sampler.h"
 #include "light/light_stage.h"
@@ -29,16 +30,6 @@ constexpr VkFormat kBackNormalFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 // What the impostors see: nearer than this is inside the object, farther is environment.
 constexpr float kImpostorNear_m = 0.01f, kImpostorFar_m = 50.0f;
-
-// gi/rsm_grid.vert and gi/rsm_mesh.vert's push block (gi/rsm.cpp RsmPush).
-struct DrawPush {
-  glm::mat4 view_proj;
-  glm::vec4 light;
-  glm::vec4 colour;
-  glm::vec4 axis;
-  glm::ivec4 misc;
-};
-static_assert(sizeof(DrawPush) == 128, "the guaranteed push-constant size");
 
 // Face f of a cube around `centre`: Vulkan clip coordinates whose x / w and y / w are
 // shared/specular_math.h's face coordinates (dot(d, right) / dot(d, forward), the same with down).
@@ -377,51 +368,23 @@ void SpecularStage::Impl::add_impostors(gpu::FrameGraph& graph, const ImpostorSe
         ri.pColorAttachments = colour;
         ri.pDepthAttachment = &depth;
         ctx.fn().cmd_begin_rendering(cmd, &ri);
-        const VkSampler linear = ctx.samplers().linear_repeat, nearest = ctx.samplers().nearest_clamp;
-        const gpu::Pipeline* gp = &*self->grid_pipeline;
-        const gpu::Pipeline* mp = &*self->mesh_pipeline;
+        gi::RsmGeometryDraw g;
+        g.grid_pipeline = grid ? &*self->grid_pipeline : nullptr;
+        g.mesh_pipeline = &*self->mesh_pipeline;
+        g.real = {real.position, self->shared.real_normal, self->shared.real_albedo};
+        g.grid_indices = indices;
+        g.grid_indirect = draws;
+        g.skip_virtual = &excluded;
         for (int f = 0; f < 6; ++f) {
           const int fx = origin.x + int(face) * (f % 3), fy = origin.y + int(face) * (f / 3);
           const VkViewport vp{float(fx), float(fy), float(face), float(face), 0.0f, 1.0f};
           const VkRect2D sc{{fx, fy}, {face, face}};
           vkCmdSetViewport(cmd, 0, 1, &vp);
           vkCmdSetScissor(cmd, 0, 1, &sc);
-          DrawPush push{face_view_proj(centre, f), glm::vec4(centre, 1.0f), glm::vec4(1.0f, 1.0f, 1.0f, -2.0f),
-                        glm::vec4(shader::specular_face_forward(f), 1.0f), misc};
-          if (grid) {
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, gp->pipeline);
-            const gpu::ShaderInterface& gi = gp->interface;
-            gpu::DescriptorPush()
-                .sampled_image(gi.find("real_position")->binding, p.view(real.position), nearest)
-                .sampled_image(gi.find("real_normal")->binding, p.view(self->shared.real_normal), nearest)
-                .sampled_image(gi.find("real_albedo")->binding, p.view(self->shared.real_albedo), nearest)
-                .sampled_image(gi.find("base_color_maps")->binding, p.view(sg->base_color_maps), linear)
-                .push(ctx, cmd, *gp);
-            vkCmdPushConstants(cmd, gp->layout, gp->stages, 0, sizeof push, &push);
-            vkCmdBindIndexBuffer(cmd, p.buffer(indices), 0, VK_INDEX_TYPE_UINT32);
-            vkCmdDrawIndexedIndirect(cmd, p.buffer(draws), VkDeviceSize(f) * 20, 1, 20);
-          }
-          vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mp->pipeline);
-          const gpu::ShaderInterface& mi = mp->interface;
-          gpu::DescriptorPush()
-              .storage_buffer(mi.find("Materials")->binding, p.buffer(sg->materials))
-              .sampled_image(mi.find("base_color_maps")->binding, p.view(sg->base_color_maps), linear)
-              .push(ctx, cmd, *mp);
-          auto draw_set = [&](const technique::MeshSet& set, bool materials) {
-            VkBuffer vb = p.buffer(set.vertices);
-            VkDeviceSize offset = 0;
-            vkCmdBindVertexBuffers(cmd, 0, 1, &vb, &offset);
-            vkCmdBindIndexBuffer(cmd, p.buffer(set.indices), 0, VK_INDEX_TYPE_UINT32);
-            for (size_t i = 0; i < set.draws.size(); ++i) {
-              const technique::DrawRange& d = set.draws[i];
-              if (materials && excluded[i]) continue;
-              push.misc.y = materials ? d.material : -1;
-              vkCmdPushConstants(cmd, mp->layout, mp->stages, 0, sizeof push, &push);
-              vkCmdDrawIndexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0);
-            }
-          };
-          if (!sg->real_proxies.empty()) draw_set(sg->real_proxies, false);
-          draw_set(sg->virtual_objects, true);
+          g.grid_indirect_offset = VkDeviceSize(f) * 20;
+          const gi::RsmPush push{face_view_proj(centre, f), glm::vec4(centre, 1.0f), glm::vec4(1.0f, 1.0f, 1.0f, -2.0f),
+                                 glm::vec4(shader::specular_face_forward(f), 1.0f), misc};
+          gi::draw_rsm_geometry(cmd, p, *sg, g, push);
         }
         ctx.fn().cmd_end_rendering(cmd);
       });
