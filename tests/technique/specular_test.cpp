@@ -7,6 +7,7 @@
 
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "capture/temp_dir.h"
@@ -55,6 +56,16 @@ RuntimeSettings settings_for(const char* technique, int level) {
   return s;
 }
 
+// Three frames of `s` with dir at level 1, with the paper's method (first) and with one of
+// SpecularAblation's flags set (second).
+using Frames = std::vector<FrameOutput>;
+std::pair<Frames, Frames> run_with_and_without(const SyntheticScene& s, bool SpecularAblation::*flag) {
+  RuntimeSettings on = settings_for("dir", 1);
+  RuntimeSettings off = on;
+  off.specular_ablation.*flag = true;
+  return {run_synthetic_frames(s, on, 3), run_synthetic_frames(s, off, 3)};
+}
+
 bool has_pass(const FrameOutput& o, const std::string& prefix) {
   for (const PassTiming& p : o.stats.passes)
     if (p.name.rfind(prefix, 0) == 0) return true;
@@ -93,11 +104,7 @@ TEST(Specular, GlassShowsTheCamerasFloorThroughIt) {
   const SyntheticScene s = SyntheticScene::create(dir.str(), glm::vec3(0.0f), glm::vec3(1.0f), 0.0f, 0.0f, 1.0f);
   const auto px = top_centre_pixels(s, 0.05f);
   ASSERT_GT(px.size(), 4u);
-  RuntimeSettings on = settings_for("dir", 1);
-  RuntimeSettings off = on;
-  off.specular_ablation.off = true;
-  const auto a = run_synthetic_frames(s, on, 3);
-  const auto b = run_synthetic_frames(s, off, 3);
+  const auto [a, b] = run_with_and_without(s, &SpecularAblation::off);
   ASSERT_EQ(a.size(), 3u);
   ASSERT_EQ(b.size(), 3u);
   const InputFrame in = s.frame(2);
@@ -128,11 +135,7 @@ TEST(Specular, GlassFocusesTheSpotLampIntoItsShadowWithNoMoreThanItIntercepts) {
   // more than the lamp's flux the boxes intercept.
   mrgi::testing::TempDir dir;
   const SyntheticScene s = SyntheticScene::create(dir.str(), glm::vec3(0.0f), glm::vec3(1.0f), 0.0f, 0.0f, 1.0f);
-  RuntimeSettings on = settings_for("dir", 1);
-  RuntimeSettings off = on;
-  off.specular_ablation.no_caustics = true;
-  const auto a = run_synthetic_frames(s, on, 3);
-  const auto b = run_synthetic_frames(s, off, 3);
+  const auto [a, b] = run_with_and_without(s, &SpecularAblation::no_caustics);
   ASSERT_EQ(a.size(), 3u);
   ASSERT_EQ(b.size(), 3u);
   EXPECT_TRUE(has_pass(a.back(), "specular caustic splat"));
@@ -172,11 +175,7 @@ TEST(Specular, GlassFocusesTheSpotLampIntoItsShadowWithNoMoreThanItIntercepts) {
 TEST(Specular, ASceneWithoutSpecularMaterialRunsNoneOfItsPassesAndIsUnchanged) {
   mrgi::testing::TempDir dir;
   const SyntheticScene s = SyntheticScene::create(dir.str());
-  RuntimeSettings on = settings_for("dir", 1);
-  RuntimeSettings off = on;
-  off.specular_ablation.off = true;
-  const auto a = run_synthetic_frames(s, on, 3);
-  const auto b = run_synthetic_frames(s, off, 3);
+  const auto [a, b] = run_with_and_without(s, &SpecularAblation::off);
   ASSERT_EQ(a.size(), 3u);
   ASSERT_EQ(b.size(), 3u);
   for (size_t i = 0; i < a.size(); ++i) {
