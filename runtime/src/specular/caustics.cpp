@@ -171,7 +171,12 @@ bool Caustics::record(gpu::FrameGraph& graph, const Impostors& imp, const std::v
     const float dist = glm::length(to);
     const glm::vec3 axis = to / dist;
     const float half = std::asin(std::min(radius / dist, 0.97f));
-    const glm::mat4 view_proj = glm::perspective(2.0f * half, 1.0f, 0.01f, dist + radius) *
+    // glm's perspective is OpenGL's (y up); flipped to Vulkan's y down like the camera's
+    // (FrameConstants::world_to_clip), so the photon maps' front and back faces are the ones the
+    // culling of their pipelines means (unflipped, the winding mirrors and "back faces" were the
+    // lamp-facing ones: the refracted photons left from the wrong side and spread over the table).
+    const glm::mat4 flip_y = glm::scale(glm::mat4(1.0f), glm::vec3(1.0f, -1.0f, 1.0f));
+    const glm::mat4 view_proj = flip_y * glm::perspective(2.0f * half, 1.0f, 0.01f, dist + radius) *
                                 glm::lookAt(lamp.position, centre, any_up(axis));
     MeshRaster r;
     r.name = "specular photon surfaces " + id;
