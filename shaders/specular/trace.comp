@@ -12,8 +12,9 @@
 //      The G-buffers are this pass's registers: each hit is shaded where it is found (its
 //      position, normal, albedo and real/virtual flag are what Sec. 5.1 stores).
 //   2. L'_rv and L'_r (eq. 3-5): each hit lit by the lamps with baseline's shadow-map pair (a
-//      real lamp's light on a real hit in L'_r too, common/shadowed_lamps.glsl) and by the SH
-//      ambient, times the Fresnel factors and the transmittance colour (eq. 9).
+//      real lamp's light on a real hit in L'_r too, common/shadowed_lamps.glsl), by the SH
+//      ambient and, in L'_rv, by the spot lamps' caustics on it (caustic_at), times the Fresnel
+//      factors and the transmittance colour (eq. 9).
 //   3. Back-projection (eq. 6-11, Sec. 4.1.3): a real hit seen by the camera (inside the view,
 //      its depth within the tolerance of the real G-buffer's there) takes the camera's colour;
 //      the rendered light where the test fails or the hit is outside the view; the environment

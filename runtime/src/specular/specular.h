@@ -1,21 +1,26 @@
 // Reflective and refractive virtual objects (Knecht et al. 2013, "Reflective and refractive
 // objects for mixed reality", ../shared/papers/reflective-refractive-caustics-dir.md), a stage of
-// the runtime after the technique's shading and before compose, so a mirror or a glass object is
-// specular whichever technique lights the diffuse scene (dir, the paper's base, or baseline, dlpv,
-// dvct, ssrt).
+// the runtime around the technique's shading, so a mirror or a glass object is specular whichever
+// technique lights the diffuse scene (dir, the paper's base, or baseline, dlpv, dvct, ssrt).
 //
 // Per frame, where a reflective or refractive object is in view (shared/specular_math.h
-// specular_kind: smooth metal, transmissive materials):
-//   specular impostor grid      the real scene's grid over the real G-buffer (baseline's caster
-//                               index list at the impostors' resolution)
-//   specular impostors <s>      per set: six 90 degree faces drawn from the set's centre (the real
-//                               grid, the proxies, the other virtual objects): world position,
-//                               normal, albedo, real or virtual (shaders/specular/impostor.frag)
-//   specular back faces         the refractive objects' back faces from the camera (Wyman 2005)
-//   specular trace              per specular pixel: the reflected and refracted rays' hits,
-//                               their light with and without the virtual objects, back-projection
-//                               into the camera frame and the composite of eq. 6-11
-//                               (shaders/specular/trace.comp), into lit_rv
+// specular_kind: smooth metal, transmissive materials), before the technique (prepare):
+//   specular impostor cells <s>  the real grid's triangles of each cube face of set s
+//                                (impostor_cells.comp: a point per impostor texel over the real
+//                                G-buffer, none across a depth edge)
+//   specular impostors <s>       per set: six 90 degree faces drawn from the set's centre (the real
+//                                grid, the proxies, the other virtual objects): world position,
+//                                normal, albedo, real or virtual (shaders/specular/impostor.frag)
+//   specular back faces          the refractive objects' back faces from the camera (Wyman 2005)
+//   specular photon ... <l>      per spot lamp whose cone holds such an object: photon maps,
+//                                photons and their splat into the caustic buffer (caustics.h); the
+//                                technique reads the photons (dir's caustic VPLs, FrameInfo::caustics)
+// and after it (finish):
+//   specular trace               per specular pixel: the reflected and refracted rays' hits,
+//                                their light with and without the virtual objects, back-projection
+//                                into the camera frame and the composite of eq. 6-11
+//                                (shaders/specular/trace.comp), into lit_rv
+//   specular caustic apply       the caustic buffer on the diffuse pixels' L_rv
 //
 // Deviations from the paper, and why:
 //   - Impostors: Popescu et al. give each surrounding object its own billboard. Here the
@@ -24,14 +29,15 @@
 //     faces of a cube around its centre (distance impostors, Szirmay-Kalos et al. 2005), searched
 //     by the same iterative refinement; one layer, so a surface hidden from the centre behind a
 //     nearer one is missing (the search then passes behind the nearer one's silhouette).
-//   - Each hit is shaded by the lamps (with the technique's shadow maps where it drew them) and
-//     the SH ambient; dir's VPLs do not light the hits yet, and a virtual hit is Lambertian.
-//   - L_env: the environment's radiance from the light stage's SH (4 bands), not the fish-eye
-//     image itself: the stage keeps no environment texture on the GPU.
+//   - Each hit is shaded by the lamps (with the technique's shadow maps where it drew them), the
+//     SH ambient and the caustic buffer; dir's VPLs do not light the hits (eq. 3 sums them too:
+//     not built yet), and a virtual hit is Lambertian.
+//   - L_env: the light stage's environment grid (64 x 32 cells of the filtered image, bilinear),
+//     not the fish-eye image at its own resolution; the SH where there is no environment image.
 //   - Eq. 9's validity is per path (specular_math.h specular_compose says why).
 //   - Caustics (Sec. 4.2, caustics.h) add to L_rv; the technique's shadow maps hold the glass as
-//     an opaque caster, so the light it lets through is the caustic's alone. Caustic VPLs
-//     (Sec. 4.2.2: dir's VPLs moved to where the caustics land) are not built yet.
+//     an opaque caster, so the light it lets through is the caustic's alone. dir's caustic VPLs
+//     (Sec. 4.2.2) are gi/vpl_sample.comp's.
 #pragma once
 #include <array>
 #include <memory>
