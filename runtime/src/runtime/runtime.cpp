@@ -350,11 +350,7 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   if (!tech) return tech.error();
   technique_ = std::move(*tech);
   if (!settings.specular_ablation.off) {
-    specular::SpecularSettings ss;
-    ss.back_projection = !settings.specular_ablation.no_back_projection;
-    ss.depth_test = !settings.specular_ablation.no_depth_test;
-    ss.caustics = !settings.specular_ablation.no_caustics;
-    auto spec = specular::SpecularStage::create(shared, ss);
+    auto spec = specular::SpecularStage::create(shared, specular::settings_for(settings.specular_ablation));
     if (!spec) return spec.error();
     specular_ = std::move(*spec);
   }

@@ -77,6 +77,14 @@ const std::array<SpecularLevel, 3>& specular_levels() {
   return levels;
 }
 
+SpecularSettings settings_for(const SpecularAblation& ablation) {
+  SpecularSettings s;
+  s.back_projection = !ablation.no_back_projection;
+  s.depth_test = !ablation.no_depth_test;
+  s.caustics = !ablation.no_caustics;
+  return s;
+}
+
 const SpecularLevel& specular_level_for(int technique_level, int technique_levels) {
   const auto& l = specular_levels();
   if (technique_level <= 0) return l[0];

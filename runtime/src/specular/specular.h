@@ -91,6 +91,10 @@ struct SpecularSettings {
   uint32_t max_caustic_map = 512;       // allocated texels per side of the photon maps
 };
 
+// The defaults with RuntimeSettings::specular_ablation's flags applied (its `off` is the
+// runtime's: no stage at all).
+SpecularSettings settings_for(const SpecularAblation& ablation);
+
 class SpecularStage {
  public:
   // nullptr (no error) when no virtual material is specular: nothing is allocated.
