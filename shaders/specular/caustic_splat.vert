@@ -1,10 +1,13 @@
 #version 460
-// Caustic photons splatted as quads into the caustic buffer CBuf at the camera's internal
+// Caustic photons splatted as squares into the caustic buffer CBuf at the camera's internal
 // resolution (caustics-DIR paper Sec. 5.2; Wyman and Davis 2006, quad sizes after Wyman 2008):
-// six vertices a photon that landed (photons.comp lists them), a quad of `quad_px` pixels around where it landed, each of its pixels
-// given E = flux / (the quad's area on the surface), so the buffer holds irradiance and the
-// photons' energy is kept whatever the quad size. Photons that landed nowhere are dropped
-// outside the clip volume.
+// a point sprite per photon that landed (photons.comp lists them), a square of `side` pixels
+// around where it landed, each of its pixels given E = flux / (the square's area on the surface),
+// so the buffer holds irradiance and the photons' energy is kept whatever the size. A point, not
+// a six-vertex quad: lavapipe shades vertices on one thread, and six vertices a photon (each
+// reading its photon and two neighbours) made this pass 6 ms of a 128^2 map. A point whose centre
+// is outside the view is clipped whole (Vulkan's point clipping): a caustic loses at most half a
+// square at the image's border.
 #extension GL_GOOGLE_include_directive : require
 #include "common/frame_constants.glsl"
 
@@ -12,12 +15,14 @@ layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
 #include "specular/photon.glsl"
 layout(std430, set = 0, binding = 1) readonly buffer Photons { Photon photons[]; };
 layout(std430, set = 0, binding = 4) readonly buffer PhotonList { uint photon_list[]; };  // photons.comp
-layout(push_constant) uniform Splat { vec4 splat; };  // x smallest quad side (internal pixels),
-                                                     // y photon map size (texels), z largest side
+layout(push_constant) uniform Splat { vec4 splat; };  // x smallest side (internal pixels), y photon
+                                                     // map size (texels), z largest side (at most
+                                                     // the device's largest point)
 layout(location = 0) flat out vec4 out_irradiance;   // rgb W/m^2; w the photon's camera depth
 layout(location = 1) flat out float out_real;        // 1: it landed on a real surface
 
-// Where the neighbouring texel's photon of the same kind landed, or the photon's own place.
+// Where the neighbouring photon of the same kind landed (`step` texels away: a stride apart),
+// or the photon's own place.
 vec3 neighbour(int index, ivec2 step, vec3 own) {
   int size = int(splat.y);
   int i = index / 2, kind = index - 2 * i;
@@ -28,10 +33,10 @@ vec3 neighbour(int index, ivec2 step, vec3 own) {
 }
 
 void main() {
-  int index = int(photon_list[gl_VertexIndex / 6]);
+  int index = int(photon_list[gl_VertexIndex]);
   Photon ph = photons[index];
-  int corner = gl_VertexIndex % 6;
   gl_Position = vec4(2.0f, 2.0f, 2.0f, 1.0f);  // outside: dropped
+  gl_PointSize = 1.0f;
   out_irradiance = vec4(0.0f);
   if (!(ph.position.w > 0.5f)) return;
   vec3 c = (frame.world_to_camera * vec4(ph.position.xyz, 1.0f)).xyz;
@@ -39,17 +44,16 @@ void main() {
   vec3 to_camera = normalize(frame.camera_world.xyz - ph.position.xyz);
   float cos_view = max(abs(dot(normalize(ph.normal.xyz), to_camera)), 0.1f);
   float px_m = c.z / frame.internal_k.x;  // a pixel's side on a surface facing the camera
-  // The quad covers the photon's share of the surface: the distance to where the neighbouring
+  // The square covers the photon's share of the surface: the distance to where the neighbouring
   // texels' photons landed (a ray differential: small where the object focuses the light, the
   // caustic's sharp core; large where it spreads it, whose few photons would otherwise be dots).
   vec3 p = ph.position.xyz;
-  float spacing = max(distance(neighbour(index, ivec2(1, 0), p), p), distance(neighbour(index, ivec2(0, 1), p), p));
+  int stride = max(int(ph.normal.w + 0.5f), 1);
+  float spacing = max(distance(neighbour(index, ivec2(stride, 0), p), p), distance(neighbour(index, ivec2(0, stride), p), p));
   float side = clamp(spacing / px_m, splat.x, splat.z);
   float area = side * side * px_m * px_m / cos_view;
   out_irradiance = vec4(ph.flux.rgb / area, c.z);
   out_real = ph.position.w < 1.5f ? 1.0f : 0.0f;
-  vec4 clip = frame.world_to_clip * vec4(ph.position.xyz, 1.0f);
-  const vec2 offsets[6] = vec2[6](vec2(-1, -1), vec2(1, -1), vec2(1, 1), vec2(-1, -1), vec2(1, 1), vec2(-1, 1));
-  vec2 ndc_per_px = 2.0f / vec2(frame.internal_output_size.xy);
-  gl_Position = clip + vec4(offsets[corner] * 0.5f * side * ndc_per_px * clip.w, 0.0f, 0.0f);
+  gl_Position = frame.world_to_clip * vec4(ph.position.xyz, 1.0f);
+  gl_PointSize = side;
 }

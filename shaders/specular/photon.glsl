@@ -13,7 +13,9 @@ struct Photon {
   vec4 flux;      // rgb W it carries; w the lamp's light its texel stands for, per unit of the
                   // lamp's colour (W / (W/sr)): flux / (colour x w) is the path's Fresnel and
                   // transmittance weight
-  vec4 normal;    // xyz unit normal of the surface it landed on, facing where it came from
+  vec4 normal;    // xyz unit normal of the surface it landed on, facing where it came from; w
+                  // photon-map texels per side between photons of its kind (1, or the glass
+                  // reflection stride)
   vec4 albedo;    // rgb that surface's diffuse albedo (the impostor's)
   vec4 origin;    // xyz its texel's point on the mirror or glass; w 1 (0: the texel saw none)
 };

@@ -24,7 +24,7 @@ layout(set = 0, binding = 6, rgba32f) readonly uniform image2D impostor_position
 layout(set = 0, binding = 7, rgba8_snorm) readonly uniform image2D impostor_normal;
 layout(set = 0, binding = 8, rgba8) readonly uniform image2D impostor_albedo;
 layout(std430, set = 0, binding = 9) writeonly buffer Photons { Photon photons[]; };
-// The photons that landed somewhere, listed for the splat's indirect draw (six vertices each;
+// The photons that landed somewhere, listed for the splat's indirect draw (a point each;
 // vertex_count reset to 0 before this pass).
 layout(std430, set = 0, binding = 10) writeonly buffer PhotonList { uint photon_list[]; };
 layout(std430, set = 0, binding = 11) buffer PhotonDraw {
@@ -50,16 +50,17 @@ int nearest_set(vec3 p) {
   return best;
 }
 
-// origin: the texel's point on the object (w 1), or w 0 where the texel sees none; emitted: the
-// lamp's light the texel stands for, per unit of its colour.
-void store(uint i, Hit h, vec3 flux, vec4 origin, float emitted) {
+// origin: the texel's point on the object (w 1), or w 0 where the texel sees none;
+// emitted: the lamp's light the texel stands for, per unit of its colour; stride: texels per side
+// between photons of its kind.
+void store(uint i, Hit h, vec3 flux, vec4 origin, float emitted, int stride) {
   bool ok = h.found && any(greaterThan(flux, vec3(0.0f)));
   photons[i].position = vec4(h.position, ok ? (h.real ? 1.0f : 2.0f) : 0.0f);
   photons[i].flux = vec4(ok ? flux : vec3(0.0f), emitted);
-  photons[i].normal = vec4(ok ? h.normal : vec3(0.0f, 1.0f, 0.0f), 0.0f);
+  photons[i].normal = vec4(ok ? h.normal : vec3(0.0f, 1.0f, 0.0f), float(stride));
   photons[i].albedo = vec4(ok ? h.albedo : vec3(0.0f), 0.0f);
   photons[i].origin = origin;
-  if (ok) photon_list[atomicAdd(photon_draw.vertex_count, 6u) / 6u] = i;
+  if (ok) photon_list[atomicAdd(photon_draw.vertex_count, 1u)] = i;
 }
 
 void main() {
@@ -72,8 +73,8 @@ void main() {
   none.found = false;
   vec4 pos = imageLoad(photon_position, texel);
   if (!(pos.w > 1.5f)) {
-    store(2u * index, none, vec3(0.0f), vec4(0.0f), 0.0f);
-    store(2u * index + 1u, none, vec3(0.0f), vec4(0.0f), 0.0f);
+    store(2u * index, none, vec3(0.0f), vec4(0.0f), 0.0f, 1);
+    store(2u * index + 1u, none, vec3(0.0f), vec4(0.0f), 0.0f, 1);
     return;
   }
   GpuMaterial m = materials[int(pos.w + 0.5f) - 2];
@@ -99,10 +100,18 @@ void main() {
     // The base colour is m's factor: the photon map holds no texture coordinates.
     vec3 t = r.transmission * transmittance_colour(m.base_color_factor.rgb, m.attenuation.rgb, m.specular.z,
                                                    distance(p, r.exit_p)) * clamp(m.specular.w, 0.0f, 1.0f);
-    store(2u * index + 1u, trace_impostor(s, r.exit_p + r.exit_d * 1e-3f, r.exit_d), flux * t, origin, emitted);
+    store(2u * index + 1u, trace_impostor(s, r.exit_p + r.exit_d * 1e-3f, r.exit_d), flux * t, origin, emitted, 1);
   } else {
     eta1 = fresnel_metal(mix(vec3(0.04f), m.base_color_factor.rgb, m.params.x), cos_i);
-    store(2u * index + 1u, none, vec3(0.0f), origin, emitted);
+    store(2u * index + 1u, none, vec3(0.0f), origin, emitted, 1);
   }
-  store(2u * index, trace_impostor(s, p + refl * 1e-3f, refl), flux * eta1, origin, emitted);
+  // Off glass, one texel's reflected photon per stride x stride block, with the block's flux
+  // (SpecularLevel::glass_reflection_stride; the others stay unlit: dir's caustic VPLs then take
+  // the refracted photon, each kind as often as its share of the light, see gi/vpl_sample.comp).
+  int stride = kind == SPECULAR_REFRACTIVE ? max(int(specular.level.x + 0.5f), 1) : 1;
+  if (stride > 1 && any(notEqual(texel % stride, ivec2(0)))) {
+    store(2u * index, none, vec3(0.0f), origin, emitted, stride);
+  } else {
+    store(2u * index, trace_impostor(s, p + refl * 1e-3f, refl), flux * eta1 * float(stride * stride), origin, emitted, stride);
+  }
 }

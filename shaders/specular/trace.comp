@@ -1,7 +1,8 @@
 #version 460
-// Reflective and refractive virtual objects in DIR (Knecht et al. 2013, Sec. 4.1 and 5.1), one
-// pass at the internal resolution over the pixels whose virtual material is specular
-// (virtual_position.w >= 2: 2 + its material index, gbuffer/virtual.frag):
+// Reflective and refractive virtual objects in DIR (Knecht et al. 2013, Sec. 4.1 and 5.1), at the
+// internal resolution over the pixels whose virtual material is specular (virtual_position.w >=
+// 2: 2 + its material index, gbuffer/virtual.frag), as trace_list.comp listed them: one pass over
+// the glass pixels (kRefractive), one over the mirrors', each compiled without the other's path:
 //   1. GBuf_refl: the mirror direction's ray searched against the set's impostors (a linear
 //      search along the ray, then secant refinement: the iterative refinement of Popescu et al.
 //      2006 on distance impostors);
@@ -11,10 +12,12 @@
 //      precomputation), Snell at the back face, then the impostor search as for the reflection.
 //      The G-buffers are this pass's registers: each hit is shaded where it is found (its
 //      position, normal, albedo and real/virtual flag are what Sec. 5.1 stores).
-//   2. L'_rv and L'_r (eq. 3-5): each hit lit by the lamps with baseline's shadow-map pair (a
-//      real lamp's light on a real hit in L'_r too, common/shadowed_lamps.glsl), by the SH
-//      ambient and, in L'_rv, by the spot lamps' caustics on it (caustic_at), times the Fresnel
-//      factors and the transmittance colour (eq. 9).
+//   2. L'_rv and L'_r (eq. 3-5): a hit on a surface the camera sees takes the technique's solution
+//      there (lamps, shadows and indirect light: dir's VPLs); one it does not see is lit by the
+//      lamps with baseline's shadow-map pair (a real lamp's light on a real hit in L'_r too,
+//      common/shadowed_lamps.glsl) and the SH ambient; in L'_rv, the spot lamps' caustics on
+//      it (in the solution, or caustic_at); times the Fresnel factors and the transmittance
+//      colour (eq. 9).
 //   3. Back-projection (eq. 6-11, Sec. 4.1.3): a real hit seen by the camera (inside the view,
 //      its depth within the tolerance of the real G-buffer's there) takes the camera's colour;
 //      the rendered light where the test fails or the hit is outside the view; the environment
@@ -33,7 +36,9 @@
 #include "common/surface_shading.glsl"
 #include "specular/specular_params.glsl"
 
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = 64) in;
+// true: the glass pixels' pass (reflection and refraction); false: the mirrors' (reflection).
+layout(constant_id = 0) const bool kRefractive = false;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
 FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(std140, set = 0, binding = 1) uniform LightUbo { LightSet light_set; };
@@ -53,14 +58,19 @@ layout(set = 0, binding = 14) uniform sampler2DArrayShadow shadow_virtual;
 layout(set = 0, binding = 15) uniform sampler2DArray shadow_primary_depth;  // one-map ablation only
 layout(set = 0, binding = 16) uniform sampler2DArray shadow_virtual_depth;
 layout(set = 0, binding = 17, r32ui) readonly uniform uimageBuffer color_words;
-layout(set = 0, binding = 18, rgba16f) writeonly uniform image2D lit_rv;
-layout(set = 0, binding = 19, rgba16f) writeonly uniform image2D lit_r;
+// The technique's solutions: read where a hit is a surface the camera sees (solution_at), written
+// at the specular pixels (never read here: a hit is not on a mirror or glass pixel).
+layout(set = 0, binding = 18, rgba16f) uniform image2D lit_rv;
+layout(set = 0, binding = 19, rgba16f) uniform image2D lit_r;
 // The light stage's environment grid (light/env_sampler.h: world-space equirectangular cells
 // of filtered radiance, u = 0.5 + atan2(x, -z) / 2 pi, v = acos(y) / pi), flags.z cells wide.
 layout(std430, set = 0, binding = 20) readonly buffer EnvGrid { vec4 env_cells[]; };
 // The spot lamps' caustics on the surfaces the camera sees (caustics.h; flags.w 1 when written
 // this frame): rgb irradiance.
 layout(set = 0, binding = 21, rgba16f) readonly uniform image2D caustics;
+// trace_list.comp's lists: this pass's kind's count, its pixels (x | y << 16) from list.x on.
+layout(std430, set = 0, binding = 22) readonly buffer TraceCounts { uint counts[2]; };
+layout(std430, set = 0, binding = 23) readonly buffer TracePixels { uint pixels[]; };
 
 #define MRGI_UPLOAD_COLOR_ONLY
 #include "common/upload_gather.glsl"
@@ -103,26 +113,35 @@ vec3 env_cell(int x, int y, int w) {
   return env_cells[y * w + x].rgb;
 }
 
-// L_env of Sec. 4.1.3: the environment's radiance along d, bilinear in the grid (the SH where
-// the stage has no grid: a light estimate without an environment image).
-// The caustic irradiance on x (a real or a virtual surface) where the camera sees it, or sees it
-// through a mirror or glass (the caustic buffer holds those: caustic_splat.frag); a hit outside
-// the view or hidden behind something else gets none (the paper's Sec. 5.2 reading of CBuf
-// through GBuf_refl and GBuf_refr).
-vec3 caustic_at(vec3 x, bool real) {
+// The internal pixel where the camera sees x itself (a real surface, or a virtual one as
+// `real` says): inside the view, the G-buffer's depth there within the tolerance of x's; for a
+// real x, no virtual object in front of it there (a specular one allowed when `under_specular`:
+// the caustic buffer holds the surfaces under mirrors and glass, caustic_splat.frag).
+// (-1, -1) where the camera does not see x.
+ivec2 seen_pixel(vec3 x, bool real, bool under_specular) {
   vec3 c = (frame.world_to_camera * vec4(x, 1.0f)).xyz;
-  if (!(c.z > 1e-3f)) return vec3(0.0f);
+  if (!(c.z > 1e-3f)) return ivec2(-1);
   vec2 ip = project_pinhole(c, frame.internal_k);
   ivec2 used = frame.internal_output_size.xy;
-  if (any(lessThan(ip, vec2(0.0f))) || any(greaterThanEqual(ip, vec2(used)))) return vec3(0.0f);
+  if (any(lessThan(ip, vec2(0.0f))) || any(greaterThanEqual(ip, vec2(used)))) return ivec2(-1);
   ivec2 q = ivec2(ip);
   vec4 v = imageLoad(virtual_position, q);
-  if (real && v.w > 0.5f && v.w < 1.5f) return vec3(0.0f);  // covered by a diffuse virtual object
+  if (real && v.w > 0.5f && (v.w < 1.5f || !under_specular)) return ivec2(-1);
   float depth = real ? imageLoad(real_position, q).w : (v.w > 0.5f ? (frame.world_to_camera * vec4(v.xyz, 1.0f)).z : 0.0f);
-  if (!(depth > 0.0f) || abs(depth - c.z) > specular.params.x * c.z) return vec3(0.0f);
-  return max(imageLoad(caustics, q).rgb, vec3(0.0f));
+  if (!(depth > 0.0f) || abs(depth - c.z) > specular.params.x * c.z) return ivec2(-1);
+  return q;
 }
 
+// The caustic irradiance on x (a real or a virtual surface) where the camera sees it, or sees it
+// through a mirror or glass; a hit outside the view or hidden behind something else gets none
+// (the paper's Sec. 5.2 reading of CBuf through GBuf_refl and GBuf_refr).
+vec3 caustic_at(vec3 x, bool real) {
+  ivec2 q = seen_pixel(x, real, true);
+  return q.x < 0 ? vec3(0.0f) : max(imageLoad(caustics, q).rgb, vec3(0.0f));
+}
+
+// L_env of Sec. 4.1.3: the environment's radiance along d, bilinear in the grid (the SH where
+// the stage has no grid: a light estimate without an environment image).
 vec3 environment_radiance(vec3 d) {
   d = normalize(d);
   int w = specular.flags.z;
@@ -150,9 +169,22 @@ void add_path(inout PathSum sum, vec3 w, Hit h, vec3 d, float exposure) {
     sum.env += w * environment_radiance(d) * exposure;
     return;
   }
+  // Eq. 3-5's L'_rv and L'_r of the hit: where the camera sees the hit's surface, the
+  // technique's own solution there (its lamps, shadows and indirect light: dir's VPLs with their
+  // ISMs, the volumes' bounce of dlpv and dvct; and the caustics, splatted into it before this
+  // pass), which is eq. 3's sum for that surface point (a virtual hit's specular lobe there is the
+  // camera's view of it, not the ray's); elsewhere the lamps and the SH ambient (shade_hit: no
+  // indirect light, which the technique computed only for what the camera sees) and the caustic
+  // buffer where the surface is under a mirror or glass.
   vec3 l_rv, l_r;
-  shade_hit(h, d, l_rv, l_r);
-  if (specular.flags.w != 0) l_rv += h.albedo * caustic_at(h.position, h.real) * (1.0f / MRGI_PI);
+  ivec2 seen = seen_pixel(h.position, h.real, false);
+  if (seen.x >= 0) {
+    l_rv = max(imageLoad(lit_rv, seen).rgb, vec3(0.0f));
+    l_r = h.real ? max(imageLoad(lit_r, seen).rgb, vec3(0.0f)) : vec3(0.0f);
+  } else {
+    shade_hit(h, d, l_rv, l_r);
+    if (specular.flags.w != 0) l_rv += h.albedo * caustic_at(h.position, h.real) * (1.0f / MRGI_PI);
+  }
   vec3 tm_rv = clamp(l_rv * exposure, vec3(0.0f), vec3(1.0f));
   vec3 tm_r = clamp(l_r * exposure, vec3(0.0f), vec3(1.0f));
   sum.rv += w * tm_rv;
@@ -173,17 +205,18 @@ int nearest_set(vec3 p) {
   return best;
 }
 
-// The specular objects' pixel bounds this frame (specular.cpp: their boxes projected): only
-// those pixels are dispatched.
-layout(push_constant) uniform Region { ivec4 region; };  // xy first pixel, zw size
+layout(push_constant) uniform List { ivec4 list; };  // x this kind's first entry in pixels
 
 void main() {
   frame = frame_ubo;  // MRGI_UNIFORM_COPIES
-  ivec2 pixel = region.xy + ivec2(gl_GlobalInvocationID.xy);
+  uint at = gl_GlobalInvocationID.x;
+  if (at >= counts[kRefractive ? 0 : 1]) return;
+  uint packed = pixels[uint(list.x) + at];
+  ivec2 pixel = ivec2(int(packed & 0xffffu), int(packed >> 16));
   ivec2 used = frame.internal_output_size.xy;
-  if (any(greaterThanEqual(pixel, used)) || any(greaterThanEqual(ivec2(gl_GlobalInvocationID.xy), region.zw))) return;
+  if (any(greaterThanEqual(pixel, used))) return;
   vec4 vpos = imageLoad(virtual_position, pixel);
-  if (!(vpos.w > 1.5f)) return;  // not a specular virtual pixel: the technique's shading stands
+  if (!(vpos.w > 1.5f)) return;  // never: listed as specular
   GpuMaterial m = materials[int(vpos.w + 0.5f) - 2];
   vec3 p = vpos.xyz;
   vec3 n = normalize(imageLoad(virtual_normal, pixel).xyz);
@@ -198,10 +231,9 @@ void main() {
 
   // GBuf_refl: the mirror direction.
   vec3 refl = mirror_direction(view, n);
-  int kind = int(m.specular.x + 0.5f);
   vec3 eta1;
   vec3 eta2 = vec3(0.0f);
-  if (kind == SPECULAR_REFRACTIVE) {
+  if (kRefractive) {
     float ior = max(m.specular.y, 1.0f);
     float f1 = fresnel_dielectric(cos_v, 1.0f / ior);
     eta1 = vec3(f1);
@@ -216,7 +248,11 @@ void main() {
   } else {
     eta1 = fresnel_metal(mix(vec3(0.04f), alb.rgb, alb.a), cos_v);
   }
-  Hit h1 = trace_impostor(s, p + refl * 1e-3f, refl);
+  // Off glass, a reflection weaker than the level's threshold is not traced: it shows L_env
+  // (SpecularLevel::glass_reflection_fresnel).
+  Hit h1;
+  h1.found = false;
+  if (!kRefractive || eta1.x >= specular.level.y) h1 = trace_impostor(s, p + refl * 1e-3f, refl);
   add_path(sum, eta1, h1, refl, exposure);
 
   vec3 final_linear = specular_compose(sum.rv, sum.r, sum.camera, sum.env, specular.params.y, specular.params.z);

@@ -2,7 +2,9 @@
 // a camera 2 m above the floor looking down, a real spot lamp, a uniform real environment), with
 // Vulkan validation on: a mirror shows the environment times its reflectance, glass shows the
 // camera's floor through it, and a scene without such a material runs none of the stage's passes
-// and gives the same frames bit for bit. Accuracy against path-traced references is the bench's.
+// and gives the same frames bit for bit; the fast level splats photons traced frames before with
+// the energy of the level that traces them all every frame. Accuracy against path-traced
+// references is the bench's.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -133,6 +135,42 @@ TEST(Specular, GlassShowsTheCamerasFloorThroughIt) {
   EXPECT_FALSE(has_pass(b.back(), "specular"));
 }
 
+// The light the caustics add to the floor the camera sees (W) and their mean gain on the floor
+// in the glass's shadow near the first box, frame `with` against frame `without`.
+struct CausticGain {
+  double added_w = 0.0, shadow_gain = 0.0;
+  int shadow_n = 0;
+};
+CausticGain caustic_gain(const SyntheticScene& s, const FrameOutput& with, const FrameOutput& without) {
+  CausticGain g;
+  const Box& box = s.virtual_boxes[0];
+  const glm::vec3 c = 0.5f * (box.lo + box.hi);
+  const double pixel_m = 2.0 / s.intrinsics.fx;  // the floor is 2 m below the camera
+  for (int v = 0; v < s.intrinsics.height; ++v)
+    for (int u = 0; u < s.intrinsics.width; ++u) {
+      const SurfaceHit h = s.trace(u, v, true);
+      if (h.kind != SurfaceKind::Floor) continue;
+      const glm::vec3 d = out_px(with, u, v) - out_px(without, u, v);
+      const double change = double(d.x + d.y + d.z) / 3.0;  // radiance x exposure (1)
+      g.added_w += std::max(change, 0.0) * 3.14159265 / s.floor_albedo * pixel_m * pixel_m;
+      if (s.blocked_by_virtual(h.point) && !s.blocked_by_real(h.point) && glm::distance(h.point, glm::vec3(c.x, 0.0f, c.z)) < 0.5f) {
+        g.shadow_gain += change;
+        ++g.shadow_n;
+      }
+    }
+  return g;
+}
+
+// The boxes subtend at most pi r^2 / d^2 of the lamp (bounding spheres): 0.36 sr x 4 W/sr.
+double intercepted_w(const SyntheticScene& s) {
+  double w = 0.0;
+  for (const Box& g : s.virtual_boxes) {
+    const double r = 0.5 * glm::length(g.hi - g.lo), dist = glm::distance(0.5f * (g.lo + g.hi), s.lamp.position);
+    w += 3.14159265 * r * r / (dist * dist) * s.lamp.intensity;
+  }
+  return w;
+}
+
 TEST(Specular, GlassFocusesTheSpotLampIntoItsShadowWithNoMoreThanItIntercepts) {
   // The spot lamp through the clear glass boxes: their caustics land on the floor they shadow
   // (the technique's maps hold glass as an opaque caster, so without caustics that floor gets
@@ -145,36 +183,45 @@ TEST(Specular, GlassFocusesTheSpotLampIntoItsShadowWithNoMoreThanItIntercepts) {
   ASSERT_EQ(b.size(), 3u);
   EXPECT_TRUE(has_pass(a.back(), "specular caustic splat"));
   EXPECT_FALSE(has_pass(b.back(), "specular caustic splat"));
-  double shadow_gain = 0.0, added_w = 0.0;
-  int shadow_n = 0;
-  const Box& box = s.virtual_boxes[0];
-  const glm::vec3 c = 0.5f * (box.lo + box.hi);
-  const double pixel_m = 2.0 / s.intrinsics.fx;  // the floor is 2 m below the camera
-  for (int v = 0; v < s.intrinsics.height; ++v)
-    for (int u = 0; u < s.intrinsics.width; ++u) {
-      const SurfaceHit h = s.trace(u, v, true);
-      if (h.kind != SurfaceKind::Floor) continue;
-      const glm::vec3 d = out_px(a.back(), u, v) - out_px(b.back(), u, v);
-      const double change = double(d.x + d.y + d.z) / 3.0;  // radiance x exposure (1)
-      added_w += std::max(change, 0.0) * 3.14159265 / s.floor_albedo * pixel_m * pixel_m;
-      if (s.blocked_by_virtual(h.point) && !s.blocked_by_real(h.point) && glm::distance(h.point, glm::vec3(c.x, 0.0f, c.z)) < 0.5f) {
-        shadow_gain += change;
-        ++shadow_n;
-      }
-    }
-  ASSERT_GT(shadow_n, 4);
+  const CausticGain g = caustic_gain(s, a.back(), b.back());
+  ASSERT_GT(g.shadow_n, 4);
   // The floor's direct light there is about 0.1 (4 W/sr at 2 m, 53 degrees off the normal,
   // albedo 0.6): the light through the glass gives a part of it back on the shadow's visible
   // part (the rest lands under the box).
-  EXPECT_GT(shadow_gain / shadow_n, 0.005) << "no caustic in the glass's shadow";
-  // The boxes subtend at most pi r^2 / d^2 of the lamp (bounding spheres): 0.36 sr x 4 W/sr.
-  double intercepted_w = 0.0;
-  for (const Box& g : s.virtual_boxes) {
-    const double r = 0.5 * glm::length(g.hi - g.lo), dist = glm::distance(0.5f * (g.lo + g.hi), s.lamp.position);
-    intercepted_w += 3.14159265 * r * r / (dist * dist) * s.lamp.intensity;
+  EXPECT_GT(g.shadow_gain / g.shadow_n, 0.005) << "no caustic in the glass's shadow";
+  EXPECT_GT(g.added_w, 0.0);
+  EXPECT_LT(g.added_w, intercepted_w(s)) << "the caustics add more light than the glass intercepts";
+}
+
+TEST(Specular, TheFastLevelSplatsPhotonsItTracedFramesAgoWithTheSameEnergy) {
+  // dir's fast level (SpecularLevel "fast": 128^2 maps, a quarter of the glass-reflected photons
+  // with four times the flux each, photons traced every eighth frame while nothing moves): the
+  // photons are traced on the first frame and splatted from the buffers on the next ones, which
+  // say so; every frame's caustic holds about the energy of level 1's, which traces all of them
+  // every frame, and no more than the glass intercepts.
+  mrgi::testing::TempDir dir;
+  const SyntheticScene s = SyntheticScene::create(dir.str(), glm::vec3(0.0f), glm::vec3(1.0f), 0.0f, 0.0f, 1.0f);
+  RuntimeSettings fast = settings_for("dir", 3);
+  RuntimeSettings fast_off = fast;
+  fast_off.specular_ablation.no_caustics = true;
+  const Frames a = run_synthetic_frames(s, fast, 4), b = run_synthetic_frames(s, fast_off, 4);
+  const auto [ref_on, ref_off] = run_with_and_without(s, &SpecularAblation::no_caustics);
+  ASSERT_EQ(a.size(), 4u);
+  ASSERT_EQ(b.size(), 4u);
+  EXPECT_TRUE(has_pass(a[0], "specular photons 0"));
+  const double reference_w = caustic_gain(s, ref_on.back(), ref_off.back()).added_w;
+  ASSERT_GT(reference_w, 0.0);
+  for (size_t i = 1; i < a.size(); ++i) {
+    EXPECT_TRUE(has_pass(a[i], "specular caustic splat 0")) << "frame " << i;
+    EXPECT_FALSE(has_pass(a[i], "specular photons 0")) << "frame " << i;
+    bool said = false;
+    for (const std::string& k : a[i].stats.skipped) said = said || k.rfind("specular photons: traced", 0) == 0;
+    EXPECT_TRUE(said) << "frame " << i;
+    const CausticGain g = caustic_gain(s, a[i], b[i]);
+    EXPECT_GT(g.added_w, 0.7 * reference_w) << "frame " << i;
+    EXPECT_LT(g.added_w, 1.3 * reference_w) << "frame " << i;
+    EXPECT_LT(g.added_w, intercepted_w(s)) << "frame " << i;
   }
-  EXPECT_GT(added_w, 0.0);
-  EXPECT_LT(added_w, intercepted_w) << "the caustics add more light than the glass intercepts";
 }
 
 TEST(Specular, ASceneWithoutSpecularMaterialRunsNoneOfItsPassesAndIsUnchanged) {

@@ -319,6 +319,27 @@ void ReflectiveShadowMaps::add_map_draw(gpu::FrameGraph& graph, const std::strin
       });
 }
 
+namespace {
+// Whether the box's eight corners are all outside one of the clip volume's planes (Vulkan clip:
+// -w <= x, y <= w, 0 <= z <= w).
+bool outside_clip(const glm::mat4& view_proj, const glm::vec3& lo, const glm::vec3& hi) {
+  int out[6] = {0, 0, 0, 0, 0, 0};
+  for (int c = 0; c < 8; ++c) {
+    const glm::vec3 p((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
+    const glm::vec4 q = view_proj * glm::vec4(p, 1.0f);
+    out[0] += q.x < -q.w;
+    out[1] += q.x > q.w;
+    out[2] += q.y < -q.w;
+    out[3] += q.y > q.w;
+    out[4] += q.z < 0.0f;
+    out[5] += q.z > q.w;
+  }
+  for (int k = 0; k < 6; ++k)
+    if (out[k] == 8) return true;
+  return false;
+}
+}  // namespace
+
 void draw_rsm_geometry(VkCommandBuffer cmd, gpu::PassContext& p, const technique::SceneGpu& scene,
                        const RsmGeometryDraw& d, RsmPush push) {
   const gpu::Context& ctx = p.context();
@@ -358,6 +379,7 @@ void draw_rsm_geometry(VkCommandBuffer cmd, gpu::PassContext& p, const technique
     for (size_t i = 0; i < set.draws.size(); ++i) {
       if (materials && d.skip_virtual && i < d.skip_virtual->size() && (*d.skip_virtual)[i]) continue;
       const technique::DrawRange& r = set.draws[i];
+      if (d.cull_view_proj && outside_clip(*d.cull_view_proj, r.bounds_min, r.bounds_max)) continue;
       // Proxies: their scene.json material hint is not on the GPU yet: mid grey.
       push.misc.y = materials ? r.material : -1;
       push.misc.z = materials ? 0 : int(0xff808080u);

@@ -81,6 +81,10 @@ struct RsmGeometryDraw {
   bool proxies = true, virtuals = true;
   const std::vector<bool>* skip_virtual = nullptr;
   const technique::LodView* lod = nullptr;
+  // Set: ranges (proxies and virtual objects) whose bounds lie wholly outside one plane of this
+  // view's clip volume are not drawn (lavapipe sets up every triangle of a draw on one thread,
+  // culled or not: the six faces of an impostor cube each see one or two of the objects).
+  const glm::mat4* cull_view_proj = nullptr;
 };
 void draw_rsm_geometry(VkCommandBuffer cmd, gpu::PassContext& p, const technique::SceneGpu& scene,
                        const RsmGeometryDraw& draw, RsmPush push);

@@ -322,6 +322,7 @@ Status Context::init(const DeviceSettings& settings) {
   w.shaderStorageImageWriteWithoutFormat = h.shaderStorageImageWriteWithoutFormat;
   w.shaderStorageImageReadWithoutFormat = h.shaderStorageImageReadWithoutFormat;
   w.largePoints = h.largePoints;
+  large_points_ = h.largePoints == VK_TRUE;
   w.depthClamp = h.depthClamp;
   w.depthBiasClamp = h.depthBiasClamp;
   w.independentBlend = h.independentBlend;

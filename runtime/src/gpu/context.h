@@ -123,6 +123,9 @@ class Context {
   // imageAtomicAdd on 32-bit float images and texel buffers (VK_EXT_shader_atomic_float), enabled
   // where the device has it.
   bool image_float_atomic_add() const { return image_float_atomic_add_; }
+  // The largest point a vertex shader may ask for (gl_PointSize, pixels): the limits'
+  // pointSizeRange where the device has largePoints (enabled then), else 1.
+  float max_point_size() const { return large_points_ ? properties_.limits.pointSizeRange[1] : 1.0f; }
   size_t validation_message_count() const;
   std::vector<std::string> validation_messages() const;
   void clear_validation_messages();
@@ -180,6 +183,7 @@ class Context {
   bool api_1_3_ = false;
   bool poison_memory_ = false;  // DeviceSettings::poison_memory
   bool image_float_atomic_add_ = false;
+  bool large_points_ = false;
   uint64_t allocated_bytes_ = 0;
   uint64_t allocation_count_ = 0;
   mutable std::mutex messages_mutex_;

@@ -301,7 +301,9 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
     gpu::ImageDesc desc;
     desc.name = h == &lit_rv_ ? "lit_rv" : "lit_r";
     desc.format = VK_FORMAT_R16G16B16A16_SFLOAT;
-    auto img = graph_->create_image(desc, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT);
+    // lit_rv is also a colour attachment: the specular stage's caustic splat blends into it.
+    const VkImageUsageFlags attachment = h == &lit_rv_ ? VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT : 0;
+    auto img = graph_->create_image(desc, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | attachment);
     if (!img) return img.error();
     *h = *img;
   }

@@ -8,8 +8,8 @@
 #include "gi/rsm.h"
 #include "gpu/shaders.h"
 #include "shared/specular_math.h"
-#include "specular/photon.glsl"
 #include "specular/mesh_raster.h"
+#include "specular/photon.glsl"
 #include "technique/scene_gpu.h"
 
 namespace mrgi::specular {
@@ -18,6 +18,7 @@ namespace {
 constexpr VkFormat kPositionFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 constexpr VkFormat kNormalFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kCausticFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+constexpr VkFormat kLitFormat = VK_FORMAT_R16G16B16A16_SFLOAT;  // the runtime's lit_rv
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 constexpr VkDeviceSize kPhotonBytes = sizeof(shader::Photon);
 
@@ -39,7 +40,8 @@ glm::vec3 any_up(const glm::vec3& forward) {
 
 Expected<Caustics> Caustics::create(const technique::SharedResources& shared, uint32_t max_map_size,
                                     const gpu::Pipeline& back_faces) {
-  if (max_map_size < 16 || max_map_size > 2048) return fail(ErrorKind::BadUsage, "caustic map size: must be 16..2048 texels");
+  if (max_map_size < 16 || max_map_size > 2048)
+    return fail(ErrorKind::BadUsage, "caustic map size: must be 16..2048 texels");
   Caustics c;
   c.shared_ = shared;
   c.max_map_ = max_map_size;
@@ -77,20 +79,24 @@ Expected<Caustics> Caustics::create(const technique::SharedResources& shared, ui
   if (!cb) return cb.error();
   c.caustics_ = *cb;
   for (int l = 0; l < kMaxLamps; ++l) {
-    auto pb = graph.create_buffer({"specular photons " + std::to_string(l), VkDeviceSize(max_map_size) * max_map_size * 2 * kPhotonBytes},
-                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    const std::string id = std::to_string(l);
+    gpu::BufferDesc pd{"specular photons " + id, VkDeviceSize(max_map_size) * max_map_size * 2 * kPhotonBytes};
+    pd.history = true;
+    auto pb = graph.create_buffer(pd, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     if (!pb) return pb.error();
     c.photons_[l] = *pb;
+    gpu::BufferDesc ld{"specular photon list " + id, VkDeviceSize(max_map_size) * max_map_size * 2 * 4};
+    ld.history = true;
+    auto lb = graph.create_buffer(ld, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    if (!lb) return lb.error();
+    c.photon_list_[l] = *lb;
+    gpu::BufferDesc dd{"specular photon draw " + id, 16};
+    dd.history = true;
+    auto db = graph.create_buffer(dd, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
+                                          VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    if (!db) return db.error();
+    c.photon_draw_[l] = *db;
   }
-  auto lb = graph.create_buffer({"specular photon list", VkDeviceSize(max_map_size) * max_map_size * 2 * 4},
-                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-  if (!lb) return lb.error();
-  c.photon_list_ = *lb;
-  auto db = graph.create_buffer({"specular photon draw", 16},
-                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
-                                    VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-  if (!db) return db.error();
-  c.photon_draw_ = *db;
 
   auto pp = gpu::load_compute_pipeline(ctx, "specular/photons.comp", {});
   if (!pp) return pp.error();
@@ -122,23 +128,25 @@ Expected<Caustics> Caustics::create(const technique::SharedResources& shared, ui
   sd.name = "specular caustic splat";
   sd.vertex_spirv = *splat_vs;
   sd.fragment_spirv = *splat_fs;
-  sd.color_formats = {kCausticFormat};
+  sd.color_formats = {kCausticFormat, kLitFormat};
   sd.depth_test = false;
   sd.depth_write = false;
   sd.cull_mode = VK_CULL_MODE_NONE;
   sd.additive_blend = true;
+  sd.topology = VK_PRIMITIVE_TOPOLOGY_POINT_LIST;
   auto spl = gpu::create_graphics_pipeline(ctx, sd);
   if (!spl) return spl.error();
   c.splat_pipeline_ = gpu::PipelineHandle(ctx, std::move(*spl));
   return c;
 }
 
-bool Caustics::record(gpu::FrameGraph& graph, const Impostors& imp, const std::vector<LightDesc>& lamps,
+bool Caustics::trace(gpu::FrameGraph& graph, const Impostors& imp, const std::vector<LightDesc>& lamps,
                       const std::vector<size_t>& objects, const glm::vec3& centre, float radius, uint32_t map_size,
-                      std::vector<std::string>& skipped) {
+                      const Refresh& refresh, std::vector<std::string>& skipped) {
   const technique::SceneGpu& sg = *shared_.scene_gpu;
   const uint32_t size = std::min(map_size, max_map_);
   recorded_.lamps.clear();
+  splat_push_.clear();
   // The strongest spot lamps whose cone meets the objects' sphere and that are outside it.
   std::vector<const LightDesc*> chosen;
   for (const LightDesc& l : lamps) {
@@ -158,12 +166,49 @@ bool Caustics::record(gpu::FrameGraph& graph, const Impostors& imp, const std::v
     skipped.push_back("specular caustics: no spot lamp's cone holds a reflective or refractive object");
     return false;
   }
-  const std::vector<size_t> front = specular_draws(sg, objects, (1 << shader::SPECULAR_REFLECTIVE) | (1 << shader::SPECULAR_REFRACTIVE));
+  const float largest_point = shared_.context->max_point_size();
+  if (largest_point < 4.0f) {
+    skipped.push_back("specular caustics: the device draws no points over " + std::to_string(largest_point) +
+                      " pixels (largePoints), and the caustic splat's photons are points");
+    return false;
+  }
+  // Trace, or splat the photons traced for the same lamps, objects and map size at most
+  // refresh.period - 1 frames ago (a due trace waits while impostors are redrawn this frame, to
+  // spread the fast level's work over frames).
+  ++frame_;
+  std::vector<float> key = {float(size), float(refresh.revision), centre.x, centre.y, centre.z, radius};
+  for (size_t o : objects) key.push_back(float(o));
+  for (const LightDesc* l : chosen) {
+    const float k[] = {l->position.x,
+                       l->position.y,
+                       l->position.z,
+                       l->direction.x,
+                       l->direction.y,
+                       l->direction.z,
+                       l->color.r * l->intensity,
+                       l->color.g * l->intensity,
+                       l->color.b * l->intensity,
+                       l->inner_angle_deg,
+                       l->outer_angle_deg};
+    key.insert(key.end(), std::begin(k), std::end(k));
+  }
+  const int64_t age = frame_ - traced_frame_;
+  const bool trace = key != traced_key_ || age >= refresh.period + 1 || (age >= refresh.period && !refresh.busy);
+  if (trace) {
+    traced_key_ = std::move(key);
+    traced_frame_ = frame_;
+  } else {
+    skipped.push_back("specular photons: traced " + std::to_string(age) +
+                      " frame(s) ago for the same lamps and objects (refresh period " + std::to_string(refresh.period) +
+                      ")");
+  }
+  const std::vector<size_t> front =
+      specular_draws(sg, objects, (1 << shader::SPECULAR_REFLECTIVE) | (1 << shader::SPECULAR_REFRACTIVE));
   const std::vector<size_t> back = specular_draws(sg, objects, 1 << shader::SPECULAR_REFRACTIVE);
-  // Quads between 1.5 pixels and a fortieth of the image's width (caustic_splat.vert sizes each
+  // Squares between 1.5 pixels and a fortieth of the image's width (caustic_splat.vert sizes each
   // by its photon's spacing; larger ones cost more in overdraw than the smoothness they add).
   const VkExtent2D internal = graph.extent(shared_.lit_rv);
-  const float quad_min_px = 1.5f, quad_max_px = std::max(4.0f, float(internal.width) / 40.0f);
+  const float quad_min_px = 1.5f, quad_max_px = std::min(std::max(4.0f, float(internal.width) / 40.0f), largest_point);
   for (size_t li = 0; li < chosen.size(); ++li) {
     const LightDesc& lamp = *chosen[li];
     const std::string id = std::to_string(li);
@@ -178,94 +223,111 @@ bool Caustics::record(gpu::FrameGraph& graph, const Impostors& imp, const std::v
     const glm::mat4 flip_y = glm::scale(glm::mat4(1.0f), glm::vec3(1.0f, -1.0f, 1.0f));
     const glm::mat4 view_proj = flip_y * glm::perspective(2.0f * half, 1.0f, 0.01f, dist + radius) *
                                 glm::lookAt(lamp.position, centre, any_up(axis));
-    MeshRaster r;
-    r.name = "specular photon surfaces " + id;
-    r.pipeline = &*surface_pipeline_;
-    r.colour = {position_, normal_};
-    r.depth = depth_;
-    r.extent = {size, size};
-    r.push.view_proj = view_proj;
-    r.push.light = glm::vec4(lamp.position, 1.0f);
-    r.draws = front;
-    add_mesh_raster(graph, sg, r);
-    if (!back.empty()) {
-      r.name = "specular photon back faces " + id;
-      r.pipeline = back_faces_;
-      r.colour = {back_position_, back_normal_};
-      r.draws = back;
-      add_mesh_raster(graph, sg, r);
-    }
-    const glm::vec3 dir = glm::normalize(lamp.direction);
-    const PhotonPush push{view_proj, glm::vec4(lamp.position, float(size)),
-                          glm::vec4(lamp.color * lamp.intensity, 2.0f * std::tan(half)),
-                          glm::vec4(dir, std::cos(glm::radians(lamp.inner_angle_deg))),
-                          glm::vec4(std::cos(glm::radians(lamp.outer_angle_deg)), axis)};
-    const gpu::BufferHandle draw = photon_draw_, photons = photons_[li];
+    const gpu::BufferHandle draw = photon_draw_[li], photons = photons_[li], list = photon_list_[li];
     recorded_.lamps.push_back({lamp.position, view_proj, size, photons});
-    graph.add_pass("specular photons reset " + id, gpu::PassKind::Transfer,
-                   [draw](gpu::PassBuilder& b) { b.write(draw, gpu::Access::TransferDst); },
-                   [draw](VkCommandBuffer cmd, gpu::PassContext& p) { vkCmdFillBuffer(cmd, p.buffer(draw), 0, 16, 0); });
-    const gpu::Pipeline* pp = &*photon_pipeline_;
-    const bool has_back = !back.empty();
-    graph.add_shader_pass(
-        "specular photons " + id, gpu::PassKind::Compute, *photon_pipeline_,
-        [this, imp, has_back, photons](gpu::ShaderPassBuilder& b) {
-          b.bind("SpecularUbo", imp.constants);
-          b.bind("Materials", shared_.scene_gpu->materials);
-          b.bind("photon_position", position_);
-          b.bind("photon_normal", normal_);
-          // Without a refractive object the back faces are never read: the front ones stand in.
-          b.bind("back_position", has_back ? back_position_ : position_);
-          b.bind("back_normal", has_back ? back_normal_ : normal_);
-          b.bind("impostor_position", imp.position);
-          b.bind("impostor_normal", imp.normal);
-          b.bind("impostor_albedo", imp.albedo);
-          b.bind("Photons", photons);
-          b.bind("PhotonList", photon_list_);
-          b.bind_over("PhotonDraw", photon_draw_);
-        },
-        [pp, push, size](VkCommandBuffer cmd, gpu::PassContext&) {
-          gpu::push_and_dispatch(cmd, *pp, &push, sizeof push, {(size + 7) / 8, (size + 7) / 8, 1});
-        });
+    if (trace) {
+      MeshRaster r;
+      r.name = "specular photon surfaces " + id;
+      r.pipeline = &*surface_pipeline_;
+      r.colour = {position_, normal_};
+      r.depth = depth_;
+      r.extent = {size, size};
+      r.push.view_proj = view_proj;
+      r.push.light = glm::vec4(lamp.position, 1.0f);
+      r.draws = front;
+      add_mesh_raster(graph, sg, r);
+      if (!back.empty()) {
+        r.name = "specular photon back faces " + id;
+        r.pipeline = back_faces_;
+        r.colour = {back_position_, back_normal_};
+        r.draws = back;
+        add_mesh_raster(graph, sg, r);
+      }
+      const glm::vec3 dir = glm::normalize(lamp.direction);
+      const PhotonPush push{view_proj, glm::vec4(lamp.position, float(size)),
+                            glm::vec4(lamp.color * lamp.intensity, 2.0f * std::tan(half)),
+                            glm::vec4(dir, std::cos(glm::radians(lamp.inner_angle_deg))),
+                            glm::vec4(std::cos(glm::radians(lamp.outer_angle_deg)), axis)};
+      graph.add_pass(
+          "specular photons reset " + id, gpu::PassKind::Transfer,
+          [draw](gpu::PassBuilder& b) { b.write(draw, gpu::Access::TransferDst); },
+          [draw](VkCommandBuffer cmd, gpu::PassContext& p) { vkCmdFillBuffer(cmd, p.buffer(draw), 0, 16, 0); });
+      const gpu::Pipeline* pp = &*photon_pipeline_;
+      const bool has_back = !back.empty();
+      graph.add_shader_pass(
+          "specular photons " + id, gpu::PassKind::Compute, *photon_pipeline_,
+          [this, imp, has_back, photons, list, draw](gpu::ShaderPassBuilder& b) {
+            b.bind("SpecularUbo", imp.constants);
+            b.bind("Materials", shared_.scene_gpu->materials);
+            b.bind("photon_position", position_);
+            b.bind("photon_normal", normal_);
+            // Without a refractive object the back faces are never read: the front ones stand in.
+            b.bind("back_position", has_back ? back_position_ : position_);
+            b.bind("back_normal", has_back ? back_normal_ : normal_);
+            b.bind("impostor_position", imp.position);
+            b.bind("impostor_normal", imp.normal);
+            b.bind("impostor_albedo", imp.albedo);
+            b.bind("Photons", photons);
+            b.bind("PhotonList", list);
+            b.bind_over("PhotonDraw", draw);
+          },
+          [pp, push, size](VkCommandBuffer cmd, gpu::PassContext&) {
+            gpu::push_and_dispatch(cmd, *pp, &push, sizeof push, {(size + 7) / 8, (size + 7) / 8, 1});
+          });
+    }
+    splat_push_.push_back(glm::vec4(quad_min_px, float(size), quad_max_px, 0.0f));
+  }
+  return true;
+}
+
+void Caustics::splat(gpu::FrameGraph& graph) {
+  for (size_t li = 0; li < recorded_.lamps.size(); ++li) {
     const bool first = li == 0;
     const gpu::Pipeline* splat = &*splat_pipeline_;
-    const glm::vec4 splat_push(quad_min_px, float(size), quad_max_px, 0.0f);
+    const glm::vec4 splat_push = splat_push_[li];
+    const gpu::BufferHandle draw = photon_draw_[li], photons = photons_[li], list = photon_list_[li];
     graph.add_shader_pass(
-        "specular caustic splat " + id, gpu::PassKind::Graphics, *splat_pipeline_,
-        [this, first, photons](gpu::ShaderPassBuilder& b) {
+        "specular caustic splat " + std::to_string(li), gpu::PassKind::Graphics, *splat_pipeline_,
+        [this, first, photons, list, draw](gpu::ShaderPassBuilder& b) {
           b.bind("FrameUbo", shared_.frame_constants);
           b.bind("Photons", photons);
-          b.bind("PhotonList", photon_list_);
-          b.uses().read(photon_draw_, gpu::Access::IndirectRead);
+          b.bind("PhotonList", list);
+          b.uses().read(draw, gpu::Access::IndirectRead);
           b.bind("real_position", shared_.real_position);
+          b.bind("real_albedo", shared_.real_albedo);
           b.bind("virtual_position", shared_.virtual_position);
+          b.bind("virtual_albedo", shared_.virtual_albedo);
           b.uses().write(caustics_, first ? gpu::Access::ColorAttachmentWrite : gpu::Access::ColorAttachmentReadWrite);
+          b.uses().write(shared_.lit_rv, gpu::Access::ColorAttachmentReadWrite);
         },
-        [this, splat, splat_push, first](VkCommandBuffer cmd, gpu::PassContext& p) {
+        [this, splat, splat_push, first, draw](VkCommandBuffer cmd, gpu::PassContext& p) {
           const gpu::Context& ctx = p.context();
           const VkExtent2D e = p.extent(caustics_);
-          VkRenderingAttachmentInfo colour{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-          colour.imageView = p.view(caustics_);
-          colour.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-          colour.loadOp = first ? VK_ATTACHMENT_LOAD_OP_CLEAR : VK_ATTACHMENT_LOAD_OP_LOAD;
-          colour.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-          colour.clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
+          VkRenderingAttachmentInfo colour[2];
+          const gpu::ImageHandle targets[2] = {caustics_, shared_.lit_rv};
+          for (int i = 0; i < 2; ++i) {
+            colour[i] = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+            colour[i].imageView = p.view(targets[i]);
+            colour[i].imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+            colour[i].loadOp = first && i == 0 ? VK_ATTACHMENT_LOAD_OP_CLEAR : VK_ATTACHMENT_LOAD_OP_LOAD;
+            colour[i].storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+            colour[i].clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
+          }
           VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
           ri.renderArea = {{0, 0}, e};
           ri.layerCount = 1;
-          ri.colorAttachmentCount = 1;
-          ri.pColorAttachments = &colour;
+          ri.colorAttachmentCount = 2;
+          ri.pColorAttachments = colour;
           ctx.fn().cmd_begin_rendering(cmd, &ri);
           const VkViewport vp{0.0f, 0.0f, float(e.width), float(e.height), 0.0f, 1.0f};
           const VkRect2D sc{{0, 0}, e};
           vkCmdSetViewport(cmd, 0, 1, &vp);
           vkCmdSetScissor(cmd, 0, 1, &sc);
           vkCmdPushConstants(cmd, splat->layout, splat->stages, 0, sizeof splat_push, &splat_push);
-          vkCmdDrawIndirect(cmd, p.buffer(photon_draw_), 0, 1, 16);
+          vkCmdDrawIndirect(cmd, p.buffer(draw), 0, 1, 16);
           ctx.fn().cmd_end_rendering(cmd);
         });
   }
-  return true;
 }
 
 }  // namespace mrgi::specular

@@ -6,10 +6,11 @@
 //   specular photon back faces <l>   the refractive objects' back faces from the lamp
 //   specular photons <l>             a reflected and a twice refracted photon per texel, traced to
 //                                    the impostors (photons.comp)
-//   specular caustic splat <l>       the photons as quads into the camera's caustic buffer
-//                                    (irradiance; caustic_splat.vert/.frag)
-// The specular stage then adds the buffer to the diffuse pixels' L_rv (caustic_apply.comp) and
-// to the surfaces its mirrors and glass show (trace.comp). Point and directional lamps make no
+// and, after the technique (splat()):
+//   specular caustic splat <l>       the photons as points into the camera's caustic buffer
+//                                    (irradiance) and, times albedo / pi, into the diffuse
+//                                    pixels' L_rv (caustic_splat.vert/.frag)
+// The specular stage's trace reads the buffer for the surfaces under its mirrors and glass. Point and directional lamps make no
 // caustics (the paper's spot lamps only: a point lamp would need a cube of photon maps).
 #pragma once
 #include <cstdint>
@@ -38,13 +39,24 @@ class Caustics {
     gpu::BufferHandle constants;
     gpu::ImageHandle position, normal, albedo;
   };
-  // Records the passes above for the lamps of `lamps` (the light stage's lights) that are spot
+  // How often the photons are traced. They are world-space (where each landed, its flux), so
+  // while the lamps, the objects and the map size stay as they were, a frame may splat the
+  // photons of an earlier one: only the splat is the camera's.
+  struct Refresh {
+    int period = 1;       // frames between traces of unchanged photons (1: every frame)
+    bool busy = false;    // this frame already redraws impostors: a due trace waits a frame
+    uint64_t revision = 0;  // the scene's (SceneGpu::revision): a change traces at once
+  };
+  // Records the photon passes for the lamps of `lamps` (the light stage's lights) that are spot
   // lamps whose cone meets the sphere (centre, radius) around `objects` (specular objects in
-  // view), with maps of `map_size` texels. Returns whether a caustic buffer was written this
-  // frame (false: no such lamp; `skipped` says why).
-  bool record(gpu::FrameGraph& graph, const Impostors& impostors, const std::vector<LightDesc>& lamps,
+  // view), with maps of `map_size` texels. Returns whether this frame has caustics (false: no
+  // such lamp; `skipped` says why); then splat() must follow.
+  bool trace(gpu::FrameGraph& graph, const Impostors& impostors, const std::vector<LightDesc>& lamps,
               const std::vector<size_t>& objects, const glm::vec3& centre, float radius, uint32_t map_size,
-              std::vector<std::string>& skipped);
+              const Refresh& refresh, std::vector<std::string>& skipped);
+  // After the technique's record() (it writes lit_rv): the splat of trace()'s photons, into the
+  // caustic buffer and the runtime's lit_rv.
+  void splat(gpu::FrameGraph& graph);
   // The caustic buffer (RGBA16F, internal resolution): rgb irradiance (W/m^2) on the surface
   // each pixel shows, a the number of photons.
   gpu::ImageHandle buffer() const { return caustics_; }
@@ -57,8 +69,14 @@ class Caustics {
   uint32_t max_map_ = 0;
   const gpu::Pipeline* back_faces_ = nullptr;
   gpu::ImageHandle position_, normal_, back_position_, back_normal_, depth_, caustics_;
-  gpu::BufferHandle photons_[kMaxLamps], photon_list_, photon_draw_;
+  // Per lamp slot, history buffers: a frame that does not trace splats the last traced ones.
+  gpu::BufferHandle photons_[kMaxLamps], photon_list_[kMaxLamps], photon_draw_[kMaxLamps];
   technique::CausticPhotons recorded_;  // this frame's lamps
+  std::vector<glm::vec4> splat_push_;   // caustic_splat.vert's push block per lamp
+  // What the photons in the buffers were traced for: the chosen lamps' parameters, the objects,
+  // the map size and the scene revision, and when.
+  std::vector<float> traced_key_;
+  int64_t traced_frame_ = 0, frame_ = 0;
   gpu::PipelineHandle surface_pipeline_, photon_pipeline_, splat_pipeline_;
 };
 

@@ -57,7 +57,7 @@ struct ObjectInView {
   size_t object = 0;
   glm::vec3 lo{0.0f}, hi{0.0f};
   float distance = 0.0f;
-  bool refractive = false;
+  bool refractive = false, reflective = false;
 };
 
 struct ImpostorSet {
@@ -70,9 +70,9 @@ struct ImpostorSet {
 
 const std::array<SpecularLevel, 3>& specular_levels() {
   static const std::array<SpecularLevel, 3> levels = {{
-      {"paper", 512, 4, 24, 4, 16, 1, 512},
-      {"high", 256, 2, 16, 3, 12, 1, 256},
-      {"fast", 96, 2, 10, 2, 8, 4, 0},
+      {"paper", 512, 4, 24, 4, 16, 0.0f, 1, 512, 1, 1, true},
+      {"high", 256, 2, 16, 3, 12, 0.0f, 1, 256, 1, 1, true},
+      {"fast", 96, 2, 10, 2, 8, 0.1f, 4, 128, 8, 2, false},
   }};
   return levels;
 }
@@ -97,7 +97,7 @@ struct SpecularStage::Impl {
   SpecularSettings settings;
   gpu::ImageHandle impostor_position, impostor_normal, impostor_albedo, impostor_depth;
   gpu::ImageHandle back_position, back_normal, back_depth;
-  gpu::ImageHandle no_shadow;
+  gpu::ImageHandle no_shadow, no_caustics;
   gpu::BufferHandle constants, own_lights;
   // Per set: the real grid's triangles of each cube face (impostor_cells.comp) and the six
   // indexed indirect draws; capacity: indices a face can hold (every triangle of the finest grid).
@@ -105,11 +105,16 @@ struct SpecularStage::Impl {
   uint32_t face_capacity = 0;
   gpu::BufferHandle env_grid;  // the light stage's environment grid, copied each frame
   int env_width = 0;           // its width in cells
-  gpu::PipelineHandle cells_pipeline, grid_pipeline, mesh_pipeline, back_pipeline, trace_pipeline, apply_pipeline;
+  gpu::PipelineHandle cells_pipeline, grid_pipeline, mesh_pipeline, back_pipeline, list_pipeline;
+  gpu::PipelineHandle trace_pipelines[2];  // trace.comp: [0] mirrors, [1] glass (kRefractive)
+  // trace_list.comp's output: dispatch arguments per kind (glass, mirrors), counts, pixels.
+  gpu::BufferHandle trace_args, trace_counts, trace_pixels;
+  uint32_t list_capacity = 0;  // pixels each kind's list holds
   std::optional<Caustics> caustics;  // null with SpecularSettings::caustics off
   bool caustics_recorded = false;    // this frame's prepare() splatted caustics
   bool active = false;               // prepare() found something to do this frame
-  glm::ivec4 region{0};              // the trace's dispatch: first pixel, size
+  glm::ivec4 region{0};              // the trace list's dispatch: first pixel, size
+  bool glass_in_view = false, mirrors_in_view = false;
   technique::CausticPhotons photons; // this frame's, for the technique
   VkExtent2D grid_points{0, 0};
   uint32_t grid_stride = 1;
@@ -187,6 +192,18 @@ Status SpecularStage::Impl::init() {
   auto nsi = graph.create_image(ns, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
   if (!nsi) return nsi.error();
   no_shadow = *nsi;
+  // Bound as the trace's caustic buffer where the caustics ablation leaves none (flags.w 0: never
+  // read), in the binding's own format.
+  gpu::ImageDesc nc;
+  nc.name = "specular no caustics";
+  nc.format = VK_FORMAT_R16G16B16A16_SFLOAT;
+  nc.size_mode = gpu::SizeMode::Absolute;
+  nc.width = nc.height = 1;
+  auto nci = graph.create_image(nc, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
+  if (!nci) return nci.error();
+  no_caustics = *nci;
+  const std::array<uint16_t, 4> zero{};  // defined contents, never read
+  MRGI_TRY(graph.upload_image(no_caustics, zero.data(), sizeof zero));
 
   // The finest grid any level draws: a point per texel of the largest face (set_grid).
   const VkExtent2D g = graph.allocated_extent(shared.real_position);
@@ -222,9 +239,33 @@ Status SpecularStage::Impl::init() {
   auto ip = gpu::load_compute_pipeline(ctx, "specular/impostor_cells.comp", {});
   if (!ip) return ip.error();
   cells_pipeline = std::move(*ip);
-  auto tp = gpu::load_compute_pipeline(ctx, "specular/trace.comp", {});
-  if (!tp) return tp.error();
-  trace_pipeline = std::move(*tp);
+  auto trace_spv = gpu::shader_spirv("specular/trace.comp");
+  if (!trace_spv) return trace_spv.error();
+  for (uint32_t refractive = 0; refractive < 2; ++refractive) {
+    auto tp = gpu::create_compute_pipeline(
+        ctx, {refractive ? "specular trace glass" : "specular trace mirrors", *trace_spv, {}, 0, {refractive}});
+    if (!tp) return tp.error();
+    trace_pipelines[refractive] = gpu::PipelineHandle(ctx, std::move(*tp));
+  }
+  auto lp = gpu::load_compute_pipeline(ctx, "specular/trace_list.comp", {});
+  if (!lp) return lp.error();
+  list_pipeline = std::move(*lp);
+  // The trace's lists (trace_list.comp): every internal pixel of each kind at most.
+  const VkExtent2D internal = graph.allocated_extent(shared.lit_rv);
+  list_capacity = internal.width * internal.height;
+  auto ta = graph.create_buffer({"specular trace args", 32}, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                                                  VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
+                                                                  VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  if (!ta) return ta.error();
+  trace_args = *ta;
+  auto tc = graph.create_buffer({"specular trace counts", 16},
+                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  if (!tc) return tc.error();
+  trace_counts = *tc;
+  auto tl = graph.create_buffer({"specular trace pixels", VkDeviceSize(list_capacity) * 2 * 4},
+                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  if (!tl) return tl.error();
+  trace_pixels = *tl;
   auto impostor_fs = gpu::shader_spirv("specular/impostor.frag");
   if (!impostor_fs) return impostor_fs.error();
   auto back_fs = gpu::shader_spirv("specular/backface.frag");
@@ -266,9 +307,6 @@ Status SpecularStage::Impl::init() {
     auto c = Caustics::create(shared, settings.max_caustic_map, *back_pipeline);
     if (!c) return c.error();
     caustics.emplace(std::move(*c));
-    auto ap = gpu::load_compute_pipeline(ctx, "specular/caustic_apply.comp", {});
-    if (!ap) return ap.error();
-    apply_pipeline = std::move(*ap);
   }
   return ok_status();
 }
@@ -383,6 +421,10 @@ void SpecularStage::Impl::add_impostors(gpu::FrameGraph& graph, const ImpostorSe
         g.grid_indices = indices;
         g.grid_indirect = draws;
         g.skip_virtual = &excluded;
+        // Each face draws the meshes at the detail its texels resolve (90 degrees over `face`
+        // texels: a focal length of face / 2) and only those inside its frustum.
+        const technique::LodView lod{centre, 0.5f * float(face), 1.0f};
+        g.lod = &lod;
         for (int f = 0; f < 6; ++f) {
           const int fx = origin.x + int(face) * (f % 3), fy = origin.y + int(face) * (f / 3);
           const VkViewport vp{float(fx), float(fy), float(face), float(face), 0.0f, 1.0f};
@@ -390,7 +432,9 @@ void SpecularStage::Impl::add_impostors(gpu::FrameGraph& graph, const ImpostorSe
           vkCmdSetViewport(cmd, 0, 1, &vp);
           vkCmdSetScissor(cmd, 0, 1, &sc);
           g.grid_indirect_offset = VkDeviceSize(f) * 20;
-          const gi::RsmPush push{face_view_proj(centre, f), glm::vec4(centre, 1.0f), glm::vec4(1.0f, 1.0f, 1.0f, -2.0f),
+          const glm::mat4 view_proj = face_view_proj(centre, f);
+          g.cull_view_proj = &view_proj;
+          const gi::RsmPush push{view_proj, glm::vec4(centre, 1.0f), glm::vec4(1.0f, 1.0f, 1.0f, -2.0f),
                                  glm::vec4(shader::specular_face_forward(f), 1.0f), misc};
           gi::draw_rsm_geometry(cmd, p, *sg, g, push);
         }
@@ -454,6 +498,7 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
     if (!technique::project_box(fc, v.lo, v.hi).visible) continue;
     v.distance = glm::distance(0.5f * (v.lo + v.hi), glm::vec3(fc.camera_world));
     v.refractive = (kinds & (1 << shader::SPECULAR_REFRACTIVE)) != 0;
+    v.reflective = (kinds & (1 << shader::SPECULAR_REFLECTIVE)) != 0;
     in_view.push_back(v);
   }
   glm::vec2 lo_px(1e30f), hi_px(-1e30f);
@@ -517,6 +562,7 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
       for (int x = 0; x < env_width; ++x) cells[size_t(y) * size_t(env_width) + size_t(x)] = glm::vec4(glm::vec3(env->cell_radiance(x, y)), 0.0f);
   }
   c->flags = glm::ivec4(0, m.settings.depth_test ? 1 : 0, env_width, 0);  // x: finish()
+  c->level = glm::vec4(float(std::max(level.glass_reflection_stride, 1)), level.glass_reflection_fresnel, 0.0f, 0.0f);
 
   m.world_to_clip = fc.world_to_clip;
   m.set_grid(graph, face);
@@ -537,6 +583,7 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
   }
   if (oldest >= 0) redraw[size_t(oldest)] = true;
   bool first = true;
+  const bool any_redrawn = std::find(redraw.begin(), redraw.end(), true) != redraw.end();
   for (int i = 0; i < set_count; ++i) {
     if (!redraw[size_t(i)]) {
       skipped.push_back("specular impostors " + std::to_string(i) + ": drawn " +
@@ -548,8 +595,13 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
     first = false;
     m.drawn[size_t(i)] = {m.frame, sets[size_t(i)].centre, sets[size_t(i)].objects, face, sg.revision()};
   }
-  bool refractive = false;
-  for (const ObjectInView& v : in_view) refractive = refractive || v.refractive;
+  bool refractive = false, reflective = false;
+  for (const ObjectInView& v : in_view) {
+    refractive = refractive || v.refractive;
+    reflective = reflective || v.reflective;
+  }
+  m.glass_in_view = refractive;
+  m.mirrors_in_view = reflective;
   if (refractive) m.add_back_faces(graph, in_view);
   else skipped.push_back("specular back faces: no refractive object in view");
 
@@ -562,15 +614,16 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
       lo = glm::min(lo, v.lo);
       hi = glm::max(hi, v.hi);
     }
-    caustics = m.caustics->record(graph, {m.constants, m.impostor_position, m.impostor_normal, m.impostor_albedo},
+    caustics = m.caustics->trace(graph, {m.constants, m.impostor_position, m.impostor_normal, m.impostor_albedo},
                                   lighting.lights, objects, 0.5f * (lo + hi), 0.5f * glm::length(hi - lo),
-                                  level.caustic_map, skipped);
+                                  level.caustic_map, {level.caustic_refresh_period, any_redrawn, sg.revision()}, skipped);
   } else {
     skipped.push_back(m.caustics ? "specular caustics: off at this level" : "specular caustics: off (ablation)");
   }
   c->flags.w = caustics ? 1 : 0;
   m.caustics_recorded = caustics;
-  if (caustics) m.photons = m.caustics->photons();
+  if (caustics && level.caustic_vpls) m.photons = m.caustics->photons();
+  else if (caustics) skipped.push_back("specular caustic VPLs: off at this level (the technique gets no photons)");
   // The trace's dispatch covers the objects' projected boxes (all of the image when a corner is
   // behind the camera).
   const glm::ivec2 size(fc.internal_output_size.x, fc.internal_output_size.y);
@@ -606,58 +659,81 @@ Status SpecularStage::finish(const technique::Technique& technique, std::vector<
   }
   c->flags.x = direct ? 1 : 0;
   const bool caustics = m.caustics_recorded;
-  const gpu::ImageHandle caustic_buffer = m.caustics ? m.caustics->buffer() : m.back_position;
+  const gpu::ImageHandle caustic_buffer = m.caustics ? m.caustics->buffer() : m.no_caustics;
   const VkSampler compare = m.shared.context->samplers().shadow_compare;
   const VkSampler nearest = m.shared.context->samplers().nearest_clamp;
   const glm::ivec4 region = m.region;
   Impl* self = &m;
+  // The caustics on the diffuse pixels (into lit_rv) and in the caustic buffer the trace reads.
+  if (caustics) m.caustics->splat(graph);
+  // The specular pixels listed by kind, then a pass per kind in view over its list.
+  const gpu::BufferHandle args = m.trace_args, counts = m.trace_counts, pixels = m.trace_pixels;
+  graph.add_pass("specular trace list reset", gpu::PassKind::Transfer,
+                 [args, counts](gpu::PassBuilder& b) {
+                   b.write(args, gpu::Access::TransferDst);
+                   b.write(counts, gpu::Access::TransferDst);
+                 },
+                 [args, counts](VkCommandBuffer cmd, gpu::PassContext& p) {
+                   // Disjoint fills (overlapping ones in one pass are a write-after-write hazard):
+                   // (0, 1, 1, -) per kind.
+                   const VkBuffer a = p.buffer(args);
+                   vkCmdFillBuffer(cmd, a, 0, 4, 0u);
+                   vkCmdFillBuffer(cmd, a, 4, 8, 1u);
+                   vkCmdFillBuffer(cmd, a, 12, 8, 0u);
+                   vkCmdFillBuffer(cmd, a, 20, 8, 1u);
+                   vkCmdFillBuffer(cmd, p.buffer(counts), 0, 16, 0u);
+                 });
+  const glm::ivec4 list_push[2] = {region, glm::ivec4(int(m.list_capacity), 0, 0, 0)};
   graph.add_shader_pass(
-      "specular trace", gpu::PassKind::Compute, *m.trace_pipeline,
-      [=](gpu::ShaderPassBuilder& b) {
-        const technique::SharedResources& r = self->shared;
-        b.bind("FrameUbo", r.frame_constants);
-        b.bind("LightUbo", light_set);
-        b.bind("SpecularUbo", self->constants);
-        b.bind("Materials", r.scene_gpu->materials);
-        b.bind("real_position", r.real_position);
-        b.bind("virtual_position", r.virtual_position);
-        b.bind("virtual_normal", r.virtual_normal);
-        b.bind("virtual_albedo", r.virtual_albedo);
-        b.bind("back_position", self->back_position);
-        b.bind("back_normal", self->back_normal);
-        b.bind("impostor_position", self->impostor_position);
-        b.bind("impostor_normal", self->impostor_normal);
-        b.bind("impostor_albedo", self->impostor_albedo);
-        b.bind_sampled("shadow_primary", shadow_primary, compare);
-        b.bind_sampled("shadow_virtual", shadow_virtual, compare);
-        b.bind_sampled("shadow_primary_depth", shadow_primary, nearest);
-        b.bind_sampled("shadow_virtual_depth", shadow_virtual, nearest);
-        b.bind("color_words", r.color_upload);
-        b.bind("EnvGrid", self->env_grid);
-        b.bind("caustics", caustic_buffer);
-        b.bind_over("lit_rv", r.lit_rv);
-        b.bind_over("lit_r", r.lit_r);
+      "specular trace list", gpu::PassKind::Compute, *m.list_pipeline,
+      [self, args, counts, pixels](gpu::ShaderPassBuilder& b) {
+        b.bind("virtual_position", self->shared.virtual_position);
+        b.bind("Materials", self->shared.scene_gpu->materials);
+        b.bind_over("TraceArgs", args);
+        b.bind_over("TraceCounts", counts);
+        b.bind("TracePixels", pixels);
       },
-      [self, region](VkCommandBuffer cmd, gpu::PassContext&) {
-        gpu::push_and_dispatch(cmd, *self->trace_pipeline, &region, sizeof region,
+      [self, list_push, region](VkCommandBuffer cmd, gpu::PassContext&) {
+        gpu::push_and_dispatch(cmd, *self->list_pipeline, list_push, sizeof list_push,
                                {(uint32_t(region.z) + 7) / 8, (uint32_t(region.w) + 7) / 8, 1});
       });
-  if (caustics) {
+  for (int refractive = 1; refractive >= 0; --refractive) {
+    if (!(refractive ? m.glass_in_view : m.mirrors_in_view)) continue;
+    const gpu::Pipeline* pipe = &*m.trace_pipelines[refractive];
+    const glm::ivec4 list(refractive ? 0 : int(m.list_capacity), 0, 0, 0);
+    const VkDeviceSize offset = refractive ? 0 : 16;
     graph.add_shader_pass(
-        "specular caustic apply", gpu::PassKind::Compute, *m.apply_pipeline,
-        [self, caustic_buffer](gpu::ShaderPassBuilder& b) {
+        refractive ? "specular trace glass" : "specular trace mirrors", gpu::PassKind::Compute, *pipe,
+        [=](gpu::ShaderPassBuilder& b) {
           const technique::SharedResources& r = self->shared;
           b.bind("FrameUbo", r.frame_constants);
-          b.bind("caustics", caustic_buffer);
+          b.bind("LightUbo", light_set);
+          b.bind("SpecularUbo", self->constants);
+          b.bind("Materials", r.scene_gpu->materials);
           b.bind("real_position", r.real_position);
-          b.bind("real_albedo", r.real_albedo);
           b.bind("virtual_position", r.virtual_position);
+          b.bind("virtual_normal", r.virtual_normal);
           b.bind("virtual_albedo", r.virtual_albedo);
+          b.bind("back_position", self->back_position);
+          b.bind("back_normal", self->back_normal);
+          b.bind("impostor_position", self->impostor_position);
+          b.bind("impostor_normal", self->impostor_normal);
+          b.bind("impostor_albedo", self->impostor_albedo);
+          b.bind_sampled("shadow_primary", shadow_primary, compare);
+          b.bind_sampled("shadow_virtual", shadow_virtual, compare);
+          b.bind_sampled("shadow_primary_depth", shadow_primary, nearest);
+          b.bind_sampled("shadow_virtual_depth", shadow_virtual, nearest);
+          b.bind("color_words", r.color_upload);
+          b.bind("EnvGrid", self->env_grid);
+          b.bind("caustics", caustic_buffer);
+          b.bind("TraceCounts", counts);
+          b.bind("TracePixels", pixels);
+          b.uses().read(args, gpu::Access::IndirectRead);
           b.bind_over("lit_rv", r.lit_rv);
+          b.bind_over("lit_r", r.lit_r);
         },
-        [self](VkCommandBuffer cmd, gpu::PassContext& p) {
-          const VkExtent2D e = p.extent(self->shared.lit_rv);
-          gpu::push_and_dispatch(cmd, *self->apply_pipeline, nullptr, 0, {(e.width + 7) / 8, (e.height + 7) / 8, 1});
+        [pipe, list, args, offset](VkCommandBuffer cmd, gpu::PassContext& p) {
+          gpu::dispatch_indirect(cmd, *pipe, &list, sizeof list, p.buffer(args), offset);
         });
   }
   return ok_status();

@@ -12,15 +12,17 @@
 //                                grid, the proxies, the other virtual objects): world position,
 //                                normal, albedo, real or virtual (shaders/specular/impostor.frag)
 //   specular back faces          the refractive objects' back faces from the camera (Wyman 2005)
-//   specular photon ... <l>      per spot lamp whose cone holds such an object: photon maps,
-//                                photons and their splat into the caustic buffer (caustics.h); the
-//                                technique reads the photons (dir's caustic VPLs, FrameInfo::caustics)
+//   specular photon ... <l>      per spot lamp whose cone holds such an object: photon maps and
+//                                photons (caustics.h; traced every caustic_refresh_period frames
+//                                while nothing moves); the technique reads the photons (dir's
+//                                caustic VPLs, FrameInfo::caustics)
 // and after it (finish):
-//   specular trace               per specular pixel: the reflected and refracted rays' hits,
-//                                their light with and without the virtual objects, back-projection
-//                                into the camera frame and the composite of eq. 6-11
+//   specular caustic splat <l>   the photons into the caustic buffer and the diffuse pixels' L_rv
+//   specular trace list          the specular pixels, listed by kind
+//   specular trace glass         per listed pixel: the reflected and refracted rays' hits, their
+//   specular trace mirrors       light with and without the virtual objects, back-projection into
+//                                the camera frame and the composite of eq. 6-11
 //                                (shaders/specular/trace.comp), into lit_rv
-//   specular caustic apply       the caustic buffer on the diffuse pixels' L_rv
 //
 // Deviations from the paper, and why:
 //   - Impostors: Popescu et al. give each surrounding object its own billboard. Here the
@@ -29,9 +31,12 @@
 //     faces of a cube around its centre (distance impostors, Szirmay-Kalos et al. 2005), searched
 //     by the same iterative refinement; one layer, so a surface hidden from the centre behind a
 //     nearer one is missing (the search then passes behind the nearer one's silhouette).
-//   - Each hit is shaded by the lamps (with the technique's shadow maps where it drew them), the
-//     SH ambient and the caustic buffer; dir's VPLs do not light the hits (eq. 3 sums them too:
-//     not built yet), and a virtual hit is Lambertian.
+//   - Eq. 3 sums the lamps and the VPLs at each hit. A hit on a surface the camera sees (the
+//     depth validity test of the back-projection) takes the technique's L_rv and L_r there,
+//     which is that sum for that surface point, with the technique's visibility (dir's ISMs) and
+//     at one image read instead of a VPL loop per ray; a hit the camera does not see is lit by
+//     the lamps (with the technique's shadow maps where it drew them) and the SH ambient, without
+//     VPLs; both get the caustic buffer. A virtual hit outside the view is Lambertian.
 //   - L_env: the light stage's environment grid (64 x 32 cells of the filtered image, bilinear),
 //     not the fish-eye image at its own resolution; the SH where there is no environment image.
 //   - Eq. 9's validity is per path (specular_math.h specular_compose says why).
@@ -62,16 +67,34 @@ struct SpecularLevel {
   int search_steps;        // linear search steps along a ray through the impostors
   int refine_steps;        // secant refinements of a bracketed crossing
   int back_face_steps;     // search steps for the refracted ray's exit in the back faces
+  // Glass pixels whose Fresnel reflectance is below this take the environment's radiance
+  // (L_env) for their reflection instead of a traced one (0: every one traced). Glass reflects
+  // 4-10% of the light over most of its face, and the reflected rays, mostly meeting far walls,
+  // run the longest searches: at 0.1 the trace on glass_mirror's fast dir frame took ~1 of 3.4 ms
+  // less; the error is at most that fraction of the difference between the two radiances.
+  float glass_reflection_fresnel;
   // Frames between redraws of a set whose objects did not move (1: every frame). The impostors
   // are world-space surfaces, so a set a frame old differs only by what the camera newly sees
   // of the real scene; at 4, two sets cost half a set's drawing a frame.
   int refresh_period;
   uint32_t caustic_map;    // texels per side of each spot lamp's photon maps (0: no caustics)
+  // Frames between traces of photons whose lamps and objects did not move (1: every frame; see
+  // Caustics::Refresh). The splat, the camera's part, runs every frame.
+  int caustic_refresh_period;
+  // Photon-map texels per side of each photon reflected off glass (1: every texel's; 2: one
+  // texel's in each 2 x 2 block, with four times the flux). Glass reflects a few percent of the
+  // light, spread widely by its curvature, so those photons are dim and each covers the largest
+  // splat: at 128^2 they took 1.4 of the splat's 2.5 ms on glass_mirror's fast dir frame.
+  int glass_reflection_stride;
+  // Whether dir's VPLs drawn on mirrors and glass move to where their photons landed (caustic
+  // VPLs, paper Sec. 4.2.2; false: such a VPL stays on the object, lighting as a diffuse one).
+  bool caustic_vpls;
 };
 // paper (512^2 impostors, a set per object up to four, 512^2 caustic maps), high (256^2, two
-// sets, 256^2 caustic maps), fast (96^2, two sets, each redrawn every fourth frame while its
-// objects stay put, no caustics: at 64^2 they cost 3.9 ms and took glass_mirror's fastest dir
-// frame from 30 to 36 ms).
+// sets, 256^2 caustic maps), fast (96^2 impostors, two sets, each redrawn every fourth frame
+// while its objects stay put; 128^2 caustic maps whose photons are traced every eighth frame
+// while the lamps and objects stay put, a quarter of the glass-reflected photons, no caustic
+// VPLs: the fast path, 33 ms at 640 x 480 on lavapipe x2).
 const std::array<SpecularLevel, 3>& specular_levels();
 // The stage's level for a technique's level: the technique's first level gets the paper's
 // settings, its last two the fast ones, the others high.
