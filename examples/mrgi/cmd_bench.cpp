@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "mrgi/platform/output_dir.h"
+#include "ablation_names.h"
 #include "commands.h"
 #include "mrgi/perf/bench.h"
 #include "mrgi/perf/regression.h"
@@ -24,6 +25,7 @@ struct BenchOptions {
   std::vector<std::string> sizes;  // --sizes WxH,...: one run per size and a scaling table
   std::vector<std::string> knobs;  // --knob NAME=VALUE (one technique)
   std::vector<std::string> sweeps;  // --sweep NAME=V1,V2,... (one technique)
+  std::vector<std::string> specular_ablation;  // --specular-ablation
   bool quiet = false;
   int confirm = 1;  // re-runs of an entry whose only finding is its frame time, before failing
 };
@@ -73,6 +75,12 @@ void run_scaling(BenchOptions& o) {
 void run_bench_command(BenchOptions& o) {
   // Before any Vulkan instance exists: lavapipe reads it when the device is created.
   perf::ensure_lp_num_threads();
+  if (!o.specular_ablation.empty()) {
+    if (!o.check.empty() || !o.write_baseline.empty())
+      throw CommandFailure(2, "--specular-ablation cannot be combined with --check or --write-baseline (the baseline "
+                              "holds the stage as it runs)");
+    set_ablations(o.specular_ablation, kSpecularAblations, o.settings.specular_ablation);
+  }
   if (!o.knobs.empty()) {
     if (o.settings.techniques.size() != 1)
       throw CommandFailure(2, "--knob: name exactly one technique with --techniques (knobs are a technique's own)");
@@ -218,6 +226,12 @@ void setup(CLI::App& app) {
   cmd->add_flag("--no-residual-light", [opts](int64_t n) { opts->settings.residual_light = n == 0; },
                 "with declared lamps: light by the lamps alone, without the estimate of the real light they do not "
                 "explain (RuntimeSettings::residual_light; an ablation)");
+  cmd->add_option("--specular-ablation", opts->specular_ablation,
+                  "mirrors and glass without one of the paper's ideas, as mrgi replay's (mrgi/runtime.h "
+                  "SpecularAblation): off (the stage's cost, against a run without it), no-back-projection, "
+                  "no-depth-test, no-caustics; comma-separated")
+      ->delimiter(',')
+      ->check(CLI::IsMember(ablation_names(kSpecularAblations)));
   cmd->add_option("--sweep", opts->sweeps,
                  "run every combination of a knob's values at every chosen level, NAME=V1,V2,... (repeatable: the "
                  "product; one technique; entries are named by level and values)");

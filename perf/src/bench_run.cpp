@@ -120,6 +120,7 @@ Expected<RunSamples> run_one(const LoadedScene& l, const std::string& technique,
   RuntimeSettings rs;
   rs.device = s.device;
   rs.residual_light = s.residual_light;
+  rs.specular_ablation = s.specular_ablation;
   rs.knobs = s.knobs;
   rs.frames_in_flight = s.frames_in_flight;
   rs.technique = technique;

@@ -15,22 +15,10 @@ layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
 #include "specular/photon.glsl"
 layout(std430, set = 0, binding = 1) readonly buffer Photons { Photon photons[]; };
 layout(std430, set = 0, binding = 4) readonly buffer PhotonList { uint photon_list[]; };  // photons.comp
-layout(push_constant) uniform Splat { vec4 splat; };  // x smallest side (internal pixels), y photon
-                                                     // map size (texels), z largest side (at most
-                                                     // the device's largest point)
+layout(push_constant) uniform Splat { vec4 splat; };  // x smallest side (internal pixels), z largest
+                                                     // (at most the device's largest point)
 layout(location = 0) flat out vec4 out_irradiance;   // rgb W/m^2; w the photon's camera depth
 layout(location = 1) flat out float out_real;        // 1: it landed on a real surface
-
-// Where the neighbouring photon of the same kind landed (`step` texels away: a stride apart),
-// or the photon's own place.
-vec3 neighbour(int index, ivec2 step, vec3 own) {
-  int size = int(splat.y);
-  int i = index / 2, kind = index - 2 * i;
-  ivec2 t = ivec2(i % size, i / size) + step;
-  if (any(greaterThanEqual(t, ivec2(size)))) return own;
-  Photon n = photons[2 * (t.y * size + t.x) + kind];
-  return n.position.w > 0.5f ? n.position.xyz : own;
-}
 
 void main() {
   int index = int(photon_list[gl_VertexIndex]);
@@ -44,12 +32,10 @@ void main() {
   vec3 to_camera = normalize(frame.camera_world.xyz - ph.position.xyz);
   float cos_view = max(abs(dot(normalize(ph.normal.xyz), to_camera)), 0.1f);
   float px_m = c.z / frame.internal_k.x;  // a pixel's side on a surface facing the camera
-  // The square covers the photon's share of the surface: the distance to where the neighbouring
-  // texels' photons landed (a ray differential: small where the object focuses the light, the
-  // caustic's sharp core; large where it spreads it, whose few photons would otherwise be dots).
-  vec3 p = ph.position.xyz;
-  int stride = max(int(ph.normal.w + 0.5f), 1);
-  float spacing = max(distance(neighbour(index, ivec2(stride, 0), p), p), distance(neighbour(index, ivec2(0, stride), p), p));
+  // The square covers the photon's share of the surface: its footprint (photon_footprint.comp,
+  // small where the object focuses the light, the caustic's sharp core; large where it spreads
+  // it, whose few photons would otherwise be dots).
+  float spacing = ph.albedo.w;
   float side = clamp(spacing / px_m, splat.x, splat.z);
   float area = side * side * px_m * px_m / cos_view;
   out_irradiance = vec4(ph.flux.rgb / area, c.z);

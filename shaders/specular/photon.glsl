@@ -16,7 +16,8 @@ struct Photon {
   vec4 normal;    // xyz unit normal of the surface it landed on, facing where it came from; w
                   // photon-map texels per side between photons of its kind (1, or the glass
                   // reflection stride)
-  vec4 albedo;    // rgb that surface's diffuse albedo (the impostor's)
+  vec4 albedo;    // rgb that surface's diffuse albedo (the impostor's); w its footprint: the
+                  // distance (m) to where its neighbours of its kind landed (photon_footprint.comp)
   vec4 origin;    // xyz its texel's point on the mirror or glass; w 1 (0: the texel saw none)
 };
 

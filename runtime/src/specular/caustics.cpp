@@ -101,6 +101,9 @@ Expected<Caustics> Caustics::create(const technique::SharedResources& shared, ui
   auto pp = gpu::load_compute_pipeline(ctx, "specular/photons.comp", {});
   if (!pp) return pp.error();
   c.photon_pipeline_ = std::move(*pp);
+  auto fpp = gpu::load_compute_pipeline(ctx, "specular/photon_footprint.comp", {});
+  if (!fpp) return fpp.error();
+  c.footprint_pipeline_ = std::move(*fpp);
   auto mesh_vs = gpu::shader_spirv("gi/rsm_mesh.vert");
   if (!mesh_vs) return mesh_vs.error();
   auto surface_fs = gpu::shader_spirv("specular/photon_surface.frag");
@@ -235,6 +238,8 @@ bool Caustics::trace(gpu::FrameGraph& graph, const Impostors& imp, const std::ve
       r.push.view_proj = view_proj;
       r.push.light = glm::vec4(lamp.position, 1.0f);
       r.draws = front;
+      // Half a texel of the map: its focal length is size / (2 tan(half)).
+      r.lod = technique::LodView{lamp.position, float(size) / (2.0f * std::tan(half)), 0.5f};
       add_mesh_raster(graph, sg, r);
       if (!back.empty()) {
         r.name = "specular photon back faces " + id;
@@ -274,8 +279,16 @@ bool Caustics::trace(gpu::FrameGraph& graph, const Impostors& imp, const std::ve
           [pp, push, size](VkCommandBuffer cmd, gpu::PassContext&) {
             gpu::push_and_dispatch(cmd, *pp, &push, sizeof push, {(size + 7) / 8, (size + 7) / 8, 1});
           });
+      const gpu::Pipeline* fp = &*footprint_pipeline_;
+      const glm::ivec4 map(int(size), 0, 0, 0);
+      graph.add_shader_pass(
+          "specular photon footprints " + id, gpu::PassKind::Compute, *footprint_pipeline_,
+          [photons](gpu::ShaderPassBuilder& b) { b.bind_over("Photons", photons); },
+          [fp, map, size](VkCommandBuffer cmd, gpu::PassContext&) {
+            gpu::push_and_dispatch(cmd, *fp, &map, sizeof map, {(size + 7) / 8, (size + 7) / 8, 1});
+          });
     }
-    splat_push_.push_back(glm::vec4(quad_min_px, float(size), quad_max_px, 0.0f));
+    splat_push_.push_back(glm::vec4(quad_min_px, 0.0f, quad_max_px, 0.0f));
   }
   return true;
 }

@@ -6,6 +6,8 @@
 //   specular photon back faces <l>   the refractive objects' back faces from the lamp
 //   specular photons <l>             a reflected and a twice refracted photon per texel, traced to
 //                                    the impostors (photons.comp)
+//   specular photon footprints <l>   each landed photon's spacing from its neighbours
+//                                    (photon_footprint.comp: the splat's square size)
 // and, after the technique (splat()):
 //   specular caustic splat <l>       the photons as points into the camera's caustic buffer
 //                                    (irradiance) and, times albedo / pi, into the diffuse
@@ -77,7 +79,7 @@ class Caustics {
   // the map size and the scene revision, and when.
   std::vector<float> traced_key_;
   int64_t traced_frame_ = 0, frame_ = 0;
-  gpu::PipelineHandle surface_pipeline_, photon_pipeline_, splat_pipeline_;
+  gpu::PipelineHandle surface_pipeline_, photon_pipeline_, footprint_pipeline_, splat_pipeline_;
 };
 
 }  // namespace mrgi::specular

@@ -54,7 +54,10 @@ void add_mesh_raster(gpu::FrameGraph& graph, const technique::SceneGpu& scene, c
           const technique::DrawRange& d = sg->virtual_objects.draws[i];
           push.misc.y = d.material;
           vkCmdPushConstants(cmd, pipe->layout, pipe->stages, 0, sizeof push, &push);
-          vkCmdDrawIndexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0);
+          const technique::DrawRange::Lod l = d.lods.empty() || !r.lod
+                                                  ? technique::DrawRange::Lod{d.first_index, d.index_count, 0.0f}
+                                                  : d.lods[technique::MeshSet::select_lod(d, *r.lod)];
+          vkCmdDrawIndexed(cmd, l.index_count, 1, l.first_index, d.vertex_offset, 0);
         }
         ctx.fn().cmd_end_rendering(cmd);
       });

@@ -3,6 +3,7 @@
 // gi/rsm_mesh.vert, whose push block (gi/rsm.cpp RsmPush) carries the view and, per draw, the
 // range's material (misc.y).
 #pragma once
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,10 @@ struct MeshRaster {
   VkExtent2D extent{0, 0};                  // {0, 0}: the first colour target's used extent
   gi::RsmPush push;  // misc.y is set per range
   std::vector<size_t> draws;                // indices into scene.virtual_objects.draws
+  // Set: each range at the coarsest level of detail within lod.max_error_px of this view
+  // (technique::MeshSet::select_lod); lavapipe sets up every triangle on one thread, and the
+  // glass_mirror sphere's 2,200 took half of the camera's back-face pass at half resolution.
+  std::optional<technique::LodView> lod;
 };
 
 void add_mesh_raster(gpu::FrameGraph& graph, const technique::SceneGpu& scene, const MeshRaster& raster);

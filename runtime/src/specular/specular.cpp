@@ -72,7 +72,7 @@ const std::array<SpecularLevel, 3>& specular_levels() {
   static const std::array<SpecularLevel, 3> levels = {{
       {"paper", 512, 4, 24, 4, 16, 0.0f, 1, 512, 1, 1, true},
       {"high", 256, 2, 16, 3, 12, 0.0f, 1, 256, 1, 1, true},
-      {"fast", 96, 2, 10, 2, 8, 0.1f, 4, 128, 8, 2, false},
+      {"fast", 96, 2, 10, 2, 8, 0.1f, 8, 128, 8, 2, false},
   }};
   return levels;
 }
@@ -119,6 +119,8 @@ struct SpecularStage::Impl {
   VkExtent2D grid_points{0, 0};
   uint32_t grid_stride = 1;
   glm::mat4 world_to_clip{1.0f};  // this frame's camera (the back faces' draw)
+  glm::vec3 camera_world{0.0f};   // and its centre and focal length (internal pixels)
+  float internal_focal_px = 0.0f;
   // What each set's block of the atlas holds: drawn at frame `frame` around `centre` for
   // `objects` at face size `face` (a set is redrawn when any of them changed or it is
   // refresh_period frames old).
@@ -453,6 +455,8 @@ void SpecularStage::Impl::add_back_faces(gpu::FrameGraph& graph, const std::vect
   r.depth = back_depth;
   r.push.view_proj = world_to_clip;
   r.draws = specular_draws(*shared.scene_gpu, refractive, 1 << shader::SPECULAR_REFRACTIVE);
+  // Half an internal pixel: the finest the virtual G-buffer's front faces are drawn at.
+  r.lod = technique::LodView{camera_world, internal_focal_px, 0.5f};
   add_mesh_raster(graph, *shared.scene_gpu, r);
 }
 
@@ -565,6 +569,8 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
   c->level = glm::vec4(float(std::max(level.glass_reflection_stride, 1)), level.glass_reflection_fresnel, 0.0f, 0.0f);
 
   m.world_to_clip = fc.world_to_clip;
+  m.camera_world = glm::vec3(fc.camera_world);
+  m.internal_focal_px = fc.internal_k.x;
   m.set_grid(graph, face);
   // Redraw the sets whose content changed; of the rest, the oldest one if it is refresh_period
   // frames old (at most one stale set is refreshed a frame: the fast level spreads the sets over
