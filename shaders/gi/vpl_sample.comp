@@ -59,6 +59,15 @@ bool caustic_vpl(vec4 pos, vec4 flux, float weight, uint h, inout Vpl v) {
   ivec2 texel = ivec2(t);
   int i = texel.y * size + texel.x;
   Photon a = photons[2 * i], b = photons[2 * i + 1];
+  // Reflected photons one texel in stride x stride (specular.h SpecularLevel::glass_reflection_stride):
+  // the block's photon, whose flux is the block's (stride^2 texels').
+  int stride = max(int(a.normal.w + 0.5f), 1);
+  float a_texels = 1.0f;
+  if (stride > 1) {
+    ivec2 rep = texel - texel % stride;
+    a = photons[2 * (rep.y * size + rep.x)];
+    a_texels = float(stride * stride);
+  }
   // The same surface point: within a few photon-map texels (the maps see the object from the
   // same lamp at different resolutions).
   float tolerance = 0.02f * distance(pos.xyz, params.lamp.xyz) + 0.005f;
@@ -70,7 +79,7 @@ bool caustic_vpl(vec4 pos, vec4 flux, float weight, uint h, inout Vpl v) {
   bool take_a = va && (!vb || halton(h, 7u) < 0.5f);
   Photon p = take_a ? a : b;
   float share = (va && vb) ? 2.0f : 1.0f;
-  vec3 path = p.flux.rgb / max(params.colour.rgb * p.flux.w, vec3(1e-30f));
+  vec3 path = p.flux.rgb / max(params.colour.rgb * p.flux.w, vec3(1e-30f)) / (take_a ? a_texels : 1.0f);
   vec3 incident = max(flux.a, 0.0f) * params.colour.rgb;
   vec3 f = incident * path * p.albedo.rgb * share / weight;
   bool finite = all(lessThan(f, vec3(3.0e38f)));

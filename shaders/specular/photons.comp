@@ -106,8 +106,8 @@ void main() {
     store(2u * index + 1u, none, vec3(0.0f), origin, emitted, 1);
   }
   // Off glass, one texel's reflected photon per stride x stride block, with the block's flux
-  // (SpecularLevel::glass_reflection_stride; the others stay unlit: dir's caustic VPLs then take
-  // the refracted photon, each kind as often as its share of the light, see gi/vpl_sample.comp).
+  // (SpecularLevel::glass_reflection_stride; the other texels' reflected photons are none, their
+  // stride says where the block's is: gi/vpl_sample.comp's caustic VPLs take it from there).
   int stride = kind == SPECULAR_REFRACTIVE ? max(int(specular.level.x + 0.5f), 1) : 1;
   if (stride > 1 && any(notEqual(texel % stride, ivec2(0)))) {
     store(2u * index, none, vec3(0.0f), origin, emitted, stride);

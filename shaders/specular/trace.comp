@@ -113,7 +113,7 @@ vec3 env_cell(int x, int y, int w) {
   return env_cells[y * w + x].rgb;
 }
 
-// The internal pixel where the camera sees x itself (a real surface, or a virtual one as
+// The internal pixel where the camera sees x itself (a real surface, or a diffuse virtual one as
 // `real` says): inside the view, the G-buffer's depth there within the tolerance of x's; for a
 // real x, no virtual object in front of it there (a specular one allowed when `under_specular`:
 // the caustic buffer holds the surfaces under mirrors and glass, caustic_splat.frag).
@@ -127,6 +127,9 @@ ivec2 seen_pixel(vec3 x, bool real, bool under_specular) {
   ivec2 q = ivec2(ip);
   vec4 v = imageLoad(virtual_position, q);
   if (real && v.w > 0.5f && (v.w < 1.5f || !under_specular)) return ivec2(-1);
+  // A mirror or glass pixel holds no solution of its own surface (the trace writes it): another
+  // specular object seen there is its base colour (shade_hit), the paper's one bounce.
+  if (!real && v.w > 1.5f) return ivec2(-1);
   float depth = real ? imageLoad(real_position, q).w : (v.w > 0.5f ? (frame.world_to_camera * vec4(v.xyz, 1.0f)).z : 0.0f);
   if (!(depth > 0.0f) || abs(depth - c.z) > specular.params.x * c.z) return ivec2(-1);
   return q;

@@ -34,15 +34,21 @@
 //   - Eq. 3 sums the lamps and the VPLs at each hit. A hit on a surface the camera sees (the
 //     depth validity test of the back-projection) takes the technique's L_rv and L_r there,
 //     which is that sum for that surface point, with the technique's visibility (dir's ISMs) and
-//     at one image read instead of a VPL loop per ray; a hit the camera does not see is lit by
-//     the lamps (with the technique's shadow maps where it drew them) and the SH ambient, without
-//     VPLs; both get the caustic buffer. A virtual hit outside the view is Lambertian.
+//     at one image read instead of a VPL loop per ray (the caustics splatted into it too); a hit
+//     the camera does not see is lit by the lamps (with the technique's shadow maps where it drew
+//     them) and the SH ambient, without VPLs, and the caustic buffer where it lies under a mirror
+//     or glass. A virtual hit outside the view is Lambertian.
 //   - L_env: the light stage's environment grid (64 x 32 cells of the filtered image, bilinear),
 //     not the fish-eye image at its own resolution; the SH where there is no environment image.
 //   - Eq. 9's validity is per path (specular_math.h specular_compose says why).
 //   - Caustics (Sec. 4.2, caustics.h) add to L_rv; the technique's shadow maps hold the glass as
 //     an opaque caster, so the light it lets through is the caustic's alone. dir's caustic VPLs
-//     (Sec. 4.2.2) are gi/vpl_sample.comp's.
+//     (Sec. 4.2.2) are gi/vpl_sample.comp's. Photons are splatted as points sized by their
+//     footprint (Wyman 2008's adaptive quads), not Shah et al.'s fixed quads.
+//   - The fast level's savings (SpecularLevel): impostors and photons are world-space and are
+//     redrawn or retraced every eighth frame while nothing moved, a quarter of the photons
+//     reflected off glass carry four times the flux, and glass reflections weaker than 10 %
+//     show L_env instead of a traced hit.
 #pragma once
 #include <array>
 #include <memory>
@@ -84,7 +90,9 @@ struct SpecularLevel {
   // Photon-map texels per side of each photon reflected off glass (1: every texel's; 2: one
   // texel's in each 2 x 2 block, with four times the flux). Glass reflects a few percent of the
   // light, spread widely by its curvature, so those photons are dim and each covers the largest
-  // splat: at 128^2 they took 1.4 of the splat's 2.5 ms on glass_mirror's fast dir frame.
+  // splat: at 128^2 they took 1.4 of the splat's 2.5 ms on glass_mirror's fast dir frame (lavapipe
+  // sets up each splat on one thread). A mirror's reflected photons, which a concave one focuses,
+  // are every texel's.
   int glass_reflection_stride;
   // Whether dir's VPLs drawn on mirrors and glass move to where their photons landed (caustic
   // VPLs, paper Sec. 4.2.2; false: such a VPL stays on the object, lighting as a diffuse one).
