@@ -195,7 +195,7 @@ TEST(Specular, GlassFocusesTheSpotLampIntoItsShadowWithNoMoreThanItIntercepts) {
 
 TEST(Specular, TheFastLevelSplatsPhotonsItTracedFramesAgoWithTheSameEnergy) {
   // dir's fast level (SpecularLevel "fast": 128^2 maps, a quarter of the glass-reflected photons
-  // with four times the flux each, photons traced every eighth frame while nothing moves): the
+  // with four times the flux each, photons traced every sixteenth frame while nothing moves): the
   // photons are traced on the first frame and splatted from the buffers on the next ones, which
   // say so; every frame's caustic holds about the energy of level 1's, which traces all of them
   // every frame, and no more than the glass intercepts.

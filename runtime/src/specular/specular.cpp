@@ -72,7 +72,7 @@ const std::array<SpecularLevel, 3>& specular_levels() {
   static const std::array<SpecularLevel, 3> levels = {{
       {"paper", 512, 4, 24, 4, 16, 0.0f, 1, 512, 1, 1, true},
       {"high", 256, 2, 16, 3, 12, 0.0f, 1, 256, 1, 1, true},
-      {"fast", 96, 2, 10, 2, 8, 0.1f, 8, 128, 8, 2, false},
+      {"fast", 96, 2, 10, 2, 8, 0.1f, 8, 128, 16, 2, false},
   }};
   return levels;
 }

@@ -46,7 +46,8 @@
 //     (Sec. 4.2.2) are gi/vpl_sample.comp's. Photons are splatted as points sized by their
 //     footprint (Wyman 2008's adaptive quads), not Shah et al.'s fixed quads.
 //   - The fast level's savings (SpecularLevel): impostors and photons are world-space and are
-//     redrawn or retraced every eighth frame while nothing moved, a quarter of the photons
+//     redrawn every eighth frame or retraced every sixteenth while nothing moved (the camera's
+//     newly seen real surfaces wait that long), a quarter of the photons
 //     reflected off glass carry four times the flux, and glass reflections weaker than 10 %
 //     show L_env instead of a traced hit.
 #pragma once
@@ -81,7 +82,7 @@ struct SpecularLevel {
   float glass_reflection_fresnel;
   // Frames between redraws of a set whose objects did not move (1: every frame). The impostors
   // are world-space surfaces, so a set a frame old differs only by what the camera newly sees
-  // of the real scene; at 4, two sets cost half a set's drawing a frame.
+  // of the real scene; at 8, two sets cost a quarter of a set's drawing a frame.
   int refresh_period;
   uint32_t caustic_map;    // texels per side of each spot lamp's photon maps (0: no caustics)
   // Frames between traces of photons whose lamps and objects did not move (1: every frame; see
@@ -99,8 +100,8 @@ struct SpecularLevel {
   bool caustic_vpls;
 };
 // paper (512^2 impostors, a set per object up to four, 512^2 caustic maps), high (256^2, two
-// sets, 256^2 caustic maps), fast (96^2 impostors, two sets, each redrawn every fourth frame
-// while its objects stay put; 128^2 caustic maps whose photons are traced every eighth frame
+// sets, 256^2 caustic maps), fast (96^2 impostors, two sets, each redrawn every eighth frame
+// while its objects stay put; 128^2 caustic maps whose photons are traced every sixteenth frame
 // while the lamps and objects stay put, a quarter of the glass-reflected photons, no caustic
 // VPLs: the fast path, 33 ms at 640 x 480 on lavapipe x2).
 const std::array<SpecularLevel, 3>& specular_levels();
