@@ -1,6 +1,6 @@
 // The public ladder of every technique (mrgi/runtime.h technique_ladder): the same levels as
 // technique_levels, each knob with a unit, internal scales in (0, 1]; an unknown technique is
-// refused by name.
+// refused by name, and "specular" (DESIGN.md's add-on) with where that stage is.
 #include <gtest/gtest.h>
 
 #include "mrgi/runtime.h"
@@ -30,4 +30,9 @@ TEST(TechniqueLadder, EveryTechniqueListsItsLevelsWithUnits) {
   auto none = mrgi::technique_ladder("no-such-technique");
   ASSERT_FALSE(none.ok());
   EXPECT_NE(none.error().message.find("no-such-technique"), std::string::npos) << none.error().message;
+  auto specular = mrgi::technique_ladder("specular");
+  ASSERT_FALSE(specular.ok());
+  EXPECT_EQ(specular.error().kind, mrgi::ErrorKind::BadUsage);
+  EXPECT_NE(specular.error().message.find("a stage of every technique"), std::string::npos) << specular.error().message;
+  EXPECT_NE(specular.error().message.find("--specular-ablation off"), std::string::npos) << specular.error().message;
 }

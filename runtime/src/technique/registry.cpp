@@ -28,14 +28,13 @@ Expected<const TechniqueEntry*> find_technique(const std::string& name) {
     if (e.name == name) return &e;
     known += (known.empty() ? "" : ", ") + std::string(e.name);
   }
-  // Techniques of DESIGN.md that are not built yet say so by name instead of "unknown".
-  static const std::pair<const char*, const char*> planned[] = {
-      {"specular", "mirrors, glass and caustics inside DIR"},
-  };
-  for (const auto& [planned_name, what] : planned)
-    if (name == planned_name)
-      return fail(ErrorKind::NotImplemented, "technique '" + name + "' (" + what +
-                                                 ") is not implemented yet; implemented: " + known);
+  // DESIGN.md's specular add-on is a stage of every technique, not a technique of its own: the
+  // name says where it is instead of "unknown".
+  if (name == "specular")
+    return fail(ErrorKind::BadUsage, "technique 'specular': mirrors, glass and caustics are a stage of every technique "
+                                     "(runtime/src/specular/), on wherever a virtual material is reflective or refractive; "
+                                     "choose the technique that lights the rest (" + known +
+                                     "), and RuntimeSettings::specular_ablation (--specular-ablation off) turns the stage off");
   return fail(ErrorKind::BadUsage, "technique '" + name + "' is not known; known techniques: " + known);
 }
 
