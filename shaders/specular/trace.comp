@@ -1,8 +1,10 @@
 #version 460
 // Reflective and refractive virtual objects in DIR (Knecht et al. 2013, Sec. 4.1 and 5.1), at the
 // internal resolution over the pixels whose virtual material is specular (virtual_position.w >=
-// 2: 2 + its material index, gbuffer/virtual.frag), as trace_list.comp listed them: one pass over
-// the glass pixels (kRefractive), one over the mirrors', each compiled without the other's path:
+// 2: 2 + its material index, gbuffer/virtual.frag), as trace_list.comp listed them: a pass over
+// the glass pixels whose reflection is traced (kRefractive, kReflect), one over the mirrors'
+// (kReflect), one over the glass pixels whose reflection shows L_env (kRefractive), each compiled
+// without the paths it never takes:
 //   1. GBuf_refl: the mirror direction's ray searched against the set's impostors (a linear
 //      search along the ray, then secant refinement: the iterative refinement of Popescu et al.
 //      2006 on distance impostors);
@@ -37,8 +39,10 @@
 #include "specular/specular_params.glsl"
 
 layout(local_size_x = 64) in;
-// true: the glass pixels' pass (reflection and refraction); false: the mirrors' (reflection).
+// kRefractive: glass pixels (refraction); kReflect: the reflection traced (else L_env: glass whose
+// Fresnel factor is below SpecularLevel::glass_reflection_fresnel).
 layout(constant_id = 0) const bool kRefractive = false;
+layout(constant_id = 1) const bool kReflect = true;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
 FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(std140, set = 0, binding = 1) uniform LightUbo { LightSet light_set; };
@@ -69,7 +73,7 @@ layout(std430, set = 0, binding = 20) readonly buffer EnvGrid { vec4 env_cells[]
 // this frame): rgb irradiance.
 layout(set = 0, binding = 21, rgba16f) readonly uniform image2D caustics;
 // trace_list.comp's lists: this pass's kind's count, its pixels (x | y << 16) from list.x on.
-layout(std430, set = 0, binding = 22) readonly buffer TraceCounts { uint counts[2]; };
+layout(std430, set = 0, binding = 22) readonly buffer TraceCounts { uint counts[4]; };
 layout(std430, set = 0, binding = 23) readonly buffer TracePixels { uint pixels[]; };
 
 #define MRGI_UPLOAD_COLOR_ONLY
@@ -208,12 +212,12 @@ int nearest_set(vec3 p) {
   return best;
 }
 
-layout(push_constant) uniform List { ivec4 list; };  // x this kind's first entry in pixels
+layout(push_constant) uniform List { ivec4 list; };  // x this list's first entry in pixels, y its index
 
 void main() {
   frame = frame_ubo;  // MRGI_UNIFORM_COPIES
   uint at = gl_GlobalInvocationID.x;
-  if (at >= counts[kRefractive ? 0 : 1]) return;
+  if (at >= counts[list.y]) return;
   uint packed = pixels[uint(list.x) + at];
   ivec2 pixel = ivec2(int(packed & 0xffffu), int(packed >> 16));
   ivec2 used = frame.internal_output_size.xy;
@@ -251,11 +255,11 @@ void main() {
   } else {
     eta1 = fresnel_metal(mix(vec3(0.04f), alb.rgb, alb.a), cos_v);
   }
-  // Off glass, a reflection weaker than the level's threshold is not traced: it shows L_env
-  // (SpecularLevel::glass_reflection_fresnel).
+  // Off glass, a reflection weaker than the level's threshold is not traced (trace_list.comp
+  // listed the pixel for the pass without it): it shows L_env (SpecularLevel::glass_reflection_fresnel).
   Hit h1;
   h1.found = false;
-  if (!kRefractive || eta1.x >= specular.level.y) h1 = trace_impostor(s, p + refl * 1e-3f, refl);
+  if (kReflect) h1 = trace_impostor(s, p + refl * 1e-3f, refl);
   add_path(sum, eta1, h1, refl, exposure);
 
   vec3 final_linear = specular_compose(sum.rv, sum.r, sum.camera, sum.env, specular.params.y, specular.params.z);

@@ -60,6 +60,16 @@ struct ObjectInView {
   bool refractive = false, reflective = false;
 };
 
+// trace_list.comp's lists, in its order: the pass over each and trace.comp's specialisation.
+struct TraceList {
+  const char* pass;
+  bool refractive, reflect;
+};
+constexpr int kTraceLists = 3;
+constexpr TraceList kTraceList[kTraceLists] = {{"specular trace glass", true, true},
+                                               {"specular trace mirrors", false, true},
+                                               {"specular trace glass unreflected", true, false}};
+
 struct ImpostorSet {
   glm::vec3 centre{0.0f};
   float radius = 0.0f;
@@ -106,7 +116,7 @@ struct SpecularStage::Impl {
   gpu::BufferHandle env_grid;  // the light stage's environment grid, copied each frame
   int env_width = 0;           // its width in cells
   gpu::PipelineHandle cells_pipeline, grid_pipeline, mesh_pipeline, back_pipeline, list_pipeline;
-  gpu::PipelineHandle trace_pipelines[2];  // trace.comp: [0] mirrors, [1] glass (kRefractive)
+  gpu::PipelineHandle trace_pipelines[kTraceLists];  // trace.comp per kTraceList
   // trace_list.comp's output: dispatch arguments per kind (glass, mirrors), counts, pixels.
   gpu::BufferHandle trace_args, trace_counts, trace_pixels;
   uint32_t list_capacity = 0;  // pixels each kind's list holds
@@ -115,6 +125,7 @@ struct SpecularStage::Impl {
   bool active = false;               // prepare() found something to do this frame
   glm::ivec4 region{0};              // the trace list's dispatch: first pixel, size
   bool glass_in_view = false, mirrors_in_view = false;
+  float glass_reflection_fresnel = 0.0f;  // this frame's level's (SpecularLevel)
   technique::CausticPhotons photons; // this frame's, for the technique
   VkExtent2D grid_points{0, 0};
   uint32_t grid_stride = 1;
@@ -243,11 +254,11 @@ Status SpecularStage::Impl::init() {
   cells_pipeline = std::move(*ip);
   auto trace_spv = gpu::shader_spirv("specular/trace.comp");
   if (!trace_spv) return trace_spv.error();
-  for (uint32_t refractive = 0; refractive < 2; ++refractive) {
-    auto tp = gpu::create_compute_pipeline(
-        ctx, {refractive ? "specular trace glass" : "specular trace mirrors", *trace_spv, {}, 0, {refractive}});
+  for (int list = 0; list < kTraceLists; ++list) {
+    const TraceList& l = kTraceList[list];
+    auto tp = gpu::create_compute_pipeline(ctx, {l.pass, *trace_spv, {}, 0, {l.refractive ? 1u : 0u, l.reflect ? 1u : 0u}});
     if (!tp) return tp.error();
-    trace_pipelines[refractive] = gpu::PipelineHandle(ctx, std::move(*tp));
+    trace_pipelines[list] = gpu::PipelineHandle(ctx, std::move(*tp));
   }
   auto lp = gpu::load_compute_pipeline(ctx, "specular/trace_list.comp", {});
   if (!lp) return lp.error();
@@ -255,7 +266,7 @@ Status SpecularStage::Impl::init() {
   // The trace's lists (trace_list.comp): every internal pixel of each kind at most.
   const VkExtent2D internal = graph.allocated_extent(shared.lit_rv);
   list_capacity = internal.width * internal.height;
-  auto ta = graph.create_buffer({"specular trace args", 32}, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+  auto ta = graph.create_buffer({"specular trace args", 16 * kTraceLists}, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
                                                                   VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
                                                                   VK_BUFFER_USAGE_TRANSFER_DST_BIT);
   if (!ta) return ta.error();
@@ -264,7 +275,7 @@ Status SpecularStage::Impl::init() {
                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT);
   if (!tc) return tc.error();
   trace_counts = *tc;
-  auto tl = graph.create_buffer({"specular trace pixels", VkDeviceSize(list_capacity) * 2 * 4},
+  auto tl = graph.create_buffer({"specular trace pixels", VkDeviceSize(list_capacity) * kTraceLists * 4},
                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (!tl) return tl.error();
   trace_pixels = *tl;
@@ -607,6 +618,7 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
     reflective = reflective || v.reflective;
   }
   m.glass_in_view = refractive;
+  m.glass_reflection_fresnel = level.glass_reflection_fresnel;
   m.mirrors_in_view = reflective;
   if (refractive) m.add_back_faces(graph, in_view);
   else skipped.push_back("specular back faces: no refractive object in view");
@@ -680,13 +692,14 @@ Status SpecularStage::finish(const technique::Technique& technique, std::vector<
                    b.write(counts, gpu::Access::TransferDst);
                  },
                  [args, counts](VkCommandBuffer cmd, gpu::PassContext& p) {
-                   // Disjoint fills (overlapping ones in one pass are a write-after-write hazard):
-                   // (0, 1, 1, -) per kind.
+                   // (0, 1, 1, -) per list, by disjoint fills (overlapping ones in one pass are a
+                   // write-after-write hazard).
                    const VkBuffer a = p.buffer(args);
                    vkCmdFillBuffer(cmd, a, 0, 4, 0u);
-                   vkCmdFillBuffer(cmd, a, 4, 8, 1u);
-                   vkCmdFillBuffer(cmd, a, 12, 8, 0u);
-                   vkCmdFillBuffer(cmd, a, 20, 8, 1u);
+                   for (VkDeviceSize l = 0; l < kTraceLists; ++l) {
+                     vkCmdFillBuffer(cmd, a, 16 * l + 4, 8, 1u);
+                     vkCmdFillBuffer(cmd, a, 16 * l + 12, l + 1 < kTraceLists ? 8 : 4, 0u);
+                   }
                    vkCmdFillBuffer(cmd, p.buffer(counts), 0, 16, 0u);
                  });
   const glm::ivec4 list_push[2] = {region, glm::ivec4(int(m.list_capacity), 0, 0, 0)};
@@ -694,6 +707,9 @@ Status SpecularStage::finish(const technique::Technique& technique, std::vector<
       "specular trace list", gpu::PassKind::Compute, *m.list_pipeline,
       [self, args, counts, pixels](gpu::ShaderPassBuilder& b) {
         b.bind("virtual_position", self->shared.virtual_position);
+        b.bind("virtual_normal", self->shared.virtual_normal);
+        b.bind("FrameUbo", self->shared.frame_constants);
+        b.bind("SpecularUbo", self->constants);
         b.bind("Materials", self->shared.scene_gpu->materials);
         b.bind_over("TraceArgs", args);
         b.bind_over("TraceCounts", counts);
@@ -703,13 +719,15 @@ Status SpecularStage::finish(const technique::Technique& technique, std::vector<
         gpu::push_and_dispatch(cmd, *self->list_pipeline, list_push, sizeof list_push,
                                {(uint32_t(region.z) + 7) / 8, (uint32_t(region.w) + 7) / 8, 1});
       });
-  for (int refractive = 1; refractive >= 0; --refractive) {
-    if (!(refractive ? m.glass_in_view : m.mirrors_in_view)) continue;
-    const gpu::Pipeline* pipe = &*m.trace_pipelines[refractive];
-    const glm::ivec4 list(refractive ? 0 : int(m.list_capacity), 0, 0, 0);
-    const VkDeviceSize offset = refractive ? 0 : 16;
+  for (int li = 0; li < kTraceLists; ++li) {
+    if (!(kTraceList[li].refractive ? m.glass_in_view : m.mirrors_in_view)) continue;
+    // A level that traces every glass reflection lists no glass pixel without one.
+    if (kTraceList[li].refractive && !kTraceList[li].reflect && !(m.glass_reflection_fresnel > 0.0f)) continue;
+    const gpu::Pipeline* pipe = &*m.trace_pipelines[li];
+    const glm::ivec4 list(li * int(m.list_capacity), li, 0, 0);
+    const VkDeviceSize offset = VkDeviceSize(16 * li);
     graph.add_shader_pass(
-        refractive ? "specular trace glass" : "specular trace mirrors", gpu::PassKind::Compute, *pipe,
+        kTraceList[li].pass, gpu::PassKind::Compute, *pipe,
         [=](gpu::ShaderPassBuilder& b) {
           const technique::SharedResources& r = self->shared;
           b.bind("FrameUbo", r.frame_constants);
