@@ -290,6 +290,26 @@ BufferHandle FrameGraph::import_buffer(const std::string& name, const GpuBuffer&
   return BufferHandle{uint32_t(buffers_.size() - 1)};
 }
 
+Expected<ImageHandle> FrameGraph::create_zero_image(const std::string& name, VkFormat format, VkImageUsageFlags usage,
+                                                    uint32_t width, uint32_t height, uint32_t depth) {
+  const uint32_t texel = bytes_per_texel(format);
+  if (texel == 0)
+    return fail(ErrorKind::BadUsage, "create_zero_image('" + name + "'): format " + std::to_string(int(format)) +
+                                         " has no known texel size");
+  ImageDesc d;
+  d.name = name;
+  d.format = format;
+  d.size_mode = SizeMode::Absolute;
+  d.width = width;
+  d.height = height;
+  d.depth = depth;
+  auto image = create_image(d, usage | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
+  if (!image) return image.error();
+  const std::vector<uint8_t> zero(size_t(width) * height * depth * texel, 0);
+  MRGI_TRY(upload_image(*image, zero.data(), zero.size()));
+  return *image;
+}
+
 Status FrameGraph::upload_image(ImageHandle image, const void* texels, VkDeviceSize size) {
   if (image.id >= images_.size()) return fail(ErrorKind::BadUsage, "upload_image: invalid image handle");
   if (in_frame_) return fail(ErrorKind::BadUsage, "upload_image('" + images_[image.id].desc.name +

@@ -342,6 +342,11 @@ class FrameGraph {
   // Fills an image with texels at start-up (staging copy, waits), leaving it SHADER_READ_ONLY
   // (sampled usage), GENERAL (storage) or TRANSFER_DST; the graph tracks the layout.
   Status upload_image(ImageHandle image, const void* texels, VkDeviceSize size);
+  // A stand-in bound where a pass's shader declares an image the frame does not have (its path
+  // compiled or branched out): `width` x `height` x `depth` texels of `format`, Absolute, filled
+  // with zeros at start-up (defined contents, never read).
+  Expected<ImageHandle> create_zero_image(const std::string& name, VkFormat format, VkImageUsageFlags usage,
+                                          uint32_t width = 1, uint32_t height = 1, uint32_t depth = 1);
 
   // Per-frame size knobs: the used extent of OutputRelative images. Never reallocates; values
   // beyond what was allocated for are BadUsage.

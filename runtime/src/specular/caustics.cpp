@@ -151,7 +151,8 @@ bool Caustics::trace(gpu::FrameGraph& graph, const Impostors& imp, const std::ve
   recorded_.lamps.clear();
   splat_push_.clear();
   // The strongest spot lamps whose cone meets the objects' sphere and that are outside it.
-  std::vector<const LightDesc*> chosen;
+  std::vector<const LightDesc*>& chosen = chosen_;
+  chosen.clear();
   for (const LightDesc& l : lamps) {
     if (l.type != LightType::Spot || !(l.intensity > 0.0f)) continue;
     if (glm::distance(l.position, centre) <= 1.05f * radius || !gi::lamp_reaches_sphere(l, centre, radius)) continue;
@@ -179,26 +180,29 @@ bool Caustics::trace(gpu::FrameGraph& graph, const Impostors& imp, const std::ve
   // refresh.period - 1 frames ago (a due trace waits while impostors are redrawn this frame, to
   // spread the fast level's work over frames).
   ++frame_;
-  std::vector<float> key = {float(size), float(refresh.revision), centre.x, centre.y, centre.z, radius};
-  for (size_t o : objects) key.push_back(float(o));
+  // What the photons depend on, compared exactly (doubles hold the revision and the indices).
+  std::vector<double>& key = key_;
+  key.assign({double(size), double(refresh.glass_reflection_stride), double(refresh.revision), centre.x, centre.y,
+              centre.z, radius});
+  for (size_t o : objects) key.push_back(double(o));
   for (const LightDesc* l : chosen) {
-    const float k[] = {l->position.x,
-                       l->position.y,
-                       l->position.z,
-                       l->direction.x,
-                       l->direction.y,
-                       l->direction.z,
-                       l->color.r * l->intensity,
-                       l->color.g * l->intensity,
-                       l->color.b * l->intensity,
-                       l->inner_angle_deg,
-                       l->outer_angle_deg};
+    const double k[] = {l->position.x,
+                        l->position.y,
+                        l->position.z,
+                        l->direction.x,
+                        l->direction.y,
+                        l->direction.z,
+                        l->color.r * l->intensity,
+                        l->color.g * l->intensity,
+                        l->color.b * l->intensity,
+                        l->inner_angle_deg,
+                        l->outer_angle_deg};
     key.insert(key.end(), std::begin(k), std::end(k));
   }
   const int64_t age = frame_ - traced_frame_;
   const bool trace = key != traced_key_ || age >= refresh.period + 1 || (age >= refresh.period && !refresh.busy);
   if (trace) {
-    traced_key_ = std::move(key);
+    traced_key_.swap(key);
     traced_frame_ = frame_;
   } else {
     skipped.push_back("specular photons: traced " + std::to_string(age) +

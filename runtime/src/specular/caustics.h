@@ -48,6 +48,7 @@ class Caustics {
     int period = 1;       // frames between traces of unchanged photons (1: every frame)
     bool busy = false;    // this frame already redraws impostors: a due trace waits a frame
     uint64_t revision = 0;  // the scene's (SceneGpu::revision): a change traces at once
+    int glass_reflection_stride = 1;  // the level's (photons.comp): a change traces at once
   };
   // Records the photon passes for the lamps of `lamps` (the light stage's lights) that are spot
   // lamps whose cone meets the sphere (centre, radius) around `objects` (specular objects in
@@ -77,8 +78,11 @@ class Caustics {
   std::vector<glm::vec4> splat_push_;   // caustic_splat.vert's push block per lamp
   // What the photons in the buffers were traced for: the chosen lamps' parameters, the objects,
   // the map size and the scene revision, and when.
-  std::vector<float> traced_key_;
+  std::vector<double> traced_key_;
   int64_t traced_frame_ = 0, frame_ = 0;
+  // Scratch kept between frames (no allocation a frame once they have grown).
+  std::vector<double> key_;
+  std::vector<const LightDesc*> chosen_;
   gpu::PipelineHandle surface_pipeline_, photon_pipeline_, footprint_pipeline_, splat_pipeline_;
 };
 

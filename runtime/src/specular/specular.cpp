@@ -58,6 +58,7 @@ struct ObjectInView {
   glm::vec3 lo{0.0f}, hi{0.0f};
   float distance = 0.0f;
   bool refractive = false, reflective = false;
+  technique::ScreenBounds screen;  // its box projected into this frame's camera
 };
 
 // trace_list.comp's lists, in its order: the pass over each and trace.comp's specialisation.
@@ -144,6 +145,11 @@ struct SpecularStage::Impl {
   };
   std::vector<DrawnSet> drawn;
   int64_t frame = 0;
+  // prepare()'s scratch, kept between frames (no allocation a frame once grown).
+  std::vector<ObjectInView> in_view;
+  std::vector<ImpostorSet> sets;
+  std::vector<bool> redraw;
+  std::vector<size_t> objects;
 
   Status init();
   void set_grid(gpu::FrameGraph& graph, uint32_t face);
@@ -207,16 +213,9 @@ Status SpecularStage::Impl::init() {
   no_shadow = *nsi;
   // Bound as the trace's caustic buffer where the caustics ablation leaves none (flags.w 0: never
   // read), in the binding's own format.
-  gpu::ImageDesc nc;
-  nc.name = "specular no caustics";
-  nc.format = VK_FORMAT_R16G16B16A16_SFLOAT;
-  nc.size_mode = gpu::SizeMode::Absolute;
-  nc.width = nc.height = 1;
-  auto nci = graph.create_image(nc, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
+  auto nci = graph.create_zero_image("specular no caustics", VK_FORMAT_R16G16B16A16_SFLOAT, VK_IMAGE_USAGE_STORAGE_BIT);
   if (!nci) return nci.error();
   no_caustics = *nci;
-  const std::array<uint16_t, 4> zero{};  // defined contents, never read
-  MRGI_TRY(graph.upload_image(no_caustics, zero.data(), sizeof zero));
 
   // The finest grid any level draws: a point per texel of the largest face (set_grid).
   const VkExtent2D g = graph.allocated_extent(shared.real_position);
@@ -495,7 +494,8 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
   m.photons = technique::CausticPhotons{};
   const technique::SceneGpu& sg = *m.shared.scene_gpu;
   gpu::FrameGraph& graph = *m.shared.graph;
-  std::vector<ObjectInView> in_view;
+  std::vector<ObjectInView>& in_view = m.in_view;
+  in_view.clear();
   for (size_t o = 0; o < sg.object_count(); ++o) {
     if (!sg.visible(o)) continue;
     const int kinds = sg.object_specular_kinds(o);
@@ -510,7 +510,8 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
       v.lo = glm::min(v.lo, sg.virtual_objects.draws[d].bounds_min);
       v.hi = glm::max(v.hi, sg.virtual_objects.draws[d].bounds_max);
     }
-    if (!technique::project_box(fc, v.lo, v.hi).visible) continue;
+    v.screen = technique::project_box(fc, v.lo, v.hi);
+    if (!v.screen.visible) continue;
     v.distance = glm::distance(0.5f * (v.lo + v.hi), glm::vec3(fc.camera_world));
     v.refractive = (kinds & (1 << shader::SPECULAR_REFRACTIVE)) != 0;
     v.reflective = (kinds & (1 << shader::SPECULAR_REFLECTIVE)) != 0;
@@ -519,7 +520,7 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
   glm::vec2 lo_px(1e30f), hi_px(-1e30f);
   bool behind = false;
   for (const ObjectInView& v : in_view) {
-    const technique::ScreenBounds b = technique::project_box(fc, v.lo, v.hi);
+    const technique::ScreenBounds& b = v.screen;
     behind = behind || b.behind;
     lo_px = glm::min(lo_px, b.min);
     hi_px = glm::max(hi_px, b.max);
@@ -533,7 +534,9 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
   const SpecularLevel& level = specular_level_for(technique_level, technique_levels);
   const uint32_t face = std::min(level.impostor_face, m.settings.max_impostor_face);
   const int set_count = std::clamp(std::min(level.own_sets, m.settings.max_sets), 1, int(in_view.size()));
-  std::vector<ImpostorSet> sets(static_cast<size_t>(set_count));
+  std::vector<ImpostorSet>& sets = m.sets;
+  sets.resize(static_cast<size_t>(set_count));
+  for (ImpostorSet& s : sets) s.objects.clear();
   for (size_t i = 0; i < in_view.size(); ++i) {
     ImpostorSet& s = sets[std::min(i, size_t(set_count - 1))];
     s.objects.push_back(in_view[i].object);
@@ -588,7 +591,8 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
   // frames).
   m.drawn.resize(size_t(m.settings.max_sets));
   ++m.frame;
-  std::vector<bool> redraw(size_t(set_count), false);
+  std::vector<bool>& redraw = m.redraw;
+  redraw.assign(size_t(set_count), false);
   int oldest = -1;
   for (int i = 0; i < set_count; ++i) {
     const Impl::DrawnSet& d = m.drawn[size_t(i)];
@@ -625,7 +629,8 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
 
   bool caustics = false;
   if (m.caustics && level.caustic_map > 0) {
-    std::vector<size_t> objects;
+    std::vector<size_t>& objects = m.objects;
+    objects.clear();
     glm::vec3 lo(1e30f), hi(-1e30f);
     for (const ObjectInView& v : in_view) {
       objects.push_back(v.object);
@@ -634,7 +639,9 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
     }
     caustics = m.caustics->trace(graph, {m.constants, m.impostor_position, m.impostor_normal, m.impostor_albedo},
                                   lighting.lights, objects, 0.5f * (lo + hi), 0.5f * glm::length(hi - lo),
-                                  level.caustic_map, {level.caustic_refresh_period, any_redrawn, sg.revision()}, skipped);
+                                  level.caustic_map,
+                                  {level.caustic_refresh_period, any_redrawn, sg.revision(), level.glass_reflection_stride},
+                                  skipped);
   } else {
     skipped.push_back(m.caustics ? "specular caustics: off at this level" : "specular caustics: off (ablation)");
   }

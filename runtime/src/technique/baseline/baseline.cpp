@@ -249,26 +249,12 @@ Status Baseline::init() {
     if (!sp) return sp.error();
     shade_pipelines_[mode] = gpu::PipelineHandle(ctx, std::move(*sp));
   }
-  gpu::ImageDesc nv;
-  nv.name = "baseline_no_volume";
-  nv.format = VK_FORMAT_R16G16B16A16_SFLOAT;
-  nv.size_mode = gpu::SizeMode::Absolute;
-  nv.width = nv.height = nv.depth = 2;
-  auto no_volume = graph.create_image(nv, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
+  auto no_volume = graph.create_zero_image("baseline_no_volume", VK_FORMAT_R16G16B16A16_SFLOAT, VK_IMAGE_USAGE_SAMPLED_BIT, 2, 2, 2);
   if (!no_volume) return no_volume.error();
   no_volume_ = *no_volume;
-  const std::array<uint16_t, 2 * 2 * 2 * 4> zero{};  // defined contents, never read
-  MRGI_TRY(graph.upload_image(no_volume_, zero.data(), sizeof zero));
-  gpu::ImageDesc ni;
-  ni.name = "baseline_no_indirect";
-  ni.format = VK_FORMAT_R32G32B32A32_UINT;
-  ni.size_mode = gpu::SizeMode::Absolute;
-  ni.width = ni.height = 1;
-  auto no_indirect = graph.create_image(ni, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
+  auto no_indirect = graph.create_zero_image("baseline_no_indirect", VK_FORMAT_R32G32B32A32_UINT, VK_IMAGE_USAGE_STORAGE_BIT);
   if (!no_indirect) return no_indirect.error();
   no_indirect_ = *no_indirect;
-  const std::array<uint32_t, 4> none{};  // defined contents, never read
-  MRGI_TRY(graph.upload_image(no_indirect_, none.data(), sizeof none));
   return ok_status();
 }
 
