@@ -119,43 +119,58 @@ TEST(PathTracer, PointLampOnDiffusePlaneIsAnalytic) {
   }
 }
 
+// A grey floor (albedo 0.6) under a point lamp of intensity 5 at `lamp_at`, with `object`, a
+// virtual mesh of material `m` (a delta material: the light tracer's caustics), over it.
+RefScene floor_under_lamp_with(const RefMaterial& m, RefMesh object, const glm::vec3& lamp_at) {
+  RefScene scene;
+  RefMaterial floor_m;
+  floor_m.base_color = glm::vec3(0.6f);
+  scene.materials.push_back(floor_m);
+  scene.materials.push_back(m);
+  scene.meshes.push_back(make_plane({20.0f, 20.0f}, glm::mat4(1.0f)));
+  object.material = 1;
+  object.is_virtual = true;
+  scene.meshes.push_back(std::move(object));
+  RefLight lamp;
+  lamp.position = lamp_at;
+  lamp.intensity = glm::vec3(5.0f);
+  scene.lights.push_back(lamp);
+  return scene;
+}
+
+// `scene` rendered with 4 million light-traced paths beside the pixel estimator.
+Expected<RenderOutput> render_light_traced(const RefScene& scene, const RefCamera& cam, int spp, int max_depth) {
+  auto tracer = PathTracer::create(scene);
+  if (!tracer) return tracer.error();
+  RenderSettings s;
+  s.spp = spp;
+  s.max_depth = max_depth;
+  s.rr_depth = 64;
+  s.threads = 2;
+  s.light_paths = 4000000;
+  return (*tracer)->render(cam, s);
+}
+
 // The caustic of a point lamp in a mirror, which the pixel estimator cannot sample (a delta lamp
 // seen through a delta BSDF) and the light tracer adds: a mirror ceiling at y = 2 over a lamp at
 // y = 1 lights the floor like a second lamp at y = 3 (its mirror image), the floor below the lamp
 // getting albedo / pi x I (1 / 1^2 + R / 3^2). Pixels away from the centre follow the same two
 // lamps. The mirror is virtual: L_r is the direct light alone.
 TEST(PathTracer, LightTracingAddsTheCausticOfAPointLampInAMirror) {
-  RefScene scene;
-  RefMaterial floor_m;
-  floor_m.base_color = glm::vec3(0.6f);
-  scene.materials.push_back(floor_m);
   RefMaterial mirror;
   mirror.type = MaterialType::Mirror;
   mirror.base_color = glm::vec3(0.9f, 0.5f, 0.25f);
-  scene.materials.push_back(mirror);
-  scene.meshes.push_back(make_plane({20.0f, 20.0f}, glm::mat4(1.0f)));
   // The plane faces +y; turned over (facing down) and raised to y = 2.
-  RefMesh ceiling = make_plane({1.5f, 1.5f}, glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 2.0f, 0.0f)) *
-                                                 glm::rotate(glm::mat4(1.0f), kPi, glm::vec3(1.0f, 0.0f, 0.0f)));
-  ceiling.material = 1;
-  ceiling.is_virtual = true;
-  scene.meshes.push_back(ceiling);
-  RefLight lamp;
-  lamp.position = {0.0f, 1.0f, 0.0f};
-  lamp.intensity = glm::vec3(5.0f);
-  scene.lights.push_back(lamp);
+  const RefScene scene = floor_under_lamp_with(
+      mirror,
+      make_plane({1.5f, 1.5f}, glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 2.0f, 0.0f)) *
+                                   glm::rotate(glm::mat4(1.0f), kPi, glm::vec3(1.0f, 0.0f, 0.0f))),
+      {0.0f, 1.0f, 0.0f});
   // The camera between the lamp and the mirror, looking down (cameras are not geometry).
   const RefCamera cam = small_camera(24, 24, 2.0, mrgi::test::opencv_look_at({0, 1.5, 0.001}, {0, 0, 0}, {0, 0, -1}));
-  auto tracer = PathTracer::create(scene);
-  ASSERT_TRUE(tracer.ok());
-  RenderSettings s;
-  s.spp = 4;
-  s.max_depth = 1;  // the floor's own bounce off the mirror stays out of the analytic answer
-  s.rr_depth = 64;
-  s.threads = 2;
-  s.light_paths = 4000000;
-  auto out = (*tracer)->render(cam, s);
-  ASSERT_TRUE(out.ok());
+  // max_depth 1: the floor's own bounce off the mirror stays out of the analytic answer.
+  auto out = render_light_traced(scene, cam, 4, 1);
+  ASSERT_TRUE(out.ok()) << out.error().message;
   for (auto [px, py] : {std::pair{12, 12}, {6, 8}, {18, 15}}) {
     const size_t i = size_t(py) * 24 + size_t(px);
     const glm::dvec3 dc((px - cam.pinhole.cx) / cam.pinhole.fx, (py - cam.pinhole.cy) / cam.pinhole.fy, 1.0);
@@ -179,35 +194,15 @@ TEST(PathTracer, LightTracingAddsTheCausticOfAPointLampInAMirror) {
 // camera sees, the power with the sphere is the power without it less what the sphere reflects
 // away and what lands outside the view (a few percent: the focus is under the sphere).
 TEST(PathTracer, LightTracingKeepsTheLightAGlassSphereBends) {
-  RefScene scene;
-  RefMaterial floor_m;
-  floor_m.base_color = glm::vec3(0.6f);
-  scene.materials.push_back(floor_m);
   RefMaterial glass;
   glass.type = MaterialType::Glass;
   glass.base_color = glm::vec3(1.0f);
   glass.ior = 1.5f;
-  scene.materials.push_back(glass);
-  scene.meshes.push_back(make_plane({20.0f, 20.0f}, glm::mat4(1.0f)));
-  RefMesh sphere = make_sphere(0.25f, 64, glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 0.6f, 0.0f)));
-  sphere.material = 1;
-  sphere.is_virtual = true;
-  scene.meshes.push_back(sphere);
-  RefLight lamp;
-  lamp.position = {0.0f, 2.0f, 0.0f};
-  lamp.intensity = glm::vec3(5.0f);
-  scene.lights.push_back(lamp);
+  const RefScene scene = floor_under_lamp_with(
+      glass, make_sphere(0.25f, 64, glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 0.6f, 0.0f))), {0.0f, 2.0f, 0.0f});
   const RefCamera cam = small_camera(48, 48, 0.6, mrgi::test::opencv_look_at({0, 3.0, 0.001}, {0, 0, 0}, {0, 0, -1}));
-  auto tracer = PathTracer::create(scene);
-  ASSERT_TRUE(tracer.ok());
-  RenderSettings s;
-  s.spp = 8;
-  s.max_depth = 8;
-  s.rr_depth = 64;
-  s.threads = 2;
-  s.light_paths = 4000000;
-  auto out = (*tracer)->render(cam, s);
-  ASSERT_TRUE(out.ok());
+  auto out = render_light_traced(scene, cam, 8, 8);
+  ASSERT_TRUE(out.ok()) << out.error().message;
   double with = 0.0, without = 0.0;
   for (size_t i = 0; i < out->real.pixel_count(); ++i) {
     if (out->virtual_mask.data[i] != 0) continue;  // the floor, where the sphere does not hide it
