@@ -29,6 +29,8 @@
 #include "common/light_set.glsl"
 #include "common/surface_shading.glsl"
 #include "dir/indirect_pack.glsl"
+#include "shared/specular_math.h"
+#include "specular/caustic_receiver.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
@@ -76,6 +78,15 @@ layout(set = 0, binding = 22, rgba32ui) readonly uniform uimage2D dir_indirect; 
 layout(constant_id = 1) const bool kOneShadowMap = false;
 layout(set = 0, binding = 23) uniform sampler2DArray shadow_primary_depth;
 layout(set = 0, binding = 24) uniform sampler2DArray shadow_virtual_depth;
+// kCausticReceivers (the specular stage's fast level, technique.h CausticPhotons::receivers):
+// the spot lamps' caustics through mirrors and glass, read from their receiver maps, added to
+// L_rv on the diffuse pixels as albedo / pi x E (caustics-DIR paper eq. 12-14: never L_r, the
+// light went through a virtual object); mirror and glass pixels get nothing (the stage's trace
+// writes them, reading the maps for what they show).
+layout(constant_id = 2) const bool kCausticReceivers = false;
+layout(set = 0, binding = 25, rgba32f) readonly uniform image2D caustic_receivers;
+layout(std430, set = 0, binding = 26) readonly buffer CausticReceiverLamps { CausticReceivers receiver_set; };
+#include "specular/caustic_receiver_lookup.glsl"
 struct LevelConstants {
   vec4 shadow;  // x used map size / allocated size, y used size (texels), z allocated size,
                 // w PCF radius (taps each side of the centre)
@@ -89,6 +100,7 @@ LevelConstants level;
 
 void main() {
   frame = frame_ubo; level = level_block;  // MRGI_UNIFORM_COPIES
+  if (kCausticReceivers) cache_caustic_receivers();
   if (kVolumeBounce != 0) volume = volume_block;
   ambient_rv = light_set.ambient_rv;
   ambient_r = light_set.ambient_r;
@@ -160,6 +172,11 @@ void main() {
     bool matched = w_sum > 1e-6f;
     l_rv += matched ? sum_rv / w_sum : any_rv;
     l_r += r_p * (matched ? sum_r / w_sum : any_r);
+  }
+  if (kCausticReceivers && !(is_virtual && pos.w > 1.5f)) {
+    vec3 to_camera = p - frame.camera_world.xyz;  // the pixel's width there: distance / focal length
+    float footprint_sq = dot(to_camera, to_camera) / (frame.internal_k.x * frame.internal_k.x);
+    l_rv += alb.rgb * (1.0f - alb.a) * caustic_receiver_irradiance(p, footprint_sq) * (1.0f / MRGI_PI);
   }
   // Half floats end at 65504: clamp so no Inf reaches compose.
   imageStore(lit_rv, pixel, vec4(clamp(sanitize(l_rv), vec3(0.0f), vec3(60000.0f)), 1.0f));

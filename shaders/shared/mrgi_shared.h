@@ -24,6 +24,7 @@ using glm::clamp;
 using glm::cos;
 using glm::dot;
 using glm::exp2;
+using glm::floor;
 using glm::isinf;
 using glm::isnan;
 using glm::length;

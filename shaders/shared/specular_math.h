@@ -14,6 +14,8 @@
 //     al. describe it (the paper's [1]).
 //   - The composite of eq. 6-11 (specular_compose).
 //   - The impostors' cube (specular_cube_face): six 90 degree faces around a set's centre.
+//   - The caustic receiver maps of the fast level (specular/caustics.h): the octahedral map of
+//     directions around a lamp (mrgi_shared.h oct_encode) and the squares photons cover in it.
 #ifndef MRGI_SPECULAR_MATH_H
 #define MRGI_SPECULAR_MATH_H
 
@@ -136,6 +138,43 @@ MRGI_FN vec3 specular_cube_face(vec3 d) {
   float z = max(dot(d, f), 1e-20f);
   vec2 uv = vec2(dot(d, specular_face_right(face)), dot(d, specular_face_down(face))) / z;
   return vec3(clamp(uv * 0.5f + vec2(0.5f), vec2(0.0f), vec2(1.0f)), float(face));
+}
+
+// ---- caustic receiver maps ----------------------------------------------------------------------
+
+// Whether a caustic photon that landed at distance `photon` (m, from the camera in the camera's
+// splat, from the lamp in a receiver map) lit the surface point at distance `surface` along the
+// same ray: within 3 % + 1 cm (the depth sensor's noise and a splat's extent on a tilted surface).
+MRGI_FN bool caustic_same_surface(float surface, float photon) {
+  return abs(surface - photon) <= 0.03f * surface + 0.01f;
+}
+
+// Solid angle (sr) of one texel of a size x size octahedral map at unit direction d. The map
+// takes the octahedron |x| + |y| + |z| = 1 to [-1, 1]^2 with area kept (the lower half's folding
+// only moves triangles), and an area element dA at the octahedron's point P = d / l1(d) subtends
+// dA cos / |P|^2 with cos = 1 / (sqrt(3) |P|) and dA = sqrt(3) du dv: du dv / |P|^3, so
+// (2 / size)^2 l1(d)^3 (1 at the poles, 3 sqrt(3) at the faces' centres; 4 pi over the map).
+MRGI_FN float oct_texel_solid_angle(vec3 d, float size) {
+  float l1 = abs(d.x) + abs(d.y) + abs(d.z);
+  float texel = 2.0f / size;
+  return texel * texel * l1 * l1 * l1;
+}
+
+// The square a photon covers in a receiver map: side in texels (x) and the area (m^2) those
+// texels cover on the surface it landed on (y), so each texel's irradiance is flux / y and the
+// square holds the photon's flux whatever its side. spacing: the photon's footprint (m, the
+// distance to where its neighbours landed); r: its distance from the lamp (m); cos_l: the cosine
+// between the surface's normal and the lamp's ray there; texel_sr: oct_texel_solid_angle there.
+// The side is a whole number of texels: a point of side n covers exactly n x n texel centres,
+// while what a fractional side covers depends on how the rasteriser rounds it. Within that
+// rounding the square covers the photon's footprint on the surface (spacing^2) at any distance
+// and tilt.
+MRGI_FN vec2 caustic_receiver_square(float spacing, float r, float cos_l, float texel_sr, float min_side,
+                                     float max_side) {
+  float c = max(cos_l, 0.1f);  // grazing: the square's area stays finite
+  float side = spacing * sqrt(c) / (max(r, 1e-4f) * sqrt(max(texel_sr, 1e-20f)));
+  side = clamp(floor(side + 0.5f), max(floor(min_side), 1.0f), max(floor(max_side), 1.0f));
+  return vec2(side, side * side * texel_sr * r * r / c);
 }
 
 #ifdef __cplusplus

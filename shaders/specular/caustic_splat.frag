@@ -12,6 +12,7 @@
 //           writes them after this pass, from the caustics on what they show).
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
+#include "shared/specular_math.h"
 #include "common/frame_constants.glsl"
 
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame; };
@@ -31,7 +32,7 @@ void main() {
   if (in_real > 0.5f && diffuse_virtual) discard;
   if (in_real < 0.5f && !(v.w > 0.5f)) discard;
   float depth = in_real > 0.5f ? imageLoad(real_position, pixel).w : (frame.world_to_camera * vec4(v.xyz, 1.0f)).z;
-  if (!(depth > 0.0f) || abs(depth - in_irradiance.w) > 0.03f * depth + 0.01f) discard;
+  if (!(depth > 0.0f) || !caustic_same_surface(depth, in_irradiance.w)) discard;
   vec3 e = finite3(max(in_irradiance.rgb, vec3(0.0f)));
   out_caustic = vec4(e, 1.0f);
   vec3 albedo = vec3(0.0f);  // a mirror or glass pixel

@@ -104,7 +104,8 @@ struct Refraction {
 };
 
 // Wyman 2005's two refractions through an object whose back faces `view_proj` (Vulkan clip of
-// a perspective view, `size` texels) drew into back_position / back_normal: Snell at the front
+// a perspective view, `size` texels) drew into back_position / back_normal over `rect` (xy the
+// first texel, zw one past the last; the rest is not read): Snell at the front
 // face (p, unit normal n facing the incoming direction d), the exit point found along the
 // refracted ray in the back faces (a search instead of Wyman's interpolated distance estimate:
 // exact where the buffer holds the exit, and no per-vertex precomputation), Snell there. Under
@@ -116,15 +117,15 @@ vec3 clip_texel(mat4 view_proj, vec3 x, ivec2 size) {  // xy texel, z view depth
   if (!(c.w > 1e-6f)) return vec3(-1.0f, -1.0f, -1.0f);
   return vec3((c.xy / c.w * 0.5f + 0.5f) * vec2(size), c.w);
 }
-bool back_behind(mat4 view_proj, vec3 x, ivec2 size, out bool inside) {
+bool back_behind(mat4 view_proj, vec3 x, ivec2 size, ivec4 rect, out bool inside) {
   vec3 q = clip_texel(view_proj, x, size);
-  inside = q.z > 0.0f && all(greaterThanEqual(q.xy, vec2(0.0f))) && all(lessThan(q.xy, vec2(size)));
+  inside = q.z > 0.0f && all(greaterThanEqual(q.xy, vec2(rect.xy))) && all(lessThan(q.xy, vec2(rect.zw)));
   if (!inside) return true;
   vec4 b = imageLoad(back_position, ivec2(q.xy));
   if (!(b.w > 0.5f)) return true;  // left the object's silhouette
   return q.z >= (view_proj * vec4(b.xyz, 1.0f)).w;
 }
-Refraction refract_through(vec3 p, vec3 d, vec3 n, float ior, mat4 view_proj, ivec2 size) {
+Refraction refract_through(vec3 p, vec3 d, vec3 n, float ior, mat4 view_proj, ivec2 size, ivec4 rect) {
   Refraction r;
   float cos_i = max(-dot(d, n), 0.0f);
   float f1 = fresnel_dielectric(cos_i, 1.0f / ior);
@@ -133,7 +134,7 @@ Refraction refract_through(vec3 p, vec3 d, vec3 n, float ior, mat4 view_proj, iv
   r.transmission = 1.0f - f1;
   vec4 t1 = refract_or_reflect(d, n, 1.0f / ior);
   vec3 q = clip_texel(view_proj, p, size);
-  ivec2 pt = clamp(ivec2(q.xy), ivec2(0), size - 1);
+  ivec2 pt = clamp(ivec2(q.xy), rect.xy, rect.zw - 1);
   vec4 back = imageLoad(back_position, pt);
   if (!(back.w > 0.5f) || t1.w < 0.5f) return r;
   float d_v = distance(back.xyz, p);
@@ -144,7 +145,7 @@ Refraction refract_through(vec3 p, vec3 d, vec3 n, float ior, mat4 view_proj, iv
   bool inside;
   for (int k = 1; k <= steps; ++k) {
     float t = 2.0f * d_v * float(k) / float(steps);
-    if (back_behind(view_proj, p + t1.xyz * t, size, inside)) {
+    if (back_behind(view_proj, p + t1.xyz * t, size, rect, inside)) {
       if (inside) t_hi = t;
       break;
     }
@@ -153,11 +154,11 @@ Refraction refract_through(vec3 p, vec3 d, vec3 n, float ior, mat4 view_proj, iv
   if (t_hi > 0.0f) {
     for (int i = 0; i < 4; ++i) {  // bisection to the back face
       float t = 0.5f * (t_lo + t_hi);
-      if (back_behind(view_proj, p + t1.xyz * t, size, inside)) t_hi = t; else t_lo = t;
+      if (back_behind(view_proj, p + t1.xyz * t, size, rect, inside)) t_hi = t; else t_lo = t;
     }
     vec3 x = p + t1.xyz * t_hi;
     vec3 c = clip_texel(view_proj, x, size);
-    ivec2 e = clamp(ivec2(c.xy), ivec2(0), size - 1);
+    ivec2 e = clamp(ivec2(c.xy), rect.xy, rect.zw - 1);
     vec4 b = imageLoad(back_position, e);
     r.exit_p = b.w > 0.5f ? b.xyz : x;
     if (b.w > 0.5f) exit_n = imageLoad(back_normal, e).xyz;

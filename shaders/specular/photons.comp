@@ -96,7 +96,7 @@ void main() {
   if (kind == SPECULAR_REFRACTIVE) {
     float ior = max(m.specular.y, 1.0f);
     eta1 = vec3(fresnel_dielectric(cos_i, 1.0f / ior));
-    Refraction r = refract_through(p, d, n, ior, view_proj, ivec2(size));
+    Refraction r = refract_through(p, d, n, ior, view_proj, ivec2(size), ivec4(0, 0, size, size));
     // The base colour is m's factor: the photon map holds no texture coordinates.
     vec3 t = r.transmission * transmittance_colour(m.base_color_factor.rgb, m.attenuation.rgb, m.specular.z,
                                                    distance(p, r.exit_p)) * clamp(m.specular.w, 0.0f, 1.0f);

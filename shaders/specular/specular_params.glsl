@@ -26,18 +26,21 @@ struct SpecularConstants {
   vec4 shadow;   // baseline's LevelConstants::shadow for the direct light's maps
   ivec4 flags;   // x 1: lamps lit with shadow maps; y 1: depth validity test on (0: ablation);
                  // z the environment grid's width in cells (EnvGrid, height z / 2; 0: none, the
-                 // environment is env_sh); w 1: the caustic buffer holds this frame's caustics
+                 // environment is env_sh); w 1: the caustic buffer holds this frame's caustics, 2: the
+                 // receiver maps do (caustic_receiver.glsl), 0: none
   vec4 level;    // x photon-map texels per side of each glass-reflected photon
                  // (SpecularLevel::glass_reflection_stride); y the smallest Fresnel factor of a
                  // reflection off glass that is traced (SpecularLevel::glass_reflection_fresnel);
                  // zw unused
+  ivec4 back_rect;  // xy the first pixel, zw one past the last of the back faces' buffers drawn
+                    // this frame (the objects' projected boxes); outside, the buffers are stale
   vec4 env_sh[16];  // rgb: the environment's radiance, SH bands 0..3 (shared/mrgi_shared.h basis)
   SpecularSet sets[MRGI_SPECULAR_MAX_SETS];
 };
 
 #ifdef __cplusplus
 static_assert(sizeof(SpecularSet) == 32, "std140 mirror");
-static_assert(sizeof(SpecularConstants) == 5 * 16 + 16 * 16 + MRGI_SPECULAR_MAX_SETS * 32, "std140 mirror");
+static_assert(sizeof(SpecularConstants) == 6 * 16 + 16 * 16 + MRGI_SPECULAR_MAX_SETS * 32, "std140 mirror");
 }  // namespace mrgi::shader
 #endif
 #endif  // MRGI_SPECULAR_PARAMS_GLSL

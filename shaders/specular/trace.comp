@@ -37,6 +37,7 @@
 #include "common/scene_materials.glsl"
 #include "common/surface_shading.glsl"
 #include "specular/specular_params.glsl"
+#include "specular/caustic_receiver.glsl"
 
 layout(local_size_x = 64) in;
 // kRefractive: glass pixels (refraction); kReflect: the reflection traced (else L_env: glass whose
@@ -72,6 +73,10 @@ layout(std430, set = 0, binding = 20) readonly buffer EnvGrid { vec4 env_cells[]
 // The spot lamps' caustics on the surfaces the camera sees (caustics.h; flags.w 1 when written
 // this frame): rgb irradiance.
 layout(set = 0, binding = 21, rgba16f) readonly uniform image2D caustics;
+// The fast level's caustic receiver maps (caustic_receiver.glsl; flags.w 2: the technique's
+// shading added them to what the camera sees, and the hits here read them too).
+layout(set = 0, binding = 24, rgba32f) readonly uniform image2D caustic_receivers;
+layout(std430, set = 0, binding = 25) readonly buffer CausticReceiverLamps { CausticReceivers receiver_set; };
 // trace_list.comp's lists: this pass's kind's count, its pixels (x | y << 16) from list.x on.
 layout(std430, set = 0, binding = 22) readonly buffer TraceCounts { uint counts[4]; };
 layout(std430, set = 0, binding = 23) readonly buffer TracePixels { uint pixels[]; };
@@ -79,6 +84,7 @@ layout(std430, set = 0, binding = 23) readonly buffer TracePixels { uint pixels[
 #define MRGI_UPLOAD_COLOR_ONLY
 #include "common/upload_gather.glsl"
 #include "common/shadowed_lamps.glsl"
+#include "specular/caustic_receiver_lookup.glsl"
 
 #include "specular/impostor_trace.glsl"
 
@@ -141,8 +147,15 @@ ivec2 seen_pixel(vec3 x, bool real, bool under_specular) {
 
 // The caustic irradiance on x (a real or a virtual surface) where the camera sees it, or sees it
 // through a mirror or glass; a hit outside the view or hidden behind something else gets none
-// (the paper's Sec. 5.2 reading of CBuf through GBuf_refl and GBuf_refr).
+// (the paper's Sec. 5.2 reading of CBuf through GBuf_refl and GBuf_refr). With receiver maps
+// (flags.w 2), wherever the photons landed, in view or not.
 vec3 caustic_at(vec3 x, bool real) {
+  // The footprint of a pixel at x's distance from the camera (a mirror's or glass's rays spread
+  // more: the level is a floor on the filtering).
+  if (specular.flags.w == 2) {
+    vec3 to_camera = x - frame.camera_world.xyz;
+    return caustic_receiver_irradiance(x, dot(to_camera, to_camera) / (frame.internal_k.x * frame.internal_k.x));
+  }
   ivec2 q = seen_pixel(x, real, true);
   return q.x < 0 ? vec3(0.0f) : max(imageLoad(caustics, q).rgb, vec3(0.0f));
 }
@@ -216,6 +229,7 @@ layout(push_constant) uniform List { ivec4 list; };  // x this list's first entr
 
 void main() {
   frame = frame_ubo;  // MRGI_UNIFORM_COPIES
+  cache_caustic_receivers();
   uint at = gl_GlobalInvocationID.x;
   if (at >= counts[list.y]) return;
   uint packed = pixels[uint(list.x) + at];
@@ -245,7 +259,7 @@ void main() {
     float f1 = fresnel_dielectric(cos_v, 1.0f / ior);
     eta1 = vec3(f1);
     // GBuf_refr: Snell at the front face, the exit in the back faces' buffer, Snell there.
-    Refraction r = refract_through(p, view, n, ior, frame.world_to_clip, used);
+    Refraction r = refract_through(p, view, n, ior, frame.world_to_clip, used, specular.back_rect);
     vec3 exit_p = r.exit_p, exit_d = r.exit_d;
     eta2 = vec3(r.transmission);
     eta2 *= transmittance_colour(alb.rgb, m.attenuation.rgb, m.specular.z, distance(p, exit_p)) *

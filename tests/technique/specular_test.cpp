@@ -193,12 +193,15 @@ TEST(Specular, GlassFocusesTheSpotLampIntoItsShadowWithNoMoreThanItIntercepts) {
   EXPECT_LT(g.added_w, intercepted_w(s)) << "the caustics add more light than the glass intercepts";
 }
 
-TEST(Specular, TheFastLevelSplatsPhotonsItTracedFramesAgoWithTheSameEnergy) {
-  // dir's fast level (SpecularLevel "fast": 128^2 maps, a quarter of the glass-reflected photons
-  // with four times the flux each, photons traced every sixteenth frame while nothing moves): the
-  // photons are traced on the first frame and splatted from the buffers on the next ones, which
-  // say so; every frame's caustic holds about the energy of level 1's, which traces all of them
-  // every frame, and no more than the glass intercepts.
+TEST(Specular, TheFastLevelReadsReceiverMapsDrawnFramesAgoWithTheSameEnergy) {
+  // dir's fast level (SpecularLevel "fast": 128^2 photon maps, a quarter of the glass-reflected
+  // photons with four times the flux each, traced every sixteenth frame while nothing moves,
+  // into 512^2 receiver maps): the photons are traced and drawn into the receiver maps on the
+  // first frame, and the next frames' shading reads the maps (no pass of the stage's on them, no
+  // splat into the camera's buffer) and says so; every frame's caustic holds about the energy of
+  // level 1's, which traces and splats all of them every frame, and no more than the glass
+  // intercepts. At this test's 32 x 24 internal pixels (10 cm on the floor) the maps' 1 cm texels
+  // are read at their coarsest level: the pixel's caustic, not a point of it.
   mrgi::testing::TempDir dir;
   const SyntheticScene s = SyntheticScene::create(dir.str(), glm::vec3(0.0f), glm::vec3(1.0f), 0.0f, 0.0f, 1.0f);
   RuntimeSettings fast = settings_for("dir", 3);
@@ -209,11 +212,16 @@ TEST(Specular, TheFastLevelSplatsPhotonsItTracedFramesAgoWithTheSameEnergy) {
   ASSERT_EQ(a.size(), 4u);
   ASSERT_EQ(b.size(), 4u);
   EXPECT_TRUE(has_pass(a[0], "specular photons 0"));
+  EXPECT_TRUE(has_pass(a[0], "specular caustic receivers 0"));
+  EXPECT_TRUE(has_pass(a[0], "specular caustic receiver mip 0.1"));
   const double reference_w = caustic_gain(s, ref_on.back(), ref_off.back()).added_w;
   ASSERT_GT(reference_w, 0.0);
-  for (size_t i = 1; i < a.size(); ++i) {
-    EXPECT_TRUE(has_pass(a[i], "specular caustic splat 0")) << "frame " << i;
+  EXPECT_TRUE(has_pass(ref_on.back(), "specular caustic splat 0")) << "level 1 splats into the camera's buffer";
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_FALSE(has_pass(a[i], "specular caustic splat")) << "frame " << i;
+    if (i == 0) continue;
     EXPECT_FALSE(has_pass(a[i], "specular photons 0")) << "frame " << i;
+    EXPECT_FALSE(has_pass(a[i], "specular caustic receivers 0")) << "frame " << i;
     bool said = false;
     for (const std::string& k : a[i].stats.skipped) said = said || k.rfind("specular photons: traced", 0) == 0;
     EXPECT_TRUE(said) << "frame " << i;
@@ -221,6 +229,7 @@ TEST(Specular, TheFastLevelSplatsPhotonsItTracedFramesAgoWithTheSameEnergy) {
     EXPECT_GT(g.added_w, 0.7 * reference_w) << "frame " << i;
     EXPECT_LT(g.added_w, 1.3 * reference_w) << "frame " << i;
     EXPECT_LT(g.added_w, intercepted_w(s)) << "frame " << i;
+    EXPECT_GT(g.shadow_gain / g.shadow_n, 0.005) << "frame " << i << ": no caustic in the glass's shadow";
   }
 }
 

@@ -102,4 +102,54 @@ TEST(SpecularMath, CubeFacesCoverEveryDirectionOnce) {
   }
 }
 
+
+TEST(SpecularMath, OctahedralTexelsCoverTheSphereOnce) {
+  // The receiver maps' texels (oct_texel_solid_angle at each texel's centre direction) add up
+  // to the sphere's 4 pi: a photon's irradiance over its square keeps its flux anywhere in the map.
+  for (const int size : {64, 256}) {
+    double sum = 0.0;
+    for (int y = 0; y < size; ++y) {
+      for (int x = 0; x < size; ++x) {
+        const vec2 e((float(x) + 0.5f) / float(size) * 2.0f - 1.0f, (float(y) + 0.5f) / float(size) * 2.0f - 1.0f);
+        sum += oct_texel_solid_angle(oct_decode(e), float(size));
+      }
+    }
+    EXPECT_NEAR(sum, 4.0 * M_PI, 4.0 * M_PI * (size == 64 ? 2e-3 : 2e-4)) << size;
+  }
+  EXPECT_FLOAT_EQ(oct_texel_solid_angle(vec3(0.0f, 0.0f, 1.0f), 2.0f), 1.0f);  // a pole
+  EXPECT_NEAR(oct_texel_solid_angle(normalize(vec3(1.0f)), 2.0f), 3.0f * std::sqrt(3.0f), 1e-4f);
+  // The solid angle of a small patch of texels matches its directions' spherical area.
+  const int size = 512;
+  const vec2 e0(0.3f, -0.45f);
+  const float h = 4.0f / float(size);  // 2 x 2 texels
+  const vec3 a = oct_decode(e0), b = oct_decode(e0 + vec2(h, 0.0f)), c = oct_decode(e0 + vec2(0.0f, h));
+  const float patch = length(glm::cross(b - a, c - a));  // small: the chord parallelogram's area
+  EXPECT_NEAR(4.0f * oct_texel_solid_angle(oct_decode(e0 + vec2(0.5f * h)), float(size)), patch, patch * 0.02f);
+}
+
+TEST(SpecularMath, AReceiverSquareKeepsThePhotonsFlux) {
+  // The square covers the photon's footprint on the surface (spacing^2) at any distance and
+  // tilt, to within the side's rounding to whole texels; its area is always that of the side
+  // drawn (side^2 texels' patches), so each texel's flux / area adds up to the photon's flux.
+  const float texel_sr = oct_texel_solid_angle(normalize(vec3(0.2f, -0.1f, 1.0f)), 512.0f);
+  for (float r : {0.5f, 1.0f, 3.0f}) {
+    for (float cos_l : {1.0f, 0.5f, 0.2f}) {
+      const vec2 q = caustic_receiver_square(0.05f, r, cos_l, texel_sr, 1.0f, 1000.0f);
+      EXPECT_EQ(q.x, std::floor(q.x)) << "whole texels";
+      const float exact = 0.05f * std::sqrt(cos_l) / (r * std::sqrt(texel_sr));  // unrounded side
+      EXPECT_NEAR(q.x, exact, 0.5f);
+      EXPECT_NEAR(q.y, 0.05f * 0.05f * (q.x * q.x) / (exact * exact), 1e-6f) << r << " " << cos_l;
+    }
+  }
+  const vec2 small = caustic_receiver_square(1e-5f, 1.0f, 1.0f, texel_sr, 1.0f, 16.0f);
+  EXPECT_FLOAT_EQ(small.x, 1.0f);
+  EXPECT_NEAR(small.y, texel_sr, texel_sr * 1e-5f);  // one texel's patch at 1 m, facing the lamp
+  const vec2 grazing = caustic_receiver_square(0.01f, 1.0f, 0.0f, texel_sr, 1.0f, 1e6f);
+  EXPECT_TRUE(std::isfinite(grazing.y) && grazing.y > 0.0f);
+  // The same-surface rule both caustic paths use: 3 % + 1 cm of the surface's distance.
+  EXPECT_TRUE(caustic_same_surface(1.0f, 1.039f));
+  EXPECT_FALSE(caustic_same_surface(1.0f, 1.041f));
+  EXPECT_FALSE(caustic_same_surface(1.0f, 0.959f));
+}
+
 }  // namespace

@@ -9,6 +9,7 @@
 #include "gpu/shaders.h"
 #include "shared/specular_math.h"
 #include "specular/mesh_raster.h"
+#include "specular/caustic_receiver.glsl"
 #include "specular/photon.glsl"
 #include "technique/scene_gpu.h"
 
@@ -20,6 +21,8 @@ constexpr VkFormat kNormalFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kCausticFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kLitFormat = VK_FORMAT_R16G16B16A16_SFLOAT;  // the runtime's lit_rv
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
+// Receiver maps: float sums of many photons' irradiance (a caustic's core holds thousands).
+constexpr VkFormat kReceiverFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 constexpr VkDeviceSize kPhotonBytes = sizeof(shader::Photon);
 
 // photons.comp's push block.
@@ -36,12 +39,22 @@ glm::vec3 any_up(const glm::vec3& forward) {
   return std::abs(forward.y) > 0.9f ? glm::vec3(1.0f, 0.0f, 0.0f) : glm::vec3(0.0f, 1.0f, 0.0f);
 }
 
+// caustic_receiver.vert's push block.
+struct ReceiverPush {
+  shader::CausticReceiverLamp lamp;
+  glm::vec4 sizes;  // x smallest square side (texels), y largest
+};
+static_assert(sizeof(ReceiverPush) <= 128, "the guaranteed push-constant size");
+
 }  // namespace
 
 Expected<Caustics> Caustics::create(const technique::SharedResources& shared, uint32_t max_map_size,
-                                    const gpu::Pipeline& back_faces) {
+                                    uint32_t max_receiver_map, const gpu::Pipeline& back_faces) {
   if (max_map_size < 16 || max_map_size > 2048)
     return fail(ErrorKind::BadUsage, "caustic map size: must be 16..2048 texels");
+  if (max_receiver_map != 0 && (max_receiver_map < 16 || max_receiver_map > 2048))
+    return fail(ErrorKind::BadUsage, "caustic receiver map size: must be 0 (none) or 16..2048 texels");
+  static_assert(kMaxLamps == MRGI_CAUSTIC_RECEIVER_LAMPS, "one receiver map a lamp with caustics");
   Caustics c;
   c.shared_ = shared;
   c.max_map_ = max_map_size;
@@ -78,6 +91,24 @@ Expected<Caustics> Caustics::create(const technique::SharedResources& shared, ui
   auto cb = graph.create_image(cd, colour);
   if (!cb) return cb.error();
   c.caustics_ = *cb;
+  c.max_receiver_ = max_receiver_map;
+  if (max_receiver_map > 0) {
+    gpu::ImageDesc rd;
+    rd.name = "specular caustic receivers";
+    rd.format = kReceiverFormat;
+    rd.size_mode = gpu::SizeMode::Absolute;
+    rd.width = (max_receiver_map + max_receiver_map / 2) * uint32_t(kMaxLamps);  // with the halvings
+    rd.height = max_receiver_map;
+    rd.history = true;  // drawn when the photons are traced, read every frame
+    auto rb = graph.create_image(rd, colour);
+    if (!rb) return rb.error();
+    c.receivers_ = *rb;
+    auto lb = graph.create_buffer(
+        {"specular caustic receiver lamps", sizeof(shader::CausticReceivers), gpu::MemoryUsage::Upload, true},
+        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    if (!lb) return lb.error();
+    c.receiver_lamps_ = *lb;
+  }
   for (int l = 0; l < kMaxLamps; ++l) {
     const std::string id = std::to_string(l);
     gpu::BufferDesc pd{"specular photons " + id, VkDeviceSize(max_map_size) * max_map_size * 2 * kPhotonBytes};
@@ -140,6 +171,23 @@ Expected<Caustics> Caustics::create(const technique::SharedResources& shared, ui
   auto spl = gpu::create_graphics_pipeline(ctx, sd);
   if (!spl) return spl.error();
   c.splat_pipeline_ = gpu::PipelineHandle(ctx, std::move(*spl));
+  if (max_receiver_map > 0) {
+    auto rvs = gpu::shader_spirv("specular/caustic_receiver.vert");
+    if (!rvs) return rvs.error();
+    auto rfs = gpu::shader_spirv("specular/caustic_receiver.frag");
+    if (!rfs) return rfs.error();
+    gpu::GraphicsPipelineDesc rd = sd;
+    rd.name = "specular caustic receivers";
+    rd.vertex_spirv = *rvs;
+    rd.fragment_spirv = *rfs;
+    rd.color_formats = {kReceiverFormat};
+    auto rp = gpu::create_graphics_pipeline(ctx, rd);
+    if (!rp) return rp.error();
+    c.receiver_pipeline_ = gpu::PipelineHandle(ctx, std::move(*rp));
+    auto mp = gpu::load_compute_pipeline(ctx, "specular/caustic_receiver_mip.comp", {});
+    if (!mp) return mp.error();
+    c.receiver_mip_pipeline_ = std::move(*mp);
+  }
   return c;
 }
 
@@ -149,7 +197,10 @@ bool Caustics::trace(gpu::FrameGraph& graph, const Impostors& imp, const std::ve
   const technique::SceneGpu& sg = *shared_.scene_gpu;
   const uint32_t size = std::min(map_size, max_map_);
   recorded_.lamps.clear();
+  recorded_.receivers = {};
+  recorded_.receiver_lamps = {};
   splat_push_.clear();
+  shader::CausticReceivers receiver_set{};
   // The strongest spot lamps whose cone meets the objects' sphere and that are outside it.
   std::vector<const LightDesc*>& chosen = chosen_;
   chosen.clear();
@@ -182,8 +233,9 @@ bool Caustics::trace(gpu::FrameGraph& graph, const Impostors& imp, const std::ve
   ++frame_;
   // What the photons depend on, compared exactly (doubles hold the revision and the indices).
   std::vector<double>& key = key_;
-  key.assign({double(size), double(refresh.glass_reflection_stride), double(refresh.revision), centre.x, centre.y,
-              centre.z, radius});
+  const uint32_t receiver = max_receiver_ > 0 ? std::min(refresh.receiver_map, max_receiver_) : 0u;
+  key.assign({double(size), double(refresh.glass_reflection_stride), double(refresh.revision), double(receiver),
+              centre.x, centre.y, centre.z, radius});
   for (size_t o : objects) key.push_back(double(o));
   for (const LightDesc* l : chosen) {
     const double k[] = {l->position.x,
@@ -293,8 +345,89 @@ bool Caustics::trace(gpu::FrameGraph& graph, const Impostors& imp, const std::ve
           });
     }
     splat_push_.push_back(glm::vec4(quad_min_px, 0.0f, quad_max_px, 0.0f));
+    if (receiver > 0) {
+      // The map's frame: its pole on the lamp's axis, so the octahedron's seams (where bilinear
+      // reads and squares break) lie 90 degrees off the cone.
+      const glm::vec3 z = glm::normalize(lamp.direction);
+      const glm::vec3 x = glm::normalize(glm::cross(any_up(z), z));
+      const glm::vec3 y = glm::cross(z, x);
+      shader::CausticReceiverLamp rl;
+      rl.position = glm::vec4(lamp.position, float(receiver));
+      rl.frame_x = glm::vec4(x, 0.0f);
+      rl.frame_y = glm::vec4(y, 0.0f);
+      rl.frame_z = glm::vec4(z, 0.0f);
+      int levels = 1;
+      while (levels < MRGI_CAUSTIC_RECEIVER_LEVELS && (receiver >> levels) >= 4) ++levels;
+      rl.atlas = glm::ivec4(int(li * (receiver + receiver / 2)), 0, levels, 0);
+      receiver_set.lamps[li] = rl;
+      receiver_set.count.x = int(li) + 1;
+      if (trace) add_receiver_splat(graph, li, rl, largest_point);
+    }
+  }
+  if (receiver > 0) {
+    *static_cast<shader::CausticReceivers*>(graph.mapped(receiver_lamps_, graph.slot())) = receiver_set;
+    recorded_.receivers = receivers_;
+    recorded_.receiver_lamps = receiver_lamps_;
   }
   return true;
+}
+
+void Caustics::add_receiver_splat(gpu::FrameGraph& graph, size_t li, const shader::CausticReceiverLamp& lamp,
+                                  float largest_point) {
+  const uint32_t side = uint32_t(lamp.position.w);
+  // Squares of one texel up to a sixteenth of the map (the octahedron's 2 units: 1/8 of a
+  // hemisphere's width), so the widest spread photons stay smooth without flooding the map.
+  const ReceiverPush push{lamp, glm::vec4(1.0f, std::min(float(side) / 16.0f, largest_point), 0.0f, 0.0f)};
+  const gpu::Pipeline* pipe = &*receiver_pipeline_;
+  const gpu::BufferHandle draw = photon_draw_[li], photons = photons_[li], list = photon_list_[li];
+  const bool first = li == 0;
+  const std::string id = std::to_string(li);
+  graph.add_shader_pass(
+      "specular caustic receivers " + id, gpu::PassKind::Graphics, *receiver_pipeline_,
+      [this, first, photons, list, draw](gpu::ShaderPassBuilder& b) {
+        b.bind("Photons", photons);
+        b.bind("PhotonList", list);
+        b.uses().read(draw, gpu::Access::IndirectRead);
+        // Each lamp's map is its own part of the atlas: the second keeps the first's.
+        b.uses().write(receivers_, first ? gpu::Access::ColorAttachmentWrite : gpu::Access::ColorAttachmentReadWrite);
+      },
+      [this, pipe, push, draw, side, li](VkCommandBuffer cmd, gpu::PassContext& p) {
+        const gpu::Context& ctx = p.context();
+        VkRenderingAttachmentInfo colour{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+        colour.imageView = p.view(receivers_);
+        colour.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+        colour.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;  // the render area: this lamp's map
+        colour.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+        colour.clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
+        const VkRect2D area{{int32_t(li * (side + side / 2)), 0}, {side, side}};
+        VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+        ri.renderArea = area;
+        ri.layerCount = 1;
+        ri.colorAttachmentCount = 1;
+        ri.pColorAttachments = &colour;
+        ctx.fn().cmd_begin_rendering(cmd, &ri);
+        const VkViewport vp{float(area.offset.x), 0.0f, float(side), float(side), 0.0f, 1.0f};
+        vkCmdSetViewport(cmd, 0, 1, &vp);
+        vkCmdSetScissor(cmd, 0, 1, &area);
+        vkCmdPushConstants(cmd, pipe->layout, pipe->stages, 0, sizeof push, &push);
+        vkCmdDrawIndirect(cmd, p.buffer(draw), 0, 1, 16);
+        ctx.fn().cmd_end_rendering(cmd);
+      });
+  // The halvings the readers take where their pixels are wider than mip 0's texels.
+  const gpu::Pipeline* mip = &*receiver_mip_pipeline_;
+  const glm::ivec2 origin(lamp.atlas.x, lamp.atlas.y);
+  for (int k = 1; k < lamp.atlas.z; ++k) {
+    const glm::ivec2 from = shader::caustic_receiver_origin(origin, int(side), k - 1);
+    const glm::ivec2 to = shader::caustic_receiver_origin(origin, int(side), k);
+    const uint32_t level_side = side >> k;
+    const glm::ivec4 push_mip[2] = {glm::ivec4(from, to), glm::ivec4(int(level_side), 0, 0, 0)};
+    graph.add_shader_pass(
+        "specular caustic receiver mip " + id + "." + std::to_string(k), gpu::PassKind::Compute, *receiver_mip_pipeline_,
+        [this](gpu::ShaderPassBuilder& b) { b.bind_over("caustic_receivers", receivers_); },
+        [mip, push_mip, level_side](VkCommandBuffer cmd, gpu::PassContext&) {
+          gpu::push_and_dispatch(cmd, *mip, push_mip, sizeof push_mip, {(level_side + 7) / 8, (level_side + 7) / 8, 1});
+        });
+  }
 }
 
 void Caustics::splat(gpu::FrameGraph& graph) {

@@ -8,7 +8,10 @@
 //                                    the impostors (photons.comp)
 //   specular photon footprints <l>   each landed photon's spacing from its neighbours
 //                                    (photon_footprint.comp: the splat's square size)
-// and, after the technique (splat()):
+//   specular caustic receivers <l>   at levels with receiver maps: the photons as points into
+//                                    the lamp's octahedral receiver map (caustic_receiver.vert/
+//                                    .frag), which the technique's direct shading reads
+// and, after the technique, unless its shading added the receiver maps (splat()):
 //   specular caustic splat <l>       the photons as points into the camera's caustic buffer
 //                                    (irradiance) and, times albedo / pi, into the diffuse
 //                                    pixels' L_rv (caustic_splat.vert/.frag)
@@ -25,6 +28,7 @@
 #include "gpu/pipelines.h"
 #include "mrgi/expected.h"
 #include "mrgi/scene.h"
+#include "specular/caustic_receiver.glsl"
 #include "technique/technique.h"
 
 namespace mrgi::specular {
@@ -34,7 +38,7 @@ class Caustics {
   // Lamps with caustic maps in one frame (the strongest spot lamps whose cone holds an object).
   static constexpr int kMaxLamps = 2;
   static Expected<Caustics> create(const technique::SharedResources& shared, uint32_t max_map_size,
-                                   const gpu::Pipeline& back_faces);
+                                   uint32_t max_receiver_map, const gpu::Pipeline& back_faces);
   // What the photon pass reads of the specular stage: its constants (impostor sets, search
   // steps) and the impostor atlas.
   struct Impostors {
@@ -49,6 +53,7 @@ class Caustics {
     bool busy = false;    // this frame already redraws impostors: a due trace waits a frame
     uint64_t revision = 0;  // the scene's (SceneGpu::revision): a change traces at once
     int glass_reflection_stride = 1;  // the level's (photons.comp): a change traces at once
+    uint32_t receiver_map = 0;  // the level's receiver map side (0: none): a change traces at once
   };
   // Records the photon passes for the lamps of `lamps` (the light stage's lights) that are spot
   // lamps whose cone meets the sphere (centre, radius) around `objects` (specular objects in
@@ -63,7 +68,7 @@ class Caustics {
   // The caustic buffer (RGBA16F, internal resolution): rgb irradiance (W/m^2) on the surface
   // each pixel shows, a the number of photons.
   gpu::ImageHandle buffer() const { return caustics_; }
-  // This frame's photons per lamp (after record()).
+  // This frame's photons per lamp and receiver maps (after trace()).
   const technique::CausticPhotons& photons() const { return recorded_; }
 
  private:
@@ -72,10 +77,16 @@ class Caustics {
   uint32_t max_map_ = 0;
   const gpu::Pipeline* back_faces_ = nullptr;
   gpu::ImageHandle position_, normal_, back_position_, back_normal_, depth_, caustics_;
+  uint32_t max_receiver_ = 0;
+  gpu::ImageHandle receivers_;        // the receiver maps' atlas (history: drawn when traced)
+  gpu::BufferHandle receiver_lamps_;  // CausticReceivers, written every frame
   // Per lamp slot, history buffers: a frame that does not trace splats the last traced ones.
   gpu::BufferHandle photons_[kMaxLamps], photon_list_[kMaxLamps], photon_draw_[kMaxLamps];
   technique::CausticPhotons recorded_;  // this frame's lamps
   std::vector<glm::vec4> splat_push_;   // caustic_splat.vert's push block per lamp
+  // The photons of lamp slot li into its part of the receiver atlas (trace frames).
+  void add_receiver_splat(gpu::FrameGraph& graph, size_t li, const shader::CausticReceiverLamp& lamp,
+                          float largest_point);
   // What the photons in the buffers were traced for: the chosen lamps' parameters, the objects,
   // the map size and the scene revision, and when.
   std::vector<double> traced_key_;
@@ -83,7 +94,8 @@ class Caustics {
   // Scratch kept between frames (no allocation a frame once they have grown).
   std::vector<double> key_;
   std::vector<const LightDesc*> chosen_;
-  gpu::PipelineHandle surface_pipeline_, photon_pipeline_, footprint_pipeline_, splat_pipeline_;
+  gpu::PipelineHandle surface_pipeline_, photon_pipeline_, footprint_pipeline_, splat_pipeline_, receiver_pipeline_,
+      receiver_mip_pipeline_;
 };
 
 }  // namespace mrgi::specular

@@ -22,6 +22,7 @@ struct MeshRaster {
   std::vector<gpu::ImageHandle> colour;     // cleared to 0
   gpu::ImageHandle depth;                   // cleared to 1
   VkExtent2D extent{0, 0};                  // {0, 0}: the first colour target's used extent
+  std::optional<VkRect2D> area;             // set: drawn and cleared there only (the rest keeps old contents)
   gi::RsmPush push;  // misc.y is set per range
   std::vector<size_t> draws;                // indices into scene.virtual_objects.draws
   // Set: each range at the coarsest level of detail within lod.max_error_px of this view

@@ -81,9 +81,9 @@ struct ImpostorSet {
 
 const std::array<SpecularLevel, 3>& specular_levels() {
   static const std::array<SpecularLevel, 3> levels = {{
-      {"paper", 512, 4, 24, 4, 16, 0.0f, 1, 512, 1, 1, true},
-      {"high", 256, 2, 16, 3, 12, 0.0f, 1, 256, 1, 1, true},
-      {"fast", 96, 2, 10, 2, 8, 0.1f, 8, 128, 16, 2, false},
+      {"paper", 512, 4, 24, 4, 16, 0.0f, 1, 512, 1, 1, true, 0},
+      {"high", 256, 2, 16, 3, 12, 0.0f, 1, 256, 1, 1, true, 0},
+      {"fast", 96, 2, 10, 2, 8, 0.1f, 8, 128, 16, 2, false, 512},
   }};
   return levels;
 }
@@ -108,8 +108,8 @@ struct SpecularStage::Impl {
   SpecularSettings settings;
   gpu::ImageHandle impostor_position, impostor_normal, impostor_albedo, impostor_depth;
   gpu::ImageHandle back_position, back_normal, back_depth;
-  gpu::ImageHandle no_shadow, no_caustics;
-  gpu::BufferHandle constants, own_lights;
+  gpu::ImageHandle no_shadow, no_caustics, no_receivers;
+  gpu::BufferHandle constants, own_lights, no_receiver_lamps;
   // Per set: the real grid's triangles of each cube face (impostor_cells.comp) and the six
   // indexed indirect draws; capacity: indices a face can hold (every triangle of the finest grid).
   std::vector<gpu::BufferHandle> face_indices, face_draws;
@@ -155,7 +155,7 @@ struct SpecularStage::Impl {
   void set_grid(gpu::FrameGraph& graph, uint32_t face);
   void add_impostors(gpu::FrameGraph& graph, const ImpostorSet& set, int index, const glm::ivec2& origin,
                      uint32_t face, bool first);
-  void add_back_faces(gpu::FrameGraph& graph, const std::vector<ObjectInView>& objects);
+  void add_back_faces(gpu::FrameGraph& graph, const std::vector<ObjectInView>& objects, const glm::ivec4& region);
 };
 
 Status SpecularStage::Impl::init() {
@@ -216,6 +216,14 @@ Status SpecularStage::Impl::init() {
   auto nci = graph.create_zero_image("specular no caustics", VK_FORMAT_R16G16B16A16_SFLOAT, VK_IMAGE_USAGE_STORAGE_BIT);
   if (!nci) return nci.error();
   no_caustics = *nci;
+  // The same for the receiver maps (flags.w 2 only), at levels without them.
+  auto nri = graph.create_zero_image("specular no caustic receivers", VK_FORMAT_R32G32B32A32_SFLOAT, VK_IMAGE_USAGE_STORAGE_BIT);
+  if (!nri) return nri.error();
+  no_receivers = *nri;
+  auto nrl = graph.create_buffer({"specular no caustic receiver lamps", sizeof(shader::CausticReceivers)},
+                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  if (!nrl) return nrl.error();
+  no_receiver_lamps = *nrl;
 
   // The finest grid any level draws: a point per texel of the largest face (set_grid).
   const VkExtent2D g = graph.allocated_extent(shared.real_position);
@@ -316,7 +324,7 @@ Status SpecularStage::Impl::init() {
   back_pipeline = gpu::PipelineHandle(ctx, std::move(*bpp));
   MRGI_TRY(gpu::require_bindings(*back_pipeline, pd.name, {"Materials"}));
   if (settings.caustics) {
-    auto c = Caustics::create(shared, settings.max_caustic_map, *back_pipeline);
+    auto c = Caustics::create(shared, settings.max_caustic_map, settings.max_caustic_receiver_map, *back_pipeline);
     if (!c) return c.error();
     caustics.emplace(std::move(*c));
   }
@@ -454,7 +462,8 @@ void SpecularStage::Impl::add_impostors(gpu::FrameGraph& graph, const ImpostorSe
       });
 }
 
-void SpecularStage::Impl::add_back_faces(gpu::FrameGraph& graph, const std::vector<ObjectInView>& objects) {
+void SpecularStage::Impl::add_back_faces(gpu::FrameGraph& graph, const std::vector<ObjectInView>& objects,
+                                          const glm::ivec4& region) {
   std::vector<size_t> refractive;
   for (const ObjectInView& o : objects)
     if (o.refractive) refractive.push_back(o.object);
@@ -465,6 +474,10 @@ void SpecularStage::Impl::add_back_faces(gpu::FrameGraph& graph, const std::vect
   r.depth = back_depth;
   r.push.view_proj = world_to_clip;
   r.draws = specular_draws(*shared.scene_gpu, refractive, 1 << shader::SPECULAR_REFRACTIVE);
+  // Drawn (and cleared) over the objects' projected boxes only, which hold every back face; the
+  // trace reads nothing outside them (SpecularConstants::back_rect). The whole internal frame's
+  // clears were most of this pass on lavapipe.
+  if (region.z > 0 && region.w > 0) r.area = VkRect2D{{region.x, region.y}, {uint32_t(region.z), uint32_t(region.w)}};
   // Half an internal pixel: the finest the virtual G-buffer's front faces are drawn at.
   r.lod = technique::LodView{camera_world, internal_focal_px, 0.5f};
   add_mesh_raster(graph, *shared.scene_gpu, r);
@@ -530,6 +543,15 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
     skipped.push_back("specular: no reflective or refractive object in view");
     return ok_status();
   }
+  // The objects' projected boxes (all of the image when a corner is behind the camera): the
+  // trace's dispatch, and the part of the back faces' buffers drawn and read.
+  const glm::ivec2 size(fc.internal_output_size.x, fc.internal_output_size.y);
+  glm::ivec2 r0(0), r1 = size;
+  if (!behind) {
+    r0 = glm::clamp(glm::ivec2(glm::floor(lo_px)) - 1, glm::ivec2(0), size);
+    r1 = glm::clamp(glm::ivec2(glm::ceil(hi_px)) + 2, glm::ivec2(0), size);
+  }
+  m.region = glm::ivec4(r0, glm::max(r1 - r0, glm::ivec2(0)));
   std::sort(in_view.begin(), in_view.end(), [](const ObjectInView& a, const ObjectInView& b) { return a.distance < b.distance; });
   const SpecularLevel& level = specular_level_for(technique_level, technique_levels);
   const uint32_t face = std::min(level.impostor_face, m.settings.max_impostor_face);
@@ -581,6 +603,10 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
   }
   c->flags = glm::ivec4(0, m.settings.depth_test ? 1 : 0, env_width, 0);  // x: finish()
   c->level = glm::vec4(float(std::max(level.glass_reflection_stride, 1)), level.glass_reflection_fresnel, 0.0f, 0.0f);
+  // Where add_back_faces draws (its render area; all of the frame for an empty box).
+  c->back_rect = m.region.z > 0 && m.region.w > 0
+                     ? glm::ivec4(m.region.x, m.region.y, m.region.x + m.region.z, m.region.y + m.region.w)
+                     : glm::ivec4(0, 0, size.x, size.y);
 
   m.world_to_clip = fc.world_to_clip;
   m.camera_world = glm::vec3(fc.camera_world);
@@ -624,7 +650,7 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
   m.glass_in_view = refractive;
   m.glass_reflection_fresnel = level.glass_reflection_fresnel;
   m.mirrors_in_view = reflective;
-  if (refractive) m.add_back_faces(graph, in_view);
+  if (refractive) m.add_back_faces(graph, in_view, m.region);
   else skipped.push_back("specular back faces: no refractive object in view");
 
   bool caustics = false;
@@ -640,24 +666,21 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
     caustics = m.caustics->trace(graph, {m.constants, m.impostor_position, m.impostor_normal, m.impostor_albedo},
                                   lighting.lights, objects, 0.5f * (lo + hi), 0.5f * glm::length(hi - lo),
                                   level.caustic_map,
-                                  {level.caustic_refresh_period, any_redrawn, sg.revision(), level.glass_reflection_stride},
+                                  {level.caustic_refresh_period, any_redrawn, sg.revision(), level.glass_reflection_stride,
+                                   level.caustic_receiver_map},
                                   skipped);
   } else {
     skipped.push_back(m.caustics ? "specular caustics: off at this level" : "specular caustics: off (ablation)");
   }
   c->flags.w = caustics ? 1 : 0;
   m.caustics_recorded = caustics;
-  if (caustics && level.caustic_vpls) m.photons = m.caustics->photons();
-  else if (caustics) skipped.push_back("specular caustic VPLs: off at this level (the technique gets no photons)");
-  // The trace's dispatch covers the objects' projected boxes (all of the image when a corner is
-  // behind the camera).
-  const glm::ivec2 size(fc.internal_output_size.x, fc.internal_output_size.y);
-  glm::ivec2 r0(0), r1 = size;
-  if (!behind) {
-    r0 = glm::clamp(glm::ivec2(glm::floor(lo_px)) - 1, glm::ivec2(0), size);
-    r1 = glm::clamp(glm::ivec2(glm::ceil(hi_px)) + 2, glm::ivec2(0), size);
+  if (caustics) {
+    m.photons = m.caustics->photons();  // with the receiver maps, if the level has them
+    if (!level.caustic_vpls) {
+      m.photons.lamps.clear();
+      skipped.push_back("specular caustic VPLs: off at this level (the technique gets no photons)");
+    }
   }
-  m.region = glm::ivec4(r0, glm::max(r1 - r0, glm::ivec2(0)));
   m.active = true;
   return ok_status();
 }
@@ -689,8 +712,13 @@ Status SpecularStage::finish(const technique::Technique& technique, std::vector<
   const VkSampler nearest = m.shared.context->samplers().nearest_clamp;
   const glm::ivec4 region = m.region;
   Impl* self = &m;
-  // The caustics on the diffuse pixels (into lit_rv) and in the caustic buffer the trace reads.
-  if (caustics) m.caustics->splat(graph);
+  // The caustics on the diffuse pixels (into lit_rv) and in the caustic buffer the trace reads,
+  // unless the technique's shading added the receiver maps (then the trace reads those).
+  const bool receivers = caustics && m.photons.receivers.valid() && direct && direct->caustics_added;
+  if (caustics && !receivers) m.caustics->splat(graph);
+  c->flags.w = !caustics ? 0 : receivers ? 2 : 1;
+  const gpu::ImageHandle receiver_maps = receivers ? m.photons.receivers : m.no_receivers;
+  const gpu::BufferHandle receiver_lamps = receivers ? m.photons.receiver_lamps : m.no_receiver_lamps;
   // The specular pixels listed by kind, then a pass per kind in view over its list.
   const gpu::BufferHandle args = m.trace_args, counts = m.trace_counts, pixels = m.trace_pixels;
   graph.add_pass("specular trace list reset", gpu::PassKind::Transfer,
@@ -757,6 +785,8 @@ Status SpecularStage::finish(const technique::Technique& technique, std::vector<
           b.bind("color_words", r.color_upload);
           b.bind("EnvGrid", self->env_grid);
           b.bind("caustics", caustic_buffer);
+          b.bind("caustic_receivers", receiver_maps);
+          b.bind("CausticReceiverLamps", receiver_lamps);
           b.bind("TraceCounts", counts);
           b.bind("TracePixels", pixels);
           b.uses().read(args, gpu::Access::IndirectRead);
@@ -773,7 +803,8 @@ Status SpecularStage::finish(const technique::Technique& technique, std::vector<
 bool SpecularStage::lights_outside_tiles() const { return impl_->caustics_recorded; }
 
 const technique::CausticPhotons* SpecularStage::caustic_photons() const {
-  return impl_->photons.lamps.empty() ? nullptr : &impl_->photons;
+  const technique::CausticPhotons& p = impl_->photons;
+  return p.lamps.empty() && !p.receivers.valid() ? nullptr : &p;
 }
 
 }  // namespace mrgi::specular

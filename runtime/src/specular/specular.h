@@ -15,9 +15,11 @@
 //   specular photon ... <l>      per spot lamp whose cone holds such an object: photon maps and
 //                                photons (caustics.h; traced every caustic_refresh_period frames
 //                                while nothing moves); the technique reads the photons (dir's
-//                                caustic VPLs, FrameInfo::caustics)
+//                                caustic VPLs, FrameInfo::caustics); at the fast level also
+//                                their receiver maps, which its direct shading reads
 // and after it (finish):
 //   specular caustic splat <l>   the photons into the caustic buffer and the diffuse pixels' L_rv
+//                                (the paper's levels; none where the shading read receiver maps)
 //   specular trace list          the specular pixels, listed by kind
 //   specular trace glass         per listed pixel: the reflected and refracted rays' hits, their
 //   specular trace mirrors       light with and without the virtual objects, back-projection into
@@ -48,8 +50,12 @@
 //   - The fast level's savings (SpecularLevel): impostors and photons are world-space and are
 //     redrawn every eighth frame or retraced every sixteenth while nothing moved (the camera's
 //     newly seen real surfaces wait that long), a quarter of the photons
-//     reflected off glass carry four times the flux, and glass reflections weaker than 10 %
-//     show L_env instead of a traced hit.
+//     reflected off glass carry four times the flux, glass reflections weaker than 10 %
+//     show L_env instead of a traced hit, and the caustics are splatted once per trace into
+//     receiver maps around the lamps (Wyman and Davis's light-space caustic maps, as an
+//     octahedral map so photons a mirror throws outside the cone are kept) that the shading reads
+//     instead of the camera's per-frame splat (SpecularLevel::caustic_receiver_map); hits outside
+//     the view get their caustics from the maps too.
 #pragma once
 #include <array>
 #include <memory>
@@ -98,6 +104,18 @@ struct SpecularLevel {
   // Whether dir's VPLs drawn on mirrors and glass move to where their photons landed (caustic
   // VPLs, paper Sec. 4.2.2; false: such a VPL stays on the object, lighting as a diffuse one).
   bool caustic_vpls;
+  // Texels per side of each lamp's caustic receiver map (0: the paper's splat into the camera's
+  // caustic buffer every frame). With a map, the photons are splatted once per trace into the
+  // octahedral map of directions around the lamp (caustic_receiver.glsl), and the technique's
+  // direct shading reads it at every pixel it lights (Technique::DirectLight::caustics_added:
+  // baseline's shade_direct, under dir, dlpv and dvct too; a technique without it would get the
+  // camera's splat, but ssrt, the one that lights otherwise, is lit by its own estimate, not by
+  // the spot lamps that make caustics). Why: the splat's per-photon setup is
+  // lavapipe's single-threaded part, 2.1 ms a frame on glass_mirror's fast dir frame, and the
+  // photons are world-space; 512^2 texels are about an internal pixel where that scene's spot
+  // lamp points (2 / 512 rad at its 0.85 m: 3.3 mm, the camera's 3.8 mm), 3.3 mm to 7.5 mm
+  // elsewhere (the map's texels span 1 to 5.2 times the pole's solid angle).
+  uint32_t caustic_receiver_map;
 };
 // paper (512^2 impostors, a set per object up to four, 512^2 caustic maps), high (256^2, two
 // sets, 256^2 caustic maps), fast (96^2 impostors, two sets, each redrawn every eighth frame
@@ -121,6 +139,7 @@ struct SpecularSettings {
   float depth_tolerance = 0.04f;
   bool caustics = true;                 // false: no caustic maps (the ablation no-caustics)
   uint32_t max_caustic_map = 512;       // allocated texels per side of the photon maps
+  uint32_t max_caustic_receiver_map = 512;  // allocated texels per side of the receiver maps
 };
 
 // The defaults with RuntimeSettings::specular_ablation's flags applied (its `off` is the

@@ -145,6 +145,12 @@ struct CausticPhotons {
     gpu::BufferHandle photons;   // caustics.h Photon[2 * size * size]
   };
   std::vector<Lamp> lamps;
+  // At levels with caustic receiver maps (specular.h SpecularLevel::caustic_receiver_map): the
+  // maps' atlas (rgba32f, specular/caustic_receiver.glsl) and its lamps (CausticReceivers, a
+  // storage buffer), for a technique whose direct shading adds the caustics to the diffuse
+  // pixels' L_rv itself (then DirectLight::caustics_added). Null handles: no maps this frame.
+  gpu::ImageHandle receivers;
+  gpu::BufferHandle receiver_lamps;
 };
 
 // What record() needs to know about the current frame.
@@ -209,6 +215,9 @@ class Technique {
     gpu::BufferHandle light_set;
     gpu::ImageHandle shadow_primary, shadow_virtual;
     glm::vec4 shadow{0.0f};
+    // This frame's shading added FrameInfo::caustics' receiver maps to the diffuse pixels' L_rv
+    // (the stage then splats no caustics into the camera's buffer).
+    bool caustics_added = false;
   };
   virtual std::optional<DirectLight> direct_light() const { return std::nullopt; }
 };

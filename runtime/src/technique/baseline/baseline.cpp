@@ -78,7 +78,7 @@ class Baseline final : public Technique {
   void set_volume_bounce(const VolumeBounce* bounce) { bounce_ = bounce ? std::optional<VolumeBounce>(*bounce) : std::nullopt; }
   void set_dir_indirect(const DirIndirect* indirect) { dir_ = indirect ? std::optional<DirIndirect>(*indirect) : std::nullopt; }
   std::optional<DirectLight> direct_light() const override {
-    return DirectLight{lights_, shadow_primary_, shadow_virtual_, shadow_constants()};
+    return DirectLight{lights_, shadow_primary_, shadow_virtual_, shadow_constants(), caustics_};
   }
 
  private:
@@ -114,11 +114,18 @@ class Baseline final : public Technique {
   static constexpr uint32_t kShadeModes[] = {0, 1, 3, 4, 6, 8};
   gpu::PipelineHandle shade_pipelines_[9];  // shade_direct.comp by kVolumeBounce (kShadeModes)
   const gpu::Pipeline& shade_pipeline() const {
-    if (dir_) return *shade_pipelines_[8];
-    if (!bounce_) return *shade_pipelines_[0];
+    const gpu::PipelineHandle* set = caustics_ ? shade_caustic_pipelines_ : shade_pipelines_;
+    if (dir_) return *set[8];
+    if (!bounce_) return *set[0];
     const bool two = bounce_->constants.mode.x == 1, rho = bounce_->constants.extent.w > 0.5f;
-    return *shade_pipelines_[(two ? 4u : 1u) | (rho ? 2u : 0u)];
+    return *set[(two ? 4u : 1u) | (rho ? 2u : 0u)];
   }
+  gpu::PipelineHandle shade_caustic_pipelines_[9];  // the same with kCausticReceivers (specular scenes)
+  // This frame's caustic receiver maps (FrameInfo::caustics), read by shade_direct; stand-ins
+  // bound where there are none.
+  bool caustics_ = false;
+  gpu::ImageHandle receivers_, no_receivers_;
+  gpu::BufferHandle receiver_lamps_, no_receiver_lamps_;
   gpu::ImageHandle no_volume_;                 // bound for the volumes when there is no bounce
   std::optional<VolumeBounce> bounce_;         // this frame's (set_volume_bounce)
   gpu::ImageHandle no_indirect_;               // bound for dir_indirect when there is none
@@ -242,13 +249,25 @@ Status Baseline::init() {
   // Layouts from the shader; one pipeline per kVolumeBounce in use: 0 direct only, 1 V^Delta on
   // real pixels, 3 and V^rho on virtual ones, 4 and 6 the two-volume ablation without and with,
   // 8 dir's VPL light.
+  // With a reflective or refractive material in the scene, each also with kCausticReceivers (the
+  // specular stage's fast level adds its caustics here).
+  const bool specular = shared_.scene_gpu->specular;
   for (const uint32_t mode : kShadeModes) {
-    auto sp = gpu::create_compute_pipeline(
-        ctx, {"baseline_shade_direct_" + std::to_string(mode), *shade_spv, {}, sizeof(ShadePush),
-              {mode, shared_.dir_ablation.one_shadow_map ? 1u : 0u}});
-    if (!sp) return sp.error();
-    shade_pipelines_[mode] = gpu::PipelineHandle(ctx, std::move(*sp));
+    for (uint32_t caustics = 0; caustics < (specular ? 2u : 1u); ++caustics) {
+      auto sp = gpu::create_compute_pipeline(
+          ctx, {"baseline_shade_direct_" + std::to_string(mode) + (caustics ? "_caustics" : ""), *shade_spv, {},
+                sizeof(ShadePush), {mode, shared_.dir_ablation.one_shadow_map ? 1u : 0u, caustics}});
+      if (!sp) return sp.error();
+      (caustics ? shade_caustic_pipelines_ : shade_pipelines_)[mode] = gpu::PipelineHandle(ctx, std::move(*sp));
+    }
   }
+  auto no_receivers = graph.create_zero_image("baseline_no_caustic_receivers", VK_FORMAT_R32G32B32A32_SFLOAT,
+                                              VK_IMAGE_USAGE_STORAGE_BIT);
+  if (!no_receivers) return no_receivers.error();
+  no_receivers_ = *no_receivers;
+  auto no_receiver_lamps = graph.create_buffer({"baseline_no_caustic_receiver_lamps", 256}, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  if (!no_receiver_lamps) return no_receiver_lamps.error();
+  no_receiver_lamps_ = *no_receiver_lamps;
   auto no_volume = graph.create_zero_image("baseline_no_volume", VK_FORMAT_R16G16B16A16_SFLOAT, VK_IMAGE_USAGE_SAMPLED_BIT, 2, 2, 2);
   if (!no_volume) return no_volume.error();
   no_volume_ = *no_volume;
@@ -270,6 +289,9 @@ Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped
   const SceneGpu& sg = *shared_.scene_gpu;
   const SharedResources& s = shared_;
   MRGI_TRY(update_lights(dir_ && dir_->shadowed_estimated >= 0 ? dir_->shadowed_estimated : level.shadowed_estimated_lights));
+  caustics_ = info.caustics && info.caustics->receivers.valid() && shade_caustic_pipelines_[0]->pipeline != VK_NULL_HANDLE;
+  receivers_ = caustics_ ? info.caustics->receivers : no_receivers_;
+  receiver_lamps_ = caustics_ ? info.caustics->receiver_lamps : no_receiver_lamps_;
 
   if (plan_.primary.empty()) {
     skipped.push_back("shadow_primary: no lamp in the scene");
@@ -337,6 +359,8 @@ Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped
         b.bind_sampled("shadow_virtual", shadow_virtual_, compare);
         b.bind_sampled("shadow_primary_depth", shadow_primary_, nearest);  // kOneShadowMap only
         b.bind_sampled("shadow_virtual_depth", shadow_virtual_, nearest);
+        b.bind("caustic_receivers", receivers_);
+        b.bind("CausticReceiverLamps", receiver_lamps_);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) { shade(cmd, pass); });
   return ok_status();
