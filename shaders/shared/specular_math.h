@@ -128,16 +128,20 @@ MRGI_FN vec3 specular_face_down(int face) {
   if (face == 3) return vec3(0.0f, 0.0f, -1.0f);
   return vec3(0.0f, -1.0f, 0.0f);
 }
+// The face's axes above written out per major axis (selects, no per-face lookups: the impostor
+// search runs this at every step of every ray, and lavapipe evaluates every branch of a lookup
+// chain); SpecularMath.CubeFaceClosedFormMatchesTheFaceAxes holds it to them.
 MRGI_FN vec3 specular_cube_face(vec3 d) {
   vec3 a = abs(d);
-  int face;
-  if (a.x >= a.y && a.x >= a.z) face = d.x >= 0.0f ? 0 : 1;
-  else if (a.y >= a.z) face = d.y >= 0.0f ? 2 : 3;
-  else face = d.z >= 0.0f ? 4 : 5;
-  vec3 f = specular_face_forward(face);
-  float z = max(dot(d, f), 1e-20f);
-  vec2 uv = vec2(dot(d, specular_face_right(face)), dot(d, specular_face_down(face))) / z;
-  return vec3(clamp(uv * 0.5f + vec2(0.5f), vec2(0.0f), vec2(1.0f)), float(face));
+  bool x_major = a.x >= a.y && a.x >= a.z;
+  bool y_major = !x_major && a.y >= a.z;
+  float sx = d.x >= 0.0f ? 1.0f : -1.0f, sy = d.y >= 0.0f ? 1.0f : -1.0f, sz = d.z >= 0.0f ? 1.0f : -1.0f;
+  float z = x_major ? a.x : (y_major ? a.y : a.z);
+  float u = x_major ? sx * d.z : (y_major ? -d.x : -sz * d.x);
+  float v = y_major ? sy * d.z : -d.y;
+  float face = x_major ? (sx > 0.0f ? 0.0f : 1.0f) : (y_major ? (sy > 0.0f ? 2.0f : 3.0f) : (sz > 0.0f ? 4.0f : 5.0f));
+  vec2 uv = vec2(u, v) / max(z, 1e-20f);
+  return vec3(clamp(uv * 0.5f + vec2(0.5f), vec2(0.0f), vec2(1.0f)), face);
 }
 
 // ---- caustic receiver maps ----------------------------------------------------------------------
