@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "bsdf.h"
 #include "shared/specular_math.h"
+#include "specular/caustic_receiver.glsl"
 
 namespace {
 using namespace mrgi::shader;
@@ -143,6 +145,29 @@ TEST(SpecularMath, OctahedralTexelsCoverTheSphereOnce) {
   const vec3 a = oct_decode(e0), b = oct_decode(e0 + vec2(h, 0.0f)), c = oct_decode(e0 + vec2(0.0f, h));
   const float patch = length(glm::cross(b - a, c - a));  // small: the chord parallelogram's area
   EXPECT_NEAR(4.0f * oct_texel_solid_angle(oct_decode(e0 + vec2(0.5f * h)), float(size)), patch, patch * 0.02f);
+}
+
+TEST(SpecularMath, AReceiverMapsHalvingsTileItsAtlasBlockWithoutOverlap) {
+  // Each lamp's block is 1.5 size x size texels: mip 0, then the halvings in a column beside it;
+  // no two levels share a texel and every one lies inside the block.
+  for (const int size : {16, 64, 512}) {
+    const glm::ivec2 origin(3 * size / 2, 0);  // the second lamp's block
+    std::vector<int> owner(size_t(3 * size / 2) * size_t(size), -1);
+    for (int k = 0; k < MRGI_CAUSTIC_RECEIVER_LEVELS && (size >> k) >= 4; ++k) {
+      const glm::ivec2 o = caustic_receiver_origin(origin, size, k) - origin;
+      const int side = size >> k;
+      ASSERT_GE(o.x, 0);
+      ASSERT_GE(o.y, 0);
+      ASSERT_LE(o.x + side, 3 * size / 2) << "size " << size << " level " << k;
+      ASSERT_LE(o.y + side, size) << "size " << size << " level " << k;
+      for (int y = 0; y < side; ++y)
+        for (int x = 0; x < side; ++x) {
+          int& w = owner[size_t(o.y + y) * size_t(3 * size / 2) + size_t(o.x + x)];
+          EXPECT_EQ(w, -1) << "size " << size << " level " << k << " overlaps level " << w;
+          w = k;
+        }
+    }
+  }
 }
 
 TEST(SpecularMath, AReceiverSquareKeepsThePhotonsFlux) {
