@@ -261,9 +261,12 @@ bool Caustics::trace(gpu::FrameGraph& graph, const Impostors& imp, const std::ve
                       " frame(s) ago for the same lamps and objects (refresh period " + std::to_string(refresh.period) +
                       ")");
   }
-  const std::vector<size_t> front =
-      specular_draws(sg, objects, (1 << shader::SPECULAR_REFLECTIVE) | (1 << shader::SPECULAR_REFRACTIVE));
-  const std::vector<size_t> back = specular_draws(sg, objects, 1 << shader::SPECULAR_REFRACTIVE);
+  // The ranges the photon maps draw: only on a frame that traces (no allocation on the others).
+  std::vector<size_t> front, back;
+  if (trace) {
+    front = specular_draws(sg, objects, (1 << shader::SPECULAR_REFLECTIVE) | (1 << shader::SPECULAR_REFRACTIVE));
+    back = specular_draws(sg, objects, 1 << shader::SPECULAR_REFRACTIVE);
+  }
   // Squares between 1.5 pixels and a fortieth of the image's width (caustic_splat.vert sizes each
   // by its photon's spacing; larger ones cost more in overdraw than the smoothness they add).
   const VkExtent2D internal = graph.extent(shared_.lit_rv);
