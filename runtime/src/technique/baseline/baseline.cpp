@@ -11,6 +11,7 @@
 #include "gpu/shaders.h"
 #include "gpu/vk_check.h"
 #include "light/light_stage.h"
+#include "specular/caustic_receiver.glsl"
 #include "technique/baseline/shadow_plan.h"
 #include "technique/image_views.h"
 #include "technique/scene_gpu.h"
@@ -265,7 +266,8 @@ Status Baseline::init() {
                                               VK_IMAGE_USAGE_STORAGE_BIT);
   if (!no_receivers) return no_receivers.error();
   no_receivers_ = *no_receivers;
-  auto no_receiver_lamps = graph.create_buffer({"baseline_no_caustic_receiver_lamps", 256}, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  auto no_receiver_lamps = graph.create_buffer({"baseline_no_caustic_receiver_lamps", sizeof(shader::CausticReceivers)},
+                                               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (!no_receiver_lamps) return no_receiver_lamps.error();
   no_receiver_lamps_ = *no_receiver_lamps;
   auto no_volume = graph.create_zero_image("baseline_no_volume", VK_FORMAT_R16G16B16A16_SFLOAT, VK_IMAGE_USAGE_SAMPLED_BIT, 2, 2, 2);
