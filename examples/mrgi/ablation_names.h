@@ -1,10 +1,10 @@
-// The ablation switches of mrgi/runtime.h by their command-line names, each written once: the
+// The ablation switches of mrgi/research.h by their command-line names, each written once: the
 // options' allowed values and the parsing of replay's and bench's flags both read these tables.
 #pragma once
 #include <string>
 #include <vector>
 
-#include "mrgi/runtime.h"
+#include "mrgi/research.h"
 
 namespace mrgi::tool {
 

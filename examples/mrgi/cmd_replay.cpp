@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <memory>
 
 #include "ablation_names.h"
 #include "commands.h"
@@ -44,13 +45,15 @@ void run_replay(const ReplayOptions& o) {
   settings.output_width = o.width;
   settings.output_height = o.height;
   settings.exposure = info.exposure;
-  set_ablations(o.dlpv_ablation, kDlpvAblations, settings.dlpv_ablation);
-  if (settings.dlpv_ablation.any() && o.quality.technique != "dlpv")
+  ResearchSettings research;
+  set_ablations(o.dlpv_ablation, kDlpvAblations, research.dlpv);
+  if (research.dlpv.any() && o.quality.technique != "dlpv")
     throw CommandFailure(2, "--dlpv-ablation: only for --technique dlpv");
-  set_ablations(o.dir_ablation, kDirAblations, settings.dir_ablation);
-  if (settings.dir_ablation.any() && o.quality.technique != "dir")
+  set_ablations(o.dir_ablation, kDirAblations, research.dir);
+  if (research.dir.any() && o.quality.technique != "dir")
     throw CommandFailure(2, "--dir-ablation: only for --technique dir");
-  set_ablations(o.specular_ablation, kSpecularAblations, settings.specular_ablation);
+  set_ablations(o.specular_ablation, kSpecularAblations, research.specular);
+  if (research.any()) settings.research = std::make_shared<const ResearchSettings>(research);
   CameraSetup cameras{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera};
   SceneDesc scene = capture.scene() ? *capture.scene() : SceneDesc{};
   // The env intensity stays known for the truth of the direction error (env frames).

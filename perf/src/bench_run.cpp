@@ -120,7 +120,11 @@ Expected<RunSamples> run_one(const LoadedScene& l, const std::string& technique,
   RuntimeSettings rs;
   rs.device = s.device;
   rs.residual_light = s.residual_light;
-  rs.specular_ablation = s.specular_ablation;
+  if (s.specular_ablation.any()) {
+    auto research = std::make_shared<ResearchSettings>();
+    research->specular = s.specular_ablation;
+    rs.research = research;
+  }
   rs.knobs = s.knobs;
   rs.frames_in_flight = s.frames_in_flight;
   rs.technique = technique;

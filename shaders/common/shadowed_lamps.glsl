@@ -1,10 +1,10 @@
-// The light stage's lamps with baseline's real/virtual shadow-map pair (DIR eq. 1-5), one copy
-// for every pass that lights points with them: baseline/shade_direct.comp (the camera's pixels)
+// The light stage's lamps with the direct-light block's real/virtual shadow-map pair (DIR eq. 1-5), one copy
+// for every pass that lights points with them: shading/direct_light.comp (the camera's pixels)
 // and specular/trace.comp (the points mirrors and glass show). The including shader declares,
 // before including this: the LightUbo `light_set`, the compare samplers shadow_primary and
 // shadow_virtual, the plain ones shadow_primary_depth and shadow_virtual_depth (read by the
 // one-map ablation only); shared/mrgi_shared.h, common/light_set.glsl and
-// common/surface_shading.glsl come first. `shadow_level` is baseline's LevelConstants::shadow:
+// common/surface_shading.glsl come first. `shadow_level` is the direct-light block's LevelConstants::shadow:
 // x used map size / allocated size, y used size (texels), z allocated size, w PCF radius.
 #ifndef MRGI_SHADOWED_LAMPS_GLSL
 #define MRGI_SHADOWED_LAMPS_GLSL
@@ -62,7 +62,7 @@ float shadow_test(sampler2DArrayShadow map, int first_layer, vec4 c, vec4 shadow
 //   L_rv += L_o * min(st_r, st_v)          (every lamp, every surface; eq. 1, 3)
 //   L_r  += L_o * r(lamp) * r_p * st_r     (real lamps on real points, real casters; eq. 2)
 // is_virtual selects the BRDF (glTF metallic-roughness; real surfaces are Lambertian).
-// one_map: DirAblation::one_shadow_map (shade_direct.comp's kOneShadowMap says more).
+// one_map: DirAblation::one_shadow_map (shading/direct_light.comp's kOneShadowMap says more).
 void add_shadowed_lamps(vec3 p, vec3 n, vec3 v, vec3 albedo, float metallic, float roughness, bool is_virtual,
                         float r_p, vec4 shadow_level, bool one_map, inout vec3 l_rv, inout vec3 l_r) {
   int count = min(light_set.count.x, MRGI_MAX_LIGHTS);

@@ -1,4 +1,4 @@
-// Surface shading shared by the techniques' shading passes (baseline/shade_direct.comp,
+// Surface shading shared by the techniques' shading passes (shading/direct_light.comp,
 // dlpv/merge.comp): one copy of the BRDF and of the ambient's evaluation. Needs
 // shared/mrgi_shared.h and common/light_set.glsl included first.
 #ifndef MRGI_SURFACE_SHADING_GLSL

@@ -1,7 +1,7 @@
 // dir: the geometry-aware merge's second half (merge_rows.comp has the first), shared by
 // merge_columns.comp and temporal.comp (which merges its own texel's column instead of reading a
 // merged image: one pass and one image round trip fewer a frame). The includer declares the
-// row-merged image as `rows` (rgba32ui, readonly) and includes dir/indirect_pack.glsl first.
+// row-merged image as `rows` (rgba32ui, readonly) and includes gi/indirect_pack.glsl first.
 #ifndef MRGI_DIR_MERGE_COLUMN_GLSL
 #define MRGI_DIR_MERGE_COLUMN_GLSL
 

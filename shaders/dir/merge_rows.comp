@@ -7,7 +7,7 @@
 // VPL subsets with 2 side taps instead of side^2 (a cross-bilateral filter, split in two).
 #extension GL_GOOGLE_include_directive : require
 #include "dir/dir_params.glsl"
-#include "dir/indirect_pack.glsl"
+#include "gi/indirect_pack.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0, rgba32ui) readonly uniform uimage2D indirect;

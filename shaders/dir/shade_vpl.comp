@@ -24,7 +24,7 @@
 #include "common/frame_constants.glsl"
 #include "common/vpl.glsl"
 #include "dir/dir_params.glsl"
-#include "dir/indirect_pack.glsl"
+#include "gi/indirect_pack.glsl"
 #include "common/light_set.glsl"
 #include "common/surface_shading.glsl"
 
@@ -54,7 +54,7 @@ DirParams params;
 void main() {
   frame = frame_ubo; params = params_block;  // MRGI_UNIFORM_COPIES
   // One texel per `extent.z` x `extent.z` G-buffer pixels (the fast levels shade the indirect
-  // light at half resolution; baseline's shading pass up-samples it, geometry-aware).
+  // light at half resolution; the direct-light block's shading pass up-samples it, geometry-aware).
   ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
   if (any(greaterThanEqual(texel, params.extent.xy))) return;
   ivec2 pixel = min(texel * params.extent.z, frame.internal_output_size.xy - 1);
@@ -110,9 +110,9 @@ void main() {
                                    : albedo * (1.0f / MRGI_PI) * e;
         bool real_path = (flags & MRGI_VPL_REAL_PATH) != 0;
         if ((flags & MRGI_VPL_DIRECTIONAL) != 0) {
-          // An environment region whose light baseline's shading adds unshadowed (its SH
+          // An environment region whose light the direct-light block adds unshadowed (its SH
           // ambient): only what the VPL's maps take away. Real pixels: the paper's difference
-          // L_rv - L_r of this VPL, L_o (min(st_r, st_v) - st_r), into L_rv (L_r keeps baseline's
+          // L_rv - L_r of this VPL, L_o (min(st_r, st_v) - st_r), into L_rv (L_r keeps the direct-light block's
           // smooth level, the denominator of the composite; the sparse real ISM's self-shadowing
           // of real surfaces would make it noisy and cancels in the difference anyway); virtual
           // pixels: L_o (min(st_r, st_v) - 1), so L_rv holds the region's light times its
@@ -127,7 +127,7 @@ void main() {
     }
   }
   float camera_distance = surface ? max(distance(pos.xyz, frame.camera_world.xyz), 1e-3f) : 0.0f;
-  // L_rv may be negative (an environment region's occlusion, taken from baseline's ambient).
+  // L_rv may be negative (an environment region's occlusion, taken from the direct-light block's ambient).
   uvec4 packed_value = pack_indirect(clamp(l_rv, vec3(-60000.0f), vec3(60000.0f)), clamp(l_r, vec3(0.0f), vec3(60000.0f)), n,
                                      camera_distance, is_virtual);
   if (!surface) packed_value.w = 0u;

@@ -13,7 +13,7 @@
 // The G-buffers are read as storage images: on lavapipe a sampled texelFetch costs 2-3x as much.
 #include "shared/mrgi_shared.h"
 #include "shared/lpv_math.h"
-#include "dlpv/volume_lookup.glsl"
+#include "gi/volume_lookup.glsl"
 #include "common/frame_constants.glsl"
 #include "common/light_set.glsl"
 #include "common/surface_shading.glsl"

@@ -1,5 +1,5 @@
 // dvct's per-pixel cone sets (delta-voxel-cone-tracing.md Sec. 3.1, 3.3), shared by indirect.comp
-// (the levels that light directly with baseline's shadow maps) and shade.comp (the paper's
+// (the levels that light directly with the direct-light block's shadow maps) and shade.comp (the paper's
 // level, shadow cones too). Needs, declared before it: shared/mrgi_shared.h, shared/vct_math.h,
 // gi/vct_trace.glsl, common/light_set.glsl, common/surface_shading.glsl, the samplers
 // light_volume, delta_volume, scene_visibility, object_visibility, `DvctParams params`,

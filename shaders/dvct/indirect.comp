@@ -1,9 +1,9 @@
 #version 460
-// dvct (technique/dvct/dvct.h) at the levels that light directly with baseline's shadow maps:
+// dvct (technique/dvct/dvct.h) at the levels that light directly with the direct-light block's shadow maps:
 // the cone-traced light at one G-buffer pixel in `mode.x` x `mode.x` (the block's first, as
-// dir's VPL shading picks it), packed as dir's indirect (dir/indirect_pack.glsl), which
-// baseline's shading pass up-samples by surface and adds to both solutions
-// (shade_direct.comp kDirIndirect). What it adds on top of baseline's direct light and ambient:
+// dir's VPL shading picks it), packed as dir's indirect (gi/indirect_pack.glsl), which
+// the direct-light block's shading pass up-samples by surface and adds to both solutions
+// (shading/direct_light.comp, its screen input). What it adds on top of the direct-light block's direct light and ambient:
 //   real pixel near the region:
 //     L_rv += albedo / pi E_with    + S_with
 //     L_r  += albedo / pi E_without + S_without
@@ -11,16 +11,16 @@
 //     L_rv += base (1 - metallic) / pi E_with + S_with
 //   (E: the diffuse cones' irradiance, with the objects from the light volume through both
 //   visibility volumes, without them from light - delta through the scene's; S: the specular
-//   cone, real surfaces with a glossy hint only; baseline's pass adds the ambient unshadowed).
+//   cone, real surfaces with a glossy hint only; the direct-light block adds the ambient unshadowed).
 // Real pixels farther than a quarter of the region's side from it keep both solutions as
-// baseline makes them: the paper's region is where the objects' influence is (Sec. 3.4).
+// the direct-light block makes them: the paper's region is where the objects' influence is (Sec. 3.4).
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
 #include "shared/vct_math.h"
 #include "common/frame_constants.glsl"
 #include "common/light_set.glsl"
 #include "common/surface_shading.glsl"
-#include "dir/indirect_pack.glsl"
+#include "gi/indirect_pack.glsl"
 #include "dvct/dvct_params.glsl"
 #include "gi/vct_trace.glsl"
 

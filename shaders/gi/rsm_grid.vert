@@ -1,7 +1,7 @@
 #version 460
 // Reflective shadow map of the real scene as the depth camera sees it (gi/rsm.h): one vertex per
 // point of a grid over the real G-buffer, drawn with the caster index list
-// (baseline/shadow_caster_indices.comp drops triangles with a missing or discontinuous vertex).
+// (shading/shadow_caster_indices.comp drops triangles with a missing or discontinuous vertex).
 // Hands on what gi/rsm.frag writes: world position, normal, the reconstructed albedo.
 layout(set = 0, binding = 0) uniform sampler2D real_position;  // xyz world, w depth (0 invalid)
 layout(set = 0, binding = 1) uniform sampler2D real_normal;    // xyz world

@@ -1,6 +1,6 @@
 #version 460
 // Voxelisation of a triangle mesh (gi/voxelize.h, Voxelizer::add_mesh): one invocation a
-// triangle of one draw range, world-space vertices in the scene's layout (technique/scene_gpu.h
+// triangle of one draw range, world-space vertices in the scene's layout (frame/scene_gpu.h
 // GpuVertex: position, normal, uv; 8 floats).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_shader_atomic_float : require

@@ -1,7 +1,7 @@
 // The caustic receiver maps of the fast level (specular/caustics.h): per spot lamp with caustics,
 // the irradiance its photons left on the surfaces they landed on, splatted once per photon trace
 // into an octahedral map of the directions around the lamp (caustic_receiver.vert/.frag), and
-// read by whatever lights a surface point (baseline/shade_direct.comp for the camera's pixels,
+// read by whatever lights a surface point (shading/direct_light.comp for the camera's pixels,
 // specular/trace.comp for what mirrors and glass show) with caustic_receiver_lookup.glsl.
 // Shared by C++ and GLSL: the lamps' block, vec4 members only.
 #ifndef MRGI_SPECULAR_CAUSTIC_RECEIVER_GLSL

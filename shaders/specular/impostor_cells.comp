@@ -1,6 +1,6 @@
 #version 460
 // The real grid's triangles each impostor face of a set draws (specular/specular.h): the grid of
-// baseline/shadow_caster_indices.comp (a point every `stride` G-buffer pixels, two triangles a
+// shading/shadow_caster_indices.comp (a point every `stride` G-buffer pixels, two triangles a
 // cell, none across a depth edge), each triangle appended to the index list of every cube face
 // one of its vertices falls in, seen from the set's centre. Drawing the whole grid into each of
 // the six faces made lavapipe set up six times the triangles it rasterised (4 of a set's 5 ms at

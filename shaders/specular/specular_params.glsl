@@ -23,7 +23,7 @@ struct SpecularConstants {
                  // steps through the back faces (refraction's exit point)
   vec4 params;   // x depth validity tolerance (fraction of the depth), y compose eps (linear
                  // camera units), z compose alpha_max, w 1: back-projection on (0: ablation)
-  vec4 shadow;   // baseline's LevelConstants::shadow for the direct light's maps
+  vec4 shadow;   // the direct-light block's LevelConstants::shadow for the direct light's maps
   ivec4 flags;   // x 1: lamps lit with shadow maps; y 1: depth validity test on (0: ablation);
                  // z the environment grid's width in cells (EnvGrid, height z / 2; 0: none, the
                  // environment is env_sh); w 1: the caustic buffer holds this frame's caustics, 2: the

@@ -16,7 +16,7 @@
 //      position, normal, albedo and real/virtual flag are what Sec. 5.1 stores).
 //   2. L'_rv and L'_r (eq. 3-5): a hit on a surface the camera sees takes the technique's solution
 //      there (lamps, shadows and indirect light: dir's VPLs); one it does not see is lit by the
-//      lamps with baseline's shadow-map pair (a real lamp's light on a real hit in L'_r too,
+//      lamps with the direct-light block's shadow-map pair (a real lamp's light on a real hit in L'_r too,
 //      common/shadowed_lamps.glsl) and the SH ambient; in L'_rv, the spot lamps' caustics on
 //      it (in the solution, or caustic_at); times the Fresnel factors and the transmittance
 //      colour (eq. 9).

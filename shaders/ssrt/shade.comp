@@ -6,7 +6,7 @@
 // The compose multiplies the camera image by the ratio of the two (mrgi_shared.h
 // differential_compose), which is eq. 13's "multiply the buffers with the colour of I_c" without
 // eq. 13's tone mapper: the runtime's compose is shared by all techniques and works in linear
-// radiance; eq. 13 itself (ssrt_direct_differential) is kept in ssrt_math.h and tested.
+// radiance; eq. 13 itself (ssrt_direct_differential) is kept in transfer_math.h and tested.
 // At step 1 the coarse cells are the pixels; above it the Gauss-filtered cells (`upsampled`,
 // upsampled.glsl) are read with Catmull-Rom bicubic interpolation (paper OursFast), clamped at 0
 // (bicubic overshoots).
@@ -15,7 +15,7 @@
 #include "shared/mrgi_shared.h"
 #include "common/workgroup_order.glsl"
 #include "common/frame_constants.glsl"
-#include "ssrt/ssrt_math.h"
+#include "shared/transfer_math.h"
 #include "ssrt/upsampled.glsl"
 
 // 8 x 8 invocations, one per pixel; the tiled pipeline sets 8 x 1, one per 4 x 2 pixels of its
@@ -178,7 +178,7 @@ void store_shaded(ivec2 pixel, PixelInputs p, vec4 s4, vec4 s5, vec4 s6) {
   if (virt) {
     vec3 av = imageLoad(virtual_albedo, pixel).rgb;
     // Plus the surface's own emission (glTF emissive), seen directly. It lights no other
-    // surface: the bounce term's senders are lit by the dominant light only (ssrt_math.h).
+    // surface: the bounce term's senders are lit by the dominant light only (transfer_math.h).
     vec3 emission = kEmission ? imageLoad(virtual_emission, pixel).rgb : vec3(0.0f);
     l_rv = av * (rd_v + ri_v / MRGI_PI) + emission;
   } else {

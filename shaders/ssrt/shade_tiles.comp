@@ -4,7 +4,7 @@
 // colour); a tile is shaded properly only when its result can visibly differ from that: the
 // tile meets the virtual objects' projected bounds (their own pixels, which a 4x4 cell centre
 // can miss), some cell of its bicubic footprint is virtual, or the footprint's two solutions
-// differ by more than the tile tolerance allows (ssrt_math.h ssrt_tile_invisible: no pixel
+// differ by more than the tile tolerance allows (transfer_math.h ssrt_tile_invisible: no pixel
 // would move by more than one 8-bit level). Where nothing virtual took part the solutions are
 // identical bit for bit (transfer.comp); much of the influence region differs by a fraction of
 // a per cent (a far virtual occluder takes one sample's weight from a few cells). On lavapipe a
@@ -14,7 +14,7 @@
 // first), list = the tile indices (ty * tiles_x + tx) in no particular order.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
-#include "ssrt/ssrt_math.h"
+#include "shared/transfer_math.h"
 #include "ssrt/upsampled.glsl"
 
 layout(local_size_x = 64) in;

@@ -20,7 +20,7 @@
 #extension GL_EXT_control_flow_attributes : require
 #include "shared/mrgi_shared.h"
 #include "common/frame_constants.glsl"
-#include "ssrt/ssrt_math.h"
+#include "shared/transfer_math.h"
 #include "ssrt/aux_views.glsl"
 #include "common/workgroup_order.glsl"
 

@@ -11,7 +11,7 @@
 
 #include "gi/light_propagation.h"
 #include "gi/rsm.h"
-#include "technique/scene_gpu.h"
+#include "frame/scene_gpu.h"
 #include "vulkan/vk_test_util.h"
 
 namespace mrgi::test {
@@ -23,7 +23,7 @@ constexpr float kRadius = 0.5f;
 
 struct RsmRig {
   std::unique_ptr<gpu::FrameGraph> graph;
-  std::unique_ptr<technique::SceneGpu> scene;
+  std::unique_ptr<frame::SceneGpu> scene;
   SceneDesc desc;
   gi::RealGBuffer real;
   std::optional<gi::ReflectiveShadowMaps> rsm;
@@ -42,7 +42,7 @@ struct RsmRig {
     box.gltf = std::string(MRGI_SOURCE_DIR) + "/perf/suite/assets/white_box.gltf";
     box.placement.position = glm::vec3(1.0f, 0.0f, 1.0f);
     desc.virtual_objects.push_back(box);
-    auto s = technique::SceneGpu::create(ctx, *graph, desc);
+    auto s = frame::SceneGpu::create(ctx, *graph, desc);
     EXPECT_TRUE(s.ok()) << s.error().message;
     scene = std::move(*s);
     // The floor y = 0 over x, z in [0.5, 1.5], seen from above, albedo 0.5.

@@ -6,10 +6,12 @@
 // it on the synthetic scene's sky.)
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "common/replay_capture.h"
+#include "mrgi/research.h"
 #include "mrgi/platform/capture.h"
 #include "mrgi/runtime.h"
 
@@ -24,7 +26,9 @@ TEST(DirAblation, EachChangesTheFrames) {
     s.device.validate = true;
     s.technique = "dir";
     s.level = 1;
-    s.dir_ablation = a;
+    auto research = std::make_shared<ResearchSettings>();
+    research->dir = a;
+    s.research = research;
     test::run_every_frame(*capture, s, outs);
   };
   std::vector<FrameOutput> paper;

@@ -76,7 +76,7 @@ struct Readback {
 
 struct Rig {
   std::unique_ptr<FrameGraph> graph;
-  technique::SharedResources shared;
+  frame::FrameResources shared;
   ImageHandle volume;
   std::optional<DepthFilterGpu> filter;
   std::vector<Readback> readbacks;
@@ -108,7 +108,7 @@ struct Rig {
       EXPECT_TRUE(b.ok()) << b.error().message;
       return *b;
     };
-    technique::SharedResources& s = r->shared;
+    frame::FrameResources& s = r->shared;
     s.frame_constants = buffer("frame_constants", sizeof(shader::FrameConstants),
                                VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
     auto upload = [&](const char* name, size_t bytes) {
@@ -541,7 +541,7 @@ TEST_F(VulkanTest, SsrtDepthFilterGpuRefusesWindowsBeyondItsLimits) {
   fs.max_output_height = in.h;
   auto g = FrameGraph::create(ctx(), fs);
   ASSERT_TRUE(g.ok());
-  technique::SharedResources s;
+  frame::FrameResources s;
   auto fc = (*g)->create_buffer({"fc", 512, MemoryUsage::Upload, true}, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   auto cu = (*g)->create_buffer(recon::camera_upload_desc("cu", 4096), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   auto du = (*g)->create_buffer(recon::camera_upload_desc("du", 4096), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);

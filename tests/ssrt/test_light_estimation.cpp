@@ -7,7 +7,7 @@
 #include <cmath>
 #include <random>
 
-#include "../../shaders/ssrt/ssrt_math.h"
+#include "../../shaders/shared/transfer_math.h"
 #include "common/sh_sky.h"
 #include "light/sh_estimator.h"
 #include "technique/ssrt/sample_directions.h"

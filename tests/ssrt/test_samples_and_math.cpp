@@ -1,12 +1,12 @@
 // The ssrt sample sets (spherical Delaunay, chi of eq. 9, pre-computed SH weights) and the
-// per-sample shader math of shaders/ssrt/ssrt_math.h (eq. 6-8, 10-15), checked on the CPU.
+// per-sample shader math of shaders/shared/transfer_math.h (eq. 6-8, 10-15), checked on the CPU.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 #include <set>
 
-#include "../../shaders/ssrt/ssrt_math.h"
+#include "../../shaders/shared/transfer_math.h"
 #include "technique/ssrt/sample_directions.h"
 #include "light/sh_tools.h"
 

@@ -16,7 +16,7 @@
 #include "../../shaders/shared/mrgi_shared.h"
 #include "gpu/floor_pass.h"
 #include "gpu/frame_graph.h"
-#include "technique/scene_gpu.h"
+#include "frame/scene_gpu.h"
 #include "technique/ssrt/ssrt.h"
 #include "light/light_stage.h"
 #include "light/sh_tools.h"
@@ -84,9 +84,9 @@ bool hit_box(glm::vec2 pixel, glm::vec3 offset, glm::vec3& point, glm::vec3& nor
 
 struct Driver {
   std::unique_ptr<FrameGraph> graph;
-  std::unique_ptr<technique::SceneGpu> scene_gpu;
+  std::unique_ptr<frame::SceneGpu> scene_gpu;
   SceneDesc scene;
-  technique::SharedResources shared;
+  frame::FrameResources shared;
   std::unique_ptr<light::LightStage> light_stage;
   std::unique_ptr<technique::Technique> tech;
   BufferHandle readback_r, readback_rv;
@@ -110,7 +110,7 @@ struct Driver {
     EXPECT_TRUE(g.ok()) << g.error().message;
     d.graph = std::move(*g);
     EXPECT_TRUE(d.graph->set_output_size(W, H).ok());
-    auto sg = technique::SceneGpu::create(ctx, *d.graph, d.scene);
+    auto sg = frame::SceneGpu::create(ctx, *d.graph, d.scene);
     EXPECT_TRUE(sg.ok()) << sg.error().message;
     d.scene_gpu = std::move(*sg);
     if (with_virtual) {
@@ -131,7 +131,7 @@ struct Driver {
       return *h;
     };
     const VkFormat f32 = VK_FORMAT_R32G32B32A32_SFLOAT, f16 = VK_FORMAT_R16G16B16A16_SFLOAT;
-    technique::SharedResources& s = d.shared;
+    frame::FrameResources& s = d.shared;
     s.real_position = image("real_position", f32, true);
     s.real_normal = image("real_normal", f16, true);
     s.real_albedo = image("real_albedo", f16, true);
@@ -176,7 +176,7 @@ struct Driver {
     EXPECT_TRUE(stage.ok()) << stage.error().message;
     d.light_stage = std::move(*stage);
     s.light_stage = d.light_stage.get();
-    auto t = technique::create_ssrt(s);
+    auto t = technique::create_ssrt(s, {});
     EXPECT_TRUE(t.ok()) << t.error().message;
     d.tech = std::move(*t);
     return d;
@@ -218,7 +218,7 @@ struct Driver {
         input.color.data[i * 3 + c] = uint8_t(std::lround(e * 255.0f));
       }
     }
-    const technique::SharedResources& s = shared;
+    const frame::FrameResources& s = shared;
     EXPECT_TRUE(graph->upload_image(s.real_position, rpos.data(), rpos.size() * 16).ok());
     EXPECT_TRUE(graph->upload_image(s.real_normal, rnrm.data(), rnrm.size() * 2).ok());
     EXPECT_TRUE(graph->upload_image(s.real_albedo, ralb.data(), ralb.size() * 2).ok());
@@ -244,7 +244,7 @@ struct Driver {
     std::memcpy(graph->mapped(shared.color_upload, graph->slot()), input.color.data.data(), input.color.data.size());
     std::memcpy(graph->mapped(shared.depth_upload, graph->slot()), input.depth.data.data(), input.depth.data.size() * 2);
     skipped.clear();
-    technique::FrameInfo info;
+    frame::FrameInfo info;
     info.camera_to_world = glm::dmat4(camera_to_world());
     info.input = &input;
     info.frame_index = index;
@@ -381,7 +381,7 @@ TEST_F(VulkanTest, SsrtSkipsTransferWhenTheInfluenceRegionIsOutOfViewAndKeepsThe
 
 TEST_F(VulkanTest, SsrtLightEstimateFromTheGpuReproducesTheFloor) {
   Driver d = Driver::make(ctx(), true);
-  const LightEstimate* est = technique::ssrt_light_estimate(*d.tech);
+  const LightEstimate* est = d.tech->light_estimate();
   ASSERT_NE(est, nullptr);
   EXPECT_FALSE(est->valid);
   for (int f = 0; f < 30; ++f) d.frame(f, 0);
@@ -444,7 +444,7 @@ TEST_F(VulkanTest, SsrtStressInputsStayFinite) {
     ASSERT_TRUE(d.graph->flush().ok());
     for (float v : d.read(d.readback_r, slot)) ASSERT_TRUE(std::isfinite(v)) << "case " << which;
     for (float v : d.read(d.readback_rv, slot)) ASSERT_TRUE(std::isfinite(v)) << "case " << which;
-    const LightEstimate* e = technique::ssrt_light_estimate(*d.tech);
+    const LightEstimate* e = d.tech->light_estimate();
     for (const auto& c : e->sh_radiance)
       ASSERT_TRUE(std::isfinite(c[0]) && std::isfinite(c[1]) && std::isfinite(c[2])) << which;
     if (which == 0 || which == 1) {
@@ -511,7 +511,7 @@ TEST_F(VulkanTest, SsrtEstimatedDominantDirectionOfARealSphereScene) {
     Driver dv = Driver::make(ctx(), true, glm::vec3(-0.55f, 0.0f, -0.55f), real_sphere);
     for (int f = 0; f < 6; ++f) dv.frame(f, 0);
     ASSERT_TRUE(dv.graph->flush().ok());
-    const LightEstimate* e = technique::ssrt_light_estimate(*dv.tech);
+    const LightEstimate* e = dv.tech->light_estimate();
     ASSERT_TRUE(e->valid);
     const glm::dvec3 got(e->direction_to_light[0], e->direction_to_light[1], e->direction_to_light[2]);
     const double angle = std::acos(std::clamp(glm::dot(got, sun), -1.0, 1.0)) * 180.0 / 3.14159265358979;

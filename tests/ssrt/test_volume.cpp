@@ -101,7 +101,7 @@ struct Rig {
   glm::vec4 k{120.0f, 120.0f, 79.5f, 59.5f};
   uint32_t max_aux = 64;
   std::unique_ptr<FrameGraph> graph;
-  technique::SharedResources shared;
+  frame::FrameResources shared;
   std::optional<ssrt::Volume> volume;
   BufferHandle rb_depth, rb_normal, rb_aux;
   std::vector<std::string> skipped;

@@ -8,11 +8,13 @@
 #include <algorithm>
 #include <cstdio>
 #include <cmath>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "capture/temp_dir.h"
+#include "mrgi/research.h"
 #include "mrgi/runtime.h"
 #include "../../shaders/shared/mrgi_shared.h"
 #include "stress_run.h"
@@ -28,7 +30,9 @@ std::vector<FrameOutput> run(const SyntheticScene& scene, const std::string& tec
                              bool validate, const DirAblation& ablation = {}) {
   RuntimeSettings s;
   s.device.validate = validate;
-  s.dir_ablation = ablation;
+  auto research = std::make_shared<ResearchSettings>();
+  research->dir = ablation;
+  s.research = research;
   s.technique = technique;
   s.level = level;
   return run_synthetic_frames(scene, s, frames);
@@ -126,7 +130,7 @@ TEST(Dir, EveryLevelRunsAndItsVplsLightTheObjectBeyondBaseline) {
   }
 }
 
-// The skip of issue 15 (technique/input_reuse.h): identical frames reuse the VPLs and ISMs and
+// The skip of issue 15 (gi/input_reuse.h): identical frames reuse the VPLs and ISMs and
 // give the recomputed frame's output bit for bit; a depth frame 1.8 mm off everywhere (within the
 // 2 mm tolerance) is reused too and stays within a few 8-bit levels of a runtime that
 // recomputes it; 1 cm of depth or 5 cm of camera motion recompute. Validation on.

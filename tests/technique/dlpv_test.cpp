@@ -8,10 +8,12 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <utility>
 #include <vector>
 
 #include "capture/temp_dir.h"
+#include "mrgi/research.h"
 #include "mrgi/runtime.h"
 #include "../../shaders/shared/mrgi_shared.h"
 #include "stress_run.h"
@@ -143,7 +145,9 @@ TEST(Dlpv, AblationsRunAndChangeTheFrame) {
     s.device.validate = true;
     s.technique = "dlpv";
     s.level = level;
-    s.dlpv_ablation = a;
+    auto research = std::make_shared<ResearchSettings>();
+    research->dlpv = a;
+    s.research = research;
     FrameOutput out;
     auto rt = create_runtime(s, scene.cameras(), scene.scene);
     if (!rt.ok()) {

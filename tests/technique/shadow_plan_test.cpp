@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "runtime/camera_math.h"
-#include "technique/baseline/shadow_plan.h"
+#include "shading/shadow_plan.h"
 
 namespace mrgi::technique {
 namespace {
@@ -24,11 +24,11 @@ LightDesc lamp(LightType type, bool real, glm::vec3 pos, glm::vec3 dir = {0, -1,
   return l;
 }
 
-TEST(ShadowPlan, RealLampsGetTwoMapsVirtualLampsOne) {
+TEST(shading::ShadowPlan, RealLampsGetTwoMapsVirtualLampsOne) {
   SceneDesc scene;
   scene.lights = {lamp(LightType::Spot, true, {0, 2, 0}), lamp(LightType::Point, false, {1, 1, 1}),
                   lamp(LightType::Point, true, {-1, 1, 0})};
-  auto plan = plan_shadow_maps(scene, Bounds{});
+  auto plan = shading::plan_shadow_maps(scene, shading::Bounds{});
   ASSERT_TRUE(plan.ok()) << plan.error().message;
   EXPECT_EQ(plan->real_lamps, 2);
   EXPECT_EQ(plan->virtual_lamps, 1);
@@ -38,26 +38,26 @@ TEST(ShadowPlan, RealLampsGetTwoMapsVirtualLampsOne) {
   EXPECT_EQ(L[0].layers, glm::ivec4(0, 0, 1, 0));
   EXPECT_EQ(L[1].layers, glm::ivec4(1, -1, 6, 0));  // virtual lamp: one map, every caster
   EXPECT_EQ(L[2].layers, glm::ivec4(7, 1, 6, 0));
-  for (const ShadowFace& f : plan->primary) {
+  for (const shading::ShadowFace& f : plan->primary) {
     EXPECT_TRUE(f.real_casters);
     EXPECT_EQ(f.virtual_casters, f.light == 1);
   }
-  for (const ShadowFace& f : plan->virtual_only) {
+  for (const shading::ShadowFace& f : plan->virtual_only) {
     EXPECT_FALSE(f.real_casters);
     EXPECT_TRUE(f.virtual_casters);
   }
 }
 
-TEST(ShadowPlan, CubeFacesSeeWhatTheShaderLooksUpInThem) {
+TEST(shading::ShadowPlan, CubeFacesSeeWhatTheShaderLooksUpInThem) {
   SceneDesc scene;
   scene.lights = {lamp(LightType::Point, true, {0.5f, 1.0f, -0.25f})};
-  auto plan = plan_shadow_maps(scene, Bounds{});
+  auto plan = shading::plan_shadow_maps(scene, shading::Bounds{});
   ASSERT_TRUE(plan.ok());
   const glm::vec3 pos = scene.lights[0].position;
   const glm::vec3 dirs[] = {{1, 0.3f, -0.6f}, {-1, 0.9f, 0.2f}, {0.1f, 1, 0.5f}, {0.4f, -1, -0.9f},
                             {-0.7f, 0.2f, 1}, {0.3f, -0.5f, -1}};
   for (const glm::vec3& d : dirs) {
-    const int face = cube_face_of(d);
+    const int face = shading::cube_face_of(d);
     const glm::vec3 n = ndc(plan->light_set.face_view_proj[face], pos + 2.0f * d);
     EXPECT_LE(std::abs(n.x), 1.0f) << face;
     EXPECT_LE(std::abs(n.y), 1.0f) << face;
@@ -68,17 +68,17 @@ TEST(ShadowPlan, CubeFacesSeeWhatTheShaderLooksUpInThem) {
 
 // A real spot straight down from 2 m (40-degree cone) and a virtual directional lamp, over a
 // 0.6 x 0.5 x 0.6 m box of bounds.
-Expected<ShadowPlan> spot_and_directional(Bounds& b) {
+Expected<shading::ShadowPlan> spot_and_directional(shading::Bounds& b) {
   SceneDesc scene;
   LightDesc spot = lamp(LightType::Spot, true, {0, 2, 0}, {0, -1, 0});
   spot.outer_angle_deg = 40.0f;
   scene.lights = {spot, lamp(LightType::Directional, false, {0, 0, 0}, glm::normalize(glm::vec3(1, -2, 0)))};
   b.add({-0.3f, 0.0f, -0.3f}, {0.3f, 0.5f, 0.3f});
-  return plan_shadow_maps(scene, b);
+  return shading::plan_shadow_maps(scene, b);
 }
 
-TEST(ShadowPlan, SpotAndDirectionalMapsCoverTheirTargets) {
-  Bounds b;
+TEST(shading::ShadowPlan, SpotAndDirectionalMapsCoverTheirTargets) {
+  shading::Bounds b;
   auto plan = spot_and_directional(b);
   ASSERT_TRUE(plan.ok());
   // A floor point on the spot's 35-degree line is inside its map; one at 85 degrees is not.
@@ -97,15 +97,15 @@ TEST(ShadowPlan, SpotAndDirectionalMapsCoverTheirTargets) {
   }
 }
 
-// The level of detail a face draws the virtual meshes at (ShadowFace::lod_per_texel): an error
+// The level of detail a face draws the virtual meshes at (shading::ShadowFace::lod_per_texel): an error
 // of e metres at distance d projects to e x focal / d texels, as the face's projection maps it
 // (checked against the matrix: 1 cm across the view at the target, in NDC x side / 2 texels).
-TEST(ShadowPlan, FacesKnowTheirTexelScaleForTheMeshesLevelOfDetail) {
-  Bounds b;
+TEST(shading::ShadowPlan, FacesKnowTheirTexelScaleForTheMeshesLevelOfDetail) {
+  shading::Bounds b;
   auto plan = spot_and_directional(b);
   ASSERT_TRUE(plan.ok());
   const float side = 256.0f;
-  for (const ShadowFace& f : plan->primary) {
+  for (const shading::ShadowFace& f : plan->primary) {
     SCOPED_TRACE(f.light);
     ASSERT_GT(f.lod_per_texel.focal_px, 0.0f);
     const glm::mat4& m = plan->light_set.face_view_proj[f.light * 6 + f.face];
@@ -117,16 +117,16 @@ TEST(ShadowPlan, FacesKnowTheirTexelScaleForTheMeshesLevelOfDetail) {
   }
 }
 
-TEST(ShadowPlan, RefusesTooManyLampsAndZeroDirections) {
+TEST(shading::ShadowPlan, RefusesTooManyLampsAndZeroDirections) {
   SceneDesc scene;
   scene.path = "scene.json";
   for (int i = 0; i < MRGI_MAX_LIGHTS + 1; ++i) scene.lights.push_back(lamp(LightType::Point, true, {0, 1, 0}));
-  auto too_many = plan_shadow_maps(scene, Bounds{});
+  auto too_many = shading::plan_shadow_maps(scene, shading::Bounds{});
   ASSERT_FALSE(too_many.ok());
   EXPECT_EQ(too_many.error().kind, ErrorKind::BadInput);
   EXPECT_NE(too_many.error().message.find("scene.json"), std::string::npos);
   scene.lights = {lamp(LightType::Spot, true, {0, 1, 0}, {0, 0, 0})};
-  auto zero = plan_shadow_maps(scene, Bounds{});
+  auto zero = shading::plan_shadow_maps(scene, shading::Bounds{});
   ASSERT_FALSE(zero.ok());
   EXPECT_NE(zero.error().message.find("lights[0].direction"), std::string::npos);
 }

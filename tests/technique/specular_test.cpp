@@ -8,11 +8,13 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "capture/temp_dir.h"
+#include "mrgi/research.h"
 #include "mrgi/image.h"
 #include "mrgi/runtime.h"
 #include "../../shaders/shared/mrgi_shared.h"
@@ -64,7 +66,9 @@ using Frames = std::vector<FrameOutput>;
 std::pair<Frames, Frames> run_with_and_without(const SyntheticScene& s, bool SpecularAblation::*flag) {
   RuntimeSettings on = settings_for("dir", 1);
   RuntimeSettings off = on;
-  off.specular_ablation.*flag = true;
+  auto research = std::make_shared<ResearchSettings>();
+  research->specular.*flag = true;
+  off.research = research;
   return {run_synthetic_frames(s, on, 3), run_synthetic_frames(s, off, 3)};
 }
 
@@ -206,7 +210,9 @@ TEST(Specular, TheFastLevelReadsReceiverMapsDrawnFramesAgoWithTheSameEnergy) {
   const SyntheticScene s = SyntheticScene::create(dir.str(), glm::vec3(0.0f), glm::vec3(1.0f), 0.0f, 0.0f, 1.0f);
   RuntimeSettings fast = settings_for("dir", 3);
   RuntimeSettings fast_off = fast;
-  fast_off.specular_ablation.no_caustics = true;
+  auto no_caustics = std::make_shared<ResearchSettings>();
+  no_caustics->specular.no_caustics = true;
+  fast_off.research = no_caustics;
   const Frames a = run_synthetic_frames(s, fast, 4), b = run_synthetic_frames(s, fast_off, 4);
   const auto [ref_on, ref_off] = run_with_and_without(s, &SpecularAblation::no_caustics);
   ASSERT_EQ(a.size(), 4u);

@@ -2,7 +2,7 @@
 // stress (issues 14 and 15: "no NaN, no energy growth over
 // 1,000 frames"), shared by dlpv_test.cpp and dir_test.cpp: a variant of the synthetic scene
 // run at one level for `n` frames whose depth alternates by 1 cm (beyond the reuse tolerance of
-// technique/input_reuse.h, so the light-dependent work is rebuilt every frame), keeping frames
+// gi/input_reuse.h, so the light-dependent work is rebuilt every frame), keeping frames
 // 0-9 and the last 102, and the notes it saw. check_stress_outcome() then asks that nothing was
 // reused, that frames of the same input are equal bit for bit once the reconstruction's filter
 // has settled (the last two against the 100th before them) and that the mean output light of the
@@ -98,7 +98,7 @@ inline void check_stress_outcome(const StressOutcome& o) {
   EXPECT_NEAR(late / early, 1.0, 0.01) << "mean light of the last frames against frames 8-9";
 }
 
-// The reuse skip of the GI techniques (technique/input_reuse.h), shared by dlpv_test.cpp and
+// The reuse skip of the GI techniques (gi/input_reuse.h), shared by dlpv_test.cpp and
 // dir_test.cpp: five frames of the synthetic scene with validation on, one frame in flight (each
 // process() returns the previous frame, so outputs come in order): frame 0, frame 1 (identical
 // input), frame 2 with the depth 1.8 mm off everywhere (within the 2 mm tolerance), frame 3 with

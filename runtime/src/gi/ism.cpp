@@ -32,7 +32,7 @@ uint32_t ImperfectShadowMaps::tiles_per_row(uint32_t vpls) const {
   return t;
 }
 
-Expected<ImperfectShadowMaps> ImperfectShadowMaps::create(gpu::FrameGraph& graph, const technique::SceneGpu& scene,
+Expected<ImperfectShadowMaps> ImperfectShadowMaps::create(gpu::FrameGraph& graph, const frame::SceneGpu& scene,
                                                           gpu::ImageHandle real_position, gpu::ImageHandle real_normal,
                                                           const IsmSettings& s) {
   if (s.name.empty()) return ism_setting_error("name", "must not be empty");
@@ -70,7 +70,7 @@ Expected<ImperfectShadowMaps> ImperfectShadowMaps::create(gpu::FrameGraph& graph
   // binary search of gi/virtual_points.glsl, and each range's material.
   std::vector<glm::ivec4> ranges;
   std::vector<int32_t> materials;
-  for (const technique::DrawRange& d : scene.virtual_objects.draws) {
+  for (const frame::DrawRange& d : scene.virtual_objects.draws) {
     const uint32_t triangles = d.index_count / 3;
     if (triangles == 0) continue;
     ranges.push_back(glm::ivec4(int(d.first_index), int(triangles), d.vertex_offset, int(m.virtual_.triangles)));
@@ -158,7 +158,7 @@ Status ImperfectShadowMaps::add_build(gpu::FrameGraph& graph, gpu::BufferHandle 
     const IsmPush virtual_push{real_push.tiles, glm::ivec4(int(virtual_.triangles), int(virtual_.range_count), 0, 0),
                                glm::vec4(0.0f)};
     const gpu::Pipeline* splat_virtual = &*splat_virtual_pipe_;
-    const technique::MeshSet& mesh = scene_->virtual_objects;
+    const frame::MeshSet& mesh = scene_->virtual_objects;
     const gpu::BufferHandle vertices = mesh.vertices, indices = mesh.indices, ranges = virtual_.ranges;
     graph.add_shader_pass(
         settings_.name + " splat virtual", gpu::PassKind::Compute, *splat_virtual_pipe_,

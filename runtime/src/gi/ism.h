@@ -16,7 +16,7 @@
 #include "gpu/frame_graph.h"
 #include "gpu/pipelines.h"
 #include "mrgi/expected.h"
-#include "technique/scene_gpu.h"
+#include "frame/scene_gpu.h"
 
 namespace mrgi::gi {
 
@@ -33,7 +33,7 @@ struct IsmSettings {
 // (uploaded once by ImperfectShadowMaps::create; the bounce light source reads them too).
 struct VirtualTriangles {
   gpu::BufferHandle ranges;     // ivec4 per draw range: first index, triangles, vertex offset, triangles before
-  gpu::BufferHandle materials;  // int per draw range: its index into technique::SceneGpu::materials
+  gpu::BufferHandle materials;  // int per draw range: its index into frame::SceneGpu::materials
   uint32_t triangles = 0;       // over every range
   uint32_t range_count = 0;     // ranges with triangles (the buffers hold at least one entry)
 };
@@ -50,7 +50,7 @@ class ImperfectShadowMaps {
  public:
   // `real_position`, `real_normal`: the real G-buffer (xyz world, w depth, 0 none; unit normal).
   // BadUsage naming the field for settings out of range.
-  static Expected<ImperfectShadowMaps> create(gpu::FrameGraph& graph, const technique::SceneGpu& scene,
+  static Expected<ImperfectShadowMaps> create(gpu::FrameGraph& graph, const frame::SceneGpu& scene,
                                               gpu::ImageHandle real_position, gpu::ImageHandle real_normal,
                                               const IsmSettings& settings);
   // Passes "<name> clear", "<name> splat real", "<name> splat virtual" (with virtual objects),
@@ -65,7 +65,7 @@ class ImperfectShadowMaps {
  private:
   ImperfectShadowMaps() = default;
   IsmSettings settings_;
-  const technique::SceneGpu* scene_ = nullptr;
+  const frame::SceneGpu* scene_ = nullptr;
   gpu::ImageHandle real_position_, real_normal_;
   gpu::ImageHandle splat_real_, splat_virtual_, distances_;
   VirtualTriangles virtual_;

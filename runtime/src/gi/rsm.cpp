@@ -46,7 +46,7 @@ Expected<RsmView> rsm_view(const LightDesc& lamp, const glm::vec3& centre, float
     v.axis = glm::vec4(dir, 0.0f);
     v.lpv.direction_or_position = dir;
     v.lpv.positional = false;
-    v.lod = technique::orthographic_lod_view(centre, dir, texel, 0.5f);
+    v.lod = frame::orthographic_lod_view(centre, dir, texel, 0.5f);
     return v;
   }
   const glm::vec3 to_centre = centre - lamp.position;
@@ -80,7 +80,7 @@ Expected<RsmView> rsm_view(const LightDesc& lamp, const glm::vec3& centre, float
   return v;
 }
 
-Expected<ReflectiveShadowMaps> ReflectiveShadowMaps::create(gpu::FrameGraph& graph, const technique::SceneGpu& scene,
+Expected<ReflectiveShadowMaps> ReflectiveShadowMaps::create(gpu::FrameGraph& graph, const frame::SceneGpu& scene,
                                                             const RealGBuffer& real, const RsmSettings& s) {
   if (s.size < 16 || s.size > 2048) return fail(ErrorKind::BadUsage, "RsmSettings.size: must be 16..2048 texels");
   ReflectiveShadowMaps r;
@@ -118,7 +118,7 @@ Expected<ReflectiveShadowMaps> ReflectiveShadowMaps::create(gpu::FrameGraph& gra
                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
   if (!ib) return ib.error();
   r.grid_indices_ = *ib;
-  auto ip = gpu::load_compute_pipeline(ctx, "baseline/shadow_caster_indices.comp", {});
+  auto ip = gpu::load_compute_pipeline(ctx, "shading/shadow_caster_indices.comp", {});
   if (!ip) return ip.error();
   r.indices_pipeline_ = std::move(*ip);
   auto frag = gpu::shader_spirv("gi/rsm.frag");
@@ -140,7 +140,7 @@ Expected<ReflectiveShadowMaps> ReflectiveShadowMaps::create(gpu::FrameGraph& gra
   MRGI_TRY(gpu::require_bindings(*r.grid_pipeline_, "rsm grid", {"real_position", "real_normal", "real_albedo", "base_color_maps"}));
   pd.name = s.name + " mesh";
   pd.vertex_spirv = *mesh_vs;
-  pd.vertex_strides = {sizeof(technique::GpuVertex)};
+  pd.vertex_strides = {sizeof(frame::GpuVertex)};
   pd.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
                    {1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12},
                    {2, 0, VK_FORMAT_R32G32_SFLOAT, 24}};
@@ -227,7 +227,7 @@ void ReflectiveShadowMaps::add_pair(gpu::FrameGraph& graph, const std::string& i
 
 void ReflectiveShadowMaps::add_map_draw(gpu::FrameGraph& graph, const std::string& label, const RsmView& view,
                                         const Maps& m, uint32_t s, bool real_casters, bool virtual_casters) {
-  const technique::SceneGpu* sg = scene_;
+  const frame::SceneGpu* sg = scene_;
   const bool grid = real_casters && grid_points_.width > 1 && grid_points_.height > 1;
   const uint32_t grid_indices = grid ? (grid_points_.width - 1) * (grid_points_.height - 1) * 6 : 0;
   const bool virtuals = virtual_casters && !sg->virtual_objects.empty();
@@ -238,7 +238,7 @@ void ReflectiveShadowMaps::add_map_draw(gpu::FrameGraph& graph, const std::strin
   const gpu::BufferHandle indices = grid_indices_;
   const gpu::Pipeline* grid_pipe = &*grid_pipeline_;
   const gpu::Pipeline* mesh_pipe = &*mesh_pipeline_;
-  const technique::LodView lod = view.lod;
+  const frame::LodView lod = view.lod;
   RsmPush push{view.view_proj, view.light, view.colour, view.axis,
                glm::ivec4(int(grid_stride_), -1, 0, int(grid_points_.width))};
   graph.add_pass(
@@ -340,7 +340,7 @@ bool outside_clip(const glm::mat4& view_proj, const glm::vec3& lo, const glm::ve
 }
 }  // namespace
 
-void draw_rsm_geometry(VkCommandBuffer cmd, gpu::PassContext& p, const technique::SceneGpu& scene,
+void draw_rsm_geometry(VkCommandBuffer cmd, gpu::PassContext& p, const frame::SceneGpu& scene,
                        const RsmGeometryDraw& d, RsmPush push) {
   const gpu::Context& ctx = p.context();
   const VkSampler linear = ctx.samplers().linear_repeat, nearest = ctx.samplers().nearest_clamp;
@@ -371,22 +371,22 @@ void draw_rsm_geometry(VkCommandBuffer cmd, gpu::PassContext& p, const technique
       .storage_buffer(mi.find("Materials")->binding, p.buffer(scene.materials))
       .sampled_image(mi.find("base_color_maps")->binding, p.view(scene.base_color_maps), linear)
       .push(ctx, cmd, *mp);
-  auto draw_set = [&](const technique::MeshSet& set, bool materials) {
+  auto draw_set = [&](const frame::MeshSet& set, bool materials) {
     VkBuffer vb = p.buffer(set.vertices);
     VkDeviceSize offset = 0;
     vkCmdBindVertexBuffers(cmd, 0, 1, &vb, &offset);
     vkCmdBindIndexBuffer(cmd, p.buffer(set.indices), 0, VK_INDEX_TYPE_UINT32);
     for (size_t i = 0; i < set.draws.size(); ++i) {
       if (materials && d.skip_virtual && i < d.skip_virtual->size() && (*d.skip_virtual)[i]) continue;
-      const technique::DrawRange& r = set.draws[i];
+      const frame::DrawRange& r = set.draws[i];
       if (d.cull_view_proj && outside_clip(*d.cull_view_proj, r.bounds_min, r.bounds_max)) continue;
       // Proxies: their scene.json material hint is not on the GPU yet: mid grey.
       push.misc.y = materials ? r.material : -1;
       push.misc.z = materials ? 0 : int(0xff808080u);
       vkCmdPushConstants(cmd, mp->layout, mp->stages, 0, sizeof push, &push);
-      const technique::DrawRange::Lod l =
-          r.lods.empty() || !d.lod ? technique::DrawRange::Lod{r.first_index, r.index_count, 0.0f}
-                                   : r.lods[technique::MeshSet::select_lod(r, *d.lod)];
+      const frame::DrawRange::Lod l =
+          r.lods.empty() || !d.lod ? frame::DrawRange::Lod{r.first_index, r.index_count, 0.0f}
+                                   : r.lods[frame::MeshSet::select_lod(r, *d.lod)];
       vkCmdDrawIndexed(cmd, l.index_count, 1, l.first_index, r.vertex_offset, 0);
     }
   };

@@ -1,7 +1,7 @@
 // Reflective shadow maps (Dachsbacher & Stamminger 2005), the shared block of the VPL-based
 // techniques: per lamp, a map of world positions, normals and reflected flux, one WITH the
 // virtual objects (R^rho) and one without (R^mu) (DLPV paper Sec. 4.3). The real scene is the
-// depth camera's (a grid over the real G-buffer, the casters of baseline's shadow maps) and the
+// depth camera's (a grid over the real G-buffer, the casters of the direct-light block's shadow maps) and the
 // scene's proxy meshes; the virtual objects are their glTF meshes and materials.
 //
 // Maps are allocated at create() for `size` texels per side and drawn at a used size per frame
@@ -19,7 +19,7 @@
 #include "gpu/pipelines.h"
 #include "mrgi/expected.h"
 #include "mrgi/scene.h"
-#include "technique/scene_gpu.h"
+#include "frame/scene_gpu.h"
 
 namespace mrgi::gi {
 
@@ -43,7 +43,7 @@ struct RsmView {
   LpvLight lpv;           // the same lamp for the injection
   // The virtual meshes' level of detail as the map sees them: the coarsest whose error stays
   // within half a map texel (a finer mesh adds triangles no texel resolves).
-  technique::LodView lod;
+  frame::LodView lod;
 };
 // BadUsage for a lamp the maps cannot see the sphere from (a point lamp inside it: its light
 // leaves in every direction, which one perspective map cannot hold).
@@ -80,18 +80,18 @@ struct RsmGeometryDraw {
   VkDeviceSize grid_indirect_offset = 0;       // this offset
   bool proxies = true, virtuals = true;
   const std::vector<bool>* skip_virtual = nullptr;
-  const technique::LodView* lod = nullptr;
+  const frame::LodView* lod = nullptr;
   // Set: ranges (proxies and virtual objects) whose bounds lie wholly outside one plane of this
   // view's clip volume are not drawn (lavapipe sets up every triangle of a draw on one thread,
   // culled or not: the six faces of an impostor cube each see one or two of the objects).
   const glm::mat4* cull_view_proj = nullptr;
 };
-void draw_rsm_geometry(VkCommandBuffer cmd, gpu::PassContext& p, const technique::SceneGpu& scene,
+void draw_rsm_geometry(VkCommandBuffer cmd, gpu::PassContext& p, const frame::SceneGpu& scene,
                        const RsmGeometryDraw& draw, RsmPush push);
 
 class ReflectiveShadowMaps {
  public:
-  static Expected<ReflectiveShadowMaps> create(gpu::FrameGraph& graph, const technique::SceneGpu& scene,
+  static Expected<ReflectiveShadowMaps> create(gpu::FrameGraph& graph, const frame::SceneGpu& scene,
                                                const RealGBuffer& real, const RsmSettings& settings);
   // The real grid's index list for this frame (call once a frame before add_pair, when the real
   // G-buffer changed): `stride` G-buffer pixels between grid points.
@@ -117,7 +117,7 @@ class ReflectiveShadowMaps {
   void add_map_draw(gpu::FrameGraph& graph, const std::string& label, const RsmView& view, const Maps& m,
                     uint32_t size, bool real_casters, bool virtual_casters);
   RsmSettings settings_;
-  const technique::SceneGpu* scene_ = nullptr;
+  const frame::SceneGpu* scene_ = nullptr;
   RealGBuffer real_;
   Maps maps_[2];
   gpu::BufferHandle grid_indices_;

@@ -49,7 +49,7 @@ inline VoxelRegion doubled_box_region(glm::vec3 box_min, glm::vec3 box_max, uint
   return {centre - glm::vec3(0.5f * side), side / float(std::max(cells, 1u))};
 }
 
-// One indexed triangle range of a mesh whose vertices are technique/scene_gpu.h GpuVertex (world
+// One indexed triangle range of a mesh whose vertices are frame/scene_gpu.h frame::GpuVertex (world
 // position, normal, uv: 8 floats) in a storage buffer, with 32-bit indices.
 struct TriangleRange {
   uint32_t first_index = 0;

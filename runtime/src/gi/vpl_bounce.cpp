@@ -17,7 +17,7 @@ struct BouncePush {
 
 }  // namespace
 
-Expected<VplBounce> VplBounce::create(gpu::FrameGraph& graph, const technique::SceneGpu& scene,
+Expected<VplBounce> VplBounce::create(gpu::FrameGraph& graph, const frame::SceneGpu& scene,
                                       const VirtualTriangles& triangles, const BounceGBuffer& gbuffer,
                                       const VplBounceSettings& s) {
   if (s.name.empty()) return fail(ErrorKind::BadUsage, "VplBounceSettings.name: must not be empty");
@@ -56,7 +56,7 @@ Status VplBounce::add_bounce(gpu::FrameGraph& graph, gpu::BufferHandle previous_
                         glm::vec4(f.centre, f.radius), glm::vec4(f.clamp_m, f.bias_relative, f.bias_m, 0.0f),
                         glm::vec4(f.focal_px, 0.0f, 0.0f)};
   const gpu::Pipeline* pipe = &*pipeline_;
-  const technique::SceneGpu* sg = scene_;
+  const frame::SceneGpu* sg = scene_;
   const VirtualTriangles tri = triangles_;
   const BounceGBuffer gb = gbuffer_;
   const gpu::BufferHandle out = bounce_;

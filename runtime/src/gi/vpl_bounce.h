@@ -21,7 +21,7 @@
 #include "gpu/frame_graph.h"
 #include "gpu/pipelines.h"
 #include "mrgi/expected.h"
-#include "technique/scene_gpu.h"
+#include "frame/scene_gpu.h"
 
 namespace mrgi::gi {
 
@@ -56,7 +56,7 @@ class VplBounce {
  public:
   static constexpr uint32_t kMaxSources = 256;  // MRGI_BOUNCE_MAX_SOURCES of vpl_bounce.comp
   // BadUsage naming the field for settings out of range.
-  static Expected<VplBounce> create(gpu::FrameGraph& graph, const technique::SceneGpu& scene,
+  static Expected<VplBounce> create(gpu::FrameGraph& graph, const frame::SceneGpu& scene,
                                     const VirtualTriangles& triangles, const BounceGBuffer& gbuffer,
                                     const VplBounceSettings& settings);
   // Pass "<name>": reads `previous_vpls` (gi/vpl.h's buffer) and `previous_ism` (gi/ism.h's
@@ -69,7 +69,7 @@ class VplBounce {
  private:
   VplBounce() = default;
   VplBounceSettings settings_;
-  const technique::SceneGpu* scene_ = nullptr;
+  const frame::SceneGpu* scene_ = nullptr;
   VirtualTriangles triangles_;
   BounceGBuffer gbuffer_;
   gpu::BufferHandle bounce_;

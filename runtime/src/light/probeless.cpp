@@ -7,7 +7,7 @@
 #include "common/frame_constants.glsl"
 #include "image/srgb.h"
 #include "shared/mrgi_shared.h"
-#include "ssrt/ssrt_math.h"
+#include "shared/transfer_math.h"
 
 namespace mrgi::light {
 namespace {

@@ -1,6 +1,6 @@
 // The light stage's own probeless input (image-space-illumination-dynamic-ar.md Sec. 5.1-5.2, on
 // the CPU): per sample of the depth image, the diffuse radiance transfer vector T(x) in SH with
-// screen-space visibility (the continuous K of eq. 7-9, shaders/ssrt/ssrt_math.h, the same
+// screen-space visibility (the continuous K of eq. 7-9, shaders/shared/transfer_math.h, the same
 // functions the ssrt technique's transfer pass runs) and the camera's linear colour I_c(x), summed
 // into the normal equations T^T T l = T^T I_c that light::LightEstimator solves.
 //

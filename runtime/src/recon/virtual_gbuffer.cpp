@@ -28,7 +28,7 @@ Expected<gpu::ImageHandle> gbuffer_image(gpu::FrameGraph& graph, const char* nam
 }  // namespace
 
 Expected<VirtualGBuffer> VirtualGBuffer::create(gpu::Context& context, gpu::FrameGraph& graph,
-                                                const technique::SceneGpu& scene) {
+                                                const frame::SceneGpu& scene) {
   VirtualGBuffer v;
   v.scene_ = &scene;
   // Storage: compute passes read it with imageLoad (on lavapipe 2-3x cheaper than a sampled
@@ -68,10 +68,10 @@ Expected<VirtualGBuffer> VirtualGBuffer::create(gpu::Context& context, gpu::Fram
   desc.vertex_spirv = *vs;
   desc.fragment_spirv = *fs;
   // Bindings and push constants (material per draw, real geometry step) from the shaders.
-  desc.vertex_strides = {sizeof(technique::GpuVertex)};
-  desc.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(technique::GpuVertex, position)},
-                     {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(technique::GpuVertex, normal)},
-                     {2, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(technique::GpuVertex, uv)}};
+  desc.vertex_strides = {sizeof(frame::GpuVertex)};
+  desc.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(frame::GpuVertex, position)},
+                     {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(frame::GpuVertex, normal)},
+                     {2, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(frame::GpuVertex, uv)}};
   desc.color_formats = {kPositionFormat, kNormalFormat, kAlbedoFormat};
   // Without the emission target the fragment shader's fourth output has no attachment: Vulkan
   // discards such a write.
@@ -97,7 +97,7 @@ Expected<VirtualGBuffer> VirtualGBuffer::create(gpu::Context& context, gpu::Fram
 }
 
 void VirtualGBuffer::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_constants,
-                            const technique::RealGeometry& real, float mesh_error_px) {
+                            const frame::RealGeometry& real, float mesh_error_px) {
   frame_constants_ = frame_constants;
   real_ = real;
   // Level of detail from this frame's camera (the constants the runtime just wrote).

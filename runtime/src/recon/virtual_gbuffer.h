@@ -1,7 +1,7 @@
 // The virtual G-buffer: the scene's glTF objects rasterised from the colour camera (OpenCV
 // intrinsics -> Vulkan projection with y down and depth 0..1, FrameConstants::world_to_clip) at
 // the internal resolution, hidden where the real surface is in front (recon's positions, or the
-// technique's own real geometry: technique::RealGeometry).
+// technique's own real geometry: frame::RealGeometry).
 // Images: virtual_position (RGBA32F: xyz world, w 1 where a virtual object is seen = the
 // real/virtual mask), virtual_normal (RGBA16F: xyz, w roughness), virtual_albedo (RGBA16F:
 // linear base colour, w metallic), virtual_emission (RGBA16F: emitted radiance, glTF emissive),
@@ -9,8 +9,8 @@
 #pragma once
 #include "gpu/frame_graph.h"
 #include "gpu/pipelines.h"
-#include "technique/scene_gpu.h"
-#include "technique/technique.h"
+#include "frame/scene_gpu.h"
+#include "frame/frame_resources.h"
 #include "common/frame_constants.glsl"
 
 namespace mrgi::recon {
@@ -18,12 +18,12 @@ namespace mrgi::recon {
 class VirtualGBuffer {
  public:
   static Expected<VirtualGBuffer> create(gpu::Context& context, gpu::FrameGraph& graph,
-                                         const technique::SceneGpu& scene);
+                                         const frame::SceneGpu& scene);
   // Adds the pass "virtual_gbuffer" (always: with no object it clears the mask).
   // Mesh ranges are drawn at the coarsest level of detail within `mesh_error_px` projected
   // internal pixels (QualityLevel::mesh_error_px; 0 = full detail).
   void record(gpu::FrameGraph& graph, gpu::BufferHandle frame_constants,
-              const technique::RealGeometry& real, float mesh_error_px);
+              const frame::RealGeometry& real, float mesh_error_px);
 
   gpu::ImageHandle position() const { return position_; }
   gpu::ImageHandle normal() const { return normal_; }
@@ -36,13 +36,13 @@ class VirtualGBuffer {
   // This frame's area_ (see there); updates previous_ and previous_extent_.
   VkRect2D projected_area(VkExtent2D extent, const shader::FrameConstants& fc);
 
-  const technique::SceneGpu* scene_ = nullptr;
+  const frame::SceneGpu* scene_ = nullptr;
   gpu::BufferHandle frame_constants_;
-  technique::RealGeometry real_;
+  frame::RealGeometry real_;
   // Why levels of detail: lavapipe sets triangles up on one thread (desk_spot's 16k-triangle
   // bunny, a few pixels per triangle at 640x480, cost 8.5 ms of this pass's 10; a quarter of
   // the triangles 1.7 ms).
-  technique::LodView lod_;
+  frame::LodView lod_;
   // The area drawn and cleared this frame: the virtual objects' projected bounds united with
   // the previous frame's (so what that frame drew is cleared), the whole image on the first
   // frame, after a size change or when a bound's corner is behind the camera. Outside it every

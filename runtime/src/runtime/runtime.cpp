@@ -1,170 +1,20 @@
-// create_runtime: the Vulkan context, the frame graph, the uploaded scene, reconstruction, the
-// virtual G-buffer, the technique and compose, all allocated once here for the technique's top
-// level. process() uploads a frame, records this frame's passes, submits, and returns the frames
-// that completed (pipelined over frames_in_flight slots).
+// The frame loop of mrgi::Runtime: per frame, wait for the slot's earlier frame and collect it,
+// place the objects and lamps, check the frame, record its stages (frame_stages.cpp) and submit;
+// the public functions that make a runtime and describe the techniques.
 #include <algorithm>
-#include <cmath>
 #include <chrono>
-#include <ctime>
+#include <cmath>
 #include <cstdio>
-#include <optional>
 #include <string>
 
 #include <glm/gtc/matrix_inverse.hpp>
 
-#include "common/frame_constants.glsl"
-#include "compose/compose.h"
-#include "gpu/context.h"
-#include "gpu/frame_graph.h"
-#include "light/light_stage.h"
-#include "mrgi/runtime.h"
-#include "recon/reconstruction.h"
-#include "recon/virtual_gbuffer.h"
-#include "scheduler/scheduler.h"
 #include "runtime/camera_math.h"
 #include "runtime/influence.h"
-#include "technique/scene_gpu.h"
-#include "technique/technique.h"
-#include "specular/specular.h"
+#include "runtime/runtime_impl.h"
 
 namespace mrgi {
-namespace {
-
-using runtime_detail::opencv_projection;
-
-// A virtual surface is hidden behind a real one closer by more than this fraction of its depth.
-constexpr float kVirtualDepthTolerance = 0.02f;
-
-bool same_intrinsics(const Intrinsics& a, const Intrinsics& b) {
-  return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy &&
-         a.cx == b.cx && a.cy == b.cy;
-}
-
-std::string size_text(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
-
-double thread_cpu_ms() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
-}
-
-// What a submitted frame needs to become a FrameOutput once its slot completes.
-struct SlotRecord {
-  bool used = false;
-  int64_t frame_index = 0;
-  int level = 0;
-  float internal_scale = 1.0f;  // the level's internal scale x the scheduler's factor
-  float scale_factor = 1.0f;    // the scheduler's factor alone
-  double predicted_ms = 0.0;    // the scheduler's prediction for this frame
-  bool scheduled = false;
-  bool technique_ran = false;
-  double record_ms = 0.0;
-  // Host work for this frame in process(): checks, recording, upload, submission, without the
-  // wait for an earlier frame's slot (which is that frame's device time, not this frame's work).
-  double host_work_ms = 0.0;
-  bool priming = false;  // a technique's priming run of this frame: its output is dropped
-  // Nothing virtual in view and the output has the camera's size: the output is the camera
-  // frame, converted on the host from this slot's colour upload when the frame completes.
-  bool camera_copy = false;
-  double light_ms = 0.0;
-  std::vector<std::string> skipped;
-  std::vector<std::string> notes;
-};
-
-class RuntimeImpl final : public Runtime {
- public:
-  RuntimeImpl() = default;
-  ~RuntimeImpl() override;
-  Status init(const RuntimeSettings& settings, const CameraSetup& cameras, const SceneDesc& scene);
-
-  Expected<std::vector<FrameOutput>> process(const InputFrame& frame) override;
-  Expected<std::vector<FrameOutput>> flush() override;
-  void recycle(FrameOutput&& done) override;
-  const DeviceInfo& device() const override { return context_->info(); }
-  const std::string& technique() const override { return technique_name_; }
-  double memory_mib() const override { return context_->memory_mib(); }
-  int level_count() const override { return int(technique_->levels().size()); }
-  std::vector<std::string> level_names() const override;
-  Status set_level(int level) override;
-  Status set_frame_budget_ms(double budget_ms) override;
-  Status set_profiling(bool on) override { return graph_->set_profiling(on); }
-  size_t object_count() const override { return scene_gpu_->object_count(); }
-  size_t lamp_count() const override { return scene_.lights.size(); }
-  Status set_lamp(size_t lamp, const LightDesc& desc) override {
-    MRGI_TRY(light_stage_->set_declared_lamp(lamp, desc));
-    app_lamp_[lamp] = 1;  // the app's from now on: scene.json's motion stops
-    keep_lamp(lamp);
-    return ok_status();
-  }
-  Status set_object_visible(size_t object, bool visible) override {
-    return scene_gpu_->set_visible(object, visible);
-  }
-  Status set_object_placement(size_t object, const Placement& placement) override {
-    MRGI_TRY(scene_gpu_->set_placement(object, placement));
-    app_placed_[object] = 1;
-    return ok_status();
-  }
-
- private:
-  Status check_validation() const;
-  Status check_frame(const InputFrame& frame) const;
-  void write_constants(const glm::dmat4& camera_to_world);
-  Expected<FrameOutput> collect(const gpu::FrameTimings& timings);
-  // Waits for the frame that last used the next slot (its output joins `outputs`) and starts
-  // that slot's record for `frame`.
-  Expected<SlotRecord*> begin_slot(const InputFrame& frame, std::vector<FrameOutput>& outputs);
-  // Records the frame's passes into the current slot and submits them.
-  Status record_and_submit(const InputFrame& frame, SlotRecord& rec, bool affected);
-  // The technique's priming run (Technique::wants_priming_run): this frame run once, waited
-  // for, its output dropped; the frames still in flight before it are collected into `outputs`.
-  Status prime(const InputFrame& frame, SlotRecord& rec, std::vector<FrameOutput>& outputs, double& prime_ms);
-
-  RuntimeSettings settings_;
-  CameraSetup cameras_;
-  SceneDesc scene_;
-  std::string technique_name_;  // the technique running (auto: the chosen one)
-  std::string choice_reason_;   // why, for technique "auto"
-  int output_w_ = 0, output_h_ = 0;
-  int level_ = 0;       // the fixed level, or the scheduler's choice when auto_level_
-  bool auto_level_ = false;
-  bool warmed_up_ = false;  // the first frame's warm-up run is done (process)
-  bool cpu_device_ = false;  // a CPU device (lavapipe): host and device work share the cores
-  std::optional<sched::Scheduler> scheduler_;  // made at start-up whatever the level (no allocation later)
-  // Declared in creation order; destroyed in reverse (the device outlives everything on it).
-  std::unique_ptr<gpu::Context> context_;
-  std::unique_ptr<gpu::FrameGraph> graph_;
-  std::unique_ptr<technique::SceneGpu> scene_gpu_;
-  std::unique_ptr<light::LightStage> light_stage_;
-  std::optional<recon::Reconstruction> recon_;
-  std::optional<recon::VirtualGBuffer> virtual_gbuffer_;
-  gpu::BufferHandle frame_constants_;
-  gpu::ImageHandle lit_rv_, lit_r_;
-  std::unique_ptr<technique::Technique> technique_;
-  // Mirrors and glass (specular/specular.h); null when no virtual material is specular.
-  std::unique_ptr<specular::SpecularStage> specular_;
-  shader::FrameConstants constants_{};  // this frame's, as write_constants wrote them
-  std::optional<compose::Compose> compose_;
-  std::vector<SlotRecord> slots_;
-  std::vector<FrameOutput> spare_outputs_;  // recycle(): images and masks to fill again
-  glm::dmat4 last_pose_{1.0};
-  bool have_pose_ = false;
-  // Per virtual object: placed by the app (set_object_placement), whose placement then holds
-  // instead of scene.json's motion.
-  std::vector<uint8_t> app_placed_;
-  std::vector<uint8_t> app_lamp_;  // lamps the app set (Runtime::set_lamp): their motion no longer applies
-  // scene_.lights[i] takes the light stage's lamp i (what the influence test reads), field by
-  // field: its motion keys stay, and nothing is allocated.
-  void keep_lamp(size_t i) {
-    const LightDesc& now = light_stage_->declared_lamp(i);
-    LightDesc& l = scene_.lights[i];
-    l.position = now.position;
-    l.direction = now.direction;
-    l.color = now.color;
-    l.intensity = now.intensity;
-    l.inner_angle_deg = now.inner_angle_deg;
-    l.outer_angle_deg = now.outer_angle_deg;
-  }
-};
+namespace runtime_detail {
 
 RuntimeImpl::~RuntimeImpl() {
   if (context_ && context_->device() != VK_NULL_HANDLE) vkDeviceWaitIdle(context_->device());
@@ -177,193 +27,6 @@ RuntimeImpl::~RuntimeImpl() {
   scene_gpu_.reset();
   graph_.reset();
   context_.reset();
-}
-
-Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cameras,
-                         const SceneDesc& scene) {
-  settings_ = settings;
-  cameras_ = cameras;
-  scene_ = scene;
-  technique_name_ = settings.technique;
-  if (settings.technique == "auto") {
-    for (const TechniqueFigure& f : settings.technique_table)
-      if (!std::isfinite(f.ms) || f.ms <= 0.0 || !std::isfinite(f.rde) || f.rde < 0.0)
-        return fail(ErrorKind::BadUsage, "RuntimeSettings.technique_table: " + f.technique + " level " +
-                                             std::to_string(f.level) + ": ms must be > 0 and rde >= 0");
-    auto choice = choose_technique(scene, settings.frame_budget_ms, settings.technique_table, settings.scheduler.headroom);
-    if (!choice) return choice.error();
-    technique_name_ = choice->technique;
-    choice_reason_ = choice->reason;
-    settings_.technique = technique_name_;
-    // The chosen technique's own figures are the scheduler's priors.
-    if (settings_.level_costs_ms.empty() && !settings.technique_table.empty()) {
-      auto names = technique_levels(technique_name_);
-      std::vector<double> costs(names ? names->size() : 0, 0.0);
-      for (const TechniqueFigure& f : settings.technique_table)
-        if (f.technique == technique_name_ && f.level >= 0 && size_t(f.level) < costs.size()) costs[size_t(f.level)] = f.ms;
-      if (std::all_of(costs.begin(), costs.end(), [](double c) { return c > 0.0; })) settings_.level_costs_ms = costs;
-    }
-  }
-  auto entry = technique::find_technique(technique_name_);
-  if (!entry) return entry.error();
-  auto ladder_or = (*entry)->ladder(settings.knobs);
-  if (!ladder_or) return ladder_or.error();
-  const std::vector<technique::QualityLevel> ladder = std::move(*ladder_or);
-  if (settings.level != kAutoLevel && (settings.level < 0 || settings.level >= int(ladder.size())))
-    return fail(ErrorKind::BadUsage, "RuntimeSettings.level " + std::to_string(settings.level) +
-                                         ": technique '" + settings_.technique + "' has levels 0.." +
-                                         std::to_string(ladder.size() - 1) + " (or kAutoLevel)");
-  MRGI_TRY(sched::check_settings(settings_, ladder.size()));
-  if (settings.frames_in_flight < 1 || settings.frames_in_flight > 3)
-    return fail(ErrorKind::BadUsage, "RuntimeSettings.frames_in_flight " +
-                                         std::to_string(settings.frames_in_flight) + ": must be 1..3");
-  if ((settings.output_width == 0) != (settings.output_height == 0) || settings.output_width < 0 ||
-      settings.output_height < 0)
-    return fail(ErrorKind::BadUsage, "RuntimeSettings.output_width/output_height: both 0 (the "
-                                     "colour camera's size) or both positive");
-  const Intrinsics& c = cameras.color;
-  const Intrinsics& d = cameras.depth;
-  if (c.width < 2 || c.height < 2 || d.width < 1 || d.height < 1 || !(c.fx > 0) || !(c.fy > 0) ||
-      !(d.fx > 0) || !(d.fy > 0))
-    return fail(ErrorKind::BadInput, "CameraSetup: colour and depth intrinsics need sizes >= 2 "
-                                     "and fx, fy > 0");
-  if (!(cameras.depth_scale > 0.0))
-    return fail(ErrorKind::BadInput, "CameraSetup.depth_scale must be > 0 (depth units per metre)");
-  if (!(cameras.exposure > 0.0))
-    return fail(ErrorKind::BadInput, "CameraSetup.exposure must be > 0");
-  if (!(settings.exposure >= 0.0))
-    return fail(ErrorKind::BadUsage, "RuntimeSettings.exposure must be >= 0 (0 = the camera's)");
-  // The settings override the capture's exposure (e.g. a user correcting a badly exposed capture).
-  if (settings.exposure > 0.0) cameras_.exposure = settings.exposure;
-  output_w_ = settings.output_width ? settings.output_width : c.width;
-  output_h_ = settings.output_height ? settings.output_height : c.height;
-  auto_level_ = settings.level == kAutoLevel;
-  {
-    std::vector<double> prior = settings_.level_costs_ms.empty()
-                                    ? sched::builtin_level_costs(settings_.technique, int(ladder.size()))
-                                    : settings_.level_costs_ms;
-    // Start at the best level the priors say fits the budget at full resolution.
-    int start = int(ladder.size()) - 1;
-    for (int l = 0; l < int(prior.size()); ++l)
-      if (prior[size_t(l)] <= settings.frame_budget_ms * (1.0 - settings.scheduler.headroom)) {
-        start = l;
-        break;
-      }
-    scheduler_.emplace(settings.scheduler, settings.frame_budget_ms, std::move(prior), auto_level_ ? start : settings.level);
-  }
-  level_ = auto_level_ ? scheduler_->choice().level : settings.level;
-
-  auto ctx = gpu::Context::create(settings.device);
-  if (!ctx) return ctx.error();
-  context_ = std::move(*ctx);
-  cpu_device_ = context_->info().type == "cpu";
-  gpu::FrameGraphSettings gs;
-  gs.max_output_width = uint32_t(output_w_);
-  gs.max_output_height = uint32_t(output_h_);
-  gs.max_render_scale = 0.0f;
-  for (const auto& l : ladder) gs.max_render_scale = std::max(gs.max_render_scale, l.internal_scale);
-  gs.frames_in_flight = uint32_t(settings.frames_in_flight);
-  auto graph = gpu::FrameGraph::create(*context_, gs);
-  if (!graph) return graph.error();
-  graph_ = std::move(*graph);
-  MRGI_TRY(graph_->set_output_size(uint32_t(output_w_), uint32_t(output_h_)));
-  MRGI_TRY(graph_->set_profiling(settings.profile_passes));
-
-  auto sg = technique::SceneGpu::create(*context_, *graph_, scene_);
-  if (!sg) return sg.error();
-  scene_gpu_ = std::move(*sg);
-  app_placed_.assign(scene_gpu_->object_count(), 0);
-  app_lamp_.assign(scene_.lights.size(), 0);
-  if (!(settings.light_lag_frames >= 0.0 && settings.light_lag_frames <= 1e6))
-    return fail(ErrorKind::BadUsage, "RuntimeSettings.light_lag_frames must be 0..1e6 frames");
-  light::LightStageSettings ls;
-  ls.estimator.lag_frames = settings.light_lag_frames;
-  ls.environment.filter_frames = settings.light_lag_frames;
-  ls.residual_light = settings.residual_light;
-  if (!scene_gpu_->virtual_objects.empty())
-    ls.focus = 0.5f * (scene_gpu_->virtual_objects.bounds_min + scene_gpu_->virtual_objects.bounds_max);
-  auto stage = light::LightStage::create(ls, scene_, cameras_);
-  if (!stage) return stage.error();
-  light_stage_ = std::move(*stage);
-  auto rc = recon::Reconstruction::create(*context_, *graph_, c, d);
-  if (!rc) return rc.error();
-  recon_.emplace(std::move(*rc));
-  auto vg = recon::VirtualGBuffer::create(*context_, *graph_, *scene_gpu_);
-  if (!vg) return vg.error();
-  virtual_gbuffer_.emplace(std::move(*vg));
-
-  auto fc = graph_->create_buffer({"frame_constants", sizeof(shader::FrameConstants),
-                                   gpu::MemoryUsage::Upload, true},
-                                  VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
-  if (!fc) return fc.error();
-  frame_constants_ = *fc;
-  for (gpu::ImageHandle* h : {&lit_rv_, &lit_r_}) {
-    gpu::ImageDesc desc;
-    desc.name = h == &lit_rv_ ? "lit_rv" : "lit_r";
-    desc.format = VK_FORMAT_R16G16B16A16_SFLOAT;
-    // lit_rv is also a colour attachment: the specular stage's caustic splat blends into it.
-    const VkImageUsageFlags attachment = h == &lit_rv_ ? VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT : 0;
-    auto img = graph_->create_image(desc, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | attachment);
-    if (!img) return img.error();
-    *h = *img;
-  }
-
-  compose::ComposeSettings compose_settings;
-  compose_settings.classify_tiles = settings.compose_tiles;
-  auto comp = compose::Compose::create(*context_, *graph_, uint32_t(output_w_), uint32_t(output_h_),
-                                       output_w_ == c.width && output_h_ == c.height, compose_settings);
-  if (!comp) return comp.error();
-  compose_.emplace(std::move(*comp));
-
-  technique::SharedResources shared;
-  shared.context = context_.get();
-  shared.knobs = settings.knobs;
-  shared.dlpv_ablation = settings.dlpv_ablation;
-  shared.dir_ablation = settings.dir_ablation;
-  shared.graph = graph_.get();
-  shared.scene = &scene_;
-  shared.scene_gpu = scene_gpu_.get();
-  shared.light_stage = light_stage_.get();
-  shared.frame_constants = frame_constants_;
-  shared.real_position = recon_->position();
-  shared.real_normal = recon_->normal();
-  shared.real_albedo = recon_->albedo();
-  shared.virtual_position = virtual_gbuffer_->position();
-  shared.virtual_normal = virtual_gbuffer_->normal();
-  shared.virtual_albedo = virtual_gbuffer_->albedo();
-  shared.virtual_emission = virtual_gbuffer_->emission();
-  shared.lit_rv = lit_rv_;
-  shared.lit_r = lit_r_;
-  shared.compose_honours_tiles = true;  // record(): compose uses Technique::compose_tiles()
-  // A technique that composes its own tiles would do so before the specular stage writes the
-  // mirrors' and glass's pixels: with a specular material in the scene the runtime composes.
-  if (settings.fuse_compose && compose_->fusable() && !(scene_gpu_->specular && !settings.specular_ablation.off)) {
-    shared.composed_output = compose_->output();
-  }
-  shared.compose_eps = compose_->settings().eps;
-  shared.compose_alpha_max = compose_->settings().alpha_max;
-  shared.color_upload = recon_->color_upload();
-  shared.depth_upload = recon_->depth_upload();
-  shared.color_intrinsics = c;
-  shared.depth_intrinsics = d;
-  shared.depth_scale = cameras_.depth_scale;
-  shared.depth_registered = same_intrinsics(c, d);
-  auto tech = (*entry)->create(shared);
-  if (!tech) return tech.error();
-  technique_ = std::move(*tech);
-  if (!settings.specular_ablation.off) {
-    auto spec = specular::SpecularStage::create(shared, specular::settings_for(settings.specular_ablation));
-    if (!spec) return spec.error();
-    specular_ = std::move(*spec);
-  }
-
-  slots_.resize(size_t(settings.frames_in_flight));
-  for (SlotRecord& s : slots_) {
-    s.skipped.reserve(16);
-    s.notes.reserve(4);
-  }
-  spare_outputs_.reserve(size_t(settings.frames_in_flight) + 1);  // recycle() never reallocates
-  return check_validation();
 }
 
 Status RuntimeImpl::check_validation() const {
@@ -500,7 +163,7 @@ Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame)
   // frame would otherwise pay beyond any budget. The repeat sees the same inputs, so the
   // temporal filters and reuse caches are where one run of the frame would leave them, nearly.
   const bool warm_up = auto_level_ && !warmed_up_;
-  const bool for_estimate = affected && technique_->wants_priming_run();
+  const bool for_estimate = affected && technique_->needs().estimate_from_frames && technique_->estimate_pending();
   if (affected && (for_estimate || warm_up)) {
     std::string note;
     warmed_up_ = true;
@@ -556,105 +219,6 @@ Status RuntimeImpl::prime(const InputFrame& frame, SlotRecord& rec, std::vector<
   }
   technique_->frames_completed();
   return ok_status();
-}
-
-// The frame skeleton, and why each full-resolution pass is there (profiled ms at 640x480 on
-// lavapipe x2, baseline on desk_spot, session 5; floor pass about 1.2 ms):
-//   upload            host memcpy of colour and depth into this slot's buffers (in host_ms, <1)
-//   recon_warp        the temporal history warped into this frame's camera; internal resolution
-//                     (0.7 at lowest's 320x240, 2.5 at high's 640x480): the merge needs it
-//   recon_positions   depth decode, 3x3 same-surface median, temporal merge, positions, albedo,
-//                     fused in one pass (2.5 / 7.8): every technique reads positions and albedo
-//   recon_normals     normals from the positions' neighbourhood (0.7 / 2.5): a separate pass
-//                     because it reads the merged positions of its neighbours
-//   virtual G-buffer  raster of the virtual objects (3.9 / 5.4)
-//   technique         its own passes (baseline: caster mesh, shadow maps, shading)
-//   compose           the only output-resolution pass (6.0 with the composite): it writes the
-//                     frame the user sees
-// A frame nothing virtual affects runs no pass at all when the output has the camera's size:
-// upload and a host conversion of the camera frame (below 1 floor pass); at another size
-// compose's camera-copy pipeline resamples it (2-3 ms). Recon and the technique are not added.
-Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, bool affected) {
-  const technique::QualityLevel& level = technique_->levels()[size_t(level_)];
-  rec.scale_factor = auto_level_ ? scheduler_->choice().scale : 1.0f;
-  rec.internal_scale = level.internal_scale * rec.scale_factor;
-  MRGI_TRY(graph_->set_render_scale(rec.internal_scale));
-  rec.technique_ran = affected;
-  write_constants(last_pose_);
-  recon_->upload(*graph_, frame);
-
-  const bool has_objects = !scene_gpu_->virtual_objects.empty() && scene_gpu_->any_visible();
-  // A frame nothing virtual affects is the camera frame (the lean skeleton above): the
-  // reconstruction is not needed for it; its temporal history restarts on the next affected
-  // frame (one frame of unfiltered depth).
-  // The specular stage's impostors and back-projection read the reconstruction's G-buffer, so it
-  // runs for a technique without one (ssrt) when a mirror or glass object is in the scene.
-  const bool recon_used = technique_->uses_reconstruction() || specular_ != nullptr;
-  if (affected && recon_used) {
-    recon_->record(*graph_, frame_constants_);
-  } else {
-    recon_->skip_frame();
-    rec.skipped.push_back(affected ? "recon: " + technique_->name() +
-                                         " builds its own real geometry and reads the camera frame itself"
-                                   : "recon: nothing virtual in view (its temporal history restarts when there is)");
-  }
-  if (affected) {
-    // The light stage runs only where something is lit with its answer.
-    // Its cost as this thread's CPU time: wall time here would count the driver's workers
-    // preempting it on a CPU device; the CPU time is the work it adds to the frame.
-    const double light_start = thread_cpu_ms();
-    MRGI_TRY(light_stage_->update(frame, last_pose_, rec.notes));
-    rec.light_ms = thread_cpu_ms() - light_start;
-    technique::FrameInfo info;
-    info.frame_index = frame.index;
-    info.level = level_;
-    info.virtual_objects_present = has_objects;
-    info.camera_to_world = last_pose_;
-    info.input = &frame;
-    MRGI_TRY(technique_->record_geometry(info, rec.skipped));
-    const std::optional<technique::RealGeometry> own = technique_->occlusion_geometry();
-    if (!own && !recon_used)
-      return fail(ErrorKind::Internal, technique_->name() +
-                                           ": skips the reconstruction but gives no real geometry "
-                                           "for the virtual objects' depth test");
-    virtual_gbuffer_->record(*graph_, frame_constants_,
-                             own ? *own : technique::RealGeometry{recon_->position(), recon_->position(), 1},
-                             level.mesh_error_px);
-    if (specular_) {
-      MRGI_TRY(specular_->prepare(constants_, level_, int(technique_->levels().size()), rec.skipped));
-      info.caustics = specular_->caustic_photons();
-    }
-    MRGI_TRY(technique_->record(info, rec.skipped));
-    if (specular_) MRGI_TRY(specular_->finish(*technique_, rec.skipped));
-  } else {
-    rec.skipped.push_back(has_objects ? "technique: no virtual object or its shadow in view"
-                                      : "technique: no virtual object and no virtual lamp in the scene");
-  }
-  // An unaffected frame at the camera's size needs no GPU pass at all: its output is the camera
-  // frame, which the host converts from the upload buffer when the (empty) frame completes
-  // (0.3 ms of host time against 2-3 ms for compose's camera-copy pass on lavapipe).
-  rec.camera_copy = !affected && output_w_ == cameras_.color.width && output_h_ == cameras_.color.height;
-  if (rec.camera_copy) {
-    rec.skipped.push_back("compose: nothing virtual in view, the camera frame is copied on the host");
-  } else {
-    compose::ComposeInputs ci{frame_constants_, recon_->color_upload(), lit_rv_, lit_r_,
-                              virtual_gbuffer_->position(), !affected};
-    if (affected) {
-      const technique::Technique::ComposeTiles tiles = technique_->compose_tiles();
-      // Caustics land where the technique's tiles may not reach: then every pixel is composed.
-      if (!(specular_ && specular_->lights_outside_tiles())) {
-        ci.tile_args = tiles.args;
-        ci.tile_list = tiles.list;
-        ci.tiles_composed = tiles.composed;
-      } else {
-        rec.skipped.push_back("compose tiles: caustics may light pixels outside them, every pixel composed");
-      }
-    }
-    compose_->record(*graph_, ci);
-  }
-  MRGI_TRY(graph_->compile());
-  MRGI_TRY(graph_->submit());
-  return check_validation();
 }
 
 void RuntimeImpl::recycle(FrameOutput&& done) {
@@ -756,7 +320,9 @@ Status RuntimeImpl::set_level(int level) {
   return ok_status();
 }
 
-}  // namespace
+}  // namespace runtime_detail
+
+using runtime_detail::RuntimeImpl;
 
 Expected<std::unique_ptr<Runtime>> create_runtime(const RuntimeSettings& settings,
                                                   const CameraSetup& cameras,

@@ -5,7 +5,7 @@
 
 #include "mrgi/runtime.h"
 #include "mrgi/scene.h"
-#include "technique/scene_gpu.h"
+#include "frame/scene_gpu.h"
 
 namespace mrgi {
 namespace {
@@ -42,8 +42,8 @@ Expected<TechniqueChoice> choose_technique(const SceneDesc& scene, double budget
     auto model = load_gltf(o.gltf, o.placement);
     if (!model) return model.error();
     for (const Material& m : model->materials)
-      glossy = glossy || m.metallic > technique::SceneGpu::kGlossyMetallic ||
-               m.roughness < technique::SceneGpu::kGlossyRoughness;
+      glossy = glossy || m.metallic > frame::SceneGpu::kGlossyMetallic ||
+               m.roughness < frame::SceneGpu::kGlossyRoughness;
   }
   const bool lamp = !scene.lights.empty();
   std::string reason;

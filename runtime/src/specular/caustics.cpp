@@ -11,7 +11,7 @@
 #include "specular/mesh_raster.h"
 #include "specular/caustic_receiver.glsl"
 #include "specular/photon.glsl"
-#include "technique/scene_gpu.h"
+#include "frame/scene_gpu.h"
 
 namespace mrgi::specular {
 namespace {
@@ -48,7 +48,7 @@ static_assert(sizeof(ReceiverPush) <= 128, "the guaranteed push-constant size");
 
 }  // namespace
 
-Expected<Caustics> Caustics::create(const technique::SharedResources& shared, uint32_t max_map_size,
+Expected<Caustics> Caustics::create(const frame::FrameResources& shared, uint32_t max_map_size,
                                     uint32_t max_receiver_map, const gpu::Pipeline& back_faces) {
   if (max_map_size < 16 || max_map_size > 2048)
     return fail(ErrorKind::BadUsage, "caustic map size: must be 16..2048 texels");
@@ -143,7 +143,7 @@ Expected<Caustics> Caustics::create(const technique::SharedResources& shared, ui
   pd.name = "specular photon surfaces";
   pd.vertex_spirv = *mesh_vs;
   pd.fragment_spirv = *surface_fs;
-  pd.vertex_strides = {sizeof(technique::GpuVertex)};
+  pd.vertex_strides = {sizeof(frame::GpuVertex)};
   pd.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
                    {1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12},
                    {2, 0, VK_FORMAT_R32G32_SFLOAT, 24}};
@@ -194,7 +194,7 @@ Expected<Caustics> Caustics::create(const technique::SharedResources& shared, ui
 bool Caustics::trace(gpu::FrameGraph& graph, const Impostors& imp, const std::vector<LightDesc>& lamps,
                       const std::vector<size_t>& objects, const glm::vec3& centre, float radius, uint32_t map_size,
                       const Refresh& refresh, std::vector<std::string>& skipped) {
-  const technique::SceneGpu& sg = *shared_.scene_gpu;
+  const frame::SceneGpu& sg = *shared_.scene_gpu;
   const uint32_t size = std::min(map_size, max_map_);
   recorded_.lamps.clear();
   recorded_.receivers = {};
@@ -298,7 +298,7 @@ bool Caustics::trace(gpu::FrameGraph& graph, const Impostors& imp, const std::ve
       r.push.light = glm::vec4(lamp.position, 1.0f);
       r.draws = front;
       // Half a texel of the map: its focal length is size / (2 tan(half)).
-      r.lod = technique::LodView{lamp.position, float(size) / (2.0f * std::tan(half)), 0.5f};
+      r.lod = frame::LodView{lamp.position, float(size) / (2.0f * std::tan(half)), 0.5f};
       add_mesh_raster(graph, sg, r);
       if (!back.empty()) {
         r.name = "specular photon back faces " + id;

@@ -29,7 +29,7 @@
 #include "mrgi/expected.h"
 #include "mrgi/scene.h"
 #include "specular/caustic_receiver.glsl"
-#include "technique/technique.h"
+#include "frame/frame_resources.h"
 
 namespace mrgi::specular {
 
@@ -37,7 +37,7 @@ class Caustics {
  public:
   // Lamps with caustic maps in one frame (the strongest spot lamps whose cone holds an object).
   static constexpr int kMaxLamps = 2;
-  static Expected<Caustics> create(const technique::SharedResources& shared, uint32_t max_map_size,
+  static Expected<Caustics> create(const frame::FrameResources& shared, uint32_t max_map_size,
                                    uint32_t max_receiver_map, const gpu::Pipeline& back_faces);
   // What the photon pass reads of the specular stage: its constants (impostor sets, search
   // steps) and the impostor atlas.
@@ -51,7 +51,7 @@ class Caustics {
   struct Refresh {
     int period = 1;       // frames between traces of unchanged photons (1: every frame)
     bool busy = false;    // this frame already redraws impostors: a due trace waits a frame
-    uint64_t revision = 0;  // the scene's (SceneGpu::revision): a change traces at once
+    uint64_t revision = 0;  // the scene's (frame::SceneGpu::revision): a change traces at once
     int glass_reflection_stride = 1;  // the level's (photons.comp): a change traces at once
     uint32_t receiver_map = 0;  // the level's receiver map side (0: none): a change traces at once
   };
@@ -69,11 +69,11 @@ class Caustics {
   // each pixel shows, a the number of photons.
   gpu::ImageHandle buffer() const { return caustics_; }
   // This frame's photons per lamp and receiver maps (after trace()).
-  const technique::CausticPhotons& photons() const { return recorded_; }
+  const frame::CausticPhotons& photons() const { return recorded_; }
 
  private:
   Caustics() = default;
-  technique::SharedResources shared_;
+  frame::FrameResources shared_;
   uint32_t max_map_ = 0;
   const gpu::Pipeline* back_faces_ = nullptr;
   gpu::ImageHandle position_, normal_, back_position_, back_normal_, depth_, caustics_;
@@ -82,7 +82,7 @@ class Caustics {
   gpu::BufferHandle receiver_lamps_;  // CausticReceivers, written every frame
   // Per lamp slot, history buffers: a frame that does not trace splats the last traced ones.
   gpu::BufferHandle photons_[kMaxLamps], photon_list_[kMaxLamps], photon_draw_[kMaxLamps];
-  technique::CausticPhotons recorded_;  // this frame's lamps
+  frame::CausticPhotons recorded_;  // this frame's lamps
   std::vector<glm::vec4> splat_push_;   // caustic_splat.vert's push block per lamp
   // The photons of lamp slot li into its part of the receiver atlas (trace frames).
   void add_receiver_splat(gpu::FrameGraph& graph, size_t li, const shader::CausticReceiverLamp& lamp,

@@ -2,8 +2,8 @@
 
 namespace mrgi::specular {
 
-void add_mesh_raster(gpu::FrameGraph& graph, const technique::SceneGpu& scene, const MeshRaster& r) {
-  const technique::SceneGpu* sg = &scene;
+void add_mesh_raster(gpu::FrameGraph& graph, const frame::SceneGpu& scene, const MeshRaster& r) {
+  const frame::SceneGpu* sg = &scene;
   graph.add_pass(
       r.name, gpu::PassKind::Graphics,
       [sg, r](gpu::PassBuilder& b) {
@@ -51,22 +51,22 @@ void add_mesh_raster(gpu::FrameGraph& graph, const technique::SceneGpu& scene, c
         vkCmdBindIndexBuffer(cmd, p.buffer(sg->virtual_objects.indices), 0, VK_INDEX_TYPE_UINT32);
         gi::RsmPush push = r.push;
         for (size_t i : r.draws) {
-          const technique::DrawRange& d = sg->virtual_objects.draws[i];
+          const frame::DrawRange& d = sg->virtual_objects.draws[i];
           push.misc.y = d.material;
           vkCmdPushConstants(cmd, pipe->layout, pipe->stages, 0, sizeof push, &push);
-          const technique::DrawRange::Lod l = d.lods.empty() || !r.lod
-                                                  ? technique::DrawRange::Lod{d.first_index, d.index_count, 0.0f}
-                                                  : d.lods[technique::MeshSet::select_lod(d, *r.lod)];
+          const frame::DrawRange::Lod l = d.lods.empty() || !r.lod
+                                                  ? frame::DrawRange::Lod{d.first_index, d.index_count, 0.0f}
+                                                  : d.lods[frame::MeshSet::select_lod(d, *r.lod)];
           vkCmdDrawIndexed(cmd, l.index_count, 1, l.first_index, d.vertex_offset, 0);
         }
         ctx.fn().cmd_end_rendering(cmd);
       });
 }
 
-std::vector<size_t> specular_draws(const technique::SceneGpu& scene, const std::vector<size_t>& objects, int kinds) {
+std::vector<size_t> specular_draws(const frame::SceneGpu& scene, const std::vector<size_t>& objects, int kinds) {
   std::vector<size_t> out;
   for (size_t o : objects) {
-    const technique::SceneGpu::DrawSpan span = scene.object_draws(o);
+    const frame::SceneGpu::DrawSpan span = scene.object_draws(o);
     for (size_t d = span.first; d < span.first + span.count; ++d) {
       const int m = scene.virtual_objects.draws[d].material;
       const int kind = m >= 0 && size_t(m) < scene.material_specular_kind.size() ? scene.material_specular_kind[size_t(m)] : 0;

@@ -12,7 +12,7 @@
 #include "gi/rsm.h"
 #include "gpu/frame_graph.h"
 #include "gpu/pipelines.h"
-#include "technique/scene_gpu.h"
+#include "frame/scene_gpu.h"
 
 namespace mrgi::specular {
 
@@ -26,14 +26,14 @@ struct MeshRaster {
   gi::RsmPush push;  // misc.y is set per range
   std::vector<size_t> draws;                // indices into scene.virtual_objects.draws
   // Set: each range at the coarsest level of detail within lod.max_error_px of this view
-  // (technique::MeshSet::select_lod); lavapipe sets up every triangle on one thread, and the
+  // (frame::MeshSet::select_lod); lavapipe sets up every triangle on one thread, and the
   // glass_mirror sphere's 2,200 took half of the camera's back-face pass at half resolution.
-  std::optional<technique::LodView> lod;
+  std::optional<frame::LodView> lod;
 };
 
-void add_mesh_raster(gpu::FrameGraph& graph, const technique::SceneGpu& scene, const MeshRaster& raster);
+void add_mesh_raster(gpu::FrameGraph& graph, const frame::SceneGpu& scene, const MeshRaster& raster);
 
 // The ranges of the given objects whose material is of one of `kinds` (bits 1 << specular_kind).
-std::vector<size_t> specular_draws(const technique::SceneGpu& scene, const std::vector<size_t>& objects, int kinds);
+std::vector<size_t> specular_draws(const frame::SceneGpu& scene, const std::vector<size_t>& objects, int kinds);
 
 }  // namespace mrgi::specular

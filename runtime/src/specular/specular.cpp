@@ -16,9 +16,9 @@
 #include "specular/caustics.h"
 #include "specular/mesh_raster.h"
 #include "specular/specular_params.glsl"
-#include "technique/light_set_writer.h"
-#include "technique/scene_gpu.h"
-#include "technique/screen_bounds.h"
+#include "light/light_set_writer.h"
+#include "frame/scene_gpu.h"
+#include "frame/screen_bounds.h"
 
 namespace mrgi::specular {
 namespace {
@@ -58,7 +58,7 @@ struct ObjectInView {
   glm::vec3 lo{0.0f}, hi{0.0f};
   float distance = 0.0f;
   bool refractive = false, reflective = false;
-  technique::ScreenBounds screen;  // its box projected into this frame's camera
+  frame::ScreenBounds screen;  // its box projected into this frame's camera
 };
 
 // trace_list.comp's lists, in its order: the pass over each and trace.comp's specialisation.
@@ -80,7 +80,7 @@ struct ImpostorSet {
 }  // namespace
 
 struct SpecularStage::Impl {
-  technique::SharedResources shared;
+  frame::FrameResources shared;
   SpecularSettings settings;
   gpu::ImageHandle impostor_position, impostor_normal, impostor_albedo, impostor_depth;
   gpu::ImageHandle back_position, back_normal, back_depth;
@@ -103,7 +103,7 @@ struct SpecularStage::Impl {
   glm::ivec4 region{0};              // the trace list's dispatch: first pixel, size
   bool glass_in_view = false, mirrors_in_view = false;
   float glass_reflection_fresnel = 0.0f;  // this frame's level's (SpecularLevel)
-  technique::CausticPhotons photons; // this frame's, for the technique
+  frame::CausticPhotons photons; // this frame's, for the technique
   VkExtent2D grid_points{0, 0};
   uint32_t grid_stride = 1;
   glm::mat4 world_to_clip{1.0f};  // this frame's camera (the back faces' draw)
@@ -283,7 +283,7 @@ Status SpecularStage::Impl::init() {
   MRGI_TRY(gpu::require_bindings(*grid_pipeline, pd.name, {"real_position", "real_normal", "real_albedo", "base_color_maps"}));
   pd.name = "specular impostor mesh";
   pd.vertex_spirv = *mesh_vs;
-  pd.vertex_strides = {sizeof(technique::GpuVertex)};
+  pd.vertex_strides = {sizeof(frame::GpuVertex)};
   pd.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
                    {1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12},
                    {2, 0, VK_FORMAT_R32G32_SFLOAT, 24}};
@@ -321,7 +321,7 @@ void SpecularStage::Impl::set_grid(gpu::FrameGraph& graph, uint32_t face) {
 
 void SpecularStage::Impl::add_impostors(gpu::FrameGraph& graph, const ImpostorSet& set, int index,
                                         const glm::ivec2& origin, uint32_t face, bool first) {
-  const technique::SceneGpu* sg = shared.scene_gpu;
+  const frame::SceneGpu* sg = shared.scene_gpu;
   const std::string id = std::to_string(index);
   const bool grid = grid_points.width > 1 && grid_points.height > 1 &&
                     uint64_t(grid_points.width - 1) * (grid_points.height - 1) * 6 <= face_capacity;
@@ -353,13 +353,13 @@ void SpecularStage::Impl::add_impostors(gpu::FrameGraph& graph, const ImpostorSe
   const std::string label = "specular impostors " + id;
   std::vector<bool> excluded(sg->virtual_objects.draws.size(), false);
   for (size_t o : set.objects) {
-    const technique::SceneGpu::DrawSpan span = sg->object_draws(o);
+    const frame::SceneGpu::DrawSpan span = sg->object_draws(o);
     for (size_t d = span.first; d < span.first + span.count; ++d) excluded[d] = true;
   }
   const Impl* self = this;
   const gpu::Access colour_access = first ? gpu::Access::ColorAttachmentWrite : gpu::Access::ColorAttachmentReadWrite;
   const gpu::Access depth_access = first ? gpu::Access::DepthAttachmentWrite : gpu::Access::DepthAttachmentReadWrite;
-  const technique::RealGeometry real{shared.real_position, shared.real_normal, 1};
+  const frame::RealGeometry real{shared.real_position, shared.real_normal, 1};
   const glm::vec3 centre = set.centre;
   const glm::ivec4 misc(int(grid_stride), -1, int(0xff808080u), int(grid_points.width));
   graph.add_pass(
@@ -419,7 +419,7 @@ void SpecularStage::Impl::add_impostors(gpu::FrameGraph& graph, const ImpostorSe
         g.skip_virtual = &excluded;
         // Each face draws the meshes at the detail its texels resolve (90 degrees over `face`
         // texels: a focal length of face / 2) and only those inside its frustum.
-        const technique::LodView lod{centre, 0.5f * float(face), 1.0f};
+        const frame::LodView lod{centre, 0.5f * float(face), 1.0f};
         g.lod = &lod;
         for (int f = 0; f < 6; ++f) {
           const int fx = origin.x + int(face) * (f % 3), fy = origin.y + int(face) * (f / 3);
@@ -455,14 +455,14 @@ void SpecularStage::Impl::add_back_faces(gpu::FrameGraph& graph, const std::vect
   // clears were most of this pass on lavapipe.
   if (region.z > 0 && region.w > 0) r.area = VkRect2D{{region.x, region.y}, {uint32_t(region.z), uint32_t(region.w)}};
   // Half an internal pixel: the finest the virtual G-buffer's front faces are drawn at.
-  r.lod = technique::LodView{camera_world, internal_focal_px, 0.5f};
+  r.lod = frame::LodView{camera_world, internal_focal_px, 0.5f};
   add_mesh_raster(graph, *shared.scene_gpu, r);
 }
 
 SpecularStage::SpecularStage(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 SpecularStage::~SpecularStage() = default;
 
-Expected<std::unique_ptr<SpecularStage>> SpecularStage::create(const technique::SharedResources& shared,
+Expected<std::unique_ptr<SpecularStage>> SpecularStage::create(const frame::FrameResources& shared,
                                                                const SpecularSettings& settings) {
   if (!shared.scene_gpu || !shared.scene_gpu->specular) return std::unique_ptr<SpecularStage>();
   if (settings.max_impostor_face < 16 || settings.max_impostor_face > 2048)
@@ -480,8 +480,8 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
                               std::vector<std::string>& skipped) {
   Impl& m = *impl_;
   m.active = false;
-  m.photons = technique::CausticPhotons{};
-  const technique::SceneGpu& sg = *m.shared.scene_gpu;
+  m.photons = frame::CausticPhotons{};
+  const frame::SceneGpu& sg = *m.shared.scene_gpu;
   gpu::FrameGraph& graph = *m.shared.graph;
   std::vector<ObjectInView>& in_view = m.in_view;
   in_view.clear();
@@ -489,7 +489,7 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
     if (!sg.visible(o)) continue;
     const int kinds = sg.object_specular_kinds(o);
     if (kinds == 0) continue;
-    const technique::SceneGpu::DrawSpan span = sg.object_draws(o);
+    const frame::SceneGpu::DrawSpan span = sg.object_draws(o);
     if (span.count == 0) continue;
     ObjectInView v;
     v.object = o;
@@ -499,7 +499,7 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
       v.lo = glm::min(v.lo, sg.virtual_objects.draws[d].bounds_min);
       v.hi = glm::max(v.hi, sg.virtual_objects.draws[d].bounds_max);
     }
-    v.screen = technique::project_box(fc, v.lo, v.hi);
+    v.screen = frame::project_box(fc, v.lo, v.hi);
     if (!v.screen.visible) continue;
     v.distance = glm::distance(0.5f * (v.lo + v.hi), glm::vec3(fc.camera_world));
     v.refractive = (kinds & (1 << shader::SPECULAR_REFRACTIVE)) != 0;
@@ -509,7 +509,7 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
   glm::vec2 lo_px(1e30f), hi_px(-1e30f);
   bool behind = false;
   for (const ObjectInView& v : in_view) {
-    const technique::ScreenBounds& b = v.screen;
+    const frame::ScreenBounds& b = v.screen;
     behind = behind || b.behind;
     lo_px = glm::min(lo_px, b.min);
     hi_px = glm::max(hi_px, b.max);
@@ -661,13 +661,12 @@ Status SpecularStage::prepare(const shader::FrameConstants& fc, int technique_le
   return ok_status();
 }
 
-Status SpecularStage::finish(const technique::Technique& technique, std::vector<std::string>& skipped) {
+Status SpecularStage::finish(const shading::DirectLightOutput* direct, std::vector<std::string>& skipped) {
   Impl& m = *impl_;
   if (!m.active) return ok_status();
   gpu::FrameGraph& graph = *m.shared.graph;
   const light::Lighting& lighting = m.shared.light_stage->lighting();
   auto* c = static_cast<shader::SpecularConstants*>(graph.mapped(m.constants, graph.slot()));
-  const std::optional<technique::Technique::DirectLight> direct = technique.direct_light();
   gpu::BufferHandle light_set = m.own_lights;
   gpu::ImageHandle shadow_primary = m.no_shadow, shadow_virtual = m.no_shadow;
   if (direct) {
@@ -677,7 +676,7 @@ Status SpecularStage::finish(const technique::Technique& technique, std::vector<
     c->shadow = direct->shadow;
   } else {
     auto* set = static_cast<shader::LightSet*>(graph.mapped(m.own_lights, graph.slot()));
-    technique::write_unshadowed_light_set(lighting, *set);
+    light::write_unshadowed_light_set(lighting, *set);
     c->shadow = glm::vec4(1.0f, 1.0f, 1.0f, 0.0f);
     skipped.push_back("specular: the technique drew no shadow maps this frame: mirrors and glass show lamps' light unshadowed");
   }
@@ -740,7 +739,7 @@ Status SpecularStage::finish(const technique::Technique& technique, std::vector<
     graph.add_shader_pass(
         kTraceList[li].pass, gpu::PassKind::Compute, *pipe,
         [=](gpu::ShaderPassBuilder& b) {
-          const technique::SharedResources& r = self->shared;
+          const frame::FrameResources& r = self->shared;
           b.bind("FrameUbo", r.frame_constants);
           b.bind("LightUbo", light_set);
           b.bind("SpecularUbo", self->constants);
@@ -778,8 +777,8 @@ Status SpecularStage::finish(const technique::Technique& technique, std::vector<
 
 bool SpecularStage::lights_outside_tiles() const { return impl_->caustics_recorded; }
 
-const technique::CausticPhotons* SpecularStage::caustic_photons() const {
-  const technique::CausticPhotons& p = impl_->photons;
+const frame::CausticPhotons* SpecularStage::caustic_photons() const {
+  const frame::CausticPhotons& p = impl_->photons;
   return p.lamps.empty() && !p.receivers.valid() ? nullptr : &p;
 }
 

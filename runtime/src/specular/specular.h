@@ -15,7 +15,7 @@
 //   specular photon ... <l>      per spot lamp whose cone holds such an object: photon maps and
 //                                photons (caustics.h; traced every caustic_refresh_period frames
 //                                while nothing moves); the technique reads the photons (dir's
-//                                caustic VPLs, FrameInfo::caustics); at the fast level also
+//                                caustic VPLs, frame::FrameInfo::caustics); at the fast level also
 //                                their receiver maps, which its direct shading reads
 // and after it (finish):
 //   specular caustic splat <l>   the photons into the caustic buffer and the diffuse pixels' L_rv
@@ -66,7 +66,9 @@
 #include "gpu/frame_graph.h"
 #include "gpu/pipelines.h"
 #include "mrgi/expected.h"
-#include "technique/technique.h"
+#include "frame/frame_resources.h"
+#include "mrgi/research.h"
+#include "shading/direct_light.h"
 
 namespace mrgi::specular {
 
@@ -107,8 +109,8 @@ struct SpecularLevel {
   // Texels per side of each lamp's caustic receiver map (0: the paper's splat into the camera's
   // caustic buffer every frame). With a map, the photons are splatted once per trace into the
   // octahedral map of directions around the lamp (caustic_receiver.glsl), and the technique's
-  // direct shading reads it at every pixel it lights (Technique::DirectLight::caustics_added:
-  // baseline's shade_direct, under dir, dlpv and dvct too; a technique without it would get the
+  // direct shading reads it at every pixel it lights (shading::DirectLightOutput::caustics_added:
+  // the direct-light block's shading, under baseline, dir, dlpv and dvct; a technique without it would get the
   // camera's splat, but ssrt, the one that lights otherwise, is lit by its own estimate, not by
   // the spot lamps that make caustics). Why: the splat's per-photon setup is
   // lavapipe's single-threaded part, 2.1 ms a frame on glass_mirror's fast dir frame, and the
@@ -142,14 +144,14 @@ struct SpecularSettings {
   uint32_t max_caustic_receiver_map = 512;  // allocated texels per side of the receiver maps
 };
 
-// The defaults with RuntimeSettings::specular_ablation's flags applied (its `off` is the
+// The defaults with ResearchSettings::specular's flags applied (mrgi/research.h) (its `off` is the
 // runtime's: no stage at all).
 SpecularSettings settings_for(const SpecularAblation& ablation);
 
 class SpecularStage {
  public:
   // nullptr (no error) when no virtual material is specular: nothing is allocated.
-  static Expected<std::unique_ptr<SpecularStage>> create(const technique::SharedResources& shared,
+  static Expected<std::unique_ptr<SpecularStage>> create(const frame::FrameResources& shared,
                                                          const SpecularSettings& settings);
   ~SpecularStage();
   // Before the technique's record(): records this frame's impostors, back faces and caustics
@@ -159,10 +161,13 @@ class SpecularStage {
   Status prepare(const shader::FrameConstants& fc, int technique_level, int technique_levels,
                  std::vector<std::string>& skipped);
   // This frame's caustic photons (after prepare; nullptr: none).
-  const technique::CausticPhotons* caustic_photons() const;
+  const frame::CausticPhotons* caustic_photons() const;
   // After the technique's record(): the mirrors' and glass's pixels (specular trace) and the
-  // caustics on the diffuse ones, over the technique's solutions.
-  Status finish(const technique::Technique& technique, std::vector<std::string>& skipped);
+  // caustics on the diffuse ones, over the technique's solutions. `direct`: what the technique's
+  // direct-light block applied this frame (Technique::direct_light), whose lights and shadow
+  // maps light the hits the same way; nullptr: it drew no shadow maps (the hits are lit
+  // unshadowed).
+  Status finish(const shading::DirectLightOutput* direct, std::vector<std::string>& skipped);
   // After record(): this frame's caustics may have lit pixels outside the technique's compose
   // tiles (Technique::compose_tiles): the frame must be composed everywhere.
   bool lights_outside_tiles() const;

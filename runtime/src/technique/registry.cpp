@@ -34,7 +34,7 @@ Expected<const TechniqueEntry*> find_technique(const std::string& name) {
     return fail(ErrorKind::BadUsage, "technique 'specular': mirrors, glass and caustics are a stage of every technique "
                                      "(runtime/src/specular/), on wherever a virtual material is reflective or refractive; "
                                      "choose the technique that lights the rest (" + known +
-                                     "), and RuntimeSettings::specular_ablation (--specular-ablation off) turns the stage off");
+                                     "), and ResearchSettings::specular (mrgi/research.h; --specular-ablation off) turns the stage off");
   return fail(ErrorKind::BadUsage, "technique '" + name + "' is not known; known techniques: " + known);
 }
 

@@ -24,6 +24,7 @@
 
 #include "mrgi/expected.h"
 #include "mrgi/metrics.h"
+#include "mrgi/research.h"
 #include "mrgi/runtime.h"
 
 namespace mrgi::perf {
@@ -47,7 +48,7 @@ struct BenchSettings {
   int floor_warmup = 3;                  // unmeasured floor frames per scene
   DeviceSettings device;
   bool residual_light = true;            // RuntimeSettings::residual_light
-  SpecularAblation specular_ablation;    // RuntimeSettings::specular_ablation (an ablation)
+  SpecularAblation specular_ablation;    // ResearchSettings::specular (mrgi/research.h, an ablation)
   std::vector<KnobSetting> knobs;        // RuntimeSettings::knobs (one technique only)
   // Knob sweeps (one technique only): every combination of the values is run at every chosen
   // level, on top of `knobs`; an entry's level_name then names its values ("high volume_cells=32

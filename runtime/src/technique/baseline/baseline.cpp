@@ -1,60 +1,11 @@
 #include "technique/baseline/baseline.h"
 
-#include <algorithm>
-#include <array>
-#include <optional>
-#include <cmath>
 #include <string>
 
-#include "gpu/pipelines.h"
 #include "technique/knobs.h"
-#include "gpu/shaders.h"
-#include "gpu/vk_check.h"
-#include "light/light_stage.h"
-#include "specular/caustic_receiver.glsl"
-#include "technique/baseline/shadow_plan.h"
-#include "technique/image_views.h"
-#include "technique/scene_gpu.h"
 
 namespace mrgi::technique {
 namespace {
-
-constexpr uint32_t kTopShadowSize = 2048;
-// Depth bias of the shadow rasterisation: constant in units of the depth format's resolution
-// at the primitive's depth, slope in units per unit of depth slope (hardware slope scaling).
-constexpr float kDepthBiasConstant = 16.0f;
-constexpr float kDepthBiasSlope = 2.5f;
-// Largest projected error (map texels) of the virtual meshes' level of detail in the shadow maps.
-constexpr float kCasterErrorTexels = 0.5f;
-
-struct GridPush {
-  glm::mat4 view_proj;
-  glm::ivec4 grid;
-};
-struct CasterGrid {
-  VkExtent2D points{0, 0};  // grid points per row, column
-  uint32_t stride = 1;      // G-buffer pixels between points
-  uint32_t index_count() const {
-    return points.width > 1 && points.height > 1 ? (points.width - 1) * (points.height - 1) * 6 : 0;
-  }
-};
-
-// The real caster grid for a G-buffer and a shadow map: a cell covers about `cell_texels`
-// shadow texels across the G-buffer's larger side (the map's resolution over the view's
-// geometry; a finer grid adds vertices the map cannot resolve). At most one point a pixel.
-CasterGrid caster_grid(VkExtent2D gbuffer, uint32_t shadow_size, double cell_texels) {
-  const uint32_t side = std::max(gbuffer.width, gbuffer.height);
-  const double cells = std::max(1.0, double(shadow_size) / std::max(1.0, cell_texels));
-  CasterGrid g;
-  g.stride = std::max<uint32_t>(1, uint32_t(std::ceil(double(side) / cells)));
-  g.points = {(gbuffer.width - 1) / g.stride + 1, (gbuffer.height - 1) / g.stride + 1};
-  return g;
-}
-
-struct ShadePush {
-  glm::vec4 shadow;
-  VolumeBounce::Constants volume;  // shade_direct.comp's VolumeConstants (kVolumeBounce only)
-};
 
 const KnobField<BaselineLevel> kBaselineKnobs[] = {
     {"shadow_map_size", "texels per side of each map face", &BaselineLevel::shadow_map_size, true},
@@ -68,441 +19,45 @@ const KnobField<BaselineLevel> kBaselineKnobs[] = {
      &BaselineLevel::shadowed_estimated_lights},
 };
 
+shading::DirectLightLevel direct_level(const BaselineLevel& l) {
+  return {l.shadow_map_size, l.pcf_radius, l.caster_cell_shadow_texels, l.shadowed_estimated_lights};
+}
+
 class Baseline final : public Technique {
  public:
-  Baseline(const SharedResources& shared, std::vector<BaselineLevel> levels)
-      : shared_(shared), ladder_(ladder_of(levels, baseline_levels(), kBaselineKnobs)), levels_(std::move(levels)) {}
+  Baseline(std::vector<BaselineLevel> levels, std::unique_ptr<shading::DirectLightBlock> direct)
+      : ladder_(ladder_of(levels, baseline_levels(), kBaselineKnobs)), levels_(std::move(levels)),
+        direct_(std::move(direct)) {}
   const std::string& name() const override { return name_; }
   const std::vector<QualityLevel>& levels() const override { return ladder_; }
-  Status init();
-  Status record(const FrameInfo& info, std::vector<std::string>& skipped) override;
-  void set_volume_bounce(const VolumeBounce* bounce) { bounce_ = bounce ? std::optional<VolumeBounce>(*bounce) : std::nullopt; }
-  void set_dir_indirect(const DirIndirect* indirect) { dir_ = indirect ? std::optional<DirIndirect>(*indirect) : std::nullopt; }
-  std::optional<DirectLight> direct_light() const override {
-    return DirectLight{lights_, shadow_primary_, shadow_virtual_, shadow_constants(), caustics_};
+  Status record(const frame::FrameInfo& info, std::vector<std::string>& skipped) override {
+    if (info.level < 0 || info.level >= int(ladder_.size()))
+      return fail(ErrorKind::BadUsage, "baseline: level " + std::to_string(info.level) + " outside 0.." +
+                                           std::to_string(ladder_.size() - 1));
+    return direct_->record(info, direct_level(levels_[size_t(info.level)]), {}, skipped);
   }
+  std::optional<shading::DirectLightOutput> direct_light() const override { return direct_->output(); }
 
  private:
-  void render_faces(VkCommandBuffer cmd, gpu::PassContext& pass, const std::vector<ShadowFace>& faces,
-                    const std::vector<VkImageView>& layer_views);
-  void shade(VkCommandBuffer cmd, gpu::PassContext& pass);
-  // shade_direct.comp's LevelConstants::shadow at this frame's level.
-  glm::vec4 shadow_constants() const {
-    return glm::vec4(float(shadow_size_) / float(kTopShadowSize), float(shadow_size_), float(kTopShadowSize),
-                     float(pcf_radius_));
-  }
-
   std::string name_ = "baseline";
-  SharedResources shared_;
   std::vector<QualityLevel> ladder_;
   std::vector<BaselineLevel> levels_;  // baseline_levels() with RuntimeSettings::knobs applied
-  // Re-plans the shadow maps when the light stage's lights or the level's number of shadowed
-  // estimated lights changed; writes this slot's lights.
-  Status update_lights(int shadowed_estimated);
-
-  ShadowPlan plan_;
-  Bounds bounds_;
-  uint64_t planned_revision_ = ~uint64_t(0);
-  uint64_t planned_objects_ = 0;  // SceneGpu::revision the plan's bounds were taken at
-  int planned_shadowed_ = -1;
-  std::vector<LightDesc> drawn_;             // the lights with shadow maps this frame
-  light::ShRgb folded_real_{}, folded_virtual_{};  // SH of the estimated lights folded into ambient
-  gpu::BufferHandle lights_;  // shader::LightSet, one per frame slot
-  gpu::ImageHandle shadow_primary_, shadow_virtual_;
-  ImageViews views_;
-  std::vector<VkImageView> primary_layer_views_, virtual_layer_views_;
-  gpu::PipelineHandle grid_pipeline_, mesh_pipeline_, caster_indices_pipeline_;
-  static constexpr uint32_t kShadeModes[] = {0, 1, 3, 4, 6, 8};
-  gpu::PipelineHandle shade_pipelines_[9];  // shade_direct.comp by kVolumeBounce (kShadeModes)
-  const gpu::Pipeline& shade_pipeline() const {
-    const gpu::PipelineHandle* set = caustics_ ? shade_caustic_pipelines_ : shade_pipelines_;
-    if (dir_) return *set[8];
-    if (!bounce_) return *set[0];
-    const bool two = bounce_->constants.mode.x == 1, rho = bounce_->constants.extent.w > 0.5f;
-    return *set[(two ? 4u : 1u) | (rho ? 2u : 0u)];
-  }
-  gpu::PipelineHandle shade_caustic_pipelines_[9];  // the same with kCausticReceivers (specular scenes)
-  // This frame's caustic receiver maps (FrameInfo::caustics), read by shade_direct; stand-ins
-  // bound where there are none.
-  bool caustics_ = false;
-  gpu::ImageHandle receivers_, no_receivers_;
-  gpu::BufferHandle receiver_lamps_, no_receiver_lamps_;
-  gpu::ImageHandle no_volume_;                 // bound for the volumes when there is no bounce
-  std::optional<VolumeBounce> bounce_;         // this frame's (set_volume_bounce)
-  gpu::ImageHandle no_indirect_;               // bound for dir_indirect when there is none
-  std::optional<DirIndirect> dir_;             // this frame's (set_dir_indirect)
-  gpu::BufferHandle caster_indices_;  // this frame's real caster mesh (shadow_caster_indices.comp)
-  bool real_caster_faces_ = false;     // some face of the plan draws the real casters
-  VkImageLayout depth_write_layout_ = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
-  // This frame's knobs (set by record before the passes are added).
-  uint32_t shadow_size_ = kTopShadowSize;
-  int pcf_radius_ = 1;
-  CasterGrid grid_;
+  std::unique_ptr<shading::DirectLightBlock> direct_;
 };
-
-Status Baseline::init() {
-  gpu::Context& ctx = *shared_.context;
-  gpu::FrameGraph& graph = *shared_.graph;
-  const SceneGpu& sg = *shared_.scene_gpu;
-
-  if (!shared_.light_stage) return fail(ErrorKind::Internal, "baseline: no light stage");
-  if (!sg.virtual_objects.empty()) bounds_.add(sg.virtual_objects.bounds_min, sg.virtual_objects.bounds_max);
-  if (!sg.real_proxies.empty()) bounds_.add(sg.real_proxies.bounds_min, sg.real_proxies.bounds_max);
-  // Shadow map layers for the most lights the stage can give: its declared lamps as they are,
-  // the rest as real directional lights (one layer in each map).
-  const light::LightStage& stage = *shared_.light_stage;
-  std::vector<LightDesc> largest = shared_.scene->lights;
-  while (int(largest.size()) < stage.max_lights()) {
-    LightDesc d;
-    d.type = LightType::Directional;
-    largest.push_back(d);
-  }
-  MRGI_TRY(plan_shadow_maps(largest, bounds_, shared_.scene->path + ": lights", plan_));
-  const size_t primary_layers = plan_.primary.size();
-  // Nothing virtual: no virtual-caster map is ever drawn (update_lights).
-  const size_t virtual_layers = sg.virtual_objects.empty() ? 0 : plan_.virtual_only.size();
-  plan_.primary.reserve(primary_layers);
-  plan_.virtual_only.reserve(plan_.virtual_only.size());
-  drawn_.reserve(largest.size());
-
-  auto lights = graph.create_buffer({"baseline_lights", sizeof(shader::LightSet), gpu::MemoryUsage::Upload, true},
-                                    VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
-  if (!lights) return lights.error();
-  lights_ = *lights;
-
-  auto make_map = [&](const char* name, size_t layers) -> Expected<gpu::ImageHandle> {
-    gpu::ImageDesc d;
-    d.name = name;
-    d.format = VK_FORMAT_D32_SFLOAT;
-    d.size_mode = gpu::SizeMode::Absolute;
-    d.width = d.height = kTopShadowSize;
-    d.layers = uint32_t(std::max<size_t>(1, layers));
-    d.array_view = true;  // sampler2DArrayShadow, whatever the lamp count
-    return graph.create_image(d, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT);
-  };
-  auto primary = make_map("shadow_primary", primary_layers);
-  if (!primary) return primary.error();
-  shadow_primary_ = *primary;
-  auto virt = make_map("shadow_virtual", virtual_layers);
-  if (!virt) return virt.error();
-  shadow_virtual_ = *virt;
-
-  views_ = ImageViews(ctx.device());
-  // A view a layer, for rendering each map (the shading pass samples the image's array view).
-  auto make_views = [&](gpu::ImageHandle h, size_t layers, std::vector<VkImageView>& per_layer) -> Status {
-    const gpu::GpuImage& img = graph.gpu_image(h);
-    for (size_t i = 0; i < layers; ++i) {
-      auto v = views_.create(img, VK_IMAGE_VIEW_TYPE_2D, uint32_t(i), 1);
-      if (!v) return v.error();
-      per_layer.push_back(*v);
-    }
-    return ok_status();
-  };
-  MRGI_TRY(make_views(shadow_primary_, primary_layers, primary_layer_views_));
-  MRGI_TRY(make_views(shadow_virtual_, virtual_layers, virtual_layer_views_));
-  depth_write_layout_ =
-      gpu::access_info(gpu::PassKind::Graphics, gpu::Access::DepthAttachmentWrite, true, true).layout;
-
-  auto grid_vs = gpu::shader_spirv("baseline/shadow_depth_grid.vert");
-  if (!grid_vs) return grid_vs.error();
-  gpu::GraphicsPipelineDesc grid;
-  grid.name = "baseline_shadow_depth_grid";
-  grid.vertex_spirv = *grid_vs;
-  grid.push_constant_bytes = sizeof(GridPush);
-  grid.depth_format = VK_FORMAT_D32_SFLOAT;
-  grid.cull_mode = VK_CULL_MODE_NONE;
-  grid.depth_bias_constant = kDepthBiasConstant;
-  grid.depth_bias_slope = kDepthBiasSlope;
-  auto gp = gpu::create_graphics_pipeline(ctx, grid);
-  if (!gp) return gp.error();
-  grid_pipeline_ = gpu::PipelineHandle(ctx, std::move(*gp));
-  MRGI_TRY(gpu::require_bindings(*grid_pipeline_, grid.name, {"real_position"}));
-
-  // Index buffer for the finest grid any level uses (one point a G-buffer pixel).
-  const VkExtent2D gbuffer = graph.allocated_extent(shared_.real_position);
-  const CasterGrid finest{gbuffer, 1};
-  auto ib = graph.create_buffer({"shadow_caster_indices", std::max<VkDeviceSize>(4, VkDeviceSize(finest.index_count()) * 4)},
-                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
-  if (!ib) return ib.error();
-  caster_indices_ = *ib;
-  auto cip = gpu::load_compute_pipeline(ctx, "baseline/shadow_caster_indices.comp", {});
-  if (!cip) return cip.error();
-  caster_indices_pipeline_ = std::move(*cip);
-
-  auto mesh_vs = gpu::shader_spirv("baseline/shadow_mesh.vert");
-  if (!mesh_vs) return mesh_vs.error();
-  gpu::GraphicsPipelineDesc mesh;
-  mesh.name = "baseline_shadow_mesh";
-  mesh.vertex_spirv = *mesh_vs;
-  mesh.push_constant_bytes = sizeof(glm::mat4);
-  mesh.vertex_strides = {sizeof(GpuVertex)};
-  mesh.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}};
-  mesh.depth_format = VK_FORMAT_D32_SFLOAT;
-  mesh.cull_mode = VK_CULL_MODE_NONE;
-  mesh.depth_bias_constant = kDepthBiasConstant;
-  mesh.depth_bias_slope = kDepthBiasSlope;
-  auto mp = gpu::create_graphics_pipeline(ctx, mesh);
-  if (!mp) return mp.error();
-  mesh_pipeline_ = gpu::PipelineHandle(ctx, std::move(*mp));
-
-  auto shade_spv = gpu::shader_spirv("baseline/shade_direct.comp");
-  if (!shade_spv) return shade_spv.error();
-  // Layouts from the shader; one pipeline per kVolumeBounce in use: 0 direct only, 1 V^Delta on
-  // real pixels, 3 and V^rho on virtual ones, 4 and 6 the two-volume ablation without and with,
-  // 8 dir's VPL light.
-  // With a reflective or refractive material in the scene, each also with kCausticReceivers (the
-  // specular stage's fast level adds its caustics here).
-  const bool specular = shared_.scene_gpu->specular;
-  for (const uint32_t mode : kShadeModes) {
-    for (uint32_t caustics = 0; caustics < (specular ? 2u : 1u); ++caustics) {
-      auto sp = gpu::create_compute_pipeline(
-          ctx, {"baseline_shade_direct_" + std::to_string(mode) + (caustics ? "_caustics" : ""), *shade_spv, {},
-                sizeof(ShadePush), {mode, shared_.dir_ablation.one_shadow_map ? 1u : 0u, caustics}});
-      if (!sp) return sp.error();
-      (caustics ? shade_caustic_pipelines_ : shade_pipelines_)[mode] = gpu::PipelineHandle(ctx, std::move(*sp));
-    }
-  }
-  auto no_receivers = graph.create_zero_image("baseline_no_caustic_receivers", VK_FORMAT_R32G32B32A32_SFLOAT,
-                                              VK_IMAGE_USAGE_STORAGE_BIT);
-  if (!no_receivers) return no_receivers.error();
-  no_receivers_ = *no_receivers;
-  auto no_receiver_lamps = graph.create_buffer({"baseline_no_caustic_receiver_lamps", sizeof(shader::CausticReceivers)},
-                                               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-  if (!no_receiver_lamps) return no_receiver_lamps.error();
-  no_receiver_lamps_ = *no_receiver_lamps;
-  auto no_volume = graph.create_zero_image("baseline_no_volume", VK_FORMAT_R16G16B16A16_SFLOAT, VK_IMAGE_USAGE_SAMPLED_BIT, 2, 2, 2);
-  if (!no_volume) return no_volume.error();
-  no_volume_ = *no_volume;
-  auto no_indirect = graph.create_zero_image("baseline_no_indirect", VK_FORMAT_R32G32B32A32_UINT, VK_IMAGE_USAGE_STORAGE_BIT);
-  if (!no_indirect) return no_indirect.error();
-  no_indirect_ = *no_indirect;
-  return ok_status();
-}
-
-Status Baseline::record(const FrameInfo& info, std::vector<std::string>& skipped) {
-  if (info.level < 0 || info.level >= int(ladder_.size()))
-    return fail(ErrorKind::BadUsage, "baseline: level " + std::to_string(info.level) +
-                                         " outside 0.." + std::to_string(ladder_.size() - 1));
-  const BaselineLevel& level = levels_[size_t(info.level)];
-  shadow_size_ = level.shadow_map_size;
-  pcf_radius_ = level.pcf_radius;
-  gpu::FrameGraph& graph = *shared_.graph;
-  grid_ = caster_grid(graph.extent(shared_.real_position), shadow_size_, level.caster_cell_shadow_texels);
-  const SceneGpu& sg = *shared_.scene_gpu;
-  const SharedResources& s = shared_;
-  MRGI_TRY(update_lights(dir_ && dir_->shadowed_estimated >= 0 ? dir_->shadowed_estimated : level.shadowed_estimated_lights));
-  caustics_ = info.caustics && info.caustics->receivers.valid() && shade_caustic_pipelines_[0]->pipeline != VK_NULL_HANDLE;
-  receivers_ = caustics_ ? info.caustics->receivers : no_receivers_;
-  receiver_lamps_ = caustics_ ? info.caustics->receiver_lamps : no_receiver_lamps_;
-
-  if (plan_.primary.empty()) {
-    skipped.push_back("shadow_primary: no lamp in the scene");
-  } else {
-    if (real_caster_faces_ && grid_.index_count() > 0) {
-      graph.add_shader_pass(
-          "shadow_caster_mesh", gpu::PassKind::Compute, *caster_indices_pipeline_,
-          [this](gpu::ShaderPassBuilder& b) {
-            b.bind_sampled("real_position", shared_.real_position, shared_.context->samplers().nearest_clamp);
-            b.bind("Indices", caster_indices_);
-          },
-          [this](VkCommandBuffer cmd, gpu::PassContext&) {
-            const glm::ivec4 g(int(grid_.points.width), int(grid_.points.height), int(grid_.stride), 0);
-            gpu::dispatch_2d(cmd, *caster_indices_pipeline_, &g, sizeof(g), grid_.points.width - 1,
-                             grid_.points.height - 1);
-          });
-    }
-    graph.add_pass(
-        "shadow_primary", gpu::PassKind::Graphics,
-        [this](gpu::PassBuilder& b) {
-          b.read(shared_.real_position, gpu::Access::Sampled);
-          if (real_caster_faces_ && grid_.index_count() > 0) b.read(caster_indices_, gpu::Access::IndexBuffer);
-          b.read(shared_.scene_gpu->real_proxies.vertices, gpu::Access::VertexBuffer);
-          b.read(shared_.scene_gpu->real_proxies.indices, gpu::Access::IndexBuffer);
-          b.read(shared_.scene_gpu->virtual_objects.vertices, gpu::Access::VertexBuffer);
-          b.read(shared_.scene_gpu->virtual_objects.indices, gpu::Access::IndexBuffer);
-          b.write(shadow_primary_, gpu::Access::DepthAttachmentWrite);
-        },
-        [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
-          render_faces(cmd, pass, plan_.primary, primary_layer_views_);
-        });
-  }
-  if (plan_.real_lamps == 0) {
-    skipped.push_back("shadow_virtual_casters: no real lamp (virtual lamps use one map)");
-  } else if (sg.virtual_objects.empty()) {
-    skipped.push_back("shadow_virtual_casters: no virtual object in the scene");
-  } else {
-    graph.add_pass(
-        "shadow_virtual_casters", gpu::PassKind::Graphics,
-        [this](gpu::PassBuilder& b) {
-          b.read(shared_.scene_gpu->virtual_objects.vertices, gpu::Access::VertexBuffer);
-          b.read(shared_.scene_gpu->virtual_objects.indices, gpu::Access::IndexBuffer);
-          b.write(shadow_virtual_, gpu::Access::DepthAttachmentWrite);
-        },
-        [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
-          render_faces(cmd, pass, plan_.virtual_only, virtual_layer_views_);
-        });
-  }
-  (void)s;
-  const VkSampler compare = shared_.context->samplers().shadow_compare;
-  const VkSampler linear = shared_.context->samplers().linear_clamp;
-  const VkSampler nearest = shared_.context->samplers().nearest_clamp;
-  graph.add_shader_pass(
-      "shade_direct", gpu::PassKind::Compute, shade_pipeline(),
-      [this, compare, linear, nearest](gpu::ShaderPassBuilder& b) {
-        const char* names[9] = {"delta_r", "delta_g", "delta_b", "rho_r", "rho_g", "rho_b", "mu_r", "mu_g", "mu_b"};
-        for (int i = 0; i < 9; ++i) {
-          const gpu::ImageHandle* set = !bounce_ ? nullptr : i < 3 ? bounce_->delta : i < 6 ? bounce_->rho : bounce_->mu;
-          b.bind_sampled(names[i], set ? set[i % 3] : no_volume_, linear);
-        }
-        bind_shading_gbuffers(b, shared_);
-        b.bind("dir_indirect", dir_ ? dir_->merged : no_indirect_);
-        b.bind("LightUbo", lights_);
-        b.bind_sampled("shadow_primary", shadow_primary_, compare);
-        b.bind_sampled("shadow_virtual", shadow_virtual_, compare);
-        b.bind_sampled("shadow_primary_depth", shadow_primary_, nearest);  // kOneShadowMap only
-        b.bind_sampled("shadow_virtual_depth", shadow_virtual_, nearest);
-        b.bind("caustic_receivers", receivers_);
-        b.bind("CausticReceiverLamps", receiver_lamps_);
-      },
-      [this](VkCommandBuffer cmd, gpu::PassContext& pass) { shade(cmd, pass); });
-  return ok_status();
-}
-
-Status Baseline::update_lights(int shadowed_estimated) {
-  const light::Lighting& lighting = shared_.light_stage->lighting();
-  const SceneGpu& sg = *shared_.scene_gpu;
-  if (sg.revision() != planned_objects_) {
-    // The virtual objects moved: the maps are fitted to the scene's bounds again.
-    bounds_ = Bounds{};
-    if (!sg.virtual_objects.empty()) bounds_.add(sg.virtual_objects.bounds_min, sg.virtual_objects.bounds_max);
-    if (!sg.real_proxies.empty()) bounds_.add(sg.real_proxies.bounds_min, sg.real_proxies.bounds_max);
-    planned_objects_ = sg.revision();
-    planned_revision_ = ~uint64_t(0);
-  }
-  if (lighting.revision != planned_revision_ || shadowed_estimated != planned_shadowed_) {
-    // Declared lamps always get their maps; of the estimated lights (environment regions, the
-    // probeless dominant light), strongest first, the level's number do, the rest light as SH.
-    drawn_.clear();
-    folded_real_ = folded_virtual_ = light::ShRgb{};
-    int kept = 0;
-    for (size_t i = 0; i < lighting.lights.size(); ++i) {
-      const bool foldable = lighting.foldable[i] != 0;
-      if (!foldable || kept < shadowed_estimated) {
-        drawn_.push_back(lighting.lights[i]);
-        kept += foldable ? 1 : 0;
-        continue;
-      }
-      light::ShRgb& into = lighting.lights[i].real ? folded_real_ : folded_virtual_;
-      for (int c = 0; c < light::kMaxShCoeffs; ++c) into[size_t(c)] += lighting.light_sh[i][size_t(c)];
-    }
-    MRGI_TRY(plan_shadow_maps(drawn_, bounds_, "light stage lights", plan_));
-    if (shared_.scene_gpu->virtual_objects.empty()) {
-      // Nothing virtual casts: the virtual-caster maps would stay empty (all lit), so none is
-      // made and the shader treats st_v as 1.
-      plan_.virtual_only.clear();
-      for (int i = 0; i < plan_.light_set.count.x; ++i) plan_.light_set.lights[i].layers.y = -1;
-    }
-    real_caster_faces_ = false;
-    for (const ShadowFace& f : plan_.primary) real_caster_faces_ = real_caster_faces_ || f.real_casters;
-    planned_revision_ = lighting.revision;
-    planned_shadowed_ = shadowed_estimated;
-  }
-  auto* set = static_cast<shader::LightSet*>(shared_.graph->mapped(lights_, shared_.graph->slot()));
-  *set = plan_.light_set;
-  set->count.y = lighting.ambient_is_residual ? 1 : 0;
-  light::ShRgb real = lighting.ambient_real, both;
-  for (int i = 0; i < light::kMaxShCoeffs; ++i) {
-    real[size_t(i)] += folded_real_[size_t(i)];
-    both[size_t(i)] = real[size_t(i)] + lighting.ambient_virtual[size_t(i)] + folded_virtual_[size_t(i)];
-  }
-  const auto rv = light::irradiance_matrices(both);
-  const auto r = light::irradiance_matrices(real);
-  set->ambient_rv = {rv[0], rv[1], rv[2]};
-  set->ambient_r = {r[0], r[1], r[2]};
-  return ok_status();
-}
-
-void Baseline::render_faces(VkCommandBuffer cmd, gpu::PassContext& pass,
-                            const std::vector<ShadowFace>& faces,
-                            const std::vector<VkImageView>& layer_views) {
-  const gpu::Context& ctx = pass.context();
-  const SceneGpu& sg = *shared_.scene_gpu;
-  const uint32_t grid_indices = grid_.index_count();
-  const uint32_t s = shadow_size_;
-  for (const ShadowFace& face : faces) {
-    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-    depth.imageView = layer_views[size_t(face.layer)];
-    depth.imageLayout = depth_write_layout_;
-    depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-    depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-    depth.clearValue.depthStencil = {1.0f, 0};
-    VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-    ri.renderArea = {{0, 0}, {s, s}};
-    ri.layerCount = 1;
-    ri.pDepthAttachment = &depth;
-    pass.context().fn().cmd_begin_rendering(cmd, &ri);
-    const VkViewport vp{0.0f, 0.0f, float(s), float(s), 0.0f, 1.0f};
-    const VkRect2D sc{{0, 0}, {s, s}};
-    vkCmdSetViewport(cmd, 0, 1, &vp);
-    vkCmdSetScissor(cmd, 0, 1, &sc);
-    if (face.real_casters && grid_indices > 0) {
-      vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, grid_pipeline_->pipeline);
-      gpu::DescriptorPush()
-          .sampled_image(grid_pipeline_->interface.find("real_position")->binding, pass.view(shared_.real_position),
-                         ctx.samplers().nearest_clamp)
-          .push(ctx, cmd, *grid_pipeline_);
-      GridPush pc{face.view_proj, glm::ivec4(int(grid_.points.width), int(grid_.points.height), int(grid_.stride), 0)};
-      vkCmdPushConstants(cmd, grid_pipeline_->layout, grid_pipeline_->stages, 0, sizeof(pc), &pc);
-      vkCmdBindIndexBuffer(cmd, pass.buffer(caster_indices_), 0, VK_INDEX_TYPE_UINT32);
-      vkCmdDrawIndexed(cmd, grid_indices, 1, 0, 0, 0);
-    }
-    const bool proxies = face.real_casters && !sg.real_proxies.empty();
-    const bool virtuals = face.virtual_casters && !sg.virtual_objects.empty();
-    if (proxies || virtuals) {
-      vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mesh_pipeline_->pipeline);
-      vkCmdPushConstants(cmd, mesh_pipeline_->layout, mesh_pipeline_->stages, 0, sizeof(glm::mat4),
-                         &face.view_proj);
-      if (proxies) sg.real_proxies.draw(cmd, pass, nullptr);
-      if (virtuals) {
-        // The coarsest level of detail within half a map texel: finer geometry the map cannot
-        // hold (desk_spot's bunny at full detail into 256^2 maps: 2 ms of a 30 ms frame).
-        LodView lod = face.lod_per_texel;
-        lod.focal_px *= float(s);
-        lod.max_error_px = kCasterErrorTexels;
-        sg.virtual_objects.draw(cmd, pass, nullptr, nullptr, lod.focal_px > 0.0f ? &lod : nullptr);
-      }
-    }
-    pass.context().fn().cmd_end_rendering(cmd);
-  }
-}
-
-void Baseline::shade(VkCommandBuffer cmd, gpu::PassContext& pass) {
-  const SharedResources& r = shared_;
-  ShadePush pc{};
-  pc.shadow = shadow_constants();
-  if (bounce_) pc.volume = bounce_->constants;
-  if (dir_) pc.volume.mode.y = dir_->divisor;
-  const VkExtent2D e = pass.extent(r.lit_rv);
-  gpu::dispatch_2d(cmd, shade_pipeline(), &pc, sizeof(pc), e.width, e.height);
-}
 
 }  // namespace
 
-void set_volume_bounce(Technique& baseline, const VolumeBounce* bounce) {
-  if (auto* b = dynamic_cast<Baseline*>(&baseline)) b->set_volume_bounce(bounce);
-}
-
-void set_dir_indirect(Technique& baseline, const DirIndirect* indirect) {
-  if (auto* b = dynamic_cast<Baseline*>(&baseline)) b->set_dir_indirect(indirect);
-}
-
 const std::array<BaselineLevel, 4>& baseline_levels() {
-  static const std::array<BaselineLevel, 4> levels = {{
-      {"high", 2048, 1.0f, 1, 2.0, 4},
-      {"medium", 1024, 1.0f, 1, 2.0, 4},
-      {"low", 512, 0.75f, 1, 2.0, 2},
-      {"lowest", 256, 0.5f, 0, 2.0, 1},
-  }};
+  static const std::array<BaselineLevel, 4> levels = [] {
+    const auto& d = shading::direct_light_levels();
+    const char* names[4] = {"high", "medium", "low", "lowest"};
+    const float scales[4] = {1.0f, 1.0f, 0.75f, 0.5f};
+    std::array<BaselineLevel, 4> out{};
+    for (size_t i = 0; i < 4; ++i)
+      out[i] = {names[i], d[i].shadow_map_size, scales[i], d[i].pcf_radius, d[i].caster_cell_shadow_texels,
+                d[i].shadowed_estimated_lights};
+    return out;
+  }();
   return levels;
 }
 
@@ -516,12 +71,12 @@ Expected<std::vector<QualityLevel>> baseline_ladder(const std::vector<KnobSettin
   return ladder_of(*levels, baseline_levels(), kBaselineKnobs);
 }
 
-Expected<std::unique_ptr<Technique>> create_baseline(const SharedResources& shared) {
-  auto levels = baseline_levels(shared.knobs);
+Expected<std::unique_ptr<Technique>> create_baseline(const frame::FrameResources& frame, const TechniqueOptions& options) {
+  auto levels = baseline_levels(options.knobs);
   if (!levels) return levels.error();
-  auto t = std::make_unique<Baseline>(shared, std::move(*levels));
-  MRGI_TRY(t->init());
-  return std::unique_ptr<Technique>(std::move(t));
+  auto direct = shading::DirectLightBlock::create(frame, {});
+  if (!direct) return direct.error();
+  return std::unique_ptr<Technique>(std::make_unique<Baseline>(std::move(*levels), std::move(*direct)));
 }
 
 }  // namespace mrgi::technique

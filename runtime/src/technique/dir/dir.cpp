@@ -13,10 +13,9 @@
 #include "gpu/pipelines.h"
 #include "gpu/shaders.h"
 #include "light/light_stage.h"
-#include "technique/baseline/baseline.h"
-#include "technique/input_reuse.h"
+#include "gi/input_reuse.h"
 #include "technique/knobs.h"
-#include "technique/scene_gpu.h"
+#include "frame/scene_gpu.h"
 
 namespace mrgi::technique {
 
@@ -45,8 +44,8 @@ const KnobField<DirLevel> kDirKnobs[] = {
     {"internal_scale", "fraction of the output width and height", &DirLevel::internal_scale},
     {"mesh_error_px", "largest projected error of the virtual meshes' level of detail (internal pixels)",
      &DirLevel::mesh_error_px},
-    {"shadowed_env", "environment regions baseline shadows with maps (-1: its level's)", &DirLevel::shadowed_env},
-    {"baseline_level", "baseline's level for the direct light", &DirLevel::baseline_level},
+    {"shadowed_env", "environment regions the direct-light block shadows with maps (-1: its level's)", &DirLevel::shadowed_env},
+    {"baseline_level", "the direct-light block's level for the direct light", &DirLevel::baseline_level},
 };
 }  // namespace
 
@@ -103,16 +102,30 @@ struct TemporalPush {
 
 class Dir final : public Technique {
  public:
-  Dir(const SharedResources& shared, std::vector<DirLevel> levels)
-      : shared_(shared), ladder_(ladder_of(levels, dir_levels(), kDirKnobs)), levels_(std::move(levels)) {}
+  Dir(const frame::FrameResources& shared, std::vector<DirLevel> levels, const DirAblation& ablation)
+      : shared_(shared), ladder_(ladder_of(levels, dir_levels(), kDirKnobs)), levels_(std::move(levels)),
+        ablation_(ablation) {}
   const std::string& name() const override { return name_; }
   const std::vector<QualityLevel>& levels() const override { return ladder_; }
   Status init();
-  Status record(const FrameInfo& info, std::vector<std::string>& skipped) override;
+  Status record(const frame::FrameInfo& info, std::vector<std::string>& skipped) override;
 
  private:
+  // The VPL buffer's slots this frame (the lamps' VPLs take the rest).
+  struct VplSlots {
+    uint32_t bounce = 0, env = 0;  // bounce VPLs, environment VPLs
+    size_t first_region = 0;       // the first of the light stage's regions with an environment VPL
+    bool env_override = false;     // the level's shadowed_env holds: the VPLs shadow the regions
+  };
+  VplSlots plan_vpl_slots(const DirLevel& level, int level_shadowed);
+  Status make_vpls(const frame::FrameInfo& info, const DirLevel& level, const VplSlots& slots, float clamp_m, bool close,
+                   std::vector<std::string>& skipped);
+  Expected<shading::ScreenIndirect> record_vpl_light(const frame::FrameInfo& info, const DirLevel& level,
+                                                     const VplSlots& slots, float clamp_m,
+                                                     std::vector<std::string>& skipped);
+
   std::string name_ = "dir";
-  SharedResources shared_;
+  frame::FrameResources shared_;
   std::vector<QualityLevel> ladder_;
   std::vector<DirLevel> levels_;  // dir_levels() with RuntimeSettings::knobs applied
   std::optional<gi::ReflectiveShadowMaps> rsm_;
@@ -126,7 +139,7 @@ class Dir final : public Technique {
   } made_;
   int bounce_generations_ = 0;  // frames the bounce ran on inputs within reuse tolerance
   gpu::BufferHandle env_vpls_;  // this frame's environment VPLs (upload, per frame slot)
-  gpu::ImageHandle indirect_, rows_, merged_;  // RGBA32UI, shaders/dir/indirect_pack.glsl
+  gpu::ImageHandle indirect_, rows_, merged_;  // RGBA32UI, shaders/gi/indirect_pack.glsl
   gpu::ImageHandle smoothed_[2];               // temporal smoothing, alternate frames (history)
   gpu::PipelineHandle shade_, merge_rows_, merge_columns_, temporal_;
   // What the last smoothed image was made from: valid, its level, which image, the pose.
@@ -137,22 +150,17 @@ class Dir final : public Technique {
     glm::dmat4 camera_to_world{1.0};
     uint32_t width = 0, height = 0;  // the smoothed light's size
   } history_;
-  std::unique_ptr<Technique> baseline_;
-  bool baseline_recorded_ = false;  // this frame's record() recorded baseline's passes
-  Status record_baseline(const FrameInfo& base, std::vector<std::string>& skipped) {
-    baseline_recorded_ = true;
-    return baseline_->record(base, skipped);
-  }
-  std::optional<DirectLight> direct_light() const override {
-    return baseline_recorded_ ? baseline_->direct_light() : std::nullopt;
-  }
-  bool glossy_ = false;  // glossy VPLs: the scene has a glossy virtual material (SceneGpu::glossy)
+  DirAblation ablation_;  // TechniqueOptions::research
+  // The lamps' direct light, with the merged VPL light as its screen input.
+  std::unique_ptr<shading::DirectLightBlock> direct_;
+  std::optional<shading::DirectLightOutput> direct_light() const override { return direct_->output(); }
+  bool glossy_ = false;  // glossy VPLs: the scene has a glossy virtual material (frame::SceneGpu::glossy)
   // This frame's lamps with VPLs (light index, view); reserved at init (no allocation per frame).
   std::vector<std::pair<size_t, gi::RsmView>> planned_;
-  InputReuse reuse_;  // what the VPLs and ISMs in the buffers were made from
+  gi::InputReuse reuse_;  // what the VPLs and ISMs in the buffers were made from
   // Whether the lamp's light reaches a virtual object: the bounding sphere of some mesh range.
   bool lamp_reaches_objects(const LightDesc& lamp) const {
-    for (const DrawRange& d : shared_.scene_gpu->virtual_objects.draws)
+    for (const frame::DrawRange& d : shared_.scene_gpu->virtual_objects.draws)
       if (gi::lamp_reaches_sphere(lamp, 0.5f * (d.bounds_min + d.bounds_max), 0.5f * glm::length(d.bounds_max - d.bounds_min)))
         return true;
     return false;
@@ -164,7 +172,7 @@ class Dir final : public Technique {
 
 Status Dir::init() {
   gpu::FrameGraph& graph = *shared_.graph;
-  const SceneGpu& sg = *shared_.scene_gpu;
+  const frame::SceneGpu& sg = *shared_.scene_gpu;
   if (!shared_.light_stage) return fail(ErrorKind::Internal, "dir: no light stage");
   has_virtual_ = !sg.virtual_objects.empty();
   uint32_t top_vpls = 1, top_ism = 8, top_rsm = 16, top_lamps = 1, top_bounce = 0;
@@ -191,7 +199,7 @@ Status Dir::init() {
     vs.name = "dir vpl";
     vs.max_vpls = top_vpls;
     vs.map_size = top_rsm;
-    vs.history = true;  // reused while nothing moved (InputReuse)
+    vs.history = true;  // reused while nothing moved (gi::InputReuse)
     vs.glossy = sg.glossy;
     auto vpls = gi::VplSampler::create(graph, vs);
     if (!vpls) return vpls.error();
@@ -204,7 +212,7 @@ Status Dir::init() {
     auto ism = gi::ImperfectShadowMaps::create(graph, sg, shared_.real_position, shared_.real_normal, is);
     if (!ism) return ism.error();
     ism_.emplace(std::move(*ism));
-    if (top_bounce > 0 && !shared_.dir_ablation.one_bounce) {
+    if (top_bounce > 0 && !ablation_.one_bounce) {
       gi::VplBounceSettings bs;
       bs.name = "dir bounce";
       bs.max_slots = top_bounce;
@@ -244,12 +252,12 @@ Status Dir::init() {
     smoothed_[k] = *h;
   }
   // The shading pass with the ablations compiled in (shade_vpl.comp kAblation), the others plain.
-  const DirAblation& ablation = shared_.dir_ablation;
+  const DirAblation& ablation = ablation_;
   const uint32_t ablation_bits = (ablation.one_shadow_map ? 1u : 0u) | (ablation.no_real_only_vpls ? 2u : 0u);
   auto shade_spv = gpu::shader_spirv("dir/shade_vpl.comp");
   if (!shade_spv) return shade_spv.error();
   // Glossy VPLs (shade_vpl.comp kGlossy) only in a scene with a glossy virtual material
-  // (SceneGpu::glossy): the lobes cost every pixel every VPL, taken or not, on lavapipe.
+  // (frame::SceneGpu::glossy): the lobes cost every pixel every VPL, taken or not, on lavapipe.
   glossy_ = shared_.scene_gpu->glossy;
   auto shade = gpu::create_compute_pipeline(graph.context(), {"dir shade vpls", *shade_spv, {}, sizeof(DirPush),
                                                               {ablation_bits, glossy_ ? 1u : 0u}});
@@ -262,34 +270,32 @@ Status Dir::init() {
     *out = std::move(*p);
   }
   reuse_.reserve(size_t(shared_.depth_intrinsics.width) * size_t(shared_.depth_intrinsics.height), shared_.depth_scale);
-  SharedResources for_baseline = shared_;
-  for_baseline.knobs.clear();  // dir's knobs (baseline_level picks baseline's level)
-  auto base = create_baseline(for_baseline);
-  if (!base) return base.error();
-  baseline_ = std::move(*base);
+  shading::DirectLightOptions direct;
+  direct.one_shadow_map = ablation_.one_shadow_map;
+  direct.screen_indirect = true;
+  auto block = shading::DirectLightBlock::create(shared_, direct);
+  if (!block) return block.error();
+  direct_ = std::move(*block);
   return ok_status();
 }
 
-Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
-  baseline_recorded_ = false;
+Status Dir::record(const frame::FrameInfo& info, std::vector<std::string>& skipped) {
+  direct_->begin_frame();
   if (info.level < 0 || info.level >= int(levels_.size()))
     return fail(ErrorKind::BadUsage, "dir: level " + std::to_string(info.level) + " outside 0.." +
                                          std::to_string(levels_.size() - 1));
   const DirLevel& level = levels_[size_t(info.level)];
-  gpu::FrameGraph& graph = *shared_.graph;
   const light::Lighting& lighting = shared_.light_stage->lighting();
   if (!glossy_)
     skipped.push_back("dir glossy VPLs: no glossy virtual material (metallic > 0.1 or roughness < 0.7) in the scene; every VPL reflects diffusely");
-  FrameInfo base = info;
-  base.level = level.baseline_level;
-  set_dir_indirect(*baseline_, nullptr);
+  shading::DirectLightLevel direct = shading::direct_light_levels()[size_t(level.baseline_level)];
   planned_.clear();
   if (!has_virtual_) {
     skipped.push_back("dir VPLs: no virtual object in the scene (the bounce is the same in both solutions)");
     reuse_.forget();
     made_.valid = false;
     history_.valid = false;
-    return record_baseline(base, skipped);
+    return direct_->record(info, direct, {}, skipped);
   }
   // The maps follow the objects (their side, radius_, is fixed at start-up: rigid motion keeps it).
   centre_ = 0.5f * (shared_.scene_gpu->virtual_objects.bounds_max + shared_.scene_gpu->virtual_objects.bounds_min);
@@ -306,139 +312,172 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     reuse_.forget();
     made_.valid = false;
     history_.valid = false;
-    return record_baseline(base, skipped);
+    return direct_->record(info, direct, {}, skipped);
   }
   // The VPLs and ISMs in the buffers stand for this frame's while its inputs stay within
-  // tolerance of the frame that made them (technique/input_reuse.h): no map, VPL or ISM pass.
+  // tolerance of the frame that made them (gi/input_reuse.h): no map, VPL or ISM pass.
   reuse_.set_frame(info.level, info.camera_to_world, info.input, shared_.scene_gpu->revision());
   for (const auto& [i, view] : planned_) reuse_.add_lamp(lighting.lights[i]);
-  // Environment VPLs: the strongest regions of the stage's cut, one directional VPL each.
-  const std::vector<light::EnvLight>& regions = shared_.light_stage->environment_regions();
-  const uint32_t bounce_slots = bounce_ ? level.bounce_vpls : 0;
-  // The regions baseline shades with shadow maps at its level come first in the cut; the VPLs
-  // take the next ones, whose light baseline adds unshadowed in its SH ambient.
-  size_t shadowed = 0;
-  for (uint8_t f : lighting.foldable) shadowed += f != 0 ? 1 : 0;
-  // A level that leaves the regions' shadows to the VPLs (shadowed_env >= 0) does so only when
-  // there are environment VPLs (else the estimated lights, the probeless one too, keep their maps).
-  const bool env_override = level.shadowed_env >= 0 && !shared_.dir_ablation.no_environment_vpls && !regions.empty();
-  const int baseline_shadowed =
-      env_override ? level.shadowed_env : baseline_levels()[size_t(level.baseline_level)].shadowed_estimated_lights;
-  shadowed = std::min(shadowed, size_t(std::max(0, baseline_shadowed)));
-  const size_t first_region = std::min(shadowed, regions.size());
-  const uint32_t env_slots =
-      shared_.dir_ablation.no_environment_vpls
-          ? 0u
-          : std::min({level.env_vpls, uint32_t(regions.size() - first_region), level.vpls - bounce_slots - 1});
-  for (uint32_t k = 0; k < env_slots; ++k) {
-    LightDesc l;
-    l.type = LightType::Directional;
-    l.direction = glm::vec3(-regions[first_region + k].direction);
-    l.color = glm::vec3(regions[first_region + k].irradiance);
-    reuse_.add_lamp(l);
-  }
-  if (bounce_slots == 0)
+  const VplSlots slots = plan_vpl_slots(level, direct.shadowed_estimated_lights);
+  if (slots.bounce == 0)
     skipped.push_back(level.bounce_vpls == 0 ? "dir bounce VPLs: none at this level (one bounce)"
                                              : "dir bounce VPLs: off (ablation one-bounce)");
   // A VPL stands for the light of the map's area over the VPL count, (2 radius)^2 / vpls: its
   // 1 / d^2 is clamped at that disk's radius.
   const float clamp_m = 2.0f * radius_ / std::sqrt(float(M_PI) * float(level.vpls));
   const bool close = reuse_.close();
-  if (close && (bounce_slots == 0 || bounce_generations_ >= kBounceGenerations)) {
+  if (close && (slots.bounce == 0 || bounce_generations_ >= kBounceGenerations)) {
     skipped.push_back("dir maps, VPLs and ISMs: reused (level, pose, depth and lamps within tolerance of the frame that made them)");
   } else {
-    bounce_generations_ = close ? bounce_generations_ + 1 : 0;
-    // The G-buffer's focal lengths in its own pixels (the colour camera's, scaled to its size).
-    const VkExtent2D g = graph.extent(shared_.real_position);
-    const Intrinsics& c = shared_.color_intrinsics;
-    const glm::vec2 focal_px(float(c.fx * double(g.width) / double(std::max(1, c.width))),
-                             float(c.fy * double(g.height) / double(std::max(1, c.height))));
-    // The bounce light source reads the previous frame's VPLs and ISMs, so it runs first.
-    const bool bounce = bounce_slots > 0 && made_.valid;
-    if (bounce_slots > 0 && !made_.valid)
-      skipped.push_back("dir bounce VPLs: no previous frame's VPLs to bounce (the first frame that makes them)");
-    if (bounce) {
-      gi::BounceFrame bf;
-      bf.slots = bounce_slots;
-      bf.source_vpls = made_.vpls;
-      bf.source_ism_size = made_.ism_size;
-      bf.source_tiles_per_row = made_.tiles_per_row;
-      bf.centre = centre_;
-      bf.radius = radius_;
-      bf.clamp_m = clamp_m;
-      bf.bias_relative = kIsmBiasRelative;
-      bf.bias_m = kIsmBiasMetres;
-      bf.focal_px = focal_px;
-      MRGI_TRY(bounce_->add_bounce(graph, vpls_->buffer(), ism_->distances(), bf));
-    }
-    const uint32_t lamp_vpls = level.vpls - bounce_slots - env_slots;
-    // The real grid at about two points a map texel across the G-buffer's larger side (dlpv's rule).
-    const uint32_t stride = std::max(1u, uint32_t(std::ceil(double(std::max(g.width, g.height)) / (level.rsm_size / 2.0))));
-    vpls_->add_clear(graph);
-    if (bounce) MRGI_TRY(vpls_->add_copy(graph, "bounce", bounce_->buffer(), lamp_vpls, bounce_slots));
-    if (env_slots > 0) {
-      auto* env = static_cast<shader::Vpl*>(graph.mapped(env_vpls_, graph.slot()));
-      const float flags = float(MRGI_VPL_VALID | MRGI_VPL_DIRECTIONAL |
-                                (shared_.light_stage->environment_real() ? MRGI_VPL_REAL_PATH : 0));
-      for (uint32_t k = 0; k < env_slots; ++k) {
-        const light::EnvLight& r = regions[first_region + k];
-        env[k] = {glm::vec4(centre_, flags), glm::vec4(glm::vec3(r.direction), radius_), glm::vec4(glm::vec3(r.irradiance), 0.0f),
-                  glm::vec4(0.0f, 0.0f, 1.0f, -1.0f), glm::vec4(0.0f)};
-      }
-      MRGI_TRY(vpls_->add_copy(graph, "environment", env_vpls_, lamp_vpls + bounce_slots, env_slots));
-    }
-    rsm_->add_grid(graph, stride);
-    const uint32_t lamps = uint32_t(planned_.size());
-    uint32_t first = 0;
-    for (uint32_t k = 0; k < lamps; ++k) {
-      const auto& [i, view] = planned_[k];
-      const uint32_t count = lamp_vpls / lamps + (k < lamp_vpls % lamps ? 1 : 0);
-      if (count == 0) continue;
-      const std::string id = std::to_string(i);
-      const gi::RsmImages mu = rsm_->images(gi::RsmMap::RealOnly, level.rsm_size);
-      const gi::VplLamp lamp{view.light, glm::vec3(view.colour)};
-      if (lamp_reaches_objects(lighting.lights[i])) {
-        rsm_->add_pair(graph, id, view, level.rsm_size);
-        // Caustic VPLs (caustics-DIR Sec. 4.2.2): this lamp's photons, when the specular stage
-        // made a caustic map for it this frame.
-        std::optional<gi::VplCaustics> caustic;
-        if (info.caustics && !shared_.dir_ablation.no_caustic_vpls)
-          for (const CausticPhotons::Lamp& c : info.caustics->lamps)
-            if (glm::distance(c.position, lighting.lights[i].position) < 1e-4f) caustic = gi::VplCaustics{c.photons, c.view_proj, c.size};
-        MRGI_TRY(vpls_->add_sample(graph, id, rsm_->images(gi::RsmMap::WithVirtual, level.rsm_size), mu,
-                                   lighting.lights[i].real, lamp, first, count, caustic ? &*caustic : nullptr));
-      } else {
-        // The spot's cone misses the virtual objects: R^rho would be R^mu's copy (issue 15's skip).
-        skipped.push_back("dir rsm rho " + id + ": no virtual object in the lamp's cone (R^mu stands for both maps)");
-        rsm_->add_real(graph, id, view, level.rsm_size);
-        MRGI_TRY(vpls_->add_sample(graph, id, mu, mu, lighting.lights[i].real, lamp, first, count));
-      }
-      first += count;
-    }
-    gi::IsmFrame f;
-    f.vpls = level.vpls;
-    f.map_size = level.ism_size;
-    f.points_per_vpl = level.points_per_vpl;
-    f.focal_px = focal_px;
-    MRGI_TRY(ism_->add_build(graph, vpls_->buffer(), f));
-    reuse_.remember();
-    made_ = {true, level.vpls, level.ism_size, ism_->tiles_per_row(level.vpls)};
+    MRGI_TRY(make_vpls(info, level, slots, clamp_m, close, skipped));
   }
+  auto light = record_vpl_light(info, level, slots, clamp_m, skipped);
+  if (!light) return light.error();
+  // The environment regions the VPLs shadow are not also shadowed by maps.
+  if (slots.env_override) direct.shadowed_estimated_lights = level.shadowed_env;
+  return direct_->record(info, direct, *light, skipped);
+}
+
+// The VPL buffer's slots this frame: bounce VPLs, environment VPLs (their directions added to
+// the reuse's lamps), the rest the lamps'. `level_shadowed`: the estimated lights the direct-light
+// block's level shadows with maps.
+Dir::VplSlots Dir::plan_vpl_slots(const DirLevel& level, int level_shadowed) {
+  // Environment VPLs: the strongest regions of the stage's cut, one directional VPL each.
+  const std::vector<light::EnvLight>& regions = shared_.light_stage->environment_regions();
+  const light::Lighting& lighting = shared_.light_stage->lighting();
+  VplSlots slots;
+  slots.bounce = bounce_ ? level.bounce_vpls : 0;
+  // The regions the direct-light block shades with shadow maps at its level come first in the
+  // cut; the VPLs take the next ones, whose light the block adds unshadowed in its SH ambient.
+  size_t shadowed = 0;
+  for (uint8_t f : lighting.foldable) shadowed += f != 0 ? 1 : 0;
+  // A level that leaves the regions' shadows to the VPLs (shadowed_env >= 0) does so only when
+  // there are environment VPLs (else the estimated lights, the probeless one too, keep their maps).
+  slots.env_override = level.shadowed_env >= 0 && !ablation_.no_environment_vpls && !regions.empty();
+  const int map_shadowed = slots.env_override ? level.shadowed_env : level_shadowed;
+  shadowed = std::min(shadowed, size_t(std::max(0, map_shadowed)));
+  slots.first_region = std::min(shadowed, regions.size());
+  slots.env =
+      ablation_.no_environment_vpls
+          ? 0u
+          : std::min({level.env_vpls, uint32_t(regions.size() - slots.first_region), level.vpls - slots.bounce - 1});
+  for (uint32_t k = 0; k < slots.env; ++k) {
+    LightDesc l;
+    l.type = LightType::Directional;
+    l.direction = glm::vec3(-regions[slots.first_region + k].direction);
+    l.color = glm::vec3(regions[slots.first_region + k].irradiance);
+    reuse_.add_lamp(l);
+  }
+  return slots;
+}
+
+// The maps, VPLs and ISMs of this frame (the bounce light source first: it reads the previous
+// frame's VPLs and ISMs).
+Status Dir::make_vpls(const frame::FrameInfo& info, const DirLevel& level, const VplSlots& slots, float clamp_m,
+                      bool close, std::vector<std::string>& skipped) {
+  gpu::FrameGraph& graph = *shared_.graph;
+  const light::Lighting& lighting = shared_.light_stage->lighting();
+  const std::vector<light::EnvLight>& regions = shared_.light_stage->environment_regions();
+  bounce_generations_ = close ? bounce_generations_ + 1 : 0;
+  // The G-buffer's focal lengths in its own pixels (the colour camera's, scaled to its size).
+  const VkExtent2D g = graph.extent(shared_.real_position);
+  const Intrinsics& c = shared_.color_intrinsics;
+  const glm::vec2 focal_px(float(c.fx * double(g.width) / double(std::max(1, c.width))),
+                           float(c.fy * double(g.height) / double(std::max(1, c.height))));
+  // The bounce light source reads the previous frame's VPLs and ISMs, so it runs first.
+  const bool bounce = slots.bounce > 0 && made_.valid;
+  if (slots.bounce > 0 && !made_.valid)
+    skipped.push_back("dir bounce VPLs: no previous frame's VPLs to bounce (the first frame that makes them)");
+  if (bounce) {
+    gi::BounceFrame bf;
+    bf.slots = slots.bounce;
+    bf.source_vpls = made_.vpls;
+    bf.source_ism_size = made_.ism_size;
+    bf.source_tiles_per_row = made_.tiles_per_row;
+    bf.centre = centre_;
+    bf.radius = radius_;
+    bf.clamp_m = clamp_m;
+    bf.bias_relative = kIsmBiasRelative;
+    bf.bias_m = kIsmBiasMetres;
+    bf.focal_px = focal_px;
+    MRGI_TRY(bounce_->add_bounce(graph, vpls_->buffer(), ism_->distances(), bf));
+  }
+  const uint32_t lamp_vpls = level.vpls - slots.bounce - slots.env;
+  // The real grid at about two points a map texel across the G-buffer's larger side (dlpv's rule).
+  const uint32_t stride = std::max(1u, uint32_t(std::ceil(double(std::max(g.width, g.height)) / (level.rsm_size / 2.0))));
+  vpls_->add_clear(graph);
+  if (bounce) MRGI_TRY(vpls_->add_copy(graph, "bounce", bounce_->buffer(), lamp_vpls, slots.bounce));
+  if (slots.env > 0) {
+    auto* env = static_cast<shader::Vpl*>(graph.mapped(env_vpls_, graph.slot()));
+    const float flags = float(MRGI_VPL_VALID | MRGI_VPL_DIRECTIONAL |
+                              (shared_.light_stage->environment_real() ? MRGI_VPL_REAL_PATH : 0));
+    for (uint32_t k = 0; k < slots.env; ++k) {
+      const light::EnvLight& r = regions[slots.first_region + k];
+      env[k] = {glm::vec4(centre_, flags), glm::vec4(glm::vec3(r.direction), radius_), glm::vec4(glm::vec3(r.irradiance), 0.0f),
+                glm::vec4(0.0f, 0.0f, 1.0f, -1.0f), glm::vec4(0.0f)};
+    }
+    MRGI_TRY(vpls_->add_copy(graph, "environment", env_vpls_, lamp_vpls + slots.bounce, slots.env));
+  }
+  rsm_->add_grid(graph, stride);
+  const uint32_t lamps = uint32_t(planned_.size());
+  uint32_t first = 0;
+  for (uint32_t k = 0; k < lamps; ++k) {
+    const auto& [i, view] = planned_[k];
+    const uint32_t count = lamp_vpls / lamps + (k < lamp_vpls % lamps ? 1 : 0);
+    if (count == 0) continue;
+    const std::string id = std::to_string(i);
+    const gi::RsmImages mu = rsm_->images(gi::RsmMap::RealOnly, level.rsm_size);
+    const gi::VplLamp lamp{view.light, glm::vec3(view.colour)};
+    if (lamp_reaches_objects(lighting.lights[i])) {
+      rsm_->add_pair(graph, id, view, level.rsm_size);
+      // Caustic VPLs (caustics-DIR Sec. 4.2.2): this lamp's photons, when the specular stage
+      // made a caustic map for it this frame.
+      std::optional<gi::VplCaustics> caustic;
+      if (info.caustics && !ablation_.no_caustic_vpls)
+        for (const frame::CausticPhotons::Lamp& c : info.caustics->lamps)
+          if (glm::distance(c.position, lighting.lights[i].position) < 1e-4f) caustic = gi::VplCaustics{c.photons, c.view_proj, c.size};
+      MRGI_TRY(vpls_->add_sample(graph, id, rsm_->images(gi::RsmMap::WithVirtual, level.rsm_size), mu,
+                                 lighting.lights[i].real, lamp, first, count, caustic ? &*caustic : nullptr));
+    } else {
+      // The spot's cone misses the virtual objects: R^rho would be R^mu's copy, so only R^mu is drawn.
+      skipped.push_back("dir rsm rho " + id + ": no virtual object in the lamp's cone (R^mu stands for both maps)");
+      rsm_->add_real(graph, id, view, level.rsm_size);
+      MRGI_TRY(vpls_->add_sample(graph, id, mu, mu, lighting.lights[i].real, lamp, first, count));
+    }
+    first += count;
+  }
+  gi::IsmFrame f;
+  f.vpls = level.vpls;
+  f.map_size = level.ism_size;
+  f.points_per_vpl = level.points_per_vpl;
+  f.focal_px = focal_px;
+  MRGI_TRY(ism_->add_build(graph, vpls_->buffer(), f));
+  reuse_.remember();
+  made_ = {true, level.vpls, level.ism_size, ism_->tiles_per_row(level.vpls)};
+  return ok_status();
+}
+
+// The VPLs' light at the level's resolution (eq. 6-8, interleaved), merged geometry-aware and
+// smoothed over frames: the direct-light block's screen input.
+Expected<shading::ScreenIndirect> Dir::record_vpl_light(const frame::FrameInfo& info, const DirLevel& level,
+                                                        const VplSlots& slots, float clamp_m,
+                                                        std::vector<std::string>& skipped) {
+  gpu::FrameGraph& graph = *shared_.graph;
   for (gpu::ImageHandle h : {indirect_, rows_, merged_, smoothed_[0], smoothed_[1]})
     MRGI_TRY(graph.set_extent_divisor(h, level.indirect_divisor));
   const VkExtent2D low = graph.extent(indirect_);
   const DirPush push{glm::ivec4(int(level.vpls), int(level.ism_size), int(ism_->tiles_per_row(level.vpls)),
                                 int(level.interleave)),
                      glm::vec4(clamp_m, kIsmBiasRelative, kIsmBiasMetres, 0.0f),
-                     glm::ivec4(int(low.width), int(low.height), int(level.indirect_divisor), int(level.vpls - env_slots))};
-  const SharedResources& r = shared_;
+                     glm::ivec4(int(low.width), int(low.height), int(level.indirect_divisor), int(level.vpls - slots.env))};
+  const frame::FrameResources& r = shared_;
   const gpu::Pipeline* shade = &*shade_;
   const gpu::BufferHandle vpl_buffer = vpls_->buffer();
   const gpu::ImageHandle distances = ism_->distances(), indirect = indirect_, rows = rows_, merged = merged_;
   graph.add_shader_pass(
       "dir shade vpls", gpu::PassKind::Compute, *shade_,
       [&](gpu::ShaderPassBuilder& b) {
-        bind_gbuffer_reads(b, r);
+        frame::bind_gbuffer_reads(b, r);
         b.bind("Vpls", vpl_buffer);
         b.bind("ism_distances", distances, 0);
         b.bind("indirect", indirect);
@@ -456,9 +495,8 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
       [merge_rows, push, low](VkCommandBuffer cmd, gpu::PassContext&) {
         gpu::dispatch_2d(cmd, *merge_rows, &push, sizeof push, low.width, low.height);
       });
-  DirIndirect to_add{merged_, int(level.indirect_divisor)};
-  to_add.shadowed_estimated = env_override ? level.shadowed_env : -1;
-  if (shared_.dir_ablation.no_temporal_smoothing) {
+  shading::ScreenIndirect to_add{merged_, int(level.indirect_divisor)};
+  if (ablation_.no_temporal_smoothing) {
     skipped.push_back("dir temporal smoothing: off (ablation no-temporal-smoothing)");
     history_.valid = false;
     // The merge's column half as a pass of its own (temporal.comp runs it otherwise).
@@ -501,18 +539,17 @@ Status Dir::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     if (!have)
       skipped.push_back("dir temporal smoothing: no history at this level and resolution yet (the frame's own light)");
     history_ = {true, info.level, write, info.camera_to_world, low.width, low.height};
-    to_add.merged = smoothed_[write];
+    to_add.packed = smoothed_[write];
   }
-  set_dir_indirect(*baseline_, &to_add);
-  return record_baseline(base, skipped);
+  return to_add;
 }
 
 }  // namespace
 
-Expected<std::unique_ptr<Technique>> create_dir(const SharedResources& shared) {
-  auto levels = dir_levels(shared.knobs);
+Expected<std::unique_ptr<Technique>> create_dir(const frame::FrameResources& shared, const TechniqueOptions& options) {
+  auto levels = dir_levels(options.knobs);
   if (!levels) return levels.error();
-  auto t = std::make_unique<Dir>(shared, std::move(*levels));
+  auto t = std::make_unique<Dir>(shared, std::move(*levels), options.research.dir);
   MRGI_TRY(t->init());
   return std::unique_ptr<Technique>(std::move(t));
 }

@@ -6,12 +6,12 @@
 // Sec. 3.3); one pass shades every pixel's share of the VPLs into both solutions with the flags
 // (shaders/dir/shade_vpl.comp, eq. 6-8), interleaved 4x4 and merged geometry-aware
 // (shaders/dir/merge_rows.comp, dir/merge_column.glsl: separable; the column half runs inside
-// the temporal smoothing's pass when that is on); baseline's shading pass adds it
+// the temporal smoothing's pass when that is on); the direct-light block's shading pass adds it
 // to both solutions with its direct light, at the level's baseline level: the same
 // real/virtual shadow-map pair per lamp, eq. 1-5. Beside the lamps' VPLs: the bounce light
 // source's (gi/vpl_bounce.h: VPLs lit by last frame's, eq. 9-10, multiple bounces over frames)
 // and the environment's (directional VPLs, one per median-cut region); the merged light is
-// smoothed over frames (shaders/dir/temporal.comp) before baseline adds it.
+// smoothed over frames (shaders/dir/temporal.comp) before the direct-light block adds it.
 //
 // Quality ladder (best first; DirLevel below, with units):
 //   level    VPLs  bounce  env  ISM    points/VPL  RSM    RSM lamps  interleave  indirect  scale  baseline
@@ -22,12 +22,12 @@
 //   fastest   16    0       4    32^2   128         64^2  1          4x4         1/2       0.5    lowest
 // "bounce": of the VPLs, the slots of the bounce light source (gi/vpl_bounce.h: multiple bounces
 // over frames; 0: one bounce, the fast path). "env": of the VPLs, at most this many
-// environment VPLs (Sec. 3.7): the light stage's median-cut regions after those baseline shades
+// environment VPLs (Sec. 3.7): the light stage's median-cut regions after those the direct-light block shades
 // with shadow maps at its level, each a directional VPL with an orthographic ISM over the
 // influence sphere, shaded at every pixel (not interleaved: it is direct light); its light is in
-// baseline's SH ambient, unshadowed, so the VPL adds what its maps take away (below). The rest
+// the direct-light block's SH ambient, unshadowed, so the VPL adds what its maps take away (below). The rest
 // of the slots are the lamps'. "indirect": the VPL light is shaded at this fraction of the
-// internal resolution and up-sampled geometry-aware in baseline's shading pass. "scale": internal scale, the fraction of the output's side.
+// internal resolution and up-sampled geometry-aware in the direct-light block's shading pass. "scale": internal scale, the fraction of the output's side.
 // "paper" is the paper's settings (Sec. 6: 256 VPLs, 128^2 ISMs, 1024 points a VPL, 4x4 split).
 // The fast levels' RSMs are 64^2: on lavapipe a map's cost is the real grid's triangles (a grid
 // point every two map texels: 128^2 took 1.5-2.3 ms at fast on corner, 64^2 0.55 ms), and 32
@@ -56,12 +56,12 @@
 //     sampling, as the paper's hierarchical warping of the fisheye image) as directional VPLs with
 //     orthographic ISMs, not point VPLs on a hemisphere (a point a few radii out lights the
 //     sphere's near side several times its far side and sees it through a few texels); and they
-//     correct baseline's unshadowed ambient instead of carrying the light themselves: on real
+//     correct the direct-light block's unshadowed ambient instead of carrying the light themselves: on real
 //     pixels L_rv gets L_o (min(st_r, st_v) - st_r), the paper's L_rv - L_r of the VPL, while L_r
-//     keeps baseline's smooth level (the composite divides by it; the sparse real ISM's
+//     keeps the direct-light block's smooth level (the composite divides by it; the sparse real ISM's
 //     self-shadowing made it noisy: env_fisheye real RDE 1.31 carrying the light, 0.87 so); on
 //     virtual pixels L_o (min(st_r, st_v) - 1), so L_rv holds the region's light times its
-//     visibility as the paper's. The strongest regions keep baseline's shadow maps;
+//     visibility as the paper's. The strongest regions keep the direct-light block's shadow maps;
 //   - temporal smoothing (the paper's [4]) reprojects the previous frame's smoothed light by the
 //     pose and blends it by a confidence from the change of normal and camera distance (the
 //     merge's same-surface test on the reprojected taps) and of the light's luminance
@@ -74,20 +74,20 @@
 //     whole BRDF; real surfaces stay diffuse (the paper's real specular is 0). The lobe's
 //     Schlick grazing term takes the incident flux as grey.
 // Ablations (mrgi/runtime.h DirAblation, `mrgi replay --dir-ablation`): one shadow map a lamp
-// and one ISM a VPL instead of two (the lamps' direct light too: baseline's shading pass reads its
-// two maps as one, shade_direct.comp kOneShadowMap), no ir(VPL), one bounce, no environment
+// and one ISM a VPL instead of two (the lamps' direct light too: the direct-light block's shading pass reads its
+// two maps as one, shading/direct_light.comp kOneShadowMap), no ir(VPL), one bounce, no environment
 // VPLs, no temporal smoothing (these four change the VPL light only).
 //
 // Skips (each in FrameStats::skipped):
-//   - no glossy virtual material (technique/scene_gpu.h SceneGpu::glossy): no lobes (the shading
+//   - no glossy virtual material (frame/scene_gpu.h frame::SceneGpu::glossy): no lobes (the shading
 //     and bounce pipelines are compiled without them), every VPL diffuse;
-//   - no virtual object, or no lamp a map can see them from: no maps, VPLs or ISMs (baseline only);
+//   - no virtual object, or no lamp a map can see them from: no maps, VPLs or ISMs (the direct-light block only);
 //   - a spot lamp whose outer cone misses every virtual mesh range's bounding sphere: R^mu only,
 //     read as both maps (R^rho would be its copy);
 //   - no bounce pass at the levels without bounce slots (and none on a frame after one without
 //     VPLs: the bounce reads the previous frame's);
 //   - the maps, VPLs and ISMs are reused, none drawn, sampled or splatted, while the level, the
-//     camera pose, the depth frame and the lamps stay within technique/input_reuse.h's
+//     camera pose, the depth frame and the lamps stay within gi/input_reuse.h's
 //     tolerances of the frame that made them (the virtual objects are static: their pose joins
 //     the comparison with dynamic scenes); a reused frame stays within 4/255 of the recomputed
 //     one at 1.8 mm of depth change (tests/technique/dir_test.cpp: 3/255 measured); with bounce
@@ -117,13 +117,13 @@ struct DirLevel {
   uint32_t indirect_divisor;  // G-buffer pixels per side of an indirect-light texel (1, 2, 4)
   float internal_scale;     // fraction of the output width and height
   float mesh_error_px;      // QualityLevel::mesh_error_px: the virtual G-buffer's level of detail
-  int shadowed_env;         // environment regions baseline shadows with maps (-1: its level's)
-  int baseline_level;       // baseline's level for the direct light
+  int shadowed_env;         // environment regions the direct-light block shadows with maps (-1: its level's)
+  int baseline_level;       // the direct-light block's level for the direct light
 };
 const std::array<DirLevel, 5>& dir_levels();  // the defaults
 // The defaults with RuntimeSettings::knobs applied (technique/knobs.h; BadUsage for a refused one).
 Expected<std::vector<DirLevel>> dir_levels(const std::vector<KnobSetting>& knobs);
 Expected<std::vector<QualityLevel>> dir_ladder(const std::vector<KnobSetting>& knobs);
-Expected<std::unique_ptr<Technique>> create_dir(const SharedResources& shared);
+Expected<std::unique_ptr<Technique>> create_dir(const frame::FrameResources& shared, const TechniqueOptions& options);
 
 }  // namespace mrgi::technique

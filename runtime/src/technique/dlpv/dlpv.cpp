@@ -10,11 +10,10 @@
 #include "gi/rsm.h"
 #include "gpu/pipelines.h"
 #include "light/light_stage.h"
-#include "technique/baseline/baseline.h"
-#include "technique/input_reuse.h"
+#include "gi/input_reuse.h"
 #include "technique/knobs.h"
-#include "technique/light_set_writer.h"
-#include "technique/scene_gpu.h"
+#include "light/light_set_writer.h"
+#include "frame/scene_gpu.h"
 
 namespace mrgi::technique {
 
@@ -37,9 +36,9 @@ const KnobField<DlpvLevel> kDlpvKnobs[] = {
     {"rsm_lamps", "real lamps, strongest first, with a map pair", &DlpvLevel::rsm_lamps},
     {"rho_volume", "1: V^rho propagated for the virtual pixels", &DlpvLevel::rho_volume},
     {"internal_scale", "fraction of the output width and height", &DlpvLevel::internal_scale},
-    {"antiradiance_shadows", "1: shadows as the volume's antiradiance (Algorithm 1); 0: baseline's shadow maps",
+    {"antiradiance_shadows", "1: shadows as the volume's antiradiance (Algorithm 1); 0: the direct-light block's shadow maps",
      &DlpvLevel::antiradiance_shadows},
-    {"baseline_level", "baseline's level for the shadow maps", &DlpvLevel::baseline_level},
+    {"baseline_level", "the direct-light block's level for the shadow maps", &DlpvLevel::baseline_level},
 };
 }  // namespace
 
@@ -66,18 +65,27 @@ constexpr float kMinVolumeSide = 0.25f;
 
 class Dlpv final : public Technique {
  public:
-  Dlpv(const SharedResources& shared, std::vector<DlpvLevel> levels)
-      : shared_(shared), ladder_(ladder_of(levels, dlpv_levels(), kDlpvKnobs)), levels_(std::move(levels)) {}
+  Dlpv(const frame::FrameResources& shared, std::vector<DlpvLevel> levels, const DlpvAblation& ablation)
+      : shared_(shared), ladder_(ladder_of(levels, dlpv_levels(), kDlpvKnobs)), levels_(std::move(levels)),
+        ablation_(ablation) {}
   const std::string& name() const override { return name_; }
   const std::vector<QualityLevel>& levels() const override { return ladder_; }
   Status init();
-  Status record(const FrameInfo& info, std::vector<std::string>& skipped) override;
+  Status record(const frame::FrameInfo& info, std::vector<std::string>& skipped) override;
 
  private:
   void write_lights();
+  // What record_volumes made this frame.
+  struct MadeVolumes {
+    bool delta = false, rho = false;  // V^Delta (V^rho - V^mu in the ablation) and V^rho present
+    MergePush push{};                 // the lookup's grid and extent
+  };
+  Status record_volumes(const frame::FrameInfo& info, const DlpvLevel& level, MadeVolumes& made,
+                        std::vector<std::string>& skipped);
+  void add_merge_pass(const MergePush& push);
 
   std::string name_ = "dlpv";
-  SharedResources shared_;
+  frame::FrameResources shared_;
   std::vector<QualityLevel> ladder_;
   std::vector<DlpvLevel> levels_;  // dlpv_levels() with RuntimeSettings::knobs applied
   gpu::BufferHandle lights_;  // shader::LightSet, one per frame slot
@@ -85,16 +93,11 @@ class Dlpv final : public Technique {
   std::optional<gi::LightPropagationVolume> delta_, rho_;
   std::optional<gi::LightPropagationVolume> mu_;  // DlpvAblation::two_volumes only
   gpu::PipelineHandle merge_;
-  std::unique_ptr<Technique> baseline_;  // direct light with shadow maps (not antiradiance levels)
-  bool baseline_recorded_ = false;  // this frame's record() recorded baseline's passes
-  Status record_baseline(const FrameInfo& base, std::vector<std::string>& skipped) {
-    baseline_recorded_ = true;
-    return baseline_->record(base, skipped);
-  }
-  std::optional<DirectLight> direct_light() const override {
-    return baseline_recorded_ ? baseline_->direct_light() : std::nullopt;
-  }
-  InputReuse reuse_;                    // what the volumes in the images were made from
+  DlpvAblation ablation_;  // TechniqueOptions::research
+  // Direct light with shadow maps (not the antiradiance levels), the volumes as its input.
+  std::unique_ptr<shading::DirectLightBlock> direct_;
+  std::optional<shading::DirectLightOutput> direct_light() const override { return direct_->output(); }
+  gi::InputReuse reuse_;                    // what the volumes in the images were made from
   bool source_delta_ = false, source_rho_ = false;  // which volumes that frame made
   bool has_virtual_ = false;
   glm::vec3 centre_{0.0f};
@@ -103,7 +106,7 @@ class Dlpv final : public Technique {
 
 Status Dlpv::init() {
   gpu::FrameGraph& graph = *shared_.graph;
-  const SceneGpu& sg = *shared_.scene_gpu;
+  const frame::SceneGpu& sg = *shared_.scene_gpu;
   if (!shared_.light_stage) return fail(ErrorKind::Internal, "dlpv: no light stage");
   auto lights = graph.create_buffer({"dlpv_lights", sizeof(shader::LightSet), gpu::MemoryUsage::Upload, true},
                                     VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
@@ -129,7 +132,7 @@ Status Dlpv::init() {
   }
   // Without virtual objects nothing is injected; the volumes are then 2^3, allocated only so the
   // merge binds images of the kind it declares (it reads none of them).
-  const DlpvAblation& ablation = shared_.dlpv_ablation;
+  const DlpvAblation& ablation = ablation_;
   gi::LpvSettings ds;
   ds.name = "dlpv delta";
   ds.resolution = top_cells;
@@ -155,26 +158,25 @@ Status Dlpv::init() {
   if (!merge) return merge.error();
   merge_ = std::move(*merge);
   reuse_.reserve(size_t(shared_.depth_intrinsics.width) * size_t(shared_.depth_intrinsics.height), shared_.depth_scale);
-  SharedResources for_baseline = shared_;
-  for_baseline.knobs.clear();  // dlpv's knobs (baseline_level picks baseline's level)
-  auto base = create_baseline(for_baseline);
-  if (!base) return base.error();
-  baseline_ = std::move(*base);
+  shading::DirectLightOptions direct;
+  direct.volume_indirect = true;
+  auto block = shading::DirectLightBlock::create(shared_, direct);
+  if (!block) return block.error();
+  direct_ = std::move(*block);
   return ok_status();
 }
 
 void Dlpv::write_lights() {
   auto* set = static_cast<shader::LightSet*>(shared_.graph->mapped(lights_, shared_.graph->slot()));
-  write_unshadowed_light_set(shared_.light_stage->lighting(), *set);
+  light::write_unshadowed_light_set(shared_.light_stage->lighting(), *set);
 }
 
-Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
-  baseline_recorded_ = false;
+Status Dlpv::record(const frame::FrameInfo& info, std::vector<std::string>& skipped) {
+  direct_->begin_frame();
   if (info.level < 0 || info.level >= int(levels_.size()))
     return fail(ErrorKind::BadUsage, "dlpv: level " + std::to_string(info.level) + " outside 0.." +
                                          std::to_string(levels_.size() - 1));
   const DlpvLevel& level = levels_[size_t(info.level)];
-  gpu::FrameGraph& graph = *shared_.graph;
   const bool antiradiance = level.antiradiance_shadows;
   const bool two = mu_.has_value();  // DlpvAblation::two_volumes
   if (two && antiradiance)
@@ -182,16 +184,51 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
                                                  "with shadow-mapped direct light; level '") + level.name +
                                          "' shadows with V^Delta's antiradiance");
   write_lights();
+  MadeVolumes made;
+  MRGI_TRY(record_volumes(info, level, made, skipped));
+  if (antiradiance) {
+    add_merge_pass(made.push);
+    return ok_status();
+  }
+  const gpu::ImageHandle dvol[3] = {delta_->accumulated(0), delta_->accumulated(1), delta_->accumulated(2)};
+  const gpu::ImageHandle rvol[3] = {rho_->accumulated(0), rho_->accumulated(1), rho_->accumulated(2)};
+  // Direct light and its shadows: the direct-light block at the matching level writes both
+  // solutions, recorded after the volumes so that its shading adds their bounce light in the
+  // same pass (its volume input): V^Delta on real pixels (the two-volume ablation: V^rho minus
+  // V^mu), V^rho on virtual ones.
+  const shading::DirectLightLevel& direct = shading::direct_light_levels()[size_t(level.baseline_level)];
+  if (!(made.delta || made.rho)) return direct_->record(info, direct, {}, skipped);
+  shading::VolumeIndirect bounce;
+  bounce.real_term = two ? shading::VolumeIndirect::RealTerm::Difference : shading::VolumeIndirect::RealTerm::One;
+  bounce.virtual_present = made.rho;
+  for (uint32_t c = 0; c < 3; ++c) {
+    bounce.real[c] = two ? rvol[c] : dvol[c];
+    bounce.subtract[c] = two ? mu_->accumulated(c) : dvol[c];
+    bounce.virtual_[c] = rvol[c];
+  }
+  bounce.constants = {made.push.grid, made.push.extent};
+  return direct_->record(info, direct, bounce, skipped);
+}
+
+// The volumes this frame: V^Delta (and V^rho where the level has it; V^rho and V^mu in the
+// two-volume ablation) injected from the real lamps' map pairs and propagated, or kept from the
+// frame that made them. Fills `made` with which are present and the lookup's constants.
+Status Dlpv::record_volumes(const frame::FrameInfo& info, const DlpvLevel& level, MadeVolumes& made,
+                            std::vector<std::string>& skipped) {
+  gpu::FrameGraph& graph = *shared_.graph;
+  const bool antiradiance = level.antiradiance_shadows;
+  const bool two = mu_.has_value();  // DlpvAblation::two_volumes
   const light::Lighting& lighting = shared_.light_stage->lighting();
-  bool delta_present = false, rho_present = false;
-  MergePush push{};
+  bool& delta_present = made.delta;
+  bool& rho_present = made.rho;
+  MergePush& push = made.push;
   if (!has_virtual_) {
     skipped.push_back("dlpv volumes: no virtual object in the scene");
   } else {
     MRGI_TRY(delta_->set_cells(graph, level.volume_cells));
     MRGI_TRY(rho_->set_cells(graph, level.volume_cells));
     // The volumes follow the objects (their side is fixed at start-up: rigid motion keeps it).
-    const SceneGpu& sg = *shared_.scene_gpu;
+    const frame::SceneGpu& sg = *shared_.scene_gpu;
     centre_ = 0.5f * (sg.virtual_objects.bounds_max + sg.virtual_objects.bounds_min);
     const gi::LpvGrid grid{centre_ - glm::vec3(0.5f * side_), side_ / float(level.volume_cells)};
     delta_->set_grid(grid);
@@ -247,7 +284,7 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
       if (!two) delta_->add_inject(graph, "delta " + id, rho_map, view->lpv, gi::InjectKind::Indirect, 1.0f, &mu_map);
       if (level.rho_volume || two)
         rho_->add_inject(graph, "rho " + id, rho_map, view->lpv,
-                         !two && shared_.dlpv_ablation.no_virtual_self_bounce ? gi::InjectKind::IndirectFromReal
+                         !two && ablation_.no_virtual_self_bounce ? gi::InjectKind::IndirectFromReal
                                                                               : gi::InjectKind::Indirect,
                          1.0f);
       if (two) mu_->add_inject(graph, "mu " + id, mu_map, view->lpv, gi::InjectKind::Indirect, 1.0f);
@@ -286,31 +323,22 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     push.extent = glm::vec4(float(delta_->settings().resolution), float(level.volume_cells), delta_present ? 1.0f : 0.0f,
                             rho_present ? 1.0f : 0.0f);
   }
-  const SharedResources& r = shared_;
+  return ok_status();
+}
+
+// The antiradiance levels' own shading (dlpv/merge.comp): lamps unshadowed, V^Delta's
+// antiradiance for their shadows and its bounce, V^rho on virtual pixels.
+void Dlpv::add_merge_pass(const MergePush& push) {
+  gpu::FrameGraph& graph = *shared_.graph;
+  const frame::FrameResources& r = shared_;
   const gpu::Pipeline* merge = &*merge_;
-  const gpu::Context& ctx = *shared_.context;
-  const VkSampler linear = ctx.samplers().linear_clamp;
+  const VkSampler linear = shared_.context->samplers().linear_clamp;
   const gpu::ImageHandle dvol[3] = {delta_->accumulated(0), delta_->accumulated(1), delta_->accumulated(2)};
   const gpu::ImageHandle rvol[3] = {rho_->accumulated(0), rho_->accumulated(1), rho_->accumulated(2)};
-  if (!antiradiance) {
-    // Direct light and its shadows: baseline's passes at the matching level write both
-    // solutions, recorded after the volumes so that its shading adds their bounce light in the
-    // same pass (shaders/baseline/shade_direct.comp, kVolumeBounce).
-    FrameInfo base = info;
-    base.level = level.baseline_level;
-    const bool bounce_present = delta_present || rho_present;
-    VolumeBounce bounce{{dvol[0], dvol[1], dvol[2]},
-                        {rvol[0], rvol[1], rvol[2]},
-                        {two ? mu_->accumulated(0) : dvol[0], two ? mu_->accumulated(1) : dvol[1],
-                         two ? mu_->accumulated(2) : dvol[2]},
-                        {push.grid, push.extent, glm::ivec4(two ? 1 : 0, 0, 0, 0)}};
-    set_volume_bounce(*baseline_, bounce_present ? &bounce : nullptr);
-    return record_baseline(base, skipped);
-  }
   graph.add_shader_pass(
       "dlpv merge", gpu::PassKind::Compute, *merge_,
       [&](gpu::ShaderPassBuilder& b) {
-        bind_shading_gbuffers(b, r);
+        frame::bind_shading_gbuffers(b, r);
         b.bind("LightUbo", lights_);
         const char* d[3] = {"delta_r", "delta_g", "delta_b"};
         const char* p[3] = {"rho_r", "rho_g", "rho_b"};
@@ -323,15 +351,15 @@ Status Dlpv::record(const FrameInfo& info, std::vector<std::string>& skipped) {
         const VkExtent2D e = p.extent(lit);
         gpu::push_and_dispatch(cmd, *merge, &push, sizeof push, {(e.width + 7) / 8, (e.height + 7) / 8, 1});
       });
-  return ok_status();
 }
+
 
 }  // namespace
 
-Expected<std::unique_ptr<Technique>> create_dlpv(const SharedResources& shared) {
-  auto levels = dlpv_levels(shared.knobs);
+Expected<std::unique_ptr<Technique>> create_dlpv(const frame::FrameResources& shared, const TechniqueOptions& options) {
+  auto levels = dlpv_levels(options.knobs);
   if (!levels) return levels.error();
-  auto t = std::make_unique<Dlpv>(shared, std::move(*levels));
+  auto t = std::make_unique<Dlpv>(shared, std::move(*levels), options.research.dlpv);
   MRGI_TRY(t->init());
   return std::unique_ptr<Technique>(std::move(t));
 }

@@ -16,9 +16,8 @@
 // "paper" is the published method with its settings (Sec. 5); the others keep its volume and
 // light the scene directly with shadow maps (Sec. 7's alternative), because the antiradiance
 // shadow is coarse (a 32^3 volume over twice the object) and cut off where the volume ends.
-// Those levels record baseline's passes after the volumes, and baseline's shading pass adds the
-// volumes' bounce light as it shades each pixel (shade_direct.comp kVolumeBounce, set through
-// set_volume_bounce): a pass of its own cost its G-buffer reads and L_rv's read-modify-write.
+// Those levels record the direct-light block after the volumes, and its shading pass adds the
+// volumes' bounce light as it shades each pixel (shading/direct_light.comp, its volume input): a pass of its own cost its G-buffer reads and L_rv's read-modify-write.
 //
 // Where mrgi differs from the paper and why:
 //   - the propagation gathers with exact face solid angles and damps negative flux by the
@@ -59,7 +58,7 @@
 //     and 1 % of its colour. (The reconstruction is a function of depth and pose, so the real
 //     grid the maps draw moves by about the depth change.) A reused frame stays within 4/255
 //     per channel of the recomputed one (tests/technique/dlpv_test.cpp: 3/255 measured at 1.8 mm).
-//     The comparison is technique/input_reuse.h, shared with dir.
+//     The comparison is gi/input_reuse.h, shared with dir.
 #pragma once
 #include <array>
 #include <memory>
@@ -78,15 +77,15 @@ struct DlpvLevel {
   bool rho_volume;         // V^rho for the virtual pixels' bounce light
   float internal_scale;    // fraction of the output width and height
   // true: the paper's Algorithm 1, shadows as the volume's antiradiance (blocked direct light
-  // injected). false: direct light with baseline's shadow maps (this baseline level), the volume
+  // injected). false: direct light with the direct-light block's shadow maps (this baseline level), the volume
   // carrying the bounce light's change only (the paper's Sec. 7 alternative).
   bool antiradiance_shadows;
-  int baseline_level;      // baseline's level for the shadow maps (when not antiradiance)
+  int baseline_level;      // the direct-light block's level for the shadow maps (when not antiradiance)
 };
 const std::array<DlpvLevel, 5>& dlpv_levels();  // the defaults
 // The defaults with RuntimeSettings::knobs applied (technique/knobs.h; BadUsage for a refused one).
 Expected<std::vector<DlpvLevel>> dlpv_levels(const std::vector<KnobSetting>& knobs);
 Expected<std::vector<QualityLevel>> dlpv_ladder(const std::vector<KnobSetting>& knobs);
-Expected<std::unique_ptr<Technique>> create_dlpv(const SharedResources& shared);
+Expected<std::unique_ptr<Technique>> create_dlpv(const frame::FrameResources& shared, const TechniqueOptions& options);
 
 }  // namespace mrgi::technique

@@ -14,11 +14,10 @@
 #include "gpu/pipelines.h"
 #include "gpu/shaders.h"
 #include "light/light_stage.h"
-#include "technique/baseline/baseline.h"
-#include "technique/input_reuse.h"
+#include "gi/input_reuse.h"
 #include "technique/knobs.h"
-#include "technique/light_set_writer.h"
-#include "technique/scene_gpu.h"
+#include "light/light_set_writer.h"
+#include "frame/scene_gpu.h"
 
 namespace mrgi::technique {
 
@@ -42,9 +41,9 @@ const KnobField<DvctLevel> kDvctKnobs[] = {
     {"rsm_lamps", "real lamps, strongest first, injected through a map pair", &DvctLevel::rsm_lamps},
     {"trace_divisor", "G-buffer pixels per traced pixel, each side (levels without shadow cones; with them every pixel)", &DvctLevel::trace_divisor},
     {"internal_scale", "fraction of the output width and height", &DvctLevel::internal_scale},
-    {"shadow_cones", "1: direct light through shadow cones (paper); 0: baseline's shadow maps",
+    {"shadow_cones", "1: direct light through shadow cones (paper); 0: the direct-light block's shadow maps",
      &DvctLevel::shadow_cones},
-    {"baseline_level", "baseline's level for the shadow maps", &DvctLevel::baseline_level},
+    {"baseline_level", "the direct-light block's level for the shadow maps", &DvctLevel::baseline_level},
     {"shadow_aperture", "full aperture of a shadow cone, radians", &DvctLevel::shadow_aperture},
     {"step_scale", "fraction of the touching-footprint step the cones take", &DvctLevel::step_scale},
 };
@@ -53,8 +52,8 @@ const KnobField<DvctLevel> kDvctKnobs[] = {
 // shadow and bounce (as dlpv's volume).
 constexpr float kMinRegionSide = 0.25f;
 // Pixels at and above this roughness trace no specular cone: the diffuse cones hold that light
-// (SceneGpu::kGlossyRoughness, the same line the scene's glossy flag draws).
-constexpr float kSpecularRoughnessLimit = SceneGpu::kGlossyRoughness;
+// (frame::SceneGpu::kGlossyRoughness, the same line the scene's glossy flag draws).
+constexpr float kSpecularRoughnessLimit = frame::SceneGpu::kGlossyRoughness;
 // The narrowest specular cone (radians): a mirror reads the volume at its finest level anyway.
 constexpr float kMinSpecularAperture = 0.05f;
 // vct_directional_occlusion's floor for a surface seen edge-on (reconstruction noise).
@@ -81,21 +80,21 @@ namespace {
 
 class Dvct final : public Technique {
  public:
-  Dvct(const SharedResources& shared, std::vector<DvctLevel> levels)
+  Dvct(const frame::FrameResources& shared, std::vector<DvctLevel> levels)
       : shared_(shared), ladder_(ladder_of(levels, dvct_levels(), kDvctKnobs)), levels_(std::move(levels)) {}
   const std::string& name() const override { return name_; }
   const std::vector<QualityLevel>& levels() const override { return ladder_; }
   Status init();
-  Status record(const FrameInfo& info, std::vector<std::string>& skipped) override;
+  Status record(const frame::FrameInfo& info, std::vector<std::string>& skipped) override;
 
  private:
   // The shading pipeline for (diffuse cones, specular cone), made at start-up for every level.
   using Variant = std::pair<uint32_t, bool>;
-  Status record_volumes(const DvctLevel& level, const FrameInfo& info, std::vector<std::string>& skipped);
+  Status record_volumes(const DvctLevel& level, const frame::FrameInfo& info, std::vector<std::string>& skipped);
   void add_cone_pass(const DvctLevel& level, const shader::DvctParams& params, bool specular);
 
   std::string name_ = "dvct";
-  SharedResources shared_;
+  frame::FrameResources shared_;
   std::vector<QualityLevel> ladder_;
   std::vector<DvctLevel> levels_;
   gpu::BufferHandle lights_;  // shader::LightSet, one per frame slot (the paper level's shading)
@@ -105,31 +104,25 @@ class Dvct final : public Technique {
   std::optional<gi::Voxelizer> scene_visibility_, object_visibility_;
   std::optional<gi::VoxelLight> light_, delta_;
   std::map<Variant, gpu::PipelineHandle> indirect_, shade_;
-  gpu::ImageHandle indirect_image_;  // RGBA32UI, dir/indirect_pack.glsl
-  std::unique_ptr<Technique> baseline_;
-  bool baseline_recorded_ = false;  // this frame's record() recorded baseline's passes
-  Status record_baseline(const FrameInfo& base, std::vector<std::string>& skipped) {
-    baseline_recorded_ = true;
-    return baseline_->record(base, skipped);
-  }
-  std::optional<DirectLight> direct_light() const override {
-    return baseline_recorded_ ? baseline_->direct_light() : std::nullopt;
-  }
-  InputReuse reuse_;
+  gpu::ImageHandle indirect_image_;  // RGBA32UI, gi/indirect_pack.glsl
+  // Direct light with shadow maps (not the shadow-cone levels), the cones' light as its screen input.
+  std::unique_ptr<shading::DirectLightBlock> direct_;
+  std::optional<shading::DirectLightOutput> direct_light() const override { return direct_->output(); }
+  gi::InputReuse reuse_;
   struct ObjectSource {
     bool valid = false;
-    uint64_t revision = 0;  // SceneGpu::revision() it was voxelised at
+    uint64_t revision = 0;  // frame::SceneGpu::revision() it was voxelised at
     uint32_t cells = 0;
   } object_source_;  // what the object visibility volume holds
   bool has_virtual_ = false, glossy_ = false;
   std::vector<RealMaterialRegion> glossy_regions_;  // the real material regions the specular cone is for
-  bool glossy_in_view(const FrameInfo& info) const;
+  bool glossy_in_view(const frame::FrameInfo& info) const;
 };
 
 Status Dvct::init() {
   gpu::FrameGraph& graph = *shared_.graph;
   const gpu::Context& ctx = *shared_.context;
-  const SceneGpu& sg = *shared_.scene_gpu;
+  const frame::SceneGpu& sg = *shared_.scene_gpu;
   if (!shared_.light_stage) return fail(ErrorKind::Internal, "dvct: no light stage");
   auto lights = graph.create_buffer({"dvct_lights", sizeof(shader::LightSet), gpu::MemoryUsage::Upload, true},
                                     VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
@@ -146,7 +139,7 @@ Status Dvct::init() {
   for (size_t i = 0; i < regions.size(); ++i) {
     real_material_table_.min_roughness[i] = glm::vec4(regions[i].min, regions[i].roughness);
     real_material_table_.max_metallic[i] = glm::vec4(regions[i].max, regions[i].metallic);
-    if (regions[i].roughness < SceneGpu::kGlossyRoughness || regions[i].metallic > SceneGpu::kGlossyMetallic)
+    if (regions[i].roughness < frame::SceneGpu::kGlossyRoughness || regions[i].metallic > frame::SceneGpu::kGlossyMetallic)
       glossy_regions_.push_back(regions[i]);
   }
   glossy_ |= !glossy_regions_.empty();
@@ -213,18 +206,18 @@ Status Dvct::init() {
   if (!indirect) return indirect.error();
   indirect_image_ = *indirect;
   reuse_.reserve(size_t(shared_.depth_intrinsics.width) * size_t(shared_.depth_intrinsics.height), shared_.depth_scale);
-  SharedResources for_baseline = shared_;
-  for_baseline.knobs.clear();  // dvct's knobs (baseline_level picks baseline's level)
-  auto base = create_baseline(for_baseline);
-  if (!base) return base.error();
-  baseline_ = std::move(*base);
+  shading::DirectLightOptions direct;
+  direct.screen_indirect = true;
+  auto block = shading::DirectLightBlock::create(shared_, direct);
+  if (!block) return block.error();
+  direct_ = std::move(*block);
   return ok_status();
 }
 
 // The four volumes for this frame: voxelised and injected, or kept from the frame that made them.
-Status Dvct::record_volumes(const DvctLevel& level, const FrameInfo& info, std::vector<std::string>& skipped) {
+Status Dvct::record_volumes(const DvctLevel& level, const frame::FrameInfo& info, std::vector<std::string>& skipped) {
   gpu::FrameGraph& graph = *shared_.graph;
-  const SceneGpu& sg = *shared_.scene_gpu;
+  const frame::SceneGpu& sg = *shared_.scene_gpu;
   MRGI_TRY(scene_visibility_->set_cells(graph, level.volume_cells));
   MRGI_TRY(object_visibility_->set_cells(graph, level.volume_cells));
   MRGI_TRY(light_->set_cells(graph, level.volume_cells));
@@ -262,9 +255,9 @@ Status Dvct::record_volumes(const DvctLevel& level, const FrameInfo& info, std::
   const uint32_t grid_stride = std::clamp(uint32_t(0.5f * region.voxel_size / pixel_m), 1u, 8u);
   scene_visibility_->add_depth_surface(graph, "reconstruction", shared_.real_position, shared_.real_normal, g.width,
                                        g.height, grid_stride);
-  auto ranges = [](const MeshSet& set) {
+  auto ranges = [](const frame::MeshSet& set) {
     std::vector<gi::TriangleRange> out;
-    for (const DrawRange& r : set.draws) out.push_back({r.first_index, r.index_count, r.vertex_offset});
+    for (const frame::DrawRange& r : set.draws) out.push_back({r.first_index, r.index_count, r.vertex_offset});
     return out;
   };
   if (!sg.real_proxies.empty())
@@ -322,7 +315,7 @@ Status Dvct::record_volumes(const DvctLevel& level, const FrameInfo& info, std::
 // Whether this frame shows a glossy surface: the objects' box (with a glossy virtual material) or
 // a glossy real region's box not wholly outside the colour camera's frustum (tested plane by plane
 // on its corners: conservative, a box beside a frustum corner may count as in view).
-bool Dvct::glossy_in_view(const FrameInfo& info) const {
+bool Dvct::glossy_in_view(const frame::FrameInfo& info) const {
   const glm::dmat4 to_camera = glm::inverse(info.camera_to_world);
   const Intrinsics& k = shared_.color_intrinsics;
   auto box_in_view = [&](const glm::vec3& lo, const glm::vec3& hi) {
@@ -338,7 +331,7 @@ bool Dvct::glossy_in_view(const FrameInfo& info) const {
     }
     return std::count(std::begin(outside), std::end(outside), 8) == 0;
   };
-  const SceneGpu& sg = *shared_.scene_gpu;
+  const frame::SceneGpu& sg = *shared_.scene_gpu;
   if (sg.glossy && info.virtual_objects_present && box_in_view(sg.virtual_objects.bounds_min, sg.virtual_objects.bounds_max))
     return true;
   for (const RealMaterialRegion& r : glossy_regions_)
@@ -350,7 +343,7 @@ void Dvct::add_cone_pass(const DvctLevel& level, const shader::DvctParams& param
   gpu::FrameGraph& graph = *shared_.graph;
   const Variant key{level.diffuse_cones, specular};
   const gpu::Pipeline* pipe = level.shadow_cones ? &*shade_.at(key) : &*indirect_.at(key);
-  const SharedResources& r = shared_;
+  const frame::FrameResources& r = shared_;
   const VkSampler linear = shared_.context->samplers().linear_clamp;
   const gpu::ImageHandle light = light_->volume().image(0), delta = delta_->volume().image(0);
   const gpu::ImageHandle scene = scene_visibility_->volume().image(0), object = object_visibility_->volume().image(0);
@@ -362,9 +355,9 @@ void Dvct::add_cone_pass(const DvctLevel& level, const shader::DvctParams& param
       full ? "dvct shade" : "dvct cones", gpu::PassKind::Compute, *pipe,
       [&, full, indirect, lights, materials](gpu::ShaderPassBuilder& b) {
         if (full) {
-          bind_shading_gbuffers(b, r);
+          frame::bind_shading_gbuffers(b, r);
         } else {
-          bind_gbuffer_reads(b, r);
+          frame::bind_gbuffer_reads(b, r);
           b.bind("indirect", indirect);
         }
         b.bind("LightUbo", lights);
@@ -381,15 +374,15 @@ void Dvct::add_cone_pass(const DvctLevel& level, const shader::DvctParams& param
       });
 }
 
-Status Dvct::record(const FrameInfo& info, std::vector<std::string>& skipped) {
-  baseline_recorded_ = false;
+Status Dvct::record(const frame::FrameInfo& info, std::vector<std::string>& skipped) {
+  direct_->begin_frame();
   if (info.level < 0 || info.level >= int(levels_.size()))
     return fail(ErrorKind::BadUsage, "dvct: level " + std::to_string(info.level) + " outside 0.." +
                                          std::to_string(levels_.size() - 1));
   const DvctLevel& level = levels_[size_t(info.level)];
   gpu::FrameGraph& graph = *shared_.graph;
   auto* set = static_cast<shader::LightSet*>(graph.mapped(lights_, graph.slot()));
-  write_unshadowed_light_set(shared_.light_stage->lighting(), *set);
+  light::write_unshadowed_light_set(shared_.light_stage->lighting(), *set);
   *static_cast<shader::DvctRealMaterials*>(graph.mapped(real_materials_, graph.slot())) = real_material_table_;
   shader::DvctParams params{};
   const bool volumes = has_virtual_ && shared_.scene_gpu->any_visible();
@@ -422,24 +415,17 @@ Status Dvct::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     add_cone_pass(level, params, specular);
     return ok_status();
   }
-  FrameInfo base = info;
-  base.level = level.baseline_level;
-  if (!volumes) {
-    set_dir_indirect(*baseline_, nullptr);
-    return record_baseline(base, skipped);
-  }
+  const shading::DirectLightLevel& direct = shading::direct_light_levels()[size_t(level.baseline_level)];
+  if (!volumes) return direct_->record(info, direct, {}, skipped);
   add_cone_pass(level, params, specular);
-  DirIndirect add;
-  add.merged = indirect_image_;
-  add.divisor = int(std::max(1u, level.trace_divisor));
-  set_dir_indirect(*baseline_, &add);
-  return record_baseline(base, skipped);
+  return direct_->record(info, direct, shading::ScreenIndirect{indirect_image_, int(std::max(1u, level.trace_divisor))},
+                         skipped);
 }
 
 }  // namespace
 
-Expected<std::unique_ptr<Technique>> create_dvct(const SharedResources& shared) {
-  auto levels = dvct_levels(shared.knobs);
+Expected<std::unique_ptr<Technique>> create_dvct(const frame::FrameResources& shared, const TechniqueOptions& options) {
+  auto levels = dvct_levels(options.knobs);
   if (!levels) return levels.error();
   auto t = std::make_unique<Dvct>(shared, std::move(*levels));
   MRGI_TRY(t->init());

@@ -18,7 +18,7 @@
 //   fastest   16^3   1        no         64^2  1      1 in 4x4    0.5       baseline lowest's
 // "paper" shades every pixel with cones alone (shaders/dvct/shade.comp). The others trace the
 // cones at one pixel in a block (shaders/dvct/indirect.comp) into dir's packed indirect image,
-// which baseline's shading pass up-samples by surface and adds as it lights the pixel with
+// which the direct-light block's shading pass up-samples by surface and adds as it lights the pixel with
 // shadow maps (the reduced-resolution shading with geometry-aware up-sampling of the fast path;
 // the shadow maps are sharper than a 64^3 volume's shadow cones and cost less on a CPU device).
 //
@@ -44,13 +44,13 @@
 //   - no virtual object: no volumes, no cones (the solutions are baseline's, or the paper
 //     level's lamps and ambient unshadowed by any object);
 //   - the volumes are reused, with nothing voxelised, drawn or injected, while what made them
-//     stays within technique/input_reuse.h's tolerances (pose, depth, lamps, objects);
-//   - the objects' visibility volume is kept while they have not moved (SceneGpu::revision) at
+//     stays within gi/input_reuse.h's tolerances (pose, depth, lamps, objects);
+//   - the objects' visibility volume is kept while they have not moved (frame::SceneGpu::revision) at
 //     the same level: it depends on nothing else (1.5 ms a frame at fast on desk_spot's bunny);
 //   - the reconstruction is voxelised from a grid of about two points a voxel where the region
 //     is nearest the camera (Voxelizer::add_depth_surface's stride), not from every pixel;
 //   - no specular cone at levels without it, or with no glossy material in view (virtual:
-//     SceneGpu::glossy and the objects' box in the camera's frustum; real: a scene.json
+//     frame::SceneGpu::glossy and the objects' box in the camera's frustum; real: a scene.json
 //     real_materials region with roughness under 0.7 or metallic over 0.1 whose box is): the
 //     shading pass's variant without it runs (compiled out, not branched around), and the frame
 //     is the same bit for bit (tests/technique/dvct_test.cpp); pixels rougher than that trace
@@ -91,6 +91,6 @@ struct DvctLevel {
 const std::array<DvctLevel, 5>& dvct_levels();  // the defaults
 Expected<std::vector<DvctLevel>> dvct_levels(const std::vector<KnobSetting>& knobs);
 Expected<std::vector<QualityLevel>> dvct_ladder(const std::vector<KnobSetting>& knobs);
-Expected<std::unique_ptr<Technique>> create_dvct(const SharedResources& shared);
+Expected<std::unique_ptr<Technique>> create_dvct(const frame::FrameResources& shared, const TechniqueOptions& options);
 
 }  // namespace mrgi::technique

@@ -62,7 +62,7 @@ Expected<gpu::ImageHandle> internal_image(gpu::FrameGraph& graph, const char* na
 }  // namespace
 
 Expected<DepthFilterGpu> DepthFilterGpu::create(gpu::Context& ctx, gpu::FrameGraph& graph,
-                                                const technique::SharedResources& shared,
+                                                const frame::FrameResources& shared,
                                                 const DepthFilterSettings& settings) {
   MRGI_TRY(validate(settings));
   const TapWindow merge = tap_window(settings.merge_window, settings.median_taps);
@@ -76,7 +76,7 @@ Expected<DepthFilterGpu> DepthFilterGpu::create(gpu::Context& ctx, gpu::FrameGra
   if (!shared.frame_constants.valid() || !shared.color_upload.valid() ||
       !shared.depth_upload.valid())
     return fail(ErrorKind::BadUsage,
-                "technique/ssrt/depth_filter_gpu.cpp: SharedResources needs frame_constants, "
+                "technique/ssrt/depth_filter_gpu.cpp: frame::FrameResources needs frame_constants, "
                 "color_upload and depth_upload");
   MRGI_TRY(recon::check_camera_upload(graph, shared.color_upload, "ssrt depth filter"));
   MRGI_TRY(recon::check_camera_upload(graph, shared.depth_upload, "ssrt depth filter"));

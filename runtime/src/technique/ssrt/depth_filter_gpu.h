@@ -49,7 +49,7 @@ constexpr uint32_t grey_level(uint32_t r, uint32_t g, uint32_t b) {
 class DepthFilterGpu {
  public:
   static Expected<DepthFilterGpu> create(gpu::Context& ctx, gpu::FrameGraph& graph,
-                                         const technique::SharedResources& shared,
+                                         const frame::FrameResources& shared,
                                          const DepthFilterSettings& settings = {});
   // Adds ssrt_depth_merge, ssrt_depth_bilateral, ssrt_depth_final (when final_pass is false it
   // is left out and "ssrt_depth_final: <reason>" is appended to skipped) and ssrt_gbuffer.

@@ -7,7 +7,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
-#include "ssrt/ssrt_math.h"
+#include "shared/transfer_math.h"
 #include "light/sh_tools.h"
 
 namespace mrgi::ssrt {

@@ -34,7 +34,7 @@ struct SampleSets {
   uint32_t directions = 0;                 // N
   std::vector<GpuSample> samples;          // kJitterSets * N, set-major
   float median_neighbour_angle = 0.0f;     // radians, over the Delaunay edges of all sets
-  float chi = 0.0f;                        // eq. 9 (see ssrt_math.h for the reading used)
+  float chi = 0.0f;                        // eq. 9 (see transfer_math.h for the reading used)
 };
 
 // Jittered stratified directions: set k places sample i < N/2 in the i-th equal-area band of

@@ -2,7 +2,7 @@
 
 #include <array>
 
-#include "technique/screen_bounds.h"
+#include "frame/screen_bounds.h"
 
 namespace mrgi::technique {
 namespace ssrt_detail {
@@ -27,13 +27,13 @@ Status Ssrt::write_geometry_constants() {
   return ok_status();
 }
 
-Status Ssrt::record_real_geometry(const FrameInfo& info, const SsrtLevel& level,
+Status Ssrt::record_real_geometry(const frame::FrameInfo& info, const SsrtLevel& level,
                                   std::vector<std::string>& skipped) {
   MRGI_TRY(write_geometry_constants());
   if (!volume_center_) {
     // The workspace cube sits on the virtual objects (where occluders matter); a scene without
     // one keeps the cube in front of the first pose.
-    const SceneGpu& sg = *shared_.scene_gpu;
+    const frame::SceneGpu& sg = *shared_.scene_gpu;
     if (!sg.virtual_objects.empty()) {
       volume_center_ = 0.5f * (sg.virtual_objects.bounds_min + sg.virtual_objects.bounds_max);
     } else {
@@ -89,7 +89,7 @@ void Ssrt::consume_readback(uint32_t slot, std::vector<std::string>& notes) {
   }
   for (int e = 0; e < light::kMaxShCoeffs * 3; ++e) sys.atb[e] = sums[136 + e];
   sys.samples = sums[184];
-  // The frame clock is not in FrameInfo: the filter steps by frame index; the timestamp
+  // The frame clock is not in frame::FrameInfo: the filter steps by frame index; the timestamp
   // reported is the frame's index at 30 frames a second.
   const Status r = shared_.light_stage->submit_system(sys, frame, double(frame) / 30.0, pending_bands_[slot], notes);
   if (!r) notes.push_back("ssrt_light_estimation: " + r.error().message);
@@ -117,12 +117,12 @@ void Ssrt::write_light() {
 // pmin/pmax, and `behind` when a corner lies behind the camera (the projection is unbounded).
 bool Ssrt::project_virtual_bounds(float grow_m, glm::vec2& pmin, glm::vec2& pmax,
                                   bool& behind) const {
-  const SceneGpu& sg = *shared_.scene_gpu;
+  const frame::SceneGpu& sg = *shared_.scene_gpu;
   if (sg.virtual_objects.empty()) return false;
   gpu::FrameGraph& graph = *shared_.graph;
   const auto* fc =
       static_cast<const shader::FrameConstants*>(graph.mapped(shared_.frame_constants, graph.slot()));
-  const ScreenBounds b = project_box(*fc, sg.virtual_objects.bounds_min - glm::vec3(grow_m),
+  const frame::ScreenBounds b = frame::project_box(*fc, sg.virtual_objects.bounds_min - glm::vec3(grow_m),
                                      sg.virtual_objects.bounds_max + glm::vec3(grow_m));
   pmin = b.min;
   pmax = b.max;
@@ -205,7 +205,7 @@ void Ssrt::add_shade_pass(const char* name, ShadeMode mode, bool run_transfer) {
   graph.add_shader_pass(
       name, gpu::PassKind::Compute, *pipe,
       [this, compose, tiled](gpu::ShaderPassBuilder& b) {
-        const SharedResources& r = shared_;
+        const frame::FrameResources& r = shared_;
         // Bound on skipped frames too (the shader declares them, the variant may not read them).
         b.bind("coarse", coarse_);
         b.bind("real_position", geo_position_);
@@ -231,7 +231,7 @@ void Ssrt::add_shade_pass(const char* name, ShadeMode mode, bool run_transfer) {
         b.bind("Output", compose ? r.composed_output : no_compose_);
       },
       [this, pipe, mode, compose, run_transfer](VkCommandBuffer cmd, gpu::PassContext& pass) {
-        const SharedResources& r = shared_;
+        const frame::FrameResources& r = shared_;
         ShadePush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), run_transfer ? 0 : 1),
                      glm::ivec4(int(used_.width), int(used_.height), int(geometry_step_), 0),
                      // Cells -> pixels, grown by the up-sampling footprint (Gauss radius plus
@@ -246,7 +246,7 @@ void Ssrt::add_shade_pass(const char* name, ShadeMode mode, bool run_transfer) {
       });
 }
 
-Status Ssrt::record_geometry(const FrameInfo& info, std::vector<std::string>& skipped) {
+Status Ssrt::record_geometry(const frame::FrameInfo& info, std::vector<std::string>& skipped) {
   if (info.level < 0 || info.level >= int(ladder_.size()))
     return fail(ErrorKind::BadUsage, "ssrt: level " + std::to_string(info.level) + " outside 0.." +
                                          std::to_string(ladder_.size() - 1));
@@ -271,7 +271,7 @@ Status Ssrt::record_geometry(const FrameInfo& info, std::vector<std::string>& sk
   return ok_status();
 }
 
-Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
+Status Ssrt::record(const frame::FrameInfo& info, std::vector<std::string>& skipped) {
   // Callers that drive the technique directly (tests, tools) may skip record_geometry().
   if (geometry_frame_ != info.frame_index || !geometry_frame_valid_)
     MRGI_TRY(record_geometry(info, skipped));
@@ -290,7 +290,7 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     graph.add_shader_pass(
         "ssrt_occluders", gpu::PassKind::Compute, *occluders_,
         [this](gpu::ShaderPassBuilder& b) {
-          const SharedResources& r = shared_;
+          const frame::FrameResources& r = shared_;
           b.bind("FrameUbo", r.frame_constants);
           b.bind("color_words", r.color_upload);
           b.bind("depth_words", r.depth_upload);
@@ -314,7 +314,7 @@ Status Ssrt::record(const FrameInfo& info, std::vector<std::string>& skipped) {
     graph.add_shader_pass(
         "ssrt_transfer", gpu::PassKind::Compute, *transfer_,
         [this](gpu::ShaderPassBuilder& b) {
-          const SharedResources& r = shared_;
+          const frame::FrameResources& r = shared_;
           b.bind("FrameUbo", r.frame_constants);
           b.bind("LightUbo", light_);
           b.bind("SampleDirections", samples_);
@@ -494,17 +494,12 @@ Expected<std::vector<QualityLevel>> ssrt_ladder(const std::vector<KnobSetting>& 
   return ladder_of(*levels, ssrt_levels(), ssrt_detail::kSsrtKnobs);
 }
 
-Expected<std::unique_ptr<Technique>> create_ssrt(const SharedResources& shared) {
-  auto levels = ssrt_levels(shared.knobs);
+Expected<std::unique_ptr<Technique>> create_ssrt(const frame::FrameResources& shared, const TechniqueOptions& options) {
+  auto levels = ssrt_levels(options.knobs);
   if (!levels) return levels.error();
   auto t = std::make_unique<ssrt_detail::Ssrt>(shared, std::move(*levels));
   MRGI_TRY(t->init());
   return std::unique_ptr<Technique>(std::move(t));
-}
-
-const LightEstimate* ssrt_light_estimate(const Technique& t) {
-  const auto* s = dynamic_cast<const ssrt_detail::Ssrt*>(&t);
-  return s ? &s->estimate() : nullptr;
 }
 
 }  // namespace mrgi::technique

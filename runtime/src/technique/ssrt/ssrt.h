@@ -44,11 +44,11 @@
 // the 64x48 unit test, and its full-resolution images are small enough to stay in cache).
 //
 // Deviations from the paper, each explained where it is implemented: chi of eq. 9 read as a
-// one-minus-cosine threshold and G of eq. 12 on the sender's normal (ssrt_math.h); F of eq. 11
+// one-minus-cosine threshold and G of eq. 12 on the sender's normal (transfer_math.h); F of eq. 11
 // with the SSDO patch area and a distance clamp; a range check (2 x radius) on occluders; light
 // in radiance units (1/pi in the transfer); the up-sampling filters do not mix real and virtual
 // cells; the composite is the runtime's ratio form rather than eq. 13's tone-mapped difference
-// (shade.comp; eq. 13-14 themselves are in ssrt_math.h and tested); indirect light comes from
+// (shade.comp; eq. 13-14 themselves are in transfer_math.h and tested); indirect light comes from
 // the main G-buffer only.
 //
 // Geometry (paper Sec. 4, run first every frame): ssrt::Volume (volume.h) fuses the raw depth
@@ -70,7 +70,7 @@
 // What made it work (session 4): only pixels the camera measured and whose green is unclipped
 // feed the sums (transfer.comp), a prior that no light comes from behind the dominant surface
 // (LightEstimatorSettings::below_surface_penalty), and the first frame primed from itself
-// (Technique::wants_priming_run). With the environment's true SH in place of the estimate the
+// (Technique::estimate_pending). With the environment's true SH in place of the estimate the
 // fast level scores RDE 0.563, so the estimate costs about 0.02.
 //
 // Cost on lavapipe (LP_NUM_THREADS=2, 640x480, `mrgi bench --techniques ssrt`, session 11:
@@ -144,8 +144,6 @@ const std::array<SsrtLevel, 4>& ssrt_levels();  // the defaults
 // The defaults with RuntimeSettings::knobs applied (technique/knobs.h; BadUsage for a refused one).
 Expected<std::vector<SsrtLevel>> ssrt_levels(const std::vector<KnobSetting>& knobs);
 Expected<std::vector<QualityLevel>> ssrt_ladder(const std::vector<KnobSetting>& knobs);
-Expected<std::unique_ptr<Technique>> create_ssrt(const SharedResources& shared);
-// The light estimate of an ssrt technique (nullptr when `t` is not one).
-const LightEstimate* ssrt_light_estimate(const Technique& t);
+Expected<std::unique_ptr<Technique>> create_ssrt(const frame::FrameResources& shared, const TechniqueOptions& options);
 
 }  // namespace mrgi::technique

@@ -20,7 +20,7 @@ Status Ssrt::init() {
       VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   if (!geo_constants) return geo_constants.error();
   geo_constants_ = *geo_constants;
-  technique::SharedResources geo_shared = shared_;
+  frame::FrameResources geo_shared = shared_;
   geo_shared.frame_constants = geo_constants_;
   auto vol = ssrt::Volume::create(ctx, graph, geo_shared, vs);
   if (!vol) return vol.error();
@@ -61,7 +61,7 @@ Status Ssrt::init() {
                 "ssrt: the levels' sample directions (4 jitter sets x N each) add up to " +
                     std::to_string(directions.size()) + ", more than the " +
                     std::to_string(SSRT_MAX_SAMPLE_DIRECTIONS) +
-                    " one uniform buffer holds (SSRT_MAX_SAMPLE_DIRECTIONS, ssrt_math.h)");
+                    " one uniform buffer holds (SSRT_MAX_SAMPLE_DIRECTIONS, transfer_math.h)");
   directions.resize(SSRT_MAX_SAMPLE_DIRECTIONS, glm::vec4(0.0f));
   const VkDeviceSize sample_bytes = directions.size() * sizeof(glm::vec4);
   auto samples = graph.create_buffer({"ssrt_sample_directions", sample_bytes},

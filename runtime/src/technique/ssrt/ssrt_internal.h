@@ -13,8 +13,8 @@
 #include "common/frame_constants.glsl"
 #include "gpu/pipelines.h"
 #include "gpu/shaders.h"
-#include "ssrt/ssrt_math.h"
-#include "technique/scene_gpu.h"
+#include "shared/transfer_math.h"
+#include "frame/scene_gpu.h"
 #include "technique/ssrt/depth_filter_gpu.h"
 #include "light/light_stage.h"
 #include "light/sh_estimator.h"
@@ -60,7 +60,7 @@ constexpr float kSaturation = 0.98f;         // camera values at/above are clipp
 constexpr float kIndirectTolerance = 1e-3f;  // eq. 14
 // Fast levels: a tile whose footprint's solutions can change no pixel's composite by more than
 // this fraction keeps the camera frame: at most 0.88 of an 8-bit level, so no pixel moves by
-// more than one level (ssrt_math.h ssrt_tile_invisible). The suite's fast level, third frame
+// more than one level (transfer_math.h ssrt_tile_invisible). The suite's fast level, third frame
 // of the 5 scenes with a virtual object: 15380 -> 10870 tiles shaded of 24000, frames identical.
 constexpr float kTileTolerance = 1.0f / 128.0f;
 constexpr float kGaussRadiusPx = 8.0f;       // paper OursFast
@@ -105,26 +105,27 @@ struct ShadePush {
 
 class Ssrt final : public Technique {
  public:
-  Ssrt(const SharedResources& shared, std::vector<SsrtLevel> levels)
+  Ssrt(const frame::FrameResources& shared, std::vector<SsrtLevel> levels)
       : shared_(shared), ladder_(ladder_of(levels, ssrt_levels(), kSsrtKnobs)), levels_(std::move(levels)) {}
   const std::string& name() const override { return name_; }
   const std::vector<QualityLevel>& levels() const override { return ladder_; }
   Status init();
-  Status record(const FrameInfo& info, std::vector<std::string>& skipped) override;
+  Status record(const frame::FrameInfo& info, std::vector<std::string>& skipped) override;
   // The paper's own geometry stage (Sec. 4) replaces the runtime's reconstruction: the
   // transfer and the shading read the filtered G-buffer, the camera colour is read from the
   // upload where it is used (cell centres, shaded tiles), and the virtual objects' depth test
   // reads the filtered G-buffer too (G_r, Fig. 2: the paper's occlusion geometry). recon's two
   // full-resolution passes cost 13-14 ms of desk_spot's fast frame on lavapipe.
-  bool uses_reconstruction() const override { return false; }
-  Status record_geometry(const FrameInfo& info, std::vector<std::string>& skipped) override;
-  std::optional<RealGeometry> occlusion_geometry() const override {
-    return RealGeometry{geo_position_, geo_normal_, geometry_step_};
+  Needs needs() const override { return {false, true}; }
+  Status record_geometry(const frame::FrameInfo& info, std::vector<std::string>& skipped) override;
+  std::optional<frame::RealGeometry> occlusion_geometry() const override {
+    return frame::RealGeometry{geo_position_, geo_normal_, geometry_step_};
   }
   const LightEstimate& estimate() const { return estimator().estimate(); }
+  const LightEstimate* light_estimate() const override { return &estimate(); }
   // Once, before the first estimate: the first frame is lit by its own estimate instead of the
   // prior (a uniform grey guess that made the first frames_in_flight frames' RDE about 1).
-  bool wants_priming_run() const override { return !primed_ && !estimator().estimate().valid; }
+  bool estimate_pending() const override { return !primed_ && !estimator().estimate().valid; }
   void frames_completed() override;
   ComposeTiles compose_tiles() const override { return compose_tiles_; }
 
@@ -133,7 +134,7 @@ class Ssrt final : public Technique {
   void consume_readback(uint32_t slot, std::vector<std::string>& notes);
   // The paper's geometry stage (Sec. 4): fuse the volume, ray-cast G_v and the aux layers, run
   // the depth filter chain into the G-buffer the transfer reads.
-  Status record_real_geometry(const FrameInfo& info, const SsrtLevel& level,
+  Status record_real_geometry(const frame::FrameInfo& info, const SsrtLevel& level,
                               std::vector<std::string>& skipped);
   void write_light();
   // Whether the virtual objects' influence region (bounds grown by the sampling radius) is in
@@ -143,7 +144,7 @@ class Ssrt final : public Technique {
   glm::ivec4 virtual_pixels() const;
   glm::ivec4 virtual_cells() const;
   // TiledCompose: Tiled, with the composite written to the runtime's output (shade.comp
-  // kCompose; SharedResources::composed_output).
+  // kCompose; frame::FrameResources::composed_output).
   enum class ShadeMode { Full, PassThrough, Tiled, TiledCompose };
   void add_shade_pass(const char* name, ShadeMode mode, bool run_transfer);
   glm::ivec4 influence_pixels() const {
@@ -154,7 +155,7 @@ class Ssrt final : public Technique {
   }
 
   std::string name_ = "ssrt";
-  SharedResources shared_;
+  frame::FrameResources shared_;
   std::vector<QualityLevel> ladder_;
   std::vector<SsrtLevel> levels_;  // ssrt_levels() with RuntimeSettings::knobs applied
   // The light stage's estimator, which this technique's sums feed.

@@ -33,7 +33,7 @@ double rotation_deg(const glm::dmat4& a, const glm::dmat4& b) {
 }  // namespace
 
 Expected<Volume> Volume::create(gpu::Context& ctx, gpu::FrameGraph& graph,
-                                const technique::SharedResources& shared,
+                                const frame::FrameResources& shared,
                                 const VolumeSettings& s) {
   const std::string where = "ssrt volume settings: ";
   if (s.max_resolution < 2 || s.max_resolution > kMaxResolution)

@@ -65,7 +65,7 @@ struct VolumeFrame {
 class Volume {
  public:
   static Expected<Volume> create(gpu::Context& ctx, gpu::FrameGraph& graph,
-                                 const technique::SharedResources& shared,
+                                 const frame::FrameResources& shared,
                                  const VolumeSettings& s = {});
   // Adds ssrt_tsdf_clear (resets only), ssrt_tsdf_fuse, ssrt_tsdf_raycast, ssrt_tsdf_normals
   // (the graph culls it unless normal_volume() is read), ssrt_tsdf_aux, or
@@ -91,7 +91,7 @@ class Volume {
   void add_passes(const VolumeFrame& frame, bool clear, bool fuse, bool views);
 
   VolumeSettings settings_;
-  technique::SharedResources shared_;
+  frame::FrameResources shared_;
   gpu::FrameGraph* graph_ = nullptr;
   gpu::BufferHandle voxels_, params_, aux_views_;
   gpu::ImageHandle depth_volume_, normal_volume_, aux_position_;

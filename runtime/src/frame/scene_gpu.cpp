@@ -1,4 +1,4 @@
-#include "technique/scene_gpu.h"
+#include "frame/scene_gpu.h"
 
 #include <algorithm>
 #include <cmath>
@@ -14,7 +14,7 @@
 #include "shared/specular_math.h"
 #include "gpu/vk_check.h"
 
-namespace mrgi::technique {
+namespace mrgi::frame {
 namespace {
 
 struct MeshData {
@@ -400,4 +400,4 @@ int SceneGpu::object_specular_kinds(size_t object) const {
   return kinds;
 }
 
-}  // namespace mrgi::technique
+}  // namespace mrgi::frame

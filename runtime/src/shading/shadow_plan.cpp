@@ -1,4 +1,4 @@
-#include "technique/baseline/shadow_plan.h"
+#include "shading/shadow_plan.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-namespace mrgi::technique {
+namespace mrgi::shading {
 namespace {
 
 // An up vector not parallel to `dir`.
@@ -57,7 +57,7 @@ Status plan_shadow_maps(const std::vector<LightDesc>& lights, const Bounds& boun
   if (lights.size() > MRGI_MAX_LIGHTS)
     return fail(ErrorKind::BadInput,
                 where + ": " + std::to_string(lights.size()) +
-                    " lamps, the baseline technique supports at most " +
+                    " lamps, the direct-light block supports at most " +
                     std::to_string(MRGI_MAX_LIGHTS));
   plan.light_set.count = glm::ivec4(int(lights.size()), 0, 0, 0);
   for (size_t i = 0; i < lights.size(); ++i) {
@@ -83,7 +83,7 @@ Status plan_shadow_maps(const std::vector<LightDesc>& lights, const Bounds& boun
 
     const int faces = l.type == LightType::Point ? 6 : 1;
     glm::mat4 mats[6];
-    LodView lod{l.position, 0.0f, 0.0f};  // for a map one texel wide
+    frame::LodView lod{l.position, 0.0f, 0.0f};  // for a map one texel wide
     if (l.type == LightType::Point) {
       for (int f = 0; f < 6; ++f)
         mats[f] = perspective_view_proj(l.position, kCubeDirs[f], glm::radians(90.0f));
@@ -108,7 +108,7 @@ Status plan_shadow_maps(const std::vector<LightDesc>& lights, const Bounds& boun
       const glm::mat4 proj = glm::orthoRH_ZO(-half, half, -half, half, 0.0f, kOrthoDepth);
       mats[0] = proj * view;
       g.cone.w = 2.0f * half;
-      lod = orthographic_lod_view(centre, dir, 2.0f * half, 0.0f);  // one texel spans the map
+      lod = frame::orthographic_lod_view(centre, dir, 2.0f * half, 0.0f);  // one texel spans the map
     }
     for (int f = 0; f < faces; ++f) plan.light_set.face_view_proj[li * 6 + f] = mats[f];
 
@@ -144,4 +144,4 @@ Status plan_shadow_maps(const std::vector<LightDesc>& lights, const Bounds& boun
   return ok_status();
 }
 
-}  // namespace mrgi::technique
+}  // namespace mrgi::shading

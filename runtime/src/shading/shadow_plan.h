@@ -17,12 +17,12 @@
 
 // Relative to this file (not through the include path) so tests, which do not have shaders/ on
 // their include path, can include this header too.
-#include "../../../../shaders/common/light_set.glsl"
+#include "common/light_set.glsl"
 #include "mrgi/expected.h"
 #include "mrgi/scene.h"
-#include "technique/lod_view.h"
+#include "frame/lod_view.h"
 
-namespace mrgi::technique {
+namespace mrgi::shading {
 
 inline constexpr float kShadowNear = 0.05f;        // metres, perspective maps
 inline constexpr float kShadowFar = 50.0f;         // metres
@@ -41,7 +41,7 @@ struct ShadowFace {
   bool virtual_casters = false;  // the glTF virtual objects
   // The virtual meshes' level of detail for this face, for a map one texel wide: its focal_px
   // times the map's side is the focal length in texels (max_error_px left to the drawer).
-  LodView lod_per_texel;
+  frame::LodView lod_per_texel;
 };
 
 struct ShadowPlan {
@@ -70,4 +70,4 @@ Status plan_shadow_maps(const std::vector<LightDesc>& lights, const Bounds& boun
 // Cube face f (0..5 = +X, -X, +Y, -Y, +Z, -Z) as the shaders pick it from a light-to-point vector.
 int cube_face_of(const glm::vec3& d);
 
-}  // namespace mrgi::technique
+}  // namespace mrgi::shading

@@ -1,5 +1,6 @@
 #version 460
-// Baseline: direct light only, with real/virtual shadow maps, per DIR eq. 1-5:
+// The direct-light block (runtime/src/shading/direct_light.h): direct light with real/virtual
+// shadow maps, per DIR eq. 1-5:
 //   L_rv += L_o * min(st_r, st_v)          (every lamp, every surface)
 //   L_r  += L_o * r(lamp) * r(p) * st_r    (only real lamps on real points, real casters)
 // L_o: Lambert for real surfaces (albedo from the camera, recon/depth_to_positions.comp);
@@ -9,26 +10,24 @@
 // a virtual object occludes the sky's bright part for the real surface below it. The rest of
 // the light is an ambient irradiance in SH (bands 0..2), unshadowed: the real part lights both
 // solutions, a virtual environment L_rv only.
-// kVolumeBounce (dlpv's shadow-mapped levels, technique/dlpv/dlpv.h): also the bounce light of
-// dlpv's volumes (L_r is left as it is: the real scene's own bounce is in the camera image):
-//   real pixel:    L_rv += albedo / pi E_delta(p, n)   (V^Delta: the virtual objects' bounce onto
-//                  the real scene, minus the bounce they block; E_rho - E_mu in the two-volume
-//                  ablation)
-//   virtual pixel: L_rv += albedo / pi E_rho(p, n)     (V^rho; levels without it add nothing)
-// Here, not in a pass of its own: that pass's G-buffer reads and read-modify-write of L_rv cost
-// more than its lookups (5.9 ms at dlpv fast on desk_spot, 18 ms on corner, profiled).
-// Bit 8 (dir, technique/dir/dir.h): also dir's merged VPL light (shaders/dir/merge_columns.comp)
-// into both solutions, L_rv += indirect_rv, L_r += indirect_r, up-sampled from its resolution
-// (volume_mode.y G-buffer pixels a texel) by bilinear weights times the surface test of
-// dir/indirect_pack.glsl (plain bilinear where no neighbour is on the pixel's surface).
+// Plus the technique's indirect light, by the encoding its input declares (kIndirect):
+//   1 screen (ScreenIndirect): packed radiance pairs (gi/indirect_pack.glsl) into both
+//     solutions, L_rv += indirect_rv, L_r += indirect_r, up-sampled from its resolution
+//     (indirect_params.y G-buffer pixels a texel) by bilinear weights times the surface test
+//     (plain bilinear where no neighbour is on the pixel's surface);
+//   2 volumes (VolumeIndirect): SH irradiance volumes into L_rv only (the real scene's own
+//     bounce is in the camera image):
+//       real pixel:    L_rv += albedo / pi E_real(p, n), E_real = E(real volume), or
+//                      E(real) - E(subtract) with kVolumeDifference
+//       virtual pixel: L_rv += albedo / pi E(virtual volume)   (kVolumeVirtual)
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
 #include "shared/lpv_math.h"
-#include "dlpv/volume_lookup.glsl"
+#include "gi/volume_lookup.glsl"
 #include "common/frame_constants.glsl"
 #include "common/light_set.glsl"
 #include "common/surface_shading.glsl"
-#include "dir/indirect_pack.glsl"
+#include "gi/indirect_pack.glsl"
 #include "shared/specular_math.h"
 #include "specular/caustic_receiver.glsl"
 
@@ -49,28 +48,26 @@ layout(set = 0, binding = 8) uniform sampler2DArrayShadow shadow_primary;
 layout(set = 0, binding = 9) uniform sampler2DArrayShadow shadow_virtual;
 layout(set = 0, binding = 10, rgba16f) writeonly uniform image2D lit_rv;
 layout(set = 0, binding = 11, rgba16f) writeonly uniform image2D lit_r;
-// Bits: 1 real pixels add V^Delta's bounce, 2 virtual pixels add V^rho's, 4 real pixels add
-// E(V^rho) - E(V^mu) (the two-volume ablation); 0 direct light only (baseline). A
-// specialisation constant, not a push constant: on lavapipe a shader pays for all of its code,
-// taken or not (compose.comp), so a level without V^rho, or without the ablation, compiles
-// those volume fetches out.
-layout(constant_id = 0) const int kVolumeBounce = 0;
-const bool kDeltaOnReal = (kVolumeBounce & 1) != 0;
-const bool kRhoOnVirtual = (kVolumeBounce & 2) != 0;
-const bool kTwoVolumesOnReal = (kVolumeBounce & 4) != 0;
-const bool kDirIndirect = (kVolumeBounce & 8) != 0;
-// dlpv's volumes (kVolumeBounce; without it a stand-in is bound and never read).
-layout(set = 0, binding = 13) uniform sampler3D delta_r;
-layout(set = 0, binding = 14) uniform sampler3D delta_g;
-layout(set = 0, binding = 15) uniform sampler3D delta_b;
-layout(set = 0, binding = 16) uniform sampler3D rho_r;
-layout(set = 0, binding = 17) uniform sampler3D rho_g;
-layout(set = 0, binding = 18) uniform sampler3D rho_b;
-layout(set = 0, binding = 19) uniform sampler3D mu_r;  // V^mu: the two-volume ablation only
-layout(set = 0, binding = 20) uniform sampler3D mu_g;
-layout(set = 0, binding = 21) uniform sampler3D mu_b;
-layout(set = 0, binding = 22, rgba32ui) readonly uniform uimage2D dir_indirect;  // bit 8 only
-// kOneShadowMap (dir's ablation one_shadow_map, mrgi/runtime.h DirAblation): a real lamp's two
+// Specialisation constants, not push constants: on lavapipe a shader pays for all of its code,
+// taken or not (compose.comp), so each encoding, and a volume input without a virtual volume or
+// the difference, compiles the rest out.
+layout(constant_id = 0) const int kIndirect = 0;  // 0 none, 1 screen, 2 volumes
+layout(constant_id = 3) const bool kVolumeDifference = false;
+layout(constant_id = 4) const bool kVolumeVirtual = false;
+const bool kScreenIndirect = kIndirect == 1;
+const bool kVolumeIndirect = kIndirect == 2;
+// The volume input (kVolumeIndirect; otherwise stand-ins are bound and never read).
+layout(set = 0, binding = 13) uniform sampler3D real_volume_r;
+layout(set = 0, binding = 14) uniform sampler3D real_volume_g;
+layout(set = 0, binding = 15) uniform sampler3D real_volume_b;
+layout(set = 0, binding = 16) uniform sampler3D virtual_volume_r;
+layout(set = 0, binding = 17) uniform sampler3D virtual_volume_g;
+layout(set = 0, binding = 18) uniform sampler3D virtual_volume_b;
+layout(set = 0, binding = 19) uniform sampler3D subtract_volume_r;  // kVolumeDifference only
+layout(set = 0, binding = 20) uniform sampler3D subtract_volume_g;
+layout(set = 0, binding = 21) uniform sampler3D subtract_volume_b;
+layout(set = 0, binding = 22, rgba32ui) readonly uniform uimage2D screen_indirect;  // kScreenIndirect only
+// kOneShadowMap (DirectLightOptions::one_shadow_map: the dir ablation of mrgi/research.h): a real lamp's two
 // maps read as the one map of Knecht et al. 2010 (the paper's [4]) would hold them: the nearer
 // caster and its kind (the maps' depths, nearest texel), so a real caster behind a virtual one
 // no longer shadows L_r (the double shadow of the paper's Fig. 5). The depths are read through
@@ -78,7 +75,7 @@ layout(set = 0, binding = 22, rgba32ui) readonly uniform uimage2D dir_indirect; 
 layout(constant_id = 1) const bool kOneShadowMap = false;
 layout(set = 0, binding = 23) uniform sampler2DArray shadow_primary_depth;
 layout(set = 0, binding = 24) uniform sampler2DArray shadow_virtual_depth;
-// kCausticReceivers (the specular stage's fast level, technique.h CausticPhotons::receivers):
+// kCausticReceivers (the specular stage's fast level, frame/frame_resources.h CausticPhotons::receivers):
 // the spot lamps' caustics through mirrors and glass, read from their receiver maps, added to
 // L_rv on the diffuse pixels as albedo / pi x E (caustics-DIR paper eq. 12-14: never L_r, the
 // light went through a virtual object); mirror and glass pixels get nothing (the stage's trace
@@ -91,8 +88,8 @@ struct LevelConstants {
   vec4 shadow;  // x used map size / allocated size, y used size (texels), z allocated size,
                 // w PCF radius (taps each side of the centre)
 };
-// volume_mode: unused here (kVolumeBounce holds the mode; baseline.h's VolumeBounce::Constants).
-layout(push_constant) uniform Level { LevelConstants level_block; VolumeConstants volume_block; ivec4 volume_mode; };
+// indirect_params.y: the screen input's divisor (G-buffer pixels per texel side).
+layout(push_constant) uniform Level { LevelConstants level_block; VolumeConstants volume_block; ivec4 indirect_params; };
 LevelConstants level;
 
 
@@ -101,7 +98,7 @@ LevelConstants level;
 void main() {
   frame = frame_ubo; level = level_block;  // MRGI_UNIFORM_COPIES
   if (kCausticReceivers) cache_caustic_receivers();
-  if (kVolumeBounce != 0) volume = volume_block;
+  if (kVolumeIndirect) volume = volume_block;
   ambient_rv = light_set.ambient_rv;
   ambient_r = light_set.ambient_r;
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
@@ -129,26 +126,28 @@ void main() {
   float roughness = is_virtual ? nrm.w : 1.0f;
   float r_p = is_virtual ? 0.0f : 1.0f;
 
-  // A virtual surface's own emission (glTF emissive) is seen directly; it lights nothing else
-  // here (this technique has no indirect light).
-  // With V^rho on virtual pixels, not the residual ambient too (light_set.glsl count.y).
-  bool ambient_here = !(kRhoOnVirtual && is_virtual && light_set.count.y != 0);
+  // A virtual surface's own emission (glTF emissive) is seen directly; what it lights is the
+  // indirect input's.
+  // With a virtual volume on virtual pixels, not the residual ambient too (light_set.glsl count.y).
+  bool ambient_here = !(kVolumeVirtual && is_virtual && light_set.count.y != 0);
   vec3 l_rv = (ambient_here ? alb.rgb * ambient_irradiance(ambient_rv, n) * (1.0f / MRGI_PI) : vec3(0.0f)) +
               (is_virtual && frame.flags.y != 0 ? imageLoad(virtual_emission, pixel).rgb : vec3(0.0f));
   vec3 l_r = r_p * alb.rgb * ambient_irradiance(ambient_r, n) * (1.0f / MRGI_PI);
   add_shadowed_lamps(p, n, v, alb.rgb, alb.a, roughness, is_virtual, r_p, level.shadow, kOneShadowMap, l_rv, l_r);
-  if (kVolumeBounce != 0) {
+  if (kVolumeIndirect) {
     if (is_virtual) {
-      if (kRhoOnVirtual && volume.extent.w > 0.5f)
-        l_rv += alb.rgb * (1.0f - alb.a) * max(volume_irradiance(rho_r, rho_g, rho_b, p, n), vec3(0.0f)) * (1.0f / MRGI_PI);
-    } else if ((kDeltaOnReal || kTwoVolumesOnReal) && volume.extent.z > 0.5f && volume_contains(p)) {
-      vec3 e = kTwoVolumesOnReal ? volume_irradiance(rho_r, rho_g, rho_b, p, n) - volume_irradiance(mu_r, mu_g, mu_b, p, n)
-                                 : volume_irradiance(delta_r, delta_g, delta_b, p, n);
+      if (kVolumeVirtual && volume.extent.w > 0.5f)
+        l_rv += alb.rgb * (1.0f - alb.a) *
+                max(volume_irradiance(virtual_volume_r, virtual_volume_g, virtual_volume_b, p, n), vec3(0.0f)) *
+                (1.0f / MRGI_PI);
+    } else if (volume.extent.z > 0.5f && volume_contains(p)) {
+      vec3 e = volume_irradiance(real_volume_r, real_volume_g, real_volume_b, p, n);
+      if (kVolumeDifference) e -= volume_irradiance(subtract_volume_r, subtract_volume_g, subtract_volume_b, p, n);
       l_rv += alb.rgb * e * (1.0f / MRGI_PI);
     }
   }
-  if (kDirIndirect) {
-    int d = max(volume_mode.y, 1);
+  if (kScreenIndirect) {
+    int d = max(indirect_params.y, 1);
     uint key = pack_indirect(vec3(0.0f), vec3(0.0f), n, max(distance(p, frame.camera_world.xyz), 1e-3f), is_virtual).w;
     ivec2 low = (frame.internal_output_size.xy + d - 1) / d;
     vec2 f = (vec2(pixel) + 0.5f) / float(d) - 0.5f;
@@ -158,7 +157,7 @@ void main() {
     float w_sum = 0.0f;
     for (int k = 0; k < 4; ++k) {
       ivec2 o = ivec2(k & 1, k >> 1);
-      uvec4 tap = imageLoad(dir_indirect, clamp(i0 + o, ivec2(0), low - 1));
+      uvec4 tap = imageLoad(screen_indirect, clamp(i0 + o, ivec2(0), low - 1));
       float w = (o.x == 1 ? t.x : 1.0f - t.x) * (o.y == 1 ? t.y : 1.0f - t.y);
       vec3 rv = unpack_indirect_rv(tap), r = unpack_indirect_r(tap);
       any_rv += w * rv;

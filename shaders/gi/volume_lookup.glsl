@@ -1,4 +1,4 @@
-// The irradiance a dlpv volume gives a surface (dlpv/merge.comp, baseline/shade_direct.comp),
+// The irradiance a dlpv volume gives a surface (dlpv/merge.comp, shading/direct_light.comp),
 // from `volume`, which the including shader fills from its push constants; needs
 // shared/lpv_math.h.
 #ifndef MRGI_DLPV_VOLUME_LOOKUP_GLSL

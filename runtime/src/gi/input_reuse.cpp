@@ -1,9 +1,9 @@
-#include "technique/input_reuse.h"
+#include "gi/input_reuse.h"
 
 #include <algorithm>
 #include <cmath>
 
-namespace mrgi::technique {
+namespace mrgi::gi {
 namespace {
 
 constexpr double kPoseM = 1e-3, kPoseDeg = 0.1;
@@ -84,4 +84,4 @@ void InputReuse::remember() {
   if (source_.valid) std::copy(input_->depth.data.begin(), input_->depth.data.end(), source_depth_.begin());
 }
 
-}  // namespace mrgi::technique
+}  // namespace mrgi::gi

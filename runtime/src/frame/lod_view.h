@@ -1,9 +1,9 @@
-// What a draw needs to choose a mesh's level of detail (technique::MeshSet::draw), in a header
-// of its own (glm only) so the CPU-only planners (baseline/shadow_plan.h) can hold one.
+// What a draw needs to choose a mesh's level of detail (MeshSet::draw), in a header
+// of its own (glm only) so the CPU-only planners (shading/shadow_plan.h) can hold one.
 #pragma once
 #include <glm/glm.hpp>
 
-namespace mrgi::technique {
+namespace mrgi::frame {
 
 // The camera centre (world) and the focal length in pixels of the image drawn; a range is drawn
 // with the coarsest level whose error, projected at the range's nearest distance from the
@@ -22,4 +22,4 @@ inline LodView orthographic_lod_view(const glm::vec3& centre, const glm::vec3& t
   return {centre - travel * kOrthographicLodDistance, kOrthographicLodDistance / texel_m, max_error_px};
 }
 
-}  // namespace mrgi::technique
+}  // namespace mrgi::frame

@@ -7,7 +7,7 @@
 
 #include "common/frame_constants.glsl"
 
-namespace mrgi::technique {
+namespace mrgi::frame {
 
 struct ScreenBounds {
   bool visible = false;  // false: one image side (or the camera plane) has every corner outside
@@ -57,4 +57,4 @@ inline glm::ivec4 box_pixels(const shader::FrameConstants& fc, glm::vec3 lo, glm
   return glm::ivec4(p0, p1);
 }
 
-}  // namespace mrgi::technique
+}  // namespace mrgi::frame

@@ -24,9 +24,9 @@
 #include "gpu/pipelines.h"
 #include "mrgi/expected.h"
 #include "mrgi/scene.h"
-#include "technique/lod_view.h"
+#include "frame/lod_view.h"
 
-namespace mrgi::technique {
+namespace mrgi::frame {
 
 // Vertex layout of both sets (32 bytes): world-space position, normal, texture coordinate.
 struct GpuVertex {
@@ -152,4 +152,4 @@ class SceneGpu {
   gpu::GpuImage texture_array_;       // owned here, imported into the graph
 };
 
-}  // namespace mrgi::technique
+}  // namespace mrgi::frame

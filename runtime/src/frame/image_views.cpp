@@ -1,8 +1,8 @@
-#include "technique/image_views.h"
+#include "frame/image_views.h"
 
 #include "gpu/vk_check.h"
 
-namespace mrgi::technique {
+namespace mrgi::frame {
 
 Expected<VkImageView> ImageViews::create(const gpu::GpuImage& image, VkImageViewType type,
                                          uint32_t base, uint32_t count) {
@@ -26,4 +26,4 @@ void ImageViews::reset() {
   views_.clear();
 }
 
-}  // namespace mrgi::technique
+}  // namespace mrgi::frame

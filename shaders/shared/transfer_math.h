@@ -3,8 +3,8 @@
 // in the GLSL subset that also compiles as C++ with GLM (same rules as shared/mrgi_shared.h), so
 // the CPU tests check exactly what the shaders run.
 //
-// GLSL:  #include "shared/mrgi_shared.h"  then  #include "ssrt/ssrt_math.h"
-// C++:   #include "ssrt/ssrt_math.h"       (everything in namespace mrgi::shader)
+// GLSL:  #include "shared/mrgi_shared.h"  then  #include "shared/transfer_math.h"
+// C++:   #include "shared/transfer_math.h"       (everything in namespace mrgi::shader)
 #ifndef MRGI_SSRT_MATH_H
 #define MRGI_SSRT_MATH_H
 

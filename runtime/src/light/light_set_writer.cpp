@@ -1,11 +1,11 @@
-#include "technique/light_set_writer.h"
+#include "light/light_set_writer.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include <glm/glm.hpp>
 
-namespace mrgi::technique {
+namespace mrgi::light {
 
 void write_unshadowed_light_set(const light::Lighting& lighting, shader::LightSet& set) {
   set = shader::LightSet{};
@@ -32,4 +32,4 @@ void write_unshadowed_light_set(const light::Lighting& lighting, shader::LightSe
   set.ambient_r = {r[0], r[1], r[2]};
 }
 
-}  // namespace mrgi::technique
+}  // namespace mrgi::light

@@ -6,8 +6,8 @@
 #include "common/light_set.glsl"
 #include "light/light_stage.h"
 
-namespace mrgi::technique {
+namespace mrgi::light {
 
 void write_unshadowed_light_set(const light::Lighting& lighting, shader::LightSet& set);
 
-}  // namespace mrgi::technique
+}  // namespace mrgi::light

@@ -10,7 +10,7 @@
 #include "gpu/context.h"
 #include "mrgi/expected.h"
 
-namespace mrgi::technique {
+namespace mrgi::frame {
 
 class ImageViews {
  public:
@@ -35,4 +35,4 @@ class ImageViews {
   std::vector<VkImageView> views_;
 };
 
-}  // namespace mrgi::technique
+}  // namespace mrgi::frame

@@ -22,7 +22,7 @@
 #include "mrgi/frame.h"
 #include "mrgi/scene.h"
 
-namespace mrgi::technique {
+namespace mrgi::gi {
 
 class InputReuse {
  public:
@@ -60,4 +60,4 @@ class InputReuse {
   double depth_scale_ = 5000.0;
 };
 
-}  // namespace mrgi::technique
+}  // namespace mrgi::gi

@@ -1,0 +1,160 @@
+// The frame as a list of stages, recorded in a declared order into the frame graph, which orders
+// and synchronises their passes by the resources each declares it reads and writes. What a
+// technique needs of the others is its declared Technique::Needs, not a case here.
+//
+// The stages, and why each full-resolution pass is there (profiled ms at 640x480 on lavapipe x2,
+// baseline on desk_spot; floor pass about 1.2 ms):
+//   (upload)          host memcpy of colour and depth into this slot's buffers (in host_ms, <1)
+//   reconstruction    recon_warp: the temporal history warped into this frame's camera, internal
+//                     resolution (0.7 at lowest's 320x240, 2.5 at high's 640x480), the merge
+//                     needs it; recon_positions: depth decode, 3x3 same-surface median, temporal
+//                     merge, positions, albedo, fused in one pass (2.5 / 7.8): every technique
+//                     reads positions and albedo; recon_normals: normals from the positions'
+//                     neighbourhood (0.7 / 2.5), a separate pass because it reads the merged
+//                     positions of its neighbours
+//   light             the light stage (host work: lamps, environment, estimate)
+//   technique geometry  a technique's own real geometry (ssrt), for the virtual depth test
+//   virtual G-buffer  raster of the virtual objects (3.9 / 5.4)
+//   specular prepare  mirrors' and glass's impostors, back faces and caustic photons
+//   technique         its own passes (baseline: the direct-light block's caster mesh, shadow
+//                     maps and shading)
+//   specular finish   the mirrors' and glass's pixels over the technique's solutions
+//   compose           the only output-resolution pass (6.0 with the composite): it writes the
+//                     frame the user sees
+// A frame nothing virtual affects runs no pass at all when the output has the camera's size:
+// upload and a host conversion of the camera frame (below 1 floor pass); at another size
+// compose's camera-copy pipeline resamples it (2-3 ms). Reconstruction and the technique are
+// not added.
+#include <string>
+
+#include "runtime/runtime_impl.h"
+
+namespace mrgi::runtime_detail {
+
+const RuntimeImpl::FrameStageEntry RuntimeImpl::kFrameStages[] = {
+    {"reconstruction", &RuntimeImpl::record_reconstruction},
+    {"light", &RuntimeImpl::update_light},
+    {"technique geometry", &RuntimeImpl::record_technique_geometry},
+    {"virtual G-buffer", &RuntimeImpl::record_virtual_gbuffer},
+    {"specular prepare", &RuntimeImpl::record_specular_prepare},
+    {"technique", &RuntimeImpl::record_technique},
+    {"specular finish", &RuntimeImpl::record_specular_finish},
+    {"compose", &RuntimeImpl::record_compose},
+};
+
+Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, bool affected) {
+  const technique::QualityLevel& level = technique_->levels()[size_t(level_)];
+  rec.scale_factor = auto_level_ ? scheduler_->choice().scale : 1.0f;
+  rec.internal_scale = level.internal_scale * rec.scale_factor;
+  MRGI_TRY(graph_->set_render_scale(rec.internal_scale));
+  rec.technique_ran = affected;
+  write_constants(last_pose_);
+  recon_->upload(*graph_, frame);
+
+  FrameContext f{frame, rec, affected, false, false, level, {}};
+  f.has_objects = !scene_gpu_->virtual_objects.empty() && scene_gpu_->any_visible();
+  // The specular stage's impostors and back-projection read the reconstruction's G-buffer, so it
+  // runs for a technique without one (ssrt) when a mirror or glass object is in the scene.
+  f.recon_used = technique_->needs().reconstruction || specular_ != nullptr;
+  f.info.frame_index = frame.index;
+  f.info.level = level_;
+  f.info.virtual_objects_present = f.has_objects;
+  f.info.camera_to_world = last_pose_;
+  f.info.input = &frame;
+  for (const FrameStageEntry& stage : kFrameStages) MRGI_TRY((this->*stage.record)(f));
+  MRGI_TRY(graph_->compile());
+  MRGI_TRY(graph_->submit());
+  return check_validation();
+}
+
+// A frame nothing virtual affects is the camera frame (the lean frame above): the reconstruction
+// is not needed for it; its temporal history restarts on the next affected frame (one frame of
+// unfiltered depth).
+Status RuntimeImpl::record_reconstruction(FrameContext& f) {
+  if (f.affected && f.recon_used) {
+    recon_->record(*graph_, frame_constants_);
+    return ok_status();
+  }
+  recon_->skip_frame();
+  f.rec.skipped.push_back(f.affected ? "recon: " + technique_->name() +
+                                           " builds its own real geometry and reads the camera frame itself"
+                                     : "recon: nothing virtual in view (its temporal history restarts when there is)");
+  return ok_status();
+}
+
+// The light stage runs only where something is lit with its answer. Its cost as this thread's
+// CPU time: wall time here would count the driver's workers preempting it on a CPU device; the
+// CPU time is the work it adds to the frame.
+Status RuntimeImpl::update_light(FrameContext& f) {
+  if (!f.affected) return ok_status();
+  const double light_start = thread_cpu_ms();
+  MRGI_TRY(light_stage_->update(f.input, last_pose_, f.rec.notes));
+  f.rec.light_ms = thread_cpu_ms() - light_start;
+  return ok_status();
+}
+
+Status RuntimeImpl::record_technique_geometry(FrameContext& f) {
+  if (!f.affected) return ok_status();
+  return technique_->record_geometry(f.info, f.rec.skipped);
+}
+
+Status RuntimeImpl::record_virtual_gbuffer(FrameContext& f) {
+  if (!f.affected) return ok_status();
+  const std::optional<frame::RealGeometry> own = technique_->occlusion_geometry();
+  if (!own && !f.recon_used)
+    return fail(ErrorKind::Internal, technique_->name() +
+                                         ": skips the reconstruction but gives no real geometry "
+                                         "for the virtual objects' depth test");
+  virtual_gbuffer_->record(*graph_, frame_constants_,
+                           own ? *own : frame::RealGeometry{recon_->position(), recon_->position(), 1},
+                           f.level.mesh_error_px);
+  return ok_status();
+}
+
+Status RuntimeImpl::record_specular_prepare(FrameContext& f) {
+  if (!f.affected || !specular_) return ok_status();
+  MRGI_TRY(specular_->prepare(constants_, level_, int(technique_->levels().size()), f.rec.skipped));
+  f.info.caustics = specular_->caustic_photons();
+  return ok_status();
+}
+
+Status RuntimeImpl::record_technique(FrameContext& f) {
+  if (f.affected) return technique_->record(f.info, f.rec.skipped);
+  f.rec.skipped.push_back(f.has_objects ? "technique: no virtual object or its shadow in view"
+                                        : "technique: no virtual object and no virtual lamp in the scene");
+  return ok_status();
+}
+
+Status RuntimeImpl::record_specular_finish(FrameContext& f) {
+  if (!f.affected || !specular_) return ok_status();
+  const std::optional<shading::DirectLightOutput> direct = technique_->direct_light();
+  return specular_->finish(direct ? &*direct : nullptr, f.rec.skipped);
+}
+
+// An unaffected frame at the camera's size needs no GPU pass at all: its output is the camera
+// frame, which the host converts from the upload buffer when the (empty) frame completes (0.3 ms
+// of host time against 2-3 ms for compose's camera-copy pass on lavapipe).
+Status RuntimeImpl::record_compose(FrameContext& f) {
+  f.rec.camera_copy = !f.affected && output_w_ == cameras_.color.width && output_h_ == cameras_.color.height;
+  if (f.rec.camera_copy) {
+    f.rec.skipped.push_back("compose: nothing virtual in view, the camera frame is copied on the host");
+    return ok_status();
+  }
+  compose::ComposeInputs ci{frame_constants_, recon_->color_upload(), lit_rv_, lit_r_, virtual_gbuffer_->position(),
+                            !f.affected};
+  if (f.affected) {
+    const technique::Technique::ComposeTiles tiles = technique_->compose_tiles();
+    // Caustics land where the technique's tiles may not reach: then every pixel is composed.
+    if (!(specular_ && specular_->lights_outside_tiles())) {
+      ci.tile_args = tiles.args;
+      ci.tile_list = tiles.list;
+      ci.tiles_composed = tiles.composed;
+    } else {
+      f.rec.skipped.push_back("compose tiles: caustics may light pixels outside them, every pixel composed");
+    }
+  }
+  compose_->record(*graph_, ci);
+  return ok_status();
+}
+
+}  // namespace mrgi::runtime_detail
