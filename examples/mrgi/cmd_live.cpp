@@ -154,10 +154,8 @@ struct TempFolder {
   }
 };
 
-void run_live(const LiveOptions& o) {
-  RuntimeSettings settings;
-  o.quality.apply(settings);  // before the source is opened: a bad level or knob ends here
-  const int level = settings.level;
+// The source's options: the environment camera with its calibration from --env-model.
+SourceOptions source_options(const LiveOptions& o) {
   SourceOptions so;
   so.env = o.env;
   if (!o.env.empty()) {
@@ -167,16 +165,11 @@ void run_live(const LiveOptions& o) {
     so.env_model = calib.env_camera;
     so.env_exposure = calib.exposure;
   }
-  auto source = take(open_source(o.source, so));
-  const CaptureInfo& info = source->info();
+  return so;
+}
 
-  std::optional<AprilTagTracker> tracker;
-  if (info.apriltag) tracker = take(AprilTagTracker::create(*info.apriltag, info.color));
-
-  // The first frame decides the default object's distance.
-  auto first = source->next(std::chrono::milliseconds(o.timeout_ms));
-  if (!first.ok()) fail_with(first.error());
-  TempFolder temp;
+// --scene's scene, or a box at the first frame's central depth (its glTF written into `temp`).
+SceneDesc live_scene(const LiveOptions& o, const InputFrame& first, double depth_scale, TempFolder& temp) {
   SceneDesc scene;
   if (!o.scene.empty()) {
     scene = take(load_scene_json(o.scene));
@@ -186,8 +179,54 @@ void run_live(const LiveOptions& o) {
     const std::string glb = (temp.path / "default_box.glb").string();
     auto st = write_box_glb(glb, 0.15f);
     if (!st.ok()) fail_with(st.error());
-    scene = default_scene(glb, central_depth_m(*first, info.depth_scale));
+    scene = default_scene(glb, central_depth_m(first, depth_scale));
   }
+  return scene;
+}
+
+// The next frame into `frame`: `pending` if it holds one, else the source's. False at the end of
+// the stream.
+bool next_frame(InputSource& source, std::optional<InputFrame>& pending, int timeout_ms, InputFrame& frame) {
+  if (pending) {
+    frame = std::move(*pending);
+    pending.reset();
+  } else {
+    auto next = source.next(std::chrono::milliseconds(timeout_ms));
+    if (!next.ok()) {
+      if (next.error().kind == ErrorKind::EndOfStream) return false;
+      fail_with(next.error());
+    }
+    frame = std::move(next.value());
+  }
+  return true;
+}
+
+// The frame's pose: its own, the tracker's (counted by tracking state), or the last one.
+void set_pose(InputFrame& frame, std::optional<AprilTagTracker>& tracker, std::map<std::string, int>& tracking_states,
+              Pose& last_pose) {
+  if (!frame.pose && tracker) {
+    const TrackingResult r = tracker->fill_pose(frame);
+    ++tracking_states[to_string(r.state)];
+  }
+  if (frame.pose) last_pose = *frame.pose;
+  else frame.pose = last_pose;  // without tracking the camera pose stays where it was
+}
+
+void run_live(const LiveOptions& o) {
+  RuntimeSettings settings;
+  o.quality.apply(settings);  // before the source is opened: a bad level or knob ends here
+  const int level = settings.level;
+  auto source = take(open_source(o.source, source_options(o)));
+  const CaptureInfo& info = source->info();
+
+  std::optional<AprilTagTracker> tracker;
+  if (info.apriltag) tracker = take(AprilTagTracker::create(*info.apriltag, info.color));
+
+  // The first frame decides the default object's distance.
+  auto first = source->next(std::chrono::milliseconds(o.timeout_ms));
+  if (!first.ok()) fail_with(first.error());
+  TempFolder temp;
+  const SceneDesc scene = live_scene(o, *first, info.depth_scale, temp);
 
   settings.device.device = o.device;
   settings.exposure = info.exposure;
@@ -244,23 +283,8 @@ void run_live(const LiveOptions& o) {
   std::optional<InputFrame> pending = std::move(first.value());
   while (!g_stop && (o.frames == 0 || submitted < size_t(o.frames))) {
     InputFrame frame;
-    if (pending) {
-      frame = std::move(*pending);
-      pending.reset();
-    } else {
-      auto next = source->next(std::chrono::milliseconds(o.timeout_ms));
-      if (!next.ok()) {
-        if (next.error().kind == ErrorKind::EndOfStream) break;
-        fail_with(next.error());
-      }
-      frame = std::move(next.value());
-    }
-    if (!frame.pose && tracker) {
-      const TrackingResult r = tracker->fill_pose(frame);
-      ++tracking_states[to_string(r.state)];
-    }
-    if (frame.pose) last_pose = *frame.pose;
-    else frame.pose = last_pose;  // without tracking the camera pose stays where it was
+    if (!next_frame(*source, pending, o.timeout_ms, frame)) break;
+    set_pose(frame, tracker, tracking_states, last_pose);
     frame.index = int64_t(submitted++);
     cameras_by_frame[frame.index] = resize_bilinear(frame.color, out_w, out_h);
     for (FrameOutput& done : encoded.take_all()) runtime->recycle(std::move(done));

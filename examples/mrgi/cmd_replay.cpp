@@ -26,18 +26,9 @@ struct ReplayOptions {
   bool validate = false, quiet = false, vulkan_1_2 = false, no_residual_light = false;
 };
 
-void run_replay(const ReplayOptions& o) {
-  if ((o.width == 0) != (o.height == 0)) throw CommandFailure(2, "--width and --height go together");
-  RuntimeSettings settings;
-  o.quality.apply(settings);  // before any file is opened: a bad level or knob ends here
-  const int level = settings.level;
-  if (!o.video.empty())
-    if (Status st = VideoOutput::check(o.video, o.out); !st.ok()) fail_with(st.error());
-  CaptureReader capture = take(CaptureReader::open(o.capture));
-  const CaptureInfo& info = capture.info();
-  const size_t frames = o.frames > 0 ? std::min<size_t>(size_t(o.frames), capture.frame_count()) : capture.frame_count();
-  if (frames == 0) throw CommandFailure(1, o.capture + ": capture has no frames");
-
+// The settings the options give beyond the quality (o.quality.apply): device, output size,
+// light and ablations; the capture gives the exposure.
+void apply_options(const ReplayOptions& o, const CaptureInfo& info, RuntimeSettings& settings) {
   settings.device.device = o.device;
   settings.device.validate = o.validate;
   settings.device.vulkan_1_2 = o.vulkan_1_2;
@@ -54,6 +45,186 @@ void run_replay(const ReplayOptions& o) {
     throw CommandFailure(2, "--dir-ablation: only for --technique dir");
   set_ablations(o.specular_ablation, kSpecularAblations, research.specular);
   if (research.any()) settings.research = std::make_shared<const ResearchSettings>(research);
+}
+
+struct Decoded {
+  InputFrame frame;
+  ImageRGB8 camera;                     // the colour frame at output size
+  std::optional<LightEstimate> truth;   // the light of the frame's environment image
+};
+struct Finished {
+  FrameOutput output;
+  ImageRGB8 camera;
+  std::optional<LightEstimate> truth;
+};
+
+// One replay's frames through the runtime, in one of the two I/O modes (run_preloaded,
+// run_overlapped), with what both share: the input side, the output side, the frames between.
+struct Replay {
+  const ReplayOptions& o;
+  CaptureReader& capture;
+  const CaptureInfo& info;
+  const size_t frames;
+  const int out_w, out_h;
+  const double env_intensity;
+  Runtime& runtime;
+  ReplayOutput& output;
+  std::optional<AprilTagTracker>& tracker;
+  size_t tracked = 0, untracked = 0;
+  size_t written = 0;
+  std::chrono::steady_clock::time_point t0;
+  // Outputs come back frames_in_flight-1 calls late: each input's camera frame and true light
+  // wait here until then.
+  std::vector<std::optional<Decoded>> in_flight;
+
+  // One frame's input side (PNG reads, AprilTag, the environment's true light) and output side
+  // (the reference read, error figures, PNG write), shared by both I/O modes.
+  Decoded decode_one(size_t i) {
+    Decoded d;
+    d.frame = take(capture.read_frame(i));
+    d.frame.index = int64_t(i);
+    if (!d.frame.pose && tracker) {
+      tracker->fill_pose(d.frame);
+      ++(d.frame.pose ? tracked : untracked);
+    }
+    d.camera = resize_bilinear(d.frame.color, out_w, out_h);
+    if (d.frame.env && info.env_camera)
+      d.truth = take(light_from_environment(*d.frame.env, *info.env_camera, env_intensity));
+    return d;
+  }
+  void encode_one(Finished& f) {
+    const size_t i = size_t(f.output.stats.frame_index);
+    std::optional<ImageRGB8> ref;
+    std::optional<ImageU8> mask;
+    if (!capture.entry(i).reference.empty()) {
+      ref = resize_bilinear(take(capture.read_reference(i)), out_w, out_h);
+      if (!capture.entry(i).reference_mask.empty())
+        mask = resize_nearest(take(capture.read_reference_mask(i)), out_w, out_h);
+    }
+    const LightEstimate* truth = f.truth ? &*f.truth : nullptr;
+    auto st = output.add(f.output, f.camera, ref ? &*ref : nullptr, mask ? &*mask : nullptr, truth);
+    if (!st.ok()) fail_with(st.error());
+    ++written;
+    if (!o.quiet)
+      progress("replay " + o.quality.technique, written, frames,
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+  Finished finish(FrameOutput&& f) {
+    const size_t i = size_t(f.stats.frame_index);
+    Finished item{std::move(f), std::move(in_flight[i]->camera), std::move(in_flight[i]->truth)};
+    in_flight[i].reset();
+    return item;
+  }
+  void run_preloaded();
+  void run_overlapped();
+};
+
+// Chunks of inputs decoded before their frames run and encoded after: the runtime's frames
+// have the cores to themselves, as on a live device, so the costs the scheduler holds to the
+// budget are the runtime's (on 2 cores, overlapped PNG I/O makes the same frame cost 13 to
+// 27 ms). A chunk is as many frames as fit in kChunkBytes; the replay hands the runtime a
+// ready output buffer for each frame it takes (recycle), so no frame pays for fresh pages.
+void Replay::run_preloaded() {
+  constexpr size_t kChunkBytes = size_t(512) << 20;
+  const size_t in_px = size_t(info.color.width) * size_t(info.color.height);
+  const size_t out_px = size_t(out_w) * size_t(out_h);
+  const size_t frame_bytes = in_px * 5 + out_px * 8 + 1;
+  const size_t chunk = o.preload_frames > 0 ? std::min(size_t(o.preload_frames), frames)
+                                            : std::clamp<size_t>(kChunkBytes / frame_bytes, 4, frames);
+  std::vector<FrameOutput> spares(chunk + 4);
+  for (FrameOutput& s : spares) {
+    s.image = ImageRGBA8(out_w, out_h);
+    s.virtual_mask = ImageU8(out_w, out_h);
+  }
+  std::vector<Finished> done;
+  done.reserve(chunk + 4);
+  for (size_t first = 0; first < frames; first += chunk) {
+    const size_t last = std::min(frames, first + chunk);
+    for (size_t i = first; i < last; ++i) in_flight[i] = decode_one(i);
+    for (size_t i = first; i < last; ++i) {
+      if (!spares.empty()) {
+        runtime.recycle(std::move(spares.back()));
+        spares.pop_back();
+      }
+      auto outs = take(runtime.process(in_flight[i]->frame));
+      in_flight[i]->frame = InputFrame{};
+      for (FrameOutput& f : outs) done.push_back(finish(std::move(f)));
+    }
+    for (FrameOutput& f : take(runtime.flush())) done.push_back(finish(std::move(f)));
+    for (Finished& f : done) {
+      encode_one(f);
+      spares.push_back(std::move(f.output));
+    }
+    done.clear();
+  }
+}
+
+// Three stages, each on its own thread, with at most kQueued items between two of them:
+// decode -> the runtime -> encode. The runtime stage never waits on file I/O, but on a
+// machine with few cores the I/O stages take cores from the frames (their costs are noisy).
+void Replay::run_overlapped() {
+  constexpr size_t kQueued = 2;
+  BoundedQueue<Decoded> decoded(kQueued);
+  BoundedQueue<Finished> finished(kQueued);
+  ReturnQueue<FrameOutput> encoded;  // outputs written, for Runtime::recycle
+  StageThread decode(
+      [&] {
+        for (size_t i = 0; i < frames; ++i)
+          if (!decoded.push(decode_one(i))) return;  // a later stage failed
+      },
+      [&] { decoded.close(); });
+  StageThread encode(
+      [&] {
+        while (auto f = finished.pop()) {
+          encode_one(*f);
+          encoded.put(std::move(f->output));
+        }
+      },
+      [&] {
+        finished.close();
+        decoded.close();  // unblocks the decoder if encoding failed
+      });
+  auto hand_on = [&](std::vector<FrameOutput>&& outs) {
+    for (FrameOutput& f : outs)
+      if (!finished.push(finish(std::move(f)))) return false;
+    return true;
+  };
+  try {
+    bool ok = true;
+    while (ok) {
+      auto d = decoded.pop();
+      if (!d) break;
+      const size_t i = size_t(d->frame.index);
+      for (FrameOutput& done : encoded.take_all()) runtime.recycle(std::move(done));
+      auto outs = runtime.process(d->frame);
+      in_flight[i] = std::move(d);
+      in_flight[i]->frame = InputFrame{};
+      ok = hand_on(take(std::move(outs)));
+    }
+    if (ok) hand_on(take(runtime.flush()));
+  } catch (...) {
+    decoded.close();
+    finished.close();
+    throw;
+  }
+  finished.close();
+  decode.join();
+  encode.join();
+}
+
+void run_replay(const ReplayOptions& o) {
+  if ((o.width == 0) != (o.height == 0)) throw CommandFailure(2, "--width and --height go together");
+  RuntimeSettings settings;
+  o.quality.apply(settings);  // before any file is opened: a bad level or knob ends here
+  const int level = settings.level;
+  if (!o.video.empty())
+    if (Status st = VideoOutput::check(o.video, o.out); !st.ok()) fail_with(st.error());
+  CaptureReader capture = take(CaptureReader::open(o.capture));
+  const CaptureInfo& info = capture.info();
+  const size_t frames = o.frames > 0 ? std::min<size_t>(size_t(o.frames), capture.frame_count()) : capture.frame_count();
+  if (frames == 0) throw CommandFailure(1, o.capture + ": capture has no frames");
+
+  apply_options(o, info, settings);
   CameraSetup cameras{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera};
   SceneDesc scene = capture.scene() ? *capture.scene() : SceneDesc{};
   // The env intensity stays known for the truth of the direction error (env frames).
@@ -79,156 +250,17 @@ void run_replay(const ReplayOptions& o) {
   // colour frames (capture.json "apriltag"). Without either the runtime keeps the last pose.
   std::optional<AprilTagTracker> tracker;
   if (info.apriltag) tracker = take(AprilTagTracker::create(*info.apriltag, info.color));
-  size_t tracked = 0, untracked = 0;
 
-  struct Decoded {
-    InputFrame frame;
-    ImageRGB8 camera;                     // the colour frame at output size
-    std::optional<LightEstimate> truth;   // the light of the frame's environment image
-  };
-  struct Finished {
-    FrameOutput output;
-    ImageRGB8 camera;
-    std::optional<LightEstimate> truth;
-  };
-  // One frame's input side (PNG reads, AprilTag, the environment's true light) and output side
-  // (the reference read, error figures, PNG write), shared by both I/O modes.
-  auto decode_one = [&](size_t i) {
-    Decoded d;
-    d.frame = take(capture.read_frame(i));
-    d.frame.index = int64_t(i);
-    if (!d.frame.pose && tracker) {
-      tracker->fill_pose(d.frame);
-      ++(d.frame.pose ? tracked : untracked);
-    }
-    d.camera = resize_bilinear(d.frame.color, out_w, out_h);
-    if (d.frame.env && info.env_camera)
-      d.truth = take(light_from_environment(*d.frame.env, *info.env_camera, env_intensity));
-    return d;
-  };
-  size_t written = 0;
-  const auto t0 = std::chrono::steady_clock::now();
-  auto encode_one = [&](Finished& f) {
-    const size_t i = size_t(f.output.stats.frame_index);
-    std::optional<ImageRGB8> ref;
-    std::optional<ImageU8> mask;
-    if (!capture.entry(i).reference.empty()) {
-      ref = resize_bilinear(take(capture.read_reference(i)), out_w, out_h);
-      if (!capture.entry(i).reference_mask.empty())
-        mask = resize_nearest(take(capture.read_reference_mask(i)), out_w, out_h);
-    }
-    const LightEstimate* truth = f.truth ? &*f.truth : nullptr;
-    auto st = output.add(f.output, f.camera, ref ? &*ref : nullptr, mask ? &*mask : nullptr, truth);
-    if (!st.ok()) fail_with(st.error());
-    ++written;
-    if (!o.quiet)
-      progress("replay " + o.quality.technique, written, frames,
-               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  };
-  // Outputs come back frames_in_flight-1 calls late: each input's camera frame and true light
-  // wait here until then.
-  std::vector<std::optional<Decoded>> in_flight(frames);
-  auto finish = [&](FrameOutput&& f) {
-    const size_t i = size_t(f.stats.frame_index);
-    Finished item{std::move(f), std::move(in_flight[i]->camera), std::move(in_flight[i]->truth)};
-    in_flight[i].reset();
-    return item;
-  };
-
+  Replay replay{o, capture, info, frames, out_w, out_h, env_intensity, *runtime, output, tracker};
+  replay.t0 = std::chrono::steady_clock::now();
+  replay.in_flight.resize(frames);
   const bool preloaded = o.io == "preloaded" || (o.io.empty() && level == kAutoLevel);
-  if (preloaded) {
-    // Chunks of inputs decoded before their frames run and encoded after: the runtime's frames
-    // have the cores to themselves, as on a live device, so the costs the scheduler holds to the
-    // budget are the runtime's (on 2 cores, overlapped PNG I/O makes the same frame cost 13 to
-    // 27 ms). A chunk is as many frames as fit in kChunkBytes; the replay hands the runtime a
-    // ready output buffer for each frame it takes (recycle), so no frame pays for fresh pages.
-    constexpr size_t kChunkBytes = size_t(512) << 20;
-    const size_t in_px = size_t(info.color.width) * size_t(info.color.height);
-    const size_t out_px = size_t(out_w) * size_t(out_h);
-    const size_t frame_bytes = in_px * 5 + out_px * 8 + 1;
-    const size_t chunk = o.preload_frames > 0 ? std::min(size_t(o.preload_frames), frames)
-                                              : std::clamp<size_t>(kChunkBytes / frame_bytes, 4, frames);
-    std::vector<FrameOutput> spares(chunk + 4);
-    for (FrameOutput& s : spares) {
-      s.image = ImageRGBA8(out_w, out_h);
-      s.virtual_mask = ImageU8(out_w, out_h);
-    }
-    std::vector<Finished> done;
-    done.reserve(chunk + 4);
-    for (size_t first = 0; first < frames; first += chunk) {
-      const size_t last = std::min(frames, first + chunk);
-      for (size_t i = first; i < last; ++i) in_flight[i] = decode_one(i);
-      for (size_t i = first; i < last; ++i) {
-        if (!spares.empty()) {
-          runtime->recycle(std::move(spares.back()));
-          spares.pop_back();
-        }
-        auto outs = take(runtime->process(in_flight[i]->frame));
-        in_flight[i]->frame = InputFrame{};
-        for (FrameOutput& f : outs) done.push_back(finish(std::move(f)));
-      }
-      for (FrameOutput& f : take(runtime->flush())) done.push_back(finish(std::move(f)));
-      for (Finished& f : done) {
-        encode_one(f);
-        spares.push_back(std::move(f.output));
-      }
-      done.clear();
-    }
-  } else {
-    // Three stages, each on its own thread, with at most kQueued items between two of them:
-    // decode -> the runtime -> encode. The runtime stage never waits on file I/O, but on a
-    // machine with few cores the I/O stages take cores from the frames (their costs are noisy).
-    constexpr size_t kQueued = 2;
-    BoundedQueue<Decoded> decoded(kQueued);
-    BoundedQueue<Finished> finished(kQueued);
-    ReturnQueue<FrameOutput> encoded;  // outputs written, for Runtime::recycle
-    StageThread decode(
-        [&] {
-          for (size_t i = 0; i < frames; ++i)
-            if (!decoded.push(decode_one(i))) return;  // a later stage failed
-        },
-        [&] { decoded.close(); });
-    StageThread encode(
-        [&] {
-          while (auto f = finished.pop()) {
-            encode_one(*f);
-            encoded.put(std::move(f->output));
-          }
-        },
-        [&] {
-          finished.close();
-          decoded.close();  // unblocks the decoder if encoding failed
-        });
-    auto hand_on = [&](std::vector<FrameOutput>&& outs) {
-      for (FrameOutput& f : outs)
-        if (!finished.push(finish(std::move(f)))) return false;
-      return true;
-    };
-    try {
-      bool ok = true;
-      while (ok) {
-        auto d = decoded.pop();
-        if (!d) break;
-        const size_t i = size_t(d->frame.index);
-        for (FrameOutput& done : encoded.take_all()) runtime->recycle(std::move(done));
-        auto outs = runtime->process(d->frame);
-        in_flight[i] = std::move(d);
-        in_flight[i]->frame = InputFrame{};
-        ok = hand_on(take(std::move(outs)));
-      }
-      if (ok) hand_on(take(runtime->flush()));
-    } catch (...) {
-      decoded.close();
-      finished.close();
-      throw;
-    }
-    finished.close();
-    decode.join();
-    encode.join();
-  }
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (written != frames)
-    throw CommandFailure(1, "internal: " + std::to_string(written) + " of " + std::to_string(frames) + " frames came back");
+  if (preloaded) replay.run_preloaded();
+  else replay.run_overlapped();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - replay.t0).count();
+  if (replay.written != frames)
+    throw CommandFailure(1, "internal: " + std::to_string(replay.written) + " of " + std::to_string(frames) +
+                                " frames came back");
   output.set_achieved({frames, seconds,
                        preloaded ? "decode a chunk of frames, process them back to back, encode them (PNG I/O included, "
                                    "never beside a frame)"
@@ -238,8 +270,8 @@ void run_replay(const ReplayOptions& o) {
               << double(frames) / seconds << " fps achieved (decode and encode included)\n";
   nlohmann::json summary = take(output.finish());
   if (tracker)
-    std::cerr << "mrgi: AprilTag tracking gave a pose for " << tracked << " frames, none for " << untracked
-              << " (capture has no groundtruth.txt pose for them)\n";
+    std::cerr << "mrgi: AprilTag tracking gave a pose for " << replay.tracked << " frames, none for "
+              << replay.untracked << " (capture has no groundtruth.txt pose for them)\n";
   std::cout << summary.dump(2) << "\n";
 }
 

@@ -230,6 +230,26 @@ Status Context::init(const DeviceSettings& settings) {
   validate_ = settings.validate;
   const char* poison_env = std::getenv("MRGI_POISON_MEMORY");
   poison_memory_ = settings.poison_memory || (poison_env != nullptr && std::string(poison_env) == "1");
+  MRGI_TRY(init_instance(settings));
+  MRGI_TRY(select_physical_device(settings));
+  const std::string who = "device " + std::to_string(info_.index) + " '" + info_.name + "'";
+  if (properties_.apiVersion < VK_API_VERSION_1_2)
+    return fail(ErrorKind::Device, who + " has Vulkan " + version_string(properties_.apiVersion) +
+                                       "; mrgi needs 1.2 or later");
+  // The 1.3 entry points only where both the device and the settings allow them.
+  const bool is13 = properties_.apiVersion >= VK_API_VERSION_1_3 && !settings.vulkan_1_2;
+  api_1_3_ = is13;
+
+  MRGI_TRY(choose_queue_family(who));
+  MRGI_TRY(create_device(who));
+  MRGI_TRY(load_device_functions(who));
+  MRGI_TRY(create_upload_pool());
+  MRGI_TRY(create_samplers());
+  return ok_status();
+}
+
+// The instance at the settings' API version, with the validation messenger when validating.
+Status Context::init_instance(const DeviceSettings& settings) {
   VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
   mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
   mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
@@ -247,7 +267,11 @@ Status Context::init(const DeviceSettings& settings) {
     if (!create_messenger) return fail(ErrorKind::Device, "VK_EXT_debug_utils: vkCreateDebugUtilsMessengerEXT missing");
     VK_CHECK(create_messenger(instance_, &mci, nullptr, &messenger_));
   }
+  return ok_status();
+}
 
+// The settings' device of those the instance lists, with its properties.
+Status Context::select_physical_device(const DeviceSettings& settings) {
   auto pds = physical_devices(instance_);
   if (!pds) return pds.error();
   const std::vector<DeviceInfo> devices = describe_all(*pds);
@@ -258,15 +282,11 @@ Status Context::init(const DeviceSettings& settings) {
   info_.selected = true;
   vkGetPhysicalDeviceProperties(physical_, &properties_);
   vkGetPhysicalDeviceMemoryProperties(physical_, &memory_properties_);
-  const std::string who = "device " + std::to_string(info_.index) + " '" + info_.name + "'";
-  if (properties_.apiVersion < VK_API_VERSION_1_2)
-    return fail(ErrorKind::Device, who + " has Vulkan " + version_string(properties_.apiVersion) +
-                                       "; mrgi needs 1.2 or later");
-  // The 1.3 entry points only where both the device and the settings allow them.
-  const bool is13 = properties_.apiVersion >= VK_API_VERSION_1_3 && !settings.vulkan_1_2;
-  api_1_3_ = is13;
+  return ok_status();
+}
 
-  // Queue: the first family with graphics and compute.
+// Queue: the first family with graphics and compute.
+Status Context::choose_queue_family(const std::string& who) {
   uint32_t nq = 0;
   vkGetPhysicalDeviceQueueFamilyProperties(physical_, &nq, nullptr);
   std::vector<VkQueueFamilyProperties> families(nq);
@@ -281,9 +301,13 @@ Status Context::init(const DeviceSettings& settings) {
     }
   }
   if (!found) return fail(ErrorKind::Device, who + " has no queue family with graphics and compute");
+  return ok_status();
+}
 
-  // Extensions and features. sync2 and dynamic rendering are core in 1.3 and extensions in 1.2.
-  std::vector<const char*> extensions;
+// The extensions mrgi requires, into `extensions`. sync2 and dynamic rendering are core in 1.3
+// and extensions in 1.2.
+Status Context::require_extensions(const std::string& who, std::vector<const char*>& extensions) {
+  const bool is13 = api_1_3_;
   auto require = [&](const char* ext) -> Status {
     if (!device_has_extension(physical_, ext))
       return fail(ErrorKind::Device, who + " lacks " + ext + ", which mrgi requires");
@@ -295,6 +319,14 @@ Status Context::init(const DeviceSettings& settings) {
     MRGI_TRY(require(VK_KHR_SYNCHRONIZATION_2_EXTENSION_NAME));
     MRGI_TRY(require(VK_KHR_DYNAMIC_RENDERING_EXTENSION_NAME));
   }
+  return ok_status();
+}
+
+// Extensions and features: the device with what the techniques use, where it has it, and its
+// queue.
+Status Context::create_device(const std::string& who) {
+  std::vector<const char*> extensions;
+  MRGI_TRY(require_extensions(who, extensions));
   VkPhysicalDeviceSynchronization2Features sync2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SYNCHRONIZATION_2_FEATURES};
   VkPhysicalDeviceDynamicRenderingFeatures dynr{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DYNAMIC_RENDERING_FEATURES};
   VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
@@ -371,7 +403,12 @@ Status Context::init(const DeviceSettings& settings) {
   dci.ppEnabledExtensionNames = extensions.data();
   VK_CHECK(vkCreateDevice(physical_, &dci, nullptr, &device_));
   vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
+  return ok_status();
+}
 
+// The entry points that are core in 1.3 and extensions in 1.2, and push descriptors.
+Status Context::load_device_functions(const std::string& who) {
+  const bool is13 = api_1_3_;
   fn_.cmd_pipeline_barrier2 = load_device_fn<PFN_vkCmdPipelineBarrier2>(
       device_, is13 ? "vkCmdPipelineBarrier2" : "vkCmdPipelineBarrier2KHR", nullptr);
   fn_.cmd_write_timestamp2 = load_device_fn<PFN_vkCmdWriteTimestamp2>(
@@ -386,12 +423,19 @@ Status Context::init(const DeviceSettings& settings) {
       !fn_.cmd_begin_rendering || !fn_.cmd_end_rendering || !fn_.cmd_push_descriptor_set)
     return fail(ErrorKind::Device, who + ": a required device entry point (sync2, dynamic rendering or "
                                          "push descriptors) could not be loaded");
+  return ok_status();
+}
 
+Status Context::create_upload_pool() {
   VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   pci.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
   pci.queueFamilyIndex = queue_family_;
   VK_CHECK(vkCreateCommandPool(device_, &pci, nullptr, &upload_pool_));
+  return ok_status();
+}
 
+// StandardSamplers: linear clamp and repeat, nearest clamp, the shadow maps' compare.
+Status Context::create_samplers() {
   VkSamplerCreateInfo sci{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
   sci.magFilter = sci.minFilter = VK_FILTER_LINEAR;
   sci.mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR;

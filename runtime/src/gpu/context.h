@@ -162,6 +162,15 @@ class Context {
  private:
   Context() = default;
   Status init(const DeviceSettings& settings);
+  // init()'s steps, in its order.
+  Status init_instance(const DeviceSettings& settings);
+  Status select_physical_device(const DeviceSettings& settings);
+  Status choose_queue_family(const std::string& who);
+  Status require_extensions(const std::string& who, std::vector<const char*>& extensions);
+  Status create_device(const std::string& who);
+  Status load_device_functions(const std::string& who);
+  Status create_upload_pool();
+  Status create_samplers();
   Expected<VkDeviceMemory> allocate(const VkMemoryRequirements& req, MemoryUsage usage,
                                     bool* coherent);
 

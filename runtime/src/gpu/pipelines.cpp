@@ -88,6 +88,115 @@ Status make_layouts(const Context& ctx, const std::string& name, const ShaderInt
   return ok_status();
 }
 
+// The graphics pipelines' fixed-function states that depend on the description.
+VkPipelineRasterizationStateCreateInfo rasterization_state(const GraphicsPipelineDesc& desc) {
+  VkPipelineRasterizationStateCreateInfo rs{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+  rs.polygonMode = VK_POLYGON_MODE_FILL;
+  rs.cullMode = desc.cull_mode;
+  rs.frontFace = desc.front_face;
+  rs.lineWidth = 1.0f;
+  rs.depthBiasEnable = (desc.depth_bias_constant != 0.0f || desc.depth_bias_slope != 0.0f) ? VK_TRUE : VK_FALSE;
+  rs.depthBiasConstantFactor = desc.depth_bias_constant;
+  rs.depthBiasSlopeFactor = desc.depth_bias_slope;
+  return rs;
+}
+
+VkPipelineDepthStencilStateCreateInfo depth_stencil_state(const GraphicsPipelineDesc& desc) {
+  VkPipelineDepthStencilStateCreateInfo ds{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
+  const bool has_depth = desc.depth_format != VK_FORMAT_UNDEFINED;
+  ds.depthTestEnable = has_depth && desc.depth_test;
+  ds.depthWriteEnable = has_depth && desc.depth_write;
+  ds.depthCompareOp = desc.depth_compare;
+  return ds;
+}
+
+std::vector<VkPipelineColorBlendAttachmentState> blend_attachments(const GraphicsPipelineDesc& desc) {
+  std::vector<VkPipelineColorBlendAttachmentState> blend(desc.color_formats.size());
+  for (auto& b : blend) {
+    b.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT |
+                       VK_COLOR_COMPONENT_A_BIT;
+    if (desc.additive_blend) {
+      b.blendEnable = VK_TRUE;
+      b.srcColorBlendFactor = b.dstColorBlendFactor = VK_BLEND_FACTOR_ONE;
+      b.srcAlphaBlendFactor = b.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
+      b.colorBlendOp = b.alphaBlendOp = VK_BLEND_OP_ADD;
+    }
+  }
+  return blend;
+}
+
+// The vertex and fragment shaders' interface, merged and resolved against desc.bindings
+// (push_bytes: in, the description's push-constant size; out, the resolved one).
+Expected<ShaderInterface> graphics_interface(const GraphicsPipelineDesc& desc, const std::string& what,
+                                             uint32_t& push_bytes) {
+  Expected<ShaderInterface> iface = reflect_shader(desc.vertex_spirv, what + " vertex shader");
+  if (iface && !desc.fragment_spirv.empty()) {
+    auto f = reflect_shader(desc.fragment_spirv, what + " fragment shader");
+    iface = f ? merge_interfaces(*iface, *f, what) : Expected<ShaderInterface>(f.error());
+  }
+  if (iface) iface = resolve_interface(desc.name, *iface, desc.bindings, push_bytes);
+  return iface;
+}
+
+// The pipeline object of `desc` with the shader modules vs and fs (none: VK_NULL_HANDLE) and
+// p's layout, into p.pipeline.
+Status create_graphics_vk_pipeline(const Context& ctx, const GraphicsPipelineDesc& desc, VkShaderModule vs,
+                                   VkShaderModule fs, Pipeline& p) {
+  VkPipelineShaderStageCreateInfo st[2] = {{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO},
+                                           {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO}};
+  st[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
+  st[0].module = vs;
+  st[0].pName = "main";
+  st[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
+  st[1].module = fs;
+  st[1].pName = "main";
+  std::vector<VkVertexInputBindingDescription> vb;
+  for (uint32_t i = 0; i < desc.vertex_strides.size(); ++i)
+    vb.push_back({i, desc.vertex_strides[i], VK_VERTEX_INPUT_RATE_VERTEX});
+  std::vector<VkVertexInputAttributeDescription> va;
+  for (const VertexAttribute& a : desc.attributes) va.push_back({a.location, a.binding, a.format, a.offset});
+  VkPipelineVertexInputStateCreateInfo vi{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+  vi.vertexBindingDescriptionCount = uint32_t(vb.size());
+  vi.pVertexBindingDescriptions = vb.data();
+  vi.vertexAttributeDescriptionCount = uint32_t(va.size());
+  vi.pVertexAttributeDescriptions = va.data();
+  VkPipelineInputAssemblyStateCreateInfo ia{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+  ia.topology = desc.topology;
+  VkPipelineViewportStateCreateInfo vp{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+  vp.viewportCount = 1;
+  vp.scissorCount = 1;
+  const VkPipelineRasterizationStateCreateInfo rs = rasterization_state(desc);
+  VkPipelineMultisampleStateCreateInfo ms{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+  ms.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
+  const VkPipelineDepthStencilStateCreateInfo ds = depth_stencil_state(desc);
+  const std::vector<VkPipelineColorBlendAttachmentState> blend = blend_attachments(desc);
+  VkPipelineColorBlendStateCreateInfo cb{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+  cb.attachmentCount = uint32_t(blend.size());
+  cb.pAttachments = blend.data();
+  const VkDynamicState dyn[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+  VkPipelineDynamicStateCreateInfo dy{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
+  dy.dynamicStateCount = 2;
+  dy.pDynamicStates = dyn;
+  VkPipelineRenderingCreateInfo ri{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
+  ri.colorAttachmentCount = uint32_t(desc.color_formats.size());
+  ri.pColorAttachmentFormats = desc.color_formats.data();
+  ri.depthAttachmentFormat = desc.depth_format;
+  VkGraphicsPipelineCreateInfo ci{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
+  ci.pNext = &ri;
+  ci.stageCount = fs ? 2 : 1;
+  ci.pStages = st;
+  ci.pVertexInputState = &vi;
+  ci.pInputAssemblyState = &ia;
+  ci.pViewportState = &vp;
+  ci.pRasterizationState = &rs;
+  ci.pMultisampleState = &ms;
+  ci.pDepthStencilState = &ds;
+  ci.pColorBlendState = &cb;
+  ci.pDynamicState = &dy;
+  ci.layout = p.layout;
+  return VK_STATUS(vkCreateGraphicsPipelines(ctx.device(), VK_NULL_HANDLE, 1, &ci, nullptr, &p.pipeline));
+}
+
 }  // namespace
 
 Expected<Pipeline> create_compute_pipeline(const Context& ctx, const ComputePipelineDesc& desc) {
@@ -146,95 +255,15 @@ Expected<Pipeline> create_graphics_pipeline(const Context& ctx, const GraphicsPi
     fs = *m;
   }
   const VkShaderStageFlags stages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
-  Expected<ShaderInterface> iface = reflect_shader(desc.vertex_spirv, what + " vertex shader");
-  if (iface && !desc.fragment_spirv.empty()) {
-    auto f = reflect_shader(desc.fragment_spirv, what + " fragment shader");
-    iface = f ? merge_interfaces(*iface, *f, what) : Expected<ShaderInterface>(f.error());
-  }
   uint32_t push_bytes = desc.push_constant_bytes;
-  if (iface) iface = resolve_interface(desc.name, *iface, desc.bindings, push_bytes);
+  Expected<ShaderInterface> iface = graphics_interface(desc, what, push_bytes);
   if (!iface) {
     vkDestroyShaderModule(ctx.device(), *vs, nullptr);
     if (fs) vkDestroyShaderModule(ctx.device(), fs, nullptr);
     return iface.error();
   }
   Status s = make_layouts(ctx, desc.name, *iface, stages, push_bytes, p);
-  if (s.ok()) {
-    VkPipelineShaderStageCreateInfo st[2] = {{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO},
-                                             {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO}};
-    st[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
-    st[0].module = *vs;
-    st[0].pName = "main";
-    st[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
-    st[1].module = fs;
-    st[1].pName = "main";
-    std::vector<VkVertexInputBindingDescription> vb;
-    for (uint32_t i = 0; i < desc.vertex_strides.size(); ++i)
-      vb.push_back({i, desc.vertex_strides[i], VK_VERTEX_INPUT_RATE_VERTEX});
-    std::vector<VkVertexInputAttributeDescription> va;
-    for (const VertexAttribute& a : desc.attributes) va.push_back({a.location, a.binding, a.format, a.offset});
-    VkPipelineVertexInputStateCreateInfo vi{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
-    vi.vertexBindingDescriptionCount = uint32_t(vb.size());
-    vi.pVertexBindingDescriptions = vb.data();
-    vi.vertexAttributeDescriptionCount = uint32_t(va.size());
-    vi.pVertexAttributeDescriptions = va.data();
-    VkPipelineInputAssemblyStateCreateInfo ia{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
-    ia.topology = desc.topology;
-    VkPipelineViewportStateCreateInfo vp{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
-    vp.viewportCount = 1;
-    vp.scissorCount = 1;
-    VkPipelineRasterizationStateCreateInfo rs{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
-    rs.polygonMode = VK_POLYGON_MODE_FILL;
-    rs.cullMode = desc.cull_mode;
-    rs.frontFace = desc.front_face;
-    rs.lineWidth = 1.0f;
-    rs.depthBiasEnable = (desc.depth_bias_constant != 0.0f || desc.depth_bias_slope != 0.0f) ? VK_TRUE : VK_FALSE;
-    rs.depthBiasConstantFactor = desc.depth_bias_constant;
-    rs.depthBiasSlopeFactor = desc.depth_bias_slope;
-    VkPipelineMultisampleStateCreateInfo ms{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
-    ms.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
-    VkPipelineDepthStencilStateCreateInfo ds{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
-    const bool has_depth = desc.depth_format != VK_FORMAT_UNDEFINED;
-    ds.depthTestEnable = has_depth && desc.depth_test;
-    ds.depthWriteEnable = has_depth && desc.depth_write;
-    ds.depthCompareOp = desc.depth_compare;
-    std::vector<VkPipelineColorBlendAttachmentState> blend(desc.color_formats.size());
-    for (auto& b : blend) {
-      b.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT |
-                         VK_COLOR_COMPONENT_A_BIT;
-      if (desc.additive_blend) {
-        b.blendEnable = VK_TRUE;
-        b.srcColorBlendFactor = b.dstColorBlendFactor = VK_BLEND_FACTOR_ONE;
-        b.srcAlphaBlendFactor = b.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
-        b.colorBlendOp = b.alphaBlendOp = VK_BLEND_OP_ADD;
-      }
-    }
-    VkPipelineColorBlendStateCreateInfo cb{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
-    cb.attachmentCount = uint32_t(blend.size());
-    cb.pAttachments = blend.data();
-    const VkDynamicState dyn[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
-    VkPipelineDynamicStateCreateInfo dy{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
-    dy.dynamicStateCount = 2;
-    dy.pDynamicStates = dyn;
-    VkPipelineRenderingCreateInfo ri{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
-    ri.colorAttachmentCount = uint32_t(desc.color_formats.size());
-    ri.pColorAttachmentFormats = desc.color_formats.data();
-    ri.depthAttachmentFormat = desc.depth_format;
-    VkGraphicsPipelineCreateInfo ci{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
-    ci.pNext = &ri;
-    ci.stageCount = fs ? 2 : 1;
-    ci.pStages = st;
-    ci.pVertexInputState = &vi;
-    ci.pInputAssemblyState = &ia;
-    ci.pViewportState = &vp;
-    ci.pRasterizationState = &rs;
-    ci.pMultisampleState = &ms;
-    ci.pDepthStencilState = &ds;
-    ci.pColorBlendState = &cb;
-    ci.pDynamicState = &dy;
-    ci.layout = p.layout;
-    s = VK_STATUS(vkCreateGraphicsPipelines(ctx.device(), VK_NULL_HANDLE, 1, &ci, nullptr, &p.pipeline));
-  }
+  if (s.ok()) s = create_graphics_vk_pipeline(ctx, desc, *vs, fs, p);
   vkDestroyShaderModule(ctx.device(), *vs, nullptr);
   if (fs) vkDestroyShaderModule(ctx.device(), fs, nullptr);
   if (!s) {

@@ -16,6 +16,53 @@ Expected<ShaderInterface> reflect_error(const std::string& what, const std::stri
   return fail(ErrorKind::BadUsage, what + ": " + why);
 }
 
+// Resource r's descriptor type (listed as `kind`, of type `type`) into b, and for storage
+// buffers and images whether the shader reads and writes it.
+Status set_descriptor_type(spvc_compiler comp, const spvc_reflected_resource& r, spvc_resource_type kind,
+                           spvc_type type, const std::string& what, const std::string& where, ShaderBinding& b) {
+  const bool no_write = spvc_compiler_has_decoration(comp, r.id, SpvDecorationNonWritable);
+  const bool no_read = spvc_compiler_has_decoration(comp, r.id, SpvDecorationNonReadable);
+  switch (kind) {
+    case SPVC_RESOURCE_TYPE_UNIFORM_BUFFER:
+      b.type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+      break;
+    case SPVC_RESOURCE_TYPE_STORAGE_BUFFER: {
+      b.type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+      // readonly / writeonly on a buffer block decorate its members.
+      spvc_type block = spvc_compiler_get_type_handle(comp, r.base_type_id);
+      const unsigned members = spvc_type_get_num_member_types(block);
+      bool all_nonwritable = members > 0, all_nonreadable = members > 0;
+      for (unsigned m = 0; m < members; ++m) {
+        all_nonwritable &= bool(spvc_compiler_has_member_decoration(comp, r.base_type_id, m, SpvDecorationNonWritable));
+        all_nonreadable &= bool(spvc_compiler_has_member_decoration(comp, r.base_type_id, m, SpvDecorationNonReadable));
+      }
+      b.written = !(all_nonwritable || no_write);
+      b.read = !(all_nonreadable || no_read);
+      break;
+    }
+    case SPVC_RESOURCE_TYPE_STORAGE_IMAGE:
+      b.type = spvc_type_get_image_dimension(type) == SpvDimBuffer ? VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER
+                                                                  : VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+      b.written = !no_write;
+      b.read = !no_read;
+      break;
+    case SPVC_RESOURCE_TYPE_SAMPLED_IMAGE:
+      b.type = spvc_type_get_image_dimension(type) == SpvDimBuffer ? VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER
+                                                                  : VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+      break;
+    case SPVC_RESOURCE_TYPE_SEPARATE_IMAGE:
+      b.type = spvc_type_get_image_dimension(type) == SpvDimBuffer ? VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER
+                                                                  : VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
+      break;
+    case SPVC_RESOURCE_TYPE_SEPARATE_SAMPLERS:
+      b.type = VK_DESCRIPTOR_TYPE_SAMPLER;
+      break;
+    default:
+      return reflect_error(what, where + ": mrgi does not bind this kind of resource").error();
+  }
+  return ok_status();
+}
+
 }  // namespace
 
 const ShaderBinding* ShaderInterface::find(std::string_view name) const {
@@ -88,46 +135,7 @@ Expected<ShaderInterface> reflect_shader(std::span<const uint32_t> spirv, const 
         b.count = spvc_type_get_array_dimension(type, 0);
         if (b.count == 0) return reflect_error(what, where + ": runtime-sized descriptor arrays are not bound");
       }
-      const bool no_write = spvc_compiler_has_decoration(comp, r.id, SpvDecorationNonWritable);
-      const bool no_read = spvc_compiler_has_decoration(comp, r.id, SpvDecorationNonReadable);
-      switch (k.type) {
-        case SPVC_RESOURCE_TYPE_UNIFORM_BUFFER:
-          b.type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-          break;
-        case SPVC_RESOURCE_TYPE_STORAGE_BUFFER: {
-          b.type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-          // readonly / writeonly on a buffer block decorate its members.
-          spvc_type block = spvc_compiler_get_type_handle(comp, r.base_type_id);
-          const unsigned members = spvc_type_get_num_member_types(block);
-          bool all_nonwritable = members > 0, all_nonreadable = members > 0;
-          for (unsigned m = 0; m < members; ++m) {
-            all_nonwritable &= bool(spvc_compiler_has_member_decoration(comp, r.base_type_id, m, SpvDecorationNonWritable));
-            all_nonreadable &= bool(spvc_compiler_has_member_decoration(comp, r.base_type_id, m, SpvDecorationNonReadable));
-          }
-          b.written = !(all_nonwritable || no_write);
-          b.read = !(all_nonreadable || no_read);
-          break;
-        }
-        case SPVC_RESOURCE_TYPE_STORAGE_IMAGE:
-          b.type = spvc_type_get_image_dimension(type) == SpvDimBuffer ? VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER
-                                                                      : VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-          b.written = !no_write;
-          b.read = !no_read;
-          break;
-        case SPVC_RESOURCE_TYPE_SAMPLED_IMAGE:
-          b.type = spvc_type_get_image_dimension(type) == SpvDimBuffer ? VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER
-                                                                      : VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-          break;
-        case SPVC_RESOURCE_TYPE_SEPARATE_IMAGE:
-          b.type = spvc_type_get_image_dimension(type) == SpvDimBuffer ? VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER
-                                                                      : VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
-          break;
-        case SPVC_RESOURCE_TYPE_SEPARATE_SAMPLERS:
-          b.type = VK_DESCRIPTOR_TYPE_SAMPLER;
-          break;
-        default:
-          return reflect_error(what, where + ": mrgi does not bind this kind of resource");
-      }
+      MRGI_TRY(set_descriptor_type(comp, r, k.type, type, what, where, b));
       if (const ShaderBinding* other = out.at_binding(b.binding))
         return reflect_error(what, where + " and '" + other->name + "' share binding " + std::to_string(b.binding));
       out.bindings.push_back(std::move(b));

@@ -49,6 +49,85 @@ Mat below_surface_gram(const glm::dvec3& normal, int n) {
   return m * (4.0 * kPi / kDirections);
 }
 
+// Refuses a system with NaN or Inf in its sums (the frame is not used).
+Status check_system_finite(const LightSystem& system, int64_t frame_index) {
+  for (double v : system.ata)
+    if (!std::isfinite(v))
+      return fail(ErrorKind::BadInput, "ssrt light estimation: frame " +
+                                           std::to_string(frame_index) +
+                                           ": T^T T holds NaN or Inf; frame not used");
+  for (double v : system.atb)
+    if (!std::isfinite(v))
+      return fail(ErrorKind::BadInput, "ssrt light estimation: frame " +
+                                           std::to_string(frame_index) +
+                                           ": T^T I_c holds NaN or Inf; frame not used");
+  return ok_status();
+}
+
+// The system's first n coefficients: T^T T into `ata` (symmetrised) and T^T I_c / albedo into
+// `atb` (each row's luminance in all three channels for white light).
+void load_system(const LightSystem& system, int n, double gray_albedo, bool white_light, Mat& ata, Rhs& atb) {
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) ata(i, j) = system.ata[i * kMaxShCoeffs + j];
+    const double inv_a = 1.0 / gray_albedo;  // T l = I_c / a
+    for (int c = 0; c < 3; ++c) atb(i, c) = system.atb[i * 3 + c] * inv_a;
+  }
+  if (white_light) {
+    for (int i = 0; i < n; ++i) {
+      const double y = luminance(glm::dvec3(atb(i, 0), atb(i, 1), atb(i, 2)));
+      atb.row(i).setConstant(y);
+    }
+  }
+  // Symmetrise (float sums from the GPU are not exactly symmetric).
+  ata = (0.5 * (ata + ata.transpose())).eval();
+}
+
+// The eigenvalues of T^T T above `fraction` of the largest: directions of the SH space the data
+// pins down on its own.
+int constrained_directions(const Mat& ata, int n, double fraction) {
+  Eigen::SelfAdjointEigenSolver<Mat> eig(ata, Eigen::EigenvaluesOnly);
+  const auto& ev = eig.eigenvalues();
+  const double max_ev = std::max(ev.maxCoeff(), 0.0);
+  int constrained = 0;
+  for (int i = 0; i < n; ++i)
+    if (max_ev > 0.0 && ev(i) > fraction * max_ev) ++constrained;
+  return constrained;
+}
+
+// The prior's band 0 fitted to this frame, its other bands as they are (ata(0, 0) > 0).
+void refit_ambient(ShRgb& prior, const Mat& ata, const Rhs& atb, int n) {
+  for (int c = 0; c < 3; ++c) {
+    double rest = 0.0;
+    for (int j = 1; j < n; ++j) rest += ata(0, j) * prior[j][c];
+    prior[0][c] = std::max(0.0, (atb(0, c) - rest) / ata(0, 0));
+  }
+}
+
+// Solves lhs x = rhs again with a penalty of `penalty` (times the sphere's Gram over the
+// directions) on the radiance where x's luminance is negative, at most `rounds` times.
+void solve_nonnegative(Rhs& x, const Mat& lhs, const Rhs& rhs, int n, double penalty, int rounds) {
+  constexpr int kDirections = 256;
+  Mat added = Mat::Zero(n, n);
+  for (int round = 0; round < rounds; ++round) {
+    Mat extra = Mat::Zero(n, n);
+    int negative = 0;
+    for (int k = 0; k < kDirections; ++k) {
+      const glm::dvec3 w = fibonacci_direction(k, kDirections);
+      const ShVector y = sh_basis(glm::vec3(w));
+      double lum = 0.0;
+      for (int i = 0; i < n; ++i)
+        lum += double(y[size_t(i)]) * (0.2126 * x(i, 0) + 0.7152 * x(i, 1) + 0.0722 * x(i, 2));
+      if (lum >= 0.0) continue;
+      ++negative;
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) extra(i, j) += double(y[size_t(i)]) * double(y[size_t(j)]);
+    }
+    if (negative == 0) break;
+    added += extra * (penalty * 4.0 * kPi / kDirections);
+    x = (lhs + added).ldlt().solve(rhs);
+  }
+}
+
 }  // namespace
 
 void LightSystem::add(const ShVector& transfer, const glm::dvec3& intensity) {
@@ -103,16 +182,7 @@ void LightEstimator::reset() {
 
 Expected<LightEstimate> LightEstimator::update(const LightSystem& system, int64_t frame_index,
                                                double timestamp_s, int solve_bands) {
-  for (double v : system.ata)
-    if (!std::isfinite(v))
-      return fail(ErrorKind::BadInput, "ssrt light estimation: frame " +
-                                           std::to_string(frame_index) +
-                                           ": T^T T holds NaN or Inf; frame not used");
-  for (double v : system.atb)
-    if (!std::isfinite(v))
-      return fail(ErrorKind::BadInput, "ssrt light estimation: frame " +
-                                           std::to_string(frame_index) +
-                                           ": T^T I_c holds NaN or Inf; frame not used");
+  MRGI_TRY(check_system_finite(system, frame_index));
   if (solve_bands < 0 || solve_bands > settings_.bands)
     return fail(ErrorKind::BadUsage, "ssrt light estimation: solve_bands " +
                                          std::to_string(solve_bands) + " outside 0.." +
@@ -121,27 +191,10 @@ Expected<LightEstimate> LightEstimator::update(const LightSystem& system, int64_
   const int n = bands * bands;
   Mat ata(n, n);
   Rhs atb(n, 3);
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) ata(i, j) = system.ata[i * kMaxShCoeffs + j];
-    const double inv_a = 1.0 / settings_.gray_albedo;  // T l = I_c / a
-    for (int c = 0; c < 3; ++c) atb(i, c) = system.atb[i * 3 + c] * inv_a;
-  }
-  if (settings_.white_light) {
-    for (int i = 0; i < n; ++i) {
-      const double y = luminance(glm::dvec3(atb(i, 0), atb(i, 1), atb(i, 2)));
-      atb.row(i).setConstant(y);
-    }
-  }
-  // Symmetrise (float sums from the GPU are not exactly symmetric).
-  ata = (0.5 * (ata + ata.transpose())).eval();
+  load_system(system, n, settings_.gray_albedo, settings_.white_light, ata, atb);
 
   // Confidence: how many directions of the SH space the data pins down on its own.
-  Eigen::SelfAdjointEigenSolver<Mat> eig(ata, Eigen::EigenvaluesOnly);
-  const auto& ev = eig.eigenvalues();
-  const double max_ev = std::max(ev.maxCoeff(), 0.0);
-  int constrained = 0;
-  for (int i = 0; i < n; ++i)
-    if (max_ev > 0.0 && ev(i) > settings_.confidence_eigen_fraction * max_ev) ++constrained;
+  const int constrained = constrained_directions(ata, n, settings_.confidence_eigen_fraction);
 
   // Tikhonov towards the previous estimate (or the prior), with its band 0 re-fitted to this
   // frame first. Why: the system is rank-deficient whenever the view shows few normals, and the
@@ -152,13 +205,7 @@ Expected<LightEstimate> LightEstimator::update(const LightSystem& system, int64_
   // valid) to the frame makes the prior explain the overall brightness; what is left for the
   // higher bands is what the data actually says about direction.
   ShRgb prior = filtered_;
-  if (settings_.refit_prior_ambient && ata(0, 0) > 0.0) {
-    for (int c = 0; c < 3; ++c) {
-      double rest = 0.0;
-      for (int j = 1; j < n; ++j) rest += ata(0, j) * prior[j][c];
-      prior[0][c] = std::max(0.0, (atb(0, c) - rest) / ata(0, 0));
-    }
-  }
+  if (settings_.refit_prior_ambient && ata(0, 0) > 0.0) refit_ambient(prior, ata, atb, n);
   const double mean_diag = ata.trace() / n;
   const double lambda = settings_.relative_regularisation * std::max(mean_diag, 0.0) +
                         settings_.min_regularisation;
@@ -182,28 +229,7 @@ Expected<LightEstimate> LightEstimator::update(const LightSystem& system, int64_
   // a few rounds). Least squares otherwise buys a better fit of the visible surfaces with
   // negative light from directions nothing constrains, which turns the dominant direction.
   const double nu = settings_.nonnegative_penalty;
-  if (nu > 0.0 && n >= 4) {
-    constexpr int kDirections = 256;
-    Mat added = Mat::Zero(n, n);
-    for (int round = 0; round < settings_.nonnegative_rounds; ++round) {
-      Mat extra = Mat::Zero(n, n);
-      int negative = 0;
-      for (int k = 0; k < kDirections; ++k) {
-        const glm::dvec3 w = fibonacci_direction(k, kDirections);
-        const ShVector y = sh_basis(glm::vec3(w));
-        double lum = 0.0;
-        for (int i = 0; i < n; ++i)
-          lum += double(y[size_t(i)]) * (0.2126 * x(i, 0) + 0.7152 * x(i, 1) + 0.0722 * x(i, 2));
-        if (lum >= 0.0) continue;
-        ++negative;
-        for (int i = 0; i < n; ++i)
-          for (int j = 0; j < n; ++j) extra(i, j) += double(y[size_t(i)]) * double(y[size_t(j)]);
-      }
-      if (negative == 0) break;
-      added += extra * (nu * std::max(mean_diag, 0.0) * 4.0 * kPi / kDirections);
-      x = (lhs + added).ldlt().solve(rhs);
-    }
-  }
+  if (nu > 0.0 && n >= 4) solve_nonnegative(x, lhs, rhs, n, nu * std::max(mean_diag, 0.0), settings_.nonnegative_rounds);
   if (!x.allFinite()) {
     return fail(ErrorKind::Internal, "ssrt light estimation: frame " +
                                          std::to_string(frame_index) +

@@ -46,6 +46,24 @@ struct ReceiverPush {
 };
 static_assert(sizeof(ReceiverPush) <= 128, "the guaranteed push-constant size");
 
+// Lamp slot li's receiver map of `receiver` texels a side in the receiver atlas. The map's
+// frame: its pole on the lamp's axis, so the octahedron's seams (where bilinear reads and squares
+// break) lie 90 degrees off the cone.
+shader::CausticReceiverLamp receiver_lamp(const LightDesc& lamp, size_t li, uint32_t receiver) {
+  const glm::vec3 z = glm::normalize(lamp.direction);
+  const glm::vec3 x = glm::normalize(glm::cross(any_up(z), z));
+  const glm::vec3 y = glm::cross(z, x);
+  shader::CausticReceiverLamp rl;
+  rl.position = glm::vec4(lamp.position, float(receiver));
+  rl.frame_x = glm::vec4(x, 0.0f);
+  rl.frame_y = glm::vec4(y, 0.0f);
+  rl.frame_z = glm::vec4(z, 0.0f);
+  int levels = 1;
+  while (levels < MRGI_CAUSTIC_RECEIVER_LEVELS && (receiver >> levels) >= 4) ++levels;
+  rl.atlas = glm::ivec4(int(li * (receiver + receiver / 2)), 0, levels, 0);
+  return rl;
+}
+
 }  // namespace
 
 Expected<Caustics> Caustics::create(const frame::FrameResources& shared, uint32_t max_map_size,
@@ -59,8 +77,19 @@ Expected<Caustics> Caustics::create(const frame::FrameResources& shared, uint32_
   c.shared_ = shared;
   c.max_map_ = max_map_size;
   c.back_faces_ = &back_faces;
-  gpu::FrameGraph& graph = *shared.graph;
-  const gpu::Context& ctx = *shared.context;
+  c.max_receiver_ = max_receiver_map;
+  MRGI_TRY(c.create_photon_maps());
+  MRGI_TRY(c.create_caustic_buffers());
+  MRGI_TRY(c.create_photon_buffers());
+  MRGI_TRY(c.create_photon_pipelines());
+  MRGI_TRY(c.create_splat_pipelines());
+  return c;
+}
+
+// The lamp's view of the objects: front and back faces' positions and normals, and depth.
+Status Caustics::create_photon_maps() {
+  gpu::FrameGraph& graph = *shared_.graph;
+  const uint32_t max_map_size = max_map_;
   const VkImageUsageFlags colour = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_STORAGE_BIT;
   auto map = [&](const char* name, VkFormat f, VkImageUsageFlags usage) -> Expected<gpu::ImageHandle> {
     gpu::ImageDesc d;
@@ -72,26 +101,34 @@ Expected<Caustics> Caustics::create(const frame::FrameResources& shared, uint32_
   };
   auto p = map("specular photon position", kPositionFormat, colour);
   if (!p) return p.error();
-  c.position_ = *p;
+  position_ = *p;
   auto n = map("specular photon normal", kNormalFormat, colour);
   if (!n) return n.error();
-  c.normal_ = *n;
+  normal_ = *n;
   auto bp = map("specular photon back position", kPositionFormat, colour);
   if (!bp) return bp.error();
-  c.back_position_ = *bp;
+  back_position_ = *bp;
   auto bn = map("specular photon back normal", kNormalFormat, colour);
   if (!bn) return bn.error();
-  c.back_normal_ = *bn;
+  back_normal_ = *bn;
   auto d = map("specular photon depth", kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
   if (!d) return d.error();
-  c.depth_ = *d;
+  depth_ = *d;
+  return ok_status();
+}
+
+// Where the photons are splatted: the camera's caustic buffer and, with max_receiver_, the
+// receiver maps' atlas and their lamps.
+Status Caustics::create_caustic_buffers() {
+  gpu::FrameGraph& graph = *shared_.graph;
+  const uint32_t max_receiver_map = max_receiver_;
+  const VkImageUsageFlags colour = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_STORAGE_BIT;
   gpu::ImageDesc cd;
   cd.name = "specular caustics";
   cd.format = kCausticFormat;  // OutputRelative, following the render scale
   auto cb = graph.create_image(cd, colour);
   if (!cb) return cb.error();
-  c.caustics_ = *cb;
-  c.max_receiver_ = max_receiver_map;
+  caustics_ = *cb;
   if (max_receiver_map > 0) {
     gpu::ImageDesc rd;
     rd.name = "specular caustic receivers";
@@ -102,39 +139,50 @@ Expected<Caustics> Caustics::create(const frame::FrameResources& shared, uint32_
     rd.history = true;  // drawn when the photons are traced, read every frame
     auto rb = graph.create_image(rd, colour);
     if (!rb) return rb.error();
-    c.receivers_ = *rb;
+    receivers_ = *rb;
     auto lb = graph.create_buffer(
         {"specular caustic receiver lamps", sizeof(shader::CausticReceivers), gpu::MemoryUsage::Upload, true},
         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     if (!lb) return lb.error();
-    c.receiver_lamps_ = *lb;
+    receiver_lamps_ = *lb;
   }
+  return ok_status();
+}
+
+// Per lamp slot: its photons, their list and the splat's indirect draw.
+Status Caustics::create_photon_buffers() {
+  gpu::FrameGraph& graph = *shared_.graph;
+  const uint32_t max_map_size = max_map_;
   for (int l = 0; l < kMaxLamps; ++l) {
     const std::string id = std::to_string(l);
     gpu::BufferDesc pd{"specular photons " + id, VkDeviceSize(max_map_size) * max_map_size * 2 * kPhotonBytes};
     pd.history = true;
     auto pb = graph.create_buffer(pd, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     if (!pb) return pb.error();
-    c.photons_[l] = *pb;
+    photons_[l] = *pb;
     gpu::BufferDesc ld{"specular photon list " + id, VkDeviceSize(max_map_size) * max_map_size * 2 * 4};
     ld.history = true;
     auto lb = graph.create_buffer(ld, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     if (!lb) return lb.error();
-    c.photon_list_[l] = *lb;
+    photon_list_[l] = *lb;
     gpu::BufferDesc dd{"specular photon draw " + id, 16};
     dd.history = true;
     auto db = graph.create_buffer(dd, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
                                           VK_BUFFER_USAGE_TRANSFER_DST_BIT);
     if (!db) return db.error();
-    c.photon_draw_[l] = *db;
+    photon_draw_[l] = *db;
   }
+  return ok_status();
+}
 
+Status Caustics::create_photon_pipelines() {
+  const gpu::Context& ctx = *shared_.context;
   auto pp = gpu::load_compute_pipeline(ctx, "specular/photons.comp", {});
   if (!pp) return pp.error();
-  c.photon_pipeline_ = std::move(*pp);
+  photon_pipeline_ = std::move(*pp);
   auto fpp = gpu::load_compute_pipeline(ctx, "specular/photon_footprint.comp", {});
   if (!fpp) return fpp.error();
-  c.footprint_pipeline_ = std::move(*fpp);
+  footprint_pipeline_ = std::move(*fpp);
   auto mesh_vs = gpu::shader_spirv("gi/rsm_mesh.vert");
   if (!mesh_vs) return mesh_vs.error();
   auto surface_fs = gpu::shader_spirv("specular/photon_surface.frag");
@@ -152,8 +200,14 @@ Expected<Caustics> Caustics::create(const frame::FrameResources& shared, uint32_
   pd.cull_mode = VK_CULL_MODE_BACK_BIT;
   auto sp = gpu::create_graphics_pipeline(ctx, pd);
   if (!sp) return sp.error();
-  c.surface_pipeline_ = gpu::PipelineHandle(ctx, std::move(*sp));
-  MRGI_TRY(gpu::require_bindings(*c.surface_pipeline_, pd.name, {"Materials"}));
+  surface_pipeline_ = gpu::PipelineHandle(ctx, std::move(*sp));
+  MRGI_TRY(gpu::require_bindings(*surface_pipeline_, pd.name, {"Materials"}));
+  return ok_status();
+}
+
+// The camera's splat and, with max_receiver_, the receiver maps' splat and their mip chain.
+Status Caustics::create_splat_pipelines() {
+  const gpu::Context& ctx = *shared_.context;
   auto splat_vs = gpu::shader_spirv("specular/caustic_splat.vert");
   if (!splat_vs) return splat_vs.error();
   auto splat_fs = gpu::shader_spirv("specular/caustic_splat.frag");
@@ -170,8 +224,8 @@ Expected<Caustics> Caustics::create(const frame::FrameResources& shared, uint32_
   sd.topology = VK_PRIMITIVE_TOPOLOGY_POINT_LIST;
   auto spl = gpu::create_graphics_pipeline(ctx, sd);
   if (!spl) return spl.error();
-  c.splat_pipeline_ = gpu::PipelineHandle(ctx, std::move(*spl));
-  if (max_receiver_map > 0) {
+  splat_pipeline_ = gpu::PipelineHandle(ctx, std::move(*spl));
+  if (max_receiver_ > 0) {
     auto rvs = gpu::shader_spirv("specular/caustic_receiver.vert");
     if (!rvs) return rvs.error();
     auto rfs = gpu::shader_spirv("specular/caustic_receiver.frag");
@@ -183,25 +237,18 @@ Expected<Caustics> Caustics::create(const frame::FrameResources& shared, uint32_
     rd.color_formats = {kReceiverFormat};
     auto rp = gpu::create_graphics_pipeline(ctx, rd);
     if (!rp) return rp.error();
-    c.receiver_pipeline_ = gpu::PipelineHandle(ctx, std::move(*rp));
+    receiver_pipeline_ = gpu::PipelineHandle(ctx, std::move(*rp));
     auto mp = gpu::load_compute_pipeline(ctx, "specular/caustic_receiver_mip.comp", {});
     if (!mp) return mp.error();
-    c.receiver_mip_pipeline_ = std::move(*mp);
+    receiver_mip_pipeline_ = std::move(*mp);
   }
-  return c;
+  return ok_status();
 }
 
-bool Caustics::trace(gpu::FrameGraph& graph, const Impostors& imp, const std::vector<LightDesc>& lamps,
-                      const std::vector<size_t>& objects, const glm::vec3& centre, float radius, uint32_t map_size,
-                      const Refresh& refresh, std::vector<std::string>& skipped) {
-  const frame::SceneGpu& sg = *shared_.scene_gpu;
-  const uint32_t size = std::min(map_size, max_map_);
-  recorded_.lamps.clear();
-  recorded_.receivers = {};
-  recorded_.receiver_lamps = {};
-  splat_push_.clear();
-  shader::CausticReceivers receiver_set{};
-  // The strongest spot lamps whose cone meets the objects' sphere and that are outside it.
+// The strongest spot lamps whose cone meets the objects' sphere and that are outside it, at most
+// kMaxLamps, into chosen_. Returns whether there is one.
+bool Caustics::choose_lamps(const std::vector<LightDesc>& lamps, const glm::vec3& centre, float radius,
+                            std::vector<std::string>& skipped) {
   std::vector<const LightDesc*>& chosen = chosen_;
   chosen.clear();
   for (const LightDesc& l : lamps) {
@@ -221,23 +268,22 @@ bool Caustics::trace(gpu::FrameGraph& graph, const Impostors& imp, const std::ve
     skipped.push_back("specular caustics: no spot lamp's cone holds a reflective or refractive object");
     return false;
   }
-  const float largest_point = shared_.context->max_point_size();
-  if (largest_point < 4.0f) {
-    skipped.push_back("specular caustics: the device draws no points over " + std::to_string(largest_point) +
-                      " pixels (largePoints), and the caustic splat's photons are points");
-    return false;
-  }
-  // Trace, or splat the photons traced for the same lamps, objects and map size at most
-  // refresh.period - 1 frames ago (a due trace waits while impostors are redrawn this frame, to
-  // spread the fast level's work over frames).
+  return true;
+}
+
+// Whether this frame traces the chosen lamps' photons (else it splats those traced for the same
+// lamps, objects and map size at most refresh.period - 1 frames ago; a due trace waits while
+// impostors are redrawn this frame, to spread the fast level's work over frames).
+bool Caustics::photons_due(uint32_t size, uint32_t receiver, const std::vector<size_t>& objects,
+                           const glm::vec3& centre, float radius, const Refresh& refresh,
+                           std::vector<std::string>& skipped) {
   ++frame_;
   // What the photons depend on, compared exactly (doubles hold the revision and the indices).
   std::vector<double>& key = key_;
-  const uint32_t receiver = max_receiver_ > 0 ? std::min(refresh.receiver_map, max_receiver_) : 0u;
   key.assign({double(size), double(refresh.glass_reflection_stride), double(refresh.revision), double(receiver),
               centre.x, centre.y, centre.z, radius});
   for (size_t o : objects) key.push_back(double(o));
-  for (const LightDesc* l : chosen) {
+  for (const LightDesc* l : chosen_) {
     const double k[] = {l->position.x,
                         l->position.y,
                         l->position.z,
@@ -261,6 +307,97 @@ bool Caustics::trace(gpu::FrameGraph& graph, const Impostors& imp, const std::ve
                       " frame(s) ago for the same lamps and objects (refresh period " + std::to_string(refresh.period) +
                       ")");
   }
+  return trace;
+}
+
+// Lamp slot li's photon passes: the objects' front (`front`) and refractive back (`back`) faces
+// from the lamp, a photon per texel traced to the impostors, and their footprints.
+void Caustics::add_photon_passes(gpu::FrameGraph& graph, const Impostors& imp, size_t li, const LightDesc& lamp,
+                                 const glm::mat4& view_proj, const glm::vec3& axis, float half, uint32_t size,
+                                 const std::vector<size_t>& front, const std::vector<size_t>& back) {
+  const frame::SceneGpu& sg = *shared_.scene_gpu;
+  const std::string id = std::to_string(li);
+  const gpu::BufferHandle draw = photon_draw_[li], photons = photons_[li], list = photon_list_[li];
+  MeshRaster r;
+  r.name = "specular photon surfaces " + id;
+  r.pipeline = &*surface_pipeline_;
+  r.colour = {position_, normal_};
+  r.depth = depth_;
+  r.extent = {size, size};
+  r.push.view_proj = view_proj;
+  r.push.light = glm::vec4(lamp.position, 1.0f);
+  r.draws = front;
+  // Half a texel of the map: its focal length is size / (2 tan(half)).
+  r.lod = frame::LodView{lamp.position, float(size) / (2.0f * std::tan(half)), 0.5f};
+  add_mesh_raster(graph, sg, r);
+  if (!back.empty()) {
+    r.name = "specular photon back faces " + id;
+    r.pipeline = back_faces_;
+    r.colour = {back_position_, back_normal_};
+    r.draws = back;
+    add_mesh_raster(graph, sg, r);
+  }
+  const glm::vec3 dir = glm::normalize(lamp.direction);
+  const PhotonPush push{view_proj, glm::vec4(lamp.position, float(size)),
+                        glm::vec4(lamp.color * lamp.intensity, 2.0f * std::tan(half)),
+                        glm::vec4(dir, std::cos(glm::radians(lamp.inner_angle_deg))),
+                        glm::vec4(std::cos(glm::radians(lamp.outer_angle_deg)), axis)};
+  graph.add_pass(
+      "specular photons reset " + id, gpu::PassKind::Transfer,
+      [draw](gpu::PassBuilder& b) { b.write(draw, gpu::Access::TransferDst); },
+      [draw](VkCommandBuffer cmd, gpu::PassContext& p) { vkCmdFillBuffer(cmd, p.buffer(draw), 0, 16, 0); });
+  const gpu::Pipeline* pp = &*photon_pipeline_;
+  const bool has_back = !back.empty();
+  graph.add_shader_pass(
+      "specular photons " + id, gpu::PassKind::Compute, *photon_pipeline_,
+      [this, imp, has_back, photons, list, draw](gpu::ShaderPassBuilder& b) {
+        b.bind("SpecularUbo", imp.constants);
+        b.bind("Materials", shared_.scene_gpu->materials);
+        b.bind("photon_position", position_);
+        b.bind("photon_normal", normal_);
+        // Without a refractive object the back faces are never read: the front ones stand in.
+        b.bind("back_position", has_back ? back_position_ : position_);
+        b.bind("back_normal", has_back ? back_normal_ : normal_);
+        b.bind("impostor_position", imp.position);
+        b.bind("impostor_normal", imp.normal);
+        b.bind("impostor_albedo", imp.albedo);
+        b.bind("Photons", photons);
+        b.bind("PhotonList", list);
+        b.bind_over("PhotonDraw", draw);
+      },
+      [pp, push, size](VkCommandBuffer cmd, gpu::PassContext&) {
+        gpu::push_and_dispatch(cmd, *pp, &push, sizeof push, {(size + 7) / 8, (size + 7) / 8, 1});
+      });
+  const gpu::Pipeline* fp = &*footprint_pipeline_;
+  const glm::ivec4 map(int(size), 0, 0, 0);
+  graph.add_shader_pass(
+      "specular photon footprints " + id, gpu::PassKind::Compute, *footprint_pipeline_,
+      [photons](gpu::ShaderPassBuilder& b) { b.bind_over("Photons", photons); },
+      [fp, map, size](VkCommandBuffer cmd, gpu::PassContext&) {
+        gpu::push_and_dispatch(cmd, *fp, &map, sizeof map, {(size + 7) / 8, (size + 7) / 8, 1});
+      });
+}
+
+bool Caustics::trace(gpu::FrameGraph& graph, const Impostors& imp, const std::vector<LightDesc>& lamps,
+                      const std::vector<size_t>& objects, const glm::vec3& centre, float radius, uint32_t map_size,
+                      const Refresh& refresh, std::vector<std::string>& skipped) {
+  const frame::SceneGpu& sg = *shared_.scene_gpu;
+  const uint32_t size = std::min(map_size, max_map_);
+  recorded_.lamps.clear();
+  recorded_.receivers = {};
+  recorded_.receiver_lamps = {};
+  splat_push_.clear();
+  shader::CausticReceivers receiver_set{};
+  if (!choose_lamps(lamps, centre, radius, skipped)) return false;
+  const std::vector<const LightDesc*>& chosen = chosen_;
+  const float largest_point = shared_.context->max_point_size();
+  if (largest_point < 4.0f) {
+    skipped.push_back("specular caustics: the device draws no points over " + std::to_string(largest_point) +
+                      " pixels (largePoints), and the caustic splat's photons are points");
+    return false;
+  }
+  const uint32_t receiver = max_receiver_ > 0 ? std::min(refresh.receiver_map, max_receiver_) : 0u;
+  const bool trace = photons_due(size, receiver, objects, centre, radius, refresh, skipped);
   // The ranges the photon maps draw: only on a frame that traces (no allocation on the others).
   std::vector<size_t> front, back;
   if (trace) {
@@ -273,7 +410,6 @@ bool Caustics::trace(gpu::FrameGraph& graph, const Impostors& imp, const std::ve
   const float quad_min_px = 1.5f, quad_max_px = std::min(std::max(4.0f, float(internal.width) / 40.0f), largest_point);
   for (size_t li = 0; li < chosen.size(); ++li) {
     const LightDesc& lamp = *chosen[li];
-    const std::string id = std::to_string(li);
     const glm::vec3 to = centre - lamp.position;
     const float dist = glm::length(to);
     const glm::vec3 axis = to / dist;
@@ -285,83 +421,11 @@ bool Caustics::trace(gpu::FrameGraph& graph, const Impostors& imp, const std::ve
     const glm::mat4 flip_y = glm::scale(glm::mat4(1.0f), glm::vec3(1.0f, -1.0f, 1.0f));
     const glm::mat4 view_proj = flip_y * glm::perspective(2.0f * half, 1.0f, 0.01f, dist + radius) *
                                 glm::lookAt(lamp.position, centre, any_up(axis));
-    const gpu::BufferHandle draw = photon_draw_[li], photons = photons_[li], list = photon_list_[li];
-    recorded_.lamps.push_back({lamp.position, view_proj, size, photons});
-    if (trace) {
-      MeshRaster r;
-      r.name = "specular photon surfaces " + id;
-      r.pipeline = &*surface_pipeline_;
-      r.colour = {position_, normal_};
-      r.depth = depth_;
-      r.extent = {size, size};
-      r.push.view_proj = view_proj;
-      r.push.light = glm::vec4(lamp.position, 1.0f);
-      r.draws = front;
-      // Half a texel of the map: its focal length is size / (2 tan(half)).
-      r.lod = frame::LodView{lamp.position, float(size) / (2.0f * std::tan(half)), 0.5f};
-      add_mesh_raster(graph, sg, r);
-      if (!back.empty()) {
-        r.name = "specular photon back faces " + id;
-        r.pipeline = back_faces_;
-        r.colour = {back_position_, back_normal_};
-        r.draws = back;
-        add_mesh_raster(graph, sg, r);
-      }
-      const glm::vec3 dir = glm::normalize(lamp.direction);
-      const PhotonPush push{view_proj, glm::vec4(lamp.position, float(size)),
-                            glm::vec4(lamp.color * lamp.intensity, 2.0f * std::tan(half)),
-                            glm::vec4(dir, std::cos(glm::radians(lamp.inner_angle_deg))),
-                            glm::vec4(std::cos(glm::radians(lamp.outer_angle_deg)), axis)};
-      graph.add_pass(
-          "specular photons reset " + id, gpu::PassKind::Transfer,
-          [draw](gpu::PassBuilder& b) { b.write(draw, gpu::Access::TransferDst); },
-          [draw](VkCommandBuffer cmd, gpu::PassContext& p) { vkCmdFillBuffer(cmd, p.buffer(draw), 0, 16, 0); });
-      const gpu::Pipeline* pp = &*photon_pipeline_;
-      const bool has_back = !back.empty();
-      graph.add_shader_pass(
-          "specular photons " + id, gpu::PassKind::Compute, *photon_pipeline_,
-          [this, imp, has_back, photons, list, draw](gpu::ShaderPassBuilder& b) {
-            b.bind("SpecularUbo", imp.constants);
-            b.bind("Materials", shared_.scene_gpu->materials);
-            b.bind("photon_position", position_);
-            b.bind("photon_normal", normal_);
-            // Without a refractive object the back faces are never read: the front ones stand in.
-            b.bind("back_position", has_back ? back_position_ : position_);
-            b.bind("back_normal", has_back ? back_normal_ : normal_);
-            b.bind("impostor_position", imp.position);
-            b.bind("impostor_normal", imp.normal);
-            b.bind("impostor_albedo", imp.albedo);
-            b.bind("Photons", photons);
-            b.bind("PhotonList", list);
-            b.bind_over("PhotonDraw", draw);
-          },
-          [pp, push, size](VkCommandBuffer cmd, gpu::PassContext&) {
-            gpu::push_and_dispatch(cmd, *pp, &push, sizeof push, {(size + 7) / 8, (size + 7) / 8, 1});
-          });
-      const gpu::Pipeline* fp = &*footprint_pipeline_;
-      const glm::ivec4 map(int(size), 0, 0, 0);
-      graph.add_shader_pass(
-          "specular photon footprints " + id, gpu::PassKind::Compute, *footprint_pipeline_,
-          [photons](gpu::ShaderPassBuilder& b) { b.bind_over("Photons", photons); },
-          [fp, map, size](VkCommandBuffer cmd, gpu::PassContext&) {
-            gpu::push_and_dispatch(cmd, *fp, &map, sizeof map, {(size + 7) / 8, (size + 7) / 8, 1});
-          });
-    }
+    recorded_.lamps.push_back({lamp.position, view_proj, size, photons_[li]});
+    if (trace) add_photon_passes(graph, imp, li, lamp, view_proj, axis, half, size, front, back);
     splat_push_.push_back(glm::vec4(quad_min_px, 0.0f, quad_max_px, 0.0f));
     if (receiver > 0) {
-      // The map's frame: its pole on the lamp's axis, so the octahedron's seams (where bilinear
-      // reads and squares break) lie 90 degrees off the cone.
-      const glm::vec3 z = glm::normalize(lamp.direction);
-      const glm::vec3 x = glm::normalize(glm::cross(any_up(z), z));
-      const glm::vec3 y = glm::cross(z, x);
-      shader::CausticReceiverLamp rl;
-      rl.position = glm::vec4(lamp.position, float(receiver));
-      rl.frame_x = glm::vec4(x, 0.0f);
-      rl.frame_y = glm::vec4(y, 0.0f);
-      rl.frame_z = glm::vec4(z, 0.0f);
-      int levels = 1;
-      while (levels < MRGI_CAUSTIC_RECEIVER_LEVELS && (receiver >> levels) >= 4) ++levels;
-      rl.atlas = glm::ivec4(int(li * (receiver + receiver / 2)), 0, levels, 0);
+      const shader::CausticReceiverLamp rl = receiver_lamp(lamp, li, receiver);
       receiver_set.lamps[li] = rl;
       receiver_set.count.x = int(li) + 1;
       if (trace) add_receiver_splat(graph, li, rl, largest_point);

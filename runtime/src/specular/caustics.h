@@ -84,6 +84,20 @@ class Caustics {
   gpu::BufferHandle photons_[kMaxLamps], photon_list_[kMaxLamps], photon_draw_[kMaxLamps];
   frame::CausticPhotons recorded_;  // this frame's lamps
   std::vector<glm::vec4> splat_push_;   // caustic_splat.vert's push block per lamp
+  // create()'s steps, in its order.
+  Status create_photon_maps();
+  Status create_caustic_buffers();
+  Status create_photon_buffers();
+  Status create_photon_pipelines();
+  Status create_splat_pipelines();
+  // trace()'s steps.
+  bool choose_lamps(const std::vector<LightDesc>& lamps, const glm::vec3& centre, float radius,
+                    std::vector<std::string>& skipped);
+  bool photons_due(uint32_t size, uint32_t receiver, const std::vector<size_t>& objects, const glm::vec3& centre,
+                   float radius, const Refresh& refresh, std::vector<std::string>& skipped);
+  void add_photon_passes(gpu::FrameGraph& graph, const Impostors& imp, size_t li, const LightDesc& lamp,
+                         const glm::mat4& view_proj, const glm::vec3& axis, float half, uint32_t size,
+                         const std::vector<size_t>& front, const std::vector<size_t>& back);
   // The photons of lamp slot li into its part of the receiver atlas (trace frames).
   void add_receiver_splat(gpu::FrameGraph& graph, size_t li, const shader::CausticReceiverLamp& lamp,
                           float largest_point);

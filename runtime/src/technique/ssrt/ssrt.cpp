@@ -271,6 +271,186 @@ Status Ssrt::record_geometry(const frame::FrameInfo& info, std::vector<std::stri
   return ok_status();
 }
 
+// The packed occluder G-buffer the transfer's samples read (occluders.comp: occ_a, occ_b).
+void Ssrt::add_occluders_pass() {
+  gpu::FrameGraph& graph = *shared_.graph;
+  graph.add_shader_pass(
+      "ssrt_occluders", gpu::PassKind::Compute, *occluders_,
+      [this](gpu::ShaderPassBuilder& b) {
+        const frame::FrameResources& r = shared_;
+        b.bind("FrameUbo", r.frame_constants);
+        b.bind("color_words", r.color_upload);
+        b.bind("depth_words", r.depth_upload);
+        b.bind("virtual_position", r.virtual_position);
+        b.bind("virtual_normal", r.virtual_normal);
+        b.bind("virtual_albedo", r.virtual_albedo);
+        b.bind("real_position", geo_position_);
+        b.bind("real_normal", geo_normal_);
+        b.bind("occ_a", occ_a_);
+        b.bind("occ_b", occ_b_);
+      },
+      [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
+        const glm::ivec4 pc(int(occluder_step_), int(used_.width), int(used_.height),
+                            int(geometry_step_));
+        const VkExtent2D e = pass.extent(occ_a_);
+        gpu::dispatch_2d(cmd, *occluders_, &pc, sizeof(pc), e.width, e.height);
+      });
+}
+
+// Three variants of one shader (the paths each does not take compiled out), with the same
+// bindings: the graph pushes the descriptors for transfer_, and the other two, bound for
+// their regions, have compatible layouts, so the descriptors stay.
+void Ssrt::add_transfer_pass() {
+  gpu::FrameGraph& graph = *shared_.graph;
+  graph.add_shader_pass(
+      "ssrt_transfer", gpu::PassKind::Compute, *transfer_,
+      [this](gpu::ShaderPassBuilder& b) {
+        const frame::FrameResources& r = shared_;
+        b.bind("FrameUbo", r.frame_constants);
+        b.bind("LightUbo", light_);
+        b.bind("SampleDirections", samples_);
+        b.bind("real_position", geo_position_);
+        b.bind("real_normal", geo_normal_);
+        b.bind("color_words", r.color_upload);
+        b.bind("depth_words", r.depth_upload);
+        b.bind("virtual_position", r.virtual_position);
+        b.bind("virtual_normal", r.virtual_normal);
+        b.bind("occ_a", occ_a_);
+        b.bind("occ_b", occ_b_);
+        b.bind("coarse", coarse_);
+        b.bind("aux_position", volume_->aux_position());
+        b.bind("AuxUbo", volume_->aux_views());
+      },
+      [this](VkCommandBuffer cmd, gpu::PassContext&) {
+        const float sample_area = 3.14159265f * kRadiusM * kRadiusM / float(directions_);
+        TransferPush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), int(directions_)),
+                        glm::ivec4(int(sample_base_[size_t(level_)]), int(bands_),
+                                   int(geometry_step_), int(occluder_step_)),
+                        glm::vec4(kRadiusM, chi_[size_t(level_)], kNormalOffsetM, kMinSenderDistM),
+                        glm::vec4(sample_area, kSaturation, kDepthBias, kRangeM),
+                        influence_cells_,
+                        glm::vec4(kAuxBiasTexels, 1.0f, 4.0f * 3.14159265f / float(directions_),
+                                  0.0f),
+                        glm::ivec4(0)};
+        // Cells whose receiver may be virtual (centre pixel inside the virtual objects'
+        // projected bounds) take the general path; the rest of the influence region, up to
+        // four bands around them, the real-receiver one; the cells outside the region, up to
+        // four bands around it, the real-only one (their real + virtual solution is the real
+        // one). Each variant's shader has the paths it does not take compiled out.
+        const glm::ivec4 v = virtual_cells();
+        const glm::ivec4 grid(0, 0, int(grid_.x), int(grid_.y));
+        const glm::ivec4 infl = cover(influence_cells_, v);
+        struct Dispatch { glm::ivec4 region; const gpu::Pipeline* pipe; };
+        std::array<Dispatch, 9> dispatches;
+        dispatches[0] = {v, &*transfer_};
+        const std::array<glm::ivec4, 4> near = bands_around(infl, v);
+        const std::array<glm::ivec4, 4> far = bands_around(grid, infl);
+        for (size_t i = 0; i < 4; ++i) {
+          dispatches[1 + i] = {near[i], &*transfer_real_};
+          dispatches[5 + i] = {far[i], &*transfer_real_only_};
+        }
+        for (const Dispatch& d : dispatches) {
+          pc.region = d.region;
+          if (pc.region.z <= pc.region.x || pc.region.w <= pc.region.y) continue;
+          const gpu::Pipeline& pipe = *d.pipe;
+          gpu::dispatch_2d(cmd, pipe, &pc, sizeof(pc), uint32_t(pc.region.z - pc.region.x),
+                           uint32_t(pc.region.w - pc.region.y));
+        }
+
+      });
+}
+
+// The transfer's sums: per strip of cells, then their total into result_ (read back).
+void Ssrt::add_light_reduce_passes() {
+  gpu::FrameGraph& graph = *shared_.graph;
+  const uint32_t strips_x = (grid_.x + kStripCells - 1) / kStripCells;
+  const uint32_t partial_count = strips_x * grid_.y;
+  graph.add_shader_pass(
+      "ssrt_light_reduce", gpu::PassKind::Compute, *reduce_,
+      [this](gpu::ShaderPassBuilder& b) {
+        b.bind("coarse", coarse_);
+        b.bind("FrameUbo", shared_.frame_constants);
+        b.bind("color_words", shared_.color_upload);
+        b.bind("depth_words", shared_.depth_upload);
+        b.bind("Partials", partials_);
+      },
+      [this, strips_x, partial_count](VkCommandBuffer cmd, gpu::PassContext&) {
+        ReducePush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), int(kStripCells)),
+                      glm::ivec4(int(used_.width), int(used_.height), int(strips_x), 0)};
+        gpu::dispatch_2d(cmd, *reduce_, &pc, sizeof(pc), partial_count, 1, 64, 1);
+      });
+  graph.add_shader_pass(
+      "ssrt_light_reduce_final", gpu::PassKind::Compute, *reduce_final_,
+      [this](gpu::ShaderPassBuilder& b) {
+        b.bind("Partials", partials_);
+        b.bind("Result", result_);
+      },
+      [this, partial_count](VkCommandBuffer cmd, gpu::PassContext&) {
+        FinalPush pc{glm::ivec4(int(partial_count), 0, 0, 0)};
+        gpu::dispatch_2d(cmd, *reduce_final_, &pc, sizeof(pc), kReduceEntries, 1, 24, 1);
+      });
+}
+
+// The coarse solution upsampled to pixels with the blur window of the level's cell size.
+void Ssrt::add_upsample_blur_pass() {
+  gpu::FrameGraph& graph = *shared_.graph;
+  const gpu::Pipeline* blur = &*blur_;
+  for (const auto& [r, pipe] : blur_by_radius_)
+    if (r == blur_radius_cells(int(step_))) blur = &*pipe;
+  graph.add_shader_pass(
+      "ssrt_upsample_blur", gpu::PassKind::Compute, *blur,
+      [this](gpu::ShaderPassBuilder& b) {
+        b.bind("coarse", coarse_);
+        b.bind("upsampled", upsampled_);
+      },
+      [this, blur](VkCommandBuffer cmd, gpu::PassContext&) {
+        BlurPush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), 0),
+                    glm::vec4(kGaussRadiusPx, 0.0f, 0.0f, 0.0f)};
+        gpu::dispatch_2d(cmd, *blur, &pc, sizeof(pc), grid_.x, grid_.y);
+      });
+}
+
+// Fast levels: pass-through everywhere, then the tiles whose result can differ from it.
+void Ssrt::add_tiled_shade_passes(std::vector<std::string>& skipped) {
+  gpu::FrameGraph& graph = *shared_.graph;
+  const glm::uvec2 tiles((used_.width + 7) / 8, (used_.height + 7) / 8);
+  graph.add_pass(
+      "ssrt_shade_tiles_clear", gpu::PassKind::Transfer,
+      [this](gpu::PassBuilder& b) { b.write(tile_args_, gpu::Access::TransferDst); },
+      [this](VkCommandBuffer cmd, gpu::PassContext& pass) { gpu::reset_dispatch_args(cmd, pass.buffer(tile_args_)); });
+  graph.add_shader_pass(
+      "ssrt_shade_tiles", gpu::PassKind::Compute, *shade_tiles_,
+      [this](gpu::ShaderPassBuilder& b) {
+        b.bind("upsampled", upsampled_);
+        b.bind("Args", tile_args_);
+        b.bind("Tiles", tile_list_);
+      },
+      [this, tiles](VkCommandBuffer cmd, gpu::PassContext&) {
+        TilesPush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), 0),
+                     glm::ivec4(int(tiles.x), int(tiles.y), 0, 0), virtual_pixels(),
+                     glm::vec4(kTileTolerance, 0.0f, 0.0f, 0.0f)};
+        gpu::dispatch_2d(cmd, *shade_tiles_, &pc, sizeof(pc), tiles.x * tiles.y, 1, 64, 1);
+      });
+  // At the output size the tiles are the compose's too: it copies the camera frame outside
+  // them, so the pass-through solutions there would never be read; at the camera's size the
+  // tiled shade composes its pixels itself (shade.comp kCompose), and compose runs no pass.
+  const VkExtent2D out = graph.output_size();
+  const bool at_output = shared_.compose_honours_tiles && used_.width == out.width &&
+                         used_.height == out.height;
+  const bool fused = at_output && shared_.composed_output.valid();
+  if (at_output) {
+    compose_tiles_ = {tile_args_, tile_list_, fused};
+    skipped.push_back("ssrt_shade: pass-through left out, compose copies the camera frame "
+                      "outside the shaded tiles");
+    if (fused)
+      skipped.push_back("compose: ssrt_shade_tiled composes its tiles (the camera frame is laid "
+                        "on the host)");
+  } else {
+    add_shade_pass("ssrt_shade", ShadeMode::PassThrough, true);
+  }
+  add_shade_pass("ssrt_shade_tiled", fused ? ShadeMode::TiledCompose : ShadeMode::Tiled, true);
+}
+
 Status Ssrt::record(const frame::FrameInfo& info, std::vector<std::string>& skipped) {
   // Callers that drive the technique directly (tests, tools) may skip record_geometry().
   if (geometry_frame_ != info.frame_index || !geometry_frame_valid_)
@@ -287,130 +467,14 @@ Status Ssrt::record(const frame::FrameInfo& info, std::vector<std::string>& skip
                              "ssrt_upsample_blur"})
       skipped.push_back(std::string(pass) + ": " + why);
   } else {
-    graph.add_shader_pass(
-        "ssrt_occluders", gpu::PassKind::Compute, *occluders_,
-        [this](gpu::ShaderPassBuilder& b) {
-          const frame::FrameResources& r = shared_;
-          b.bind("FrameUbo", r.frame_constants);
-          b.bind("color_words", r.color_upload);
-          b.bind("depth_words", r.depth_upload);
-          b.bind("virtual_position", r.virtual_position);
-          b.bind("virtual_normal", r.virtual_normal);
-          b.bind("virtual_albedo", r.virtual_albedo);
-          b.bind("real_position", geo_position_);
-          b.bind("real_normal", geo_normal_);
-          b.bind("occ_a", occ_a_);
-          b.bind("occ_b", occ_b_);
-        },
-        [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
-          const glm::ivec4 pc(int(occluder_step_), int(used_.width), int(used_.height),
-                              int(geometry_step_));
-          const VkExtent2D e = pass.extent(occ_a_);
-          gpu::dispatch_2d(cmd, *occluders_, &pc, sizeof(pc), e.width, e.height);
-        });
-    // Three variants of one shader (the paths each does not take compiled out), with the same
-    // bindings: the graph pushes the descriptors for transfer_, and the other two, bound for
-    // their regions, have compatible layouts, so the descriptors stay.
-    graph.add_shader_pass(
-        "ssrt_transfer", gpu::PassKind::Compute, *transfer_,
-        [this](gpu::ShaderPassBuilder& b) {
-          const frame::FrameResources& r = shared_;
-          b.bind("FrameUbo", r.frame_constants);
-          b.bind("LightUbo", light_);
-          b.bind("SampleDirections", samples_);
-          b.bind("real_position", geo_position_);
-          b.bind("real_normal", geo_normal_);
-          b.bind("color_words", r.color_upload);
-          b.bind("depth_words", r.depth_upload);
-          b.bind("virtual_position", r.virtual_position);
-          b.bind("virtual_normal", r.virtual_normal);
-          b.bind("occ_a", occ_a_);
-          b.bind("occ_b", occ_b_);
-          b.bind("coarse", coarse_);
-          b.bind("aux_position", volume_->aux_position());
-          b.bind("AuxUbo", volume_->aux_views());
-        },
-        [this](VkCommandBuffer cmd, gpu::PassContext&) {
-          const float sample_area = 3.14159265f * kRadiusM * kRadiusM / float(directions_);
-          TransferPush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), int(directions_)),
-                          glm::ivec4(int(sample_base_[size_t(level_)]), int(bands_),
-                                     int(geometry_step_), int(occluder_step_)),
-                          glm::vec4(kRadiusM, chi_[size_t(level_)], kNormalOffsetM, kMinSenderDistM),
-                          glm::vec4(sample_area, kSaturation, kDepthBias, kRangeM),
-                          influence_cells_,
-                          glm::vec4(kAuxBiasTexels, 1.0f, 4.0f * 3.14159265f / float(directions_),
-                                    0.0f),
-                          glm::ivec4(0)};
-          // Cells whose receiver may be virtual (centre pixel inside the virtual objects'
-          // projected bounds) take the general path; the rest of the influence region, up to
-          // four bands around them, the real-receiver one; the cells outside the region, up to
-          // four bands around it, the real-only one (their real + virtual solution is the real
-          // one). Each variant's shader has the paths it does not take compiled out.
-          const glm::ivec4 v = virtual_cells();
-          const glm::ivec4 grid(0, 0, int(grid_.x), int(grid_.y));
-          const glm::ivec4 infl = cover(influence_cells_, v);
-          struct Dispatch { glm::ivec4 region; const gpu::Pipeline* pipe; };
-          std::array<Dispatch, 9> dispatches;
-          dispatches[0] = {v, &*transfer_};
-          const std::array<glm::ivec4, 4> near = bands_around(infl, v);
-          const std::array<glm::ivec4, 4> far = bands_around(grid, infl);
-          for (size_t i = 0; i < 4; ++i) {
-            dispatches[1 + i] = {near[i], &*transfer_real_};
-            dispatches[5 + i] = {far[i], &*transfer_real_only_};
-          }
-          for (const Dispatch& d : dispatches) {
-            pc.region = d.region;
-            if (pc.region.z <= pc.region.x || pc.region.w <= pc.region.y) continue;
-            const gpu::Pipeline& pipe = *d.pipe;
-            gpu::dispatch_2d(cmd, pipe, &pc, sizeof(pc), uint32_t(pc.region.z - pc.region.x),
-                             uint32_t(pc.region.w - pc.region.y));
-          }
-
-        });
-    const uint32_t strips_x = (grid_.x + kStripCells - 1) / kStripCells;
-    const uint32_t partial_count = strips_x * grid_.y;
-    graph.add_shader_pass(
-        "ssrt_light_reduce", gpu::PassKind::Compute, *reduce_,
-        [this](gpu::ShaderPassBuilder& b) {
-          b.bind("coarse", coarse_);
-          b.bind("FrameUbo", shared_.frame_constants);
-          b.bind("color_words", shared_.color_upload);
-          b.bind("depth_words", shared_.depth_upload);
-          b.bind("Partials", partials_);
-        },
-        [this, strips_x, partial_count](VkCommandBuffer cmd, gpu::PassContext&) {
-          ReducePush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), int(kStripCells)),
-                        glm::ivec4(int(used_.width), int(used_.height), int(strips_x), 0)};
-          gpu::dispatch_2d(cmd, *reduce_, &pc, sizeof(pc), partial_count, 1, 64, 1);
-        });
-    graph.add_shader_pass(
-        "ssrt_light_reduce_final", gpu::PassKind::Compute, *reduce_final_,
-        [this](gpu::ShaderPassBuilder& b) {
-          b.bind("Partials", partials_);
-          b.bind("Result", result_);
-        },
-        [this, partial_count](VkCommandBuffer cmd, gpu::PassContext&) {
-          FinalPush pc{glm::ivec4(int(partial_count), 0, 0, 0)};
-          gpu::dispatch_2d(cmd, *reduce_final_, &pc, sizeof(pc), kReduceEntries, 1, 24, 1);
-        });
+    add_occluders_pass();
+    add_transfer_pass();
+    add_light_reduce_passes();
     graph.mark_output(result_);
     pending_[graph.slot()] = info.frame_index;
     pending_bands_[graph.slot()] = int(bands_);
     if (step_ > 1) {
-      const gpu::Pipeline* blur = &*blur_;
-      for (const auto& [r, pipe] : blur_by_radius_)
-        if (r == blur_radius_cells(int(step_))) blur = &*pipe;
-      graph.add_shader_pass(
-          "ssrt_upsample_blur", gpu::PassKind::Compute, *blur,
-          [this](gpu::ShaderPassBuilder& b) {
-            b.bind("coarse", coarse_);
-            b.bind("upsampled", upsampled_);
-          },
-          [this, blur](VkCommandBuffer cmd, gpu::PassContext&) {
-            BlurPush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), 0),
-                        glm::vec4(kGaussRadiusPx, 0.0f, 0.0f, 0.0f)};
-            gpu::dispatch_2d(cmd, *blur, &pc, sizeof(pc), grid_.x, grid_.y);
-          });
+      add_upsample_blur_pass();
     } else {
       skipped.push_back("ssrt_upsample_blur: level samples every pixel");
     }
@@ -421,43 +485,7 @@ Status Ssrt::record(const frame::FrameInfo& info, std::vector<std::string>& skip
   } else if (step_ <= 1) {
     add_shade_pass("ssrt_shade", ShadeMode::Full, true);
   } else {
-    // Fast levels: pass-through everywhere, then the tiles whose result can differ from it.
-    const glm::uvec2 tiles((used_.width + 7) / 8, (used_.height + 7) / 8);
-    graph.add_pass(
-        "ssrt_shade_tiles_clear", gpu::PassKind::Transfer,
-        [this](gpu::PassBuilder& b) { b.write(tile_args_, gpu::Access::TransferDst); },
-        [this](VkCommandBuffer cmd, gpu::PassContext& pass) { gpu::reset_dispatch_args(cmd, pass.buffer(tile_args_)); });
-    graph.add_shader_pass(
-        "ssrt_shade_tiles", gpu::PassKind::Compute, *shade_tiles_,
-        [this](gpu::ShaderPassBuilder& b) {
-          b.bind("upsampled", upsampled_);
-          b.bind("Args", tile_args_);
-          b.bind("Tiles", tile_list_);
-        },
-        [this, tiles](VkCommandBuffer cmd, gpu::PassContext&) {
-          TilesPush pc{glm::ivec4(int(grid_.x), int(grid_.y), int(step_), 0),
-                       glm::ivec4(int(tiles.x), int(tiles.y), 0, 0), virtual_pixels(),
-                       glm::vec4(kTileTolerance, 0.0f, 0.0f, 0.0f)};
-          gpu::dispatch_2d(cmd, *shade_tiles_, &pc, sizeof(pc), tiles.x * tiles.y, 1, 64, 1);
-        });
-    // At the output size the tiles are the compose's too: it copies the camera frame outside
-    // them, so the pass-through solutions there would never be read; at the camera's size the
-    // tiled shade composes its pixels itself (shade.comp kCompose), and compose runs no pass.
-    const VkExtent2D out = graph.output_size();
-    const bool at_output = shared_.compose_honours_tiles && used_.width == out.width &&
-                           used_.height == out.height;
-    const bool fused = at_output && shared_.composed_output.valid();
-    if (at_output) {
-      compose_tiles_ = {tile_args_, tile_list_, fused};
-      skipped.push_back("ssrt_shade: pass-through left out, compose copies the camera frame "
-                        "outside the shaded tiles");
-      if (fused)
-        skipped.push_back("compose: ssrt_shade_tiled composes its tiles (the camera frame is laid "
-                          "on the host)");
-    } else {
-      add_shade_pass("ssrt_shade", ShadeMode::PassThrough, true);
-    }
-    add_shade_pass("ssrt_shade_tiled", fused ? ShadeMode::TiledCompose : ShadeMode::Tiled, true);
+    add_tiled_shade_passes(skipped);
   }
   return ok_status();
 }

@@ -4,10 +4,26 @@
 namespace mrgi::technique::ssrt_detail {
 
 Status Ssrt::init() {
-  gpu::Context& ctx = *shared_.context;
-  gpu::FrameGraph& graph = *shared_.graph;
   if (!shared_.light_stage) return fail(ErrorKind::Internal, "ssrt: no light stage");
   shared_.light_stage->use_external_system();  // its transfer pass sums the system (Sec. 5.2)
+  MRGI_TRY(create_geometry_stage());
+  MRGI_TRY(create_sample_directions());
+  MRGI_TRY(create_light_buffers());
+  MRGI_TRY(create_solution_images());
+  // Layouts from the shaders (gpu/reflect.h; the passes bind by name); push sizes are the C++
+  // structs', checked against the shaders' declarations.
+  MRGI_TRY(create_transfer_pipelines());
+  MRGI_TRY(create_blur_pipelines());
+  MRGI_TRY(create_shade_pipelines());
+  MRGI_TRY(create_shade_tile_buffers());
+  return ok_status();
+}
+
+// The paper's geometry stage (Sec. 4): its constants, the volume at the levels' largest
+// resolutions, the depth filter chain, and the occluder G-buffer.
+Status Ssrt::create_geometry_stage() {
+  gpu::Context& ctx = *shared_.context;
+  gpu::FrameGraph& graph = *shared_.graph;
   ssrt::VolumeSettings vs;
   vs.max_resolution = 1;
   vs.max_aux_resolution = 1;
@@ -43,7 +59,12 @@ Status Ssrt::init() {
   geo_images_ = {volume_->depth_volume(), volume_->normal_volume(), filter_->input(),
                  filter_->merged(), filter_->merged_intensity(), filter_->bilateral(),
                  filter_->final_depth(), filter_->position(), filter_->normal()};
+  return ok_status();
+}
 
+Status Ssrt::create_sample_directions() {
+  gpu::Context& ctx = *shared_.context;
+  gpu::FrameGraph& graph = *shared_.graph;
   // Sample directions of every level, one uniform buffer (transfer.comp SampleDirections): the
   // transfer reads them at per-lane indices (the jitter set is the cell's), and lavapipe gathers
   // a uniform buffer with vector inserts but a storage buffer lane by lane in a branchy loop
@@ -70,7 +91,13 @@ Status Ssrt::init() {
   if (!samples) return samples.error();
   samples_ = *samples;
   MRGI_TRY(ctx.upload_buffer(graph.gpu_buffer(samples_, 0), directions.data(), sample_bytes));
+  return ok_status();
+}
 
+// The light the shading reads, and the transfer's sums: per-strip partials and their total,
+// read back.
+Status Ssrt::create_light_buffers() {
+  gpu::FrameGraph& graph = *shared_.graph;
   auto light = graph.create_buffer(
       {"ssrt_light", sizeof(shader::SsrtLight), gpu::MemoryUsage::Upload, true},
       VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
@@ -92,7 +119,12 @@ Status Ssrt::init() {
   result_ = *result;
   pending_.assign(graph.frames_in_flight(), -1);
   pending_bands_.assign(graph.frames_in_flight(), 0);
+  return ok_status();
+}
 
+// The transfer's coarse solution per cell and its upsampled, blurred one.
+Status Ssrt::create_solution_images() {
+  gpu::FrameGraph& graph = *shared_.graph;
   gpu::ImageDesc cd;
   cd.name = "ssrt_coarse";
   cd.format = VK_FORMAT_R32G32B32A32_SFLOAT;
@@ -106,9 +138,12 @@ Status Ssrt::init() {
   auto upsampled = graph.create_image(ud, VK_IMAGE_USAGE_STORAGE_BIT);
   if (!upsampled) return upsampled.error();
   upsampled_ = *upsampled;
+  return ok_status();
+}
 
-  // Layouts from the shaders (gpu/reflect.h; the passes bind by name); push sizes are the C++
-  // structs', checked against the shaders' declarations.
+// transfer.comp's three variants, and the occluders and the sums' reductions.
+Status Ssrt::create_transfer_pipelines() {
+  gpu::Context& ctx = *shared_.context;
   auto transfer_spv = gpu::shader_spirv("ssrt/transfer.comp");
   if (!transfer_spv) return transfer_spv.error();
   // Variants (transfer.comp's constants kRealReceivers, kRealOnly): the general path, real
@@ -137,7 +172,12 @@ Status Ssrt::init() {
   p = gpu::load_compute_pipeline(ctx, "ssrt/light_reduce_final.comp", {}, sizeof(FinalPush));
   if (!p) return p.error();
   reduce_final_ = std::move(*p);
-  p = gpu::load_compute_pipeline(ctx, "ssrt/upsample_blur.comp", {}, sizeof(BlurPush));
+  return ok_status();
+}
+
+Status Ssrt::create_blur_pipelines() {
+  gpu::Context& ctx = *shared_.context;
+  auto p = gpu::load_compute_pipeline(ctx, "ssrt/upsample_blur.comp", {}, sizeof(BlurPush));
   if (!p) return p.error();
   blur_ = std::move(*p);
   // One blur per window radius the ladder uses, the radius a constant (upsample_blur.comp).
@@ -156,6 +196,12 @@ Status Ssrt::init() {
     if (!bp) return bp.error();
     blur_by_radius_.emplace_back(r, gpu::PipelineHandle(ctx, std::move(*bp)));
   }
+  return ok_status();
+}
+
+// shade.comp's variants and the fast levels' tile selection.
+Status Ssrt::create_shade_pipelines() {
+  gpu::Context& ctx = *shared_.context;
   auto shade_spv = gpu::shader_spirv("ssrt/shade.comp");
   if (!shade_spv) return shade_spv.error();
   const struct {
@@ -179,9 +225,17 @@ Status Ssrt::init() {
     if (!sp) return sp.error();
     *v.handle = gpu::PipelineHandle(ctx, std::move(*sp));
   }
-  p = gpu::load_compute_pipeline(ctx, "ssrt/shade_tiles.comp", {}, sizeof(TilesPush));
+  auto p = gpu::load_compute_pipeline(ctx, "ssrt/shade_tiles.comp", {}, sizeof(TilesPush));
   if (!p) return p.error();
   shade_tiles_ = std::move(*p);
+  return ok_status();
+}
+
+// The fast levels' shade tiles: indirect dispatch arguments and tile indices.
+Status Ssrt::create_shade_tile_buffers() {
+  gpu::FrameGraph& graph = *shared_.graph;
+  // The top level's 8 x 8 pixel tiles at most.
+  const VkExtent2D top = graph.allocated_extent(shared_.lit_r);
   const uint32_t max_tiles = ((top.width + 7) / 8) * ((top.height + 7) / 8);
   auto args = graph.create_buffer({"ssrt_shade_tile_args", 16},
                                   VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |

@@ -130,6 +130,21 @@ class Ssrt final : public Technique {
   ComposeTiles compose_tiles() const override { return compose_tiles_; }
 
  private:
+  // init()'s steps, in its order (ssrt_init.cpp).
+  Status create_geometry_stage();
+  Status create_sample_directions();
+  Status create_light_buffers();
+  Status create_solution_images();
+  Status create_transfer_pipelines();
+  Status create_blur_pipelines();
+  Status create_shade_pipelines();
+  Status create_shade_tile_buffers();
+  // record()'s passes after the geometry stage.
+  void add_occluders_pass();
+  void add_transfer_pass();
+  void add_light_reduce_passes();
+  void add_upsample_blur_pass();
+  void add_tiled_shade_passes(std::vector<std::string>& skipped);
   // Solves the sums the frame that last used `slot` read back (it must have completed).
   void consume_readback(uint32_t slot, std::vector<std::string>& notes);
   // The paper's geometry stage (Sec. 4): fuse the volume, ray-cast G_v and the aux layers, run
