@@ -292,14 +292,14 @@ void setup(CLI::App& app) {
                   "ignored and the runtime estimates the light from the frames, as for an app that declares none")
       ->check(CLI::IsMember({"declared", "estimate"}));
   cmd->add_option("--dlpv-ablation", opts->dlpv_ablation,
-                  "dlpv without one of the paper's ideas (mrgi/runtime.h DlpvAblation): two-volumes (V^rho and V^mu "
+                  "dlpv without one of the paper's ideas (mrgi/research.h DlpvAblation): two-volumes (V^rho and V^mu "
                   "propagated apart, not V^Delta), no-damping (of negative flux), no-shift (VPLs at their surface, not "
                   "half a cell along the normal), no-self-bounce (V^rho from the real "
                   "surfaces' VPLs only, not the virtual objects' own); comma-separated")
       ->delimiter(',')
       ->check(CLI::IsMember(ablation_names(kDlpvAblations)));
   cmd->add_option("--specular-ablation", opts->specular_ablation,
-                  "mirrors and glass without one of the paper's ideas (mrgi/runtime.h SpecularAblation), any "
+                  "mirrors and glass without one of the paper's ideas (mrgi/research.h SpecularAblation), any "
                   "technique: off (shaded by the technique as any material), no-back-projection (real surfaces in "
                   "a mirror or through glass show their rendered light, not the camera's colour), no-depth-test "
                   "(the camera's colour is taken without the depth validity test), no-caustics (spot lamps make no caustics "
@@ -307,7 +307,7 @@ void setup(CLI::App& app) {
       ->delimiter(',')
       ->check(CLI::IsMember(ablation_names(kSpecularAblations)));
   cmd->add_option("--dir-ablation", opts->dir_ablation,
-                  "dir without one of the paper's ideas (mrgi/runtime.h DirAblation): one-shadow-map (one shadow map a "
+                  "dir without one of the paper's ideas (mrgi/research.h DirAblation): one-shadow-map (one shadow map a "
                   "lamp and one ISM a VPL with the nearest caster and its kind, not one each), no-real-only-vpls (no ir(VPL): the real bounce "
                   "a virtual object blocks stays in L_r), one-bounce (no bounce light source: the lamps' VPLs only, "
                   "at the levels with multiple bounces), no-environment-vpls (the environment light baseline leaves "

@@ -41,7 +41,7 @@ layout(std430, set = 0, binding = 7) readonly buffer Vpls { Vpl vpls[]; };
 layout(set = 0, binding = 8, rg32f) readonly uniform image2D ism_distances;  // level 0: x real, y virtual
 layout(set = 0, binding = 9, rgba32ui) writeonly uniform uimage2D indirect;  // indirect_pack.glsl
 layout(push_constant) uniform Params { DirParams params_block; };
-// Ablations (mrgi/runtime.h DirAblation), one pipeline each: bit 1 one shadow map (the nearest
+// Ablations (mrgi/research.h DirAblation), one pipeline each: bit 1 one shadow map (the nearest
 // surface and its kind), bit 2 no ir(VPL) (real-only VPLs light nothing).
 layout(constant_id = 0) const int kAblation = 0;
 layout(constant_id = 1) const bool kGlossy = false;

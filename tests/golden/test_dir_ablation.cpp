@@ -1,4 +1,4 @@
-// dir's ablations (mrgi/runtime.h DirAblation) on the bundled 160x120 desk capture (a real spot
+// dir's ablations (mrgi/research.h DirAblation) on the bundled 160x120 desk capture (a real spot
 // lamp, a virtual bunny on a real desk in front of a wall), validation on: each changes the
 // frames (it is not ignored) and keeps them finite. The synthetic scene of tests/technique has
 // no real surface the changed VPL light reaches (a flat floor seen from above), hence this one.

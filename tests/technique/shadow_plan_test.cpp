@@ -24,7 +24,7 @@ LightDesc lamp(LightType type, bool real, glm::vec3 pos, glm::vec3 dir = {0, -1,
   return l;
 }
 
-TEST(shading::ShadowPlan, RealLampsGetTwoMapsVirtualLampsOne) {
+TEST(ShadowPlan, RealLampsGetTwoMapsVirtualLampsOne) {
   SceneDesc scene;
   scene.lights = {lamp(LightType::Spot, true, {0, 2, 0}), lamp(LightType::Point, false, {1, 1, 1}),
                   lamp(LightType::Point, true, {-1, 1, 0})};
@@ -48,7 +48,7 @@ TEST(shading::ShadowPlan, RealLampsGetTwoMapsVirtualLampsOne) {
   }
 }
 
-TEST(shading::ShadowPlan, CubeFacesSeeWhatTheShaderLooksUpInThem) {
+TEST(ShadowPlan, CubeFacesSeeWhatTheShaderLooksUpInThem) {
   SceneDesc scene;
   scene.lights = {lamp(LightType::Point, true, {0.5f, 1.0f, -0.25f})};
   auto plan = shading::plan_shadow_maps(scene, shading::Bounds{});
@@ -77,7 +77,7 @@ Expected<shading::ShadowPlan> spot_and_directional(shading::Bounds& b) {
   return shading::plan_shadow_maps(scene, b);
 }
 
-TEST(shading::ShadowPlan, SpotAndDirectionalMapsCoverTheirTargets) {
+TEST(ShadowPlan, SpotAndDirectionalMapsCoverTheirTargets) {
   shading::Bounds b;
   auto plan = spot_and_directional(b);
   ASSERT_TRUE(plan.ok());
@@ -100,7 +100,7 @@ TEST(shading::ShadowPlan, SpotAndDirectionalMapsCoverTheirTargets) {
 // The level of detail a face draws the virtual meshes at (shading::ShadowFace::lod_per_texel): an error
 // of e metres at distance d projects to e x focal / d texels, as the face's projection maps it
 // (checked against the matrix: 1 cm across the view at the target, in NDC x side / 2 texels).
-TEST(shading::ShadowPlan, FacesKnowTheirTexelScaleForTheMeshesLevelOfDetail) {
+TEST(ShadowPlan, FacesKnowTheirTexelScaleForTheMeshesLevelOfDetail) {
   shading::Bounds b;
   auto plan = spot_and_directional(b);
   ASSERT_TRUE(plan.ok());
@@ -117,7 +117,7 @@ TEST(shading::ShadowPlan, FacesKnowTheirTexelScaleForTheMeshesLevelOfDetail) {
   }
 }
 
-TEST(shading::ShadowPlan, RefusesTooManyLampsAndZeroDirections) {
+TEST(ShadowPlan, RefusesTooManyLampsAndZeroDirections) {
   SceneDesc scene;
   scene.path = "scene.json";
   for (int i = 0; i < MRGI_MAX_LIGHTS + 1; ++i) scene.lights.push_back(lamp(LightType::Point, true, {0, 1, 0}));

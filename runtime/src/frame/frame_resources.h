@@ -51,7 +51,8 @@ struct FrameResources {
   bool depth_registered = true;  // depth pixels align with colour pixels (same intrinsics)
   // The consumer of lit_rv / lit_r composes through Technique::compose_tiles() (the runtime
   // does): a technique may then leave the solutions undefined outside the tiles it lists.
-  // False (tests and tools reading the solutions themselves): they are defined everywhere.
+  // False (tests and tools reading the solutions themselves, or a stage after the technique
+  // that reads them at any pixel: the specular stage): they are defined everywhere.
   bool compose_honours_tiles = false;
   // The runtime's compose output, for a technique that composes its own tiles (ComposeTiles::
   // composed): valid handles only when the runtime honours that, i.e. compose_honours_tiles is

@@ -199,11 +199,15 @@ frame::FrameResources RuntimeImpl::frame_resources(const RuntimeSettings& settin
   shared.virtual_emission = virtual_gbuffer_->emission();
   shared.lit_rv = lit_rv_;
   shared.lit_r = lit_r_;
-  shared.compose_honours_tiles = true;  // record(): compose uses Technique::compose_tiles()
-  // A technique that composes its own tiles would do so before the specular stage writes the
-  // mirrors' and glass's pixels: with a specular material in the scene the runtime composes.
-  if (settings.fuse_compose && compose_->fusable() && !(scene_gpu_->specular && !research_of(settings).specular.off))
-    shared.composed_output = compose_->output();
+  // The specular stage reads the technique's solutions wherever a mirror or glass pixel's ray
+  // lands (the back-projection), so with a specular material in the scene they must be defined
+  // at every pixel, not only in the technique's compose tiles (ssrt's tiled levels left the rest
+  // as the memory held, which made glass_mirror's frames differ from run to run); and a
+  // technique that composes its own tiles would do so before the stage writes the mirrors' and
+  // glass's pixels: then the runtime composes.
+  const bool specular_stage = scene_gpu_->specular && !research_of(settings).specular.off;
+  shared.compose_honours_tiles = !specular_stage;  // record(): compose uses Technique::compose_tiles()
+  if (settings.fuse_compose && compose_->fusable() && !specular_stage) shared.composed_output = compose_->output();
   shared.compose_eps = compose_->settings().eps;
   shared.compose_alpha_max = compose_->settings().alpha_max;
   shared.color_upload = recon_->color_upload();

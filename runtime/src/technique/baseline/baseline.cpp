@@ -3,6 +3,7 @@
 #include <string>
 
 #include "technique/knobs.h"
+#include "technique/laddered.h"
 
 namespace mrgi::technique {
 namespace {
@@ -23,25 +24,19 @@ shading::DirectLightLevel direct_level(const BaselineLevel& l) {
   return {l.shadow_map_size, l.pcf_radius, l.caster_cell_shadow_texels, l.shadowed_estimated_lights};
 }
 
-class Baseline final : public Technique {
+class Baseline final : public Laddered<BaselineLevel> {
  public:
   Baseline(std::vector<BaselineLevel> levels, std::unique_ptr<shading::DirectLightBlock> direct)
-      : ladder_(ladder_of(levels, baseline_levels(), kBaselineKnobs)), levels_(std::move(levels)),
+      : Laddered("baseline", ladder_of(levels, baseline_levels(), kBaselineKnobs), std::move(levels)),
         direct_(std::move(direct)) {}
-  const std::string& name() const override { return name_; }
-  const std::vector<QualityLevel>& levels() const override { return ladder_; }
   Status record(const frame::FrameInfo& info, std::vector<std::string>& skipped) override {
-    if (info.level < 0 || info.level >= int(ladder_.size()))
-      return fail(ErrorKind::BadUsage, "baseline: level " + std::to_string(info.level) + " outside 0.." +
-                                           std::to_string(ladder_.size() - 1));
-    return direct_->record(info, direct_level(levels_[size_t(info.level)]), {}, skipped);
+    auto level = level_for(info);
+    if (!level) return level.error();
+    return direct_->record(info, direct_level(**level), {}, skipped);
   }
   std::optional<shading::DirectLightOutput> direct_light() const override { return direct_->output(); }
 
  private:
-  std::string name_ = "baseline";
-  std::vector<QualityLevel> ladder_;
-  std::vector<BaselineLevel> levels_;  // baseline_levels() with RuntimeSettings::knobs applied
   std::unique_ptr<shading::DirectLightBlock> direct_;
 };
 

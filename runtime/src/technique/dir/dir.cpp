@@ -15,6 +15,7 @@
 #include "light/light_stage.h"
 #include "gi/input_reuse.h"
 #include "technique/knobs.h"
+#include "technique/laddered.h"
 #include "frame/scene_gpu.h"
 
 namespace mrgi::technique {
@@ -100,13 +101,11 @@ struct TemporalPush {
   glm::vec4 params;
 };
 
-class Dir final : public Technique {
+class Dir final : public Laddered<DirLevel> {
  public:
   Dir(const frame::FrameResources& shared, std::vector<DirLevel> levels, const DirAblation& ablation)
-      : shared_(shared), ladder_(ladder_of(levels, dir_levels(), kDirKnobs)), levels_(std::move(levels)),
-        ablation_(ablation) {}
-  const std::string& name() const override { return name_; }
-  const std::vector<QualityLevel>& levels() const override { return ladder_; }
+      : Laddered("dir", ladder_of(levels, dir_levels(), kDirKnobs), std::move(levels)),
+        shared_(shared), ablation_(ablation) {}
   Status init();
   Status record(const frame::FrameInfo& info, std::vector<std::string>& skipped) override;
 
@@ -124,10 +123,7 @@ class Dir final : public Technique {
                                                      const VplSlots& slots, float clamp_m,
                                                      std::vector<std::string>& skipped);
 
-  std::string name_ = "dir";
   frame::FrameResources shared_;
-  std::vector<QualityLevel> ladder_;
-  std::vector<DirLevel> levels_;  // dir_levels() with RuntimeSettings::knobs applied
   std::optional<gi::ReflectiveShadowMaps> rsm_;
   std::optional<gi::VplSampler> vpls_;
   std::optional<gi::ImperfectShadowMaps> ism_;
@@ -281,10 +277,9 @@ Status Dir::init() {
 
 Status Dir::record(const frame::FrameInfo& info, std::vector<std::string>& skipped) {
   direct_->begin_frame();
-  if (info.level < 0 || info.level >= int(levels_.size()))
-    return fail(ErrorKind::BadUsage, "dir: level " + std::to_string(info.level) + " outside 0.." +
-                                         std::to_string(levels_.size() - 1));
-  const DirLevel& level = levels_[size_t(info.level)];
+  auto level_or = level_for(info);
+  if (!level_or) return level_or.error();
+  const DirLevel& level = **level_or;
   const light::Lighting& lighting = shared_.light_stage->lighting();
   if (!glossy_)
     skipped.push_back("dir glossy VPLs: no glossy virtual material (metallic > 0.1 or roughness < 0.7) in the scene; every VPL reflects diffusely");

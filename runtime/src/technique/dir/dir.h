@@ -73,7 +73,7 @@
 //     stands for its share of the maps, not a point); virtual pixels reflect VPL light by their
 //     whole BRDF; real surfaces stay diffuse (the paper's real specular is 0). The lobe's
 //     Schlick grazing term takes the incident flux as grey.
-// Ablations (mrgi/runtime.h DirAblation, `mrgi replay --dir-ablation`): one shadow map a lamp
+// Ablations (mrgi/research.h DirAblation, `mrgi replay --dir-ablation`): one shadow map a lamp
 // and one ISM a VPL instead of two (the lamps' direct light too: the direct-light block's shading pass reads its
 // two maps as one, shading/direct_light.comp kOneShadowMap), no ir(VPL), one bounce, no environment
 // VPLs, no temporal smoothing (these four change the VPL light only).

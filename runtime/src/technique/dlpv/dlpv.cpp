@@ -12,6 +12,7 @@
 #include "light/light_stage.h"
 #include "gi/input_reuse.h"
 #include "technique/knobs.h"
+#include "technique/laddered.h"
 #include "light/light_set_writer.h"
 #include "frame/scene_gpu.h"
 
@@ -63,13 +64,11 @@ struct MergePush {
 // at least 0.25 m (a thin object still has room around it for its shadow and bounce).
 constexpr float kMinVolumeSide = 0.25f;
 
-class Dlpv final : public Technique {
+class Dlpv final : public Laddered<DlpvLevel> {
  public:
   Dlpv(const frame::FrameResources& shared, std::vector<DlpvLevel> levels, const DlpvAblation& ablation)
-      : shared_(shared), ladder_(ladder_of(levels, dlpv_levels(), kDlpvKnobs)), levels_(std::move(levels)),
-        ablation_(ablation) {}
-  const std::string& name() const override { return name_; }
-  const std::vector<QualityLevel>& levels() const override { return ladder_; }
+      : Laddered("dlpv", ladder_of(levels, dlpv_levels(), kDlpvKnobs), std::move(levels)),
+        shared_(shared), ablation_(ablation) {}
   Status init();
   Status record(const frame::FrameInfo& info, std::vector<std::string>& skipped) override;
 
@@ -82,12 +81,10 @@ class Dlpv final : public Technique {
   };
   Status record_volumes(const frame::FrameInfo& info, const DlpvLevel& level, MadeVolumes& made,
                         std::vector<std::string>& skipped);
+  uint32_t inject_lamps(const DlpvLevel& level, float radius, uint32_t stride, std::vector<std::string>& skipped);
   void add_merge_pass(const MergePush& push);
 
-  std::string name_ = "dlpv";
   frame::FrameResources shared_;
-  std::vector<QualityLevel> ladder_;
-  std::vector<DlpvLevel> levels_;  // dlpv_levels() with RuntimeSettings::knobs applied
   gpu::BufferHandle lights_;  // shader::LightSet, one per frame slot
   std::optional<gi::ReflectiveShadowMaps> rsm_;
   std::optional<gi::LightPropagationVolume> delta_, rho_;
@@ -173,10 +170,9 @@ void Dlpv::write_lights() {
 
 Status Dlpv::record(const frame::FrameInfo& info, std::vector<std::string>& skipped) {
   direct_->begin_frame();
-  if (info.level < 0 || info.level >= int(levels_.size()))
-    return fail(ErrorKind::BadUsage, "dlpv: level " + std::to_string(info.level) + " outside 0.." +
-                                         std::to_string(levels_.size() - 1));
-  const DlpvLevel& level = levels_[size_t(info.level)];
+  auto level_or = level_for(info);
+  if (!level_or) return level_or.error();
+  const DlpvLevel& level = **level_or;
   const bool antiradiance = level.antiradiance_shadows;
   const bool two = mu_.has_value();  // DlpvAblation::two_volumes
   if (two && antiradiance)
@@ -216,7 +212,6 @@ Status Dlpv::record(const frame::FrameInfo& info, std::vector<std::string>& skip
 Status Dlpv::record_volumes(const frame::FrameInfo& info, const DlpvLevel& level, MadeVolumes& made,
                             std::vector<std::string>& skipped) {
   gpu::FrameGraph& graph = *shared_.graph;
-  const bool antiradiance = level.antiradiance_shadows;
   const bool two = mu_.has_value();  // DlpvAblation::two_volumes
   const light::Lighting& lighting = shared_.light_stage->lighting();
   bool& delta_present = made.delta;
@@ -250,48 +245,12 @@ Status Dlpv::record_volumes(const frame::FrameInfo& info, const DlpvLevel& level
         ++n;
       }
     const bool reuse = reuse_.close();
-    bool grid_added = false;
     uint32_t lamps = 0;
     if (reuse) {
       lamps = uint32_t(reuse_.lamp_count());
       skipped.push_back("dlpv maps and volumes: reused (level, pose, depth and lamps within tolerance of the frame that made them)");
     }
-    for (size_t i = 0; !reuse && i < lighting.lights.size() && lamps < level.rsm_lamps; ++i) {
-      const LightDesc& lamp = lighting.lights[i];
-      if (!lamp.real) continue;
-      auto view = gi::rsm_view(lamp, centre_, radius, level.rsm_size);
-      if (!view) {
-        skipped.push_back("dlpv rsm (light " + std::to_string(i) + "): " + view.error().message);
-        continue;
-      }
-      if (!grid_added) {
-        if (two) {
-          rho_->add_clear(graph);
-          mu_->add_clear(graph);
-        } else {
-          delta_->add_clear(graph);
-          if (level.rho_volume) rho_->add_clear(graph);
-        }
-        rsm_->add_grid(graph, stride);
-        grid_added = true;
-      }
-      const std::string id = std::to_string(i);
-      const gi::RsmImages rho_map = rsm_->images(gi::RsmMap::WithVirtual, level.rsm_size);
-      const gi::RsmImages mu_map = rsm_->images(gi::RsmMap::RealOnly, level.rsm_size);
-      rsm_->add_pair(graph, id, *view, level.rsm_size);
-      // V^Delta = R^rho's VPLs - R^mu's, from the texels the virtual objects cover (the rest
-      // cancel exactly, rsm.h), in one pass.
-      if (!two) delta_->add_inject(graph, "delta " + id, rho_map, view->lpv, gi::InjectKind::Indirect, 1.0f, &mu_map);
-      if (level.rho_volume || two)
-        rho_->add_inject(graph, "rho " + id, rho_map, view->lpv,
-                         !two && ablation_.no_virtual_self_bounce ? gi::InjectKind::IndirectFromReal
-                                                                              : gi::InjectKind::Indirect,
-                         1.0f);
-      if (two) mu_->add_inject(graph, "mu " + id, mu_map, view->lpv, gi::InjectKind::Indirect, 1.0f);
-      if (antiradiance)
-        delta_->add_inject(graph, "blocked direct " + id, mu_map, view->lpv, gi::InjectKind::Direct, -1.0f, &rho_map);
-      ++lamps;
-    }
+    if (!reuse) lamps = inject_lamps(level, radius, stride, skipped);
     if (reuse) {
       delta_present = source_delta_;
       rho_present = source_rho_;
@@ -324,6 +283,55 @@ Status Dlpv::record_volumes(const frame::FrameInfo& info, const DlpvLevel& level
                             rho_present ? 1.0f : 0.0f);
   }
   return ok_status();
+}
+
+// Each real lamp's map pair (strongest first, the level's number) injected: V^Delta from the
+// texels the objects change, V^rho (and V^mu in the ablation), V^Delta's antiradiance at the
+// paper level. Returns the lamps injected.
+uint32_t Dlpv::inject_lamps(const DlpvLevel& level, float radius, uint32_t stride, std::vector<std::string>& skipped) {
+  gpu::FrameGraph& graph = *shared_.graph;
+  const bool antiradiance = level.antiradiance_shadows;
+  const bool two = mu_.has_value();  // DlpvAblation::two_volumes
+  const light::Lighting& lighting = shared_.light_stage->lighting();
+  bool grid_added = false;
+  uint32_t lamps = 0;
+  for (size_t i = 0; i < lighting.lights.size() && lamps < level.rsm_lamps; ++i) {
+    const LightDesc& lamp = lighting.lights[i];
+    if (!lamp.real) continue;
+    auto view = gi::rsm_view(lamp, centre_, radius, level.rsm_size);
+    if (!view) {
+      skipped.push_back("dlpv rsm (light " + std::to_string(i) + "): " + view.error().message);
+      continue;
+    }
+    if (!grid_added) {
+      if (two) {
+        rho_->add_clear(graph);
+        mu_->add_clear(graph);
+      } else {
+        delta_->add_clear(graph);
+        if (level.rho_volume) rho_->add_clear(graph);
+      }
+      rsm_->add_grid(graph, stride);
+      grid_added = true;
+    }
+    const std::string id = std::to_string(i);
+    const gi::RsmImages rho_map = rsm_->images(gi::RsmMap::WithVirtual, level.rsm_size);
+    const gi::RsmImages mu_map = rsm_->images(gi::RsmMap::RealOnly, level.rsm_size);
+    rsm_->add_pair(graph, id, *view, level.rsm_size);
+    // V^Delta = R^rho's VPLs - R^mu's, from the texels the virtual objects cover (the rest
+    // cancel exactly, rsm.h), in one pass.
+    if (!two) delta_->add_inject(graph, "delta " + id, rho_map, view->lpv, gi::InjectKind::Indirect, 1.0f, &mu_map);
+    if (level.rho_volume || two)
+      rho_->add_inject(graph, "rho " + id, rho_map, view->lpv,
+                       !two && ablation_.no_virtual_self_bounce ? gi::InjectKind::IndirectFromReal
+                                                                            : gi::InjectKind::Indirect,
+                       1.0f);
+    if (two) mu_->add_inject(graph, "mu " + id, mu_map, view->lpv, gi::InjectKind::Indirect, 1.0f);
+    if (antiradiance)
+      delta_->add_inject(graph, "blocked direct " + id, mu_map, view->lpv, gi::InjectKind::Direct, -1.0f, &rho_map);
+    ++lamps;
+  }
+  return lamps;
 }
 
 // The antiradiance levels' own shading (dlpv/merge.comp): lamps unshadowed, V^Delta's

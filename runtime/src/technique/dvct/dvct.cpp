@@ -16,6 +16,7 @@
 #include "light/light_stage.h"
 #include "gi/input_reuse.h"
 #include "technique/knobs.h"
+#include "technique/laddered.h"
 #include "light/light_set_writer.h"
 #include "frame/scene_gpu.h"
 
@@ -78,12 +79,11 @@ Expected<std::vector<QualityLevel>> dvct_ladder(const std::vector<KnobSetting>& 
 
 namespace {
 
-class Dvct final : public Technique {
+class Dvct final : public Laddered<DvctLevel> {
  public:
   Dvct(const frame::FrameResources& shared, std::vector<DvctLevel> levels)
-      : shared_(shared), ladder_(ladder_of(levels, dvct_levels(), kDvctKnobs)), levels_(std::move(levels)) {}
-  const std::string& name() const override { return name_; }
-  const std::vector<QualityLevel>& levels() const override { return ladder_; }
+      : Laddered("dvct", ladder_of(levels, dvct_levels(), kDvctKnobs), std::move(levels)),
+        shared_(shared) {}
   Status init();
   Status record(const frame::FrameInfo& info, std::vector<std::string>& skipped) override;
 
@@ -93,10 +93,7 @@ class Dvct final : public Technique {
   Status record_volumes(const DvctLevel& level, const frame::FrameInfo& info, std::vector<std::string>& skipped);
   void add_cone_pass(const DvctLevel& level, const shader::DvctParams& params, bool specular);
 
-  std::string name_ = "dvct";
   frame::FrameResources shared_;
-  std::vector<QualityLevel> ladder_;
-  std::vector<DvctLevel> levels_;
   gpu::BufferHandle lights_;  // shader::LightSet, one per frame slot (the paper level's shading)
   gpu::BufferHandle real_materials_;  // shader::DvctRealMaterials, one per frame slot
   shader::DvctRealMaterials real_material_table_{};  // scene.json's regions, as the shaders read them
@@ -376,10 +373,9 @@ void Dvct::add_cone_pass(const DvctLevel& level, const shader::DvctParams& param
 
 Status Dvct::record(const frame::FrameInfo& info, std::vector<std::string>& skipped) {
   direct_->begin_frame();
-  if (info.level < 0 || info.level >= int(levels_.size()))
-    return fail(ErrorKind::BadUsage, "dvct: level " + std::to_string(info.level) + " outside 0.." +
-                                         std::to_string(levels_.size() - 1));
-  const DvctLevel& level = levels_[size_t(info.level)];
+  auto level_or = level_for(info);
+  if (!level_or) return level_or.error();
+  const DvctLevel& level = **level_or;
   gpu::FrameGraph& graph = *shared_.graph;
   auto* set = static_cast<shader::LightSet*>(graph.mapped(lights_, graph.slot()));
   light::write_unshadowed_light_set(shared_.light_stage->lighting(), *set);

@@ -247,10 +247,9 @@ void Ssrt::add_shade_pass(const char* name, ShadeMode mode, bool run_transfer) {
 }
 
 Status Ssrt::record_geometry(const frame::FrameInfo& info, std::vector<std::string>& skipped) {
-  if (info.level < 0 || info.level >= int(ladder_.size()))
-    return fail(ErrorKind::BadUsage, "ssrt: level " + std::to_string(info.level) + " outside 0.." +
-                                         std::to_string(ladder_.size() - 1));
-  const SsrtLevel& level = levels_[size_t(info.level)];
+  auto level_or = level_for(info);
+  if (!level_or) return level_or.error();
+  const SsrtLevel& level = **level_or;
   level_ = info.level;
   step_ = level.subsample;
   directions_ = level.directions;

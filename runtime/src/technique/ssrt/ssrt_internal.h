@@ -23,6 +23,7 @@
 
 #include "technique/ssrt/ssrt.h"
 #include "technique/knobs.h"
+#include "technique/laddered.h"
 
 namespace mrgi::technique::ssrt_detail {
 
@@ -103,12 +104,11 @@ struct ShadePush {
   glm::vec4 opts;
 };
 
-class Ssrt final : public Technique {
+class Ssrt final : public Laddered<SsrtLevel> {
  public:
   Ssrt(const frame::FrameResources& shared, std::vector<SsrtLevel> levels)
-      : shared_(shared), ladder_(ladder_of(levels, ssrt_levels(), kSsrtKnobs)), levels_(std::move(levels)) {}
-  const std::string& name() const override { return name_; }
-  const std::vector<QualityLevel>& levels() const override { return ladder_; }
+      : Laddered("ssrt", ladder_of(levels, ssrt_levels(), kSsrtKnobs), std::move(levels)),
+        shared_(shared) {}
   Status init();
   Status record(const frame::FrameInfo& info, std::vector<std::string>& skipped) override;
   // The paper's own geometry stage (Sec. 4) replaces the runtime's reconstruction: the
@@ -169,10 +169,7 @@ class Ssrt final : public Technique {
                       influence_cells_.z * st + grow, influence_cells_.w * st + grow);
   }
 
-  std::string name_ = "ssrt";
   frame::FrameResources shared_;
-  std::vector<QualityLevel> ladder_;
-  std::vector<SsrtLevel> levels_;  // ssrt_levels() with RuntimeSettings::knobs applied
   // The light stage's estimator, which this technique's sums feed.
   const light::LightEstimator& estimator() const { return shared_.light_stage->estimator(); }
   std::optional<ssrt::Volume> volume_;
