@@ -166,7 +166,7 @@ Status DirectLightBlock::Impl::create_maps() {
   plan_.virtual_only.reserve(plan_.virtual_only.size());
   drawn_.reserve(largest.size());
 
-  auto lights = graph.create_buffer({"baseline_lights", sizeof(shader::LightSet), gpu::MemoryUsage::Upload, true},
+  auto lights = graph.create_buffer({"direct_light_lights", sizeof(shader::LightSet), gpu::MemoryUsage::Upload, true},
                                     VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   if (!lights) return lights.error();
   lights_ = *lights;
@@ -219,7 +219,7 @@ Status DirectLightBlock::Impl::create_pipelines() {
   auto grid_vs = gpu::shader_spirv("shading/shadow_depth_grid.vert");
   if (!grid_vs) return grid_vs.error();
   gpu::GraphicsPipelineDesc grid;
-  grid.name = "baseline_shadow_depth_grid";
+  grid.name = "direct_light_shadow_grid";
   grid.vertex_spirv = *grid_vs;
   grid.push_constant_bytes = sizeof(GridPush);
   grid.depth_format = VK_FORMAT_D32_SFLOAT;
@@ -238,7 +238,7 @@ Status DirectLightBlock::Impl::create_pipelines() {
   auto mesh_vs = gpu::shader_spirv("shading/shadow_mesh.vert");
   if (!mesh_vs) return mesh_vs.error();
   gpu::GraphicsPipelineDesc mesh;
-  mesh.name = "baseline_shadow_mesh";
+  mesh.name = "direct_light_shadow_mesh";
   mesh.vertex_spirv = *mesh_vs;
   mesh.push_constant_bytes = sizeof(glm::mat4);
   mesh.vertex_strides = {sizeof(frame::GpuVertex)};
@@ -279,18 +279,18 @@ Status DirectLightBlock::Impl::create_pipelines() {
 
 Status DirectLightBlock::Impl::create_stand_ins() {
   gpu::FrameGraph& graph = *frame_.graph;
-  auto no_receivers = graph.create_zero_image("baseline_no_caustic_receivers", VK_FORMAT_R32G32B32A32_SFLOAT,
+  auto no_receivers = graph.create_zero_image("direct_light_no_caustic_receivers", VK_FORMAT_R32G32B32A32_SFLOAT,
                                               VK_IMAGE_USAGE_STORAGE_BIT);
   if (!no_receivers) return no_receivers.error();
   no_receivers_ = *no_receivers;
-  auto no_receiver_lamps = graph.create_buffer({"baseline_no_caustic_receiver_lamps", sizeof(shader::CausticReceivers)},
+  auto no_receiver_lamps = graph.create_buffer({"direct_light_no_caustic_receiver_lamps", sizeof(shader::CausticReceivers)},
                                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (!no_receiver_lamps) return no_receiver_lamps.error();
   no_receiver_lamps_ = *no_receiver_lamps;
-  auto no_volume = graph.create_zero_image("baseline_no_volume", VK_FORMAT_R16G16B16A16_SFLOAT, VK_IMAGE_USAGE_SAMPLED_BIT, 2, 2, 2);
+  auto no_volume = graph.create_zero_image("direct_light_no_volume", VK_FORMAT_R16G16B16A16_SFLOAT, VK_IMAGE_USAGE_SAMPLED_BIT, 2, 2, 2);
   if (!no_volume) return no_volume.error();
   no_volume_ = *no_volume;
-  auto no_indirect = graph.create_zero_image("baseline_no_indirect", VK_FORMAT_R32G32B32A32_UINT, VK_IMAGE_USAGE_STORAGE_BIT);
+  auto no_indirect = graph.create_zero_image("direct_light_no_indirect", VK_FORMAT_R32G32B32A32_UINT, VK_IMAGE_USAGE_STORAGE_BIT);
   if (!no_indirect) return no_indirect.error();
   no_indirect_ = *no_indirect;
   return ok_status();

@@ -16,11 +16,11 @@
 namespace mrgi::specular {
 namespace {
 
-constexpr VkFormat kPositionFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
-constexpr VkFormat kNormalFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+constexpr VkFormat kPhotonPositionFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+constexpr VkFormat kPhotonNormalFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kCausticFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kLitFormat = VK_FORMAT_R16G16B16A16_SFLOAT;  // the runtime's lit_rv
-constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
+constexpr VkFormat kPhotonDepthFormat = VK_FORMAT_D32_SFLOAT;
 // Receiver maps: float sums of many photons' irradiance (a caustic's core holds thousands).
 constexpr VkFormat kReceiverFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 constexpr VkDeviceSize kPhotonBytes = sizeof(shader::Photon);
@@ -99,19 +99,19 @@ Status Caustics::create_photon_maps() {
     d.width = d.height = max_map_size;
     return graph.create_image(d, usage);
   };
-  auto p = map("specular photon position", kPositionFormat, colour);
+  auto p = map("specular photon position", kPhotonPositionFormat, colour);
   if (!p) return p.error();
   position_ = *p;
-  auto n = map("specular photon normal", kNormalFormat, colour);
+  auto n = map("specular photon normal", kPhotonNormalFormat, colour);
   if (!n) return n.error();
   normal_ = *n;
-  auto bp = map("specular photon back position", kPositionFormat, colour);
+  auto bp = map("specular photon back position", kPhotonPositionFormat, colour);
   if (!bp) return bp.error();
   back_position_ = *bp;
-  auto bn = map("specular photon back normal", kNormalFormat, colour);
+  auto bn = map("specular photon back normal", kPhotonNormalFormat, colour);
   if (!bn) return bn.error();
   back_normal_ = *bn;
-  auto d = map("specular photon depth", kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
+  auto d = map("specular photon depth", kPhotonDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
   if (!d) return d.error();
   depth_ = *d;
   return ok_status();
@@ -195,8 +195,8 @@ Status Caustics::create_photon_pipelines() {
   pd.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
                    {1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12},
                    {2, 0, VK_FORMAT_R32G32_SFLOAT, 24}};
-  pd.color_formats = {kPositionFormat, kNormalFormat};
-  pd.depth_format = kDepthFormat;
+  pd.color_formats = {kPhotonPositionFormat, kPhotonNormalFormat};
+  pd.depth_format = kPhotonDepthFormat;
   pd.cull_mode = VK_CULL_MODE_BACK_BIT;
   auto sp = gpu::create_graphics_pipeline(ctx, pd);
   if (!sp) return sp.error();
