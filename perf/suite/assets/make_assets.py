@@ -9,6 +9,12 @@ glass_sphere.gltf  0.08 m radius clear glass sphere (KHR_materials_transmission 
                    1.5) resting on y = 0, for `glass_mirror`.
 mirror_box.gltf    0.1 x 0.16 x 0.02 m perfect-mirror slab (metallic 1, roughness 0) standing on
                    y = 0, for `glass_mirror`.
+For the independently rendered validation set (perf/cycles/scenes/): objects that span albedo and
+colour, each diffuse (roughness 1) and resting on y = 0:
+orange_box.gltf    0.16 m cube, albedo (0.8, 0.3, 0.08): colour bleeding onto white walls.
+yellow_sphere.gltf 0.1 m radius, albedo (0.8, 0.7, 0.12).
+dark_sphere.gltf   0.1 m radius, albedo 0.04: a virtual object that mostly blocks light.
+white_sphere.gltf  0.1 m radius, albedo 0.85: a virtual object that mostly reflects it.
 Made for this project; same licence as the repository.
 """
 import base64
@@ -113,3 +119,14 @@ write("glass_sphere", sphere(0.08),
 write("mirror_box", box(0.1, 0.16, 0.02),
       {"name": "mirror", "pbrMetallicRoughness": {"baseColorFactor": [0.95, 0.95, 0.95, 1], "metallicFactor": 1,
                                                   "roughnessFactor": 0}}, [])
+
+
+def diffuse(name, rgb):
+    return {"name": name, "pbrMetallicRoughness": {"baseColorFactor": list(rgb) + [1], "metallicFactor": 0,
+                                                   "roughnessFactor": 1}}
+
+
+write("orange_box", box(0.16, 0.16, 0.16), diffuse("orange", (0.8, 0.3, 0.08)), [])
+write("yellow_sphere", sphere(0.1), diffuse("yellow", (0.8, 0.7, 0.12)), [])
+write("dark_sphere", sphere(0.1), diffuse("dark", (0.04, 0.04, 0.04)), [])
+write("white_sphere", sphere(0.1), diffuse("white", (0.85, 0.85, 0.85)), [])
