@@ -110,6 +110,7 @@ class Dir final : public Laddered<DirLevel> {
   Status record(const frame::FrameInfo& info, std::vector<std::string>& skipped) override;
 
  private:
+  Status create_gi_blocks(uint32_t top_vpls, uint32_t top_ism, uint32_t top_rsm, uint32_t top_bounce);
   // The VPL buffer's slots this frame (the lamps' VPLs take the rest).
   struct VplSlots {
     uint32_t bounce = 0, env = 0;  // bounce VPLs, environment VPLs
@@ -166,6 +167,51 @@ class Dir final : public Laddered<DirLevel> {
   float radius_ = 1.0f;
 };
 
+// The GI blocks sized for the top level: the map pairs, the VPL sampler, the ISMs and the
+// bounce light source (none without virtual objects: nothing differs between the solutions).
+Status Dir::create_gi_blocks(uint32_t top_vpls, uint32_t top_ism, uint32_t top_rsm, uint32_t top_bounce) {
+  gpu::FrameGraph& graph = *shared_.graph;
+  const frame::SceneGpu& sg = *shared_.scene_gpu;
+  const glm::vec3 size = sg.virtual_objects.bounds_max - sg.virtual_objects.bounds_min;
+  centre_ = 0.5f * (sg.virtual_objects.bounds_max + sg.virtual_objects.bounds_min);
+  const float side = std::max(kMinInfluenceSide, 2.0f * std::max({size.x, size.y, size.z}));
+  radius_ = 0.5f * side * std::sqrt(3.0f);
+  gi::RsmSettings rs;
+  rs.name = "dir rsm";
+  rs.size = top_rsm;
+  auto rsm = gi::ReflectiveShadowMaps::create(graph, sg, {shared_.real_position, shared_.real_normal, shared_.real_albedo}, rs);
+  if (!rsm) return rsm.error();
+  rsm_.emplace(std::move(*rsm));
+  gi::VplSettings vs;
+  vs.name = "dir vpl";
+  vs.max_vpls = top_vpls;
+  vs.map_size = top_rsm;
+  vs.history = true;  // reused while nothing moved (gi::InputReuse)
+  vs.glossy = sg.glossy;
+  auto vpls = gi::VplSampler::create(graph, vs);
+  if (!vpls) return vpls.error();
+  vpls_.emplace(std::move(*vpls));
+  gi::IsmSettings is;
+  is.name = "dir ism";
+  is.max_vpls = top_vpls;
+  is.map_size = top_ism;
+  is.history = true;
+  auto ism = gi::ImperfectShadowMaps::create(graph, sg, shared_.real_position, shared_.real_normal, is);
+  if (!ism) return ism.error();
+  ism_.emplace(std::move(*ism));
+  if (top_bounce > 0 && !ablation_.one_bounce) {
+    gi::VplBounceSettings bs;
+    bs.name = "dir bounce";
+    bs.max_slots = top_bounce;
+    bs.glossy = sg.glossy;
+    auto bounce = gi::VplBounce::create(graph, sg, ism_->virtual_triangles(),
+                                        {shared_.real_position, shared_.real_normal, shared_.real_albedo}, bs);
+    if (!bounce) return bounce.error();
+    bounce_.emplace(std::move(*bounce));
+  }
+  return ok_status();
+}
+
 Status Dir::init() {
   gpu::FrameGraph& graph = *shared_.graph;
   const frame::SceneGpu& sg = *shared_.scene_gpu;
@@ -180,45 +226,7 @@ Status Dir::init() {
     top_lamps = std::max(top_lamps, l.rsm_lamps);
   }
   planned_.reserve(top_lamps);
-  if (has_virtual_) {
-    const glm::vec3 size = sg.virtual_objects.bounds_max - sg.virtual_objects.bounds_min;
-    centre_ = 0.5f * (sg.virtual_objects.bounds_max + sg.virtual_objects.bounds_min);
-    const float side = std::max(kMinInfluenceSide, 2.0f * std::max({size.x, size.y, size.z}));
-    radius_ = 0.5f * side * std::sqrt(3.0f);
-    gi::RsmSettings rs;
-    rs.name = "dir rsm";
-    rs.size = top_rsm;
-    auto rsm = gi::ReflectiveShadowMaps::create(graph, sg, {shared_.real_position, shared_.real_normal, shared_.real_albedo}, rs);
-    if (!rsm) return rsm.error();
-    rsm_.emplace(std::move(*rsm));
-    gi::VplSettings vs;
-    vs.name = "dir vpl";
-    vs.max_vpls = top_vpls;
-    vs.map_size = top_rsm;
-    vs.history = true;  // reused while nothing moved (gi::InputReuse)
-    vs.glossy = sg.glossy;
-    auto vpls = gi::VplSampler::create(graph, vs);
-    if (!vpls) return vpls.error();
-    vpls_.emplace(std::move(*vpls));
-    gi::IsmSettings is;
-    is.name = "dir ism";
-    is.max_vpls = top_vpls;
-    is.map_size = top_ism;
-    is.history = true;
-    auto ism = gi::ImperfectShadowMaps::create(graph, sg, shared_.real_position, shared_.real_normal, is);
-    if (!ism) return ism.error();
-    ism_.emplace(std::move(*ism));
-    if (top_bounce > 0 && !ablation_.one_bounce) {
-      gi::VplBounceSettings bs;
-      bs.name = "dir bounce";
-      bs.max_slots = top_bounce;
-      bs.glossy = sg.glossy;
-      auto bounce = gi::VplBounce::create(graph, sg, ism_->virtual_triangles(),
-                                          {shared_.real_position, shared_.real_normal, shared_.real_albedo}, bs);
-      if (!bounce) return bounce.error();
-      bounce_.emplace(std::move(*bounce));
-    }
-  }
+  if (has_virtual_) MRGI_TRY(create_gi_blocks(top_vpls, top_ism, top_rsm, top_bounce));
   gpu::BufferDesc ed{"dir environment vpls", VkDeviceSize(kMaxEnvVpls) * sizeof(shader::Vpl), gpu::MemoryUsage::Upload};
   auto env = graph.create_buffer(ed, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (!env) return env.error();
