@@ -3,8 +3,9 @@
 # error"). Run:
 #
 #   blender -b --factory-startup -noaudio -P tools/cycles/render_description.py -- \
-#       DESCRIPTION.json OUTDIR [--frames N] [--spp S] [--threads T]
+#       DESCRIPTION.json OUTDIR [--frames N] [--spp S] [--threads T] [--seed K]
 #
+# (--seed overrides render.seed, e.g. for a second render of frame 0 that measures the noise floor.)
 # Per frame f (time f / fps, as mrgi synth) it writes linear-radiance float OpenEXR files
 # OUTDIR/NNNNNN_<what>.exr, all at the colour camera's size unless said otherwise:
 #   C       the camera view of the real scene (virtual objects hidden), linear radiance
@@ -40,7 +41,7 @@
 #    as mrgi's ideal depth and mask are.
 #  * Point and spot lamps: mrgi's intensity * color is radiant intensity in W/sr per channel.
 #    Cycles' point and spot lamps of `energy` P emit P / (4 pi) W/sr (checked: a 1 W/sr lamp 1 m
-#    above a white Lambertian floor gives radiance 1/pi there; tools/cycles/README), so
+#    above a white Lambertian floor gives radiance 1/pi there; perf/cycles/README.md), so
 #    energy = 4 pi * max channel and color = channel / max channel. Radius (shadow_soft_size) 0:
 #    mrgi's lamps are points.
 #  * Spot cone: mrgi's falloff is smoothstep(cos outer, cos inner, cos angle) on the cosine of
@@ -62,11 +63,12 @@
 #    (D the world direction in Blender axes); background strength = intensity. The procedural sky
 #    ("environment.sky") is not built here (refused).
 #  * Materials (mrgi's bsdf.h): diffuse -> Diffuse BSDF, roughness 0 (Lambert, as mrgi);
-#    glossy -> Principled BSDF, GGX (single scattering, as mrgi), specular 0.5 (F0 0.04 as mrgi),
-#    base colour, roughness (alpha = roughness^2 in both), metallic. Differences not removed:
-#    Principled's diffuse lobe is Disney's (retro-reflection that grows with roughness, darker at
-#    grazing angles) where mrgi's is Lambert * 0.96 * (1 - metallic), and its Fresnel is not
-#    exactly Schlick. mirror -> Glossy BSDF SHARP with the base colour (constant reflectance, as
+#    glossy -> Diffuse BSDF (Lambert) of base * (1 - metallic) * 0.96 plus a Principled BSDF
+#    used as a pure GGX lobe (metallic 1, base colour = F0 = mix(0.04, base, metallic),
+#    single-scattering GGX as mrgi, alpha = roughness^2 in both). Principled's own diffuse lobe
+#    is Disney's (retro-reflection growing with roughness), not mrgi's Lambert * 0.96, so it is
+#    not used. Left different: Principled's metallic Fresnel goes from F0 to white along a
+#    dielectric Fresnel curve, close to but not Schlick's. mirror -> Glossy BSDF SHARP with the base colour (constant reflectance, as
 #    mrgi). glass -> Glass BSDF SHARP with ior and the base colour (Cycles tints the reflection
 #    too, mrgi only the transmission). emission -> added Emission of strength 1 (radiance),
 #    front face only as mrgi.
@@ -112,12 +114,12 @@ def fail(msg):
 
 def parse_args():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-    opts = {"frames": None, "spp": None, "threads": 0}
+    opts = {"frames": None, "spp": None, "threads": 0, "seed": None}
     pos = []
     i = 0
     while i < len(argv):
         a = argv[i]
-        if a in ("--frames", "--spp", "--threads"):
+        if a in ("--frames", "--spp", "--threads", "--seed"):
             if i + 1 >= len(argv):
                 fail(a + " needs a value")
             try:
@@ -130,7 +132,7 @@ def parse_args():
             i += 1
     if len(pos) != 2:
         fail("usage: blender -b --factory-startup -noaudio -P render_description.py -- "
-             "DESCRIPTION.json OUTDIR [--frames N] [--spp S] [--threads T]")
+             "DESCRIPTION.json OUTDIR [--frames N] [--spp S] [--threads T] [--seed K]")
     return pos[0], pos[1], opts
 
 
@@ -217,13 +219,40 @@ def new_material(name, m, emission_front_only=True):
         s.inputs["Roughness"].default_value = 0.0  # Lambert
         color_in = s.inputs["Color"]
     elif t == "glossy":
-        s = nt.nodes.new("ShaderNodeBsdfPrincipled")
-        s.distribution = "GGX"
-        s.inputs["Base Color"].default_value = color
-        s.inputs["Roughness"].default_value = m.get("roughness", 0.5)
-        s.inputs["Metallic"].default_value = m.get("metallic", 0.0)
-        s.inputs["Specular"].default_value = 0.5  # F0 = 0.08 * 0.5 = 0.04 for dielectrics
-        color_in = s.inputs["Base Color"]
+        # mrgi's glossy (bsdf.h): Lambert of base * (1 - metallic) * 0.96 plus a GGX lobe with
+        # F0 = mix(0.04, base, metallic). Principled's own diffuse lobe is Disney's (brighter, with
+        # retro-reflection), so the Lambert part is a Diffuse BSDF and the Principled BSDF is used
+        # as a pure GGX lobe: metallic 1 makes its base colour the F0 (Fresnel towards white at
+        # grazing angles, close to Schlick) and switches its diffuse off.
+        metal = m.get("metallic", 0.0)
+        d = nt.nodes.new("ShaderNodeBsdfDiffuse")
+        d.inputs["Roughness"].default_value = 0.0
+        p = nt.nodes.new("ShaderNodeBsdfPrincipled")
+        p.distribution = "GGX"
+        p.inputs["Metallic"].default_value = 1.0
+        p.inputs["Roughness"].default_value = m.get("roughness", 0.5)
+        p.inputs["Specular"].default_value = 0.5
+        rgb = nt.nodes.new("ShaderNodeRGB")
+        rgb.outputs[0].default_value = color
+        diff_w = nt.nodes.new("ShaderNodeMixRGB")  # base * (1 - metallic) * 0.96
+        diff_w.blend_type = "MULTIPLY"
+        diff_w.inputs["Fac"].default_value = 1.0
+        diff_w.inputs["Color2"].default_value = ((1.0 - metal) * 0.96,) * 3 + (1.0,)
+        f0 = nt.nodes.new("ShaderNodeMixRGB")  # mix(0.04, base, metallic)
+        f0.blend_type = "MIX"
+        f0.inputs["Fac"].default_value = metal
+        f0.inputs["Color1"].default_value = (0.04, 0.04, 0.04, 1.0)
+        nt.links.new(diff_w.outputs[0], d.inputs["Color"])
+        nt.links.new(f0.outputs[0], p.inputs["Base Color"])
+        s = nt.nodes.new("ShaderNodeAddShader")
+        nt.links.new(d.outputs[0], s.inputs[0])
+        nt.links.new(p.outputs[0], s.inputs[1])
+        # The base colour (or a texture linked in by rebuild_gltf_material) feeds both weights.
+        reroute = nt.nodes.new("NodeReroute")
+        nt.links.new(rgb.outputs[0], reroute.inputs[0])
+        nt.links.new(reroute.outputs[0], diff_w.inputs["Color1"])
+        nt.links.new(reroute.outputs[0], f0.inputs["Color2"])
+        color_in = reroute.inputs[0]
     elif t == "mirror":
         s = nt.nodes.new("ShaderNodeBsdfGlossy")
         s.distribution = "SHARP"
@@ -486,7 +515,7 @@ def build_world(desc, base):
 
 # ---- rendering -------------------------------------------------------------------------------
 
-def setup_render(desc, spp, threads):
+def setup_render(desc, spp, threads, seed):
     sc = bpy.context.scene
     sc.render.engine = "CYCLES"
     cy = sc.cycles
@@ -501,7 +530,7 @@ def setup_render(desc, spp, threads):
     cy.caustics_refractive = True
     if hasattr(cy, "use_guiding"):
         cy.use_guiding = False
-    cy.seed = int(desc.get("render", {}).get("seed", 1)) % (1 << 31)
+    cy.seed = int(seed if seed is not None else desc.get("render", {}).get("seed", 1)) % (1 << 31)
     cy.use_animated_seed = False
     depth = int(desc.get("render", {}).get("max_depth", 6))
     cy.max_bounces = depth
@@ -593,7 +622,7 @@ def main():
 
     clear_scene()
     sc = bpy.context.scene
-    comp = setup_render(desc, spp, opts["threads"])
+    comp = setup_render(desc, spp, opts["threads"], opts["seed"])
     for i, o in enumerate(desc.get("real_objects", [])):
         if o["shape"] == "gltf":
             root, meshes = import_gltf(os.path.join(base, o["gltf"]), "real%d" % i)
@@ -654,12 +683,15 @@ def main():
 
     report_path = os.path.join(outdir, "renders.json")
     report = {"description": os.path.abspath(desc_path), "blender": bpy.app.version_string, "spp": spp,
+              "seed": bpy.context.scene.cycles.seed,
               "frames": frames, "threads": opts["threads"], "frame_seconds": {}}
     if os.path.exists(report_path):
         with open(report_path) as f:
             old = json.load(f)
-        if old.get("spp") == spp:
-            report["frame_seconds"] = old.get("frame_seconds", {})
+        if old.get("spp") != spp or old.get("seed") != report["seed"] or old.get("description") != report["description"]:
+            fail("%s holds renders of %s at %s spp, seed %s; use another OUTDIR or remove it" %
+                 (outdir, old.get("description"), old.get("spp"), old.get("seed")))
+        report["frame_seconds"] = old.get("frame_seconds", {})
     for f in range(frames):
         names = ["C", "G", "depth", "normal", "mask"] + (["env"] if env_cam else [])
         if all(os.path.exists(os.path.join(outdir, "%06d_%s.exr" % (f, n))) for n in names):
