@@ -16,6 +16,9 @@
 #                 shadow, without the speckle of a noisy render): IoU of the two sets, the
 #                 distance between their centroids in pixels, and the mean of (G - C) luminance
 #                 over each set
+#   depth         of the pixels either depth frame measures: the share both measure, and the
+#                 median and 99th percentile of |difference| in mm (both use mrgi's Kinect model
+#                 with the same seed, so equal ideal depth and incidence give equal frames)
 #   delta_rde     ||D_cycles - D_mrgi|| / ||D_mrgi||, D = G - C linear, over all / real (mask 0 in
 #                 both) / virtual pixels: the RDE an output that matched Cycles exactly would score
 #                 against the mrgi reference; it includes both references' Monte Carlo noise
@@ -32,6 +35,8 @@ CHECKS = {
     "mask_iou_min": 0.95,
     "shadow_iou_min": 0.6,
     "shadow_centroid_px_max": 10.0,
+    "depth_both_measured_min": 0.98,
+    "depth_median_mm_max": 1.0,
 }
 
 
@@ -39,15 +44,21 @@ def srgb_to_linear(v):
     return np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)
 
 
-def load_png_bytes(path):
+def load_png_bytes(path, scale=255.0):
     if not os.path.exists(path):
         raise SystemExit("compare_captures: %s: missing" % path)
     im = bpy.data.images.load(path)
     im.colorspace_settings.name = "Non-Color"  # raw stored values, no conversion
     w, h = im.size
-    a = np.array(im.pixels[:], dtype=np.float32).reshape(h, w, 4)[::-1]
+    a = np.array(im.pixels[:], dtype=np.float64).reshape(h, w, 4)[::-1]
     bpy.data.images.remove(im)
-    return np.rint(a * 255.0).astype(np.int32)
+    return np.rint(a * scale).astype(np.int64)
+
+
+def load_depth_m(capture, rel):
+    with open(os.path.join(capture, "capture.json")) as f:
+        scale = float(json.load(f).get("depth_scale", 5000.0))
+    return load_png_bytes(os.path.join(capture, rel), 65535.0)[..., 0] / scale
 
 
 def read_list(capture, name):
@@ -120,7 +131,7 @@ def main():
     for cap in caps:
         with open(os.path.join(cap, "capture.json")) as f:
             exposure.append(float(json.load(f).get("exposure", 1.0)))
-    lists = [(read_list(cap, "rgb.txt"), read_list(cap, "reference.txt")) for cap in caps]
+    lists = [(read_list(cap, "rgb.txt"), read_list(cap, "reference.txt"), read_list(cap, "depth.txt")) for cap in caps]
     n = min(len(lists[0][0]), len(lists[1][0]))
     if frames:
         n = min(n, frames)
@@ -130,6 +141,9 @@ def main():
     for f in range(n):
         (cm, gm, mm), (cc, gc, mc) = [load_frame(caps[k], lists[k][0][f], lists[k][1][f], exposure[k]) for k in (0, 1)]
         dm, dc = gm - cm, gc - cc
+        zm, zc = [load_depth_m(caps[k], lists[k][2][f]) for k in (0, 1)]
+        either, both = (zm > 0) | (zc > 0), (zm > 0) & (zc > 0)
+        dz = np.abs(zm - zc)[both] * 1000.0
         both_real = ~mm & ~mc
         virt = mm | mc
         sm, sc = shadow_set(cm, gm, both_real), shadow_set(cc, gc, both_real)
@@ -154,6 +168,9 @@ def main():
             "shadow_mean_delta_luminance": [round(float(luminance(dm)[sm].mean()), 5) if sm.any() else None,
                                             round(float(luminance(dc)[sc].mean()), 5) if sc.any() else None],
             "delta_rde_all_real_virtual": [round(rde(dm, dc, s), 4) for s in (all_px, both_real, virt)],
+            "depth_both_measured": round(float(both.sum()) / max(1, int(either.sum())), 4),
+            "depth_abs_diff_mm_median_p99": [round(float(np.median(dz)), 2), round(float(np.percentile(dz, 99)), 2)]
+            if dz.size else None,
         }
         report["frames"].append(fr)
         print(json.dumps(fr))
@@ -168,6 +185,12 @@ def main():
             failures.append("frame %d: mask IoU %.3f < %g" % (fr["frame"], fr["mask_iou"], CHECKS["mask_iou_min"]))
         if fr["shadow_iou"] is not None and fr["shadow_iou"] < CHECKS["shadow_iou_min"]:
             failures.append("frame %d: shadow IoU %.3f < %g" % (fr["frame"], fr["shadow_iou"], CHECKS["shadow_iou_min"]))
+        if fr["depth_both_measured"] < CHECKS["depth_both_measured_min"]:
+            failures.append("frame %d: depth measured in both at %.3f of the pixels either measures < %g" %
+                            (fr["frame"], fr["depth_both_measured"], CHECKS["depth_both_measured_min"]))
+        dz = fr["depth_abs_diff_mm_median_p99"]
+        if dz is not None and dz[0] > CHECKS["depth_median_mm_max"]:
+            failures.append("frame %d: median depth difference %.2f mm > %g" % (fr["frame"], dz[0], CHECKS["depth_median_mm_max"]))
         if fr["shadow_centroid_px"] > CHECKS["shadow_centroid_px_max"]:
             failures.append("frame %d: shadow centroids %.1f px apart > %g" %
                             (fr["frame"], fr["shadow_centroid_px"], CHECKS["shadow_centroid_px_max"]))
