@@ -19,6 +19,8 @@
 #   depth         of the pixels either depth frame measures: the share both measure, and the
 #                 median and 99th percentile of |difference| in mm (both use mrgi's Kinect model
 #                 with the same seed, so equal ideal depth and incidence give equal frames)
+#   env_mean_ratio  when both captures have env frames: mean linear radiance per channel of the
+#                 env frame inside the fisheye circle, Cycles / mrgi
 #   delta_rde     ||D_cycles - D_mrgi|| / ||D_mrgi||, D = G - C linear, over all / real (mask 0 in
 #                 both) / virtual pixels: the RDE an output that matched Cycles exactly would score
 #                 against the mrgi reference; it includes both references' Monte Carlo noise
@@ -82,6 +84,14 @@ def load_frame(capture, rgb_rel, ref_rel, exposure):
     return c, g, mask
 
 
+def load_exr(path):
+    im = bpy.data.images.load(path)
+    w, h = im.size
+    a = np.array(im.pixels[:], dtype=np.float64).reshape(h, w, 4)[::-1, :, :3]
+    bpy.data.images.remove(im)
+    return a
+
+
 def luminance(x):
     return 0.2126 * x[..., 0] + 0.7152 * x[..., 1] + 0.0722 * x[..., 2]
 
@@ -132,6 +142,7 @@ def main():
         with open(os.path.join(cap, "capture.json")) as f:
             exposure.append(float(json.load(f).get("exposure", 1.0)))
     lists = [(read_list(cap, "rgb.txt"), read_list(cap, "reference.txt"), read_list(cap, "depth.txt")) for cap in caps]
+    envs = [read_list(cap, "env.txt") if os.path.exists(os.path.join(cap, "env.txt")) else None for cap in caps]
     n = min(len(lists[0][0]), len(lists[1][0]))
     if frames:
         n = min(n, frames)
@@ -172,6 +183,12 @@ def main():
             "depth_abs_diff_mm_median_p99": [round(float(np.median(dz)), 2), round(float(np.percentile(dz, 99)), 2)]
             if dz.size else None,
         }
+        if envs[0] and envs[1]:
+            em, ec = [load_exr(os.path.join(caps[k], envs[k][f])) for k in (0, 1)]
+            h, w = em.shape[:2]
+            yy, xx = np.mgrid[0:h, 0:w]
+            inside = np.hypot(xx - 0.5 * (w - 1), yy - 0.5 * (h - 1)) < 0.5 * min(w, h) - 1
+            fr["env_mean_ratio"] = [round(float(a / b), 4) for a, b in zip(ec[inside].mean(0), em[inside].mean(0))]
         report["frames"].append(fr)
         print(json.dumps(fr))
     ratio = sums["c"][1] / sums["c"][0]
