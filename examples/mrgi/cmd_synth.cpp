@@ -16,6 +16,7 @@ struct SynthArgs {
   std::optional<int> frames, spp, width, height, threads;
   std::optional<uint64_t> seed, noise_floor_seed;
   std::string reference_format = "delta";
+  std::string from_renders;
   bool resume = false;
   std::optional<int> stop_after;
 };
@@ -32,6 +33,7 @@ void run_synth(const SynthArgs& a) {
   options.threads = a.threads.value_or(0);
   options.noise_floor_seed = a.noise_floor_seed;
   options.resume = a.resume;
+  options.from_renders = a.from_renders;
   options.stop_after = a.stop_after;
   options.references = a.reference_format == "plain" ? ReferenceStorage::Plain : ReferenceStorage::Delta;
   options.progress = [](const std::string& what, size_t done, size_t total, double elapsed) {
@@ -45,8 +47,9 @@ void run_synth(const SynthArgs& a) {
                  report.frames_rendered, report.frames_resumed + report.frames_rendered, report.frames,
                  report.seconds, report.frame_seconds, a.out.c_str());
   } else {
-    std::fprintf(stderr, "synth: wrote %s: %d frames (%d resumed), %d spp, %.1f s (%.1f s rendering over all runs)%s\n",
-                 a.out.c_str(), report.frames, report.frames_resumed, report.spp, report.seconds,
+    const std::string spp = report.spp ? std::to_string(report.spp) + " spp" : "frames from " + a.from_renders;
+    std::fprintf(stderr, "synth: wrote %s: %d frames (%d resumed), %s, %.1f s (%.1f s rendering over all runs)%s\n",
+                 a.out.c_str(), report.frames, report.frames_resumed, spp.c_str(), report.seconds,
                  report.frame_seconds, report.dropped_samples ? " (non-finite samples were dropped)" : "");
   }
   if (report.noise_floor)
@@ -82,6 +85,10 @@ void setup(CLI::App& app) {
   cmd->add_option("--stop-after", args->stop_after,
                   "render at most N frames in this run, then stop, leaving OUT.partial for --resume")
       ->check(CLI::Range(1, 100000));
+  cmd->add_option("--from-renders", args->from_renders,
+                  "take the frames from another renderer's EXR images of the same description instead of "
+                  "path-tracing them (tools/cycles/render_description.py writes them; layout in "
+                  "tools/reference/src/synth_from_renders.h)");
   cmd->add_option("--threads", args->threads, "render threads (default: all cores)")->check(CLI::Range(1, 256));
   cmd->callback([args] { run_synth(*args); });
 }

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -306,6 +307,89 @@ TEST_F(SynthTest, ImageEnvironmentIsCopiedIntoTheCapture) {
   ASSERT_TRUE(env.ok()) << env.error().message;
   EXPECT_EQ(env->width, 32);
   EXPECT_EQ(env->height, 16);
+}
+
+// `--from-renders`: the frames come from another renderer's EXRs (tools/cycles), through the same
+// sensor models and writer; bad inputs are refused naming the file before anything is written.
+TEST_F(SynthTest, FromRendersTakesTheImagesAndRefusesBadOnes) {
+  auto d = load_scene_description(write("ok.json", tiny()));
+  ASSERT_TRUE(d.ok()) << d.error().message;
+  const fs::path renders = dir_ / "renders";
+  fs::create_directories(renders);
+  auto file = [&](int f, const char* what) {
+    char name[64];
+    std::snprintf(name, sizeof name, "%06d_%s.exr", f, what);
+    return (renders / name).string();
+  };
+  auto filled = [](int w, int h, float v) { return ImageRGBF(w, h, v); };
+  for (int f = 0; f < 2; ++f) {
+    ImageRGBF c = filled(32, 24, 0.2f), g = c, mask = filled(32, 24, 0.0f);
+    for (int y = 8; y < 16; ++y)
+      for (int x = 10; x < 20; ++x) {
+        for (int k = 0; k < 3; ++k) g.at(x, y)[k] = 0.5f;
+        mask.at(x, y)[0] = 1.0f;
+      }
+    ImageRGBF normal(32, 24);
+    for (size_t i = 0; i < normal.pixel_count(); ++i) {  // 0.5 + 0.5 n, n = +y (the floor)
+      normal.data[3 * i] = 0.5f;
+      normal.data[3 * i + 1] = 1.0f;
+      normal.data[3 * i + 2] = 0.5f;
+    }
+    ASSERT_TRUE(write_exr(file(f, "C"), c).ok());
+    ASSERT_TRUE(write_exr(file(f, "G"), g).ok());
+    ASSERT_TRUE(write_exr(file(f, "depth"), filled(32, 24, 1.0f)).ok());
+    ASSERT_TRUE(write_exr(file(f, "normal"), normal).ok());
+    ASSERT_TRUE(write_exr(file(f, "mask"), mask).ok());
+    if (f == 0) {
+      ASSERT_TRUE(write_exr(file(f, "env"), filled(16, 16, 0.1f)).ok());
+    }
+  }
+  SynthOptions o;
+  o.out = (dir_ / "cap").string();
+  o.from_renders = renders.string();
+  // Frame 1 has no env image: refused before anything is written.
+  auto missing = synthesize_capture(*d, o);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.error().message.find("000001_env.exr: missing"), std::string::npos) << missing.error().message;
+  EXPECT_FALSE(fs::exists(dir_ / "cap.partial"));
+  // The wrong size is refused naming the file and the size it must have.
+  ASSERT_TRUE(write_exr(file(1, "env"), filled(8, 8, 0.1f)).ok());
+  auto wrong = synthesize_capture(*d, o);
+  ASSERT_FALSE(wrong.ok());
+  EXPECT_NE(wrong.error().message.find("000001_env.exr: is 8x8, must be 16x16"), std::string::npos)
+      << wrong.error().message;
+  // Options that only a path-traced render has are refused.
+  SynthOptions with_spp = o;
+  with_spp.spp = 4;
+  EXPECT_FALSE(synthesize_capture(*d, with_spp).ok());
+
+  ASSERT_TRUE(write_exr(file(1, "env"), filled(16, 16, 0.1f)).ok());
+  auto report = synthesize_capture(*d, o);
+  ASSERT_TRUE(report.ok()) << report.error().message;
+  auto capture = CaptureReader::open(o.out);
+  ASSERT_TRUE(capture.ok()) << capture.error().message;
+  ASSERT_EQ(capture->frame_count(), 2u);
+  auto f0 = capture->read_frame(0);
+  auto reference = capture->read_reference(0);
+  auto mask = capture->read_reference_mask(0);
+  ASSERT_TRUE(f0.ok() && reference.ok() && mask.ok());
+  ASSERT_TRUE(f0->env.has_value());
+  // The camera model (exposure 1.5, sRGB) applied to the given radiance; G differs from C exactly
+  // inside the given mask; depth 1 m is measured (Kinect model: within a few mm).
+  const uint8_t c8 = f0->color.data[0];
+  EXPECT_NEAR(c8, 255.0 * std::pow(0.2 * 1.5, 1.0 / 2.4) * 1.055 - 0.055 * 255.0, 1.5);
+  size_t virtual_pixels = 0, differing = 0, measured = 0;
+  for (size_t i = 0; i < mask->pixel_count(); ++i) {
+    virtual_pixels += mask->data[i] != 0;
+    differing += reference->data[3 * i] != f0->color.data[3 * i];
+    if (f0->depth.data[i]) {
+      ++measured;
+      EXPECT_NEAR(f0->depth.data[i] / capture->info().depth_scale, 1.0, 0.02);
+    }
+  }
+  EXPECT_EQ(virtual_pixels, 80u);
+  EXPECT_EQ(differing, 80u);
+  EXPECT_GT(measured, mask->pixel_count() / 2);
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include "mrgi/reference/sensors.h"
 #include "shared/mrgi_shared.h"
 #include "environment_sampler.h"
+#include "synth_from_renders.h"
 #include "synth_resume.h"
 #include "synth_scene.h"
 
@@ -207,10 +208,16 @@ Expected<SynthReport> synthesize_capture(const SceneDescription& description, co
     d.intrinsics = d.intrinsics.scaled_to(w, h);
   }
   if (options.out.empty()) return fail(ErrorKind::BadUsage, "--out must name the capture folder to create");
+  const bool from_renders = !options.from_renders.empty();
+  if (from_renders && (options.noise_floor_seed || options.resume || options.stop_after || options.spp || options.seed ||
+                       options.width || options.height))
+    return fail(ErrorKind::BadUsage, "--from-renders takes the frames as rendered: --noise-floor-seed, --resume, "
+                                     "--stop-after, --spp, --seed, --width and --height do not apply");
   std::error_code ec;
   if (fs::exists(options.out, ec))
     return fail(ErrorKind::BadUsage, options.out + ": already exists; synth does not overwrite captures");
 
+  if (from_renders) MRGI_TRY(check_renders_present(options.from_renders, d));
   auto scene = SynthScene::load(d);
   if (!scene) return scene.error();
 
@@ -338,7 +345,7 @@ Expected<SynthReport> synthesize_capture(const SceneDescription& description, co
 
   SynthReport report;
   report.frames = d.frames;
-  report.spp = d.spp;
+  report.spp = from_renders ? 0 : d.spp;  // from renders: the renderer's own (its renders.json)
   report.frames_resumed = int(state.frames.size());
   const auto start = std::chrono::steady_clock::now();
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
@@ -349,12 +356,38 @@ Expected<SynthReport> synthesize_capture(const SceneDescription& description, co
     }
     const double t = f / d.fps;
     const double frame_start = elapsed();
-    auto tracer = PathTracer::create(scene->at_time(t));
-    if (!tracer) return tracer.error();
     RefCamera cam;
     cam.pinhole = d.intrinsics;
     const Pose pose = camera_pose_at(d, t);
     cam.camera_to_world = pose.matrix();
+    if (from_renders) {
+      auto rendered = load_rendered_frame(options.from_renders, f, d, pose);
+      if (!rendered) return rendered.error();
+      InputFrame frame;
+      frame.index = f;
+      frame.timestamp = t;
+      frame.depth_timestamp = t;
+      frame.pose = pose;
+      auto color = camera_frame(rendered->render.real, d.exposure, d.noise, d.seed, uint64_t(f));
+      if (!color) return color.error();
+      frame.color = std::move(*color);
+      auto reference = camera_frame(rendered->render.combined, d.exposure, d.noise, d.seed, uint64_t(f));
+      if (!reference) return reference.error();
+      auto depth = depth_frame(rendered->render.depth_z, rendered->render.cos_incidence, cam.pinhole.width,
+                               cam.pinhole.height, d.depth, d.seed, uint64_t(f));
+      if (!depth) return depth.error();
+      frame.depth = std::move(*depth);
+      if (d.env_camera) frame.env = std::move(rendered->env);
+      SynthFrameRecord record;
+      record.seconds = elapsed() - frame_start;
+      state.frames.push_back(record);
+      MRGI_TRY(save_synth_resume(resume_path, state));
+      MRGI_TRY(writer->add_frame(frame, &*reference, &rendered->render.virtual_mask));
+      ++report.frames_rendered;
+      continue;
+    }
+    auto tracer = PathTracer::create(scene->at_time(t));
+    if (!tracer) return tracer.error();
     RenderSettings rs;
     rs.spp = d.spp;
     rs.max_depth = d.max_depth;
@@ -419,7 +452,7 @@ Expected<SynthReport> synthesize_capture(const SceneDescription& description, co
     report.frame_seconds += r.seconds;
   }
   if (!state.frames.empty()) report.noise_floor = state.frames[0].noise_floor;
-  if (report.finished && d.light_probe && !fs::exists(staging / "light_probe" / "probe_direct.exr")) {
+  if (report.finished && d.light_probe && !from_renders && !fs::exists(staging / "light_probe" / "probe_direct.exr")) {
     // The probe: the real scene's incident radiance at the virtual objects' frame-0 centre.
     const RefScene at0 = scene->at_time(0.0);
     glm::dvec3 lo(1e30), hi(-1e30);

@@ -46,6 +46,12 @@ struct SynthOptions {
   // Render at most this many frames in this run, then stop and leave OUT.partial for `resume`
   // (splits a long render over several runs). Unset: render to the end.
   std::optional<int> stop_after;
+  // When set, the frames are not path-traced: their radiance, depth, normals, virtual masks and
+  // env images are read from this folder of another renderer's images of the same description
+  // (tools/cycles/render_description.py; layout in synth_from_renders.h), and go through the same
+  // sensor models and capture writer. No light probe is made. Not with noise_floor_seed, resume
+  // or stop_after (a conversion is quick: run it again).
+  std::string from_renders;
   // Progress over all frames: (what, done, total, seconds elapsed).
   std::function<void(const std::string&, size_t, size_t, double)> progress;
 };
