@@ -234,7 +234,7 @@ TEST_F(VulkanTest, VctConesSeeTheWallsRadianceFromItsFrontAndNothingElsewhere) {
   // step here) and meets the wall once, at level 2-3, interpolated with the empty space before
   // it: it gathers about half of the wall's light and occlusion (0.57 on lavapipe). A known
   // limit of the paper's step rule on thin surfaces; dvct's diffuse cones are measured against
-  // the path-traced reference before a denser step is chosen. shading::Bounds: not nothing, not more.
+  // the path-traced reference before a denser step is chosen. Bounds: not nothing, not more.
   for (int c = 0; c < 3; ++c) {
     EXPECT_GT(r[1][c], 0.4f * radiance[c]) << "wide cone, channel " << c;
     EXPECT_LT(r[1][c], 1.05f * radiance[c]) << "wide cone, channel " << c;

@@ -8,7 +8,7 @@
 // given the environment image itself (importance-sampled lights with shadow maps) is printed
 // beside it: it knows the true light, so it is the bar for the estimate, not for the technique.
 //
-// shading::Bounds: measured (session 4, lavapipe) plus a margin. fast: direction 8.5 median / 9.0 worst
+// Bounds: measured on lavapipe plus a margin. fast: direction 8.5 median / 9.0 worst
 // degrees, RDE 0.583; fastest: 7.4 / 7.8 degrees, RDE 0.618. Session 12: baseline high with the
 // environment image 0.517 (a constant ambient before: 0.629), with the probeless estimate see
 // the printout.

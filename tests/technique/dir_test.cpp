@@ -130,7 +130,7 @@ TEST(Dir, EveryLevelRunsAndItsVplsLightTheObjectBeyondBaseline) {
   }
 }
 
-// The skip of issue 15 (gi/input_reuse.h): identical frames reuse the VPLs and ISMs and
+// The reuse of unchanged inputs (gi/input_reuse.h): identical frames reuse the VPLs and ISMs and
 // give the recomputed frame's output bit for bit; a depth frame 1.8 mm off everywhere (within the
 // 2 mm tolerance) is reused too and stays within a few 8-bit levels of a runtime that
 // recomputes it; 1 cm of depth or 5 cm of camera motion recompute. Validation on.
