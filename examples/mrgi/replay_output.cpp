@@ -49,6 +49,8 @@ nlohmann::json figures_json(const ErrorFigures& f) {
   j["rmse8"] = f.rmse8;
   j["ssim"] = f.ssim;
   j["pixels"] = f.pixels;
+  j["change_sum"] = f.change_sum;
+  j["truth_change_sum"] = f.truth_change_sum;
   return j;
 }
 
@@ -115,8 +117,9 @@ Status ReplayOutput::add(const FrameOutput& out, const ImageRGB8& camera, const 
   if (reference) {
     auto r = measure_error(out.image, camera, *reference, mask);
     if (!r.ok()) return r.error();
-    s["error"] = {{"all", figures_json(r->all)}, {"real", figures_json(r->real)},
-                  {"virtual", figures_json(r->virtual_)}};
+    s["error"] = {{"all", figures_json(r->all)},           {"real", figures_json(r->real)},
+                  {"virtual", figures_json(r->virtual_)},  {"influenced", figures_json(r->influenced)},
+                  {"rest", figures_json(r->rest)}};
     if (!pooled_) {
       pooled_ = *r;
     } else {
@@ -189,9 +192,16 @@ Expected<nlohmann::json> ReplayOutput::finish() {
   }
   if (pooled_) {
     auto rde = [](const ErrorFigures& f) { return f.rde_defined ? nlohmann::json(f.rde) : nlohmann::json(nullptr); };
-    summary["rde"] = {{"all", rde(pooled_->all)}, {"real", rde(pooled_->real)}, {"virtual", rde(pooled_->virtual_)}};
-    summary["error"] = {{"all", figures_json(pooled_->all)}, {"real", figures_json(pooled_->real)},
-                        {"virtual", figures_json(pooled_->virtual_)}};
+    summary["rde"] = {{"all", rde(pooled_->all)},
+                      {"real", rde(pooled_->real)},
+                      {"virtual", rde(pooled_->virtual_)},
+                      {"influenced", rde(pooled_->influenced)},
+                      {"rest", rde(pooled_->rest)}};
+    summary["error"] = {{"all", figures_json(pooled_->all)},
+                        {"real", figures_json(pooled_->real)},
+                        {"virtual", figures_json(pooled_->virtual_)},
+                        {"influenced", figures_json(pooled_->influenced)},
+                        {"rest", figures_json(pooled_->rest)}};
   }
   MRGI_TRY(write_json(partial_ + "/stats.json", stats_));
   MRGI_TRY(write_json(partial_ + "/summary.json", summary));

@@ -30,12 +30,16 @@ nlohmann::json figures_json(const ErrorFigures& f) {
           {"delta_rms", f.delta_rms},
           {"rmse8", f.rmse8},
           {"ssim", f.ssim},
-          {"pixels", f.pixels}};
+          {"pixels", f.pixels},
+          {"change_sum", f.change_sum},
+          {"truth_change_sum", f.truth_change_sum}};
 }
 
 nlohmann::json error_json(bool has_reference, const RdeReport& r) {
   if (!has_reference) return nullptr;
-  return {{"all", figures_json(r.all)}, {"real", figures_json(r.real)}, {"virtual", figures_json(r.virtual_)}};
+  return {{"all", figures_json(r.all)},           {"real", figures_json(r.real)},
+          {"virtual", figures_json(r.virtual_)},  {"influenced", figures_json(r.influenced)},
+          {"rest", figures_json(r.rest)}};
 }
 
 std::string fmt(double v, int decimals) {
@@ -256,6 +260,21 @@ std::string report_markdown(const BenchResult& r, const CheckReport* check) {
         << rde_cell(l.has_reference, l.error.real) << " | " << rde_cell(l.has_reference, l.error.virtual_) << " | "
         << (l.has_reference ? fmt(l.error.all.rmse8, 2) : "-") << " | "
         << (l.has_reference ? fmt(l.error.all.ssim, 4) : "-") << " |\n";
+    }
+    // Where the error is: the truth's regions (mrgi/metrics.h RdeReport::influenced, rest) and
+    // how much light the output takes from or adds to the real pixels against the truth.
+    o << "\nError by region (RDE over the real pixels the virtual objects change in the truth, and over the "
+         "real pixels they leave; *real change*: the signed sum of output - camera over the real pixels and "
+         "channels, linear, against the same sum of truth - camera):\n\n"
+         "| scene | level | RDE virtual | RDE influenced | RDE rest | real change | truth's | ratio |\n"
+         "|---|---|---:|---:|---:|---:|---:|---:|\n";
+    for (const BenchEntry& e : r.entries) {
+      if (e.technique != t || !e.has_reference) continue;
+      const ErrorFigures& real = e.error.real;
+      o << "| " << e.scene << " | " << e.level << " " << e.level_name << " | " << rde_cell(true, e.error.virtual_)
+        << " | " << rde_cell(true, e.error.influenced) << " | " << rde_cell(true, e.error.rest) << " | "
+        << fmt(real.change_sum, 1) << " | " << fmt(real.truth_change_sum, 1) << " | "
+        << (std::abs(real.truth_change_sum) > 1e-9 ? fmt(real.change_sum / real.truth_change_sum, 2) : "-") << " |\n";
     }
     // Per-pass medians, median over scenes of each scene's median, per level.
     o << "\nPer pass, profiling mode (median over scenes of the per-scene median and p95, ms; ratio to the floor; "

@@ -9,7 +9,8 @@
 // strongest median-cut regions or the probeless dominant light, each with its shadow maps, so
 // a virtual object occludes the sky's bright part for the real surface below it. The rest of
 // the light is an ambient irradiance in SH (bands 0..2), unshadowed: the real part lights both
-// solutions, a virtual environment L_rv only.
+// solutions, a virtual environment L_rv only; in L_rv it loses what the virtual objects hide of
+// it (kEnvOcclusion, shading/environment_occlusion.h).
 // Plus the technique's indirect light, by the encoding its input declares (kIndirect):
 //   1 screen (ScreenIndirect): packed radiance pairs (gi/indirect_pack.glsl) into both
 //     solutions, L_rv += indirect_rv, L_r += indirect_r, up-sampled from its resolution
@@ -84,16 +85,51 @@ layout(constant_id = 2) const bool kCausticReceivers = false;
 layout(set = 0, binding = 25, rgba32f) readonly uniform image2D caustic_receivers;
 layout(std430, set = 0, binding = 26) readonly buffer CausticReceiverLamps { CausticReceivers receiver_set; };
 #include "specular/caustic_receiver_lookup.glsl"
+// kEnvOcclusion (the block's environment occlusion, shading/environment_occlusion.h): the
+// irradiance the virtual objects hide of the ambient, one texel per indirect_params.z internal
+// pixels (0: none this frame), taken off the ambient of L_rv (never L_r: the camera already
+// shows the real scene's own occlusion).
+layout(constant_id = 5) const bool kEnvOcclusion = false;
+layout(set = 0, binding = 27, rgba16f) readonly uniform image2D env_occlusion;
 struct LevelConstants {
   vec4 shadow;  // x used map size / allocated size, y used size (texels), z allocated size,
                 // w PCF radius (taps each side of the centre)
 };
-// indirect_params.y: the screen input's divisor (G-buffer pixels per texel side).
+// indirect_params.y: the screen input's divisor (G-buffer pixels per texel side); z: the
+// environment occlusion's (0: none this frame).
 layout(push_constant) uniform Level { LevelConstants level_block; VolumeConstants volume_block; ivec4 indirect_params; };
 LevelConstants level;
 
 
 #include "common/shadowed_lamps.glsl"
+
+// The environment occlusion at a pixel whose surface key (distance to the camera, negative on a
+// virtual surface) is `key`: bilinear over the texels on the same surface (key within 5 % + 2
+// cm), else over those of the same kind (real / virtual), else none.
+vec3 hidden_environment(ivec2 pixel, float key) {
+  int d = indirect_params.z;
+  if (d == 1) return imageLoad(env_occlusion, pixel).rgb;
+  ivec2 low = (frame.internal_output_size.xy + d - 1) / d;
+  vec2 f = (vec2(pixel) + 0.5f) / float(d) - 0.5f;
+  ivec2 i0 = ivec2(floor(f));
+  vec2 t = f - vec2(i0);
+  vec3 same = vec3(0.0f), kind = vec3(0.0f);
+  float w_same = 0.0f, w_kind = 0.0f;
+  for (int k = 0; k < 4; ++k) {
+    ivec2 o = ivec2(k & 1, k >> 1);
+    vec4 tap = imageLoad(env_occlusion, clamp(i0 + o, ivec2(0), low - 1));
+    float w = (o.x == 1 ? t.x : 1.0f - t.x) * (o.y == 1 ? t.y : 1.0f - t.y) + 1e-4f;
+    if (tap.a * key > 0.0f) {
+      kind += w * tap.rgb;
+      w_kind += w;
+      if (abs(tap.a - key) <= 0.05f * abs(key) + 0.02f) {
+        same += w * tap.rgb;
+        w_same += w;
+      }
+    }
+  }
+  return w_same > 0.0f ? same / w_same : (w_kind > 0.0f ? kind / w_kind : vec3(0.0f));
+}
 
 void main() {
   frame = frame_ubo; level = level_block;  // MRGI_UNIFORM_COPIES
@@ -130,7 +166,12 @@ void main() {
   // indirect input's.
   // With a virtual volume on virtual pixels, not the residual ambient too (light_set.glsl count.y).
   bool ambient_here = !(kVolumeVirtual && is_virtual && light_set.count.y != 0);
-  vec3 l_rv = (ambient_here ? alb.rgb * ambient_irradiance(ambient_rv, n) * (1.0f / MRGI_PI) : vec3(0.0f)) +
+  vec3 e_ambient = ambient_here ? ambient_irradiance(ambient_rv, n) : vec3(0.0f);
+  if (kEnvOcclusion && indirect_params.z > 0 && ambient_here) {
+    float key = distance(p, frame.camera_world.xyz);
+    e_ambient = max(e_ambient - hidden_environment(pixel, is_virtual ? -key : key), vec3(0.0f));
+  }
+  vec3 l_rv = alb.rgb * e_ambient * (1.0f / MRGI_PI) +
               (is_virtual && frame.flags.y != 0 ? imageLoad(virtual_emission, pixel).rgb : vec3(0.0f));
   vec3 l_r = r_p * alb.rgb * ambient_irradiance(ambient_r, n) * (1.0f / MRGI_PI);
   add_shadowed_lamps(p, n, v, alb.rgb, alb.a, roughness, is_virtual, r_p, level.shadow, kOneShadowMap, l_rv, l_r);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 
 #include "light/env_sampler.h"
@@ -268,6 +269,50 @@ TEST(LightStage, UniformEnvironmentLightsAnUpFacingSurfaceLikeTheMean) {
 
 }  // namespace
 
+// An environment of uniform radiance `base` with a cap of half-angle `cap_deg` around `dir` at
+// `contrast` times it, as an equirectangular file, lit through the stage; the shadowed lights.
+std::vector<LightDesc> shadowed_lights_of(double cap_deg, double contrast, const std::string& name) {
+  const int w = 256, h = 128;
+  const glm::dvec3 dir = glm::normalize(glm::dvec3(0.3, 0.8, -0.5));
+  ImageRGBF img(w, h);
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      const double l = glm::dot(equirect_direction(u, v, w, h), dir) >= std::cos(cap_deg * kDeg) ? 0.1 * contrast : 0.1;
+      float* t = img.at(u, v);
+      t[0] = t[1] = t[2] = float(l);
+    }
+  const std::string path = ::testing::TempDir() + name + ".exr";
+  EXPECT_TRUE(write_exr(path, img).ok());
+  SceneDesc scene;
+  scene.environment.present = true;
+  scene.environment.image = path;
+  auto stage = LightStage::create({}, scene, CameraSetup{});
+  EXPECT_TRUE(stage.ok());
+  if (!stage.ok()) return {};
+  for (const LightDesc& l : (*stage)->lighting().lights)
+    EXPECT_LT(angle_deg(-glm::dvec3(l.direction), dir), 8.0) << name;  // a region holds some of the rest too
+  return (*stage)->lighting().lights;
+}
+
+// Only compact, bright regions become shadowed lights (LightStageSettings::shadowed_min_contrast,
+// shadowed_max_solid_angle_sr, EnvSamplerSettings::source_contrast); both sides of each rule.
+TEST(LightStage, OnlyCompactBrightSourcesCastShadows) {
+  const LightStageSettings d;
+  // A 6-degree source (0.034 sr, under 0.05) far brighter than the rest: shadowed.
+  EXPECT_FALSE(shadowed_lights_of(6.0, 200.0, "compact_bright").empty());
+  // The same source too dim to stand out (contrast 2 < 3): ambient only.
+  EXPECT_TRUE(shadowed_lights_of(6.0, 2.0, "compact_dim").empty());
+  // A broad bright source, a lit wall near the env camera or a big window (30 degrees, 0.84 sr
+  // > 0.05): ambient only, however its median cut splits it.
+  EXPECT_TRUE(shadowed_lights_of(30.0, 20.0, "broad_bright").empty());
+  // Just either side of the size limit: 7.0 degrees is 0.0469 sr, 7.5 is 0.0538 sr.
+  ASSERT_NEAR(d.shadowed_max_solid_angle_sr, 0.05, 1e-12);
+  EXPECT_FALSE(shadowed_lights_of(7.0, 200.0, "below_limit").empty());
+  EXPECT_TRUE(shadowed_lights_of(7.5, 200.0, "above_limit").empty());
+  // A uniform environment has nothing to shadow.
+  EXPECT_TRUE(shadowed_lights_of(0.0, 1.0, "uniform").empty());
+}
+
 namespace {
 // The env camera source end to end: the suite's fisheye capture (capture.json env_camera, env/
 // frames) gives the stage its lights per frame, named in the note, the sun among them.
@@ -284,14 +329,16 @@ TEST(LightStage, EnvCameraFramesLightTheScene) {
   std::vector<std::string> notes;
   ASSERT_TRUE((*stage)->update(*f, f->pose->matrix(), notes).ok());
   ASSERT_FALSE(notes.empty());
-  EXPECT_EQ(notes.back(), "light: environment image (env camera, 16 median-cut regions, 4 shadowed)");
+  // The courtyard's brightest parts (a hazy low sun, lit clouds) are broad, so none is a
+  // shadowed light (LightStageSettings::shadowed_max_solid_angle_sr): all of it is ambient,
+  // which the virtual objects occlude softly.
+  EXPECT_EQ(notes.back(), "light: environment image (env camera, 16 median-cut regions, 0 shadowed)");
   const Lighting& lit = (*stage)->lighting();
   EXPECT_EQ(lit.source, LightSourceKind::Environment);
-  ASSERT_EQ(lit.lights.size(), 4u);
-  // One of the shadowed lights sits at the sun: the env image's brightest pixel, through the
-  // equidistant model (r = f theta) and the env camera's rotation, within 10 degrees. (The
-  // courtyard's low sun carries about as much light as a sixteenth of its sky, so its region is
-  // one of the strongest, not necessarily the first.)
+  EXPECT_EQ(lit.lights.size(), 0u);
+  ASSERT_EQ((*stage)->environment_regions().size(), 16u);
+  // One of the regions sits at the sun: the env image's brightest pixel, through the
+  // equidistant model (r = f theta) and the env camera's rotation, within 10 degrees.
   const ImageRGBF& env = *f->env;
   int bu = 0, bv = 0;
   float best = -1.0f;
@@ -307,7 +354,7 @@ TEST(LightStage, EnvCameraFramesLightTheScene) {
   const glm::dvec3 d_cam(std::sin(theta) * dx / r, std::sin(theta) * dy / r, std::cos(theta));
   const glm::dvec3 sun = glm::mat3_cast(cam.rotation) * d_cam;
   double closest = -1.0;
-  for (const LightDesc& l : lit.lights) closest = std::max(closest, glm::dot(-glm::dvec3(l.direction), sun));
+  for (const EnvLight& r : (*stage)->environment_regions()) closest = std::max(closest, glm::dot(r.direction, sun));
   EXPECT_GT(closest, std::cos(10.0 * kDeg));  // 6.7: the centroid of a region holding sky too
 }
 }  // namespace
@@ -358,5 +405,53 @@ TEST(LightStage, DeclaredLampsChangeAtRunTime) {
   EXPECT_EQ((*external)->lighting().lights.size(), lights);
   EXPECT_EQ((*external)->lighting().revision, ext_revision);
   EXPECT_EQ((*external)->declared_lamp(0).intensity, 0.0f);
+}
+}  // namespace
+
+namespace {
+// The near-field rule (LightStageSettings::near_field_distance_m): a compact bright region the
+// env camera sees is a shadowed light only when no surface of the depth image lies along its
+// direction within 3 m of the env camera. A wall 1 m away in that direction: ambient; the same
+// wall 5 m away, or a direction the depth camera cannot judge: a shadowed light.
+TEST(LightStage, BrightNearSurfacesAreNotDistantLights) {
+  const glm::dvec3 dir = glm::normalize(glm::dvec3(0.1, 0.05, 1.0));
+  const int w = 128, h = 64;
+  ImageRGBF env(w, h);
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      const float l = glm::dot(equirect_direction(u, v, w, h), dir) >= std::cos(5.0 * kDeg) ? 20.0f : 0.1f;
+      float* t = env.at(u, v);
+      t[0] = t[1] = t[2] = l;
+    }
+  SceneDesc scene;
+  scene.environment.present = true;
+  scene.environment.from_env_camera = true;
+  EnvCamera cam;  // equirectangular, world axes, at the origin
+  cam.position = glm::dvec3(0.0);
+  CameraSetup setup;
+  setup.color = setup.depth = Intrinsics{64, 48, 50.0, 50.0, 31.5, 23.5};
+  setup.depth_scale = 1000.0;
+  setup.env_camera = cam;
+  // The colour/depth camera 1 m behind the env camera, looking along +z (OpenCV axes = world).
+  const glm::dmat4 camera_to_world = glm::translate(glm::dmat4(1.0), glm::dvec3(0.0, 0.0, -1.0));
+  auto lights_with_wall_at = [&](double camera_depth_m) {
+    auto stage = LightStage::create({}, scene, setup);
+    EXPECT_TRUE(stage.ok());
+    InputFrame f;
+    f.env = env;
+    f.color = ImageRGB8(64, 48, 128);
+    f.depth = ImageU16(64, 48, uint16_t(camera_depth_m * 1000.0));
+    std::vector<std::string> notes;
+    EXPECT_TRUE((*stage)->update(f, camera_to_world, notes).ok());
+    return (*stage)->lighting().lights.size();
+  };
+  EXPECT_EQ(lights_with_wall_at(2.0), 0u);   // the wall 1 m from the env camera: near
+  EXPECT_GE(lights_with_wall_at(6.0), 1u);   // 5 m: beyond the near field
+  EXPECT_GE(lights_with_wall_at(0.0), 1u);   // no measurement: nothing known to be near
+  // Either side of the 3 m limit: the wall at 2.8 m and at 3.2 m from the env camera along z
+  // (the region's direction is a few degrees off the cap's axis: the ray meets the wall a little
+  // farther).
+  EXPECT_EQ(lights_with_wall_at(3.8), 0u);
+  EXPECT_GE(lights_with_wall_at(4.2), 1u);
 }
 }  // namespace

@@ -7,7 +7,8 @@
 //   exposure     > 0, default 1
 //   env_camera   {model "equirectangular" | "fisheye_equidistant", f (px, fisheye: required > 0),
 //                 cx, cy (px, fisheye: required), fov_deg (fisheye, (0, 360], default 180),
-//                 rotation [x,y,z,w] (default identity)}
+//                 rotation [x,y,z,w] (default identity), position [x,y,z] (world metres,
+//                 optional: where the env camera is, so declared lamps it sees can be removed)}
 //   apriltag     {family (an AprilTag library family name, default tag36h11), size_m > 0 (default
 //                 0.1), tags [{id >= 0 (unique), position [3], rotation [x,y,z,w]}]}
 // Unknown keys, wrong types and out-of-range values are refused naming file, key path and rule.
@@ -44,7 +45,7 @@ Expected<Intrinsics> read_intrinsics(const JsonObject& obj) {
 }
 
 Expected<EnvCamera> read_env_camera(const JsonObject& obj) {
-  MRGI_TRY(obj.only_keys({"model", "f", "cx", "cy", "fov_deg", "rotation"}));
+  MRGI_TRY(obj.only_keys({"model", "f", "cx", "cy", "fov_deg", "rotation", "position"}));
   EnvCamera cam;
   auto model = obj.string("model");
   if (!model) return model.error();
@@ -74,6 +75,11 @@ Expected<EnvCamera> read_env_camera(const JsonObject& obj) {
   auto rot = obj.quat_xyzw("rotation", glm::dquat(1.0, 0.0, 0.0, 0.0));
   if (!rot) return rot.error();
   cam.rotation = *rot;
+  if (obj.has("position")) {
+    auto pos = obj.vec3("position");
+    if (!pos) return pos.error();
+    cam.position = *pos;
+  }
   return cam;
 }
 
@@ -195,6 +201,7 @@ Status write_capture_json(const std::string& path, const CaptureInfo& info) {
       e["fov_deg"] = cam.fov_deg;
     }
     e["rotation"] = to_json_xyzw(cam.rotation);
+    if (cam.position) e["position"] = {cam.position->x, cam.position->y, cam.position->z};
     j["env_camera"] = e;
   }
   if (info.apriltag) {

@@ -36,6 +36,10 @@ struct EnvCamera {
   // centre (cx, cy) in pixels; fov_deg is the full field of view of the image circle.
   double f = 0.0, cx = 0.0, cy = 0.0, fov_deg = 180.0;
   glm::dquat rotation{1.0, 0.0, 0.0, 0.0};  // env camera to world (fisheye looks along its +z)
+  // Where the env camera is (world metres), when known: declared lamps it sees are then removed
+  // from its images (they would be counted twice, light/lamp_removal.h). Absent: only
+  // directional lamps (a declared sun) can be found in the image.
+  std::optional<glm::dvec3> position;
 };
 
 struct InputFrame {

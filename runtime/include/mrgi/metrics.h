@@ -22,10 +22,19 @@ struct ErrorFigures {
   // Sums behind rde, so figures over many frames pool as sqrt(sum err2 / sum ref2).
   double err2 = 0.0;       // sum over the set of |O-G|^2 (linear RGB)
   double ref2 = 0.0;       // sum over the set of |G-C|^2
+  // Signed sums over the set and the three channels of O-C and of G-C (linear RGB): how much
+  // light the output adds (> 0) or takes away (< 0) against how much the truth does, e.g. the
+  // darkening a virtual object's occlusion casts on the real pixels around it.
+  double change_sum = 0.0, truth_change_sum = 0.0;
 };
 
 struct RdeReport {
   ErrorFigures all, real, virtual_;  // virtual_: pixels where the mask is non-zero
+  // The real pixels split by the truth: `influenced` where the virtual objects change them
+  // (|G-C| in some channel above three 8-bit sRGB steps at C's level, three times the
+  // quantisation noise of the two images), `rest` the others (where the output should not
+  // change them).
+  ErrorFigures influenced, rest;
 };
 
 // virtual_mask: nullptr = every pixel is real; else one byte per pixel, non-zero = virtual.

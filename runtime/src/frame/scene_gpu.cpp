@@ -11,8 +11,10 @@
 #include <stb/stb_image_resize.h>
 
 #include "common/scene_materials.glsl"
+#include "frame/occluder_spheres.h"
 #include "shared/specular_math.h"
 #include "gpu/vk_check.h"
+#include "mrgi/metrics.h"
 
 namespace mrgi::frame {
 namespace {
@@ -166,6 +168,74 @@ void MeshSet::draw(VkCommandBuffer cmd, const gpu::PassContext& pass,
   }
 }
 
+namespace {
+
+// The object's mean diffuse albedo (linear RGB): each primitive's base colour factor times its
+// texture's mean, weighted by the primitive's surface area; metals reflect little diffusely.
+glm::vec3 mean_albedo(const Model& model) {
+  glm::dvec3 sum(0.0);
+  double area = 0.0;
+  for (const MeshPrimitive& prim : model.primitives) {
+    double a = 0.0;
+    for (size_t t = 0; t + 2 < prim.indices.size(); t += 3) {
+      if (prim.indices[t] >= prim.positions.size() || prim.indices[t + 1] >= prim.positions.size() ||
+          prim.indices[t + 2] >= prim.positions.size())
+        continue;
+      const glm::vec3 p0 = prim.positions[prim.indices[t]], p1 = prim.positions[prim.indices[t + 1]],
+                      p2 = prim.positions[prim.indices[t + 2]];
+      a += 0.5 * double(glm::length(glm::cross(p1 - p0, p2 - p0)));
+    }
+    glm::dvec3 albedo(1.0);
+    float metallic = 1.0f;
+    if (prim.material >= 0 && size_t(prim.material) < model.materials.size()) {
+      const Material& mat = model.materials[size_t(prim.material)];
+      albedo = glm::dvec3(glm::vec3(mat.base_color_factor));
+      metallic = mat.metallic;
+      if (mat.base_color_texture >= 0 && size_t(mat.base_color_texture) < model.textures.size()) {
+        const ImageRGBA8& img = model.textures[size_t(mat.base_color_texture)].image;
+        glm::dvec3 t(0.0);
+        size_t n = 0;
+        for (size_t i = 0; i < img.pixel_count(); i += 7, ++n)
+          t += glm::dvec3(srgb8_to_linear(img.data[i * 4]), srgb8_to_linear(img.data[i * 4 + 1]),
+                          srgb8_to_linear(img.data[i * 4 + 2]));
+        if (n) albedo *= t / double(n);
+      }
+    }
+    sum += a * albedo * double(1.0f - std::clamp(metallic, 0.0f, 1.0f));
+    area += a;
+  }
+  return area > 0.0 && std::isfinite(area) ? glm::vec3(sum / area) : glm::vec3(0.0f);
+}
+
+// The object's primitives as one mesh, fitted with sphere proxies (model space).
+std::vector<glm::vec4> fit_model_occluders(const Model& model) {
+  std::vector<glm::vec3> positions;
+  std::vector<uint32_t> indices;
+  for (const MeshPrimitive& prim : model.primitives) {
+    const uint32_t base = uint32_t(positions.size());
+    positions.insert(positions.end(), prim.positions.begin(), prim.positions.end());
+    for (uint32_t i : prim.indices) indices.push_back(base + i);
+  }
+  OccluderFitSettings fit;
+  fit.max_spheres = SceneGpu::kOccluderSpheres;
+  return fit_occluder_spheres(positions, indices, fit);
+}
+
+}  // namespace
+
+void SceneGpu::occluder_spheres(int per_object, std::vector<glm::vec4>& out, std::vector<glm::vec4>* albedo) const {
+  for (const ObjectSpan& o : objects_) {
+    if (!o.visible) continue;
+    const glm::mat4 m = o.placement.matrix();
+    const float grow = std::max({o.placement.scale.x, o.placement.scale.y, o.placement.scale.z});
+    const size_t n = std::min(o.occluders.size(), size_t(std::max(per_object, 0)));
+    for (size_t k = 0; k < n; ++k) {
+      out.emplace_back(glm::vec3(m * glm::vec4(glm::vec3(o.occluders[k]), 1.0f)), o.occluders[k].w * grow);
+      if (albedo) albedo->emplace_back(o.albedo, 0.0f);
+    }
+  }
+}
+
 Expected<std::unique_ptr<SceneGpu>> SceneGpu::create(gpu::Context& context, gpu::FrameGraph& graph,
                                                      const SceneDesc& scene) {
   std::unique_ptr<SceneGpu> out(new SceneGpu(context));
@@ -216,6 +286,8 @@ Expected<std::unique_ptr<SceneGpu>> SceneGpu::create(gpu::Context& context, gpu:
     span.vertex_count = uint32_t(virtual_data.vertices.size()) - span.first_vertex;
     span.draw_count = virtual_data.draws.size() - span.first_draw;
     span.placement = scene.virtual_objects[out->objects_.size()].placement;
+    span.occluders = fit_model_occluders(m);
+    span.albedo = mean_albedo(m);
     out->objects_.push_back(span);
   }
   for (const DrawRange& d : virtual_data.draws) {

@@ -131,6 +131,14 @@ class SceneGpu {
   DrawSpan object_draws(size_t object) const { return {objects_[object].first_draw, objects_[object].draw_count}; }
   // Whether one of object i's ranges has a specular material, and of which kinds (bit 1 << kind).
   int object_specular_kinds(size_t object) const;
+  // Sphere proxies of each object's solid (frame/occluder_spheres.h), fitted at start-up, at
+  // most kOccluderSpheres an object, most important first. Appends to `out` the world-space
+  // spheres (xyz centre, w radius, metres) of the visible objects at their newest placements,
+  // the first `per_object` of each (the radius scaled by the placement's largest scale), and
+  // with `albedo` each sphere's object's mean diffuse albedo (linear rgb; base colour x texture
+  // mean x (1 - metallic), area-weighted).
+  static constexpr int kOccluderSpheres = 16;
+  void occluder_spheres(int per_object, std::vector<glm::vec4>& out, std::vector<glm::vec4>* albedo = nullptr) const;
 
  private:
   explicit SceneGpu(gpu::Context& context) : context_(context) {}
@@ -141,6 +149,8 @@ class SceneGpu {
     size_t first_draw = 0, draw_count = 0;
     Placement placement;
     bool visible = true;
+    std::vector<glm::vec4> occluders;  // model space, most important first
+    glm::vec3 albedo{0.0f};            // mean diffuse albedo (occluder_spheres)
   };
   size_t visible_count_ = 0;
   gpu::Context& context_;

@@ -25,11 +25,16 @@ Expected<EnvSampler> EnvSampler::create(const EnvSamplerSettings& s) {
                        "must be a power of two, 1..256"));
   MRGI_TRY(check_env_setting(s.filter_frames >= 0.0 && std::isfinite(s.filter_frames), "filter_frames",
                        "must be finite and >= 0 frames"));
+  MRGI_TRY(check_env_setting(s.source_contrast > 0.0 && std::isfinite(s.source_contrast), "source_contrast",
+                             "must be finite and > 0"));
   EnvSampler e(s);
   const int w = s.grid_width, h = w / 2;
   const size_t cells = size_t(w) * size_t(h);
   e.cell_solid_angle_.resize(cells);
   e.cell_sh_.resize(cells);
+  e.cell_source_.assign(cells, -1);
+  e.source_solid_angle_.reserve(cells);
+  e.flood_.reserve(cells);
   for (int y = 0; y < h; ++y) {
     // Exact solid angle of a latitude band cell: (cos theta0 - cos theta1) * 2 pi / w.
     const double t0 = kPi * y / h, t1 = kPi * (y + 1) / h;
@@ -114,7 +119,7 @@ Status EnvSampler::build_map(const ImageRGBF& image, const EnvCamera& camera,
 }
 
 Status EnvSampler::update(const ImageRGBF& image, const EnvCamera& camera,
-                          const glm::dquat& env_to_world, double intensity) {
+                          const glm::dquat& env_to_world, double intensity, const glm::dvec3& unseen_radiance) {
   if (image.empty() || image.data.size() != image.pixel_count() * 3)
     return fail(ErrorKind::BadInput, "environment sampling: empty or malformed environment image");
   if (camera.model == EnvModel::FisheyeEquidistant && !(camera.f > 0.0))
@@ -145,7 +150,7 @@ Status EnvSampler::update(const ImageRGBF& image, const EnvCamera& camera,
                            ? 1.0 - std::exp(-1.0 / settings_.filter_frames)
                            : 1.0;
   for (size_t c = 0; c < size_t(w) * size_t(h); ++c) {
-    const glm::dvec3 l = cell_seen_[c] > 0.0 ? cell_sum_[c] / cell_seen_[c] : glm::dvec3(0.0);
+    const glm::dvec3 l = cell_seen_[c] > 0.0 ? cell_sum_[c] / cell_seen_[c] : unseen_radiance;
     radiance_[c] += alpha * (l - radiance_[c]);
     // The moment scales with the cell's coverage; normalised to a full cell like the radiance.
     const glm::dvec3 m = cell_seen_[c] > 0.0 ? frame_moment_[c] * (cell_solid_angle_[c] / cell_seen_[c])
@@ -217,6 +222,11 @@ void EnvSampler::cut() {
     }
     std::swap(regions_, next_regions_);
   }
+  double lit = 0.0;
+  for (size_t c = 0; c < radiance_.size(); ++c)
+    if (luminance(radiance_[c]) > 0.0) lit += cell_solid_angle_[c];
+  mean_lit_luminance_ = lit > 0.0 ? sat(w, h) / lit : 0.0;
+  find_sources();
   lights_.clear();
   for (const RegionRect& r : regions_) {
     EnvLight l;
@@ -226,11 +236,21 @@ void EnvSampler::cut() {
         const size_t c = size_t(y) * w + x;
         l.irradiance += radiance_[c] * cell_solid_angle_[c];
         l.solid_angle_sr += cell_solid_angle_[c];
+        if (luminance(radiance_[c]) > 0.0) l.lit_solid_angle_sr += cell_solid_angle_[c];
         moment += moment_[c];
         for (int i = 0; i < kMaxShCoeffs; ++i)
           l.region_sh[size_t(i)] += radiance_[c] * double(cell_sh_[c][size_t(i)]);
       }
     }
+    double brightest = -1.0;
+    for (int y = r.y0; y < r.y1; ++y)
+      for (int x = r.x0; x < r.x1; ++x) {
+        const size_t c = size_t(y) * w + x;
+        if (const double lum = luminance(radiance_[c]); lum > brightest) {
+          brightest = lum;
+          l.source_solid_angle_sr = cell_source_[c] >= 0 ? source_solid_angle_[size_t(cell_source_[c])] : 0.0;
+        }
+      }
     const double len = glm::length(moment);
     l.direction = len > 0.0 && std::isfinite(len)
                       ? moment / len
@@ -240,6 +260,43 @@ void EnvSampler::cut() {
   std::stable_sort(lights_.begin(), lights_.end(), [](const EnvLight& a, const EnvLight& b) {
     return luminance(a.irradiance) > luminance(b.irradiance);
   });
+}
+
+void EnvSampler::find_sources() {
+  const int w = settings_.grid_width, h = grid_height();
+  const double threshold = settings_.source_contrast * mean_lit_luminance_;
+  std::fill(cell_source_.begin(), cell_source_.end(), -1);
+  source_solid_angle_.clear();
+  if (!(mean_lit_luminance_ > 0.0)) return;
+  auto bright = [&](size_t c) { return luminance(radiance_[c]) >= threshold; };
+  for (size_t start = 0; start < cell_source_.size(); ++start) {
+    if (cell_source_[start] >= 0 || !bright(start)) continue;
+    const int32_t id = int32_t(source_solid_angle_.size());
+    double energy = 0.0, peak = 0.0;
+    flood_.clear();
+    flood_.push_back(int32_t(start));
+    cell_source_[start] = id;
+    while (!flood_.empty()) {
+      const int32_t c = flood_.back();
+      flood_.pop_back();
+      const double lum = luminance(radiance_[size_t(c)]);
+      energy += lum * cell_solid_angle_[size_t(c)];
+      peak = std::max(peak, lum);
+      const int cx = c % w, cy = c / w;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int ny = cy + dy;
+          if ((dx == 0 && dy == 0) || ny < 0 || ny >= h) continue;
+          const size_t n = size_t(ny) * w + size_t((cx + dx + w) % w);  // azimuth wraps
+          if (cell_source_[n] >= 0 || !bright(n)) continue;
+          cell_source_[n] = id;
+          flood_.push_back(int32_t(n));
+        }
+    }
+    // Its energy over its peak radiance: the solid angle of a uniform source of that peak, which
+    // the cells it only partly covers do not inflate (a 3-degree sun on 5.6-degree cells).
+    source_solid_angle_.push_back(peak > 0.0 ? energy / peak : 0.0);
+  }
 }
 
 }  // namespace mrgi::light

@@ -39,6 +39,11 @@ struct EnvSamplerSettings {
   // moves 1 - exp(-1 / filter_frames) of the way). 0 = no filtering. The lag of a change is about
   // this many frames.
   double filter_frames = 2.0;
+  // A cell belongs to a light source when its luminance is at least this many times the mean
+  // over the lit cells; each 8-connected group of such cells (wrapping around in azimuth) is one
+  // source, whose solid angle (its energy over its peak radiance, so the cells it covers only
+  // in part do not inflate it) each region reports (EnvLight::source_solid_angle_sr).
+  double source_contrast = 3.0;
 };
 
 // One light of the cut: a region of the sphere collapsed to a directional light.
@@ -46,6 +51,10 @@ struct EnvLight {
   glm::dvec3 direction{0.0, 1.0, 0.0};  // unit, world, towards the light
   glm::dvec3 irradiance{0.0};           // W/m^2 per linear RGB channel at normal incidence
   double solid_angle_sr = 0.0;          // of its region
+  double lit_solid_angle_sr = 0.0;      // of its cells holding light (seen by the image)
+  // Solid angle of the light source (EnvSamplerSettings::source_contrast) its brightest cell
+  // belongs to; 0 when that cell is not bright enough to be part of one.
+  double source_solid_angle_sr = 0.0;
   // Radiance SH (4 bands) of the region's own cells: what the environment's SH loses when this
   // region is drawn as a light instead (radiance_sh() minus it is >= 0 everywhere the SH of
   // the other regions is, unlike subtracting a delta light's SH, which rings).
@@ -61,8 +70,10 @@ class EnvSampler {
   // its directions to the world) into the grid, filters it with the previous frames, cuts it.
   // BadInput for an empty image or a fisheye without a focal length. NaN, Inf and negative
   // texels count as 0.
+  // Cells no pixel covers (below a fisheye's horizon) take `unseen_radiance` (the light stage's
+  // prior for what the env camera cannot see; 0 = no light from there).
   Status update(const ImageRGBF& image, const EnvCamera& camera, const glm::dquat& env_to_world,
-                double intensity = 1.0);
+                double intensity = 1.0, const glm::dvec3& unseen_radiance = glm::dvec3(0.0));
   // Forgets the history (the next update is not blended with earlier frames).
   void reset() { have_history_ = false; }
 
@@ -71,6 +82,10 @@ class EnvSampler {
   const std::vector<EnvLight>& lights() const { return lights_; }
   // Radiance SH (4 bands) of the whole filtered grid.
   const ShRgb& radiance_sh() const { return sh_; }
+  // Mean luminance of the radiance over the cells holding light (what the image saw), 0 when
+  // none does: what a region's own mean radiance is compared with (LightStageSettings::
+  // shadowed_min_contrast).
+  double mean_lit_luminance() const { return mean_lit_luminance_; }
   const EnvSamplerSettings& settings() const { return settings_; }
   int grid_height() const { return settings_.grid_width / 2; }
   // Filtered radiance of grid cell (x, y), linear RGB (for tests and plots).
@@ -117,6 +132,13 @@ class EnvSampler {
   std::vector<double> energy_sat_;             // summed-area table of luminance * cell dw
   bool have_history_ = false;
   std::vector<EnvLight> lights_;
+  double mean_lit_luminance_ = 0.0;
+  // Per cell: its source's index into source_solid_angle_ (-1: not in a source); reserved at
+  // start-up, as is the flood's stack.
+  std::vector<int32_t> cell_source_;
+  std::vector<double> source_solid_angle_;
+  std::vector<int32_t> flood_;
+  void find_sources();
   ShRgb sh_{};
   std::vector<ShVector> cell_sh_;              // Y_i(cell centre) * cell dw
 };

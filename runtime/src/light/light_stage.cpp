@@ -1,5 +1,7 @@
 #include "light/light_stage.h"
 
+#include "mrgi/metrics.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -61,6 +63,9 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
                                                          const SceneDesc& scene, const CameraSetup& cameras) {
   if (settings.shadowed_environment_lights < 0 || settings.shadowed_environment_lights > kMaxStageLights)
     return fail(ErrorKind::BadUsage, "LightStageSettings.shadowed_environment_lights: must be 0..8");
+  if (!(settings.shadowed_min_contrast >= 0.0) || !(settings.shadowed_max_solid_angle_sr > 0.0))
+    return fail(ErrorKind::BadUsage, "LightStageSettings.shadowed_min_contrast must be >= 0 and "
+                                     "shadowed_max_solid_angle_sr > 0");
   if (settings.residual_shading_bands < 1 || settings.residual_shading_bands > 3)
     return fail(ErrorKind::BadUsage, "LightStageSettings.residual_shading_bands: must be 1..3");
   if (auto check = LightEstimator::create(settings.external_estimator); !check) return check.error();
@@ -77,6 +82,7 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
                                          : (s.declared_ > 0 ? LightSourceKind::Declared : LightSourceKind::Probeless);
   for (const LightDesc& l : scene.lights)
     if (l.real) s.real_lamps_.push_back(l);
+  s.lamp_removal_ = LampRemoval(settings.lamp_removal);
   s.residual_ = s.planned_ == LightSourceKind::Declared && settings.residual_light && !s.real_lamps_.empty();
   auto estimator = LightEstimator::create(s.residual_ ? settings.residual_estimator : settings.estimator);
   if (!estimator) return estimator.error();
@@ -87,6 +93,8 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
     if (!sampler) return sampler.error();
     s.env_.emplace(std::move(*sampler));
     s.env_lights_ = std::min(settings.shadowed_environment_lights, kMaxStageLights - s.declared_);
+    s.shadowed_regions_.reserve(size_t(std::max(s.env_lights_, 0)));
+    s.near_.reserve(size_t(settings.environment.samples));
     if (!env.from_env_camera) {  // a file: sampled once, here
       auto img = load_hdr_image(env.image);
       if (!img) return img.error();
@@ -188,6 +196,64 @@ const std::vector<EnvLight>& LightStage::environment_regions() const {
   return lighting_.environment && env_ && env_->valid() ? env_->lights() : none;
 }
 
+glm::dvec3 LightStage::mean_camera_radiance(const InputFrame& frame) const {
+  const ImageRGB8& c = frame.color;
+  if (c.empty() || !(cameras_.exposure > 0.0)) return glm::dvec3(0.0);
+  glm::dvec3 sum(0.0);
+  size_t n = 0;
+  for (int y = 4; y < c.height; y += 8)
+    for (int x = 4; x < c.width; x += 8) {
+      const uint8_t* p = c.at(x, y);
+      sum += glm::dvec3(srgb8_to_linear(p[0]), srgb8_to_linear(p[1]), srgb8_to_linear(p[2]));
+      ++n;
+    }
+  return n ? sum / (double(n) * cameras_.exposure) : glm::dvec3(0.0);
+}
+
+bool LightStage::crosses_surface(const glm::dvec3& from, const glm::dvec3& direction, const InputFrame& frame,
+                                 const glm::dmat4& world_to_camera) const {
+  const ImageU16& depth = frame.depth;
+  const Intrinsics& k = cameras_.depth;
+  const double scale = cameras_.depth_scale;
+  bool in_front = false;
+  const double step = std::max(settings_.near_field_step_m, 1e-3);
+  for (double t = step; t <= settings_.near_field_distance_m; t += step) {
+    const glm::dvec3 p = glm::dvec3(world_to_camera * glm::dvec4(from + direction * t, 1.0));
+    if (!(p.z > 0.05)) continue;
+    const int u = int(std::lround(k.fx * p.x / p.z + k.cx)), v = int(std::lround(k.fy * p.y / p.z + k.cy));
+    if (u < 0 || v < 0 || u >= depth.width || v >= depth.height) continue;
+    const uint16_t raw = depth.at(u, v)[0];
+    if (raw == 0) continue;
+    const double measured = double(raw) / scale;
+    if (p.z < measured - settings_.near_field_tolerance_m) {
+      in_front = true;
+    } else if (in_front && p.z > measured + settings_.near_field_tolerance_m) {
+      return true;  // passed behind the surface the depth camera sees: the ray met it
+    }
+  }
+  return false;
+}
+
+void LightStage::mark_near_regions(const InputFrame& frame, const glm::dmat4& camera_to_world) {
+  near_.assign(env_->lights().size(), 0);
+  const std::optional<EnvCamera>& cam = cameras_.env_camera;
+  if (!cam || !cam->position || frame.depth.empty() || !(settings_.near_field_distance_m > 0.0)) return;
+  const glm::dmat4 world_to_camera = glm::inverse(camera_to_world);
+  // Only the candidates (compact and bright) need the march.
+  for (size_t k = 0; k < env_->lights().size(); ++k) {
+    const EnvLight& r = env_->lights()[k];
+    if (!shadowable_region(r, env_->mean_lit_luminance())) continue;
+    near_[k] = crosses_surface(*cam->position, r.direction, frame, world_to_camera) ? 1 : 0;
+  }
+}
+
+bool LightStage::shadowable_region(const EnvLight& r, double mean_luminance) const {
+  if (!(r.lit_solid_angle_sr > 0.0) || !(mean_luminance > 0.0)) return false;
+  const double contrast = luminance(r.irradiance) / r.lit_solid_angle_sr / mean_luminance;
+  return contrast >= settings_.shadowed_min_contrast && r.source_solid_angle_sr > 0.0 &&
+         r.source_solid_angle_sr <= settings_.shadowed_max_solid_angle_sr;
+}
+
 void LightStage::set_environment_lighting(bool real) {
   // Lamps first (unchanged), then the strongest regions as shadowed directional lights; the SH
   // of the other regions is the ambient.
@@ -196,10 +262,16 @@ void LightStage::set_environment_lighting(bool real) {
   lighting_.foldable.resize(size_t(declared_));
   ShRgb ambient = env_->radiance_sh();
   const auto& regions = env_->lights();
-  bool changed = last_env_directions_.size() != size_t(std::min<size_t>(regions.size(), size_t(env_lights_)));
-  last_env_directions_.resize(std::min<size_t>(regions.size(), size_t(env_lights_)));
-  for (size_t k = 0; k < regions.size() && int(k) < env_lights_; ++k) {
-    const EnvLight& r = regions[k];
+  // The strongest regions that are compact and bright (LightStageSettings::
+  // shadowed_min_contrast), up to env_lights_.
+  shadowed_regions_.clear();
+  for (size_t k = 0; k < regions.size() && int(shadowed_regions_.size()) < env_lights_; ++k)
+    if (shadowable_region(regions[k], env_->mean_lit_luminance()) && !(k < near_.size() && near_[k]))
+      shadowed_regions_.push_back(k);
+  bool changed = last_env_directions_.size() != shadowed_regions_.size();
+  last_env_directions_.resize(shadowed_regions_.size());
+  for (size_t k = 0; k < shadowed_regions_.size(); ++k) {
+    const EnvLight& r = regions[shadowed_regions_[k]];
     LightDesc l;
     l.type = LightType::Directional;
     l.real = real;
@@ -309,7 +381,16 @@ Status LightStage::update(const InputFrame& frame, const glm::dmat4& camera_to_w
   const EnvironmentDesc& env = scene_.environment;
   if (planned_ == LightSourceKind::Environment && env.from_env_camera) {
     if (frame.env && cameras_.env_camera) {
-      MRGI_TRY(env_->update(*frame.env, *cameras_.env_camera, glm::dquat(env.rotation), env.intensity));
+      // Declared lamps the env camera sees are taken out of its image first (lamp_removal.h).
+      const ImageRGBF* image = &*frame.env;
+      lamps_removed_ = 0;
+      if (settings_.remove_declared_lamps && !real_lamps_.empty()) {
+        env_scratch_ = *frame.env;
+        lamps_removed_ = lamp_removal_.apply(env_scratch_, *cameras_.env_camera, real_lamps_);
+        if (lamps_removed_ > 0) image = &env_scratch_;
+      }
+      MRGI_TRY(env_->update(*image, *cameras_.env_camera, glm::dquat(env.rotation), env.intensity,
+                            settings_.unseen_from_camera ? mean_camera_radiance(frame) : glm::dvec3(0.0)));
     } else if (frame.env) {
       notes.push_back("light: this frame's env image came without an env camera model (capture.json "
                       "env_camera): not used");
@@ -317,6 +398,7 @@ Status LightStage::update(const InputFrame& frame, const glm::dmat4& camera_to_w
       notes.push_back("light: no env image in this frame, the last one's light kept");
     }
     if (env_->valid()) {
+      mark_near_regions(frame, camera_to_world);
       set_environment_lighting(env.real);
       lighting_.source = LightSourceKind::Environment;
     } else {
@@ -356,9 +438,13 @@ Status LightStage::update(const InputFrame& frame, const glm::dmat4& camera_to_w
       break;
     }
     case LightSourceKind::Environment:
-      std::snprintf(text, sizeof text, "light: environment image (%s, %zu median-cut regions, %d shadowed)%s",
+      std::snprintf(text, sizeof text, "light: environment image (%s, %zu median-cut regions, %d shadowed%s%s)%s",
                     env.from_env_camera ? "env camera" : "file", env_->lights().size(),
                     int(lighting_.lights.size()) - declared_,
+                    std::count(near_.begin(), near_.end(), uint8_t(1)) > 0 ? ", bright near surfaces left as ambient" : "",
+                    lamps_removed_ > 0 ? (lamps_removed_ == 1 ? ", 1 declared lamp taken out of it"
+                                                              : ", declared lamps taken out of it")
+                                       : "",
                     declared_ > 0 ? " and declared lamps" : "");
       break;
     case LightSourceKind::Declared:

@@ -3,8 +3,12 @@
 // and hands every technique the same answer:
 //   - declared lamps (scene.json `lights`, real and virtual, as tracked lamps are);
 //   - an environment image (scene.json `environment`: a file, or the env camera's frames):
-//     median-cut importance sampling (env_sampler.h); the strongest regions become shadowed
-//     directional lights, the rest stays as SH ambient;
+//     median-cut importance sampling (env_sampler.h); of the strongest regions, those that are
+//     compact, bright and distant (LightStageSettings::shadowed_min_contrast, near_field_
+//     distance_m) become shadowed directional lights, the rest stays as SH ambient (which the
+//     direct-light block occludes by the virtual objects, shading/environment_occlusion.h).
+//     Declared lamps the env camera sees are taken out of its images first (lamp_removal.h);
+//     what it cannot see (below an upward fisheye) takes the colour camera's mean radiance;
 //   - neither: the probeless estimate from colour and depth (light::LightEstimator, fed by the
 //     stage's own ProbelessBuilder or by a technique's GPU sums, ssrt's), as one shadowed
 //     dominant directional light plus the rest of the estimate as SH ambient;
@@ -24,6 +28,7 @@
 #include <glm/glm.hpp>
 
 #include "light/env_sampler.h"
+#include "light/lamp_removal.h"
 #include "light/probeless.h"
 #include "light/sh_estimator.h"
 #include "light/sh_tools.h"
@@ -44,6 +49,43 @@ struct LightStageSettings {
   // Regions of the environment's cut that become shadowed directional lights (the strongest;
   // the others' light stays in the ambient SH, unshadowed). 0..8, at most 8 minus the lamps.
   int shadowed_environment_lights = 4;
+  // Which regions may become shadowed lights at all: only compact, bright ones (a sun, a
+  // window, an undeclared lamp), whose light arrives from one narrow direction, so one shadow
+  // map stands for it. A region qualifies when its mean radiance (luminance over its lit cells)
+  // is at least shadowed_min_contrast times the environment's mean over all its lit cells AND
+  // its brightest cell belongs to a source (a connected group of cells at least
+  // EnvSamplerSettings::source_contrast times that mean) of at most shadowed_max_solid_angle_sr:
+  // the source's size, not the region's (a median cut splits a big bright wall into small
+  // regions, each of which would look compact). Everything else (a sky, a room's
+  // walls and ceiling, a lit wall close to the env camera, which a median cut splits into broad
+  // regions of ordinary radiance) stays in the ambient SH, which the direct-light block occludes
+  // softly by the virtual objects (shading/environment_occlusion.h) instead of casting a few
+  // long hard shadows from it. 0.5 sr: a cone of 23 degrees half-angle (a 1.5 m window seen from
+  // 2 m); contrast 3: a sun or window is tens to thousands of times the mean, an overcast sky's
+  // or a room's brightest broad parts 1-2 times.
+  double shadowed_min_contrast = 3.0;
+  double shadowed_max_solid_angle_sr = 0.05;
+  // What an env camera cannot see (below an upward fisheye's horizon: the floor and the room
+  // around the virtual objects) lights them as the mean radiance the colour camera sees, not as
+  // darkness. Why: the light from below is what the real surfaces reflect, and the camera
+  // frame shows those surfaces; with none, a virtual object's underside and lower half were
+  // black where the truth is lit by the floor.
+  bool unseen_from_camera = true;
+  // Declared real lamps the env camera sees are taken out of its images before sampling
+  // (light/lamp_removal.h), so their light is not counted twice (as the lamp and as an
+  // environment region).
+  bool remove_declared_lamps = true;
+  // Near field: a region whose direction, from the env camera's position (capture.json
+  // env_camera.position), reaches a surface of the frame's depth image within this distance is
+  // a nearby surface the env camera sees (a lit table top, a wall a few decimetres away), whose
+  // light is bounce, not a distant light: it never becomes a shadowed light, whatever its
+  // contrast. The ray is marched in near_field_step_m steps; it meets a surface where a step
+  // lies behind the depth image's surface (by more than near_field_tolerance_m) after one in
+  // front of it. Directions the depth camera does not see count as distant. 3 m: a room.
+  double near_field_distance_m = 3.0;
+  double near_field_step_m = 0.02;
+  double near_field_tolerance_m = 0.03;
+  LampRemovalSettings lamp_removal;
   ProbelessSettings probeless;
   // The estimator of the probeless source fed by the stage's own builder. RGB (white_light
   // false): the paper's white-light assumption gives a grey estimate under a blue sky. Chosen on
@@ -201,7 +243,23 @@ class LightStage {
   // system was solved this frame.
   Status add_probeless_parts(const InputFrame& frame, const glm::dmat4& camera_to_world,
                              std::vector<std::string>& notes, bool& solved);
+  // `near`: per region of the sampler's cut, whether it is a surface near the env camera
+  // (near_regions); empty = none known to be.
   void set_environment_lighting(bool real);
+  // Marks near_ for this frame's regions: the ray from the env camera towards each region's
+  // direction crosses a surface of the frame's depth image within near_field_distance_m.
+  void mark_near_regions(const InputFrame& frame, const glm::dmat4& camera_to_world);
+  bool crosses_surface(const glm::dvec3& from, const glm::dvec3& direction, const InputFrame& frame,
+                       const glm::dmat4& world_to_camera) const;
+  std::vector<uint8_t> near_;  // per region; reserved at start-up
+  // Whether an environment region may be a shadowed light (LightStageSettings::shadowed_min_contrast).
+  bool shadowable_region(const EnvLight& r, double mean_luminance) const;
+  // The mean radiance of the colour frame (linear, over the exposure): the unseen prior.
+  glm::dvec3 mean_camera_radiance(const InputFrame& frame) const;
+  std::vector<size_t> shadowed_regions_;  // this frame's, indices into the sampler's lights
+  LampRemoval lamp_removal_;
+  ImageRGBF env_scratch_;                 // the env image with the declared lamps taken out
+  int lamps_removed_ = 0;                 // this frame's
   void finish_declared();
 
   LightStageSettings settings_;

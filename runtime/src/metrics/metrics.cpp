@@ -74,13 +74,15 @@ std::vector<double> ssim_map(const Image<uint8_t, CO>& o, const ImageRGB8& g) {
 }
 
 struct Accumulator {
-  double err2 = 0.0, ref2 = 0.0, rmse2 = 0.0, ssim = 0.0;
+  double err2 = 0.0, ref2 = 0.0, rmse2 = 0.0, ssim = 0.0, change = 0.0, truth_change = 0.0;
   size_t pixels = 0;
   ErrorFigures finish() const {
     ErrorFigures f;
     f.pixels = pixels;
     f.err2 = err2;
     f.ref2 = ref2;
+    f.change_sum = change;
+    f.truth_change_sum = truth_change;
     if (pixels == 0) return f;
     // ||G-C|| below one 8-bit step's worth over the set counts as "nothing to change".
     const double floor = 1e-12;
@@ -106,25 +108,37 @@ Expected<RdeReport> measure(const Image<uint8_t, CO>& o, const ImageRGB8& c, con
                                          ", reference is " + size(g.width, g.height));
   const auto& lin = srgb_table();
   const auto ssim = ssim_map(o, g);
-  Accumulator all, real, virt;
+  Accumulator all, real, virt, influenced, rest;
   for (size_t i = 0; i < g.pixel_count(); ++i) {
-    double e2 = 0.0, r2 = 0.0, m2 = 0.0;
+    double e2 = 0.0, r2 = 0.0, m2 = 0.0, change = 0.0, truth_change = 0.0;
+    bool changed = false;
     for (int k = 0; k < 3; ++k) {
-      const double ov = lin[o.data[i * CO + k]], cv = lin[c.data[i * 3 + k]], gv = lin[g.data[i * 3 + k]];
+      const uint8_t c8 = c.data[i * 3 + k];
+      const double ov = lin[o.data[i * CO + k]], cv = lin[c8], gv = lin[g.data[i * 3 + k]];
       e2 += (ov - gv) * (ov - gv);  // (O-C)-(G-C) = O-G
       r2 += (gv - cv) * (gv - cv);
+      change += ov - cv;
+      truth_change += gv - cv;
       const double d8 = double(o.data[i * CO + k]) - double(g.data[i * 3 + k]);
       m2 += d8 * d8;
+      // One sRGB code step at C's level, linear (the larger of the steps on either side).
+      const double step = std::max(lin[std::min(255, c8 + 1)] - lin[c8], lin[c8] - lin[std::max(0, c8 - 1)]);
+      changed = changed || std::abs(gv - cv) > 3.0 * step;
     }
-    for (Accumulator* acc : {&all, (mask && mask->data[i]) ? &virt : &real}) {
+    const bool is_virtual = mask && mask->data[i];
+    Accumulator* split = is_virtual ? nullptr : (changed ? &influenced : &rest);
+    for (Accumulator* acc : {&all, is_virtual ? &virt : &real, split}) {
+      if (!acc) continue;
       acc->err2 += e2;
       acc->ref2 += r2;
       acc->rmse2 += m2;
       acc->ssim += ssim[i];
+      acc->change += change;
+      acc->truth_change += truth_change;
       acc->pixels += 1;
     }
   }
-  return RdeReport{all.finish(), real.finish(), virt.finish()};
+  return RdeReport{all.finish(), real.finish(), virt.finish(), influenced.finish(), rest.finish()};
 }
 
 }  // namespace
@@ -138,11 +152,14 @@ ErrorFigures pool(const ErrorFigures& a, const ErrorFigures& b) {
   acc.ref2 = a.ref2 + b.ref2;
   acc.rmse2 = (a.rmse8 * a.rmse8 * double(a.pixels) + b.rmse8 * b.rmse8 * double(b.pixels)) * 3.0;
   acc.ssim = a.ssim * double(a.pixels) + b.ssim * double(b.pixels);
+  acc.change = a.change_sum + b.change_sum;
+  acc.truth_change = a.truth_change_sum + b.truth_change_sum;
   return acc.finish();
 }
 
 RdeReport pool(const RdeReport& a, const RdeReport& b) {
-  return {pool(a.all, b.all), pool(a.real, b.real), pool(a.virtual_, b.virtual_)};
+  return {pool(a.all, b.all), pool(a.real, b.real), pool(a.virtual_, b.virtual_), pool(a.influenced, b.influenced),
+          pool(a.rest, b.rest)};
 }
 
 Expected<RdeReport> measure_error(const ImageRGB8& output, const ImageRGB8& camera,

@@ -33,6 +33,7 @@
 #include "frame/frame_resources.h"
 #include "gpu/frame_graph.h"
 #include "mrgi/expected.h"
+#include "shading/environment_occlusion.h"
 
 namespace mrgi::shading {
 
@@ -45,10 +46,15 @@ struct DirectLightLevel {
   // strongest first, how many get shadow maps; the rest light as SH ambient. Declared lamps
   // always get theirs.
   int shadowed_estimated_lights = 4;
+  // The virtual objects' occlusion of the ambient light (environment_occlusion.h): its grid
+  // (internal pixels a texel side) and sphere proxies an object.
+  EnvOcclusionLevel env_occlusion;
 };
 
 // The block's standard ladder, best first: high (2048^2 maps, 3x3 PCF, 4 shadowed estimated
-// lights), medium (1024^2, 3x3, 4), low (512^2, 3x3, 2), lowest (256^2, one tap, 1). Each
+// lights, environment occlusion at every pixel by 16 spheres an object), medium (1024^2, 3x3,
+// 4, every 2x2 pixels by 16), low (512^2, 3x3, 2, every 4x4 by 8), lowest (256^2, one tap, 1,
+// every 4x4 by 4). Each
 // shadowed estimated light costs two maps and a shading term (env_fisheye, 4 at every level:
 // high 461 ms, lowest 75 ms against 49 and 25 with none).
 const std::array<DirectLightLevel, 4>& direct_light_levels();

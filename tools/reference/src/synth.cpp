@@ -159,6 +159,7 @@ RefCamera env_camera_model(const EnvCameraDesc& e, EnvCamera* info) {
   info->cy = cam.fisheye_cy;
   info->fov_deg = e.fov_deg;
   info->rotation = rot;
+  info->position = e.position;
   return cam;
 }
 

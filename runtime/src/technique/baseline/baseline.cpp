@@ -18,10 +18,15 @@ const KnobField<BaselineLevel> kBaselineKnobs[] = {
      "of the light stage's estimated lights (environment regions, the probeless dominant light), strongest first, "
      "how many get shadow maps; the rest light as SH ambient",
      &BaselineLevel::shadowed_estimated_lights},
+    {"env_occlusion_divisor", "internal pixels a texel side of the virtual objects' occlusion of the ambient light (1-8)",
+     &BaselineLevel::env_occlusion_divisor},
+    {"env_occlusion_spheres", "sphere proxies an object that occlude the ambient light (0 = off, at most 16)",
+     &BaselineLevel::env_occlusion_spheres},
 };
 
 shading::DirectLightLevel direct_level(const BaselineLevel& l) {
-  return {l.shadow_map_size, l.pcf_radius, l.caster_cell_shadow_texels, l.shadowed_estimated_lights};
+  return {l.shadow_map_size, l.pcf_radius, l.caster_cell_shadow_texels, l.shadowed_estimated_lights,
+          {l.env_occlusion_divisor, l.env_occlusion_spheres}};
 }
 
 class Baseline final : public Laddered<BaselineLevel> {
@@ -50,7 +55,7 @@ const std::array<BaselineLevel, 4>& baseline_levels() {
     std::array<BaselineLevel, 4> out{};
     for (size_t i = 0; i < 4; ++i)
       out[i] = {names[i], d[i].shadow_map_size, scales[i], d[i].pcf_radius, d[i].caster_cell_shadow_texels,
-                d[i].shadowed_estimated_lights};
+                d[i].shadowed_estimated_lights, d[i].env_occlusion.divisor, d[i].env_occlusion.spheres_per_object};
     return out;
   }();
   return levels;

@@ -34,6 +34,8 @@ struct BaselineLevel {
   int pcf_radius;                   // bilinear compare taps on each side of the centre tap
   double caster_cell_shadow_texels; // shadow texels a real caster grid cell spans (see above)
   int shadowed_estimated_lights;    // estimated lights with shadow maps (shading/direct_light.h)
+  int env_occlusion_divisor;        // internal pixels a texel side of the environment occlusion
+  int env_occlusion_spheres;        // sphere proxies an object that occlude the ambient (0 = off)
 };
 const std::array<BaselineLevel, 4>& baseline_levels();  // the defaults
 // The defaults with RuntimeSettings::knobs applied (technique/knobs.h; BadUsage for a refused one).

@@ -338,6 +338,9 @@ Status Dir::record(const frame::FrameInfo& info, std::vector<std::string>& skipp
   if (!light) return light.error();
   // The environment regions the VPLs shadow are not also shadowed by maps.
   if (slots.env_override) direct.shadowed_estimated_lights = level.shadowed_env;
+  // Environment VPLs (ISM-shadowed) carry the objects' occlusion of the environment: the block
+  // then leaves it to them (with both, moving's real-pixel RDE at dir high went 0.44 -> 0.54).
+  if (slots.env > 0) direct.env_occlusion.spheres_per_object = 0;
   return direct_->record(info, direct, *light, skipped);
 }
 

@@ -1,0 +1,116 @@
+#include "shading/environment_occlusion.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "frame/scene_gpu.h"
+#include "gpu/pipelines.h"
+#include "gpu/shaders.h"
+#include "shared/occlusion_math.h"
+
+namespace mrgi::shading {
+
+struct EnvironmentOcclusion::Impl {
+  frame::FrameResources frame_;
+  gpu::PipelineHandle pipeline_;
+  gpu::BufferHandle set_;          // shader::EnvOcclusionSet, one per frame slot
+  gpu::ImageHandle image_, none_;  // the result (allocated at the internal size), the stand-in
+  int divisor_ = 0;                // this frame's; 0: left out
+  std::vector<glm::vec4> spheres_, albedo_;  // reserved at start-up
+};
+
+EnvironmentOcclusion::EnvironmentOcclusion(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+EnvironmentOcclusion::~EnvironmentOcclusion() = default;
+
+Expected<std::unique_ptr<EnvironmentOcclusion>> EnvironmentOcclusion::create(const frame::FrameResources& frame) {
+  auto m = std::make_unique<Impl>();
+  m->frame_ = frame;
+  gpu::FrameGraph& graph = *frame.graph;
+  auto pipe = gpu::load_compute_pipeline(*frame.context, "shading/environment_occlusion.comp", {});
+  if (!pipe) return pipe.error();
+  m->pipeline_ = std::move(*pipe);
+  auto set = graph.create_buffer({"env_occlusion_set", sizeof(shader::EnvOcclusionSet), gpu::MemoryUsage::Upload, true},
+                                 VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  if (!set) return set.error();
+  m->set_ = *set;
+  // At the internal size (the largest any divisor needs); a frame uses its top-left corner.
+  gpu::ImageDesc d;
+  d.name = "env_occlusion";
+  d.format = VK_FORMAT_R16G16B16A16_SFLOAT;
+  auto image = graph.create_image(d, VK_IMAGE_USAGE_STORAGE_BIT);
+  if (!image) return image.error();
+  m->image_ = *image;
+  auto none = graph.create_zero_image("env_occlusion_none", VK_FORMAT_R16G16B16A16_SFLOAT, VK_IMAGE_USAGE_STORAGE_BIT);
+  if (!none) return none.error();
+  m->none_ = *none;
+  m->spheres_.reserve(size_t(frame.scene_gpu->object_count()) * frame::SceneGpu::kOccluderSpheres);
+  m->albedo_.reserve(m->spheres_.capacity());
+  return std::unique_ptr<EnvironmentOcclusion>(new EnvironmentOcclusion(std::move(m)));
+}
+
+void EnvironmentOcclusion::record(const EnvOcclusionLevel& level, const light::ShRgb& ambient,
+                                  std::vector<std::string>& skipped) {
+  Impl& m = *impl_;
+  m.divisor_ = 0;
+  const frame::SceneGpu& sg = *m.frame_.scene_gpu;
+  if (level.spheres_per_object <= 0) {
+    skipped.push_back("env_occlusion: off at this level");
+    return;
+  }
+  if (!sg.any_visible()) {
+    skipped.push_back("env_occlusion: no virtual object visible");
+    return;
+  }
+  // The ambient's mean radiance (band 0) is what any sphere can hide at most on average.
+  if (!(std::max({ambient[0].x, ambient[0].y, ambient[0].z}) > 0.0)) {
+    skipped.push_back("env_occlusion: no ambient light to occlude");
+    return;
+  }
+  m.spheres_.clear();
+  // Each object's first spheres_per_object proxies, as many as fit: with many objects, the first
+  // ones of every object before more of any (a round-robin over ranks).
+  const int objects = std::max<int>(1, int(sg.object_count()));
+  const int per_object = std::min(level.spheres_per_object, std::max(1, MRGI_MAX_OCCLUDER_SPHERES / objects));
+  m.albedo_.clear();
+  sg.occluder_spheres(per_object, m.spheres_, &m.albedo_);
+  if (m.spheres_.empty()) {
+    skipped.push_back("env_occlusion: the visible objects have no solid to stand in for");
+    return;
+  }
+  m.divisor_ = std::clamp(level.divisor, 1, 8);
+  auto* set = static_cast<shader::EnvOcclusionSet*>(m.frame_.graph->mapped(m.set_, m.frame_.graph->slot()));
+  set->count = glm::ivec4(int(std::min<size_t>(m.spheres_.size(), MRGI_MAX_OCCLUDER_SPHERES)), m.divisor_, 0, 0);
+  for (int c = 0; c < 3; ++c)
+    for (int k = 0; k < 4; ++k)
+      set->radiance[c * 4 + k] = glm::vec4(float(ambient[size_t(k * 4)][c]), float(ambient[size_t(k * 4 + 1)][c]),
+                                           float(ambient[size_t(k * 4 + 2)][c]), float(ambient[size_t(k * 4 + 3)][c]));
+  for (size_t i = 0; i < size_t(set->count.x); ++i) {
+    set->spheres[i] = m.spheres_[i];
+    set->albedo[i] = m.albedo_[i];
+  }
+  const frame::FrameResources& r = m.frame_;
+  const int divisor = m.divisor_;
+  r.graph->add_shader_pass(
+      "env_occlusion", gpu::PassKind::Compute, *m.pipeline_,
+      [&r, &m](gpu::ShaderPassBuilder& b) {
+        b.bind("FrameUbo", r.frame_constants);
+        b.bind("OcclusionUbo", m.set_);
+        b.bind("real_position", r.real_position);
+        b.bind("real_normal", r.real_normal);
+        b.bind("virtual_position", r.virtual_position);
+        b.bind("virtual_normal", r.virtual_normal);
+        b.bind("env_occlusion", m.image_);
+      },
+      [&m, divisor](VkCommandBuffer cmd, gpu::PassContext& pass) {
+        const VkExtent2D e = pass.extent(m.frame_.lit_rv);
+        gpu::dispatch_2d(cmd, *m.pipeline_, nullptr, 0, (e.width + uint32_t(divisor) - 1) / uint32_t(divisor),
+                         (e.height + uint32_t(divisor) - 1) / uint32_t(divisor));
+      });
+}
+
+void EnvironmentOcclusion::skip() { impl_->divisor_ = 0; }
+
+gpu::ImageHandle EnvironmentOcclusion::image() const { return impl_->divisor_ > 0 ? impl_->image_ : impl_->none_; }
+int EnvironmentOcclusion::divisor() const { return impl_->divisor_; }
+
+}  // namespace mrgi::shading

@@ -1,0 +1,77 @@
+#version 460
+// Environment occlusion by the virtual objects (shading/environment_occlusion.h): per texel of
+// a grid of `divisor` x `divisor` internal pixels, the surface at the texel's centre pixel (the
+// virtual one where there is one, else the real one) and the irradiance the virtual objects'
+// sphere proxies hide from it of the occludable ambient light (its radiance SH), per
+// shared/occlusion_math.h, less what their objects' surfaces send it instead (albedo / pi x
+// the ambient irradiance facing the point). Written as rgb = that net irradiance taken away
+// (W/m^2, negative where an object gives more than it hides), a = the surface's key:
+// its distance to the camera, negative on a virtual surface, 0 where there is none (the
+// direct-light pass up-samples by it).
+#extension GL_GOOGLE_include_directive : require
+#include "shared/mrgi_shared.h"
+#include "shared/occlusion_math.h"
+#include "common/frame_constants.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
+FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
+layout(std140, set = 0, binding = 1) uniform OcclusionUbo { EnvOcclusionSet occluders; };
+layout(set = 0, binding = 2, rgba32f) readonly uniform image2D real_position;
+layout(set = 0, binding = 3, rgba16f) readonly uniform image2D real_normal;
+layout(set = 0, binding = 4, rgba32f) readonly uniform image2D virtual_position;
+layout(set = 0, binding = 5, rgba16f) readonly uniform image2D virtual_normal;
+layout(set = 0, binding = 6, rgba16f) writeonly uniform image2D env_occlusion;
+
+// Spheres farther than this many radii are skipped: each would hide less than 1 / 16^2 of the
+// sky (0.4 %), and the many such terms of a large object together stay under a few percent of
+// what the near ones hide.
+const float kReachRadii = 16.0f;
+
+void main() {
+  frame = frame_ubo;
+  const int divisor = max(occluders.count.y, 1);
+  const ivec2 internal_size = frame.internal_output_size.xy;
+  const ivec2 texels = (internal_size + divisor - 1) / divisor;
+  const ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
+  if (any(greaterThanEqual(texel, texels))) return;
+  const ivec2 pixel = min(texel * divisor + divisor / 2, internal_size - 1);
+  vec4 vpos = imageLoad(virtual_position, pixel);
+  bool is_virtual = vpos.w > 0.5f;
+  vec4 pos = is_virtual ? vpos : imageLoad(real_position, pixel);
+  if (!(pos.w > 0.0f)) {
+    imageStore(env_occlusion, texel, vec4(0.0f));
+    return;
+  }
+  vec3 n = normalize((is_virtual ? imageLoad(virtual_normal, pixel) : imageLoad(real_normal, pixel)).xyz);
+  vec3 p = pos.xyz;
+  SH16 sh_r, sh_g, sh_b;
+  sh_r.c0 = occluders.radiance[0], sh_r.c1 = occluders.radiance[1], sh_r.c2 = occluders.radiance[2], sh_r.c3 = occluders.radiance[3];
+  sh_g.c0 = occluders.radiance[4], sh_g.c1 = occluders.radiance[5], sh_g.c2 = occluders.radiance[6], sh_g.c3 = occluders.radiance[7];
+  sh_b.c0 = occluders.radiance[8], sh_b.c1 = occluders.radiance[9], sh_b.c2 = occluders.radiance[10], sh_b.c3 = occluders.radiance[11];
+  SphereOcclusion o = sphere_occlusion_none();
+  const int count = min(occluders.count.x, MRGI_MAX_OCCLUDER_SPHERES);
+  for (int i = 0; i < count; ++i) {
+    vec4 s = occluders.spheres[i];
+    vec3 d = s.xyz - p;
+    float l2 = dot(d, d), r2 = s.w * s.w;
+    // Inside a proxy (a virtual surface in its own sphere, or a real point the object covers):
+    // that sphere says nothing about what this point sees.
+    if (l2 <= r2 * 1.0001f || l2 > r2 * (kReachRadii * kReachRadii)) continue;
+    float inv_l = inversesqrt(l2);
+    vec3 w = d * inv_l;
+    float s2 = r2 / l2;
+    float f = sphere_form_factor(dot(n, w), s2);
+    if (f > 1e-5f) {
+      // What the sphere hides (the sky's cap) less what it shows instead: the object's own
+      // surface facing the point, lit by the same ambient (albedo / pi x E(-w)).
+      vec3 hidden = sh_cap_mean_radiance(sh_r, sh_g, sh_b, w, sqrt(1.0f - s2));
+      vec3 shown = occluders.albedo[i].rgb * sh_irradiance16(sh_r, sh_g, sh_b, -w) * (1.0f / MRGI_PI);
+      o = sphere_occlusion_add(o, f, hidden - shown);
+    }
+  }
+  float key = distance(p, frame.camera_world.xyz);
+  vec3 hidden = sphere_occlusion_irradiance(o);
+  hidden = any(isnan(hidden)) || any(isinf(hidden)) ? vec3(0.0f) : clamp(hidden, vec3(-60000.0f), vec3(60000.0f));
+  imageStore(env_occlusion, texel, vec4(hidden, is_virtual ? -key : key));
+}

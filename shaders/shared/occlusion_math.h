@@ -1,0 +1,123 @@
+// Environment occlusion by sphere proxies, shared by the shader (shaders/shading/
+// environment_occlusion.comp) and the C++ tests, under the rules of mrgi_shared.h.
+//
+// A virtual object stands between a real surface point and part of the environment: the point
+// loses the radiance the object hides, weighted by the cosine to its normal. With the object
+// approximated by spheres (frame/occluder_spheres.h), each sphere hides a cap of the sky:
+//   - sphere_form_factor: the cap's cosine-weighted solid angle over pi (the fraction of a
+//     uniform sky's irradiance it blocks), exact also where the sphere crosses the point's
+//     horizon (the form factor of a sphere seen from a differential area, J. Snyder, "Area
+//     light sources for real-time graphics", 1996; the horizon-crossing case as written up by
+//     Lagarde & de Rousiers, "Moving Frostbite to PBR", 2014, eq. 18);
+//   - sh_cap_band_factors: the mean of an SH band over a cap, as a factor of the band's value
+//     at the cap's centre (Funk-Hecke with the cap's indicator as kernel), so the mean radiance
+//     the cap hides is one evaluation of the environment's SH with per-band factors
+//     (sh_cap_mean_radiance), not an integral per pixel.
+// Several spheres combine as independent occluders: the blocked fraction is 1 - prod(1 - f_i)
+// (overlapping spheres of one object would count their shared part twice if summed), and the
+// blocked radiance is the f-weighted mean of their caps' radiance (sphere_occlusion_add /
+// sphere_occlusion_irradiance).
+#ifndef MRGI_OCCLUSION_MATH_H
+#define MRGI_OCCLUSION_MATH_H
+
+#include "shared/mrgi_shared.h"
+
+#ifdef __cplusplus
+namespace mrgi::shader {
+using glm::ivec4;
+#define MRGI_FN inline
+#else
+#define MRGI_FN
+#endif
+
+// Fraction (0..1) of the cosine-weighted hemisphere above a point with unit normal n that a
+// sphere covers: cos_theta = dot(n, direction to the sphere's centre), sin_alpha_sq =
+// (radius / distance)^2 (< 1: the point is outside the sphere). Fully above the horizon it is
+// sin^2(alpha) cos(theta); fully below, 0.
+MRGI_FN float sphere_form_factor(float cos_theta, float sin_alpha_sq) {
+  float s2 = clamp(sin_alpha_sq, 1e-8f, 0.9999f);
+  float c = clamp(cos_theta, -1.0f, 1.0f);
+  if (c * c >= s2) return c > 0.0f ? s2 * c : 0.0f;
+  // The cap crosses the horizon: the part above it.
+  float sin_theta = sqrt(max(1.0f - c * c, 1e-12f));
+  float x = sqrt(1.0f / s2 - 1.0f);  // cot(alpha)
+  float y = clamp(-x * c / sin_theta, -1.0f, 1.0f);
+  float s = sin_theta * sqrt(max(1.0f - y * y, 0.0f));
+  float e = (c * acos(y) - x * s) * s2 + atan(s / x);
+  return clamp(e / MRGI_PI, 0.0f, 1.0f);
+}
+
+// Per band l = 0..3: the mean over a cap of half-angle alpha (cos_alpha) of a band-l function,
+// over its value at the cap's centre: (2 pi / solid angle) * integral_{cos_alpha}^1 P_l(t) dt.
+// 1 for every band as the cap shrinks to a point; (1, 1/2, 0, -1/8) for a hemisphere.
+MRGI_FN vec4 sh_cap_band_factors(float cos_alpha) {
+  float c = clamp(cos_alpha, -1.0f, 1.0f);
+  // The integrals of P1, P2, P3 from c to 1 are (1 - c^2) / 2, (c - c^3) / 2 and
+  // (5 c^2 - 1)(1 - c^2) / 8; each has the factor (1 - c), which the solid angle 2 pi (1 - c)
+  // divides out exactly (no 0 / 0 as the cap shrinks).
+  return vec4(1.0f, 0.5f * (1.0f + c), 0.5f * c * (1.0f + c), (5.0f * c * c - 1.0f) * (1.0f + c) * 0.125f);
+}
+
+// Mean radiance of a radiance SH (one SH16 a colour channel, bands 0..3) over the cap around
+// unit `direction` with half-angle cos_alpha, clamped at 0 (SH ringing).
+MRGI_FN vec3 sh_cap_mean_radiance(SH16 r, SH16 g, SH16 b, vec3 direction, float cos_alpha) {
+  vec4 f = sh_cap_band_factors(cos_alpha);
+  SH16 y = sh_basis16(direction);
+  y.c0 = y.c0 * vec4(f.x, f.y, f.y, f.y);
+  y.c1 = y.c1 * vec4(f.z, f.z, f.z, f.z);
+  y.c2 = y.c2 * vec4(f.z, f.w, f.w, f.w);
+  y.c3 = y.c3 * f.w;
+  return max(vec3(sh_dot(r, y), sh_dot(g, y), sh_dot(b, y)), vec3(0.0f));
+}
+
+// Irradiance at unit normal n from a radiance SH16 per channel (bands 0..2; band 3 of the
+// clamped cosine is 0), clamped at 0.
+MRGI_FN vec3 sh_irradiance16(SH16 r, SH16 g, SH16 b, vec3 n) {
+  SH16 y = sh_scale_cosine_lobe(sh_basis16(n));
+  return max(vec3(sh_dot(r, y), sh_dot(g, y), sh_dot(b, y)), vec3(0.0f));
+}
+
+// Accumulated occlusion of a point: product of the unblocked fractions, and the sum of f_i and
+// of f_i times cap radiance_i.
+struct SphereOcclusion {
+  float open;           // prod (1 - f_i)
+  float weight;         // sum f_i
+  vec3 weighted;        // sum f_i * mean cap radiance_i
+};
+MRGI_FN SphereOcclusion sphere_occlusion_none() {
+  SphereOcclusion o;
+  o.open = 1.0f;
+  o.weight = 0.0f;
+  o.weighted = vec3(0.0f);
+  return o;
+}
+MRGI_FN SphereOcclusion sphere_occlusion_add(SphereOcclusion o, float fraction, vec3 radiance) {
+  o.open *= 1.0f - fraction;
+  o.weight += fraction;
+  o.weighted += radiance * fraction;
+  return o;
+}
+// The irradiance (W/m^2 per channel) the spheres hide from the point: pi x the blocked fraction
+// x the fraction-weighted mean radiance of their caps.
+MRGI_FN vec3 sphere_occlusion_irradiance(SphereOcclusion o) {
+  if (!(o.weight > 1e-8f)) return vec3(0.0f);
+  return o.weighted * (MRGI_PI * (1.0f - o.open) / o.weight);
+}
+
+// The environment-occlusion pass's uniform block (shading/environment_occlusion.h), std140.
+#define MRGI_MAX_OCCLUDER_SPHERES 64
+struct EnvOcclusionSet {
+  ivec4 count;                                   // x spheres; y divisor (internal pixels a texel side)
+  vec4 radiance[12];                             // radiance SH16 of the occludable light: r c0..c3, g, b
+  vec4 spheres[MRGI_MAX_OCCLUDER_SPHERES];       // world xyz centre, w radius (metres)
+  vec4 albedo[MRGI_MAX_OCCLUDER_SPHERES];        // rgb the sphere's object's mean diffuse albedo
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(EnvOcclusionSet) == 16 * (1 + 12 + 2 * MRGI_MAX_OCCLUDER_SPHERES), "std140 mirror");
+#undef MRGI_FN
+}  // namespace mrgi::shader
+#else
+#undef MRGI_FN
+#endif
+#endif  // MRGI_OCCLUSION_MATH_H

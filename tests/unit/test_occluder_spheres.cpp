@@ -1,0 +1,119 @@
+// Sphere proxies of a mesh's solid (runtime/src/frame/occluder_spheres.h): they stay inside the
+// solid they stand for, fill most of it, come most important first, and refuse nothing silently.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "frame/occluder_spheres.h"
+
+namespace {
+using mrgi::frame::fit_occluder_spheres;
+using mrgi::frame::occluder_coverage;
+
+struct Mesh {
+  std::vector<glm::vec3> p;
+  std::vector<uint32_t> i;
+};
+
+Mesh box(glm::vec3 lo, glm::vec3 hi) {
+  Mesh m;
+  for (int k = 0; k < 8; ++k) m.p.emplace_back(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z);
+  const uint32_t f[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
+  for (const auto& q : f) m.i.insert(m.i.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
+  return m;
+}
+
+Mesh uv_sphere(glm::vec3 c, float r, int rings = 24, int segments = 48) {
+  Mesh m;
+  for (int a = 0; a <= rings; ++a)
+    for (int b = 0; b <= segments; ++b) {
+      const float t = 3.14159265f * a / rings, ph = 6.2831853f * b / segments;
+      m.p.push_back(c + r * glm::vec3(std::sin(t) * std::cos(ph), std::cos(t), std::sin(t) * std::sin(ph)));
+    }
+  for (int a = 0; a < rings; ++a)
+    for (int b = 0; b < segments; ++b) {
+      const uint32_t i0 = uint32_t(a * (segments + 1) + b), i1 = i0 + 1, i2 = i0 + uint32_t(segments + 1), i3 = i2 + 1;
+      m.i.insert(m.i.end(), {i0, i2, i1, i1, i2, i3});
+    }
+  return m;
+}
+
+TEST(OccluderSpheres, ASphereIsFittedByOneSphereOfItsSize) {
+  const Mesh m = uv_sphere(glm::vec3(0.2f, 1.0f, -0.5f), 0.3f);
+  const auto s = fit_occluder_spheres(m.p, m.i);
+  ASSERT_FALSE(s.empty());
+  EXPECT_NEAR(s[0].x, 0.2f, 0.03f);
+  EXPECT_NEAR(s[0].y, 1.0f, 0.03f);
+  EXPECT_NEAR(s[0].z, -0.5f, 0.03f);
+  EXPECT_NEAR(s[0].w, 0.3f, 0.03f);  // within a voxel (0.6 / 24 = 0.025 m)
+  EXPECT_GT(occluder_coverage(m.p, m.i, {s[0]}), 0.85);
+}
+
+TEST(OccluderSpheres, ABoxIsFilledBySpheresInsideIt) {
+  const glm::vec3 lo(-0.5f, 0.0f, -0.1f), hi(0.5f, 0.2f, 0.1f);
+  const Mesh m = box(lo, hi);
+  const auto s = fit_occluder_spheres(m.p, m.i);
+  ASSERT_GE(s.size(), 3u);  // a 5:1:1 box is not one sphere
+  for (const glm::vec4& q : s) {
+    // Inscribed: no sphere reaches more than a voxel (1/24 m) beyond the box.
+    EXPECT_LE(q.x + q.w, hi.x + 0.045f);
+    EXPECT_GE(q.x - q.w, lo.x - 0.045f);
+    EXPECT_LE(q.y + q.w, hi.y + 0.045f);
+    EXPECT_GE(q.y - q.w, lo.y - 0.045f);
+  }
+  // Inscribed spheres cannot fill a box's edges: a square's inscribed circle is pi / 4 of it.
+  const double all = occluder_coverage(m.p, m.i, s);
+  EXPECT_GT(all, 0.72);
+  // The first spheres matter most: half the list covers more than half of what all of it does.
+  const std::vector<glm::vec4> half(s.begin(), s.begin() + std::ptrdiff_t(s.size() / 2));
+  EXPECT_GT(occluder_coverage(m.p, m.i, half), 0.5 * all);
+  // More spheres allowed, at least as good.
+  mrgi::frame::OccluderFitSettings few;
+  few.max_spheres = 2;
+  EXPECT_LE(fit_occluder_spheres(m.p, m.i, few).size(), 2u);
+  EXPECT_LE(occluder_coverage(m.p, m.i, fit_occluder_spheres(m.p, m.i, few)), all + 1e-9);
+}
+
+TEST(OccluderSpheres, AMeshOpenAtItsBaseIsStillASolid) {
+  // A sphere without its bottom cap (as a scanned object standing on a table): the hole is far
+  // larger than a voxel, yet the fit is the sphere, not a shell of thin spheres.
+  const Mesh whole = uv_sphere(glm::vec3(0.0f), 0.3f);
+  Mesh open = whole;
+  open.i.clear();
+  for (size_t t = 0; t + 2 < whole.i.size(); t += 3) {
+    const float lowest = std::min({whole.p[whole.i[t]].y, whole.p[whole.i[t + 1]].y, whole.p[whole.i[t + 2]].y});
+    if (lowest > -0.2f) open.i.insert(open.i.end(), {whole.i[t], whole.i[t + 1], whole.i[t + 2]});
+  }
+  ASSERT_LT(open.i.size(), whole.i.size());
+  const auto s = fit_occluder_spheres(open.p, open.i);
+  ASSERT_FALSE(s.empty());
+  EXPECT_GT(s[0].w, 0.2f);
+}
+
+TEST(OccluderSpheres, NothingToFitGivesNoSpheres) {
+  EXPECT_TRUE(fit_occluder_spheres({}, {}).empty());
+  // One point repeated: no extent.
+  EXPECT_TRUE(fit_occluder_spheres({glm::vec3(1.0f)}, {0, 0, 0}).empty());
+  // Indices out of range are skipped, not read.
+  EXPECT_TRUE(fit_occluder_spheres({glm::vec3(0.0f)}, {0, 7, 9}).empty());
+  // NaN positions are skipped too.
+  Mesh m = box(glm::vec3(0.0f), glm::vec3(0.1f));
+  m.p.push_back(glm::vec3(std::nanf("")));
+  m.i.insert(m.i.end(), {0, 1, 8});
+  const auto s = fit_occluder_spheres(m.p, m.i);
+  ASSERT_FALSE(s.empty());
+  for (const glm::vec4& q : s) EXPECT_TRUE(std::isfinite(q.x) && std::isfinite(q.w));
+}
+
+TEST(OccluderSpheres, AnOpenSheetKeepsOnlyThinSpheres) {
+  // A single square (no volume): the shell alone, spheres of about half a voxel.
+  Mesh m;
+  m.p = {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}};
+  m.i = {0, 1, 2, 0, 2, 3};
+  const auto s = fit_occluder_spheres(m.p, m.i);
+  ASSERT_FALSE(s.empty());
+  for (const glm::vec4& q : s) EXPECT_LE(q.w, 1.0f / 24.0f);
+}
+
+}  // namespace

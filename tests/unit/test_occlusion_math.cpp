@@ -1,0 +1,118 @@
+// The environment-occlusion math (shaders/shared/occlusion_math.h) on the CPU, against numeric
+// integration over the sphere: the same functions environment_occlusion.comp runs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "shared/occlusion_math.h"
+
+namespace {
+using namespace mrgi::shader;
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Fraction of the cosine-weighted hemisphere around +z that a sphere of sin(alpha) = s at
+// polar angle theta from +z covers, by a fine product quadrature (theta, phi) over the upper
+// hemisphere.
+double numeric_form_factor(double theta, double sin_alpha) {
+  const glm::dvec3 c(std::sin(theta), 0.0, std::cos(theta));
+  const double cos_alpha = std::sqrt(1.0 - sin_alpha * sin_alpha);
+  const int nt = 1200, np = 2400;
+  double sum = 0.0;
+  for (int i = 0; i < nt; ++i) {
+    const double t = (i + 0.5) / nt * (kPi / 2.0);
+    for (int j = 0; j < np; ++j) {
+      const double p = (j + 0.5) / np * 2.0 * kPi;
+      const glm::dvec3 w(std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t));
+      if (glm::dot(w, c) >= cos_alpha) sum += std::cos(t) * std::sin(t);
+    }
+  }
+  return sum * (kPi / 2.0 / nt) * (2.0 * kPi / np) / kPi;
+}
+
+TEST(OcclusionMath, SphereFormFactorAboveTheHorizonIsSinSquaredCos) {
+  for (double s : {0.1, 0.3, 0.6})
+    for (double theta : {0.0, 0.4, 0.8}) {
+      if (std::cos(theta) < s) continue;
+      EXPECT_NEAR(sphere_form_factor(float(std::cos(theta)), float(s * s)), s * s * std::cos(theta), 1e-6);
+    }
+}
+
+TEST(OcclusionMath, SphereFormFactorMatchesIntegrationAcrossTheHorizon) {
+  // Spheres straddling the horizon (the floor beside an object), and the two clean cases.
+  const double cases[][2] = {{1.3, 0.5}, {1.5708, 0.5}, {1.8, 0.5}, {1.4, 0.9}, {1.9, 0.8}, {0.3, 0.4}, {2.6, 0.3}};
+  for (const auto& c : cases) {
+    const double expected = numeric_form_factor(c[0], c[1]);
+    const float got = sphere_form_factor(float(std::cos(c[0])), float(c[1] * c[1]));
+    EXPECT_NEAR(got, expected, 2e-3 + 0.01 * expected) << "theta " << c[0] << " sin alpha " << c[1];
+  }
+  // Below the horizon entirely: nothing.
+  EXPECT_EQ(sphere_form_factor(-0.9f, 0.1f), 0.0f);
+}
+
+TEST(OcclusionMath, SphereFormFactorIsFiniteAtTheLimits) {
+  for (float c : {-1.0f, -0.5f, 0.0f, 1e-7f, 0.5f, 1.0f})
+    for (float s2 : {0.0f, 1e-9f, 0.5f, 0.9999f, 1.0f, 2.0f}) {
+      const float f = sphere_form_factor(c, s2);
+      EXPECT_TRUE(std::isfinite(f)) << c << " " << s2;
+      EXPECT_GE(f, 0.0f);
+      EXPECT_LE(f, 1.0f);
+    }
+}
+
+// Mean of SH16 radiance over a cap, numerically.
+glm::dvec3 numeric_cap_mean(const SH16 ch[3], glm::dvec3 axis, double cos_alpha) {
+  const int n = 400000;
+  glm::dvec3 sum(0.0);
+  int count = 0;
+  for (int k = 0; k < n; ++k) {
+    const double y = 1.0 - 2.0 * (k + 0.5) / n, r = std::sqrt(std::max(0.0, 1.0 - y * y));
+    const double phi = kPi * (3.0 - std::sqrt(5.0)) * k;
+    const glm::dvec3 w(r * std::cos(phi), y, r * std::sin(phi));
+    if (glm::dot(w, axis) < cos_alpha) continue;
+    const SH16 b = sh_basis16(glm::vec3(w));
+    sum += glm::dvec3(sh_dot(ch[0], b), sh_dot(ch[1], b), sh_dot(ch[2], b));
+    ++count;
+  }
+  return sum / double(count);
+}
+
+TEST(OcclusionMath, CapMeanRadianceMatchesIntegration) {
+  // A positive radiance with every band present (a sky: bright above, a sun-ish lobe).
+  SH16 ch[3];
+  for (int c = 0; c < 3; ++c) {
+    ch[c].c0 = vec4(2.0f + c, 0.8f, 0.5f - 0.1f * c, 0.3f);
+    ch[c].c1 = vec4(0.2f, -0.15f, 0.25f, 0.1f);
+    ch[c].c2 = vec4(-0.1f, 0.05f, 0.08f, -0.04f);
+    ch[c].c3 = vec4(0.03f, 0.06f, -0.02f, 0.05f);
+  }
+  const glm::dvec3 axis = glm::normalize(glm::dvec3(0.3, 0.8, -0.4));
+  for (double alpha_deg : {5.0, 25.0, 60.0, 90.0}) {
+    const double ca = std::cos(alpha_deg * kPi / 180.0);
+    const glm::dvec3 expected = numeric_cap_mean(ch, axis, ca);
+    const vec3 got = sh_cap_mean_radiance(ch[0], ch[1], ch[2], glm::vec3(axis), float(ca));
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], expected[c], 2e-3 * (1.0 + std::abs(expected[c]))) << alpha_deg;
+  }
+  // The band factors of a hemisphere and of a point.
+  const vec4 h = sh_cap_band_factors(0.0f), p = sh_cap_band_factors(1.0f);
+  EXPECT_NEAR(h.y, 0.5f, 1e-6f);
+  EXPECT_NEAR(h.z, 0.0f, 1e-6f);
+  EXPECT_NEAR(h.w, -0.125f, 1e-6f);
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(p[i], 1.0f, 1e-4f);
+}
+
+TEST(OcclusionMath, DisjointSpheresUnderAUniformSkyBlockTheirSolidAngle) {
+  // Two small spheres far apart above a point, uniform sky of radiance 2: the blocked irradiance
+  // is about 2 x pi x (f1 + f2) (the product form differs from the sum only by f1 f2).
+  const float f1 = sphere_form_factor(0.9f, 0.01f), f2 = sphere_form_factor(0.5f, 0.04f);
+  SphereOcclusion o = sphere_occlusion_none();
+  o = sphere_occlusion_add(o, f1, vec3(2.0f));
+  o = sphere_occlusion_add(o, f2, vec3(2.0f));
+  const vec3 e = sphere_occlusion_irradiance(o);
+  EXPECT_NEAR(e.x, 2.0 * kPi * (1.0 - (1.0 - f1) * (1.0 - f2)), 1e-5);
+  EXPECT_NEAR(e.x, 2.0 * kPi * (f1 + f2), 2.0 * kPi * f1 * f2 + 1e-5);
+  // Nothing added: nothing blocked.
+  EXPECT_EQ(sphere_occlusion_irradiance(sphere_occlusion_none()).x, 0.0f);
+}
+
+}  // namespace
