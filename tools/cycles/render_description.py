@@ -61,7 +61,8 @@
 #    lookup of a Blender direction V is u = 0.5 - atan2(V.y, V.x) / 2pi, v (up) = 0.5 +
 #    asin(V.z) / pi, so the world texture is fed V = A R^T B^-1 D with A d = (-d.z, -d.x, d.y)
 #    (D the world direction in Blender axes); background strength = intensity. The procedural sky
-#    ("environment.sky") is not built here (refused).
+#    ("environment.sky") is built as a world shader of the same formula (build_sky), its sun an
+#    analytic disc carrying sun_irradiance, sampled through a 2048-wide importance map.
 #  * Materials (mrgi's bsdf.h): diffuse -> Diffuse BSDF, roughness 0 (Lambert, as mrgi);
 #    glossy -> Diffuse BSDF (Lambert) of base * (1 - metallic) * 0.96 plus a Principled BSDF
 #    used as a pure GGX lobe (metallic 1, base colour = F0 = mix(0.04, base, metallic),
@@ -479,6 +480,86 @@ def lamp_object(i, l):
     return ob
 
 
+def env_axis_node(nt, tc, row):
+    """A node whose value is row . (R^T B^-1 D): one environment-space component of the world
+    direction D (Blender axes) the world shader is evaluated for."""
+    dot = nt.nodes.new("ShaderNodeVectorMath")
+    dot.operation = "DOT_PRODUCT"
+    dot.inputs[1].default_value = tuple(row)
+    nt.links.new(tc.outputs["Generated"], dot.inputs[0])
+    return dot.outputs["Value"]
+
+
+def build_sky(nt, bg, env):
+    """mrgi's procedural sky (description.h ProceduralSky) as a world shader: radiance horizon +
+    (zenith - horizon) sqrt(y) above the horizon and `ground` below (y the environment-space up
+    component), plus an analytic sun disc of sun_radius_deg whose uniform radiance carries
+    sun_irradiance (mrgi rasterises the same disc into an equirect image whose disc pixels carry
+    it; here the disc is exact, so the two differ only in the disc's outline). The world's
+    importance map is made fine enough (2048 wide) that the disc is sampled as a light."""
+    sky = env["sky"]
+    r = quat_xyzw(env.get("rotation")).to_matrix()
+    k = r.transposed() @ B_INV.to_3x3()  # Blender direction -> environment space (mrgi axes)
+    tc = nt.nodes.new("ShaderNodeTexCoord")
+    y = env_axis_node(nt, tc, k[1])
+    up = nt.nodes.new("ShaderNodeMath")
+    up.operation = "GREATER_THAN"
+    up.inputs[1].default_value = 0.0
+    nt.links.new(y, up.inputs[0])
+    root = nt.nodes.new("ShaderNodeMath")  # sqrt(max(y, 0))
+    root.operation = "POWER"
+    root.use_clamp = False
+    clampy = nt.nodes.new("ShaderNodeMath")
+    clampy.operation = "MAXIMUM"
+    clampy.inputs[1].default_value = 0.0
+    nt.links.new(y, clampy.inputs[0])
+    nt.links.new(clampy.outputs[0], root.inputs[0])
+    root.inputs[1].default_value = 0.5
+
+    def rgb_mix(fac, a, b):
+        m = nt.nodes.new("ShaderNodeMixRGB")
+        m.blend_type = "MIX"
+        nt.links.new(fac, m.inputs["Fac"])
+        for slot, v in (("Color1", a), ("Color2", b)):
+            if isinstance(v, (list, tuple)):
+                m.inputs[slot].default_value = (v[0], v[1], v[2], 1.0)
+            else:
+                nt.links.new(v, m.inputs[slot])
+        return m.outputs["Color"]
+
+    gradient = rgb_mix(root.outputs[0], sky.get("horizon", [0.12, 0.15, 0.20]), sky.get("zenith", [0.05, 0.09, 0.20]))
+    g = sky.get("ground", [0.03, 0.03, 0.03])
+    if not isinstance(g, (list, tuple)):
+        g = [g, g, g]
+    base = rgb_mix(up.outputs[0], g, gradient)
+    # Sun disc: cos(angle to the sun) >= cos(radius) adds irradiance / (disc solid angle).
+    sun = Vector(sky.get("sun_direction", [0, 1, 0])).normalized()
+    radius = math.radians(sky.get("sun_radius_deg", 2.0))
+    solid = 2.0 * math.pi * (1.0 - math.cos(radius))
+    irr = sky.get("sun_irradiance", [3, 3, 3])
+    if not isinstance(irr, (list, tuple)):
+        irr = [irr, irr, irr]
+    row = Vector((sun.x * k[0][0] + sun.y * k[1][0] + sun.z * k[2][0],
+                  sun.x * k[0][1] + sun.y * k[1][1] + sun.z * k[2][1],
+                  sun.x * k[0][2] + sun.y * k[1][2] + sun.z * k[2][2]))  # k^T sun: dot(sun, k D)
+    cosang = env_axis_node(nt, tc, row)
+    inside = nt.nodes.new("ShaderNodeMath")
+    inside.operation = "GREATER_THAN"
+    inside.inputs[1].default_value = math.cos(radius)
+    nt.links.new(cosang, inside.inputs[0])
+    disc = nt.nodes.new("ShaderNodeMixRGB")
+    disc.blend_type = "ADD"
+    nt.links.new(inside.outputs[0], disc.inputs["Fac"])
+    nt.links.new(base, disc.inputs["Color1"])
+    disc.inputs["Color2"].default_value = (irr[0] / solid, irr[1] / solid, irr[2] / solid, 1.0)
+    nt.links.new(disc.outputs["Color"], bg.inputs["Color"])
+    bg.inputs["Strength"].default_value = env.get("intensity", 1.0)
+    w = bpy.context.scene.world
+    if hasattr(w, "cycles"):
+        w.cycles.sampling_method = "MANUAL"
+        w.cycles.sample_map_resolution = 2048
+
+
 def build_world(desc, base):
     world = bpy.data.worlds.new("mrgi")
     bpy.context.scene.world = world
@@ -491,7 +572,8 @@ def build_world(desc, base):
         bg.inputs["Strength"].default_value = 0.0
         return
     if "sky" in env:
-        fail("environment.sky (procedural sky) is not built by this script")
+        build_sky(nt, bg, env)
+        return
     tex = nt.nodes.new("ShaderNodeTexEnvironment")
     tex.image = bpy.data.images.load(os.path.join(base, env["image"]))
     tex.image.colorspace_settings.name = "Linear"
