@@ -96,3 +96,35 @@ TEST(Metrics, PoolingTwoFramesEqualsOneBigFrame) {
   EXPECT_NEAR(p.rde, 1.0, 1e-12);  // camera-only output on both frames
   EXPECT_NEAR(p.rmse8 * p.rmse8 * 16 * 3, r1->all.rmse8 * r1->all.rmse8 * 8 * 3 + r2->all.rmse8 * r2->all.rmse8 * 8 * 3, 1e-6);
 }
+
+TEST(Metrics, TheTruthSplitsRealPixelsIntoInfluencedAndRest) {
+  // A 4x4 frame: one virtual pixel, one real pixel the truth darkens (a shadow, 100 -> 60 in one
+  // channel), one it changes by a single 8-bit step (quantisation, not an effect), the rest equal.
+  ImageRGB8 c = filled(4, 4, 100), g = c, o = c;
+  ImageU8 mask(4, 4, 0);
+  mask.at(0, 0)[0] = 255;
+  g.at(0, 0)[1] = 180;
+  g.at(1, 1)[0] = 60;   // the shadow
+  g.at(2, 2)[0] = 101;  // one step: below three steps of noise
+  o.at(1, 1)[0] = 80;   // the output darkens it half as much
+  o.at(3, 3)[2] = 90;   // and darkens a pixel the truth leaves
+  auto r = measure_error(o, c, g, &mask);
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r->influenced.pixels, 1u);
+  EXPECT_EQ(r->rest.pixels, 14u);
+  EXPECT_EQ(r->influenced.pixels + r->rest.pixels, r->real.pixels);
+  // Signed sums of the change, linear: the output took less light from the shadow pixel than
+  // the truth, and some from a pixel the truth did not touch.
+  const double l100 = srgb8_to_linear(100), l80 = srgb8_to_linear(80), l60 = srgb8_to_linear(60),
+               l90 = srgb8_to_linear(90), l101 = srgb8_to_linear(101);
+  EXPECT_NEAR(r->influenced.change_sum, l80 - l100, 1e-9);
+  EXPECT_NEAR(r->influenced.truth_change_sum, l60 - l100, 1e-9);
+  EXPECT_NEAR(r->rest.change_sum, l90 - l100, 1e-9);
+  EXPECT_NEAR(r->rest.truth_change_sum, l101 - l100, 1e-9);
+  EXPECT_NEAR(r->real.change_sum, r->influenced.change_sum + r->rest.change_sum, 1e-12);
+  EXPECT_TRUE(r->rest.rde_defined);  // the one-step pixel: something to compare against
+  // Pooling keeps the sums.
+  const RdeReport twice = pool(*r, *r);
+  EXPECT_NEAR(twice.influenced.truth_change_sum, 2.0 * r->influenced.truth_change_sum, 1e-12);
+  EXPECT_EQ(twice.rest.pixels, 28u);
+}
