@@ -294,6 +294,26 @@ std::vector<LightDesc> shadowed_lights_of(double cap_deg, double contrast, const
   return (*stage)->lighting().lights;
 }
 
+// The stage refuses settings of its environment rules that cannot work, naming them.
+TEST(LightStage, RefusesBadEnvironmentRuleSettings) {
+  SceneDesc scene;
+  auto refused = [&](LightStageSettings s, const char* field) {
+    auto stage = LightStage::create(s, scene, CameraSetup{});
+    ASSERT_FALSE(stage.ok()) << field;
+    EXPECT_NE(stage.error().message.find(field), std::string::npos) << stage.error().message;
+  };
+  LightStageSettings s;
+  s.shadowed_max_solid_angle_sr = 0.0;
+  refused(s, "shadowed_max_solid_angle_sr");
+  s = {};
+  s.lamp_removal.ring_outer_deg = s.lamp_removal.ring_inner_deg;
+  refused(s, "lamp_removal");
+  s = {};
+  s.near_field_step_m = 0.0;
+  refused(s, "near_field_step_m");
+  EXPECT_TRUE(LightStage::create({}, scene, CameraSetup{}).ok());
+}
+
 // Only compact, bright regions become shadowed lights (LightStageSettings::shadowed_min_contrast,
 // shadowed_max_solid_angle_sr, EnvSamplerSettings::source_contrast); both sides of each rule.
 TEST(LightStage, OnlyCompactBrightSourcesCastShadows) {

@@ -1,7 +1,5 @@
 #include "light/light_stage.h"
 
-#include "mrgi/metrics.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -9,6 +7,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "light/sh_tools.h"
+#include "mrgi/metrics.h"
 #include "shared/mrgi_shared.h"
 
 namespace mrgi::light {
@@ -66,6 +65,15 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
   if (!(settings.shadowed_min_contrast >= 0.0) || !(settings.shadowed_max_solid_angle_sr > 0.0))
     return fail(ErrorKind::BadUsage, "LightStageSettings.shadowed_min_contrast must be >= 0 and "
                                      "shadowed_max_solid_angle_sr > 0");
+  const LampRemovalSettings& lr = settings.lamp_removal;
+  if (!(lr.contrast > 0.0) || !(lr.search_deg > 0.0) || !(lr.max_deg > 0.0) || !(lr.ring_inner_deg > 0.0) ||
+      !(lr.ring_outer_deg > lr.ring_inner_deg))
+    return fail(ErrorKind::BadUsage, "LightStageSettings.lamp_removal: contrast and the angles must be > 0, "
+                                     "ring_outer_deg > ring_inner_deg");
+  if (!(settings.near_field_distance_m >= 0.0) || !(settings.near_field_step_m > 0.0) ||
+      !(settings.near_field_tolerance_m >= 0.0))
+    return fail(ErrorKind::BadUsage, "LightStageSettings.near_field_distance_m and near_field_tolerance_m must be "
+                                     ">= 0 and near_field_step_m > 0");
   if (settings.residual_shading_bands < 1 || settings.residual_shading_bands > 3)
     return fail(ErrorKind::BadUsage, "LightStageSettings.residual_shading_bands: must be 1..3");
   if (auto check = LightEstimator::create(settings.external_estimator); !check) return check.error();
@@ -255,8 +263,8 @@ bool LightStage::shadowable_region(const EnvLight& r, double mean_luminance) con
 }
 
 void LightStage::set_environment_lighting(bool real) {
-  // Lamps first (unchanged), then the strongest regions as shadowed directional lights; the SH
-  // of the other regions is the ambient.
+  // Lamps first (unchanged), then the strongest compact, bright, distant regions as shadowed
+  // directional lights; the SH of the other regions is the ambient.
   lighting_.lights.resize(size_t(declared_));
   lighting_.light_sh.resize(size_t(declared_));
   lighting_.foldable.resize(size_t(declared_));
