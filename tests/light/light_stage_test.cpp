@@ -271,7 +271,7 @@ TEST(LightStage, UniformEnvironmentLightsAnUpFacingSurfaceLikeTheMean) {
 
 // An environment of uniform radiance `base` with a cap of half-angle `cap_deg` around `dir` at
 // `contrast` times it, as an equirectangular file, lit through the stage; the shadowed lights.
-std::vector<LightDesc> shadowed_lights_of(double cap_deg, double contrast, const std::string& name) {
+static std::vector<LightDesc> shadowed_lights_of(double cap_deg, double contrast, const std::string& name) {
   const int w = 256, h = 128;
   const glm::dvec3 dir = glm::normalize(glm::dvec3(0.3, 0.8, -0.5));
   ImageRGBF img(w, h);

@@ -168,7 +168,7 @@ SolidGrid voxelise(const std::vector<glm::vec3>& p, const std::vector<uint32_t>&
   return g;
 }
 
-bool inside(const glm::vec3& q, const glm::vec4& s) {
+bool in_sphere(const glm::vec3& q, const glm::vec4& s) {
   const glm::vec3 e = q - glm::vec3(s);
   return glm::dot(e, e) <= s.w * s.w;
 }
@@ -203,14 +203,14 @@ std::vector<glm::vec4> fit_occluder_spheres(const std::vector<glm::vec3>& positi
       const glm::vec4 s(g.centre(order[c]), g.radius[order[c]] + 0.5f * g.cell);
       size_t gain = 0;
       for (size_t i : solid)
-        if (!covered[i] && inside(g.centre(i), s)) ++gain;
+        if (!covered[i] && in_sphere(g.centre(i), s)) ++gain;
       if (gain > best_gain) best_gain = gain, best = order[c];
     }
     // The sphere reaches the surface (inscribed radius); voxels count as covered by their centre
     // within half a voxel more, so a one-voxel shell is covered by its own spheres.
     const glm::vec4 reach(g.centre(best), g.radius[best] + 0.5f * g.cell);
     for (size_t i : solid)
-      if (!covered[i] && inside(g.centre(i), reach)) covered[i] = 1, ++covered_count;
+      if (!covered[i] && in_sphere(g.centre(i), reach)) covered[i] = 1, ++covered_count;
     spheres.emplace_back(g.centre(best), g.radius[best]);
   }
   return spheres;
@@ -224,7 +224,7 @@ double occluder_coverage(const std::vector<glm::vec3>& positions, const std::vec
     if (!g.solid[i]) continue;
     ++total;
     for (const glm::vec4& s : spheres)
-      if (inside(g.centre(i), glm::vec4(glm::vec3(s), s.w + 0.5f * g.cell))) {
+      if (in_sphere(g.centre(i), glm::vec4(glm::vec3(s), s.w + 0.5f * g.cell))) {
         ++in;
         break;
       }

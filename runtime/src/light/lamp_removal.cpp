@@ -5,12 +5,12 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "light/sh_tools.h"
+
 namespace mrgi::light {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
-double lum(const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; }
+double pixel_luminance(const float* p) { return luminance(glm::dvec3(p[0], p[1], p[2])); }
 
 }  // namespace
 
@@ -67,8 +67,8 @@ bool LampRemoval::remove_one(ImageRGBF& image, const EnvCamera&, const glm::dvec
     for (int x = x0; x <= x1; ++x) {
       const double r = glm::length(glm::dvec2(x, y) - at);
       const float* p = image.at(x, y);
-      if (r < r0 || r > r1 || !(lum(p) > 0.0)) continue;
-      ring_.push_back(float(lum(p)));
+      if (r < r0 || r > r1 || !(pixel_luminance(p) > 0.0)) continue;
+      ring_.push_back(float(pixel_luminance(p)));
     }
   if (ring_.size() < 4) return false;
   std::nth_element(ring_.begin(), ring_.begin() + std::ptrdiff_t(ring_.size() / 2), ring_.end());
@@ -78,7 +78,7 @@ bool LampRemoval::remove_one(ImageRGBF& image, const EnvCamera&, const glm::dvec
     for (int x = x0; x <= x1; ++x) {
       const double r = glm::length(glm::dvec2(x, y) - at);
       const float* p = image.at(x, y);
-      if (r < r0 || r > r1 || !(lum(p) > 0.0) || lum(p) >= threshold) continue;
+      if (r < r0 || r > r1 || !(pixel_luminance(p) > 0.0) || pixel_luminance(p) >= threshold) continue;
       sum += glm::dvec3(p[0], p[1], p[2]);
       ++n;
     }
@@ -89,8 +89,8 @@ bool LampRemoval::remove_one(ImageRGBF& image, const EnvCamera&, const glm::dvec
   double best = threshold;
   for (int y = std::max(0, int(at.y - search)); y <= std::min(h - 1, int(at.y + search)); ++y)
     for (int x = std::max(0, int(at.x - search)); x <= std::min(w - 1, int(at.x + search)); ++x)
-      if (glm::length(glm::dvec2(x, y) - at) <= search && lum(image.at(x, y)) > best) {
-        best = lum(image.at(x, y));
+      if (glm::length(glm::dvec2(x, y) - at) <= search && pixel_luminance(image.at(x, y)) > best) {
+        best = pixel_luminance(image.at(x, y));
         seed = y * w + x;
       }
   if (seed < 0) return false;
@@ -106,7 +106,7 @@ bool LampRemoval::remove_one(ImageRGBF& image, const EnvCamera&, const glm::dvec
       for (int dx = -1; dx <= 1; ++dx) {
         const int x = cx + dx, y = cy + dy;
         if (x < 0 || y < 0 || x >= w || y >= h || mask_[size_t(y) * w + x]) continue;
-        if (glm::length(glm::dvec2(x, y) - at) > reach || lum(image.at(x, y)) < threshold) continue;
+        if (glm::length(glm::dvec2(x, y) - at) > reach || pixel_luminance(image.at(x, y)) < threshold) continue;
         mask_[size_t(y) * w + x] = 1;
         stack_.push_back(y * w + x);
       }
