@@ -27,6 +27,8 @@ struct SolidGrid {
   bool empty() const { return solid.empty(); }
 };
 
+bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
 void mark_surface(SolidGrid& g, const std::vector<glm::vec3>& p, const std::vector<uint32_t>& idx) {
   auto mark = [&](const glm::vec3& q) {
     const glm::ivec3 v = glm::clamp(glm::ivec3(glm::floor((q - g.origin) / g.cell)), glm::ivec3(1), g.dims - 2);
@@ -35,6 +37,7 @@ void mark_surface(SolidGrid& g, const std::vector<glm::vec3>& p, const std::vect
   for (size_t t = 0; t + 2 < idx.size(); t += 3) {
     if (idx[t] >= p.size() || idx[t + 1] >= p.size() || idx[t + 2] >= p.size()) continue;
     const glm::vec3 a = p[idx[t]], b = p[idx[t + 1]], c = p[idx[t + 2]];
+    if (!finite(a) || !finite(b) || !finite(c)) continue;  // a NaN vertex has no voxel
     const float edge = std::max({glm::length(b - a), glm::length(c - a), glm::length(c - b)});
     // Samples half a voxel apart, so no voxel the triangle crosses is skipped.
     const int steps = std::clamp(int(std::ceil(edge / (0.5f * g.cell))), 1, 4096);
