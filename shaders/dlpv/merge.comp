@@ -7,7 +7,9 @@
 //                  (V^rho: bounce light from the real and virtual surfaces; without V^rho, at the
 //                  cheaper levels, the virtual pixel's own shading: lamps and ambient)
 // E_volume(p, n) = lpv_irradiance of the volume's accumulated intensity, trilinear at p (0 outside
-// the volume). Lamps are unshadowed here (Algorithm 1): a virtual object's shadow on the real
+// the volume). E_ambient_rv is less what the virtual objects hide of it (the direct-light block's
+// environment occlusion, shading/environment_occlusion.h): the volume carries the lamps'
+// antiradiance, not the environment's. Lamps are unshadowed here (Algorithm 1): a virtual object's shadow on the real
 // scene is the volume's antiradiance (paper Sec. 4.3.2), and real shadows are in the camera image.
 #extension GL_GOOGLE_include_directive : require
 // The G-buffers are read as storage images: on lavapipe a sampled texelFetch costs 2-3x as much.
@@ -38,7 +40,10 @@ layout(set = 0, binding = 13) uniform sampler3D rho_g;
 layout(set = 0, binding = 14) uniform sampler3D rho_b;
 layout(set = 0, binding = 15, rgba16f) writeonly uniform image2D lit_rv;
 layout(set = 0, binding = 16, rgba16f) writeonly uniform image2D lit_r;
-layout(push_constant) uniform Volume { VolumeConstants volume_block; };
+layout(set = 0, binding = 17, rgba16f) readonly uniform image2D env_occlusion;
+// occlusion.x: the environment occlusion's divisor (0: none this frame).
+layout(push_constant) uniform Volume { VolumeConstants volume_block; ivec4 occlusion; };
+#include "shading/env_occlusion_lookup.glsl"
 
 
 void main() {
@@ -93,7 +98,8 @@ void main() {
   if (is_virtual) {
     // With V^rho, not the residual ambient too (light_set.glsl count.y: it holds that bounce).
     bool rho = volume.extent.w > 0.5f;
-    vec3 e = rho && light_set.count.y != 0 ? vec3(0.0f) : ambient_irradiance(ambient_rv, n);
+    vec3 e = rho && light_set.count.y != 0 ? vec3(0.0f)
+                                           : occluded_ambient(ambient_irradiance(ambient_rv, n), pixel, p, true, occlusion.x);
     if (rho) e += volume_irradiance(rho_r, rho_g, rho_b, p, n);
     l_rv = lamps + alb.rgb * max(e, vec3(0.0f)) * (1.0f / MRGI_PI) +
            (frame.flags.y != 0 ? imageLoad(virtual_emission, pixel).rgb : vec3(0.0f));
@@ -101,7 +107,8 @@ void main() {
   } else {
     l_r = real_lamps + alb.rgb * ambient_irradiance(ambient_r, n) * (1.0f / MRGI_PI);
     vec3 delta = volume.extent.z > 0.5f ? volume_irradiance(delta_r, delta_g, delta_b, p, n) : vec3(0.0f);
-    l_rv = lamps + alb.rgb * (ambient_irradiance(ambient_rv, n) + delta) * (1.0f / MRGI_PI);
+    vec3 e_ambient = occluded_ambient(ambient_irradiance(ambient_rv, n), pixel, p, false, occlusion.x);
+    l_rv = lamps + alb.rgb * (e_ambient + delta) * (1.0f / MRGI_PI);
   }
   // Half floats end at 65504, and antiradiance can overshoot below 0: clamp.
   imageStore(lit_rv, pixel, vec4(clamp(sanitize(l_rv), vec3(0.0f), vec3(60000.0f)), 1.0f));

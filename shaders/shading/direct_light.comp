@@ -103,33 +103,7 @@ LevelConstants level;
 
 #include "common/shadowed_lamps.glsl"
 
-// The environment occlusion at a pixel whose surface key (distance to the camera, negative on a
-// virtual surface) is `key`: bilinear over the texels on the same surface (key within 5 % + 2
-// cm), else over those of the same kind (real / virtual), else none.
-vec3 hidden_environment(ivec2 pixel, float key) {
-  int d = indirect_params.z;
-  if (d == 1) return imageLoad(env_occlusion, pixel).rgb;
-  ivec2 low = (frame.internal_output_size.xy + d - 1) / d;
-  vec2 f = (vec2(pixel) + 0.5f) / float(d) - 0.5f;
-  ivec2 i0 = ivec2(floor(f));
-  vec2 t = f - vec2(i0);
-  vec3 same = vec3(0.0f), kind = vec3(0.0f);
-  float w_same = 0.0f, w_kind = 0.0f;
-  for (int k = 0; k < 4; ++k) {
-    ivec2 o = ivec2(k & 1, k >> 1);
-    vec4 tap = imageLoad(env_occlusion, clamp(i0 + o, ivec2(0), low - 1));
-    float w = (o.x == 1 ? t.x : 1.0f - t.x) * (o.y == 1 ? t.y : 1.0f - t.y) + 1e-4f;
-    if (tap.a * key > 0.0f) {
-      kind += w * tap.rgb;
-      w_kind += w;
-      if (abs(tap.a - key) <= 0.05f * abs(key) + 0.02f) {
-        same += w * tap.rgb;
-        w_same += w;
-      }
-    }
-  }
-  return w_same > 0.0f ? same / w_same : (w_kind > 0.0f ? kind / w_kind : vec3(0.0f));
-}
+#include "shading/env_occlusion_lookup.glsl"
 
 void main() {
   frame = frame_ubo; level = level_block;  // MRGI_UNIFORM_COPIES
@@ -167,10 +141,7 @@ void main() {
   // With a virtual volume on virtual pixels, not the residual ambient too (light_set.glsl count.y).
   bool ambient_here = !(kVolumeVirtual && is_virtual && light_set.count.y != 0);
   vec3 e_ambient = ambient_here ? ambient_irradiance(ambient_rv, n) : vec3(0.0f);
-  if (kEnvOcclusion && indirect_params.z > 0 && ambient_here) {
-    float key = distance(p, frame.camera_world.xyz);
-    e_ambient = max(e_ambient - hidden_environment(pixel, is_virtual ? -key : key), vec3(0.0f));
-  }
+  if (kEnvOcclusion && ambient_here) e_ambient = occluded_ambient(e_ambient, pixel, p, is_virtual, indirect_params.z);
   vec3 l_rv = alb.rgb * e_ambient * (1.0f / MRGI_PI) +
               (is_virtual && frame.flags.y != 0 ? imageLoad(virtual_emission, pixel).rgb : vec3(0.0f));
   vec3 l_r = r_p * alb.rgb * ambient_irradiance(ambient_r, n) * (1.0f / MRGI_PI);

@@ -128,6 +128,8 @@ struct DirectLightBlock::Impl {
   // lights changed; writes this slot's lights.
   Status update_lights(int shadowed_estimated);
   void add_shadow_passes(std::vector<std::string>& skipped);
+  // The environment occlusion pass of `ambient` at `level`, or left out (the residual ambient).
+  void record_occlusion(const EnvOcclusionLevel& level, const light::ShRgb& ambient, std::vector<std::string>& skipped);
   void add_shade_pass(const gpu::Pipeline& pipeline);
   void render_faces(VkCommandBuffer cmd, gpu::PassContext& pass, const std::vector<ShadowFace>& faces,
                     const std::vector<VkImageView>& layer_views);
@@ -332,17 +334,7 @@ Status DirectLightBlock::record(const frame::FrameInfo& info, const DirectLightL
   m.receivers_ = m.caustics_ ? info.caustics->receivers : m.no_receivers_;
   m.receiver_lamps_ = m.caustics_ ? info.caustics->receiver_lamps : m.no_receiver_lamps_;
   m.add_shadow_passes(skipped);
-  if (m.occlusion_) {
-    if (m.frame_.light_stage->lighting().ambient_is_residual) {
-      // The residual estimate (lamps without an environment) is the room's own bounce as seen
-      // through the camera; occluding it measured worse (corner, baseline high RDE 0.339 ->
-      // 0.349) and changed no other lamp scene, so it stays unoccluded.
-      m.occlusion_->skip();
-      skipped.push_back("env_occlusion: the ambient is the lamps' residual estimate, not occluded");
-    } else {
-      m.occlusion_->record(level.env_occlusion, m.ambient_rv_, skipped);
-    }
-  }
+  m.record_occlusion(level.env_occlusion, m.ambient_rv_, skipped);
   m.add_shade_pass(*m.shade_pipelines_.at(variant_of(indirect, m.caustics_).key()));
   return ok_status();
 }
@@ -545,6 +537,29 @@ void DirectLightBlock::Impl::render_faces(VkCommandBuffer cmd, gpu::PassContext&
     }
     pass.context().fn().cmd_end_rendering(cmd);
   }
+}
+
+void DirectLightBlock::Impl::record_occlusion(const EnvOcclusionLevel& level, const light::ShRgb& ambient,
+                                              std::vector<std::string>& skipped) {
+  if (!occlusion_) return;
+  if (frame_.light_stage->lighting().ambient_is_residual) {
+    // The residual estimate (lamps without an environment) is the room's own bounce as seen
+    // through the camera; occluding it measured worse (corner, baseline high RDE 0.339 ->
+    // 0.349) and changed no other lamp scene, so it stays unoccluded.
+    occlusion_->skip();
+    skipped.push_back("env_occlusion: the ambient is the lamps' residual estimate, not occluded");
+  } else {
+    occlusion_->record(level, ambient, skipped);
+  }
+}
+
+DirectLightBlock::EnvOcclusionResult DirectLightBlock::record_env_occlusion(const EnvOcclusionLevel& level,
+                                                                            const light::ShRgb& ambient,
+                                                                            std::vector<std::string>& skipped) {
+  Impl& m = *impl_;
+  if (!m.occlusion_) return {m.no_occlusion_, 0};
+  m.record_occlusion(level, ambient, skipped);
+  return {m.occlusion_->image(), m.occlusion_->divisor()};
 }
 
 void DirectLightBlock::begin_frame() { impl_->recorded_ = false; }

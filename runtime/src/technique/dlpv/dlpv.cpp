@@ -58,6 +58,7 @@ namespace {
 struct MergePush {
   glm::vec4 grid;    // min corner, cell size
   glm::vec4 extent;  // cells allocated, cells used, V^Delta present, V^rho present
+  glm::ivec4 occlusion{0};  // x: the environment occlusion's divisor (0: none this frame)
 };
 
 // The volume around the virtual objects: twice their largest bounding-box edge (paper Sec. 4.2),
@@ -82,7 +83,7 @@ class Dlpv final : public Laddered<DlpvLevel> {
   Status record_volumes(const frame::FrameInfo& info, const DlpvLevel& level, MadeVolumes& made,
                         std::vector<std::string>& skipped);
   uint32_t inject_lamps(const DlpvLevel& level, float radius, uint32_t stride, std::vector<std::string>& skipped);
-  void add_merge_pass(const MergePush& push);
+  void add_merge_pass(const MergePush& push, gpu::ImageHandle env_occlusion);
 
   frame::FrameResources shared_;
   gpu::BufferHandle lights_;  // shader::LightSet, one per frame slot
@@ -183,7 +184,15 @@ Status Dlpv::record(const frame::FrameInfo& info, std::vector<std::string>& skip
   MadeVolumes made;
   MRGI_TRY(record_volumes(info, level, made, skipped));
   if (antiradiance) {
-    add_merge_pass(made.push);
+    // The volume's antiradiance shadows the lamps it injects; the ambient's occlusion by the
+    // objects is the direct-light block's, as at the other levels.
+    const light::Lighting& lighting = shared_.light_stage->lighting();
+    light::ShRgb ambient;
+    for (size_t i = 0; i < ambient.size(); ++i) ambient[i] = lighting.ambient_real[i] + lighting.ambient_virtual[i];
+    const shading::DirectLightLevel& direct = shading::direct_light_levels()[size_t(level.baseline_level)];
+    const auto occlusion = direct_->record_env_occlusion(direct.env_occlusion, ambient, skipped);
+    made.push.occlusion.x = occlusion.divisor;
+    add_merge_pass(made.push, occlusion.image);
     return ok_status();
   }
   const gpu::ImageHandle dvol[3] = {delta_->accumulated(0), delta_->accumulated(1), delta_->accumulated(2)};
@@ -336,7 +345,7 @@ uint32_t Dlpv::inject_lamps(const DlpvLevel& level, float radius, uint32_t strid
 
 // The antiradiance levels' own shading (dlpv/merge.comp): lamps unshadowed, V^Delta's
 // antiradiance for their shadows and its bounce, V^rho on virtual pixels.
-void Dlpv::add_merge_pass(const MergePush& push) {
+void Dlpv::add_merge_pass(const MergePush& push, gpu::ImageHandle env_occlusion) {
   gpu::FrameGraph& graph = *shared_.graph;
   const frame::FrameResources& r = shared_;
   const gpu::Pipeline* merge = &*merge_;
@@ -348,6 +357,7 @@ void Dlpv::add_merge_pass(const MergePush& push) {
       [&](gpu::ShaderPassBuilder& b) {
         frame::bind_shading_gbuffers(b, r);
         b.bind("LightUbo", lights_);
+        b.bind("env_occlusion", env_occlusion);
         const char* d[3] = {"delta_r", "delta_g", "delta_b"};
         const char* p[3] = {"rho_r", "rho_g", "rho_b"};
         for (int c = 0; c < 3; ++c) {
