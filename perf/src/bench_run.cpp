@@ -144,6 +144,7 @@ Expected<RunSamples> run_one(const LoadedScene& l, const std::string& technique,
   RunSamples r;
   BenchEntry& e = r.entry;
   e.scene = l.suite.name;
+  e.set = l.suite.set;
   e.technique = technique;
   e.level = level;
   const auto level_names = rt->level_names();
@@ -320,7 +321,7 @@ Expected<BenchResult> run_bench(const BenchSettings& s) {
                    !shell_first_line("git -C '" + src_dir + "' status --porcelain --untracked-files=no 2>/dev/null").empty();
   }
 
-  auto suite = load_suite(s.suite);
+  auto suite = load_suites(s.suite);
   if (!suite.ok()) return suite.error();
   auto scenes = select_scenes(*suite, s.scenes);
   if (!scenes.ok()) return scenes.error();

@@ -81,6 +81,52 @@ Status write_text(const std::string& path, const std::string& text) {
   return ok_status();
 }
 
+// With scenes from more than one manifest: per set and technique level, the median over its
+// scenes of each scene's RDE (pooled over its frames) and the worst scene, so a set made by
+// another renderer (perf/cycles-*.json) reads beside the suite instead of inside its mean.
+std::string accuracy_by_set(const BenchResult& r) {
+  std::vector<std::string> sets;
+  for (const BenchEntry& e : r.entries)
+    if (std::find(sets.begin(), sets.end(), e.set) == sets.end()) sets.push_back(e.set);
+  if (sets.size() < 2) return "";
+  std::ostringstream o;
+  o << "## Accuracy by scene set\n\nMedian over each set's scenes of the scene's RDE (its measured frames pooled), "
+       "and the set's worst scene by all-pixel RDE:\n\n"
+       "| set | technique | level | scenes | RDE all | RDE real | RDE virtual | worst scene (all) |\n"
+       "|---|---|---|---:|---:|---:|---:|---|\n";
+  for (const std::string& set : sets) {
+    std::vector<std::pair<std::string, int>> levels;  // technique, level, in first-seen order
+    for (const BenchEntry& e : r.entries)
+      if (e.set == set && e.has_reference &&
+          std::find(levels.begin(), levels.end(), std::make_pair(e.technique, e.level)) == levels.end())
+        levels.emplace_back(e.technique, e.level);
+    for (const auto& [technique, level] : levels) {
+      std::vector<double> all, real, virt;
+      std::string name, worst;
+      double worst_rde = -1.0;
+      for (const BenchEntry& e : r.entries) {
+        if (e.set != set || e.technique != technique || e.level != level || !e.has_reference) continue;
+        name = e.level_name;
+        if (e.error.all.rde_defined) {
+          all.push_back(e.error.all.rde);
+          if (e.error.all.rde > worst_rde) {
+            worst_rde = e.error.all.rde;
+            worst = e.scene;
+          }
+        }
+        if (e.error.real.rde_defined) real.push_back(e.error.real.rde);
+        if (e.error.virtual_.rde_defined) virt.push_back(e.error.virtual_.rde);
+      }
+      auto med = [](const std::vector<double>& v) { return v.empty() ? std::string("-") : fmt(percentile(v, 50), 3); };
+      o << "| " << set << " | " << technique << " | " << level << " " << name << " | " << all.size() << " | "
+        << med(all) << " | " << med(real) << " | " << med(virt) << " | "
+        << (worst.empty() ? std::string("-") : worst + " " + fmt(worst_rde, 3)) << " |\n";
+    }
+  }
+  o << "\n";
+  return o.str();
+}
+
 }  // namespace
 
 nlohmann::json bench_json(const BenchResult& r, const CheckReport* check) {
@@ -114,6 +160,7 @@ nlohmann::json bench_json(const BenchResult& r, const CheckReport* check) {
       passes.push_back(pj);
     }
     entries.push_back({{"scene", e.scene},
+                       {"set", e.set},
                        {"technique", e.technique},
                        {"level", e.level},
                        {"level_name", e.level_name},
@@ -229,6 +276,7 @@ std::string report_markdown(const BenchResult& r, const CheckReport* check) {
       << " | " << fmt(f.p95_ms, 3) << " | " << fmt(f.min_ms, 3) << " |\n";
   o << "\n";
 
+  o << accuracy_by_set(r);
   const std::vector<LevelAggregate> levels = aggregate_levels(r);
   std::vector<size_t> plotted;
   const std::vector<size_t> front = front_of(levels, &plotted);

@@ -1,5 +1,6 @@
 #include "mrgi/perf/suite.h"
 
+#include <algorithm>
 #include <cctype>
 #include <filesystem>
 #include <fstream>
@@ -74,10 +75,34 @@ Expected<std::vector<SuiteScene>> load_suite(const std::string& path) {
     fs::path cap(capture);
     if (cap.is_relative()) cap = base / cap;
     scene.capture = cap.lexically_normal().string();
+    scene.set = fs::path(path).stem().string();
     scenes.push_back(std::move(scene));
   }
   if (scenes.empty()) return fail(ErrorKind::BadInput, path + ": the suite lists no scenes");
   return scenes;
+}
+
+Expected<std::vector<SuiteScene>> load_suites(const std::string& paths) {
+  std::vector<SuiteScene> all;
+  std::vector<std::string> from;  // per scene of `all`, its manifest
+  size_t start = 0;
+  while (start <= paths.size()) {
+    const size_t comma = std::min(paths.find(',', start), paths.size());
+    const std::string path = paths.substr(start, comma - start);
+    start = comma + 1;
+    if (path.empty()) return fail(ErrorKind::BadUsage, "--suite: an empty manifest path in '" + paths + "'");
+    auto scenes = load_suite(path);
+    if (!scenes.ok()) return scenes.error();
+    for (SuiteScene& s : *scenes) {
+      for (size_t i = 0; i < all.size(); ++i)
+        if (all[i].name == s.name)
+          return fail(ErrorKind::BadInput, path + ": scene name '" + s.name + "' is also in " + from[i] +
+                                               " (names must be unique over the manifests of one run)");
+      all.push_back(std::move(s));
+      from.push_back(path);
+    }
+  }
+  return all;
 }
 
 Expected<std::vector<SuiteScene>> select_scenes(const std::vector<SuiteScene>& suite,

@@ -17,7 +17,8 @@ struct DvctParams {
                  // diffuse and specular cones' reach (m); w: roughness at and above which no
                  // specular cone is traced (the diffuse cones hold that light)
   ivec4 mode;    // x: G-buffer pixels per indirect texel (indirect.comp); y: 1 the volumes hold
-                 // this frame's light (0: no virtual object or lamp: nothing changes); z, w unused
+                 // this frame's light (0: no virtual object or lamp: nothing changes); z: the
+                 // environment occlusion's divisor (shade.comp; 0: none this frame); w unused
   vec4 texture;  // x: voxels per side allocated (a cheaper level uses a corner of each mip
                  // level: texture coordinates divide by this); y, z, w unused
 };

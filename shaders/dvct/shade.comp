@@ -39,10 +39,15 @@ layout(set = 0, binding = 13, rgba16f) writeonly uniform image2D lit_rv;
 layout(set = 0, binding = 14, rgba16f) writeonly uniform image2D lit_r;
 layout(std140, set = 0, binding = 15) uniform RealMaterialUbo { DvctRealMaterials real_materials; };
 layout(push_constant) uniform Params { DvctParams params_block; };
+// The direct-light block's environment occlusion (shading/environment_occlusion.h), one texel
+// per params.mode.z internal pixels (0: none this frame): the ambient is unshadowed here as in
+// baseline, and its occlusion by the objects is the block's, not the cones'.
+layout(set = 0, binding = 16, rgba16f) readonly uniform image2D env_occlusion;
 DvctParams params;
 layout(constant_id = 0) const int kDiffuseCones = 9;
 layout(constant_id = 1) const bool kSpecular = true;
 #include "dvct/cone_shading.glsl"
+#include "shading/env_occlusion_lookup.glsl"
 
 void main() {
   frame = frame_ubo;  // MRGI_UNIFORM_COPIES
@@ -100,11 +105,13 @@ void main() {
     DvctGather d;
     d.with = vec3(0.0f);
     if (volumes) d = dvct_diffuse(p, n, VCT_LIGHT);
-    l_rv += alb.rgb * (1.0f - alb.a) * (1.0f / MRGI_PI) * (ambient_irradiance(ambient_rv, n) + d.with);
+    l_rv += alb.rgb * (1.0f - alb.a) * (1.0f / MRGI_PI) *
+            (occluded_ambient(ambient_irradiance(ambient_rv, n), pixel, p, true, params.mode.z) + d.with);
     if (volumes) l_rv += dvct_specular(p, n, view, mix(vec3(0.04f), alb.rgb, alb.a), nrm.w, VCT_LIGHT).with;
     if (frame.flags.y != 0) l_rv += imageLoad(virtual_emission, pixel).rgb;
   } else {
-    const vec3 amb_rv = ambient_irradiance(ambient_rv, n), amb_r = ambient_irradiance(ambient_r, n);
+    const vec3 amb_rv = occluded_ambient(ambient_irradiance(ambient_rv, n), pixel, p, false, params.mode.z);
+    const vec3 amb_r = ambient_irradiance(ambient_r, n);
     l_r += alb.rgb * (1.0f / MRGI_PI) * amb_r;
     l_rv += alb.rgb * (1.0f / MRGI_PI) * amb_rv;
     if (volumes && dvct_near_region(p, 0.25f * side)) {

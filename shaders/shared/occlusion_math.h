@@ -13,6 +13,10 @@
 //     at the cap's centre (Funk-Hecke with the cap's indicator as kernel), so the mean radiance
 //     the cap hides is one evaluation of the environment's SH with per-band factors
 //     (sh_cap_mean_radiance), not an integral per pixel.
+//   - cap_overlap_solid_angle: the solid angle two caps share (exact), so a bright, broad part
+//     of the environment (a low sun behind haze, a window) kept apart from the SH as a cone is
+//     hidden by the part of it a sphere's cap covers: its shadow falls in its direction, which
+//     an SH of 4 bands blurs over the whole hemisphere.
 // Several spheres combine as independent occluders: the blocked fraction is 1 - prod(1 - f_i)
 // (overlapping spheres of one object would count their shared part twice if summed), and the
 // blocked radiance is the f-weighted mean of their caps' radiance (sphere_occlusion_add /
@@ -77,6 +81,32 @@ MRGI_FN vec3 sh_irradiance16(SH16 r, SH16 g, SH16 b, vec3 n) {
   return max(vec3(sh_dot(r, y), sh_dot(g, y), sh_dot(b, y)), vec3(0.0f));
 }
 
+// Solid angle (sr) shared by two caps on the unit sphere with half-angles a and b (radians,
+// 0..pi/2) whose centres are `theta` apart (0..pi). The lune of two small circles: with
+// x = cos(theta), 2 [pi - acos((x - cos a cos b) / (sin a sin b))
+//                    - cos a acos((cos b - x cos a) / (sin theta sin a))
+//                    - cos b acos((cos a - x cos b) / (sin theta sin b))];
+// the smaller cap's whole solid angle when it lies inside the other, 0 when they are apart.
+MRGI_FN float cap_overlap_solid_angle(float theta, float a, float b) {
+  float lo = min(a, b), hi = max(a, b);
+  if (theta >= a + b || lo <= 0.0f) return 0.0f;
+  if (theta <= hi - lo) return 2.0f * MRGI_PI * (1.0f - cos(lo));
+  if (a + b < 0.2f) {
+    // Small caps: the lens of two discs in the tangent plane (relative error about (a + b)^2 / 8,
+    // where the spherical form loses its digits to cos ~ 1 in single precision).
+    float d = max(theta, 1e-9f);
+    float u = clamp((d * d + a * a - b * b) / (2.0f * d * a), -1.0f, 1.0f);
+    float v = clamp((d * d + b * b - a * a) / (2.0f * d * b), -1.0f, 1.0f);
+    float k = max((-d + a + b) * (d + a - b) * (d - a + b) * (d + a + b), 0.0f);
+    return max(a * a * acos(u) + b * b * acos(v) - 0.5f * sqrt(k), 0.0f);
+  }
+  float ca = cos(a), cb = cos(b), sa = sin(a), sb = sin(b), x = cos(theta), st = max(sin(theta), 1e-6f);
+  float t0 = acos(clamp((x - ca * cb) / max(sa * sb, 1e-12f), -1.0f, 1.0f));
+  float t1 = acos(clamp((cb - x * ca) / max(st * sa, 1e-12f), -1.0f, 1.0f));
+  float t2 = acos(clamp((ca - x * cb) / max(st * sb, 1e-12f), -1.0f, 1.0f));
+  return clamp(2.0f * (MRGI_PI - t0 - ca * t1 - cb * t2), 0.0f, 2.0f * MRGI_PI * (1.0f - cos(lo)));
+}
+
 // Accumulated occlusion of a point: product of the unblocked fractions, and the sum of f_i and
 // of f_i times cap radiance_i.
 struct SphereOcclusion {
@@ -106,15 +136,22 @@ MRGI_FN vec3 sphere_occlusion_irradiance(SphereOcclusion o) {
 
 // The environment-occlusion pass's uniform block (shading/environment_occlusion.h), std140.
 #define MRGI_MAX_OCCLUDER_SPHERES 64
+#define MRGI_MAX_OCCLUSION_REGIONS 4
 struct EnvOcclusionSet {
   ivec4 count;                                   // x spheres; y divisor (internal pixels a texel side)
   vec4 radiance[12];                             // radiance SH16 of the occludable light: r c0..c3, g, b
   vec4 spheres[MRGI_MAX_OCCLUDER_SPHERES];       // world xyz centre, w radius (metres)
   vec4 albedo[MRGI_MAX_OCCLUDER_SPHERES];        // rgb the sphere's object's mean diffuse albedo
+  // count.z broad regions kept apart from `radiance` (cap_overlap_solid_angle): xyz the unit
+  // direction towards the region, w its cone's half-angle (radians); rgb its irradiance at
+  // normal incidence (W/m^2).
+  vec4 regions[MRGI_MAX_OCCLUSION_REGIONS];
+  vec4 region_irradiance[MRGI_MAX_OCCLUSION_REGIONS];
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(EnvOcclusionSet) == 16 * (1 + 12 + 2 * MRGI_MAX_OCCLUDER_SPHERES), "std140 mirror");
+static_assert(sizeof(EnvOcclusionSet) == 16 * (1 + 12 + 2 * MRGI_MAX_OCCLUDER_SPHERES + 2 * MRGI_MAX_OCCLUSION_REGIONS),
+              "std140 mirror");
 #undef MRGI_FN
 }  // namespace mrgi::shader
 #else

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
 #include <random>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -269,15 +270,19 @@ TEST(LightStage, UniformEnvironmentLightsAnUpFacingSurfaceLikeTheMean) {
 
 }  // namespace
 
-// An environment of uniform radiance `base` with a cap of half-angle `cap_deg` around `dir` at
-// `contrast` times it, as an equirectangular file, lit through the stage; the shadowed lights.
-static std::vector<LightDesc> shadowed_lights_of(double cap_deg, double contrast, const std::string& name) {
+static const glm::dvec3 kCapDirection = glm::normalize(glm::dvec3(0.3, 0.8, -0.5));
+
+// An environment of uniform radiance 0.1 with a cap of half-angle `cap_deg` around
+// kCapDirection at `contrast` times it, as an equirectangular file, lit through the stage
+// (`settings`); the stage's lighting.
+static std::optional<Lighting> lighting_of(double cap_deg, double contrast, const std::string& name,
+                                           const LightStageSettings& settings = {}) {
   const int w = 256, h = 128;
-  const glm::dvec3 dir = glm::normalize(glm::dvec3(0.3, 0.8, -0.5));
   ImageRGBF img(w, h);
   for (int v = 0; v < h; ++v)
     for (int u = 0; u < w; ++u) {
-      const double l = glm::dot(equirect_direction(u, v, w, h), dir) >= std::cos(cap_deg * kDeg) ? 0.1 * contrast : 0.1;
+      const double l =
+          glm::dot(equirect_direction(u, v, w, h), kCapDirection) >= std::cos(cap_deg * kDeg) ? 0.1 * contrast : 0.1;
       float* t = img.at(u, v);
       t[0] = t[1] = t[2] = float(l);
     }
@@ -286,12 +291,51 @@ static std::vector<LightDesc> shadowed_lights_of(double cap_deg, double contrast
   SceneDesc scene;
   scene.environment.present = true;
   scene.environment.image = path;
-  auto stage = LightStage::create({}, scene, CameraSetup{});
+  auto stage = LightStage::create(settings, scene, CameraSetup{});
   EXPECT_TRUE(stage.ok());
-  if (!stage.ok()) return {};
-  for (const LightDesc& l : (*stage)->lighting().lights)
-    EXPECT_LT(angle_deg(-glm::dvec3(l.direction), dir), 8.0) << name;  // a region holds some of the rest too
-  return (*stage)->lighting().lights;
+  if (!stage.ok()) return std::nullopt;
+  return (*stage)->lighting();
+}
+
+// The broad bright parts of the ambient are kept as cones for the objects' occlusion
+// (Lighting::ambient_regions, LightStageSettings::occlusion_region_min_contrast): a big bright
+// window's regions, most concentrated first, pointing at it; none in a uniform environment once
+// the rule asks for more than its mean; never a region that is a shadowed light.
+TEST(LightStage, AmbientRegionsAreTheBroadBrightParts) {
+  auto broad = lighting_of(30.0, 20.0, "regions_broad");
+  ASSERT_TRUE(broad);
+  ASSERT_FALSE(broad->ambient_regions.empty());
+  EXPECT_LE(broad->ambient_regions.size(), size_t(Lighting::kMaxOcclusionRegions));
+  EXPECT_TRUE(broad->lights.empty());
+  for (const Lighting::AmbientRegion& r : broad->ambient_regions) {
+    EXPECT_LT(angle_deg(r.direction, kCapDirection), 30.0);  // inside the window's cone
+    EXPECT_GT(r.half_angle_rad, 0.0);
+    EXPECT_LT(r.half_angle_rad, 30.0 * kDeg);  // a median cut splits it
+    EXPECT_GT(luminance(r.irradiance), 0.0);
+  }
+  LightStageSettings strict;
+  strict.occlusion_region_min_contrast = 2.0;
+  auto uniform = lighting_of(0.0, 1.0, "regions_uniform", strict);
+  ASSERT_TRUE(uniform);
+  EXPECT_TRUE(uniform->ambient_regions.empty());
+  auto still = lighting_of(30.0, 20.0, "regions_broad_strict", strict);
+  ASSERT_TRUE(still);
+  EXPECT_FALSE(still->ambient_regions.empty());
+  // A compact bright source is a shadowed light, not also an ambient region.
+  auto compact = lighting_of(6.0, 200.0, "regions_compact");
+  ASSERT_TRUE(compact);
+  ASSERT_FALSE(compact->lights.empty());
+  for (const Lighting::AmbientRegion& r : compact->ambient_regions)
+    EXPECT_GT(angle_deg(r.direction, -glm::dvec3(compact->lights[0].direction)), 1e-3);
+}
+
+// The shadowed lights of lighting_of's environment.
+static std::vector<LightDesc> shadowed_lights_of(double cap_deg, double contrast, const std::string& name) {
+  auto lighting = lighting_of(cap_deg, contrast, name);
+  if (!lighting) return {};
+  for (const LightDesc& l : lighting->lights)
+    EXPECT_LT(angle_deg(-glm::dvec3(l.direction), kCapDirection), 8.0) << name;  // a region holds some of the rest too
+  return lighting->lights;
 }
 
 // The stage refuses settings of its environment rules that cannot work, naming them.
@@ -311,6 +355,9 @@ TEST(LightStage, RefusesBadEnvironmentRuleSettings) {
   s = {};
   s.near_field_step_m = 0.0;
   refused(s, "near_field_step_m");
+  s = {};
+  s.occlusion_region_min_contrast = -1.0;
+  refused(s, "occlusion_region_min_contrast");
   EXPECT_TRUE(LightStage::create({}, scene, CameraSetup{}).ok());
 }
 

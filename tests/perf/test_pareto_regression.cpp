@@ -311,6 +311,38 @@ TEST(Suite, Refusals) {
   EXPECT_ERROR(perf::load_suite(dir.file("e.json")), BadInput, "scenes[0].capture", "string");
 }
 
+// Several manifests read as one run: scenes in order, each with its set's name; a name two
+// manifests share is refused naming both files.
+TEST(Suite, SeveralManifestsAsOneRun) {
+  TempDir dir;
+  write_text(dir.file("perf/suite.json"), R"({"scenes": [{"name": "desk", "capture": "perf/suite/desk"}]})");
+  write_text(dir.file("perf/cycles-heldout.json"), R"({"scenes": [{"name": "sky", "capture": "perf/cycles/sky"}]})");
+  auto s = perf::load_suites(dir.file("perf/suite.json") + "," + dir.file("perf/cycles-heldout.json"));
+  ASSERT_TRUE(s.ok()) << s.error().message;
+  ASSERT_EQ(s->size(), 2u);
+  EXPECT_EQ((*s)[0].set, "suite");
+  EXPECT_EQ((*s)[1].name, "sky");
+  EXPECT_EQ((*s)[1].set, "cycles-heldout");
+  EXPECT_EQ((*s)[1].capture, dir.file("perf/cycles/sky"));
+  write_text(dir.file("perf/again.json"), R"({"scenes": [{"name": "desk", "capture": "x"}]})");
+  EXPECT_ERROR(perf::load_suites(dir.file("perf/suite.json") + "," + dir.file("perf/again.json")), BadInput,
+               "'desk'", "suite.json");
+  EXPECT_ERROR(perf::load_suites(dir.file("perf/suite.json") + ","), BadUsage, "empty manifest path");
+}
+
+// With more than one set, the report gives each set's median RDE apart; with one, no such table.
+TEST(Report, AccuracyBySetWhenSeveralSets) {
+  perf::BenchResult r = constructed_result();
+  EXPECT_EQ(perf::report_markdown(r, nullptr).find("Accuracy by scene set"), std::string::npos);
+  for (perf::BenchEntry& e : r.entries) e.set = e.scene == "desk" ? "suite" : "cycles-heldout";
+  const std::string md = perf::report_markdown(r, nullptr);
+  EXPECT_NE(md.find("## Accuracy by scene set"), std::string::npos);
+  // desk (suite): RDE 0.3 at high, 0.5 at low, the worst of its set; empty has no defined RDE.
+  EXPECT_NE(md.find("| suite | baseline | 0 high | 1 | 0.300 | - | - | desk 0.300 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| suite | baseline | 1 low | 1 | 0.500 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| cycles-heldout | baseline | 0 high | 0 | - | - | - | - |"), std::string::npos) << md;
+}
+
 TEST(Plot, DrawsSeriesFrontAndAxes) {
   perf::BenchResult r = constructed_result();
   const mrgi::ImageRGB8 img = perf::render_pareto_plot(r);

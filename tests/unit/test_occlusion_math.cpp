@@ -2,6 +2,7 @@
 // integration over the sphere: the same functions environment_occlusion.comp runs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "shared/occlusion_math.h"
@@ -99,6 +100,59 @@ TEST(OcclusionMath, CapMeanRadianceMatchesIntegration) {
   EXPECT_NEAR(h.z, 0.0f, 1e-6f);
   EXPECT_NEAR(h.w, -0.125f, 1e-6f);
   for (int i = 0; i < 4; ++i) EXPECT_NEAR(p[i], 1.0f, 1e-4f);
+}
+
+// Solid angle two caps share, by a product quadrature over the smaller cap (around +z), cap b's
+// centre `theta` away in the xz plane.
+double numeric_cap_overlap(double theta, double a, double b) {
+  const double small = std::min(a, b), big = std::max(a, b);
+  const glm::dvec3 c(std::sin(theta), 0.0, std::cos(theta));
+  const int nt = 1500, np = 3000;
+  double sum = 0.0;
+  for (int i = 0; i < nt; ++i) {
+    const double t = (i + 0.5) / nt * small;
+    for (int j = 0; j < np; ++j) {
+      const double p = (j + 0.5) / np * 2.0 * kPi;
+      const glm::dvec3 w(std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t));
+      if (glm::dot(w, c) >= std::cos(big)) sum += std::sin(t);
+    }
+  }
+  return sum * (small / nt) * (2.0 * kPi / np);
+}
+
+TEST(OcclusionMath, CapOverlapMatchesIntegration) {
+  // {theta, a, b}: partial overlaps of small and large caps, a cap nearly inside the other, and
+  // two hemispheres.
+  const double cases[][3] = {{0.3, 0.2, 0.25}, {0.5, 0.1, 0.45}, {0.2, 0.4, 0.4}, {1.0, 0.8, 0.5},
+                             {0.38, 0.1, 0.3}, {0.7, 1.5707, 1.5707}, {0.05, 0.02, 0.04},
+                             {0.12, 0.09, 0.1}, {0.15, 0.1, 0.11}};  // either side of the small-cap form
+  for (const auto& c : cases) {
+    const double expected = numeric_cap_overlap(c[0], c[1], c[2]);
+    const float got = cap_overlap_solid_angle(float(c[0]), float(c[1]), float(c[2]));
+    EXPECT_NEAR(got, expected, 1e-3 * (2.0 * kPi * (1.0 - std::cos(std::min(c[1], c[2])))) + 1e-6)
+        << "theta " << c[0] << " a " << c[1] << " b " << c[2];
+    // Symmetric in the two caps.
+    EXPECT_NEAR(got, cap_overlap_solid_angle(float(c[0]), float(c[2]), float(c[1])), 1e-5 + 1e-4 * got);
+  }
+}
+
+TEST(OcclusionMath, CapOverlapLimits) {
+  // Apart: nothing; one inside the other: the smaller cap whole; two hemispheres theta apart:
+  // 2 (pi - theta).
+  EXPECT_EQ(cap_overlap_solid_angle(0.5f, 0.2f, 0.25f), 0.0f);
+  const float inside = cap_overlap_solid_angle(0.1f, 0.1f, 0.3f);
+  EXPECT_NEAR(inside, 2.0 * kPi * (1.0 - std::cos(0.1)), 1e-6);
+  EXPECT_NEAR(cap_overlap_solid_angle(0.7f, 1.5707963f, 1.5707963f), 2.0 * (kPi - 0.7), 1e-4);
+  // Grows as the caps come together, never beyond the smaller cap.
+  float last = -1.0f;
+  for (int i = 40; i >= 0; --i) {
+    const float v = cap_overlap_solid_angle(0.6f * float(i) / 40.0f, 0.2f, 0.35f);
+    EXPECT_TRUE(std::isfinite(v));
+    EXPECT_GE(v, last - 1e-6f);
+    EXPECT_LE(v, 2.0 * kPi * (1.0 - std::cos(0.2)) + 1e-6);
+    last = v;
+  }
+  EXPECT_EQ(cap_overlap_solid_angle(0.3f, 0.0f, 0.4f), 0.0f);
 }
 
 TEST(OcclusionMath, DisjointSpheresUnderAUniformSkyBlockTheirSolidAngle) {

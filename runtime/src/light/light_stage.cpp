@@ -65,6 +65,8 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
   if (!(settings.shadowed_min_contrast >= 0.0) || !(settings.shadowed_max_solid_angle_sr > 0.0))
     return fail(ErrorKind::BadUsage, "LightStageSettings.shadowed_min_contrast must be >= 0 and "
                                      "shadowed_max_solid_angle_sr > 0");
+  if (!(settings.occlusion_region_min_contrast >= 0.0))
+    return fail(ErrorKind::BadUsage, "LightStageSettings.occlusion_region_min_contrast must be >= 0");
   const LampRemovalSettings& lr = settings.lamp_removal;
   if (!(lr.contrast > 0.0) || !(lr.search_deg > 0.0) || !(lr.max_deg > 0.0) || !(lr.ring_inner_deg > 0.0) ||
       !(lr.ring_outer_deg > lr.ring_inner_deg))
@@ -122,6 +124,8 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
   s.last_env_directions_.reserve(kMaxStageLights);
   s.lighting_.light_sh.reserve(kMaxStageLights);
   s.lighting_.foldable.reserve(kMaxStageLights);
+  s.lighting_.ambient_regions.reserve(Lighting::kMaxOcclusionRegions);
+  s.region_order_.reserve(64);
   for (const LightDesc& l : scene.lights) {
     s.lighting_.lights.push_back(l);
     s.lighting_.light_sh.push_back(ShRgb{});
@@ -294,8 +298,37 @@ void LightStage::set_environment_lighting(bool real) {
   }
   lighting_.ambient_real = real ? ambient : ShRgb{};
   lighting_.ambient_virtual = real ? ShRgb{} : ambient;
+  set_ambient_regions();
   if (changed) ++lighting_.revision;
   finish_declared();
+}
+
+void LightStage::set_ambient_regions() {
+  // The regions not drawn as lights, brighter than the environment's mean by the stated
+  // contrast, most concentrated (highest mean radiance) first.
+  lighting_.ambient_regions.clear();
+  const auto& regions = env_->lights();
+  const double mean = env_->mean_lit_luminance();
+  if (!(mean > 0.0)) return;
+  region_order_.clear();
+  for (size_t k = 0; k < regions.size(); ++k) {
+    const EnvLight& r = regions[k];
+    if (std::find(shadowed_regions_.begin(), shadowed_regions_.end(), k) != shadowed_regions_.end()) continue;
+    if (!(r.solid_angle_sr > 0.0) || !(r.lit_solid_angle_sr > 0.0)) continue;
+    const double contrast = luminance(r.irradiance) / r.lit_solid_angle_sr / mean;
+    if (contrast >= settings_.occlusion_region_min_contrast) region_order_.emplace_back(contrast, k);
+  }
+  std::sort(region_order_.begin(), region_order_.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  for (size_t i = 0; i < region_order_.size() && i < size_t(Lighting::kMaxOcclusionRegions); ++i) {
+    const EnvLight& r = regions[region_order_[i].second];
+    Lighting::AmbientRegion a;
+    a.direction = r.direction;
+    a.irradiance = r.irradiance;
+    // The cone of the region's solid angle (at most a hemisphere).
+    a.half_angle_rad = std::acos(std::clamp(1.0 - r.solid_angle_sr / (2.0 * kPi), 0.0, 1.0));
+    a.sh = r.region_sh;
+    lighting_.ambient_regions.push_back(a);
+  }
 }
 
 void LightStage::set_probeless_lighting() {
@@ -323,6 +356,7 @@ void LightStage::set_probeless_lighting() {
   }
   lighting_.ambient_real = ambient;
   lighting_.ambient_virtual = ShRgb{};
+  lighting_.ambient_regions.clear();
   lighting_.estimate = est;
   ++lighting_.revision;
 }
@@ -415,6 +449,7 @@ Status LightStage::update(const InputFrame& frame, const glm::dmat4& camera_to_w
       lighting_.light_sh.resize(size_t(declared_));
       lighting_.foldable.resize(size_t(declared_));
       lighting_.ambient_real = lighting_.ambient_virtual = ShRgb{};
+      lighting_.ambient_regions.clear();
       lighting_.source = declared_ > 0 ? LightSourceKind::Declared : LightSourceKind::None;
       finish_declared();
     }

@@ -23,6 +23,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -60,11 +61,16 @@ struct LightStageSettings {
   // walls and ceiling, a lit wall close to the env camera, which a median cut splits into broad
   // regions of ordinary radiance) stays in the ambient SH, which the direct-light block occludes
   // softly by the virtual objects (shading/environment_occlusion.h) instead of casting a few
-  // long hard shadows from it. 0.5 sr: a cone of 23 degrees half-angle (a 1.5 m window seen from
-  // 2 m); contrast 3: a sun or window is tens to thousands of times the mean, an overcast sky's
+  // long hard shadows from it. 0.05 sr: a cone of 7.2 degrees half-angle (a window 0.5 m across
+  // seen from 2 m); contrast 3: a sun or window is tens to thousands of times the mean, an overcast sky's
   // or a room's brightest broad parts 1-2 times.
   double shadowed_min_contrast = 3.0;
   double shadowed_max_solid_angle_sr = 0.05;
+  // Of the regions left in the ambient, those whose mean radiance is at least this many times
+  // the environment's mean are also kept as cones for the virtual objects' occlusion
+  // (Lighting::ambient_regions): a region brighter than the mean is where the objects' soft
+  // shadow points; at or below it, the SH's blur loses little. >= 0.
+  double occlusion_region_min_contrast = 1.0;
   // What an env camera cannot see (below an upward fisheye's horizon: the floor and the room
   // around the virtual objects) lights them as the mean radiance the colour camera sees, not as
   // darkness. Why: the light from below is what the real surfaces reflect, and the camera
@@ -179,6 +185,20 @@ struct Lighting {
   // Radiance SH (4 bands) of the light not in `lights`: real (lights real and virtual surfaces)
   // and virtual (a virtual environment: lights virtual surfaces only).
   ShRgb ambient_real{}, ambient_virtual{};
+  // The broadest-bright parts of the ambient's environment, kept as cones for the virtual
+  // objects' occlusion of it (shading/environment_occlusion.h: their shadows fall in their
+  // direction, which the SH blurs): the regions not drawn as lights whose mean radiance is at
+  // least LightStageSettings::occlusion_region_min_contrast x the environment's, most
+  // concentrated first, at most kMaxOcclusionRegions. Their light stays in the ambient SH too
+  // (`sh` is its part). Empty without an environment.
+  struct AmbientRegion {
+    glm::dvec3 direction{0.0, 1.0, 0.0};  // unit, world, towards the region
+    glm::dvec3 irradiance{0.0};           // W/m^2 per linear RGB channel at normal incidence
+    double half_angle_rad = 0.0;          // of the cone of the region's solid angle
+    ShRgb sh{};                           // the region's radiance SH (EnvLight::region_sh)
+  };
+  static constexpr int kMaxOcclusionRegions = 4;
+  std::vector<AmbientRegion> ambient_regions;
   // ambient_real is the residual estimate (LightStageSettings::residual_light): all of the
   // real light but the lamps' direct light, the real scene's own bounce included.
   bool ambient_is_residual = false;
@@ -246,6 +266,8 @@ class LightStage {
   // `near`: per region of the sampler's cut, whether it is a surface near the env camera
   // (near_regions); empty = none known to be.
   void set_environment_lighting(bool real);
+  // Lighting::ambient_regions from this frame's regions and shadowed_regions_.
+  void set_ambient_regions();
   // Marks near_ for this frame's regions: the ray from the env camera towards each region's
   // direction crosses a surface of the frame's depth image within near_field_distance_m.
   void mark_near_regions(const InputFrame& frame, const glm::dmat4& camera_to_world);
@@ -257,6 +279,7 @@ class LightStage {
   // The mean radiance of the colour frame (linear, over the exposure): the unseen prior.
   glm::dvec3 mean_camera_radiance(const InputFrame& frame) const;
   std::vector<size_t> shadowed_regions_;  // this frame's, indices into the sampler's lights
+  std::vector<std::pair<double, size_t>> region_order_;  // set_ambient_regions' (contrast, index)
   LampRemoval lamp_removal_;
   ImageRGBF env_scratch_;                 // the env image with the declared lamps taken out
   int lamps_removed_ = 0;                 // this frame's

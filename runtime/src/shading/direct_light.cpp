@@ -13,6 +13,7 @@
 #include "gpu/vk_check.h"
 #include "light/light_stage.h"
 #include "shading/shadow_plan.h"
+#include "shared/occlusion_math.h"
 #include "specular/caustic_receiver.glsl"
 
 namespace mrgi::shading {
@@ -320,10 +321,13 @@ Status DirectLightBlock::record(const frame::FrameInfo& info, const DirectLightL
                                          " indirect input, which DirectLightOptions did not declare");
   const EnvOcclusionLevel& occ = level.env_occlusion;
   if (occ.divisor < 1 || occ.divisor > 8 || occ.spheres_per_object < 0 ||
-      occ.spheres_per_object > frame::SceneGpu::kOccluderSpheres)
+      occ.spheres_per_object > frame::SceneGpu::kOccluderSpheres || occ.regions < 0 ||
+      occ.regions > MRGI_MAX_OCCLUSION_REGIONS)
     return fail(ErrorKind::BadUsage, "direct light: env_occlusion divisor " + std::to_string(occ.divisor) +
-                                         " (1..8) or spheres " + std::to_string(occ.spheres_per_object) + " (0.." +
-                                         std::to_string(frame::SceneGpu::kOccluderSpheres) + ") out of range");
+                                         " (1..8), spheres " + std::to_string(occ.spheres_per_object) + " (0.." +
+                                         std::to_string(frame::SceneGpu::kOccluderSpheres) + ") or regions " +
+                                         std::to_string(occ.regions) + " (0.." +
+                                         std::to_string(MRGI_MAX_OCCLUSION_REGIONS) + ") out of range");
   m.shadow_size_ = level.shadow_map_size;
   m.pcf_radius_ = level.pcf_radius;
   m.indirect_ = indirect;
@@ -549,15 +553,17 @@ void DirectLightBlock::Impl::record_occlusion(const EnvOcclusionLevel& level, co
     occlusion_->skip();
     skipped.push_back("env_occlusion: the ambient is the lamps' residual estimate, not occluded");
   } else {
-    occlusion_->record(level, ambient, skipped);
+    occlusion_->record(level, ambient, frame_.light_stage->lighting().ambient_regions, skipped);
   }
 }
 
 DirectLightBlock::EnvOcclusionResult DirectLightBlock::record_env_occlusion(const EnvOcclusionLevel& level,
-                                                                            const light::ShRgb& ambient,
                                                                             std::vector<std::string>& skipped) {
   Impl& m = *impl_;
   if (!m.occlusion_) return {m.no_occlusion_, 0};
+  const light::Lighting& lighting = m.frame_.light_stage->lighting();
+  light::ShRgb ambient;
+  for (size_t i = 0; i < ambient.size(); ++i) ambient[i] = lighting.ambient_real[i] + lighting.ambient_virtual[i];
   m.record_occlusion(level, ambient, skipped);
   return {m.occlusion_->image(), m.occlusion_->divisor()};
 }
@@ -584,10 +590,10 @@ Expected<std::unique_ptr<DirectLightBlock>> DirectLightBlock::create(const frame
 
 const std::array<DirectLightLevel, 4>& direct_light_levels() {
   static const std::array<DirectLightLevel, 4> levels = {{
-      {2048, 1, 2.0, 4, {1, 16}},  // high
-      {1024, 1, 2.0, 4, {2, 16}},  // medium
-      {512, 1, 2.0, 2, {4, 8}},    // low
-      {256, 0, 2.0, 1, {4, 4}},    // lowest
+      {2048, 1, 2.0, 4, {1, 16, 4}},  // high
+      {1024, 1, 2.0, 4, {2, 16, 4}},  // medium
+      {512, 1, 2.0, 2, {4, 8, 2}},    // low
+      {256, 0, 2.0, 1, {4, 4, 1}},    // lowest
   }};
   return levels;
 }

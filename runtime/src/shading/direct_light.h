@@ -129,17 +129,16 @@ class DirectLightBlock {
   // encoding the options did not ask for); appends "pass: reason" for each pass left out.
   Status record(const frame::FrameInfo& info, const DirectLightLevel& level, const IndirectLight& indirect,
                 std::vector<std::string>& skipped);
-  // The block's environment occlusion alone, of the unshadowed ambient `ambient` (radiance SH,
-  // world axes), for a technique that shades the ambient itself on a frame it does not record
-  // the block (dlpv's antiradiance levels): the pass is recorded (or left out, as record() would)
-  // and its result returned for the technique's shader to read with
-  // shaders/shading/env_occlusion_lookup.glsl.
+  // The block's environment occlusion alone, of the light stage's ambient (real and virtual, no
+  // light folded in: light::write_unshadowed_light_set's), for a technique that shades the
+  // ambient itself on a frame it does not record the block (dlpv's antiradiance levels, dvct's
+  // shadow cones): the pass is recorded (or left out, as record() would) and its result returned
+  // for the technique's shader to read with shaders/shading/env_occlusion_lookup.glsl.
   struct EnvOcclusionResult {
     gpu::ImageHandle image;  // RGBA16F (environment_occlusion.h); a 1x1 zero image when left out
     int divisor = 0;         // internal pixels a texel side; 0 when left out
   };
-  EnvOcclusionResult record_env_occlusion(const EnvOcclusionLevel& level, const light::ShRgb& ambient,
-                                          std::vector<std::string>& skipped);
+  EnvOcclusionResult record_env_occlusion(const EnvOcclusionLevel& level, std::vector<std::string>& skipped);
   // A technique that records the block on some frames only calls this at the start of each
   // frame: output() then says whether this frame's shading used the block.
   void begin_frame();

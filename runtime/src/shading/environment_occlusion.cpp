@@ -49,6 +49,7 @@ Expected<std::unique_ptr<EnvironmentOcclusion>> EnvironmentOcclusion::create(con
 }
 
 void EnvironmentOcclusion::record(const EnvOcclusionLevel& level, const light::ShRgb& ambient,
+                                  const std::vector<light::Lighting::AmbientRegion>& regions,
                                   std::vector<std::string>& skipped) {
   Impl& m = *impl_;
   m.divisor_ = 0;
@@ -79,11 +80,20 @@ void EnvironmentOcclusion::record(const EnvOcclusionLevel& level, const light::S
   }
   m.divisor_ = std::clamp(level.divisor, 1, 8);
   auto* set = static_cast<shader::EnvOcclusionSet*>(m.frame_.graph->mapped(m.set_, m.frame_.graph->slot()));
-  set->count = glm::ivec4(int(std::min<size_t>(m.spheres_.size(), MRGI_MAX_OCCLUDER_SPHERES)), m.divisor_, 0, 0);
+  // The regions kept as cones leave the SH the caps are evaluated on.
+  const int kept = std::clamp(std::min(level.regions, int(regions.size())), 0, MRGI_MAX_OCCLUSION_REGIONS);
+  light::ShRgb rest = ambient;
+  for (int k = 0; k < kept; ++k) {
+    const light::Lighting::AmbientRegion& r = regions[size_t(k)];
+    for (size_t i = 0; i < rest.size(); ++i) rest[i] -= r.sh[i];
+    set->regions[k] = glm::vec4(glm::vec3(r.direction), float(r.half_angle_rad));
+    set->region_irradiance[k] = glm::vec4(glm::vec3(r.irradiance), 0.0f);
+  }
+  set->count = glm::ivec4(int(std::min<size_t>(m.spheres_.size(), MRGI_MAX_OCCLUDER_SPHERES)), m.divisor_, kept, 0);
   for (int c = 0; c < 3; ++c)
     for (int k = 0; k < 4; ++k)
-      set->radiance[c * 4 + k] = glm::vec4(float(ambient[size_t(k * 4)][c]), float(ambient[size_t(k * 4 + 1)][c]),
-                                           float(ambient[size_t(k * 4 + 2)][c]), float(ambient[size_t(k * 4 + 3)][c]));
+      set->radiance[c * 4 + k] = glm::vec4(float(rest[size_t(k * 4)][c]), float(rest[size_t(k * 4 + 1)][c]),
+                                           float(rest[size_t(k * 4 + 2)][c]), float(rest[size_t(k * 4 + 3)][c]));
   for (size_t i = 0; i < size_t(set->count.x); ++i) {
     set->spheres[i] = m.spheres_[i];
     set->albedo[i] = m.albedo_[i];

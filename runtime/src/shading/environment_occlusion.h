@@ -22,7 +22,11 @@
 // virtual) so an object's edge does not bleed onto the floor behind it.
 //
 // The light it occludes is the ambient only (the light stage's SH after its shadowed lights are
-// taken out): shadowed lights already have their shadow maps.
+// taken out): shadowed lights already have their shadow maps. The ambient's broad bright
+// regions (a low sun behind haze, a window: light::Lighting::ambient_regions) are taken out of
+// the SH and hidden as cones, the exact part of each a proxy's cap covers
+// (cap_overlap_solid_angle), so the soft shadow falls away from them as in the truth instead
+// of spreading round the object as the SH's 4 bands do.
 #pragma once
 #include <memory>
 #include <string>
@@ -30,6 +34,7 @@
 
 #include "frame/frame_resources.h"
 #include "gpu/frame_graph.h"
+#include "light/light_stage.h"
 #include "light/sh_tools.h"
 #include "mrgi/expected.h"
 
@@ -38,6 +43,9 @@ namespace mrgi::shading {
 struct EnvOcclusionLevel {
   int divisor = 2;             // internal pixels per texel side, 1..8
   int spheres_per_object = 8;  // the first this many of each object's proxies; 0 = off
+  // Of the light stage's broad bright regions (light::Lighting::ambient_regions), at most this
+  // many are hidden as cones (exact cap overlap) instead of through the SH; 0..4.
+  int regions = 4;
 };
 
 class EnvironmentOcclusion {
@@ -46,8 +54,10 @@ class EnvironmentOcclusion {
   ~EnvironmentOcclusion();
   // Adds this frame's pass, or leaves it out (appending "env_occlusion: reason" to `skipped`)
   // when nothing is occluded: the level turns it off, no virtual object is visible or the
-  // ambient is black. `ambient` is the occludable light's radiance SH (4 bands, world axes).
-  void record(const EnvOcclusionLevel& level, const light::ShRgb& ambient, std::vector<std::string>& skipped);
+  // ambient is black. `ambient` is the occludable light's radiance SH (4 bands, world axes);
+  // `regions` the parts of it kept as cones (their SH is in `ambient`).
+  void record(const EnvOcclusionLevel& level, const light::ShRgb& ambient,
+              const std::vector<light::Lighting::AmbientRegion>& regions, std::vector<std::string>& skipped);
   // Leaves this frame's pass out (image() is then the zero stand-in).
   void skip();
   // This frame's result (RGBA16F, rgb the irradiance the objects take away, W/m^2, negative

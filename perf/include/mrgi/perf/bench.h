@@ -33,7 +33,7 @@ namespace mrgi::perf {
 using ProgressFn = std::function<void(const std::string&, size_t, size_t, double)>;
 
 struct BenchSettings {
-  std::string suite;                     // path of suite.json
+  std::string suite;                     // path of suite.json; several, comma-separated, run as one
   std::vector<std::string> scenes;       // empty = every scene of the suite
   std::vector<std::string> techniques;   // empty = technique_names()
   // Empty or {"all"} = every level; else level indices ("0"), names, or "last" (the cheapest).
@@ -76,6 +76,7 @@ struct PassSummary {
 
 struct BenchEntry {
   std::string scene, technique, level_name;
+  std::string set;                       // the scene's manifest (SuiteScene::set)
   int level = 0;
   int width = 0, height = 0;             // output size
   // The headline: wall-clock ms per frame sustained over the measured frames (phase 1), and

@@ -22,11 +22,13 @@ const KnobField<BaselineLevel> kBaselineKnobs[] = {
      &BaselineLevel::env_occlusion_divisor},
     {"env_occlusion_spheres", "sphere proxies an object that occlude the ambient light (0 = off, at most 16)",
      &BaselineLevel::env_occlusion_spheres},
+    {"env_occlusion_regions", "broad bright regions of the ambient light the objects hide as cones, not through its SH (0-4)",
+     &BaselineLevel::env_occlusion_regions},
 };
 
 shading::DirectLightLevel direct_level(const BaselineLevel& l) {
   return {l.shadow_map_size, l.pcf_radius, l.caster_cell_shadow_texels, l.shadowed_estimated_lights,
-          {l.env_occlusion_divisor, l.env_occlusion_spheres}};
+          {l.env_occlusion_divisor, l.env_occlusion_spheres, l.env_occlusion_regions}};
 }
 
 class Baseline final : public Laddered<BaselineLevel> {
@@ -55,7 +57,8 @@ const std::array<BaselineLevel, 4>& baseline_levels() {
     std::array<BaselineLevel, 4> out{};
     for (size_t i = 0; i < 4; ++i)
       out[i] = {names[i], d[i].shadow_map_size, scales[i], d[i].pcf_radius, d[i].caster_cell_shadow_texels,
-                d[i].shadowed_estimated_lights, d[i].env_occlusion.divisor, d[i].env_occlusion.spheres_per_object};
+                d[i].shadowed_estimated_lights, d[i].env_occlusion.divisor, d[i].env_occlusion.spheres_per_object,
+                d[i].env_occlusion.regions};
     return out;
   }();
   return levels;

@@ -36,6 +36,7 @@ struct BaselineLevel {
   int shadowed_estimated_lights;    // estimated lights with shadow maps (shading/direct_light.h)
   int env_occlusion_divisor;        // internal pixels a texel side of the environment occlusion
   int env_occlusion_spheres;        // sphere proxies an object that occlude the ambient (0 = off)
+  int env_occlusion_regions;        // broad bright regions of the ambient occluded as cones (0..4)
 };
 const std::array<BaselineLevel, 4>& baseline_levels();  // the defaults
 // The defaults with RuntimeSettings::knobs applied (technique/knobs.h; BadUsage for a refused one).

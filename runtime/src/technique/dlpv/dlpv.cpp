@@ -186,11 +186,8 @@ Status Dlpv::record(const frame::FrameInfo& info, std::vector<std::string>& skip
   if (antiradiance) {
     // The volume's antiradiance shadows the lamps it injects; the ambient's occlusion by the
     // objects is the direct-light block's, as at the other levels.
-    const light::Lighting& lighting = shared_.light_stage->lighting();
-    light::ShRgb ambient;
-    for (size_t i = 0; i < ambient.size(); ++i) ambient[i] = lighting.ambient_real[i] + lighting.ambient_virtual[i];
     const shading::DirectLightLevel& direct = shading::direct_light_levels()[size_t(level.baseline_level)];
-    const auto occlusion = direct_->record_env_occlusion(direct.env_occlusion, ambient, skipped);
+    const auto occlusion = direct_->record_env_occlusion(direct.env_occlusion, skipped);
     made.push.occlusion.x = occlusion.divisor;
     add_merge_pass(made.push, occlusion.image);
     return ok_status();

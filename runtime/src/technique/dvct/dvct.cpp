@@ -91,7 +91,9 @@ class Dvct final : public Laddered<DvctLevel> {
   // The shading pipeline for (diffuse cones, specular cone), made at start-up for every level.
   using Variant = std::pair<uint32_t, bool>;
   Status record_volumes(const DvctLevel& level, const frame::FrameInfo& info, std::vector<std::string>& skipped);
-  void add_cone_pass(const DvctLevel& level, const shader::DvctParams& params, bool specular);
+  // `env_occlusion`: the block's environment occlusion, read by the shadow-cone level's shading.
+  void add_cone_pass(const DvctLevel& level, const shader::DvctParams& params, bool specular,
+                     gpu::ImageHandle env_occlusion);
 
   frame::FrameResources shared_;
   gpu::BufferHandle lights_;  // shader::LightSet, one per frame slot (the paper level's shading)
@@ -336,7 +338,8 @@ bool Dvct::glossy_in_view(const frame::FrameInfo& info) const {
   return false;
 }
 
-void Dvct::add_cone_pass(const DvctLevel& level, const shader::DvctParams& params, bool specular) {
+void Dvct::add_cone_pass(const DvctLevel& level, const shader::DvctParams& params, bool specular,
+                         gpu::ImageHandle env_occlusion) {
   gpu::FrameGraph& graph = *shared_.graph;
   const Variant key{level.diffuse_cones, specular};
   const gpu::Pipeline* pipe = level.shadow_cones ? &*shade_.at(key) : &*indirect_.at(key);
@@ -350,9 +353,10 @@ void Dvct::add_cone_pass(const DvctLevel& level, const shader::DvctParams& param
   const uint32_t divisor = std::max(1u, level.trace_divisor);
   graph.add_shader_pass(
       full ? "dvct shade" : "dvct cones", gpu::PassKind::Compute, *pipe,
-      [&, full, indirect, lights, materials](gpu::ShaderPassBuilder& b) {
+      [&, full, indirect, lights, materials, env_occlusion](gpu::ShaderPassBuilder& b) {
         if (full) {
           frame::bind_shading_gbuffers(b, r);
+          b.bind("env_occlusion", env_occlusion);
         } else {
           frame::bind_gbuffer_reads(b, r);
           b.bind("indirect", indirect);
@@ -408,12 +412,16 @@ Status Dvct::record(const frame::FrameInfo& info, std::vector<std::string>& skip
   else if (!specular)
     skipped.push_back("dvct specular cone: no glossy material in view (compiled out this frame)");
   if (level.shadow_cones) {
-    add_cone_pass(level, params, specular);
+    // The cones shadow the lamps; the ambient's occlusion by the objects is the block's.
+    const shading::DirectLightLevel& direct = shading::direct_light_levels()[size_t(level.baseline_level)];
+    const auto occlusion = direct_->record_env_occlusion(direct.env_occlusion, skipped);
+    params.mode.z = occlusion.divisor;
+    add_cone_pass(level, params, specular, occlusion.image);
     return ok_status();
   }
   const shading::DirectLightLevel& direct = shading::direct_light_levels()[size_t(level.baseline_level)];
   if (!volumes) return direct_->record(info, direct, {}, skipped);
-  add_cone_pass(level, params, specular);
+  add_cone_pass(level, params, specular, {});
   return direct_->record(info, direct, shading::ScreenIndirect{indirect_image_, int(std::max(1u, level.trace_divisor))},
                          skipped);
 }

@@ -38,7 +38,9 @@
 //     corner real 0.885 -> 1.026, env_fisheye virtual 0.291 -> 0.437, moving real 0.410 ->
 //     0.461, desk_spot equal): the cones over-occlude near a surface (its own voxels at coarse
 //     mip levels, and vct_directional_occlusion's coverage rule, which treats a compact object
-//     as a wall across the footprint), so the objects' occlusion of the ambient is left out.
+//     as a wall across the footprint), so the cones do not occlude the ambient: at every level
+//     that is the direct-light block's environment occlusion (shading/environment_occlusion.h;
+//     the paper level's shading reads it through DirectLightBlock::record_env_occlusion).
 //
 // Skips (each in FrameStats::skipped):
 //   - no virtual object: no volumes, no cones (the solutions are baseline's, or the paper
