@@ -10,6 +10,7 @@
 // its distance to the camera, negative on a virtual surface, 0 where there is none (the
 // direct-light pass up-samples by it).
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 #include "shared/mrgi_shared.h"
 #include "shared/occlusion_math.h"
 #include "common/frame_constants.glsl"
@@ -55,7 +56,9 @@ void main() {
   const int count = min(occluders.count.x, MRGI_MAX_OCCLUDER_SPHERES);
   // The broad regions kept apart from the SH: the unblocked fraction of each one's cone.
   const int regions = clamp(occluders.count.z, 0, MRGI_MAX_OCCLUSION_REGIONS);
-  float region_open[MRGI_MAX_OCCLUSION_REGIONS] = float[](1.0f, 1.0f, 1.0f, 1.0f);
+  // (Loops over the regions run to the constant bound, unrolled, so every index is a constant:
+  // on lavapipe a dynamically indexed local or uniform array is gathered lane by lane.)
+  vec4 region_open = vec4(1.0f);
   for (int i = 0; i < count; ++i) {
     vec4 s = occluders.spheres[i];
     vec3 d = s.xyz - p;
@@ -71,25 +74,32 @@ void main() {
       // What the sphere hides (the sky's cap) less what it shows instead: the object's own
       // surface facing the point, lit by the same ambient (albedo / pi x E(-w)).
       vec3 hidden = sh_cap_mean_radiance(sh_r, sh_g, sh_b, w, sqrt(1.0f - s2));
-      // The object is lit by the regions kept apart from the SH too.
       vec3 e_facing = sh_irradiance16(sh_r, sh_g, sh_b, -w);
-      for (int k = 0; k < regions; ++k)
-        e_facing += occluders.region_irradiance[k].rgb * max(-dot(w, occluders.regions[k].xyz), 0.0f);
+      if (regions > 0) {
+        // The part of each region's cone the sphere's cap covers; the object is lit by the
+        // regions too.
+        float cap = asin(sqrt(s2)), vers_cap = 1.0f - sqrt(1.0f - s2);
+        [[unroll]] for (int k = 0; k < MRGI_MAX_OCCLUSION_REGIONS; ++k) {
+          if (k >= regions) break;
+          vec4 region = occluders.regions[k];
+          float cos_theta = dot(w, region.xyz);
+          e_facing += occluders.region_irradiance[k].rgb * max(-cos_theta, 0.0f);
+          float theta = acos(clamp(cos_theta, -1.0f, 1.0f));
+          region_open[k] *= 1.0f - cap_covered_fraction_v(theta, cap, occluders.region_irradiance[k].w, vers_cap, region.w);
+        }
+      }
       vec3 shown = occluders.albedo[i].rgb * e_facing * (1.0f / MRGI_PI);
       o = sphere_occlusion_add(o, f, hidden - shown);
-      float cap = asin(sqrt(s2));
-      for (int k = 0; k < regions; ++k) {
-        vec4 region = occluders.regions[k];
-        float solid = 2.0f * MRGI_PI * (1.0f - cos(region.w));
-        float overlap = cap_overlap_solid_angle(acos(clamp(dot(w, region.xyz), -1.0f, 1.0f)), cap, region.w);
-        region_open[k] *= 1.0f - clamp(overlap / max(solid, 1e-6f), 0.0f, 1.0f);
-      }
     }
   }
   float key = distance(p, frame.camera_world.xyz);
   vec3 hidden = sphere_occlusion_irradiance(o);
-  for (int k = 0; k < regions; ++k)
-    hidden += occluders.region_irradiance[k].rgb * max(dot(n, occluders.regions[k].xyz), 0.0f) * (1.0f - region_open[k]);
+  if (regions > 0) {
+    [[unroll]] for (int k = 0; k < MRGI_MAX_OCCLUSION_REGIONS; ++k) {
+      if (k >= regions) break;
+      hidden += occluders.region_irradiance[k].rgb * max(dot(n, occluders.regions[k].xyz), 0.0f) * (1.0f - region_open[k]);
+    }
+  }
   hidden = any(isnan(hidden)) || any(isinf(hidden)) ? vec3(0.0f) : clamp(hidden, vec3(-60000.0f), vec3(60000.0f));
   imageStore(env_occlusion, texel, vec4(hidden, is_virtual ? -key : key));
 }

@@ -19,6 +19,7 @@
 namespace mrgi::shader {
 using glm::abs;
 using glm::acos;
+using glm::asin;
 using glm::atan;
 using glm::clamp;
 using glm::cos;

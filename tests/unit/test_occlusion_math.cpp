@@ -155,6 +155,32 @@ TEST(OcclusionMath, CapOverlapLimits) {
   EXPECT_EQ(cap_overlap_solid_angle(0.3f, 0.0f, 0.4f), 0.0f);
 }
 
+// The pass's fraction of a region's cone a proxy covers (cap_covered_fraction) against the exact
+// lune over half-angles 1-80 degrees and every separation where they meet: within 0.11 of the
+// region's solid angle everywhere, 0.025 on average; exact at the two ends.
+TEST(OcclusionMath, CapCoveredFractionFollowsTheExactOverlap) {
+  double worst = 0.0, sum = 0.0;
+  int n = 0;
+  for (int i = 0; i < 30; ++i)
+    for (int j = 0; j < 25; ++j) {
+      const double a = 0.02 + 1.38 * i / 29.0, b = 0.05 + 1.15 * j / 24.0;
+      const double region = 2.0 * kPi * (1.0 - std::cos(b));
+      for (int k = 0; k < 40; ++k) {
+        const double theta = (a + b) * k / 39.0;
+        const double exact = cap_overlap_solid_angle(float(theta), float(a), float(b)) / region;
+        const double got = cap_covered_fraction(float(theta), float(a), float(b));
+        worst = std::max(worst, std::abs(got - exact));
+        sum += std::abs(got - exact);
+        ++n;
+      }
+      EXPECT_NEAR(cap_covered_fraction(float(a + b + 0.01), float(a), float(b)), 0.0f, 1e-6f);
+      EXPECT_NEAR(cap_covered_fraction(float(std::abs(a - b) * 0.5), float(a), float(b)),
+                  std::min(1.0, (1.0 - std::cos(a)) / (1.0 - std::cos(b))), 1e-4);
+    }
+  EXPECT_LT(worst, 0.11);
+  EXPECT_LT(sum / n, 0.025);
+}
+
 TEST(OcclusionMath, DisjointSpheresUnderAUniformSkyBlockTheirSolidAngle) {
   // Two small spheres far apart above a point, uniform sky of radiance 2: the blocked irradiance
   // is about 2 x pi x (f1 + f2) (the product form differs from the sum only by f1 f2).

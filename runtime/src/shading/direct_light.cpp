@@ -592,8 +592,8 @@ const std::array<DirectLightLevel, 4>& direct_light_levels() {
   static const std::array<DirectLightLevel, 4> levels = {{
       {2048, 1, 2.0, 4, {1, 16, 4}},  // high
       {1024, 1, 2.0, 4, {2, 16, 4}},  // medium
-      {512, 1, 2.0, 2, {4, 8, 2}},    // low
-      {256, 0, 2.0, 1, {4, 4, 1}},    // lowest
+      {512, 1, 2.0, 2, {4, 8, 1}},    // low
+      {256, 0, 2.0, 1, {4, 4, 0}},    // lowest
   }};
   return levels;
 }

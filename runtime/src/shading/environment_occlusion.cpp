@@ -86,14 +86,16 @@ void EnvironmentOcclusion::record(const EnvOcclusionLevel& level, const light::S
   for (int k = 0; k < kept; ++k) {
     const light::Lighting::AmbientRegion& r = regions[size_t(k)];
     for (size_t i = 0; i < rest.size(); ++i) rest[i] -= r.sh[i];
-    set->regions[k] = glm::vec4(glm::vec3(r.direction), float(r.half_angle_rad));
-    set->region_irradiance[k] = glm::vec4(glm::vec3(r.irradiance), 0.0f);
+    set->regions[k] = glm::vec4(glm::vec3(r.direction), float(1.0 - std::cos(r.half_angle_rad)));
+    set->region_irradiance[k] = glm::vec4(glm::vec3(r.irradiance), float(r.half_angle_rad));
   }
   set->count = glm::ivec4(int(std::min<size_t>(m.spheres_.size(), MRGI_MAX_OCCLUDER_SPHERES)), m.divisor_, kept, 0);
   for (int c = 0; c < 3; ++c)
-    for (int k = 0; k < 4; ++k)
-      set->radiance[c * 4 + k] = glm::vec4(float(rest[size_t(k * 4)][c]), float(rest[size_t(k * 4 + 1)][c]),
-                                           float(rest[size_t(k * 4 + 2)][c]), float(rest[size_t(k * 4 + 3)][c]));
+    for (int k = 0; k < 4; ++k) {
+      const size_t i = size_t(k * 4);
+      set->radiance[c * 4 + k] =
+          glm::vec4(float(rest[i][c]), float(rest[i + 1][c]), float(rest[i + 2][c]), float(rest[i + 3][c]));
+    }
   for (size_t i = 0; i < size_t(set->count.x); ++i) {
     set->spheres[i] = m.spheres_[i];
     set->albedo[i] = m.albedo_[i];
