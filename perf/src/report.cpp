@@ -117,7 +117,7 @@ std::string accuracy_by_set(const BenchResult& r) {
         if (e.error.real.rde_defined) real.push_back(e.error.real.rde);
         if (e.error.virtual_.rde_defined) virt.push_back(e.error.virtual_.rde);
       }
-      auto med = [](const std::vector<double>& v) { return v.empty() ? std::string("-") : fmt(percentile(v, 50), 3); };
+      auto med = [](const std::vector<double>& v) { return v.empty() ? std::string("-") : fmt(median(v), 3); };
       o << "| " << set << " | " << technique << " | " << level << " " << name << " | " << all.size() << " | "
         << med(all) << " | " << med(real) << " | " << med(virt) << " | "
         << (worst.empty() ? std::string("-") : worst + " " + fmt(worst_rde, 3)) << " |\n";

@@ -341,6 +341,19 @@ TEST(Report, AccuracyBySetWhenSeveralSets) {
   EXPECT_NE(md.find("| suite | baseline | 0 high | 1 | 0.300 | - | - | desk 0.300 |"), std::string::npos) << md;
   EXPECT_NE(md.find("| suite | baseline | 1 low | 1 | 0.500 |"), std::string::npos) << md;
   EXPECT_NE(md.find("| cycles-heldout | baseline | 0 high | 0 | - | - | - | - |"), std::string::npos) << md;
+  // Two scenes in a set: the median is the mean of the middle two (0.3 and 0.7 at high).
+  perf::BenchEntry other = r.entries.front();
+  for (perf::BenchEntry& e : r.entries) {
+    e.set = "suite";
+    if (e.scene == "empty") {
+      e.error.all.rde_defined = true;
+      e.error.all.rde = 0.7;
+    }
+  }
+  other.scene = "sky";
+  other.set = "cycles-heldout";
+  r.entries.push_back(other);
+  EXPECT_NE(perf::report_markdown(r, nullptr).find("| suite | baseline | 0 high | 2 | 0.500 |"), std::string::npos);
 }
 
 TEST(Plot, DrawsSeriesFrontAndAxes) {
