@@ -1,6 +1,7 @@
 #include "replay_output.h"
 
 #include "mrgi/perf/canvas.h"
+#include "mrgi/perf/report.h"
 #include "mrgi/perf/stats.h"
 
 #include <algorithm>
@@ -42,17 +43,6 @@ int lp_num_threads() {
 
 }  // namespace
 
-nlohmann::json figures_json(const ErrorFigures& f) {
-  nlohmann::json j;
-  j["rde"] = f.rde_defined ? nlohmann::json(f.rde) : nlohmann::json(nullptr);
-  j["delta_rms"] = f.delta_rms;
-  j["rmse8"] = f.rmse8;
-  j["ssim"] = f.ssim;
-  j["pixels"] = f.pixels;
-  j["change_sum"] = f.change_sum;
-  j["truth_change_sum"] = f.truth_change_sum;
-  return j;
-}
 
 
 Expected<ReplayOutput> ReplayOutput::create(const std::string& dir, const ReplayMeta& meta) {
@@ -117,9 +107,7 @@ Status ReplayOutput::add(const FrameOutput& out, const ImageRGB8& camera, const 
   if (reference) {
     auto r = measure_error(out.image, camera, *reference, mask);
     if (!r.ok()) return r.error();
-    s["error"] = {{"all", figures_json(r->all)},           {"real", figures_json(r->real)},
-                  {"virtual", figures_json(r->virtual_)},  {"influenced", figures_json(r->influenced)},
-                  {"rest", figures_json(r->rest)}};
+    s["error"] = perf::error_report_json(*r);
     if (!pooled_) {
       pooled_ = *r;
     } else {
@@ -196,12 +184,10 @@ Expected<nlohmann::json> ReplayOutput::finish() {
                       {"real", rde(pooled_->real)},
                       {"virtual", rde(pooled_->virtual_)},
                       {"influenced", rde(pooled_->influenced)},
-                      {"rest", rde(pooled_->rest)}};
-    summary["error"] = {{"all", figures_json(pooled_->all)},
-                        {"real", figures_json(pooled_->real)},
-                        {"virtual", figures_json(pooled_->virtual_)},
-                        {"influenced", figures_json(pooled_->influenced)},
-                        {"rest", figures_json(pooled_->rest)}};
+                      {"rest", rde(pooled_->rest)},
+                      {"darkened", rde(pooled_->darkened)},
+                      {"brightened", rde(pooled_->brightened)}};
+    summary["error"] = perf::error_report_json(*pooled_);
   }
   MRGI_TRY(write_json(partial_ + "/stats.json", stats_));
   MRGI_TRY(write_json(partial_ + "/summary.json", summary));

@@ -81,7 +81,6 @@ class ReplayOutput {
   std::vector<double> light_error_deg_;
 };
 
-nlohmann::json figures_json(const ErrorFigures& f);
 // The estimated light (techniques that estimate it): direction, intensity, confidence, SH.
 nlohmann::json light_json(const LightEstimate& e);
 

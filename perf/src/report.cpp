@@ -25,21 +25,9 @@ nlohmann::json time_json(const TimeSummary& t) {
           {"min_ratio", t.min_ratio}};
 }
 
-nlohmann::json figures_json(const ErrorFigures& f) {
-  return {{"rde", f.rde_defined ? nlohmann::json(f.rde) : nlohmann::json(nullptr)},
-          {"delta_rms", f.delta_rms},
-          {"rmse8", f.rmse8},
-          {"ssim", f.ssim},
-          {"pixels", f.pixels},
-          {"change_sum", f.change_sum},
-          {"truth_change_sum", f.truth_change_sum}};
-}
-
 nlohmann::json error_json(bool has_reference, const RdeReport& r) {
   if (!has_reference) return nullptr;
-  return {{"all", figures_json(r.all)},           {"real", figures_json(r.real)},
-          {"virtual", figures_json(r.virtual_)},  {"influenced", figures_json(r.influenced)},
-          {"rest", figures_json(r.rest)}};
+  return error_report_json(r);
 }
 
 std::string fmt(double v, int decimals) {
@@ -128,6 +116,28 @@ std::string accuracy_by_set(const BenchResult& r) {
 }
 
 }  // namespace
+
+nlohmann::json error_figures_json(const ErrorFigures& f) {
+  return {{"rde", f.rde_defined ? nlohmann::json(f.rde) : nlohmann::json(nullptr)},
+          {"delta_rms", f.delta_rms},
+          {"rmse8", f.rmse8},
+          {"ssim", f.ssim},
+          {"pixels", f.pixels},
+          {"change_sum", f.change_sum},
+          {"truth_change_sum", f.truth_change_sum},
+          {"change_rgb", {f.change_rgb[0], f.change_rgb[1], f.change_rgb[2]}},
+          {"truth_change_rgb", {f.truth_change_rgb[0], f.truth_change_rgb[1], f.truth_change_rgb[2]}}};
+}
+
+nlohmann::json error_report_json(const RdeReport& r) {
+  return {{"all", error_figures_json(r.all)},
+          {"real", error_figures_json(r.real)},
+          {"virtual", error_figures_json(r.virtual_)},
+          {"influenced", error_figures_json(r.influenced)},
+          {"rest", error_figures_json(r.rest)},
+          {"darkened", error_figures_json(r.darkened)},
+          {"brightened", error_figures_json(r.brightened)}};
+}
 
 nlohmann::json bench_json(const BenchResult& r, const CheckReport* check) {
   nlohmann::json j;
@@ -323,6 +333,25 @@ std::string report_markdown(const BenchResult& r, const CheckReport* check) {
         << " | " << rde_cell(true, e.error.influenced) << " | " << rde_cell(true, e.error.rest) << " | "
         << fmt(real.change_sum, 1) << " | " << fmt(real.truth_change_sum, 1) << " | "
         << (std::abs(real.truth_change_sum) > 1e-9 ? fmt(real.change_sum / real.truth_change_sum, 2) : "-") << " |\n";
+    }
+    // What the objects do to the real scene, split by the truth's sign: each effect's mean change
+    // per pixel and channel, the output's against the truth's.
+    o << "\nError by effect (the real pixels the objects change in the truth, split by the sign of its change of "
+         "luminance: *darkened* = their shadows and occlusion, *brightened* = their bounce light, colour bleeding, "
+         "caustics and reflections; R, G, B: mean change per pixel, linear x 1000, output / truth):\n\n"
+         "| scene | level | darkened px | RDE | R | G | B | brightened px | RDE | R | G | B |\n"
+         "|---|---|---:|---:|---|---|---|---:|---:|---|---|---|\n";
+    for (const BenchEntry& e : r.entries) {
+      if (e.technique != t || !e.has_reference) continue;
+      o << "| " << e.scene << " | " << e.level << " " << e.level_name;
+      for (const ErrorFigures* f : {&e.error.darkened, &e.error.brightened}) {
+        o << " | " << f->pixels << " | " << rde_cell(true, *f);
+        for (int k = 0; k < 3; ++k) {
+          const double n = f->pixels > 0 ? 1000.0 / double(f->pixels) : 0.0;
+          o << " | " << (f->pixels > 0 ? fmt(f->change_rgb[k] * n, 1) + " / " + fmt(f->truth_change_rgb[k] * n, 1) : "-");
+        }
+      }
+      o << " |\n";
     }
     // Per-pass medians, median over scenes of each scene's median, per level.
     o << "\nPer pass, profiling mode (median over scenes of the per-scene median and p95, ms; ratio to the floor; "

@@ -128,3 +128,36 @@ TEST(Metrics, TheTruthSplitsRealPixelsIntoInfluencedAndRest) {
   EXPECT_NEAR(twice.influenced.truth_change_sum, 2.0 * r->influenced.truth_change_sum, 1e-12);
   EXPECT_EQ(twice.rest.pixels, 28u);
 }
+
+// The influenced real pixels split by the sign of the truth's change: a shadow is `darkened`, a
+// bleed of red light `brightened`; per-channel sums say which colour each has, the output's
+// beside the truth's.
+TEST(Metrics, TheTruthSplitsItsChangesIntoDarkenedAndBrightened) {
+  ImageRGB8 c = filled(4, 4, 100), g = c, o = c;
+  g.at(1, 1)[0] = g.at(1, 1)[1] = g.at(1, 1)[2] = 60;  // a grey shadow
+  g.at(2, 2)[0] = 130;                                   // red bleeding onto a real wall
+  g.at(2, 2)[2] = 95;                                    // (and a little blue light blocked)
+  o.at(1, 1)[0] = o.at(1, 1)[1] = o.at(1, 1)[2] = 80;  // the output: a lighter shadow
+  o.at(2, 2)[0] = 160;                                   // and too much red
+  auto r = measure_error(o, c, g, nullptr);
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r->darkened.pixels, 1u);
+  EXPECT_EQ(r->brightened.pixels, 1u);
+  EXPECT_EQ(r->darkened.pixels + r->brightened.pixels, r->influenced.pixels);
+  const double l100 = srgb8_to_linear(100);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(r->darkened.truth_change_rgb[k], srgb8_to_linear(60) - l100, 1e-9);
+    EXPECT_NEAR(r->darkened.change_rgb[k], srgb8_to_linear(80) - l100, 1e-9);
+  }
+  EXPECT_NEAR(r->brightened.truth_change_rgb[0], srgb8_to_linear(130) - l100, 1e-9);
+  EXPECT_NEAR(r->brightened.change_rgb[0], srgb8_to_linear(160) - l100, 1e-9);
+  EXPECT_NEAR(r->brightened.truth_change_rgb[1], 0.0, 1e-12);
+  EXPECT_NEAR(r->brightened.truth_change_rgb[2], srgb8_to_linear(95) - l100, 1e-9);
+  EXPECT_NEAR(r->brightened.change_rgb[2], 0.0, 1e-12);  // the output missed the blocked blue
+  // The channel sums add up to the total, and pooling keeps them.
+  EXPECT_NEAR(r->brightened.change_rgb[0] + r->brightened.change_rgb[1] + r->brightened.change_rgb[2],
+              r->brightened.change_sum, 1e-12);
+  const RdeReport twice = pool(*r, *r);
+  EXPECT_NEAR(twice.brightened.truth_change_rgb[0], 2.0 * r->brightened.truth_change_rgb[0], 1e-12);
+  EXPECT_EQ(twice.darkened.pixels, 2u);
+}

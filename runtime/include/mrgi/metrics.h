@@ -26,6 +26,9 @@ struct ErrorFigures {
   // light the output adds (> 0) or takes away (< 0) against how much the truth does, e.g. the
   // darkening a virtual object's occlusion casts on the real pixels around it.
   double change_sum = 0.0, truth_change_sum = 0.0;
+  // The same per channel (R, G, B): "too strong", "wrong colour" and "missing" read directly
+  // (a mean change per pixel is the sum over `pixels`).
+  double change_rgb[3] = {0.0, 0.0, 0.0}, truth_change_rgb[3] = {0.0, 0.0, 0.0};
 };
 
 struct RdeReport {
@@ -35,6 +38,11 @@ struct RdeReport {
   // quantisation noise of the two images), `rest` the others (where the output should not
   // change them).
   ErrorFigures influenced, rest;
+  // `influenced` split by the sign of the truth's change of luminance there: `darkened` where
+  // the virtual objects take light from the real scene (their shadows, their occlusion of the
+  // environment), `brightened` where they add light (bounce and colour bleeding, caustics,
+  // their reflection in real surfaces).
+  ErrorFigures darkened, brightened;
 };
 
 // virtual_mask: nullptr = every pixel is real; else one byte per pixel, non-zero = virtual.
@@ -46,7 +54,7 @@ Expected<RdeReport> measure_error(const ImageRGBA8& output, const ImageRGB8& cam
 
 // Pools figures of several frames (pixel-weighted means for rmse8/ssim, sums for rde).
 ErrorFigures pool(const ErrorFigures& a, const ErrorFigures& b);
-// The same for each of a report's three pixel sets.
+// The same for each of a report's pixel sets.
 RdeReport pool(const RdeReport& a, const RdeReport& b);
 
 // sRGB transfer (IEC 61966-2-1), 8-bit code to linear [0,1]; a 256-entry table.

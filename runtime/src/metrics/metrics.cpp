@@ -75,6 +75,7 @@ std::vector<double> ssim_map(const Image<uint8_t, CO>& o, const ImageRGB8& g) {
 
 struct Accumulator {
   double err2 = 0.0, ref2 = 0.0, rmse2 = 0.0, ssim = 0.0, change = 0.0, truth_change = 0.0;
+  double change_rgb[3] = {0.0, 0.0, 0.0}, truth_change_rgb[3] = {0.0, 0.0, 0.0};
   size_t pixels = 0;
   ErrorFigures finish() const {
     ErrorFigures f;
@@ -83,6 +84,10 @@ struct Accumulator {
     f.ref2 = ref2;
     f.change_sum = change;
     f.truth_change_sum = truth_change;
+    for (int k = 0; k < 3; ++k) {
+      f.change_rgb[k] = change_rgb[k];
+      f.truth_change_rgb[k] = truth_change_rgb[k];
+    }
     if (pixels == 0) return f;
     // ||G-C|| below one 8-bit step's worth over the set counts as "nothing to change".
     const double floor = 1e-12;
@@ -108,9 +113,11 @@ Expected<RdeReport> measure(const Image<uint8_t, CO>& o, const ImageRGB8& c, con
                                          ", reference is " + size(g.width, g.height));
   const auto& lin = srgb_table();
   const auto ssim = ssim_map(o, g);
-  Accumulator all, real, virt, influenced, rest;
+  Accumulator all, real, virt, influenced, rest, darkened, brightened;
+  const double luma[3] = {0.2126, 0.7152, 0.0722};  // Rec. 709, linear
   for (size_t i = 0; i < g.pixel_count(); ++i) {
-    double e2 = 0.0, r2 = 0.0, m2 = 0.0, change = 0.0, truth_change = 0.0;
+    double e2 = 0.0, r2 = 0.0, m2 = 0.0, change = 0.0, truth_change = 0.0, truth_luma = 0.0;
+    double change_rgb[3], truth_rgb[3];
     bool changed = false;
     for (int k = 0; k < 3; ++k) {
       const uint8_t c8 = c.data[i * 3 + k];
@@ -119,6 +126,9 @@ Expected<RdeReport> measure(const Image<uint8_t, CO>& o, const ImageRGB8& c, con
       r2 += (gv - cv) * (gv - cv);
       change += ov - cv;
       truth_change += gv - cv;
+      change_rgb[k] = ov - cv;
+      truth_rgb[k] = gv - cv;
+      truth_luma += luma[k] * (gv - cv);
       const double d8 = double(o.data[i * CO + k]) - double(g.data[i * 3 + k]);
       m2 += d8 * d8;
       // One sRGB code step at C's level, linear (the larger of the steps on either side).
@@ -127,7 +137,8 @@ Expected<RdeReport> measure(const Image<uint8_t, CO>& o, const ImageRGB8& c, con
     }
     const bool is_virtual = mask && mask->data[i];
     Accumulator* split = is_virtual ? nullptr : (changed ? &influenced : &rest);
-    for (Accumulator* acc : {&all, is_virtual ? &virt : &real, split}) {
+    Accumulator* effect = is_virtual || !changed ? nullptr : (truth_luma < 0.0 ? &darkened : &brightened);
+    for (Accumulator* acc : {&all, is_virtual ? &virt : &real, split, effect}) {
       if (!acc) continue;
       acc->err2 += e2;
       acc->ref2 += r2;
@@ -135,10 +146,15 @@ Expected<RdeReport> measure(const Image<uint8_t, CO>& o, const ImageRGB8& c, con
       acc->ssim += ssim[i];
       acc->change += change;
       acc->truth_change += truth_change;
+      for (int k = 0; k < 3; ++k) {
+        acc->change_rgb[k] += change_rgb[k];
+        acc->truth_change_rgb[k] += truth_rgb[k];
+      }
       acc->pixels += 1;
     }
   }
-  return RdeReport{all.finish(), real.finish(), virt.finish(), influenced.finish(), rest.finish()};
+  return RdeReport{all.finish(),        real.finish(), virt.finish(),     influenced.finish(),
+                   rest.finish(),       darkened.finish(), brightened.finish()};
 }
 
 }  // namespace
@@ -154,12 +170,16 @@ ErrorFigures pool(const ErrorFigures& a, const ErrorFigures& b) {
   acc.ssim = a.ssim * double(a.pixels) + b.ssim * double(b.pixels);
   acc.change = a.change_sum + b.change_sum;
   acc.truth_change = a.truth_change_sum + b.truth_change_sum;
+  for (int k = 0; k < 3; ++k) {
+    acc.change_rgb[k] = a.change_rgb[k] + b.change_rgb[k];
+    acc.truth_change_rgb[k] = a.truth_change_rgb[k] + b.truth_change_rgb[k];
+  }
   return acc.finish();
 }
 
 RdeReport pool(const RdeReport& a, const RdeReport& b) {
-  return {pool(a.all, b.all), pool(a.real, b.real), pool(a.virtual_, b.virtual_), pool(a.influenced, b.influenced),
-          pool(a.rest, b.rest)};
+  return {pool(a.all, b.all),   pool(a.real, b.real),         pool(a.virtual_, b.virtual_),   pool(a.influenced, b.influenced),
+          pool(a.rest, b.rest), pool(a.darkened, b.darkened), pool(a.brightened, b.brightened)};
 }
 
 Expected<RdeReport> measure_error(const ImageRGB8& output, const ImageRGB8& camera,

@@ -19,6 +19,11 @@
 namespace mrgi::perf {
 
 nlohmann::json bench_json(const BenchResult& result, const CheckReport* check);
+// An error report as JSON, the form bench.json and mrgi replay's stats and summary share: per
+// pixel set (all, real, virtual, influenced, rest, darkened, brightened) its RDE (null when
+// undefined), delta RMS, RMSE, SSIM, pixels and the signed change sums, total and per channel.
+nlohmann::json error_figures_json(const ErrorFigures& f);
+nlohmann::json error_report_json(const RdeReport& r);
 std::string bench_csv(const BenchResult& result);
 std::string report_markdown(const BenchResult& result, const CheckReport* check);
 // 960 x 640 plot of the suite aggregates (aggregate_levels), one colour and marker per technique.
