@@ -12,6 +12,7 @@
 #include "gpu/context.h"
 #include "gpu/floor_pass.h"
 #include "mrgi/perf/bench.h"
+#include "mrgi/perf/temporal.h"
 #include "mrgi/perf/stats.h"
 #include "mrgi/perf/suite.h"
 #include "mrgi/platform/capture.h"
@@ -24,6 +25,50 @@
 
 namespace mrgi::perf {
 namespace {
+
+// Temporal stability over consecutive measured frames of one run (mrgi/perf/temporal.h): only
+// where the output is the capture's size and the frames have depth and poses.
+Status measure_stability(const LoadedScene& l, const std::vector<FrameOutput>& kept, BenchEntry& e) {
+  const size_t n = l.frames.size();
+  const Intrinsics& k = l.info.color;
+  double sum = 0.0, truth = 0.0;
+  size_t pairs = 0, truth_pairs = 0;
+  for (size_t i = 1; i < kept.size(); ++i) {
+    const FrameOutput& a = kept[i - 1];
+    const FrameOutput& b = kept[i];
+    if (b.stats.frame_index != a.stats.frame_index + 1) continue;
+    const size_t sa = ping_pong(size_t(a.stats.frame_index), n), sb = ping_pong(size_t(b.stats.frame_index), n);
+    const InputFrame& fa = l.frames[sa];
+    const InputFrame& fb = l.frames[sb];
+    if (sa == sb || !fa.pose || !fb.pose || fa.depth.empty() || fb.depth.empty()) continue;
+    if (a.image.width != k.width || a.image.height != k.height || fa.color.width != k.width ||
+        fa.depth.width != k.width || fa.depth.height != k.height)
+      continue;
+    auto view = [&](const FrameOutput& o, const InputFrame& f, size_t src) {
+      StabilityFrame v;
+      v.camera = &f.color;
+      v.output = &o.image;
+      v.reference = l.references[src] ? &*l.references[src] : nullptr;
+      v.virtual_mask = o.virtual_mask.empty() ? nullptr : &o.virtual_mask;
+      v.depth = &f.depth;
+      v.camera_to_world = f.pose->matrix();
+      return v;
+    };
+    auto r = delta_stability(view(a, fa, sa), view(b, fb, sb), k, l.info.depth_scale);
+    if (!r.ok()) return fail(r.error().kind, "scene '" + l.suite.name + "': " + r.error().message);
+    if (r->pixels == 0) continue;
+    sum += r->output_change;
+    ++pairs;
+    if (r->has_truth) {
+      truth += r->truth_change;
+      ++truth_pairs;
+    }
+  }
+  e.stability_pairs = pairs;
+  e.stability = pairs > 0 ? sum / double(pairs) : 0.0;
+  e.truth_stability = truth_pairs > 0 ? truth / double(truth_pairs) : -1.0;
+  return ok_status();
+}
 
 std::string shell_first_line(const std::string& command) {
   std::string out;
@@ -248,6 +293,7 @@ Expected<RunSamples> run_one(const LoadedScene& l, const std::string& technique,
     pooled_any = true;
   }
   e.has_reference = pooled_any;
+  MRGI_TRY(measure_stability(l, kept, e));
   kept.clear();
 
   // Phase 2, profiling mode: the same runtime, warm, each pass submitted alone and host-timed,

@@ -38,6 +38,12 @@ std::string fmt(double v, int decimals) {
 }
 
 // An RDE cell: "-" when there is no reference or the RDE is undefined over that set.
+// The frame-to-frame change of the delta on static real pixels, linear x 1000, output / truth.
+std::string stability_cell(const BenchEntry& e) {
+  if (e.stability_pairs == 0) return "-";
+  return fmt(1000.0 * e.stability, 2) + (e.truth_stability >= 0.0 ? " / " + fmt(1000.0 * e.truth_stability, 2) : "");
+}
+
 std::string rde_cell(bool has_reference, const ErrorFigures& f) {
   return has_reference && f.rde_defined ? fmt(f.rde, 3) : "-";
 }
@@ -185,6 +191,11 @@ nlohmann::json bench_json(const BenchResult& r, const CheckReport* check) {
                        {"passes", passes},
                        {"memory_mib", e.memory_mib},
                        {"error", error_json(e.has_reference, e.error)},
+                       {"stability", {{"pairs", e.stability_pairs},
+                                      {"output", e.stability_pairs > 0 ? nlohmann::json(e.stability) : nlohmann::json(nullptr)},
+                                      {"truth", e.stability_pairs > 0 && e.truth_stability >= 0.0
+                                                    ? nlohmann::json(e.truth_stability)
+                                                    : nlohmann::json(nullptr)}}},
                        {"skipped", e.skipped}});
   }
   j["entries"] = entries;
@@ -278,7 +289,9 @@ std::string report_markdown(const BenchResult& r, const CheckReport* check) {
        "(host thread and driver workers) over the same frames, per frame: on a shared machine it moves less with "
        "other tenants' load than wall time, so compare builds by it. RDE is pooled over the measured frames (0 = perfect, 1 = no better than the camera "
        "frame; `-` = undefined: no reference, or nothing should change in that set of pixels). RMSE in 8-bit "
-       "units and SSIM are over all pixels.\n\n";
+       "units and SSIM are over all pixels. *flicker* is the frame-to-frame change of the output's delta (output - "
+       "camera) on real surfaces that did not move, mean per pixel and channel, linear x 1000, over consecutive "
+       "measured frames, beside the truth's own (mrgi/perf/temporal.h).\n\n";
 
   o << "## Floor pass per scene\n\n| scene | size | samples | median ms | p95 ms | min ms |\n|---|---|---:|---:|---:|---:|\n";
   for (const SceneFloor& f : r.floors)
@@ -296,8 +309,8 @@ std::string report_markdown(const BenchResult& r, const CheckReport* check) {
 
   for (const std::string& t : techniques) {
     o << "## " << t << "\n\n";
-    o << "| scene | level | sustained ms | p95 ms | ratio | CPU ms | split | memory MiB | RDE all | RDE real | RDE virtual | RMSE | SSIM |\n";
-    o << "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    o << "| scene | level | sustained ms | p95 ms | ratio | CPU ms | split | memory MiB | RDE all | RDE real | RDE virtual | RMSE | SSIM | flicker |\n";
+    o << "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n";
     for (const BenchEntry& e : r.entries) {
       if (e.technique != t) continue;
       o << "| " << e.scene << " | " << e.level << " " << e.level_name << " | " << fmt(e.sustained_ms, 2) << " | "
@@ -306,7 +319,7 @@ std::string report_markdown(const BenchResult& r, const CheckReport* check) {
         << fmt(e.memory_mib, 1) << " | " << rde_cell(e.has_reference, e.error.all) << " | "
         << rde_cell(e.has_reference, e.error.real) << " | " << rde_cell(e.has_reference, e.error.virtual_) << " | "
         << (e.has_reference ? fmt(e.error.all.rmse8, 2) : "-") << " | "
-        << (e.has_reference ? fmt(e.error.all.ssim, 4) : "-") << " |\n";
+        << (e.has_reference ? fmt(e.error.all.ssim, 4) : "-") << " | " << stability_cell(e) << " |\n";
     }
     for (size_t i = 0; i < levels.size(); ++i) {
       const LevelAggregate& l = levels[i];
@@ -317,7 +330,7 @@ std::string report_markdown(const BenchResult& r, const CheckReport* check) {
         << " | " << fmt(l.mean_cpu_ms, 1) << " | | " << fmt(l.max_memory_mib, 1) << " | " << rde_cell(l.has_reference, l.error.all) << " | "
         << rde_cell(l.has_reference, l.error.real) << " | " << rde_cell(l.has_reference, l.error.virtual_) << " | "
         << (l.has_reference ? fmt(l.error.all.rmse8, 2) : "-") << " | "
-        << (l.has_reference ? fmt(l.error.all.ssim, 4) : "-") << " |\n";
+        << (l.has_reference ? fmt(l.error.all.ssim, 4) : "-") << " | |\n";
     }
     // Where the error is: the truth's regions (mrgi/metrics.h RdeReport::influenced, rest) and
     // how much light the output takes from or adds to the real pixels against the truth.

@@ -433,6 +433,15 @@ TEST(Report, CsvAndMarkdownHoldEveryEntry) {
   EXPECT_TRUE(j["suite_aggregate"][0]["pareto"].get<bool>());
   EXPECT_TRUE(j["suite_aggregate"][1]["pareto"].get<bool>());
   EXPECT_DOUBLE_EQ(j["suite_aggregate"][1]["mean_sustained_ms"].get<double>(), 10.0);
+  // Temporal stability: "-" where not measured; output / truth x 1000 where it is.
+  EXPECT_NE(md.find("| SSIM | flicker |"), std::string::npos);
+  perf::BenchResult with = r;
+  with.entries[0].stability_pairs = 3;
+  with.entries[0].stability = 0.003;
+  with.entries[0].truth_stability = 0.009;
+  EXPECT_NE(perf::report_markdown(with, nullptr).find(" | 3.00 / 9.00 |"), std::string::npos);
+  EXPECT_EQ(perf::bench_json(with, nullptr)["entries"][0]["stability"]["pairs"].get<size_t>(), 3u);
+  EXPECT_TRUE(perf::bench_json(r, nullptr)["entries"][0]["stability"]["output"].is_null());
 }
 
 }  // namespace

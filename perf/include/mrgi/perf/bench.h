@@ -94,6 +94,12 @@ struct BenchEntry {
   bool has_reference = false;            // error below is meaningful only when true
   RdeReport error;                       // pooled over the measured frames
   std::vector<std::string> skipped;      // distinct skip notes seen over the measured frames
+  // Temporal stability (mrgi/perf/temporal.h): the mean over consecutive measured frame pairs
+  // of the frame-to-frame change of the delta on static real pixels, linear, and the truth's;
+  // stability_pairs 0 = not measured (no depth or poses, another output size, one frame),
+  // truth_stability < 0 = no references.
+  size_t stability_pairs = 0;
+  double stability = 0.0, truth_stability = -1.0;
 };
 
 struct SceneFloor {
