@@ -125,7 +125,7 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
   s.lighting_.light_sh.reserve(kMaxStageLights);
   s.lighting_.foldable.reserve(kMaxStageLights);
   s.lighting_.ambient_regions.reserve(Lighting::kMaxOcclusionRegions);
-  s.region_order_.reserve(64);
+  s.region_order_.reserve(size_t(settings.environment.samples));  // one entry a region at most
   for (const LightDesc& l : scene.lights) {
     s.lighting_.lights.push_back(l);
     s.lighting_.light_sh.push_back(ShRgb{});
