@@ -23,10 +23,10 @@ namespace mrgi::technique {
 const std::array<DirLevel, 5>& dir_levels() {
   static const std::array<DirLevel, 5> levels = {{
       {"paper", 256, 64, 16, 128, 1024, 512, 4, 4, 1, 1.0f, 0.0f, -1, 0},
-      {"high", 256, 64, 16, 64, 512, 256, 4, 4, 1, 1.0f, 0.0f, -1, 0},
-      {"medium", 64, 16, 16, 64, 512, 256, 2, 4, 1, 1.0f, 0.0f, -1, 1},
-      {"fast", 32, 0, 8, 32, 256, 64, 1, 4, 2, 0.5f, 0.5f, 0, 3},
-      {"fastest", 16, 0, 4, 32, 128, 64, 1, 4, 2, 0.5f, 0.5f, 0, 3},
+      {"high", 256, 64, 0, 64, 512, 256, 4, 4, 1, 1.0f, 0.0f, -1, 0},
+      {"medium", 64, 16, 0, 64, 512, 256, 2, 4, 1, 1.0f, 0.0f, -1, 1},
+      {"fast", 32, 0, 0, 32, 256, 64, 1, 4, 2, 0.5f, 0.5f, 0, 3},
+      {"fastest", 16, 0, 0, 32, 128, 64, 1, 4, 2, 0.5f, 0.5f, 0, 3},
   }};
   return levels;
 }
@@ -359,7 +359,8 @@ Dir::VplSlots Dir::plan_vpl_slots(const DirLevel& level, int level_shadowed) {
   for (uint8_t f : lighting.foldable) shadowed += f != 0 ? 1 : 0;
   // A level that leaves the regions' shadows to the VPLs (shadowed_env >= 0) does so only when
   // there are environment VPLs (else the estimated lights, the probeless one too, keep their maps).
-  slots.env_override = level.shadowed_env >= 0 && !ablation_.no_environment_vpls && !regions.empty();
+  slots.env_override =
+      level.shadowed_env >= 0 && level.env_vpls > 0 && !ablation_.no_environment_vpls && !regions.empty();
   const int map_shadowed = slots.env_override ? level.shadowed_env : level_shadowed;
   shadowed = std::min(shadowed, size_t(std::max(0, map_shadowed)));
   slots.first_region = std::min(shadowed, regions.size());
