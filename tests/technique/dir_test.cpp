@@ -286,7 +286,7 @@ TEST(Dir, ASpotMissingTheObjectsDrawsNoVirtualMap) {
 // alternates by 1 cm (beyond the reuse tolerance), so VPLs and ISMs are rebuilt every frame and
 // nothing may accumulate: frames of the same input are equal bit for bit once the
 // reconstruction's filter has settled (the last against the 100th from last), and the mean
-// light of the last frames is within 1 % of frames 8-9's.
+// light of the last 20 frames is within 1 % of frames 40-59's.
 const StressVariant kStress[] = {
     {"lamp_at_1e6", glm::vec3(0.8f, 0.2f, 0.2f), [](SyntheticScene& s) { s.scene.lights[0].intensity = 1e6f; }},
     {"point_lamp_inside_the_object", glm::vec3(0.8f, 0.2f, 0.2f),

@@ -106,7 +106,7 @@ TEST(Dlpv, VolumesAreReusedOnlyWhileTheInputsStayWithinTolerance) {
 // larger than the scene (the volume, twice its size, is then coarser than the real box). The
 // volume is rebuilt every frame, so nothing may accumulate: once the reconstruction's temporal
 // filter has settled, frames of the same input are equal bit for bit (the last against the
-// 100th from last) and the mean output light of the last frames is within 1 % of frames 8-9's.
+// 100th from last) and the mean output light of the last 20 frames is within 1 % of frames 40-59's.
 // The volume's own values under a 1e6 lamp are checked finite in tests/gi/test_lpv.cpp.
 const StressVariant kStress[] = {
     {"lamp_at_1e6", glm::vec3(0.8f, 0.2f, 0.2f), [](SyntheticScene& s) { s.scene.lights[0].intensity = 1e6f; }},

@@ -279,7 +279,7 @@ TEST(Dvct, AGlossyRegionOutOfViewTracesNoSpecularCone) {
 // surface in its region), a mirror-smooth metal object (roughness 0: the narrowest specular cone) and a
 // fully rough one (roughness 1: at the limit, no specular cone), and a lamp at 1e6. Nothing may accumulate: frames of the same input are equal bit for
 // bit once the reconstruction's filter settled, and the mean light of the last frames is within
-// 1 % of frames 8-9's.
+// 1 % of frames 40-59's.
 const StressVariant kStress[] = {
     {"object_larger_than_the_scene", glm::vec3(0.8f, 0.2f, 0.2f),
      [](SyntheticScene& s) { s.scene.virtual_objects[0].placement.scale *= 20.0f; }},
