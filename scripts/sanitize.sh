@@ -5,8 +5,8 @@
 # only) and a short run of every fuzz target (scripts/fuzz.sh, FUZZ_SECONDS each, default 10).
 # In the test command it runs the areas that read outside input (unit, capture, scene, the .oni
 # reader and the fuzz corpora) to keep the command near 15 minutes on 2 cores;
-# MRGI_SANITIZE_ALL=1 builds and runs every test (about 12 minutes more; session 11: 376 tests,
-# no report in mrgi's code after the .oni probe fix).
+# MRGI_SANITIZE_ALL=1 builds and runs every test (about 12 minutes more; last full run: 376 tests,
+# no report in mrgi's code).
 # To fit the CI time (the test command builds the tree twice on 2 cores): -O0 with line tables
 # only, and the libraries as unity translation units (MRGI_UNITY_LIBS).
 set -euo pipefail

@@ -41,6 +41,46 @@ std::pair<int, int> parse_size(const std::string& text) {
 
 // --sizes: the same bench once per output size, each written to DIR/WxH/, and DIR/scaling.md
 // and scaling.json comparing them (built under DIR.partial like every bench output).
+// The suites (comma-separated) as paths that open: a relative one not found from the current
+// folder is looked for from the repository the executable was built in (bin/ sits in
+// <repo>/build/, or <repo>/build-*/), so `mrgi bench` works from any folder; a suite found
+// nowhere is refused naming every place looked.
+std::string resolve_suites(const std::string& list) {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> roots;
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec)
+    for (fs::path p = exe.parent_path(); !p.empty() && p != p.root_path(); p = p.parent_path())
+      if (fs::exists(p / "perf" / "suite.json", ec)) {
+        roots.push_back(p);
+        break;
+      }
+  std::string out;
+  for (size_t at = 0; at <= list.size();) {
+    const size_t comma = std::min(list.find(',', at), list.size());
+    const std::string item = list.substr(at, comma - at);
+    at = comma + 1;
+    std::string found = item;
+    if (!item.empty() && fs::path(item).is_relative() && !fs::exists(item, ec)) {
+      std::string looked = (fs::current_path(ec) / item).string();
+      found.clear();
+      for (const fs::path& r : roots) {
+        if (fs::exists(r / item, ec)) {
+          found = (r / item).string();
+          break;
+        }
+        looked += ", " + (r / item).string();
+      }
+      if (found.empty())
+        throw CommandFailure(2, "--suite " + item + ": not found (looked at " + looked +
+                                "); run from the repository root or give the manifest's path");
+    }
+    out += (out.empty() ? "" : ",") + found;
+  }
+  return out;
+}
+
 void run_scaling(BenchOptions& o) {
   if (!o.check.empty() || !o.write_baseline.empty())
     throw CommandFailure(2, "--sizes cannot be combined with --check or --write-baseline");
@@ -113,6 +153,7 @@ void run_bench_command(BenchOptions& o) {
       o.settings.sweeps.push_back({g.substr(0, eq), values});
     }
   }
+  o.settings.suite = resolve_suites(o.settings.suite);
   if (!o.sizes.empty()) return run_scaling(o);
   std::optional<perf::Baseline> baseline;
   if (!o.check.empty()) baseline = take(perf::load_baseline(o.check));  // fail before hours of work
@@ -218,7 +259,7 @@ void setup(CLI::App& app) {
   cmd->add_option("--check", opts->check, "baseline to compare with (perf/baseline.json); exit 1 on a regression");
   cmd->add_option("--write-baseline", opts->write_baseline, "write a baseline from this run to FILE");
   cmd->add_option("--device", opts->settings.device.device,
-                  "Vulkan device: index or name part (default $MRGI_DEVICE, else lavapipe)");
+                  "Vulkan device: index, cpu / lavapipe, gpu, or name part (default $MRGI_DEVICE, else lavapipe)");
   cmd->add_flag("--validate", opts->settings.device.validate, "enable Vulkan validation layers (slower)");
   cmd->add_flag("--vulkan-1-2", opts->settings.device.vulkan_1_2,
                 "use the Vulkan 1.2 path on a 1.3 device (synchronization2 and dynamic rendering from their KHR "

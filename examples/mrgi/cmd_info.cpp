@@ -126,7 +126,7 @@ void run_info(const InfoOptions& o) {
 void setup(CLI::App& app) {
   auto opts = std::make_shared<InfoOptions>();
   CLI::App* cmd = app.add_subcommand("info", "Vulkan devices, the one mrgi uses, and a technique's memory budget");
-  cmd->add_option("--device", opts->device, "device index or name substring (default: $MRGI_DEVICE, else lavapipe)");
+  cmd->add_option("--device", opts->device, "Vulkan device: index, cpu / lavapipe, gpu, or name part (default $MRGI_DEVICE, else lavapipe)");
   cmd->add_flag("--validate", opts->validate, "load the Khronos validation layer (fails if it is not installed)");
   cmd->add_option("--technique", opts->technique,
                   "also print this technique's quality ladder (every level's knobs with units) and its start-up "

@@ -235,7 +235,7 @@ void run_live(const LiveOptions& o) {
   const int out_w = info.color.width, out_h = info.color.height;
   ReplayMeta meta{source->name(), runtime->technique(), level,
                   level == kAutoLevel ? "auto" : runtime->level_names()[size_t(level)], runtime->device().name,
-                  runtime->memory_mib(), out_w, out_h};
+                  runtime->device().type == "cpu", runtime->memory_mib(), out_w, out_h};
   ReplayOutput output = take(ReplayOutput::create(o.out, meta));
 
   std::signal(SIGINT, on_sigint);
@@ -318,7 +318,7 @@ void setup(CLI::App& app) {
   cmd->add_option("--out,-o", o->out, "output folder (frames/, stats.json, summary.json, side_by_side.png); "
                                       "no preview window is implemented, so it is required")->required();
   cmd->add_option("--frames,-n", o->frames, "stop after N frames (0 = until the stream ends or Ctrl-C)")->check(CLI::NonNegativeNumber);
-  cmd->add_option("--device", o->device, "Vulkan device: index or name part");
+  cmd->add_option("--device", o->device, "Vulkan device: index, cpu / lavapipe, gpu, or name part");
   cmd->add_option("--env", o->env, "fisheye environment camera, v4l2:/dev/videoN or libcamera:ID (needs a calibrated model)");
   cmd->add_option("--env-model", o->env_model, "capture.json whose env_camera (fisheye equidistant) and exposure calibrate --env");
   cmd->add_option("--timeout-ms", o->timeout_ms, "longest wait for one frame before failing (ms)")->check(CLI::Range(1, 600000))->capture_default_str();

@@ -63,10 +63,10 @@ void setup(CLI::App& app) {
   cmd->add_option("--suite", o->settings.suite, "suite manifest (JSON)")->capture_default_str();
   cmd->add_option("--scene,-s", o->settings.scene, "suite scene (with a virtual object and a lamp)")->capture_default_str();
   cmd->add_option("--technique,-t", o->settings.technique, "technique")->capture_default_str();
-  cmd->add_option("--budget-ms", o->settings.budget_ms, "frame budget, ms")->capture_default_str()->check(CLI::Range(0.1, 1e6));
+  cmd->add_option("--budget-ms", o->settings.budget_ms, "frame budget, ms")->capture_default_str()->check(frame_budget_ms_check());
   cmd->add_option("--frames,-n", o->settings.frames, "frames in the run (>= 60)")->capture_default_str()->check(CLI::Range(60, 100000));
   cmd->add_flag("--no-oracle", o->no_oracle, "skip the fixed-level runs the oracle needs");
-  cmd->add_option("--device", o->settings.device.device, "Vulkan device: index or name part");
+  cmd->add_option("--device", o->settings.device.device, "Vulkan device: index, cpu / lavapipe, gpu, or name part");
   cmd->add_option("--out,-o", o->out, "output folder (report.md, trace.png, load.json)")->required();
   cmd->add_flag("--quiet,-q", o->quiet, "no progress on stderr");
   cmd->callback([o] { run_loadtest(*o); });

@@ -33,7 +33,7 @@ void setup(CLI::App& app) {
   cmd->add_option("--steps", o->settings.steps, "propagation steps");
   cmd->add_option("--rsm", o->settings.rsm_sizes, "RSM sizes, texels per side");
   cmd->add_option("--repeats", o->settings.repeats, "timed runs per entry (median reported)")->check(CLI::Range(1, 100));
-  cmd->add_option("--device", o->settings.device.device, "Vulkan device: index or name part (default lavapipe)");
+  cmd->add_option("--device", o->settings.device.device, "Vulkan device: index, cpu / lavapipe, gpu, or name part (default lavapipe)");
   cmd->add_option("-o,--out", o->out, "also write the Markdown tables to this file");
   cmd->callback([o] { run(*o); });
 }

@@ -44,7 +44,7 @@ void setup(CLI::App& app) {
   cmd->add_option("--repeats", opts->settings.repeats, "timed runs per kernel (median reported)")
       ->check(CLI::Range(1, 1000));
   cmd->add_option("--device", opts->settings.device.device,
-                  "Vulkan device: index or name part (default $MRGI_DEVICE, else lavapipe)");
+                  "Vulkan device: index, cpu / lavapipe, gpu, or name part (default $MRGI_DEVICE, else lavapipe)");
   cmd->add_flag("--json", opts->json, "JSON on stdout instead of Markdown");
   cmd->add_option("-o,--out", opts->out, "also write the Markdown table to this file");
   cmd->callback([opts] { run_peaks(*opts); });

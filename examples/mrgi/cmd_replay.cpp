@@ -1,6 +1,7 @@
 // mrgi replay CAPTURE --technique NAME --out DIR [--level N|last] [--frames N] [--width W --height H]
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -23,7 +24,7 @@ struct ReplayOptions {
   std::vector<std::string> dir_ablation;
   std::vector<std::string> specular_ablation;
   int frames = 0, width = 0, height = 0, preload_frames = 0;
-  bool validate = false, quiet = false, vulkan_1_2 = false, no_residual_light = false;
+  bool validate = false, quiet = false, vulkan_1_2 = false, no_residual_light = false, profile = false;
 };
 
 // The settings the options give beyond the quality (o.quality.apply): device, output size,
@@ -31,6 +32,7 @@ struct ReplayOptions {
 void apply_options(const ReplayOptions& o, const CaptureInfo& info, RuntimeSettings& settings) {
   settings.device.device = o.device;
   settings.device.validate = o.validate;
+  settings.profile_passes = o.profile;
   settings.device.vulkan_1_2 = o.vulkan_1_2;
   settings.residual_light = !o.no_residual_light;
   settings.output_width = o.width;
@@ -45,6 +47,12 @@ void apply_options(const ReplayOptions& o, const CaptureInfo& info, RuntimeSetti
     throw CommandFailure(2, "--dir-ablation: only for --technique dir");
   set_ablations(o.specular_ablation, kSpecularAblations, research.specular);
   if (research.any()) settings.research = std::make_shared<const ResearchSettings>(research);
+}
+
+double process_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
 struct Decoded {
@@ -73,6 +81,11 @@ struct Replay {
   size_t tracked = 0, untracked = 0;
   size_t written = 0;
   std::chrono::steady_clock::time_point t0;
+  // run_preloaded: wall-clock and process CPU seconds of the chunks' frames alone (from a chunk's
+  // first output to its flush(), no decoding or encoding inside) and the frames completed in
+  // them, for the sustained figure.
+  double frames_seconds = 0.0, frames_cpu_seconds = 0.0;
+  size_t sustained_frames = 0;
   // Outputs come back frames_in_flight-1 calls late: each input's camera frame and true light
   // wait here until then.
   std::vector<std::optional<Decoded>> in_flight;
@@ -141,6 +154,22 @@ void Replay::run_preloaded() {
   for (size_t first = 0; first < frames; first += chunk) {
     const size_t last = std::min(frames, first + chunk);
     for (size_t i = first; i < last; ++i) in_flight[i] = decode_one(i);
+    // Completion to completion, as the bench's sustained phase: the window opens when the
+    // chunk's first output comes back (the pipeline filled, frame 0's start-up behind it) and
+    // closes at the flush; the outputs after the first are the frames it holds.
+    std::optional<std::chrono::steady_clock::time_point> wall0;
+    double cpu0 = 0.0;
+    auto collect = [&](std::vector<FrameOutput>&& outs) {
+      if (outs.empty()) return;
+      if (!wall0) {
+        wall0 = std::chrono::steady_clock::now();
+        cpu0 = process_cpu_seconds();
+        sustained_frames += outs.size() - 1;
+      } else {
+        sustained_frames += outs.size();
+      }
+      for (FrameOutput& f : outs) done.push_back(finish(std::move(f)));
+    };
     for (size_t i = first; i < last; ++i) {
       if (!spares.empty()) {
         runtime.recycle(std::move(spares.back()));
@@ -148,9 +177,13 @@ void Replay::run_preloaded() {
       }
       auto outs = take(runtime.process(in_flight[i]->frame));
       in_flight[i]->frame = InputFrame{};
-      for (FrameOutput& f : outs) done.push_back(finish(std::move(f)));
+      collect(std::move(outs));
     }
-    for (FrameOutput& f : take(runtime.flush())) done.push_back(finish(std::move(f)));
+    collect(take(runtime.flush()));
+    if (wall0) {
+      frames_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - *wall0).count();
+      frames_cpu_seconds += process_cpu_seconds() - cpu0;
+    }
     for (Finished& f : done) {
       encode_one(f);
       spares.push_back(std::move(f.output));
@@ -212,6 +245,31 @@ void Replay::run_overlapped() {
   encode.join();
 }
 
+// stdout's one line a run (the figures are in summary.json): what ran, the headline frame time
+// and the error against the references when the capture has them.
+std::string replay_line(const nlohmann::json& summary, const std::string& out) {
+  char buf[160];
+  std::string line = summary.value("technique", "") + " " + summary.value("level_name", "") + ", " +
+                     std::to_string(summary.value("frames", 0)) + " frames";
+  if (summary["sustained_ms"].is_number()) {
+    std::snprintf(buf, sizeof buf, ": sustained %.1f ms a frame, CPU %.1f ms", summary["sustained_ms"].get<double>(),
+                  summary["cpu_ms"].get<double>());
+    line += buf;
+  } else {
+    line += ": sustained ms " + summary.value("sustained_is", std::string("not measured"));
+  }
+  if (summary.contains("rde")) {
+    auto fig = [&](const char* k) {
+      const auto& v = summary["rde"][k];
+      if (!v.is_number()) return std::string("-");
+      std::snprintf(buf, sizeof buf, "%.3f", v.get<double>());
+      return std::string(buf);
+    };
+    line += "; RDE all " + fig("all") + ", real " + fig("real") + ", virtual " + fig("virtual");
+  }
+  return line + "; " + out + "/summary.json";
+}
+
 void run_replay(const ReplayOptions& o) {
   if ((o.width == 0) != (o.height == 0)) throw CommandFailure(2, "--width and --height go together");
   RuntimeSettings settings;
@@ -237,7 +295,7 @@ void run_replay(const ReplayOptions& o) {
 
   const int out_w = o.width ? o.width : info.color.width, out_h = o.height ? o.height : info.color.height;
   ReplayMeta meta{o.capture, runtime->technique(), level, level == kAutoLevel ? "auto" : runtime->level_names()[size_t(level)],
-                  runtime->device().name,
+                  runtime->device().name, runtime->device().type == "cpu",
                   runtime->memory_mib(), out_w, out_h};
   ReplayOutput output = take(ReplayOutput::create(o.out, meta));
   if (!o.video.empty()) {
@@ -254,7 +312,7 @@ void run_replay(const ReplayOptions& o) {
   Replay replay{o, capture, info, frames, out_w, out_h, env_intensity, *runtime, output, tracker};
   replay.t0 = std::chrono::steady_clock::now();
   replay.in_flight.resize(frames);
-  const bool preloaded = o.io == "preloaded" || (o.io.empty() && level == kAutoLevel);
+  const bool preloaded = o.io != "overlapped";
   if (preloaded) replay.run_preloaded();
   else replay.run_overlapped();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - replay.t0).count();
@@ -265,6 +323,9 @@ void run_replay(const ReplayOptions& o) {
                        preloaded ? "decode a chunk of frames, process them back to back, encode them (PNG I/O included, "
                                    "never beside a frame)"
                                  : "decode, process and encode every frame, overlapped (PNG I/O included)"});
+  if (preloaded)
+    output.set_sustained({replay.frames_seconds, replay.frames_cpu_seconds, replay.sustained_frames,
+                          settings.frames_in_flight});
   if (!o.quiet)
     std::cerr << "mrgi: replayed " << frames << " frames in " << seconds << " s: "
               << double(frames) / seconds << " fps achieved (decode and encode included)\n";
@@ -272,7 +333,7 @@ void run_replay(const ReplayOptions& o) {
   if (tracker)
     std::cerr << "mrgi: AprilTag tracking gave a pose for " << replay.tracked << " frames, none for "
               << replay.untracked << " (capture has no groundtruth.txt pose for them)\n";
-  std::cout << summary.dump(2) << "\n";
+  std::cout << replay_line(summary, o.out) << "\n";
 }
 
 void setup(CLI::App& app) {
@@ -315,8 +376,12 @@ void setup(CLI::App& app) {
                   "on mirrors and glass stay there instead of moving to where their light lands); comma-separated")
       ->delimiter(',')
       ->check(CLI::IsMember(ablation_names(kDirAblations)));
-  cmd->add_option("--device", opts->device, "Vulkan device: index or name part (default $MRGI_DEVICE, else lavapipe)");
+  cmd->add_option("--device", opts->device, "Vulkan device: index, cpu / lavapipe, gpu, or name part (default $MRGI_DEVICE, else lavapipe)");
   cmd->add_flag("--validate", opts->validate, "enable Vulkan validation layers");
+  cmd->add_flag("--profile", opts->profile,
+                "profiling mode: each pass submitted alone and host-timed, so stats.json's per-pass times add up "
+                "to the frame on any device (without it, a CPU device's GPU timestamps do not time passes); "
+                "frames run slower");
   cmd->add_flag("--vulkan-1-2", opts->vulkan_1_2,
                 "use the Vulkan 1.2 path on a 1.3 device (synchronization2 and dynamic rendering from their KHR "
                 "extensions, as a 1.2 driver runs them)");
@@ -324,10 +389,10 @@ void setup(CLI::App& app) {
                 "with declared lamps: light by the lamps alone, without the estimate of the real light they do not "
                 "explain (RuntimeSettings::residual_light; an ablation)");
   cmd->add_option("--io", opts->io,
-                  "preloaded: decode a chunk of frames, run them back to back, then write them, so the frames "
-                  "have the cores to themselves as on a live device (the default with --level auto: the scheduler "
-                  "holds the frames' own cost to the budget); overlapped: decode and write on their own threads "
-                  "beside the frames (the default with a fixed level: faster on many cores)")
+                  "preloaded (default): decode a chunk of frames, run them back to back, then write them, so the "
+                  "frames have the cores to themselves as on a live device, the scheduler holds their own cost to "
+                  "the budget and the headline sustained ms is measured; overlapped: decode and write on their own "
+                  "threads beside the frames (faster end to end on many cores; no sustained ms)")
       ->check(CLI::IsMember({"preloaded", "overlapped"}));
   cmd->add_option("--preload-frames", opts->preload_frames,
                   "--io preloaded: frames decoded ahead at a time (default: as many as fit in 512 MiB, about 130 "

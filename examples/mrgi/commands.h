@@ -63,6 +63,10 @@ struct QualityOptions {
   void apply(RuntimeSettings& settings) const;  // technique, level, frame_budget_ms, knobs
 };
 
+// --budget-ms's rule, said in words (CLI11's range check prints its raw bounds): a frame budget
+// in ms, at least 0.1 and at most 1e6.
+CLI::Validator frame_budget_ms_check();
+
 // Progress on stderr for long work (one line, rewritten in place when stderr is a terminal).
 void progress(const std::string& what, size_t done, size_t total, double elapsed_s);
 

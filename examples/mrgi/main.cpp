@@ -90,10 +90,23 @@ void QualityOptions::add(CLI::App& cmd) {
       ->capture_default_str();
   cmd.add_option("--budget-ms", budget_ms, "frame budget the scheduler holds, ms (--level auto)")
       ->capture_default_str()
-      ->check(CLI::Range(0.1, 1e6));
+      ->check(frame_budget_ms_check());
   cmd.add_option("--knob", knobs,
                  "set one quality knob at every level, NAME=VALUE (repeatable; mrgi info --technique T lists them "
                  "with their spans)");
+}
+
+CLI::Validator frame_budget_ms_check() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (text.empty() || *end != '\0' || !(v >= 0.1 && v <= 1e6))
+          return "'" + text + "' is not a frame budget: give the milliseconds a frame may take, at least 0.1 and at "
+                 "most 1e6 (33.3 holds 30 fps, 16.7 holds 60 fps)";
+        return std::string();
+      },
+      "MS in [0.1, 1e6]", "frame budget");
 }
 
 void QualityOptions::apply(RuntimeSettings& settings) const {

@@ -5,7 +5,12 @@
 //                           notes (a priming run, a missing pose), the frame's error figures
 //                           when a reference exists, and the estimated light (ssrt) when the
 //                           technique estimates one
-//   DIR/summary.json        frames, median_frame_ms, p95_frame_ms, achieved {fps, ms_per_frame},
+//   DIR/summary.json        frames; the headline frame time sustained_ms (wall clock per frame
+//                           with inputs preloaded and frames in flight, as `mrgi bench` names it)
+//                           and cpu_ms (process CPU per frame) beside it; median_device_ms and
+//                           p95_device_ms (GPU timestamps, or the passes' sum when profiled);
+//                           passes_ms_are (whether per-pass times can be trusted on this device);
+//                           achieved {fps, ms_per_frame} (end to end, PNG I/O included),
 //                           technique, level, device, budget {share_within, level_switches,
 //                           frames_per_level, median and p95 cost},
 //                           lp_num_threads, memory_mib, rde {all, real, virtual} with references,
@@ -36,6 +41,7 @@ struct ReplayMeta {
   int level = 0;
   std::string level_name;
   std::string device;
+  bool cpu_device = false;  // a CPU Vulkan device (lavapipe): GPU timestamps do not time passes
   double memory_mib = 0.0;
   int width = 0, height = 0;
 };
@@ -58,6 +64,14 @@ class ReplayOutput {
     std::string what;  // what the interval covers
   };
   void set_achieved(const Achieved& a) { achieved_ = a; }
+  // The headline (summary.json "sustained_ms", "cpu_ms"): the frames alone, processed back to
+  // back with their inputs already decoded; absent where the frames ran beside I/O.
+  struct Sustained {
+    double wall_seconds = 0.0, cpu_seconds = 0.0;
+    size_t frames = 0;
+    int frames_in_flight = 0;
+  };
+  void set_sustained(const Sustained& s) { sustained_ = s; }
   // The composited frames also go to this clip (--video), finished with the rest.
   void set_video(VideoOutput&& video) { video_.emplace(std::move(video)); }
 
@@ -73,6 +87,7 @@ class ReplayOutput {
   double budget_ms_ = 0.0;
   bool profiled_ = false;
   Achieved achieved_;
+  Sustained sustained_;
   std::optional<RdeReport> pooled_;
   ImageRGB8 side_by_side() const;
   ImageRGB8 last_camera_, last_reference_;

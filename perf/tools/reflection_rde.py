@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""RDE over a virtual object's reflection region on a real floor or table (issue 18, the glossy
+"""RDE over a virtual object's reflection region on a real floor or table (the glossy
 suite scene), from a replay's frames against the capture's references. Standard library only.
 
 The reflection region of a frame: the real pixels directly below the virtual object's silhouette

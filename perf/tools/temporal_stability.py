@@ -1,7 +1,6 @@
 #!/usr/bin/env python3
 """Temporal stability of a replay: the frame-to-frame change of the delta (output - camera) on
-real surfaces that did not move (issue 15: "frame-to-frame change of the delta in static
-regions").
+real surfaces that did not move (static regions).
 
 For each frame t > 0, every real pixel with a measured depth is lifted to the world with frame
 t's depth and pose and projected into frame t-1 (capture.json intrinsics, groundtruth.txt

@@ -83,7 +83,8 @@ MRGI_FN float paraboloid_texel_solid_angle(vec2 uv, float size) {
 //     there: only the tint of the grazing rise is lost).
 // The lobe is at least MRGI_VPL_MIN_ROUGHNESS wide: a VPL stands for the light of its share of the
 // maps (hundreds of texels), not for one point, and a narrower lobe turns it into a spot that the
-// few dozen VPLs of a frame cannot average (a mirror's reflection is issue 19's caustic maps).
+// few dozen VPLs of a frame cannot average (a mirror's reflection is the specular stage's
+// caustic maps).
 #define MRGI_VPL_MIN_ROUGHNESS 0.3f
 
 struct VplGlossySplit {

@@ -139,7 +139,7 @@ TEST(CaptureRefuses, LineWithTooFewOrTooManyFields) {
   EXPECT_ERROR(CaptureReader::open(f.folder()), BadInput, "rgb.txt:4:", "expected 'timestamp path', got 3 fields");
 }
 
-// Issue 12 cases 5 and 8: a NUL byte inside a listed path (it would name another file where the
+// A NUL byte inside a listed path (it would name another file where the
 // file system reads it) and a list that is a FIFO (opening it would block for ever).
 TEST(CaptureRefuses, NulByteInAListedPathAndAFifoList) {
   CaptureFixture f(2);

@@ -184,7 +184,7 @@ TEST(HdrIo, RadianceHdrFromStb) {
   EXPECT_NEAR(img->data[3], 0.5f, 1e-2f);
 }
 
-// Issue 12 case 4: a 2 KB .hdr whose header asks for 120 GB is refused before allocating.
+// A 2 KB .hdr whose header asks for 120 GB is refused before allocating.
 TEST(HdrIo, RadianceHeaderBeyondTheSizeLimitIsRefused) {
   TempDir dir;
   std::string hdr = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 100000 +X 100000\n";

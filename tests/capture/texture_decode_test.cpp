@@ -1,6 +1,6 @@
 // Texture decoding for glTF (image/texture_decode.h): libjpeg-turbo and libpng from memory.
-// Valid files decode to RGBA8; truncated and mutated ones (single bytes changed, as the fuzzing
-// of issue 12 found stb_image writing out of bounds on) are refused or decoded, never crash;
+// Valid files decode to RGBA8; truncated and mutated ones (single bytes changed, the kind of
+// input fuzzing found stb_image writing out of bounds on) are refused or decoded, never crash;
 // sizes beyond the limit are refused before allocation.
 #include <gtest/gtest.h>
 

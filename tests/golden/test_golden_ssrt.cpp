@@ -1,6 +1,6 @@
 // ssrt against the path-traced reference on the suite's environment-lit scene (perf/suite/
 // env_fisheye: 640x480, 8 frames, 512 spp, courtyard HDR with a sun 34 degrees up behind the
-// camera), validation layers on: issue 4's "done when" as a test. The probeless estimate's
+// camera), validation layers on. The probeless estimate's
 // dominant direction is compared with the band-1 direction of each frame's environment image,
 // and the pooled RDE with `baseline`'s when baseline too lights the scene from the frames (the
 // light stage's probeless estimate, scene.json's environment dropped): both then know only what
@@ -9,9 +9,9 @@
 // beside it: it knows the true light, so it is the bar for the estimate, not for the technique.
 //
 // Bounds: measured on lavapipe plus a margin. fast: direction 8.5 median / 9.0 worst
-// degrees, RDE 0.583; fastest: 7.4 / 7.8 degrees, RDE 0.618. Session 12: baseline high with the
-// environment image 0.517 (a constant ambient before: 0.629), with the probeless estimate see
-// the printout.
+// degrees, RDE 0.583; fastest: 7.4 / 7.8 degrees, RDE 0.618. baseline high with the
+// environment image: 0.517 (0.629 with a constant ambient in place of its importance-sampled
+// lights); with the probeless estimate, see the printout.
 // The full and half levels take about 4 s and 1 s a frame on lavapipe, too slow for CI's
 // budget for one test; their figures are in ssrt.h.
 #include <gtest/gtest.h>

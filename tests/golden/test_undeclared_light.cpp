@@ -1,6 +1,6 @@
-// Issue 13's first "done when": every technique runs on a capture whose scene.json declares no
-// lamp and no environment, lights its virtual object with the light stage's estimate (not
-// black), and says in every frame's notes where the light came from. Validation layers on.
+// Every technique runs on a capture whose scene.json declares no lamp and no environment,
+// lights its virtual object with the light stage's estimate (not black), and says in every
+// frame's notes where the light came from. Validation layers on.
 #include <gtest/gtest.h>
 
 #include <string>

@@ -142,9 +142,9 @@ TEST(Probeless, EstimatesTheSunsDirectionAndColourInARoomCorner) {
   std::printf("probeless: direction error %.1f deg, confidence %.2f, %.1f ms for the whole system (%d x %d samples)\n",
               err, double(lit.estimate.confidence), ms, 80, 60);
   // The view shows three orientations (floor, two walls; the box's faces repeat them), so the
-  // light's direction rests on the box's shadow and the priors: 27 degrees (session 12). The
+  // light's direction rests on the box's shadow and the priors (measured: 27 degrees). The
   // bound catches a broken estimator (a sign or axis error gives 90-180), not its accuracy,
-  // which the light family measures on path-traced scenes (perf/results/light-family.md).
+  // which the light family measures on path-traced scenes (perf/results/light-family/light-family.md).
   EXPECT_LT(err, 35.0);
   // The light's colour (band 0 and the dominant light) within 10 % per channel of the truth's,
   // each normalised by its luminance: the estimate is RGB, not grey.
@@ -290,7 +290,7 @@ TEST(Probeless, ColourVoteIgnoresAMinorityRedWall) {
   };
   const double gray_world = colour_error(false), voted = colour_error(true);
   std::printf("red wall: colour error gray-world %.2f, vote %.2f\n", gray_world, voted);
-  EXPECT_GT(gray_world, 0.1);  // the wall tints the light (0.15, session 12)
+  EXPECT_GT(gray_world, 0.1);  // the wall tints the light (0.15 measured)
   EXPECT_LT(voted, 0.1);
 }
 

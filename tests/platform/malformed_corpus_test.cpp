@@ -1,4 +1,4 @@
-// The malformed-input corpus (issue 12): broken captures generated here from a two-frame copy of
+// The malformed-input corpus: broken captures generated here from a two-frame copy of
 // the bundled sample (data/sample), one defect each, every one replayed by the real tool. Each
 // must be refused with exit 1 and a message that names the broken file and the rule, and leave
 // no output behind (neither OUT nor OUT.partial). The generator is the table below: a case is a

@@ -169,8 +169,7 @@ TEST(OpenNISource, CorruptFilesAreNamedErrorsNotHangs) {
   });
 }
 
-// Issue 12 case 9: a folder named like a recording gave std::bad_alloc; a FIFO would block.
-// Issue 12 case 2: one changed byte in a property name (the second node's
+// One changed byte in a property name (the second node's
 // "xnSupportedMapOutputModesCount", so the driver never reads the count it then uses) passes the
 // record-structure check and segfaulted inside OpenNI2's Device::open. The probe process takes
 // the crash: a named BadInput, this process unharmed, nothing opened.
@@ -199,6 +198,8 @@ TEST(OpenNISource, AFileThatCrashesTheDriverIsRefusedNotFatal) {
   });
 }
 
+// A folder named like a recording (reading it as one would throw std::bad_alloc) and a FIFO
+// (opening it would block) are refused as BadInput ("not a regular file").
 TEST(OpenNISource, AFolderOrFifoNamedOniIsABadInputNotACrash) {
   test::TempDir dir("oni-not-a-file");
   std::filesystem::create_directories(dir.file("folder.oni"));

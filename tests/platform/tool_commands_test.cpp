@@ -2,6 +2,7 @@
 // `mrgi live` on the Kinect recording (default object), and `mrgi record` + `mrgi replay`.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -142,14 +143,66 @@ TEST_F(ToolCommands, ReplayPreloadedWritesTheFramesOverlappedWrites) {
                 " 2> " + dir.file("e2.txt")),
             0)
       << slurp(dir.file("e2.txt"));
-  EXPECT_NE(slurp(dir.file("b.json")).find("decode a chunk of frames"), std::string::npos);
+  // stdout: one line a run, naming the headline figure and where the summary is; the summary
+  // says which frame time is the headline and whether the per-pass times can be trusted.
+  const std::string line = slurp(dir.file("b.json"));
+  EXPECT_EQ(std::count(line.begin(), line.end(), '\n'), 1) << line;
+  EXPECT_NE(line.find("sustained "), std::string::npos) << line;
+  EXPECT_NE(line.find("RDE all "), std::string::npos) << line;
+  EXPECT_NE(line.find("/b/summary.json"), std::string::npos) << line;
+  const auto b = nlohmann::json::parse(slurp(dir.file("b") + "/summary.json"));
+  EXPECT_NE(b["achieved"]["is"].get<std::string>().find("decode a chunk of frames"), std::string::npos);
+  ASSERT_TRUE(b["sustained_ms"].is_number()) << b.dump(1);
+  EXPECT_GT(b["sustained_ms"].get<double>(), 0.0);
+  EXPECT_GT(b["cpu_ms"].get<double>(), 0.0);
+  EXPECT_NE(b["passes_ms_are"].get<std::string>().find("unreliable"), std::string::npos)
+      << "lavapipe's GPU timestamps do not time passes: " << b["passes_ms_are"];
+  const auto a = nlohmann::json::parse(slurp(dir.file("a") + "/summary.json"));
+  EXPECT_TRUE(a["sustained_ms"].is_null()) << "frames beside I/O are not the headline";
   for (int i = 0; i < 5; ++i) {
     char name[32];
     std::snprintf(name, sizeof name, "/frames/%06d.png", i);
-    auto a = load_png_rgba8(dir.file("a") + name);
-    auto b = load_png_rgba8(dir.file("b") + name);
-    ASSERT_TRUE(a.ok() && b.ok()) << name;
-    EXPECT_TRUE(a->data == b->data) << "frame " << i << " differs between the I/O modes";
+    auto fa = load_png_rgba8(dir.file("a") + name);
+    auto fb = load_png_rgba8(dir.file("b") + name);
+    ASSERT_TRUE(fa.ok() && fb.ok()) << name;
+    EXPECT_TRUE(fa->data == fb->data) << "frame " << i << " differs between the I/O modes";
+  }
+  // --profile: the passes timed one by one, and said so.
+  ASSERT_EQ(run(replay + " --profile --out " + dir.file("c") + " > /dev/null 2> " + dir.file("e3.txt")), 0)
+      << slurp(dir.file("e3.txt"));
+  const auto c = nlohmann::json::parse(slurp(dir.file("c") + "/summary.json"));
+  EXPECT_EQ(c["passes_ms_are"].get<std::string>().rfind("profiled", 0), 0u) << c["passes_ms_are"];
+}
+
+// bench's default suite (perf/suite.json) is found from any folder, through the repository the
+// tool was built in; a suite found nowhere is refused naming where it was looked for.
+TEST_F(ToolCommands, BenchFindsItsSuiteFromAnyFolderOrSaysWhereItLooked) {
+  test::TempDir dir("bench-elsewhere");
+  const std::string in_dir = "cd " + dir.path.string() + " && LP_NUM_THREADS=2 timeout 300 " + MRGI_TOOL;
+  ASSERT_EQ(run(in_dir + " bench --frames 1 -t baseline --levels 3 -s desk_spot -q -o out > /dev/null 2> " +
+                dir.file("err.txt")),
+            0)
+      << slurp(dir.file("err.txt"));
+  EXPECT_TRUE(std::filesystem::exists(dir.file("out/bench.json")));
+  EXPECT_EQ(run(in_dir + " bench --suite no-such-suite.json -q -o out2 > /dev/null 2> " + dir.file("err2.txt")), 2);
+  const std::string err = slurp(dir.file("err2.txt"));
+  EXPECT_NE(err.find("looked at " + dir.path.string() + "/no-such-suite.json"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("out2")));
+}
+
+// A budget out of range is refused in words (what the number is, its range, an example), exit 2,
+// before anything is opened or written.
+TEST_F(ToolCommands, FrameBudgetOutOfRangeIsRefusedInWords) {
+  test::TempDir dir("budget");
+  for (const char* v : {"0", "-5", "abc", "1e7"}) {
+    EXPECT_EQ(run(std::string("timeout 60 ") + MRGI_TOOL + " replay " + MRGI_SOURCE_DIR + "/data/sample --budget-ms " +
+                  v + " -q --out " + dir.file("o") + " > /dev/null 2> " + dir.file("err.txt")),
+              2)
+        << v;
+    const std::string err = slurp(dir.file("err.txt"));
+    EXPECT_NE(err.find("is not a frame budget"), std::string::npos) << v << ": " << err;
+    EXPECT_NE(err.find("33.3 holds 30 fps"), std::string::npos) << err;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("o"))) << v;
   }
 }
 

@@ -307,7 +307,8 @@ void write_triangle_bin(const std::string& path) {
   std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(tri), sizeof(tri));
 }
 
-// Issue 12 case 1: 15,000 nested arrays overflowed the stack inside tinygltf's JSON parser.
+// 15,000 nested arrays would overflow the stack inside tinygltf's JSON parser: the nesting depth
+// is checked before parsing.
 TEST(GltfHardening, DeeplyNestedJsonIsRefusedBeforeParsing) {
   TempDir dir;
   write_triangle_bin(dir.file("t.bin"));
@@ -322,7 +323,7 @@ TEST(GltfHardening, DeeplyNestedJsonIsRefusedBeforeParsing) {
   EXPECT_TRUE(ok.ok()) << ok.error().message;
 }
 
-// Issue 12 case 4: a node listed twice as a child per level expands to 2^levels instances.
+// A node listed twice as a child per level expands to 2^levels instances: their count is bounded.
 TEST(GltfHardening, ExponentialNodeInstancingIsBounded) {
   TempDir dir;
   write_triangle_bin(dir.file("t.bin"));
@@ -334,7 +335,7 @@ TEST(GltfHardening, ExponentialNodeInstancingIsBounded) {
   EXPECT_ERROR(load_gltf(dir.file("bomb.gltf"), Placement{}), BadInput, "bomb.gltf", "node instances", "limit");
 }
 
-// Issue 12 case 5: URIs outside the model's folder, and FIFOs, are never opened.
+// URIs outside the model's folder, and FIFOs, are never opened.
 TEST(GltfHardening, BufferUrisStayInsideTheModelFolderAndRegularFiles) {
   TempDir dir;
   std::filesystem::create_directories(dir.file("model"));
@@ -352,7 +353,7 @@ TEST(GltfHardening, BufferUrisStayInsideTheModelFolderAndRegularFiles) {
   EXPECT_ERROR(load_gltf(dir.file("pipe.gltf"), Placement{}), NotFound, "pipe.gltf");
 }
 
-// Issue 12 case 8: a required extension mrgi does not implement is refused by name.
+// A required extension mrgi does not implement is refused by name.
 TEST(GltfHardening, RequiredExtensionsAreRefusedByName) {
   TempDir dir;
   write_triangle_bin(dir.file("t.bin"));
@@ -364,7 +365,7 @@ TEST(GltfHardening, RequiredExtensionsAreRefusedByName) {
                "KHR_draco_mesh_compression", "extensionsRequired");
 }
 
-// Issue 12 cases 8 and 9: glTF 1.0 (it said "no scene"), a primitive without triangles.
+// glTF 1.0 is refused as such (not as "no scene"), and so is a primitive without triangles.
 TEST(GltfHardening, VersionOneAndEmptyPrimitivesAreNamed) {
   TempDir dir;
   write_triangle_bin(dir.file("t.bin"));
@@ -396,7 +397,7 @@ TEST(GltfHardening, TruncatedOrForeignGlbHeadersAreRefused) {
 namespace mrgi {
 namespace {
 
-// Issue 12 case 10: KHR_texture_transform on the base colour texture (offset, rotation, scale
+// KHR_texture_transform on the base colour texture (offset, rotation, scale
 // and its texCoord override) is applied to the primitive's coordinates, as the extension's
 // T * R * S matrix; bad values are refused naming the field.
 std::string textured_triangle_gltf(const std::string& texture_info, const std::string& extra_material = "") {
@@ -460,7 +461,7 @@ TEST(GltfLoader, TextureTransformIsAppliedToTheBaseColourCoordinates) {
   EXPECT_NEAR(plain1->primitives[0].uvs[1].x, 0.25f, 1e-6f);
 }
 
-// Issue 12 case 9: a texture image that is not there is refused naming the file (not only the
+// A texture image that is not there is refused naming the file (not only the
 // image's index), and nothing is loaded.
 TEST(GltfHardening, AMissingTextureFileIsNamed) {
   TempDir dir;

@@ -255,8 +255,8 @@ INSTANTIATE_TEST_SUITE_P(
                  ErrorKind::BadInput, "real_geometry[0].material.shiny", "unknown key"},
         BadScene{"{\"version\": 1,\n  \"lights\": [,]}", ErrorKind::BadInput, "line 2", "invalid JSON"},
         BadScene{R"([1, 2])", ErrorKind::BadInput, "top level", "must be an object"},
-        // Issue 12 case 8: a repeated key (JSON keeps the last one silently) and numbers finite as
-        // doubles but infinite as the floats they end up in.
+        // A repeated key (JSON keeps the last one silently) and numbers finite as doubles but
+        // infinite as the floats they end up in.
         BadScene{R"({"version": 1, "version": 1})", ErrorKind::BadInput, "'version'", "appears twice"},
         BadScene{R"({"version": 1, "lights": [{"type": "point", "real": true, "position": [0,0,0]},
                    {"type": "point", "real": true, "real": false, "position": [0,0,0]}]})",

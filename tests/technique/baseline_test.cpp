@@ -312,7 +312,7 @@ TEST(TechniqueRegistry, NamesAndLevels) {
 namespace mrgi::test {
 namespace {
 
-// Issue 13, item 5: under an environment (no lamp), the virtual box shadows the sky for the real
+// Under an environment (no lamp), the virtual box shadows the sky for the real
 // floor at its foot: the light stage's strongest environment regions are drawn with shadow maps.
 // A sky bright above and dark below; floor pixels just outside the box's footprint get darker,
 // floor pixels far from every object keep the camera's value.
@@ -358,7 +358,7 @@ TEST_F(BaselineTest, AVirtualObjectUnderASkyCastsAContactShadow) {
   ASSERT_GT(far, 5);
   near_ratio /= near;
   far_ratio /= far;
-  // Measured 0.91 (session 12): four of the sixteen median-cut regions are shadowed, and the
+  // Measured 0.91: four of the sixteen median-cut regions are shadowed, and the
   // sky's share they carry is half the light; without the shadowed regions it is 1.
   EXPECT_LT(near_ratio, 0.95) << "no contact shadow at the box's foot";
   EXPECT_NEAR(far_ratio, 1.0, 0.03) << "open floor changed";

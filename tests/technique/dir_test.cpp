@@ -1,7 +1,7 @@
 // The dir technique end to end on the synthetic scene (synthetic_scene.h) with Vulkan validation
 // on (a message fails process()/flush()): every level runs, says what it does not build yet, and
 // its VPLs light the virtual boxes beyond baseline's direct light at the same baseline level
-// (the floor's bounce: the paper's VPL 1, L_r D_r D_v E). Stress (issue 15): 1,000 frames stay
+// (the floor's bounce: the paper's VPL 1, L_r D_r D_v E). Stress: 1,000 frames stay
 // finite and do not grow. Accuracy against path-traced references is the bench's (perf/).
 #include <gtest/gtest.h>
 
@@ -262,7 +262,8 @@ TEST(Dir, TemporalSmoothingKeepsStillFramesAndSaysWhenItHasNoHistory) {
   EXPECT_TRUE(has(plain.back(), "dir temporal smoothing: off"));
 }
 
-// A spot whose cone misses the virtual objects draws R^mu only (issue 15's skip) and says so.
+// A spot whose cone misses the virtual objects draws R^mu only (R^rho would be its copy) and
+// says so in FrameStats::skipped.
 TEST(Dir, ASpotMissingTheObjectsDrawsNoVirtualMap) {
   mrgi::testing::TempDir dir;
   SyntheticScene scene = SyntheticScene::create(dir.str());
@@ -279,7 +280,7 @@ TEST(Dir, ASpotMissingTheObjectsDrawsNoVirtualMap) {
   EXPECT_TRUE(note);
 }
 
-// Stress (issue 15): 1,000 frames at the fast level for a lamp at 1e6, a point lamp inside the
+// Stress: 1,000 frames at the fast level for a lamp at 1e6, a point lamp inside the
 // virtual object (no map can hold it: skipped and said, the frame still lit directly), a black
 // object (its map covers texels but reflects nothing: no VPL from the virtual map) and a spot
 // cone so narrow that its map is lit in a few texels (every VPL drawn from them). The depth

@@ -99,7 +99,7 @@ TEST(Dlpv, VolumesAreReusedOnlyWhileTheInputsStayWithinTolerance) {
   check_reuse_within_tolerance(dir.str(), "dlpv", 2, "dlpv maps and volumes: reused");
 }
 
-// Stress (issue 14): 1,000 frames at the fast level, each recomputing its maps and volumes (the
+// Stress: 1,000 frames at the fast level, each recomputing its maps and volumes (the
 // depth alternates by 1 cm, beyond the reuse tolerance), for a lamp at 1e6, a point lamp inside
 // the volume (no map can hold it: skipped, said, the frame still lit directly), a black virtual
 // object (the delta is negative only: it blocks and reflects nothing) and an object 20 times

@@ -272,7 +272,7 @@ TEST(Dvct, AGlossyRegionOutOfViewTracesNoSpecularCone) {
   EXPECT_TRUE(with.back().image.data == without.back().image.data);
 }
 
-// Stress (issue 18): 1,000 frames at the fast level (16^3; the glossy variants with its specular
+// Stress: 1,000 frames at the fast level (16^3; the glossy variants with its specular
 // cone turned on by knob), each rebuilding its volumes (the depth alternates by 1 cm, beyond the
 // reuse tolerance): an object larger than the scene (the region, twice its size, holds the whole
 // real scene coarsely), an empty volume (one box 1 m above the floor, in view, with no real

@@ -1,4 +1,4 @@
-// glTF emissive materials (issue 12 case 10): a virtual surface's emission is added to its
+// glTF emissive materials: a virtual surface's emission is added to its
 // radiance by every technique, so its pixels brighten by exactly the emitted radiance (times the
 // exposure) and the real pixels stay as they were. Validation layers on.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Soak (issue 12 case 6): every technique at its cheapest level runs hundreds of frames with a
+// Soak: every technique at its cheapest level runs hundreds of frames with a
 // moving camera without growing executable code or memory after start-up. lavapipe 22.3 compiled
 // a shader per bind where a loop's bound was a uniform (shaders/common/opaque_uniform.glsl):
 // ssrt_tsdf_fuse added one executable mapping per frame and RSS grew without bound.

@@ -1,17 +1,16 @@
 // Harnesses shared by the GI techniques' tests (dlpv_test.cpp, dir_test.cpp). The 1,000-frame
-// stress (issues 14 and 15: "no NaN, no energy growth over
-// 1,000 frames"), shared by dlpv_test.cpp and dir_test.cpp: a variant of the synthetic scene
-// run at one level for `n` frames whose depth alternates by 1 cm (beyond the reuse tolerance of
-// gi/input_reuse.h, so the light-dependent work is rebuilt every frame), keeping frames
-// 0-59 and the last 102, and the notes it saw. check_stress_outcome() then asks that nothing was
-// reused, that frames of the same input are equal bit for bit once the reconstruction's filter
-// has settled (the last two against the 100th before them) and that the mean output light of the
-// last 20 frames is within 1 % of frames 40-59's. Why frames 40-59 and not the first frames: a
-// technique that carries light from one frame to the next (dir's bounce VPLs) draws each frame's
-// VPLs from the last frame's by importance, so its first tens of frames may still switch between
-// nearby selections (one VPL near a wall under a lamp at 1e6 saturates a few pixels: a 4 % change
-// of a 64 x 48 image's mean at frame 20, constant from there to frame 1,000). Growth of 1.1e-5 a
-// frame reaches 1 % over the 940 frames between the two windows.
+// stress (no NaN, no energy growth over 1,000 frames), shared by dlpv_test.cpp and dir_test.cpp: a
+// variant of the synthetic scene run at one level for `n` frames whose depth alternates by 1 cm
+// (beyond the reuse tolerance of gi/input_reuse.h, so the light-dependent work is rebuilt every
+// frame), keeping frames 0-59 and the last 102, and the notes it saw. check_stress_outcome() then
+// asks that nothing was reused, that frames of the same input are equal bit for bit once the
+// reconstruction's filter has settled (the last two against the 100th before them) and that the
+// mean output light of the last 20 frames is within 1 % of frames 40-59's. Why frames 40-59 and not
+// the first frames: a technique that carries light from one frame to the next (dir's bounce VPLs)
+// draws each frame's VPLs from the last frame's by importance, so its first tens of frames may
+// still switch between nearby selections (one VPL near a wall under a lamp at 1e6 saturates a few
+// pixels: a 4 % change of a 64 x 48 image's mean at frame 20, constant from there to frame 1,000).
+// Growth of 1.1e-5 a frame reaches 1 % over the 940 frames between the two windows.
 #pragma once
 #include <gtest/gtest.h>
 

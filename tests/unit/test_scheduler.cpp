@@ -1,8 +1,9 @@
 // The frame-budget scheduler (scheduler/scheduler.h) on simulated cost traces: a device whose
 // frame cost is a level's base cost x the load x the resolution factor, with noise, and one frame
 // of latency between a choice and its cost (as with two frames in flight). Targets as the load
-// test's (issue 17): at least 95 % of frames within the budget after the first second, at most one
-// level switch per second, mean level within one of an oracle that knows every frame's cost.
+// test's (perf/include/mrgi/perf/load_test.h): at least 95 % of frames within the budget after
+// the first second, at most one level switch per second, mean level within one of an oracle that
+// knows every frame's cost.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -40,6 +40,24 @@ TEST(DeviceSelection, NumberIsIndexTextIsNameSubstring) {
   EXPECT_EQ(*select_device_index(fake_devices(), "UHD"), 2u);
 }
 
+TEST(DeviceSelection, KindAliasesPickByDeviceType) {
+  // lavapipe names itself "llvmpipe (LLVM ...)": its documented name must still select it.
+  EXPECT_EQ(*select_device_index(fake_devices(), "lavapipe"), 1u);
+  EXPECT_EQ(*select_device_index(fake_devices(), "LLVMpipe"), 1u);
+  EXPECT_EQ(*select_device_index(fake_devices(), "cpu"), 1u);
+  EXPECT_EQ(*select_device_index(fake_devices(), "gpu"), 0u) << "discrete before integrated";
+  auto integrated_only = fake_devices();
+  integrated_only.erase(integrated_only.begin());
+  EXPECT_EQ(*select_device_index(integrated_only, "GPU"), 2u);
+  auto no_gpu = select_device_index({fake_devices()[1]}, "gpu");
+  ASSERT_FALSE(no_gpu.ok());
+  EXPECT_EQ(no_gpu.error().kind, ErrorKind::BadUsage);
+  EXPECT_NE(no_gpu.error().message.find("no GPU device"), std::string::npos) << no_gpu.error().message;
+  auto no_cpu = select_device_index({fake_devices()[0]}, "lavapipe");
+  ASSERT_FALSE(no_cpu.ok());
+  EXPECT_NE(no_cpu.error().message.find("0: AMD"), std::string::npos) << no_cpu.error().message;
+}
+
 TEST(DeviceSelection, UnmatchedSelectorIsBadUsageListingDevices) {
   auto bad_name = select_device_index(fake_devices(), "geforce");
   ASSERT_FALSE(bad_name.ok());

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes the light-estimation family's scene descriptions (perf/suite/light/<name>.json) and its
-manifest (perf/suite/light/family.json), for issue 13: small captures (320x240, 2 frames) that
+manifest (perf/suite/light/family.json): small captures (320x240, 2 frames) that
 differ in everything a light estimator assumes, rendered by `mrgi synth` (render_family.sh).
 
 Every scene is built so its main light reaches the virtual object (no wall between them): the
@@ -10,7 +10,7 @@ exposure 1 does not clip (interior.exr: irradiance 7 W/m^2 upwards, scaled by 0.
 The split into a tuning half and a held-out half is fixed here, before any tuning: one of each
 pair of related scenes is held out, so every kind of light (sun and sky, indoor HDR, one lamp,
 two lamps) and of view is in both halves. Nothing in the held-out half may be used to choose a
-parameter; perf/results/light-family.md reports both halves.
+parameter; perf/results/light-family/light-family.md reports both halves.
 
 Run from the repository root: python3 perf/suite/light/make_family.py
 """
@@ -160,7 +160,7 @@ def description(body, seed):
 
 def main():
     manifest = {"version": 1,
-                "about": "Light-estimation family (issue 13): 320x240 captures, 2 frames, rendered by mrgi synth "
+                "about": "Light-estimation family: 320x240 captures, 2 frames, rendered by mrgi synth "
                          "from the descriptions here (make_family.py writes them; render_family.sh renders). "
                          "held_out scenes are never used to choose a parameter.",
                 "scenes": []}

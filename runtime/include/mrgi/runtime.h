@@ -28,7 +28,9 @@ struct DeviceInfo {
 
 struct DeviceSettings {
   // Device selector: empty = $MRGI_DEVICE, else lavapipe (llvmpipe) if present, else device 0.
-  // A number picks by index; other text picks the first device whose name contains it.
+  // A number picks by index; "cpu", "lavapipe" or "llvmpipe" the first CPU device; "gpu" the
+  // first discrete GPU, else integrated, else virtual; other text the first device whose name
+  // contains it (case-insensitive).
   std::string device;
   bool validate = false;    // Vulkan validation layers; a message becomes an error in tests
   // Process-wide (glibc): keep memory the driver frees at the end of a frame instead of

@@ -7,6 +7,7 @@
 #include <cctype>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 
 #include "gpu/vk_check.h"
 
@@ -191,10 +192,29 @@ Expected<uint32_t> select_device_index(const std::vector<DeviceInfo>& devices,
                                          std::to_string(devices.size()) + " devices):" + device_list_text(devices));
   }
   const std::string want = lower(selector);
+  // Aliases by kind, before names: Mesa's lavapipe names itself "llvmpipe (LLVM ...)", so the
+  // name the documentation uses would match nothing as a substring.
+  auto first_of_type = [&](std::initializer_list<const char*> types) -> std::optional<uint32_t> {
+    for (const char* t : types)
+      for (const auto& d : devices)
+        if (d.type == t) return d.index;
+    return std::nullopt;
+  };
+  std::optional<uint32_t> alias;
+  const bool cpu_alias = want == "cpu" || want == "lavapipe" || want == "llvmpipe";
+  if (cpu_alias) alias = first_of_type({"cpu"});
+  if (want == "gpu") alias = first_of_type({"discrete-gpu", "integrated-gpu", "virtual-gpu"});
+  if (alias) return *alias;
+  if (cpu_alias || want == "gpu")
+    return fail(ErrorKind::BadUsage, "device selector '" + selector + "': no " +
+                                         (cpu_alias ? "CPU (lavapipe) device" : "GPU device") +
+                                         " among the Vulkan devices (install mesa-vulkan-drivers for lavapipe):" +
+                                         device_list_text(devices));
   for (const auto& d : devices)
     if (lower(d.name).find(want) != std::string::npos) return d.index;
   return fail(ErrorKind::BadUsage, "device selector '" + selector +
-                                       "' matches no device name (use an index or a name substring):" +
+                                       "' matches no device name (use an index, a name substring, or cpu / "
+                                       "lavapipe / gpu):" +
                                        device_list_text(devices));
 }
 

@@ -96,7 +96,7 @@ struct LightStageSettings {
   // The estimator of the probeless source fed by the stage's own builder. RGB (white_light
   // false): the paper's white-light assumption gives a grey estimate under a blue sky. Chosen on
   // the light family's tuning half only (perf/suite/light/family.json; perf/results/
-  // light-family.md), session 12, direction error median / worst over its six scenes:
+  // light-family/light-family.md), direction error median / worst over its six scenes:
   //   as ssrt's (regularisation 1e-2, no non-negativity)              20.6 / 37.8 degrees
   //   + non-negative radiance (nonnegative_penalty 10)                18.4 / 38.0
   //   + regularisation 1e-3                                           17.4 / 40.5 (chosen)
@@ -113,7 +113,7 @@ struct LightStageSettings {
     return s;
   }();
   // The estimator when a technique hands in its own sums (ssrt: its transfer's visibility and
-  // every pixel; the settings it was tuned with, session 4), in RGB.
+  // every pixel; the settings it was tuned with), in RGB.
   LightEstimatorSettings external_estimator = [] {
     LightEstimatorSettings s;
     s.white_light = false;

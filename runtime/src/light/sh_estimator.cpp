@@ -200,9 +200,9 @@ Expected<LightEstimate> LightEstimator::update(const LightSystem& system, int64_
   // frame first. Why: the system is rank-deficient whenever the view shows few normals, and the
   // regularised solution then moves from the prior only along the data's directions. For a floor
   // those mix band 0 with the band-1 "up" coefficient, so a floor darker than the prior predicts
-  // was explained as light from below (session 2: the env_fisheye estimate pointed down, 143
-  // degrees off). Fitting the prior's ambient (band 0, always well constrained when any pixel is
-  // valid) to the frame makes the prior explain the overall brightness; what is left for the
+  // was explained as light from below (without the re-fit the env_fisheye estimate pointed down,
+  // 143 degrees off). Fitting the prior's ambient (band 0, always well constrained when any pixel
+  // is valid) to the frame makes the prior explain the overall brightness; what is left for the
   // higher bands is what the data actually says about direction.
   ShRgb prior = filtered_;
   if (settings_.refit_prior_ambient && ata(0, 0) > 0.0) refit_ambient(prior, ata, atb, n);

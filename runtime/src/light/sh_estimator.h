@@ -52,7 +52,7 @@ struct LightEstimatorSettings {
   // Per-band growth of the penalty: gamma_l = 1 + band_penalty * l (l + 1). Higher bands are
   // the ones least constrained by diffuse reflection (Ramamoorthi & Hanrahan 2001). Default 0:
   // on env_fisheye a growing penalty shrank the sun's band-2 lobe, and the estimate's RDE rose
-  // from 0.586 to 0.602 (fast level, session 4).
+  // from 0.586 to 0.602 (fast level).
   double band_penalty = 0.0;
   // Weight (relative to the mean diagonal of T^T T, like relative_regularisation) of the prior
   // that no light arrives from behind the frame's dominant real surface (a floor, a table, a

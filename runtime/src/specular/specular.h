@@ -123,7 +123,7 @@ struct SpecularLevel {
 // sets, 256^2 caustic maps), fast (96^2 impostors, two sets, each redrawn every eighth frame
 // while its objects stay put; 128^2 caustic maps whose photons are traced every sixteenth frame
 // while the lamps and objects stay put, a quarter of the glass-reflected photons, no caustic
-// VPLs: the fast path, 33 ms at 640 x 480 on lavapipe x2).
+// VPLs: the fast path, for 33 ms at 640 x 480 on lavapipe x2).
 const std::array<SpecularLevel, 3>& specular_levels();
 // The stage's level for a technique's level: the technique's first level gets the paper's
 // settings, its last two the fast ones, the others high.

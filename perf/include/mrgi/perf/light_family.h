@@ -1,4 +1,4 @@
-// The light-estimation family (perf/suite/light/family.json, issue 13): every capture replayed
+// The light-estimation family (perf/suite/light/family.json): every capture replayed
 // twice through one technique, once lit by what its scene.json declares (lamps, environment
 // image: the true light) and once with nothing declared (the runtime's probeless estimate), and
 // the estimate compared with the truth, the light sources as the virtual objects' centre sees
@@ -61,7 +61,8 @@ Expected<std::vector<LightFamilyResult>> run_light_family(
 
 // Markdown: one row per scene, then the summary of each half (median and worst direction
 // error, median irradiance error, worst colour error on the sky scenes, median and worst RDE
-// ratio) against the issue's targets.
+// ratio) against the family's targets (direction median / worst 15 / 30 degrees, colour worst
+// 0.10 on the sky scenes, RDE ratio median / worst 1.15).
 std::string light_family_markdown(const std::vector<LightFamilyResult>& results,
                                   const LightFamilySettings& settings);
 std::string light_family_json(const std::vector<LightFamilyResult>& results);

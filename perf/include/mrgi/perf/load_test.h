@@ -1,4 +1,4 @@
-// The scheduler's load test (issue 17): one suite scene replayed for `frames` frames while its
+// The scheduler's load test: one suite scene replayed for `frames` frames while its
 // load changes on a fixed script (keyed by frame index, so every run sees the same one):
 //   - a CPU load on one core switches on and off (a thread spinning: a stand-in for thermal
 //     throttling on lavapipe, whose work runs on the same cores);

@@ -21,7 +21,7 @@
 //   fast      32    0       0    32^2   256         64^2  1          4x4         1/2       0.5    lowest
 //   fastest   16    0       0    32^2   128         64^2  1          4x4         1/2       0.5    lowest
 // "bounce": of the VPLs, the slots of the bounce light source (gi/vpl_bounce.h: multiple bounces
-// over frames; 0: one bounce, the fast path). "env": of the VPLs, at most this many
+// over frames; 0: one bounce, the fast path). "env": of the VPLs, at most this many
 // environment VPLs (Sec. 3.7): the light stage's median-cut regions after those the direct-light block shades
 // with shadow maps at its level, each a directional VPL with an orthographic ISM over the
 // influence sphere, shaded at every pixel (not interleaved: it is direct light); its light is in

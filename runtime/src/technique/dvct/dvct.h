@@ -34,8 +34,8 @@
 //     its lamps) lights every pixel unshadowed, as in baseline; the paper has no such term (its
 //     environment is injected only as the lamps its RSMs see). Shading it by the diffuse cones
 //     (each cone's ambient radiance times its transmittance with the objects minus without)
-//     made RDE worse on every suite scene it was tried on, at the high level (session 23:
-//     corner real 0.885 -> 1.026, env_fisheye virtual 0.291 -> 0.437, moving real 0.410 ->
+//     made RDE worse on every suite scene it was measured on, at the high level (corner
+//     real 0.885 -> 1.026, env_fisheye virtual 0.291 -> 0.437, moving real 0.410 ->
 //     0.461, desk_spot equal): the cones over-occlude near a surface (its own voxels at coarse
 //     mip levels, and vct_directional_occlusion's coverage rule, which treats a compact object
 //     as a wall across the footprint), so the cones do not occlude the ambient: at every level

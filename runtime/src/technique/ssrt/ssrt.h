@@ -67,38 +67,41 @@
 // and pooled RDE (baseline, which reads the environment image itself: 0.629):
 //   full 16.4 / 16.8 degrees, RDE 0.568;  half 7.4 / 7.6, 0.564;  fast 7.9 / 8.1, 0.561;
 //   fastest 5.2 / 5.4, 0.619.
-// What made it work (session 4): only pixels the camera measured and whose green is unclipped
-// feed the sums (transfer.comp), a prior that no light comes from behind the dominant surface
+// What makes it work: only pixels the camera measured and whose green is unclipped feed the
+// sums (transfer.comp), a prior that no light comes from behind the dominant surface
 // (LightEstimatorSettings::below_surface_penalty), and the first frame primed from itself
 // (Technique::estimate_pending). With the environment's true SH in place of the estimate the
-// fast level scores RDE 0.563, so the estimate costs about 0.02.
+// fast level scores RDE 0.563, so the estimate costs about 0.02. Every level, fastest included,
+// uses 4 SH bands: the transfer accumulates all 16 coefficients whatever the level, so 2 bands
+// would save nothing and cost the direction (46 degrees off; LightEstimatorSettings::
+// below_surface_penalty says why).
 //
-// Cost on lavapipe (LP_NUM_THREADS=2, 640x480, `mrgi bench --techniques ssrt`, session 11:
-// perf/results/report-ssrt-640x480.md (4 frames after 1), report-ssrt-fast-16frames.md and
-// ab-ssrt-fast-session11.md; floor 1.6-2.8 ms, session 8's was 1.5): suite mean sustained full
-// 823 ms, half 480, fast 42.8, fastest 40.0; fast over the scenes with a virtual object 20.0
-// floors (median; 17.3-21.9) on a loaded machine, 21.3 in a quieter hour, against about 22 for
-// 33 ms on a 1.5 ms floor. Fast level split (profiling mode, ratio to the floor): transfer 5.9
-// floors, shade (composing its tiles) 2.1 and its tile test 0.45, host 1.3, ray cast 1.3, blur
-// 0.95, filters 0.9, virtual G-buffer 0.8, occluders 0.75, fuse 0.7, G-buffer 0.5, light sums
-// 0.5, aux layers 0.3: about 17.5 floors profiled, 20 sustained.
-// Measured gains behind them (fast level): no runtime reconstruction (-14 ms), constant
-// indices into the transfer's and the light sums' local arrays (a dynamic index had put them
-// in per-lane scratch memory: -5 and -3 ms), the occluder G-buffer (cache misses, then fewer
-// reads), mesh levels of detail and a bounded virtual G-buffer, the grouped bicubic in shade, N_v
-// culled, three aux lookups instead of four, the camera copy on the host; session 9: compose
-// fused into the tiled shade (its pass gone), one weighted bicubic sum, R'_d as weight x L(w)
-// (16 accumulators fewer), each sender normalised once, integer divisions through floats, the
-// right aux layer mirrored from the left one's matrix (transfer -17 %), the blur's radius a
-// specialization constant (blur -14 %); session 10: workgroups in spread order for lavapipe's
-// static split of a dispatch between its workers, tiles that cannot move a pixel by one 8-bit
-// level left to the camera frame (ssrt_tile_invisible: shaded tiles -29 %), aux layers at 32
-// texels on the fast levels (their ray cast -75 %), the light sums' final pass on 8 workgroups;
-// session 11 (read from lavapipe's JIT code, perf/tools/jit_probe.py): uniform blocks copied on
-// each pass's first line (a uniform read after any branch is a per-lane gather on lavapipe:
-// transfer 32 -> 18 ms), the sample directions in a uniform buffer and the camera uploads and
-// voxels through texel buffers (a per-lane storage-buffer load is a branchy loop over the lanes:
-// transfer -22 %, ray cast -45 %, shade -20 %).
+// Cost on lavapipe (LP_NUM_THREADS=2, 640x480, `mrgi bench --techniques ssrt`;
+// perf/results/report-ssrt-640x480.md (4 frames after 1) and report-ssrt-fast-16frames.md;
+// floor 1.6-2.8 ms): suite mean sustained full 823 ms, half 480, fast 42.8, fastest 40.0; fast
+// over the scenes with a virtual object 20.0 floors (median; 17.3-21.9) on a loaded machine,
+// 21.3 in a quieter hour, against about 22 for 33 ms on a 1.5 ms floor. Fast level split
+// (profiling mode, ratio to the floor): transfer 5.9 floors, shade (composing its tiles) 2.1 and
+// its tile test 0.45, host 1.3, ray cast 1.3, blur 0.95, filters 0.9, virtual G-buffer 0.8,
+// occluders 0.75, fuse 0.7, G-buffer 0.5, light sums 0.5, aux layers 0.3: about 17.5 floors
+// profiled, 20 sustained.
+// Why the passes are shaped as they are (fast level, measured against the alternative; A/B reports
+// perf/results/ab-ssrt-fast-*.md): no runtime reconstruction (-14 ms); constant indices into the
+// transfer's and the light sums' local arrays (a dynamic index puts them in per-lane scratch
+// memory: -5 and -3 ms); compose fused into the tiled shade; the right aux layer mirrored from the
+// left one's matrix (transfer -17 %); the blur's radius a specialization constant (blur -14 %);
+// tiles that cannot move a pixel by one 8-bit level left to the camera frame (ssrt_tile_invisible:
+// shaded tiles -29 %); aux layers at 32 texels on the fast levels (their ray cast -75 %);
+// workgroups in spread order for lavapipe's static split of a dispatch between its workers. Two
+// lavapipe rules, read from its JIT code (perf/tools/jit_probe.py): a uniform read after any branch
+// is a per-lane gather, so uniform blocks are copied on each pass's first line (transfer 32 -> 18
+// ms); a per-lane storage-buffer load is a branchy loop over the lanes, so the sample directions
+// live in a uniform buffer and the camera uploads and voxels are read through texel buffers
+// (transfer -22 %, ray cast -45 %, shade -20 %). Also for speed: the occluder G-buffer, mesh levels
+// of detail and a bounded virtual G-buffer, one weighted (grouped) bicubic sum in shade, N_v
+// culled, three aux lookups instead of four, the camera copy on the host, R'_d as weight x L(w) (16
+// accumulators fewer), each sender normalised once, integer divisions through floats, the light
+// sums' final pass on 8 workgroups.
 // What the transfer's time is (knock-out runs, process CPU, desk_spot/corner): the real-receiver
 // path is 87 % of it; the aux test 35 % (each layer about 7 ms of CPU; without its image loads
 // only 10 % less, so it is the arithmetic and the registers it holds, not the reads); the SH
@@ -108,10 +111,7 @@
 // from their side (env_fisheye's boxes and ball are 0.6-0.7, its floor 0.5); the fast level
 // meets the 33 ms bar on lavapipe without margin (20-22 floor passes against about 22); its
 // coarse geometry costs corner 0.017 RDE (0.748 -> 0.765; geometry_step 2 gives 0.741 but ~24
-// ms more). The fastest level had 2 SH bands
-// until session 4; the transfer accumulates all 16 coefficients whatever the level, so 2 bands
-// saved nothing and cost the direction (46 degrees off; LightEstimatorSettings::
-// below_surface_penalty says why).
+// ms more).
 #pragma once
 #include <array>
 #include <cstdint>
