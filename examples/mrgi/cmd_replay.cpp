@@ -86,8 +86,8 @@ struct Replay {
   // them, for the sustained figure.
   double frames_seconds = 0.0, frames_cpu_seconds = 0.0;
   size_t sustained_frames = 0;
-  // Outputs come back frames_in_flight-1 calls late: each input's camera frame and true light
-  // wait here until then.
+  // Outputs come back frames_in_flight calls late (Runtime::process): each input's camera frame
+  // and true light wait here until then.
   std::vector<std::optional<Decoded>> in_flight;
 
   // One frame's input side (PNG reads, AprilTag, the environment's true light) and output side
@@ -304,7 +304,7 @@ void run_replay(const ReplayOptions& o) {
     output.set_video(take(VideoOutput::create(o.video, out_w, out_h, capture_fps(stamps))));
   }
 
-  // DESIGN.md: poses come from groundtruth.txt when present, else from AprilTag tracking of the
+  // docs/DESIGN.md: poses come from groundtruth.txt when present, else from AprilTag tracking of the
   // colour frames (capture.json "apriltag"). Without either the runtime keeps the last pose.
   std::optional<AprilTagTracker> tracker;
   if (info.apriltag) tracker = take(AprilTagTracker::create(*info.apriltag, info.color));

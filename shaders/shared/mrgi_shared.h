@@ -133,7 +133,7 @@ MRGI_FN float luminance(vec3 linear_rgb) {
   return dot(linear_rgb, vec3(0.2126f, 0.7152f, 0.0722f));
 }
 
-// The camera model (DESIGN.md, capture.json `exposure`): linear radiance times exposure is the
+// The camera model (docs/DESIGN.md, capture.json `exposure`): linear radiance times exposure is the
 // linear sensor value, clipped at 1 (sensor saturation), then the sRGB curve. Compose and the
 // reference renderer both use it, so both "see" with the same camera. Negative or NaN-free
 // input is assumed; values below 0 clip to 0.

@@ -235,7 +235,7 @@ void main() {
   // Outside the projected influence region nothing virtual lies within the occluder range of
   // this surface, and the range check below makes sure only occluders within that range count,
   // so the real + virtual solution equals the real one bit for bit: it is copied, not computed
-  // (DESIGN.md: tiles outside the influence region are not shaded).
+  // (docs/DESIGN.md: tiles outside the influence region are not shaded).
   bool influenced = !kRealOnly && (virt || (cell.x >= pc.influence.x && cell.x < pc.influence.z &&
                              cell.y >= pc.influence.y && cell.y < pc.influence.w));
   int base = pc.config.x + set * pc.grid.w;

@@ -240,5 +240,25 @@ TEST(CaptureRefuses, BadCaptureJsonAndSceneJson) {
   EXPECT_ERROR(CaptureReader::open(f.folder()), BadInput, "scene.json", "lights[0].real", "true or false");
 }
 
+// scene.json's environment from the env camera needs the camera (capture.json env_camera) and
+// its images (env.txt): without either it would light nothing, so the capture is refused naming
+// what is missing; with both it opens.
+TEST(CaptureRefuses, EnvironmentFromEnvCameraWithoutTheCameraOrItsImages) {
+  CaptureFixture f(1);
+  write_text(f.file("scene.json"), R"({"version": 1, "environment": {"from_env_camera": true}})");
+  EXPECT_ERROR(CaptureReader::open(f.folder()), BadInput, "scene.json", "environment.from_env_camera",
+               "capture.json", "env_camera");
+  std::string with_env = testing::capture_json(kW, kH);
+  with_env.insert(with_env.size() - 1, R"(, "env_camera": {"model": "equirectangular"})");
+  write_text(f.file("capture.json"), with_env);
+  EXPECT_ERROR(CaptureReader::open(f.folder()), BadInput, "scene.json", "environment.from_env_camera", "env.txt");
+  ASSERT_TRUE(write_exr(f.file("env/a.exr"), ImageRGBF(4, 2, 0.25f)).ok());
+  write_text(f.file("env.txt"), "1.0 env/a.exr\n");
+  auto reader = CaptureReader::open(f.folder());
+  ASSERT_TRUE(reader.ok()) << reader.error().message;
+  ASSERT_TRUE(reader->scene().has_value());
+  EXPECT_TRUE(reader->scene()->environment.from_env_camera);
+}
+
 }  // namespace
 }  // namespace mrgi

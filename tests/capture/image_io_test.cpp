@@ -184,6 +184,27 @@ TEST(HdrIo, RadianceHdrFromStb) {
   EXPECT_NEAR(img->data[3], 0.5f, 1e-2f);
 }
 
+// Flat (not run-length) pixel data cut short: stb would fill the missing rows with zeros; the
+// loader refuses it naming the rows and bytes, for a narrow image (always flat) and for a wide one
+// whose first scanline lacks the run-length marker. Whole files still load.
+TEST(HdrIo, FlatRadianceDataCutShortIsRefused) {
+  TempDir dir;
+  const std::string narrow = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 2\n";
+  const std::string pixel("\x80\x40\x20\x81", 4);
+  testing::write_text(dir.file("whole.hdr"), narrow + pixel + pixel + pixel + pixel);
+  EXPECT_TRUE(load_hdr_image(dir.file("whole.hdr")).ok());
+  testing::write_text(dir.file("half.hdr"), narrow + pixel + pixel);
+  EXPECT_ERROR(load_hdr_image(dir.file("half.hdr")), BadInput, "half.hdr", "ends early", "need 16 bytes",
+               "has 8");
+  const std::string wide = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4 +X 16\n";
+  std::string rows;
+  for (int i = 0; i < 16 * 4; ++i) rows += pixel;
+  testing::write_text(dir.file("wide.hdr"), wide + rows);
+  EXPECT_TRUE(load_hdr_image(dir.file("wide.hdr")).ok());
+  testing::write_text(dir.file("wide_cut.hdr"), wide + rows.substr(0, rows.size() / 2));
+  EXPECT_ERROR(load_hdr_image(dir.file("wide_cut.hdr")), BadInput, "wide_cut.hdr", "ends early", "rows 0..3");
+}
+
 // A 2 KB .hdr whose header asks for 120 GB is refused before allocating.
 TEST(HdrIo, RadianceHeaderBeyondTheSizeLimitIsRefused) {
   TempDir dir;

@@ -3,6 +3,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include <sys/stat.h>
 
@@ -194,6 +195,40 @@ TEST(GltfLoader, VolumeAttenuationIsReadAndBadTransmissionValuesAreRefused) {
   {
     TinyGltf f("4", R"({"KHR_materials_volume": {"attenuationColor": [2, 0, 0]}})");
     EXPECT_ERROR(load_gltf(f.path, Placement{}), BadInput, "tri.gltf", "attenuationColor", "[0, 1]");
+  }
+}
+
+// Transforms are kept as 32-bit floats: a node value finite only as a double, a world transform
+// whose product overflows, or a position that does once transformed is refused, naming the node
+// or primitive and the field; never infinite vertices.
+TEST(GltfHardening, TransformsBeyondFloatRangeAreRefusedNamingTheField) {
+  auto with = [](TinyGltf& f, const std::string& parent, const std::string& child) {
+    std::ifstream in(f.path);
+    std::string text((std::istreambuf_iterator<char>(in)), {});
+    text.replace(text.find(R"("translation": [0, 1, 0])"), 24, parent);
+    text.replace(text.find(R"("scale": [2, 2, 2])"), 18, child);
+    write_text(f.path, text);
+  };
+  {
+    TinyGltf f;
+    with(f, R"("translation": [0, 1, 0])", R"("scale": [1e39, 1, 1])");
+    EXPECT_ERROR(load_gltf(f.path, Placement{}), BadInput, "tri.gltf", "node 1", "scale[0]", "finite 32-bit float");
+  }
+  {
+    TinyGltf f;
+    with(f, R"("scale": [1e20, 1e20, 1e20])", R"("scale": [1e20, 1e20, 1e20])");
+    EXPECT_ERROR(load_gltf(f.path, Placement{}), BadInput, "tri.gltf", "node 1", "world transform", "not finite");
+  }
+  {
+    TinyGltf f;
+    with(f, R"("translation": [0, 3e38, 0])", R"("scale": [3e38, 3e38, 3e38])");
+    EXPECT_ERROR(load_gltf(f.path, Placement{}), BadInput, "tri.gltf", "mesh 0 primitive 0", "position",
+                 "not finite");
+  }
+  {
+    TinyGltf f;  // large but representable: loads
+    with(f, R"("translation": [0, 1, 0])", R"("scale": [1e30, 1e30, 1e30])");
+    EXPECT_TRUE(load_gltf(f.path, Placement{}).ok());
   }
 }
 

@@ -1,6 +1,6 @@
 // The public ladder of every technique (mrgi/runtime.h technique_ladder): the same levels as
 // technique_levels, each knob with a unit, internal scales in (0, 1]; an unknown technique is
-// refused by name, and "specular" (DESIGN.md's add-on) with where that stage is.
+// refused by name, and "specular" (docs/DESIGN.md's add-on) with where that stage is.
 #include <gtest/gtest.h>
 
 #include "mrgi/runtime.h"

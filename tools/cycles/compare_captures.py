@@ -1,4 +1,4 @@
-# Compares two captures of the same scene description (capture format v1, DESIGN.md): one from
+# Compares two captures of the same scene description (capture format v1, docs/DESIGN.md): one from
 # mrgi's own path tracer (`mrgi synth`), one converted from Blender Cycles renders (`mrgi synth
 # --from-renders`), to show where the two renderers agree and by how much. Both went through the
 # same camera model (exposure, sRGB, 8 bits), so the figures are in decoded linear camera values.

@@ -1,5 +1,5 @@
 # Renders an mrgi scene description (tools/reference/include/mrgi/reference/description.h) with
-# Blender Cycles, as an independent check on mrgi's own path tracer (DESIGN.md "Ground truth and
+# Blender Cycles, as an independent check on mrgi's own path tracer (docs/DESIGN.md "Ground truth and
 # error"). Run:
 #
 #   blender -b --factory-startup -noaudio -P tools/cycles/render_description.py -- \

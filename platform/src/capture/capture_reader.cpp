@@ -293,6 +293,18 @@ Expected<CaptureReader> CaptureReader::open(const std::string& folder) {
   if (*has_scene) {
     auto scene = load_scene_json(scene_json);
     if (!scene) return scene.error();
+    // An environment from the env camera needs that camera and its images here, or it would
+    // light nothing without a word.
+    if (scene->environment.present && scene->environment.from_env_camera) {
+      if (!reader.info_.env_camera)
+        return fail(ErrorKind::BadInput, scene_json + ": environment.from_env_camera: true needs an environment "
+                                         "camera, and " + (dir / "capture.json").string() +
+                                         " has no \"env_camera\" (or give environment.image)");
+      if (env_paths.empty())
+        return fail(ErrorKind::BadInput, scene_json + ": environment.from_env_camera: true needs environment "
+                                         "camera images, and the capture has no env.txt listing them (" +
+                                         (dir / "env.txt").string() + ")");
+    }
     reader.scene_ = std::move(*scene);
   }
 

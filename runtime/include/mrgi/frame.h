@@ -1,5 +1,5 @@
 // One input frame, as every source delivers it: capture replay, OpenNI2, V4L2, libcamera.
-// Conventions (DESIGN.md): camera is OpenCV/TUM (x right, y down, looking along +z); poses are
+// Conventions (docs/DESIGN.md): camera is OpenCV/TUM (x right, y down, looking along +z); poses are
 // camera-to-world; world is right-handed, metres, +y up.
 #pragma once
 #include <cstdint>

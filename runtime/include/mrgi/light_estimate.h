@@ -4,7 +4,7 @@
 // ARCore Environmental HDR's shape (EnvironmentalHdr: main light, 27 SH coefficients, a small
 // HDR cubemap); and Filament's pre-scaled irradiance SH (to_filament_irradiance).
 //
-// Conventions (DESIGN.md): world space, right-handed, metres, +y up; linear RGB.
+// Conventions (docs/DESIGN.md): world space, right-handed, metres, +y up; linear RGB.
 // SH: real orthonormal basis of shaders/shared/mrgi_shared.h (Sloan 2008 sign convention and
 // index order l*(l+1)+m, m = -l..l). Radiance is L(w) = sum_i sh_radiance[i] * Y_i(w).
 #pragma once

@@ -1,4 +1,4 @@
-// Error metrics shared by the runtime, the tests and the bench (DESIGN.md "Ground truth and
+// Error metrics shared by the runtime, the tests and the bench (docs/DESIGN.md "Ground truth and
 // error"). O = mrgi's output, C = the camera frame, G = the ground-truth augmented frame.
 #pragma once
 #include <cstddef>

@@ -110,7 +110,7 @@ struct KnobSetting {
 // Level "last" in the CLI resolves to technique_level_count(name) - 1.
 struct RuntimeSettings {
   DeviceSettings device;
-  // baseline | ssrt | dlpv | dir, or "auto": chosen at start-up for the scene and the budget by
+  // baseline | dir | dlpv | dvct | ssrt, or "auto": chosen at start-up for the scene and the budget by
   // choose_technique (with technique_table), Runtime::technique() says which.
   std::string technique = "baseline";
   std::vector<TechniqueFigure> technique_table;  // for "auto"; empty: the built-in table
@@ -226,9 +226,12 @@ struct FrameOutput {
   // Output size; 255 where a virtual object is seen (composited as TM(L_rv)), 0 on real pixels.
   // For RDE over real / virtual pixels (metrics.h).
   Image<uint8_t, 1> virtual_mask;
-  // The real-world light estimated from the camera image, for techniques that estimate it
-  // (ssrt); empty for the others. The newest estimate when this frame completed: it was solved
-  // from an earlier frame (LightEstimate::frame_index says which).
+  // The light the runtime lights with, as SH radiance and a dominant direction (every
+  // technique): the declared lamps and environment projected to SH plus the residual estimate of
+  // the real light they do not explain, or, with nothing declared (and always for ssrt), the
+  // probeless estimate from the camera images; empty while no light is known. It is the newest
+  // when this output was collected, so with frames in flight it can come from a later input frame
+  // than this one: LightEstimate::frame_index says which (tests/technique/frame_order_test.cpp).
   std::optional<LightEstimate> light;
 };
 
@@ -240,8 +243,10 @@ struct FrameOutput {
 class Runtime {
  public:
   virtual ~Runtime() = default;
-  // Processes one frame. Frames are pipelined: the output returned belongs to the frame given
-  // frames_in_flight-1 calls earlier; flush() drains the rest at the end of a stream. Once per
+  // Processes one frame. Frames are pipelined: the call given frame k returns frame
+  // k - frames_in_flight (with 2 in flight, frame 0 comes back from the call given frame 2; the
+  // first frames_in_flight calls return nothing); flush() returns the last frames_in_flight frames
+  // in order at the end of a stream (tests/technique/frame_order_test.cpp). Once per
   // runtime, a technique that estimates from the frames themselves (ssrt's light) has its first
   // frame run twice, waiting for the first run, so that frame is lit by its own estimate; with
   // the level on kAutoLevel the first frame is also run once in every frame slot first (the

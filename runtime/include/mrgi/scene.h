@@ -1,4 +1,4 @@
-// scene.json v1 (DESIGN.md) and the glTF 2.0 content it places.
+// scene.json v1 (docs/DESIGN.md) and the glTF 2.0 content it places.
 // Units: metres, radians only where named *_rad, degrees where named *_deg; colours linear RGB.
 #pragma once
 #include <cstdint>

@@ -1,4 +1,4 @@
-// Compose (DESIGN.md "One frame, as data"): tone-maps L_rv and L_r with the camera's response and
+// Compose (docs/DESIGN.md "One frame, as data"): tone-maps L_rv and L_r with the camera's response and
 // adds their difference onto the camera frame per caustics-DIR eq. 1-2 (shaders/compose/
 // compose.comp says how and why in linear space), at the output resolution (the solutions are
 // upsampled bilinearly when the internal resolution is lower). Writes the RGBA8 sRGB frame with

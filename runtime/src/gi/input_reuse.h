@@ -1,6 +1,6 @@
 // Whether work made from one frame's inputs (reflective shadow maps, VPLs, ISMs, propagated
 // volumes) may stand for another frame's: the skip "inputs unchanged -> reuse the last volumes,
-// VPLs or transfer" of DESIGN.md, shared by dlpv and dir. What the work depends on is the level,
+// VPLs or transfer" of docs/DESIGN.md, shared by dlpv and dir. What the work depends on is the level,
 // the camera pose (the reconstruction is a function of depth and pose), the depth frame and the
 // lamps it was made for; each must stay within the stated tolerance of the frame that made it:
 //   - the same level;

@@ -100,9 +100,8 @@ Expected<ImageRGBF> load_exr(const std::string& path) {
 // bytes as stbi__hdr_load does and refuses such a file first: a scanline's four channels must
 // each be filled by runs of 1 .. what is left, within the data. Scanlines stb reads flat (width
 // outside [8, 32768), or the first one without the 2, 2 marker, after which stb reads the rest
-// flat) are bounded by the image's size and not walked.
+// flat) must be all there: 4 bytes a pixel to the image's end.
 Status check_hdr_runs(const std::vector<uint8_t>& data, int w, int h, const std::string& path) {
-  if (w < 8 || w >= 32768) return ok_status();
   size_t pos = 0;
   const size_t n = data.size();
   auto get8 = [&]() -> int { return pos < n ? data[pos++] : 0; };  // stb reads 0 past the end
@@ -129,9 +128,21 @@ Status check_hdr_runs(const std::vector<uint8_t>& data, int w, int h, const std:
   while (line_first_byte() != 0) {
   }
   line_first_byte();  // the resolution
+  // Flat pixels (4 bytes each) from `at` to the end: stb reads zeros past the data's end, so an
+  // image cut short would load with black rows; it is refused instead.
+  auto flat_rest = [&](size_t at, int row) -> Status {
+    const size_t need = size_t(4) * size_t(w) * size_t(h - row);
+    if (n - std::min(at, n) >= need) return ok_status();
+    return fail(ErrorKind::BadInput, path + ": Radiance HDR pixel data ends early: rows " + std::to_string(row) +
+                                         ".." + std::to_string(h - 1) + " need " + std::to_string(need) +
+                                         " bytes (4 a pixel, flat), the file has " + std::to_string(n - std::min(at, n)) +
+                                         " (a truncated file?)");
+  };
+  if (w < 8 || w >= 32768) return flat_rest(pos, 0);
   for (int j = 0; j < h; ++j) {
+    const size_t row_start = pos;
     const int c1 = get8(), c2 = get8(), len_hi = get8();
-    if (c1 != 2 || c2 != 2 || (len_hi & 0x80)) return ok_status();  // stb reads the rest flat
+    if (c1 != 2 || c2 != 2 || (len_hi & 0x80)) return flat_rest(row_start, j);  // stb reads the rest flat
     if (((len_hi << 8) | get8()) != w) return ok_status();          // stb refuses it itself
     for (int k = 0; k < 4; ++k) {
       for (int i = 0; i < w;) {

@@ -1,4 +1,4 @@
-// The light stage (DESIGN.md "estimate light"): between reconstruction and the technique, once
+// The light stage (docs/DESIGN.md "estimate light"): between reconstruction and the technique, once
 // per frame, it decides from what the capture or sensor gives where the real light comes from
 // and hands every technique the same answer:
 //   - declared lamps (scene.json `lights`, real and virtual, as tracked lamps are);

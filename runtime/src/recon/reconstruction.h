@@ -1,4 +1,4 @@
-// Reconstruction (DESIGN.md "One frame, as data"): the real G-buffer from the RGB-D stream, with
+// Reconstruction (docs/DESIGN.md "One frame, as data"): the real G-buffer from the RGB-D stream, with
 // the DIR paper's temporal depth filter (section 4.2, eq. 11-14).
 //   upload          colour (sRGB8) and depth (u16) copied into this frame slot's upload buffers;
 //                   the pose change since the previous frame is computed here (CPU, double)

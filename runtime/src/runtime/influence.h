@@ -1,4 +1,4 @@
-// Does anything virtual change what this camera sees? (DESIGN.md "Scheduler and skipping": no
+// Does anything virtual change what this camera sees? (docs/DESIGN.md "Scheduler and skipping": no
 // virtual object in view or in its influence region -> no GI.) For the direct-light techniques
 // the influence of a virtual object is the object itself and the shadow it casts from each lamp:
 // the convex hull of its box and of the box pushed away from every lamp to infinity. The test is

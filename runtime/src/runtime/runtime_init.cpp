@@ -17,6 +17,12 @@ Status RuntimeImpl::init(const RuntimeSettings& settings, const CameraSetup& cam
   auto ladder = choose_technique_and_ladder(settings);
   if (!ladder) return ladder.error();
   MRGI_TRY(check_settings(settings, ladder->size()));
+  // An environment taken from the environment camera with no such camera would light nothing,
+  // silently: refused.
+  if (scene.environment.present && scene.environment.from_env_camera && !cameras.env_camera)
+    return fail(ErrorKind::BadUsage, "SceneDesc.environment.from_env_camera is true but CameraSetup.env_camera is "
+                                     "empty: give the environment camera's model (capture.json \"env_camera\") or "
+                                     "an environment image");
   // The settings override the capture's exposure (e.g. a user correcting a badly exposed capture).
   if (settings.exposure > 0.0) cameras_.exposure = settings.exposure;
   output_w_ = settings.output_width ? settings.output_width : cameras.color.width;

@@ -17,6 +17,7 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <utility>
 
 #include <glm/gtc/matrix_inverse.hpp>
 #include <glm/gtc/type_ptr.hpp>
@@ -497,6 +498,12 @@ Status add_primitive(LoadContext& ctx, int mesh_index, size_t prim_index, const 
       }
     }
   }
+  for (const glm::vec3& p : out.positions)
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      return fail(ErrorKind::BadInput, ctx.path + ": mesh " + std::to_string(mesh_index) + " primitive " +
+                                           std::to_string(prim_index) +
+                                           ": a position is not finite as a 32-bit float once its node's transform "
+                                           "is applied (scale or translation too large)");
   ctx.out->primitives.push_back(std::move(out));
   return ok_status();
 }
@@ -515,7 +522,23 @@ Status visit_node(LoadContext& ctx, int node_index, const glm::dmat4& parent, in
                                          " node instances (limit; nodes listed as children of several parents "
                                          "are instanced once per path)");
   const auto& node = ctx.gltf.nodes[size_t(node_index)];
+  // The runtime keeps transforms and positions as 32-bit floats: a value that is finite only as a
+  // double (a scale of 1e39) would become infinite vertices, so it is refused naming the field.
+  const std::pair<const char*, const std::vector<double>*> fields[] = {
+      {"matrix", &node.matrix}, {"translation", &node.translation}, {"rotation", &node.rotation}, {"scale", &node.scale}};
+  for (const auto& [name, values] : fields)
+    for (size_t k = 0; k < values->size(); ++k)
+      if (!std::isfinite(float((*values)[k])))
+        return fail(ErrorKind::BadInput, ctx.path + ": node " + std::to_string(node_index) + ": " + name + "[" +
+                                             std::to_string(k) + "] = " + std::to_string((*values)[k]) +
+                                             " is not a finite 32-bit float (|value| at most 3.4e38)");
   const glm::dmat4 world = parent * node_local_matrix(node);
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(float(world[c][r])))
+        return fail(ErrorKind::BadInput, ctx.path + ": node " + std::to_string(node_index) +
+                                             ": its world transform (its ancestors' times its own) is not finite "
+                                             "as 32-bit floats");
   if (node.mesh >= 0) {
     if (size_t(node.mesh) >= ctx.gltf.meshes.size())
       return fail(ErrorKind::BadInput, ctx.path + ": node " + std::to_string(node_index) + ": mesh " +

@@ -1,4 +1,4 @@
-// scene.json v1 (DESIGN.md). The schema, key by key:
+// scene.json v1 (docs/DESIGN.md). The schema, key by key:
 //   version          required, 1
 //   virtual_objects  [{gltf (required), position [3], rotation [x,y,z,w], scale number|[3]}]
 //   lights           [{type point|spot|directional (required), real bool (required),

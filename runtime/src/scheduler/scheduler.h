@@ -1,4 +1,4 @@
-// The frame-budget scheduler (DESIGN.md "Scheduler and skipping"): after each completed frame it
+// The frame-budget scheduler (docs/DESIGN.md "Scheduler and skipping"): after each completed frame it
 // reads what the frame cost and chooses the next frame's quality level and, inside the level, its
 // internal resolution, so that frames fit the budget with a margin and quality does not flicker.
 // Pure host logic on numbers: it never allocates after construction, never waits on the device

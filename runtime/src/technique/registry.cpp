@@ -28,7 +28,7 @@ Expected<const TechniqueEntry*> find_technique(const std::string& name) {
     if (e.name == name) return &e;
     known += (known.empty() ? "" : ", ") + std::string(e.name);
   }
-  // DESIGN.md's specular add-on is a stage of every technique, not a technique of its own: the
+  // docs/DESIGN.md's specular add-on is a stage of every technique, not a technique of its own: the
   // name says where it is instead of "unknown".
   if (name == "specular")
     return fail(ErrorKind::BadUsage, "technique 'specular': mirrors, glass and caustics are a stage of every technique "

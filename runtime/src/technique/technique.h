@@ -1,4 +1,4 @@
-// The technique interface (DESIGN.md "Techniques"): one GI method from the papers per module,
+// The technique interface (docs/DESIGN.md "Techniques"): one GI method from the papers per module,
 // each in its own folder under technique/, registered by name in registry.cpp.
 //
 // A technique

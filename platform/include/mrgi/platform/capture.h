@@ -1,4 +1,4 @@
-// Capture format v1 (DESIGN.md): a TUM RGB-D compatible folder.
+// Capture format v1 (docs/DESIGN.md): a TUM RGB-D compatible folder.
 //   rgb.txt, depth.txt       "timestamp path" per line, '#' comments
 //   rgb/*.png                8-bit sRGB colour      depth/*.png  16-bit, depth_scale units per metre
 //   groundtruth.txt          optional "timestamp tx ty tz qx qy qz qw", camera-to-world

@@ -4,7 +4,7 @@
 // libcamera adapter (CameraSettings).
 //
 // Colour-only cameras deliver no depth: InputFrame::depth is a colour-sized image of zeros
-// (0 = no measurement, DESIGN.md), so depth-dependent passes see "nothing measured".
+// (0 = no measurement, docs/DESIGN.md), so depth-dependent passes see "nothing measured".
 #pragma once
 #include <memory>
 #include <optional>

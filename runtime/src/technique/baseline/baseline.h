@@ -1,4 +1,4 @@
-// The `baseline` technique: direct light only, as most AR apps ship (DESIGN.md "Techniques"): the
+// The `baseline` technique: direct light only, as most AR apps ship (docs/DESIGN.md "Techniques"): the
 // direct-light block (shading/direct_light.h) with no indirect input: the DIR paper's real/virtual
 // shadow-map pair per real lamp (no double shadows, eq. 1-5), the light stage's estimated lights
 // with maps for the strongest, the rest as SH ambient without occlusion.

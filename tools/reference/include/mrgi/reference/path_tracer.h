@@ -1,4 +1,4 @@
-// The path-traced ground truth (DESIGN.md "Ground truth and error"): an Embree 3 path tracer that
+// The path-traced ground truth (docs/DESIGN.md "Ground truth and error"): an Embree 3 path tracer that
 // renders the real-only scene (L_r) and the real+virtual scene (L_rv) of a mixed-reality setup
 // with the same random numbers, so that L_rv - L_r is low-noise.
 //

@@ -1,6 +1,6 @@
 // The synthetic capture generator behind `mrgi synth`: renders a scene description
 // (mrgi/reference/description.h) with the reference path tracer and its sensor models and
-// writes a capture v1 folder (DESIGN.md) through CaptureWriter:
+// writes a capture v1 folder (docs/DESIGN.md) through CaptureWriter:
 //   rgb/, depth/, groundtruth.txt   camera frames C (camera response of L_r, sensor noise), Kinect
 //                                   depth of the real scene, camera-to-world poses
 //   env/                            fisheye HDR frames (.exr) when the description has an env camera
