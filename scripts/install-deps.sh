@@ -3,7 +3,7 @@
 # Idempotent: packages already present are skipped by apt. Needs root (or sudo).
 set -euo pipefail
 PKGS=(
-  build-essential cmake ninja-build pkg-config git
+  build-essential cmake ninja-build pkg-config git doxygen
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools
   glslang-tools spirv-tools libspirv-cross-c-shared-dev
   libglm-dev libeigen3-dev libmeshoptimizer-dev libtinygltf-dev nlohmann-json3-dev libstb-dev libtinyexr-dev libopenexr-dev

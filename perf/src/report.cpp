@@ -366,33 +366,11 @@ std::string report_markdown(const BenchResult& r, const CheckReport* check) {
       }
       o << " |\n";
     }
-    // Per-pass medians, median over scenes of each scene's median, per level.
-    o << "\nPer pass, profiling mode (median over scenes of the per-scene median and p95, ms; ratio to the floor; "
-         "CPU ms: the process's CPU time over the pass, every thread):\n\n";
-    o << "| level | pass | median ms | p95 ms | ratio | CPU ms |\n|---|---|---:|---:|---:|---:|\n";
-    for (const LevelAggregate& l : levels) {
-      if (l.technique != t) continue;
-      std::vector<std::string> order;
-      std::map<std::string, std::vector<double>> med, p95, ratio, cpu;
-      for (const BenchEntry& e : r.entries) {
-        if (e.technique != t || e.level != l.level) continue;
-        for (const PassSummary& p : e.passes) {
-          if (!med.count(p.name)) order.push_back(p.name);
-          med[p.name].push_back(p.time.median_ms);
-          p95[p.name].push_back(p.time.p95_ms);
-          ratio[p.name].push_back(p.time.median_ratio);
-          cpu[p.name].push_back(p.cpu_median_ms);
-        }
-      }
-      for (const std::string& p : order)
-        o << "| " << l.level << " " << l.level_name << " | " << p << " | " << fmt(percentile(med[p], 50), 3) << " | "
-          << fmt(percentile(p95[p], 50), 3) << " | " << fmt(percentile(ratio[p], 50), 2) << " | "
-          << fmt(percentile(cpu[p], 50), 2) << " |\n";
-    }
     o << "\n";
   }
 
-  o << "## Where the frame goes\n\n![profiled passes per level, stacked, beside the sustained frame](passes.png)\n\n";
+  o << "## Where the frame goes\n\n![profiled passes per level, stacked, beside the sustained frame](passes.png)\n\n"
+       "Every pass of every level, in ms: [passes.md](passes.md).\n\n";
   o << "## Frame time against error\n\n![frame ms against RDE, Pareto front](pareto.png)\n\n";
   o << "Pareto front (suite aggregate, no other level is both faster and more accurate):";
   if (front.empty()) o << " none (no level has a defined RDE)";
@@ -480,6 +458,46 @@ nlohmann::json scaling_json(const std::vector<BenchResult>& by_size) {
   return j;
 }
 
+// passes.md: every level's passes, median over scenes of each scene's median and p95 (ms), the
+// ratio to the floor and the CPU ms; kept out of report.md, where one row a pass and level made
+// the table most of the report.
+std::string pass_table_markdown(const BenchResult& r) {
+  std::ostringstream o;
+  o << "# mrgi bench: time per pass\n\nProfiling mode (each pass submitted alone and host-timed): median over "
+       "scenes of the per-scene median and p95, ms; ratio to the floor pass ("
+    << fmt(r.floor_median_ms, 3) << " ms); CPU ms: the process's CPU time over the pass, every thread. The chart: "
+       "[passes.png](passes.png); the rest of the run: [report.md](report.md).\n\n";
+  const std::vector<LevelAggregate> levels = aggregate_levels(r);
+  std::vector<std::string> techniques;
+  for (const BenchEntry& e : r.entries)
+    if (std::find(techniques.begin(), techniques.end(), e.technique) == techniques.end()) techniques.push_back(e.technique);
+  for (const std::string& t : techniques) {
+    o << "## " << t << "\n\n";
+    o << "| level | pass | median ms | p95 ms | ratio | CPU ms |\n|---|---|---:|---:|---:|---:|\n";
+    for (const LevelAggregate& l : levels) {
+      if (l.technique != t) continue;
+      std::vector<std::string> order;
+      std::map<std::string, std::vector<double>> med, p95, ratio, cpu;
+      for (const BenchEntry& e : r.entries) {
+        if (e.technique != t || e.level != l.level) continue;
+        for (const PassSummary& p : e.passes) {
+          if (!med.count(p.name)) order.push_back(p.name);
+          med[p.name].push_back(p.time.median_ms);
+          p95[p.name].push_back(p.time.p95_ms);
+          ratio[p.name].push_back(p.time.median_ratio);
+          cpu[p.name].push_back(p.cpu_median_ms);
+        }
+      }
+      for (const std::string& p : order)
+        o << "| " << l.level << " " << l.level_name << " | " << p << " | " << fmt(percentile(med[p], 50), 3) << " | "
+          << fmt(percentile(p95[p], 50), 3) << " | " << fmt(percentile(ratio[p], 50), 2) << " | "
+          << fmt(percentile(cpu[p], 50), 2) << " |\n";
+    }
+    o << "\n";
+  }
+  return o.str();
+}
+
 Status write_bench_outputs(const std::string& dir_in, const BenchResult& r, const CheckReport* check) {
   // Only an earlier mrgi output (or an empty folder) is replaced, and a failed write removes
   // its own DIR.partial (mrgi/platform/output_dir.h).
@@ -491,6 +509,7 @@ Status write_bench_outputs(const std::string& dir_in, const BenchResult& r, cons
   MRGI_TRY(write_text(partial + "/report.md", report_markdown(r, check)));
   MRGI_TRY(write_png(partial + "/pareto.png", render_pareto_plot(r)));
   MRGI_TRY(write_png(partial + "/passes.png", render_pass_plot(r)));
+  MRGI_TRY(write_text(partial + "/passes.md", pass_table_markdown(r)));
   if (check) MRGI_TRY(write_text(partial + "/junit.xml", junit_xml(r, *check)));
   return out->commit();
 }

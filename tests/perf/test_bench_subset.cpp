@@ -129,7 +129,8 @@ void check_outputs(const perf::BenchResult& r) {
   EXPECT_TRUE(fs::exists(out + "/passes.png"));
   auto png = mrgi::load_png_rgb8(out + "/pareto.png");
   ASSERT_TRUE(png.ok()) << png.error().message;
-  EXPECT_EQ(png->width, 960);
+  EXPECT_EQ(png->width, 1640);
+  EXPECT_TRUE(fs::exists(out + "/passes.md"));
   // A second write replaces the earlier bench output; a folder that is not one is refused.
   EXPECT_TRUE(perf::write_bench_outputs(out, r, nullptr).ok());
   mrgi::testing::write_text(dir.file("precious/data.txt"), "x");

@@ -359,9 +359,10 @@ TEST(Report, AccuracyBySetWhenSeveralSets) {
 TEST(Plot, DrawsSeriesFrontAndAxes) {
   perf::BenchResult r = constructed_result();
   const mrgi::ImageRGB8 img = perf::render_pareto_plot(r);
-  ASSERT_EQ(img.width, 960);
-  ASSERT_EQ(img.height, 640);
-  // The first technique's colour (31, 119, 180) appears (its markers), and so does black (axes,
+  ASSERT_EQ(img.width, 1640);
+  ASSERT_EQ(img.height, 600);
+  // The first technique's colour (31, 119, 180) appears (its markers, in the all, real and
+  // virtual panels), and so does black (axes,
   // text); most of the picture stays white.
   size_t blue = 0, black = 0, white = 0;
   for (size_t i = 0; i < img.pixel_count(); ++i) {
@@ -384,36 +385,41 @@ TEST(Plot, DrawsSeriesFrontAndAxes) {
   EXPECT_LT(blue2, 100u);
 }
 
-// passes.png: each level's bar is its passes stacked to scale (shade: 5 ms at every level, so
-// two bars of equal blue length), with a black tick at the sustained frame (20 and 10 ms).
+// passes.png: each level's bar is its passes stacked on the bar's own scale, the larger of its
+// passes' sum and its sustained frame (shade: 5 ms at every level; the levels' frames are 20 and
+// 10 ms, so shade fills a quarter of the first bar and half of the second), with a black tick at
+// the sustained frame, here the bar's full width.
 TEST(Plot, PassBarsAreToScale) {
   perf::BenchResult r = constructed_result();
   for (perf::BenchEntry& e : r.entries) e.passes.push_back({"compose", {4, 2.0 + e.level, 3.0, 1.0, 1.0}});
   const mrgi::ImageRGB8 img = perf::render_pass_plot(r);
-  ASSERT_EQ(img.width, 1100);
+  ASSERT_EQ(img.width, 1480);
+  const int px0 = 210, px1 = 1480 - 520;  // the bars' area
   // Row through the middle of each bar: count the first colour (the costliest pass: shade,
   // 5 ms) and the second (compose: 2 ms, then 3 ms).
   auto count_row = [&](int y, uint8_t r0, uint8_t g0, uint8_t b0) {
     int n = 0;
-    for (int x = 0; x < 1100 - 290; ++x) n += img.at(x, y)[0] == r0 && img.at(x, y)[1] == g0 && img.at(x, y)[2] == b0;
+    for (int x = 0; x < px1; ++x) n += img.at(x, y)[0] == r0 && img.at(x, y)[1] == g0 && img.at(x, y)[2] == b0;
     return n;
   };
   // Bars start at y = 70 + 10, 22 px high, 32 px apart.
   const int y0 = 70 + 10 + 11, y1 = y0 + 32;
   const int shade0 = count_row(y0, 31, 119, 180), shade1 = count_row(y1, 31, 119, 180);
   const int compose0 = count_row(y0, 255, 127, 14), compose1 = count_row(y1, 255, 127, 14);
-  EXPECT_GT(shade0, 20);
-  EXPECT_NEAR(shade0, shade1, 2);
+  EXPECT_NEAR(shade0, (px1 - px0) * 5.0 / 20.0, 4) << "5 ms of a 20 ms frame";
+  EXPECT_NEAR(shade1, (px1 - px0) * 5.0 / 10.0, 4) << "5 ms of a 10 ms frame";
   EXPECT_NEAR(double(compose0) / shade0, 2.0 / 5.0, 0.05);
   EXPECT_NEAR(double(compose1) / shade1, 3.0 / 5.0, 0.05);
-  // The sustained tick lies right of the stack for the 20 ms level (7 ms of passes).
-  int tick_x = -1;
-  for (int x = 1100 - 290; x > 210; --x)
-    if (img.at(x, y0 - 13)[0] == 0 && img.at(x, y0 - 13)[1] == 0 && img.at(x, y0 - 13)[2] == 0) {
-      tick_x = x;
-      break;
-    }
-  EXPECT_GT(tick_x, 210 + (shade0 + compose0) * 2) << "the tick at 20 ms is beyond twice the 7 ms stack";
+  // The sustained tick of each bar lies at its right end.
+  for (int y : {y0 - 13, y1 - 13}) {
+    int tick_x = -1;
+    for (int x = px1 + 3; x > px0; --x)
+      if (img.at(x, y)[0] == 0 && img.at(x, y)[1] == 0 && img.at(x, y)[2] == 0) {
+        tick_x = x;
+        break;
+      }
+    EXPECT_NEAR(tick_x, px1, 3) << "row " << y;
+  }
 }
 
 TEST(Report, CsvAndMarkdownHoldEveryEntry) {

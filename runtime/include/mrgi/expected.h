@@ -1,5 +1,6 @@
-// Errors by kind, returned as values. C++20 has no std::expected, so mrgi carries a small one.
-// Every loader, adapter and factory returns Expected<T>; nothing is printed and ignored.
+/// \file
+/// Errors by kind, returned as values. C++20 has no std::expected, so mrgi carries a small one.
+/// Every loader, adapter and factory returns Expected<T>; nothing is printed and ignored.
 #pragma once
 #include <cassert>
 #include <string>
@@ -9,12 +10,12 @@
 namespace mrgi {
 
 enum class ErrorKind {
-  BadInput,     // a file or value breaks a documented rule (exit code 1 in the tool)
-  BadUsage,     // wrong command-line use or settings out of range (exit code 2)
-  NotFound,     // a file, device or adapter is absent
-  Device,       // Vulkan or sensor failure at run time
-  Timeout,      // a bounded wait ran out (sensor stopped sending)
-  EndOfStream,  // a stream ended normally
+  BadInput,     ///< a file or value breaks a documented rule (exit code 1 in the tool)
+  BadUsage,     ///< wrong command-line use or settings out of range (exit code 2)
+  NotFound,     ///< a file, device or adapter is absent
+  Device,       ///< Vulkan or sensor failure at run time
+  Timeout,      ///< a bounded wait ran out (sensor stopped sending)
+  EndOfStream,  ///< a stream ended normally
   NotImplemented,
   Internal,
 };
@@ -23,10 +24,10 @@ const char* to_string(ErrorKind kind);
 
 struct Error {
   ErrorKind kind = ErrorKind::Internal;
-  std::string message;  // names the file, the field or line, and the rule
+  std::string message;  ///< names the file, the field or line, and the rule
 };
 
-// Builds an Error; used as `return fail(ErrorKind::BadInput, path + ": ...")`.
+/// Builds an Error; used as `return fail(ErrorKind::BadInput, path + ": ...")`.
 inline Error fail(ErrorKind kind, std::string message) { return Error{kind, std::move(message)}; }
 
 template <class T>
@@ -49,14 +50,14 @@ class [[nodiscard]] Expected {
   std::variant<T, Error> v_;
 };
 
-// Expected<void>: success or an Error.
+/// Expected<void>: success or an Error.
 struct Ok {};
 using Status = Expected<Ok>;
 inline Status ok_status() { return Ok{}; }
 
 }  // namespace mrgi
 
-// Propagates an error from an expression returning Expected<...>/Status.
+/// Propagates an error from an expression returning Expected<...>/Status.
 #define MRGI_TRY(expr)                                        \
   do {                                                        \
     auto&& mrgi_try_result_ = (expr);                         \

@@ -4,8 +4,11 @@
 //               RDE, delta RMS, RMSE, SSIM), suite aggregates per level, the Pareto front and
 //               the regression check when one was asked for
 //   bench.csv   one row per scene/technique/level
-//   report.md   per technique a table per level and scene, per-pass medians, the floors, the plot
-//   pareto.png  median frame ms against RDE per technique level (suite aggregate), front marked
+//   report.md   per technique a table per level and scene, the error by region and effect, the
+//               floors, the plots
+//   passes.md   every level's passes (pass_table_markdown)
+//   passes.png  each level's passes, stacked (render_pass_plot)
+//   pareto.png  sustained ms against RDE per technique level (suite aggregate), fronts marked
 #pragma once
 #include <string>
 
@@ -26,11 +29,14 @@ nlohmann::json error_figures_json(const ErrorFigures& f);
 nlohmann::json error_report_json(const RdeReport& r);
 std::string bench_csv(const BenchResult& result);
 std::string report_markdown(const BenchResult& result, const CheckReport* check);
-// 960 x 640 plot of the suite aggregates (aggregate_levels), one colour and marker per technique.
+// 1640 x 600 plot of the suite aggregates (aggregate_levels): RDE over all, real and virtual pixels
+// against sustained ms, one colour and marker per technique.
 ImageRGB8 render_pareto_plot(const BenchResult& result);
-// 1100 x (bars) plot of each level's profiled passes, stacked, beside its sustained frame
+// 1480 x (bars) plot of each level's profiled passes, stacked, each bar on its own scale
 // (perf/src/pass_plot.cpp says what is drawn).
 ImageRGB8 render_pass_plot(const BenchResult& result);
+// passes.md: every level's passes (median, p95, ratio to the floor, CPU ms), by technique.
+std::string pass_table_markdown(const BenchResult& r);
 
 // Writes the four files. DIR must be absent, empty or an earlier bench output (has bench.json).
 Status write_bench_outputs(const std::string& dir, const BenchResult& result, const CheckReport* check);

@@ -1,5 +1,6 @@
-// Capture replay as an InputSource: frames of a capture folder (format v1) in order, then
-// ErrorKind::EndOfStream. open_source() dispatches plain folder paths here.
+/// \file
+/// Capture replay as an InputSource: frames of a capture folder (format v1) in order, then
+/// ErrorKind::EndOfStream. open_source() dispatches plain folder paths here.
 #pragma once
 #include <memory>
 #include <string>
@@ -9,8 +10,8 @@
 
 namespace mrgi {
 
-// Opens FOLDER with CaptureReader::open (all its checks) and replays it. Never waits: next()
-// returns at once whatever the timeout.
+/// Opens FOLDER with CaptureReader::open (all its checks) and replays it. Never waits: next()
+/// returns at once whatever the timeout.
 Expected<std::unique_ptr<InputSource>> make_capture_source(const std::string& folder);
 
 }  // namespace mrgi
