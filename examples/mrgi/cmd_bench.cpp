@@ -195,7 +195,7 @@ void run_bench_command(BenchOptions& o) {
     auto wb = perf::write_baseline(o.write_baseline, perf::make_baseline(result));
     if (!wb.ok()) fail_with(wb.error());
   }
-  std::printf("bench: %zu runs on %s (LP_NUM_THREADS=%s), floor %.3f ms, %.1f s; wrote %s/{bench.json,bench.csv,report.md,pareto.png}\n",
+  std::printf("bench: %zu runs on %s (LP_NUM_THREADS=%s), floor %.3f ms, %.1f s; wrote %s/{bench.json,bench.csv,report.md,passes.md,pareto.png,passes.png}\n",
               result.entries.size(), result.device.c_str(),
               result.lp_num_threads.empty() ? "unset" : result.lp_num_threads.c_str(), result.floor_median_ms,
               result.duration_s, o.out.c_str());
