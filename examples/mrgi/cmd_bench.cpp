@@ -214,7 +214,7 @@ void setup(CLI::App& app) {
   opts->settings.suite = "perf/suite.json";
   CLI::App* cmd = app.add_subcommand(
       "bench", "Run every technique and quality level over the scene suite; write bench.json, bench.csv, "
-               "report.md and pareto.png; optionally check against a baseline");
+               "report.md, passes.md, pareto.png and passes.png; optionally check against a baseline");
   cmd->add_option("--suite", opts->settings.suite, "suite manifest (JSON); several comma-separated (perf/suite.json,perf/cycles-tuning.json) run as one, the report giving each set's accuracy apart")->capture_default_str();
   cmd->add_option("--techniques,-t", opts->settings.techniques, "techniques to run, comma-separated (default: all)")
       ->delimiter(',');
