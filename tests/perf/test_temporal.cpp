@@ -12,15 +12,8 @@
 namespace {
 using namespace mrgi;
 
-Intrinsics small_camera() {
-  Intrinsics k;
-  k.width = 64;
-  k.height = 48;
-  k.fx = k.fy = 60.0;
-  k.cx = 31.5;
-  k.cy = 23.5;
-  return k;
-}
+// 64 x 48 pixels, focal 60 px, pixel-centre principal point.
+Intrinsics small_camera() { return Intrinsics{64, 48, 60.0, 60.0, 31.5, 23.5}; }
 
 // A frame looking at a wall 1 m away (depth_scale 1000), the camera at world x = `x`; the
 // output darkens (to 80 from 100) the wall where world x is in [0, 0.2] m.

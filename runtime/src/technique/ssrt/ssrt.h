@@ -79,8 +79,8 @@
 // Cost on lavapipe (LP_NUM_THREADS=2, 640x480, `mrgi bench --techniques ssrt`;
 // perf/results/report-ssrt-640x480.md (4 frames after 1) and report-ssrt-fast-16frames.md;
 // floor 1.6-2.8 ms): suite mean sustained full 823 ms, half 480, fast 42.8, fastest 40.0; fast
-// over the scenes with a virtual object 20.0 floors (median; 17.3-21.9) on a loaded machine,
-// 21.3 in a quieter hour, against about 22 for 33 ms on a 1.5 ms floor. Fast level split
+// over the scenes with a virtual object 20.0 floors (median; 17.3-21.9 over two runs, 21.3 in
+// a third), against about 22 for 33 ms on a 1.5 ms floor. Fast level split
 // (profiling mode, ratio to the floor): transfer 5.9 floors, shade (composing its tiles) 2.1 and
 // its tile test 0.45, host 1.3, ray cast 1.3, blur 0.95, filters 0.9, virtual G-buffer 0.8,
 // occluders 0.75, fuse 0.7, G-buffer 0.5, light sums 0.5, aux layers 0.3: about 17.5 floors

@@ -1,0 +1,19 @@
+# mrgi_shared_library_abi(TARGET): what an installed shared library of mrgi's carries.
+# - VERSION and SOVERSION libNAME.so.MAJOR.MINOR: before 1.0 a minor version may change the ABI
+#   (mrgiConfigVersion's SameMinorVersion says the same), so the SONAME carries both.
+# - The version script cmake/hide-third-party.map: the third-party code built into it is not
+#   exported (GNU ld and lld; CMake 3.25 does not name the linker, so an unnamed one is taken as
+#   GNU ld, Debian's default).
+# Nothing for a static build.
+function(mrgi_shared_library_abi target)
+  if(NOT MRGI_SHARED_LIBS)
+    return()
+  endif()
+  set_target_properties(${target} PROPERTIES VERSION ${PROJECT_VERSION}
+                                             SOVERSION ${PROJECT_VERSION_MAJOR}.${PROJECT_VERSION_MINOR})
+  if(CMAKE_CXX_COMPILER_LINKER_ID MATCHES "GNU|LLD" OR NOT CMAKE_CXX_COMPILER_LINKER_ID)
+    set(map ${PROJECT_SOURCE_DIR}/cmake/hide-third-party.map)
+    target_link_options(${target} PRIVATE -Wl,--version-script=${map})
+    set_property(TARGET ${target} APPEND PROPERTY LINK_DEPENDS ${map})
+  endif()
+endfunction()
