@@ -15,7 +15,7 @@ orange_box.gltf    0.16 m cube, albedo (0.8, 0.3, 0.08): colour bleeding onto wh
 yellow_sphere.gltf 0.1 m radius, albedo (0.8, 0.7, 0.12).
 dark_sphere.gltf   0.1 m radius, albedo 0.04: a virtual object that mostly blocks light.
 white_sphere.gltf  0.1 m radius, albedo 0.85: a virtual object that mostly reflects it.
-Made for this project; same licence as the repository.
+Made for this project; Apache-2.0, as the repository (LICENSE).
 """
 import base64
 import json
