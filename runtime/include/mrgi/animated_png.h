@@ -8,11 +8,12 @@
 #include <string>
 
 #include "mrgi/expected.h"
+#include "mrgi/export.h"
 #include "mrgi/image.h"
 
 namespace mrgi {
 
-class AnimatedPngWriter {
+class MRGI_API AnimatedPngWriter {
  public:
   /// Frames of width x height shown at `fps` (0.1..1000), looping. Writes PATH.partial and
   /// renames it to PATH in finish(): a failed or abandoned clip leaves no file behind.

@@ -7,6 +7,8 @@
 #include <utility>
 #include <variant>
 
+#include "mrgi/export.h"
+
 namespace mrgi {
 
 enum class ErrorKind {
@@ -20,7 +22,7 @@ enum class ErrorKind {
   Internal,
 };
 
-const char* to_string(ErrorKind kind);
+MRGI_API const char* to_string(ErrorKind kind);
 
 struct Error {
   ErrorKind kind = ErrorKind::Internal;

@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "mrgi/export.h"
 #include "mrgi/glm_contract.h"
 
 #include "mrgi/image.h"
@@ -14,7 +15,7 @@
 namespace mrgi {
 
 /// Pinhole intrinsics in pixels for an image of width x height.
-struct Intrinsics {
+struct MRGI_API Intrinsics {
   int width = 640;
   int height = 480;
   double fx = 517.3, fy = 516.5, cx = 318.6, cy = 255.3;  ///< TUM Freiburg 1 defaults
@@ -23,7 +24,7 @@ struct Intrinsics {
 };
 
 /// Rigid camera-to-world transform.
-struct Pose {
+struct MRGI_API Pose {
   glm::dvec3 translation{0.0};
   glm::dquat rotation{1.0, 0.0, 0.0, 0.0};  ///< w, x, y, z (glm order); unit length
   glm::dmat4 matrix() const;                  ///< camera-to-world

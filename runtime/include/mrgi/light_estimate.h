@@ -13,6 +13,7 @@
 #include <cstdint>
 
 #include "mrgi/expected.h"
+#include "mrgi/export.h"
 #include "mrgi/frame.h"
 #include "mrgi/image.h"
 
@@ -51,7 +52,7 @@ struct LightEstimate {
 /// then the dominant direction and intensity from band 1 exactly as for an estimate. This is
 /// the ground truth an estimate is compared with. `intensity` scales the radiance. confidence is
 /// 1, frame_index -1. BadInput for an empty image or a fisheye without a focal length.
-Expected<LightEstimate> light_from_environment(const ImageRGBF& image, const EnvCamera& camera,
+MRGI_API Expected<LightEstimate> light_from_environment(const ImageRGBF& image, const EnvCamera& camera,
                                                double intensity = 1.0, int bands = 4);
 
 /// ARCore Environmental HDR's shape (ArLightEstimate_getEnvironmentalHdr*): what an app written
@@ -76,7 +77,7 @@ struct EnvironmentalHdr {
 };
 
 /// BadUsage for face_size outside 0..256 (0 = no cubemap).
-Expected<EnvironmentalHdr> to_environmental_hdr(const LightEstimate& estimate, int face_size = 16);
+MRGI_API Expected<EnvironmentalHdr> to_environmental_hdr(const LightEstimate& estimate, int face_size = 16);
 
 /// Filament's irradiance SH (IndirectLight::Builder::irradiance(3, sh)): 9 RGB coefficients
 /// pre-scaled by the cosine lobe A_l / pi and the basis constants, so that Filament's shader
@@ -87,12 +88,12 @@ Expected<EnvironmentalHdr> to_environmental_hdr(const LightEstimate& estimate, i
 /// 0.282095, -0.325735, 0.325735, -0.325735, 0.273137, -0.273137, 0.078848, -0.273137, 0.136569,
 /// the same as Sceneform applies to ARCore's coefficients. Both use +y up, right-handed world
 /// axes, so no rotation is needed.
-std::array<Rgb, 9> to_filament_irradiance(const LightEstimate& estimate);
+MRGI_API std::array<Rgb, 9> to_filament_irradiance(const LightEstimate& estimate);
 
 /// Angle in degrees between the dominant directions of two estimates.
-double direction_error_deg(const LightEstimate& a, const LightEstimate& b);
+MRGI_API double direction_error_deg(const LightEstimate& a, const LightEstimate& b);
 
 /// Irradiance E(n) of an estimate for a unit normal n (world space), linear RGB.
-Rgb irradiance_at(const LightEstimate& estimate, const std::array<float, 3>& normal);
+MRGI_API Rgb irradiance_at(const LightEstimate& estimate, const std::array<float, 3>& normal);
 
 }  // namespace mrgi

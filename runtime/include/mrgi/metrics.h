@@ -5,6 +5,7 @@
 #include <cstddef>
 
 #include "mrgi/expected.h"
+#include "mrgi/export.h"
 #include "mrgi/image.h"
 
 namespace mrgi {
@@ -48,17 +49,17 @@ struct RdeReport {
 
 /// virtual_mask: nullptr = every pixel is real; else one byte per pixel, non-zero = virtual.
 /// Different sizes are a BadInput error naming the sizes.
-Expected<RdeReport> measure_error(const ImageRGB8& output, const ImageRGB8& camera,
+MRGI_API Expected<RdeReport> measure_error(const ImageRGB8& output, const ImageRGB8& camera,
                                   const ImageRGB8& reference, const ImageU8* virtual_mask);
-Expected<RdeReport> measure_error(const ImageRGBA8& output, const ImageRGB8& camera,
+MRGI_API Expected<RdeReport> measure_error(const ImageRGBA8& output, const ImageRGB8& camera,
                                   const ImageRGB8& reference, const ImageU8* virtual_mask);
 
 /// Pools figures of several frames (pixel-weighted means for rmse8/ssim, sums for rde).
-ErrorFigures pool(const ErrorFigures& a, const ErrorFigures& b);
+MRGI_API ErrorFigures pool(const ErrorFigures& a, const ErrorFigures& b);
 /// The same for each of a report's pixel sets.
-RdeReport pool(const RdeReport& a, const RdeReport& b);
+MRGI_API RdeReport pool(const RdeReport& a, const RdeReport& b);
 
 /// sRGB transfer (IEC 61966-2-1), 8-bit code to linear [0,1]; a 256-entry table.
-float srgb8_to_linear(uint8_t v);
+MRGI_API float srgb8_to_linear(uint8_t v);
 
 }  // namespace mrgi

@@ -1,6 +1,13 @@
 /// \file
 /// The public API: create a Runtime for a capture's cameras and scene, feed it frames, get
-/// composited RGBA8 frames and per-pass statistics back.
+/// composited RGBA8 frames and per-frame statistics back. In the order an app needs it:
+///  1. create_runtime() with a CameraSetup, a SceneDesc (mrgi/scene.h) and RuntimeSettings;
+///  2. Runtime::process() per camera frame (mrgi/frame.h), flush() at the end of a stream;
+///  3. what comes back: FrameOutput (image, mask, FrameStats, the light);
+///  4. the settings: RuntimeSettings, DeviceSettings, SchedulerSettings;
+///  5. devices: list_devices();
+///  6. techniques and their quality levels: choose_technique(), technique_ladder().
+/// Research-only ablations live in mrgi/research.h; an app does not need them.
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -9,23 +16,170 @@
 #include <vector>
 
 #include "mrgi/expected.h"
+#include "mrgi/export.h"
 #include "mrgi/frame.h"
 #include "mrgi/light_estimate.h"
 #include "mrgi/scene.h"
 
 namespace mrgi {
 
+class Runtime;
+struct RuntimeSettings;
+struct DeviceInfo;
+struct FrameOutput;
 struct ResearchSettings;  // mrgi/research.h
 
-struct DeviceInfo {
-  uint32_t index = 0;
-  std::string name;
-  std::string type;         ///< "cpu", "integrated-gpu", "discrete-gpu", ...
-  std::string driver;       ///< driver name and version
-  uint32_t api_version = 0;
-  uint64_t device_local_mib = 0;
-  bool selected = false;    ///< what mrgi would use with the given selector
+// ---------------------------------------------------------------------------------------------
+// 1-2. Creating a runtime and running frames
+// ---------------------------------------------------------------------------------------------
+
+/// The capture's cameras (capture.json): colour and depth intrinsics in pixels, the depth image's
+/// units and the exposure.
+struct CameraSetup {
+  Intrinsics color;
+  Intrinsics depth;
+  double depth_scale = 5000.0;  ///< depth image units per metre (TUM: 5000)
+  double exposure = 1.0;        ///< linear radiance -> linear camera value, before the sRGB curve
+  /// The environment camera's model (capture.json `env_camera`), for frames that carry env
+  /// images (InputFrame::env); without it those images cannot be mapped to directions.
+  std::optional<EnvCamera> env_camera;
 };
+
+/// Creates a runtime for `cameras` and `scene`: picks the Vulkan device, loads the scene's glTF
+/// models and environment, builds the technique's frame graph and allocates everything for its
+/// most expensive level (nothing is allocated per frame after this). Takes seconds on a CPU
+/// device (pipeline compilation). The app owns the returned runtime; it keeps no reference to
+/// the arguments. Errors: BadUsage naming the setting for settings out of range or a knob the
+/// technique refuses; BadInput naming the file and field for a scene, model or environment that
+/// breaks its rules; NotFound for an unknown technique or no device matching the selector;
+/// Device where Vulkan fails.
+MRGI_API Expected<std::unique_ptr<Runtime>> create_runtime(const RuntimeSettings& settings,
+                                                  const CameraSetup& cameras,
+                                                  const SceneDesc& scene);
+
+/// Thread safety: a Runtime is not thread-safe. Call its methods from one thread at a time
+/// (synchronise externally if several threads drive it); process() does its recording and host
+/// work on the calling thread, and the Vulkan driver runs the frames on its own threads. Each
+/// Runtime owns its own Vulkan instance, device and frame graph; what runtimes share is
+/// process-wide: DeviceSettings::keep_freed_memory's malloc setting.
+class MRGI_API Runtime {
+ public:
+  virtual ~Runtime() = default;
+  /// Processes one frame. Frames are pipelined: the call given frame k returns frame
+  /// k - frames_in_flight (with 2 in flight, frame 0 comes back from the call given frame 2; the
+  /// first frames_in_flight calls return nothing); flush() returns the last frames_in_flight frames
+  /// in order at the end of a stream (tests/technique/frame_order_test.cpp). Once per
+  /// runtime, a technique that estimates from the frames themselves (ssrt's light) has its first
+  /// frame run twice, waiting for the first run, so that frame is lit by its own estimate; with
+  /// the level on kAutoLevel the first frame is also run once in every frame slot first (the
+  /// driver's first use of pipelines and slot memory would otherwise be charged to the budget).
+  /// That call returns the frames still in flight at once, and the frame's stats note the runs.
+  virtual Expected<std::vector<FrameOutput>> process(const InputFrame& frame) = 0;
+  virtual Expected<std::vector<FrameOutput>> flush() = 0;
+  /// Hands a delivered frame back once the caller is done with it: a later process() or flush()
+  /// fills its image and mask instead of allocating new ones. Optional, but a live loop should:
+  /// each new output image is fresh memory the OS zeroes page by page (at 640x480, 1.5 MB a
+  /// frame: 75 % of the host thread's time in a sustained ssrt run on lavapipe, on cores the
+  /// renderer needs). Frames of another size are dropped; at most frames_in_flight + 1 are kept.
+  virtual void recycle(FrameOutput&& done) = 0;
+  virtual const DeviceInfo& device() const = 0;
+  virtual const std::string& technique() const = 0;  ///< the technique running (auto: the chosen one)
+  virtual double memory_mib() const = 0;      ///< everything allocated at start-up, MiB
+  virtual int level_count() const = 0;
+  virtual std::vector<std::string> level_names() const = 0;
+  /// Fixes the level from the next frame on (kAutoLevel: the scheduler chooses again). Never
+  /// allocates. BadUsage outside kAutoLevel, 0..level_count()-1.
+  virtual Status set_level(int level) = 0;
+  /// The frame budget from the next frame on (ms, > 0); BadUsage otherwise.
+  virtual Status set_frame_budget_ms(double budget_ms) = 0;
+  /// Profiling mode from the next frame on (RuntimeSettings::profile_passes); never allocates.
+  virtual Status set_profiling(bool on) = 0;
+  /// The virtual objects: scene.json's (SceneDesc::virtual_objects), in its order; the capacity
+  /// is fixed at start-up. set_object_placement moves one from the next process() on (an app's
+  /// object moving), replacing its scene.json motion from then on; it never allocates. BadUsage
+  /// for an index out of range, a non-finite placement or a scale that is not positive.
+  virtual size_t object_count() const = 0;
+  virtual Status set_object_placement(size_t object, const Placement& placement) = 0;
+  /// Adds (true) or removes (false) object i from the next process() on, within that capacity:
+  /// a removed object is not drawn, lit, shadowed or reflected; with none shown, frames are the
+  /// camera frame. BadUsage for an index out of range.
+  virtual Status set_object_visible(size_t object, bool visible) = 0;
+  /// The lamps: scene.json's (SceneDesc::lights), in its order, capacity fixed at start-up.
+  /// set_lamp changes lamp i from the next process() on: moved, turned, recoloured, dimmed to 0
+  /// (off: an app that adds lamps later declares them dark at start-up) or back; its kind (type,
+  /// real) stays. Never allocates. BadUsage naming the field for an index out of range or a lamp
+  /// scene.json would refuse.
+  virtual size_t lamp_count() const = 0;
+  virtual Status set_lamp(size_t lamp, const LightDesc& desc) = 0;
+};
+
+// ---------------------------------------------------------------------------------------------
+// 3. What a frame gives back
+// ---------------------------------------------------------------------------------------------
+
+struct PassTiming {
+  std::string name;
+  double gpu_ms = 0.0;
+  /// Profiled frames: the process's CPU time (every thread: on a CPU device the driver's workers
+  /// run the pass) over the pass's submission, ms; 0 otherwise. Over gpu_ms x the device's
+  /// threads it says how well a pass keeps them busy, and it moves less with other tenants' load.
+  double cpu_ms = 0.0;
+};
+
+struct FrameStats {
+  int64_t frame_index = 0;
+  /// Time per pass that ran, ms: host-timed submissions when `profiled`, else GPU timestamps
+  /// (on lavapipe those do not bracket the work: see RuntimeSettings::profile_passes).
+  std::vector<PassTiming> passes;
+  double gpu_total_ms = 0.0;           ///< first to last timestamp; profiled: the sum of the passes
+  bool profiled = false;               ///< the frame ran in profiling mode
+  /// Host time of process() for this frame: checks, upload, recording and submission. Not the
+  /// frame time: the GPU runs the frame after process() returns (frames are pipelined).
+  double record_ms = 0.0;
+  /// Host std::chrono::steady_clock seconds when the runtime saw the frame complete: the
+  /// difference between two frames' values is the sustained frame interval a live device sees.
+  double completed_s = 0.0;
+  /// Host time spent on this frame outside the GPU work: process() (record_ms, less the passes'
+  /// own time in profiling mode, where process() waits for each) plus reading the output back.
+  /// On a CPU device this competes with the passes for the same cores, so a frame's sustained
+  /// wall clock is about its passes plus this.
+  double host_ms = 0.0;
+  /// CPU time of the light stage this frame (light/light_stage.h: environment sampling or the
+  /// probeless system's part and solve) on the calling thread, ms; inside record_ms and host_ms.
+  double light_ms = 0.0;
+  int level = 0;
+  /// The internal resolution this frame ran at, as a fraction of the output's side (the level's
+  /// internal scale x the scheduler's factor).
+  float internal_scale = 1.0f;
+  /// What the frame cost, ms: device time (first to last timestamp; profiled: the passes' sum)
+  /// plus host_ms on a CPU device, the larger of the two on a GPU. What the scheduler reads.
+  double cost_ms = 0.0;
+  double predicted_ms = 0.0;  ///< the scheduler's prediction of cost_ms when it chose this frame's quality
+  double budget_ms = 0.0;     ///< RuntimeSettings::frame_budget_ms when the frame was recorded
+  bool scheduled = false;     ///< the level and scale were the scheduler's (kAutoLevel)
+  std::vector<std::string> skipped;    ///< passes culled or skipped this frame, with reason
+  /// Conditions worth knowing about this frame, e.g. "pose: none given, previous pose used".
+  std::vector<std::string> notes;
+};
+
+struct FrameOutput {
+  ImageRGBA8 image;    ///< composited frame, output size
+  FrameStats stats;
+  /// Output size; 255 where a virtual object is seen (composited as TM(L_rv)), 0 on real pixels.
+  /// For RDE over real / virtual pixels (metrics.h).
+  Image<uint8_t, 1> virtual_mask;
+  /// The light the runtime lights with, as SH radiance and a dominant direction (every
+  /// technique): the declared lamps and environment projected to SH plus the residual estimate of
+  /// the real light they do not explain, or, with nothing declared (and always for ssrt), the
+  /// probeless estimate from the camera images; empty while no light is known. It is the newest
+  /// when this output was collected, so with frames in flight it can come from a later input frame
+  /// than this one: LightEstimate::frame_index says which (tests/technique/frame_order_test.cpp).
+  std::optional<LightEstimate> light;
+};
+
+// ---------------------------------------------------------------------------------------------
+// 4. Settings
+// ---------------------------------------------------------------------------------------------
 
 struct DeviceSettings {
   /// Device selector: empty = $MRGI_DEVICE, else lavapipe (llvmpipe) if present, else device 0.
@@ -50,9 +204,6 @@ struct DeviceSettings {
   /// on a 1.3 device.
   bool vulkan_1_2 = false;
 };
-
-/// Lists the Vulkan devices and marks the one `settings` would pick.
-Expected<std::vector<DeviceInfo>> list_devices(const DeviceSettings& settings);
 
 /// The frame-budget scheduler's constants (scheduler/scheduler.h says how it decides). The
 /// defaults are the anchors' where they give one (Filament's dynamic resolution controller,
@@ -176,135 +327,26 @@ struct RuntimeSettings {
   bool residual_light = true;
 };
 
-struct PassTiming {
+// ---------------------------------------------------------------------------------------------
+// 5. Devices
+// ---------------------------------------------------------------------------------------------
+
+struct DeviceInfo {
+  uint32_t index = 0;
   std::string name;
-  double gpu_ms = 0.0;
-  /// Profiled frames: the process's CPU time (every thread: on a CPU device the driver's workers
-  /// run the pass) over the pass's submission, ms; 0 otherwise. Over gpu_ms x the device's
-  /// threads it says how well a pass keeps them busy, and it moves less with other tenants' load.
-  double cpu_ms = 0.0;
+  std::string type;         ///< "cpu", "integrated-gpu", "discrete-gpu", ...
+  std::string driver;       ///< driver name and version
+  uint32_t api_version = 0;
+  uint64_t device_local_mib = 0;
+  bool selected = false;    ///< what mrgi would use with the given selector
 };
 
-struct FrameStats {
-  int64_t frame_index = 0;
-  /// Time per pass that ran, ms: host-timed submissions when `profiled`, else GPU timestamps
-  /// (on lavapipe those do not bracket the work: see RuntimeSettings::profile_passes).
-  std::vector<PassTiming> passes;
-  double gpu_total_ms = 0.0;           ///< first to last timestamp; profiled: the sum of the passes
-  bool profiled = false;               ///< the frame ran in profiling mode
-  /// Host time of process() for this frame: checks, upload, recording and submission. Not the
-  /// frame time: the GPU runs the frame after process() returns (frames are pipelined).
-  double record_ms = 0.0;
-  /// Host std::chrono::steady_clock seconds when the runtime saw the frame complete: the
-  /// difference between two frames' values is the sustained frame interval a live device sees.
-  double completed_s = 0.0;
-  /// Host time spent on this frame outside the GPU work: process() (record_ms, less the passes'
-  /// own time in profiling mode, where process() waits for each) plus reading the output back.
-  /// On a CPU device this competes with the passes for the same cores, so a frame's sustained
-  /// wall clock is about its passes plus this.
-  double host_ms = 0.0;
-  /// CPU time of the light stage this frame (light/light_stage.h: environment sampling or the
-  /// probeless system's part and solve) on the calling thread, ms; inside record_ms and host_ms.
-  double light_ms = 0.0;
-  int level = 0;
-  /// The internal resolution this frame ran at, as a fraction of the output's side (the level's
-  /// internal scale x the scheduler's factor).
-  float internal_scale = 1.0f;
-  /// What the frame cost, ms: device time (first to last timestamp; profiled: the passes' sum)
-  /// plus host_ms on a CPU device, the larger of the two on a GPU. What the scheduler reads.
-  double cost_ms = 0.0;
-  double predicted_ms = 0.0;  ///< the scheduler's prediction of cost_ms when it chose this frame's quality
-  double budget_ms = 0.0;     ///< RuntimeSettings::frame_budget_ms when the frame was recorded
-  bool scheduled = false;     ///< the level and scale were the scheduler's (kAutoLevel)
-  std::vector<std::string> skipped;    ///< passes culled or skipped this frame, with reason
-  /// Conditions worth knowing about this frame, e.g. "pose: none given, previous pose used".
-  std::vector<std::string> notes;
-};
+/// Lists the Vulkan devices and marks the one `settings` would pick.
+MRGI_API Expected<std::vector<DeviceInfo>> list_devices(const DeviceSettings& settings);
 
-struct FrameOutput {
-  ImageRGBA8 image;    ///< composited frame, output size
-  FrameStats stats;
-  /// Output size; 255 where a virtual object is seen (composited as TM(L_rv)), 0 on real pixels.
-  /// For RDE over real / virtual pixels (metrics.h).
-  Image<uint8_t, 1> virtual_mask;
-  /// The light the runtime lights with, as SH radiance and a dominant direction (every
-  /// technique): the declared lamps and environment projected to SH plus the residual estimate of
-  /// the real light they do not explain, or, with nothing declared (and always for ssrt), the
-  /// probeless estimate from the camera images; empty while no light is known. It is the newest
-  /// when this output was collected, so with frames in flight it can come from a later input frame
-  /// than this one: LightEstimate::frame_index says which (tests/technique/frame_order_test.cpp).
-  std::optional<LightEstimate> light;
-};
-
-/// Thread safety: a Runtime is not thread-safe. Call its methods from one thread at a time
-/// (synchronise externally if several threads drive it); process() does its recording and host
-/// work on the calling thread, and the Vulkan driver runs the frames on its own threads. Each
-/// Runtime owns its own Vulkan instance, device and frame graph; what runtimes share is
-/// process-wide: DeviceSettings::keep_freed_memory's malloc setting.
-class Runtime {
- public:
-  virtual ~Runtime() = default;
-  /// Processes one frame. Frames are pipelined: the call given frame k returns frame
-  /// k - frames_in_flight (with 2 in flight, frame 0 comes back from the call given frame 2; the
-  /// first frames_in_flight calls return nothing); flush() returns the last frames_in_flight frames
-  /// in order at the end of a stream (tests/technique/frame_order_test.cpp). Once per
-  /// runtime, a technique that estimates from the frames themselves (ssrt's light) has its first
-  /// frame run twice, waiting for the first run, so that frame is lit by its own estimate; with
-  /// the level on kAutoLevel the first frame is also run once in every frame slot first (the
-  /// driver's first use of pipelines and slot memory would otherwise be charged to the budget).
-  /// That call returns the frames still in flight at once, and the frame's stats note the runs.
-  virtual Expected<std::vector<FrameOutput>> process(const InputFrame& frame) = 0;
-  virtual Expected<std::vector<FrameOutput>> flush() = 0;
-  /// Hands a delivered frame back once the caller is done with it: a later process() or flush()
-  /// fills its image and mask instead of allocating new ones. Optional, but a live loop should:
-  /// each new output image is fresh memory the OS zeroes page by page (at 640x480, 1.5 MB a
-  /// frame: 75 % of the host thread's time in a sustained ssrt run on lavapipe, on cores the
-  /// renderer needs). Frames of another size are dropped; at most frames_in_flight + 1 are kept.
-  virtual void recycle(FrameOutput&& done) = 0;
-  virtual const DeviceInfo& device() const = 0;
-  virtual const std::string& technique() const = 0;  ///< the technique running (auto: the chosen one)
-  virtual double memory_mib() const = 0;      ///< everything allocated at start-up, MiB
-  virtual int level_count() const = 0;
-  virtual std::vector<std::string> level_names() const = 0;
-  /// Fixes the level from the next frame on (kAutoLevel: the scheduler chooses again). Never
-  /// allocates. BadUsage outside kAutoLevel, 0..level_count()-1.
-  virtual Status set_level(int level) = 0;
-  /// The frame budget from the next frame on (ms, > 0); BadUsage otherwise.
-  virtual Status set_frame_budget_ms(double budget_ms) = 0;
-  /// Profiling mode from the next frame on (RuntimeSettings::profile_passes); never allocates.
-  virtual Status set_profiling(bool on) = 0;
-  /// The virtual objects: scene.json's (SceneDesc::virtual_objects), in its order; the capacity
-  /// is fixed at start-up. set_object_placement moves one from the next process() on (an app's
-  /// object moving), replacing its scene.json motion from then on; it never allocates. BadUsage
-  /// for an index out of range, a non-finite placement or a scale that is not positive.
-  virtual size_t object_count() const = 0;
-  virtual Status set_object_placement(size_t object, const Placement& placement) = 0;
-  /// Adds (true) or removes (false) object i from the next process() on, within that capacity:
-  /// a removed object is not drawn, lit, shadowed or reflected; with none shown, frames are the
-  /// camera frame. BadUsage for an index out of range.
-  virtual Status set_object_visible(size_t object, bool visible) = 0;
-  /// The lamps: scene.json's (SceneDesc::lights), in its order, capacity fixed at start-up.
-  /// set_lamp changes lamp i from the next process() on: moved, turned, recoloured, dimmed to 0
-  /// (off: an app that adds lamps later declares them dark at start-up) or back; its kind (type,
-  /// real) stays. Never allocates. BadUsage naming the field for an index out of range or a lamp
-  /// scene.json would refuse.
-  virtual size_t lamp_count() const = 0;
-  virtual Status set_lamp(size_t lamp, const LightDesc& desc) = 0;
-};
-
-struct CameraSetup {
-  Intrinsics color;
-  Intrinsics depth;
-  double depth_scale = 5000.0;
-  double exposure = 1.0;
-  /// The environment camera's model (capture.json `env_camera`), for frames that carry env
-  /// images (InputFrame::env); without it those images cannot be mapped to directions.
-  std::optional<EnvCamera> env_camera;
-};
-
-Expected<std::unique_ptr<Runtime>> create_runtime(const RuntimeSettings& settings,
-                                                  const CameraSetup& cameras,
-                                                  const SceneDesc& scene);
+// ---------------------------------------------------------------------------------------------
+// 6. Techniques and their quality levels
+// ---------------------------------------------------------------------------------------------
 
 struct TechniqueChoice {
   std::string technique;
@@ -317,13 +359,13 @@ struct TechniqueChoice {
 /// one with the fastest level. `table`: a bench's figures for this device; empty: the built-in
 /// table (lavapipe x2, 640x480, scheduler/technique_choice.cpp). BadInput where the scene's glTF
 /// cannot be read (its materials say whether it is glossy).
-Expected<TechniqueChoice> choose_technique(const SceneDesc& scene, double budget_ms,
+MRGI_API Expected<TechniqueChoice> choose_technique(const SceneDesc& scene, double budget_ms,
                                            const std::vector<TechniqueFigure>& table = {},
                                            double headroom = SchedulerSettings{}.headroom);
 
 /// Names of the registered techniques and their level names (best first).
-std::vector<std::string> technique_names();
-Expected<std::vector<std::string>> technique_levels(const std::string& technique);
+MRGI_API std::vector<std::string> technique_names();
+MRGI_API Expected<std::vector<std::string>> technique_levels(const std::string& technique);
 
 /// One quality knob of a level: what it sets, its value and its unit ("virtual point lights",
 /// "texels per side", ...). `mrgi info --technique NAME` prints the ladder from these.
@@ -343,7 +385,7 @@ struct QualityLevelInfo {
 /// A technique's ladder, best level first (the levels RuntimeSettings::level and
 /// Runtime::set_level index), with `knobs` applied as RuntimeSettings::knobs would. NotFound for
 /// an unknown technique, BadUsage for a knob it refuses.
-Expected<std::vector<QualityLevelInfo>> technique_ladder(const std::string& technique,
+MRGI_API Expected<std::vector<QualityLevelInfo>> technique_ladder(const std::string& technique,
                                                          const std::vector<KnobSetting>& knobs = {});
 
 }  // namespace mrgi

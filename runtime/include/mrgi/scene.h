@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "mrgi/export.h"
 #include "mrgi/glm_contract.h"
 
 #include "mrgi/expected.h"
@@ -13,7 +14,7 @@
 
 namespace mrgi {
 
-struct Placement {
+struct MRGI_API Placement {
   glm::vec3 position{0.0f};
   glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};  ///< JSON gives x y z w; stored in glm's w,x,y,z
   glm::vec3 scale{1.0f};                      ///< JSON accepts a number (uniform) or [x, y, z]
@@ -39,7 +40,7 @@ struct VirtualObjectDesc {
 
 /// The placement of keyframed `motion` at time t (see VirtualObjectDesc::motion); `motion` must
 /// not be empty.
-Placement placement_at(const std::vector<PoseKey>& motion, double t);
+MRGI_API Placement placement_at(const std::vector<PoseKey>& motion, double t);
 
 enum class LightType { Point, Spot, Directional };
 /// A keyframe of a lamp's motion (scene.json lights[].motion): where it is, where it points and
@@ -69,7 +70,7 @@ struct LightDesc {
 
 /// `lamp` as its motion has it at time t (without the motion: no allocation); `lamp.motion` must
 /// not be empty.
-LightDesc lamp_at(const LightDesc& lamp, double t);
+MRGI_API LightDesc lamp_at(const LightDesc& lamp, double t);
 
 struct EnvironmentDesc {
   bool present = false;
@@ -116,8 +117,8 @@ struct SceneDesc {
 
 /// Parses and validates scene.json. Unknown keys, wrong types, non-unit quaternions, NaNs,
 /// negative intensities or spot angles with inner > outer are refused, naming file, key and rule.
-Expected<SceneDesc> load_scene_json(const std::string& path);
-Status write_scene_json(const std::string& path, const SceneDesc& scene);
+MRGI_API Expected<SceneDesc> load_scene_json(const std::string& path);
+MRGI_API Status write_scene_json(const std::string& path, const SceneDesc& scene);
 
 // ---- Loaded glTF content -------------------------------------------------------------------
 
@@ -160,6 +161,6 @@ struct Model {
 
 /// Loads a .gltf/.glb (tinygltf), flattens the node hierarchy of the default scene and applies
 /// `placement` on top. Triangles only; other primitive modes are refused with the mesh's name.
-Expected<Model> load_gltf(const std::string& path, const Placement& placement);
+MRGI_API Expected<Model> load_gltf(const std::string& path, const Placement& placement);
 
 }  // namespace mrgi

@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "mrgi/export.h"
 #include "mrgi/platform/capture.h"
 
 namespace mrgi {
@@ -57,7 +58,7 @@ enum class TrackingState {
   Holding,      ///< no usable tag this frame; last pose kept (younger than hold_s)
   Lost,         ///< no usable tag for longer than hold_s: no pose
 };
-const char* to_string(TrackingState s);
+MRGI_API const char* to_string(TrackingState s);
 
 struct TrackingResult {
   TrackingState state = TrackingState::NotAcquired;
@@ -68,7 +69,7 @@ struct TrackingResult {
   double rms_px = 0.0;           ///< reprojection RMS of the raw pose
 };
 
-class AprilTagDetector {
+class MRGI_API AprilTagDetector {
  public:
   static Expected<AprilTagDetector> create(const std::string& family, const AprilTagTrackerSettings& settings = {});
   AprilTagDetector(AprilTagDetector&&) noexcept;
@@ -91,11 +92,11 @@ struct PoseSolve {
   int tags_used = 0;
   double rms_px = 0.0;
 };
-Expected<PoseSolve> solve_camera_pose(const std::vector<AprilTagDetection>& detections,
+MRGI_API Expected<PoseSolve> solve_camera_pose(const std::vector<AprilTagDetection>& detections,
                                       const AprilTagSettings& tags, const Intrinsics& intrinsics,
                                       double max_rms_px);
 
-class AprilTagTracker {
+class MRGI_API AprilTagTracker {
  public:
   /// BadInput when the settings have no tags, a non-positive size, or an unknown family.
   static Expected<AprilTagTracker> create(const AprilTagSettings& tags, const Intrinsics& intrinsics,

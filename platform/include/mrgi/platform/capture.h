@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "mrgi/expected.h"
+#include "mrgi/export.h"
 #include "mrgi/frame.h"
 #include "mrgi/scene.h"
 
@@ -62,7 +63,7 @@ struct CaptureFrameEntry {
   int reference_line = 0;         ///< line of reference.txt that lists them (for messages)
 };
 
-class CaptureReader {
+class MRGI_API CaptureReader {
  public:
   /// Validates the folder's lists, capture.json, scene.json and every file's existence, and the
   /// first frame's image sizes and bit depths. Errors name file, line and rule.
@@ -97,7 +98,7 @@ enum class ReferenceStorage { Plain, Delta };
 
 /// Writes a capture folder. The folder is built under FOLDER.partial and renamed on finish(),
 /// so an interrupted write never leaves something that looks like a valid capture.
-class CaptureWriter {
+class MRGI_API CaptureWriter {
  public:
   static Expected<CaptureWriter> create(const std::string& folder, const CaptureInfo& info,
                                         const std::optional<SceneDesc>& scene,
@@ -130,7 +131,7 @@ class CaptureWriter {
   double last_timestamp_ = 0.0;
 };
 
-Expected<CaptureInfo> load_capture_json(const std::string& path);
-Status write_capture_json(const std::string& path, const CaptureInfo& info);
+MRGI_API Expected<CaptureInfo> load_capture_json(const std::string& path);
+MRGI_API Status write_capture_json(const std::string& path, const CaptureInfo& info);
 
 }  // namespace mrgi

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "mrgi/expected.h"
+#include "mrgi/export.h"
 #include "mrgi/image.h"
 #include "mrgi/platform/capture.h"
 
@@ -19,12 +20,12 @@ namespace mrgi {
 inline constexpr const char* kDeltaReferenceSuffix = ".delta.png";
 
 /// True when PATH's file name ends in ".delta.png".
-bool is_delta_reference_path(const std::string& path);
+MRGI_API bool is_delta_reference_path(const std::string& path);
 
 /// D = (reference - color) mod 256 per channel. BadUsage when the sizes differ.
-Expected<ImageRGB8> encode_reference_delta(const ImageRGB8& reference, const ImageRGB8& color);
+MRGI_API Expected<ImageRGB8> encode_reference_delta(const ImageRGB8& reference, const ImageRGB8& color);
 /// reference = (color + delta) mod 256 per channel. BadUsage when the sizes differ.
-Expected<ImageRGB8> decode_reference_delta(const ImageRGB8& delta, const ImageRGB8& color);
+MRGI_API Expected<ImageRGB8> decode_reference_delta(const ImageRGB8& delta, const ImageRGB8& color);
 
 struct ReferenceConversion {
   size_t converted = 0;   ///< references rewritten (and verified) in the requested storage
@@ -36,11 +37,11 @@ struct ReferenceConversion {
 /// write), reads it back and checks it decodes to exactly the original pixels, then rewrites
 /// reference.txt (write-then-rename) and only then removes the old files. An error part-way leaves
 /// the old reference.txt and files in place, so the capture stays valid.
-Expected<ReferenceConversion> convert_capture_references(const std::string& folder, ReferenceStorage storage);
+MRGI_API Expected<ReferenceConversion> convert_capture_references(const std::string& folder, ReferenceStorage storage);
 
 /// Writes every reference of CAPTURE as a plain 8-bit RGB PNG DIR/NNNNNN.png (NNNNNN = the frame
 /// index), reconstructing delta references; DIR is created and must not hold files yet. Returns the
 /// number written.
-Expected<size_t> export_references(const CaptureReader& capture, const std::string& dir);
+MRGI_API Expected<size_t> export_references(const CaptureReader& capture, const std::string& dir);
 
 }  // namespace mrgi

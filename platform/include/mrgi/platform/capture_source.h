@@ -6,12 +6,13 @@
 #include <string>
 
 #include "mrgi/expected.h"
+#include "mrgi/export.h"
 #include "mrgi/platform/source.h"
 
 namespace mrgi {
 
 /// Opens FOLDER with CaptureReader::open (all its checks) and replays it. Never waits: next()
 /// returns at once whatever the timeout.
-Expected<std::unique_ptr<InputSource>> make_capture_source(const std::string& folder);
+MRGI_API Expected<std::unique_ptr<InputSource>> make_capture_source(const std::string& folder);
 
 }  // namespace mrgi

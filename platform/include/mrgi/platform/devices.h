@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "mrgi/export.h"
 #include "mrgi/platform/libcamera.h"
 #include "mrgi/platform/openni.h"
 #include "mrgi/platform/source.h"
@@ -34,10 +35,10 @@ struct BuildAdapter {
   const char* option;   ///< the CMake option
   const char* package;  ///< the Debian package it needs
 };
-const std::vector<BuildAdapter>& build_adapters();
+MRGI_API const std::vector<BuildAdapter>& build_adapters();
 
 /// Asks every adapter; never fails (each adapter's failure is kept in its status).
-DeviceReport list_devices_all_adapters();
+MRGI_API DeviceReport list_devices_all_adapters();
 
 struct SourceOptions {
   OpenNISettings openni;
@@ -58,11 +59,11 @@ struct SourceOptions {
 
 /// SOURCE: a capture folder, "openni:", "openni:FILE.oni", "openni:URI", "v4l2:/dev/videoN",
 /// "libcamera:" (first camera) or "libcamera:ID". Unknown prefixes are BadUsage.
-Expected<std::unique_ptr<InputSource>> open_source(const std::string& source, const SourceOptions& options);
+MRGI_API Expected<std::unique_ptr<InputSource>> open_source(const std::string& source, const SourceOptions& options);
 
 /// The pairing open_source() does for options.env, for sources opened by other means (tests,
 /// embedders): frames of `main` get the newest frame of `env` as InputFrame::env.
-std::unique_ptr<InputSource> pair_with_env_camera(std::unique_ptr<InputSource> main, std::unique_ptr<InputSource> env,
+MRGI_API std::unique_ptr<InputSource> pair_with_env_camera(std::unique_ptr<InputSource> main, std::unique_ptr<InputSource> env,
                                                   const SourceOptions& options);
 
 struct RecordSettings {
@@ -73,9 +74,9 @@ struct RecordSettings {
 /// Reads SOURCE until EndOfStream (or max_frames) and writes capture format v1 to FOLDER with the
 /// source's info() as capture.json. Any other error (Timeout, Device, BadInput) stops the
 /// recording, removes the partial folder and is returned naming the frame. Returns the frame count.
-Expected<size_t> record_to_capture(InputSource& source, const std::string& folder, const RecordSettings& settings);
+MRGI_API Expected<size_t> record_to_capture(InputSource& source, const std::string& folder, const RecordSettings& settings);
 
 /// Decodes an 8-bit sRGB env frame to linear radiance: srgb_to_linear(v) / exposure.
-void env_frame_to_radiance(const ImageRGB8& frame, double exposure, ImageRGBF& out);
+MRGI_API void env_frame_to_radiance(const ImageRGB8& frame, double exposure, ImageRGBF& out);
 
 }  // namespace mrgi

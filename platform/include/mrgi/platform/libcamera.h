@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "mrgi/export.h"
 #include "mrgi/platform/source.h"
 #include "mrgi/platform/v4l2.h"
 
@@ -20,10 +21,10 @@ struct LibcameraEntry {
 
 /// Cameras libcamera's pipeline handlers manage now. Starting the camera manager failing is an
 /// error (Device); no camera is an empty list.
-Expected<std::vector<LibcameraEntry>> list_libcamera_cameras();
+MRGI_API Expected<std::vector<LibcameraEntry>> list_libcamera_cameras();
 
 /// Opens camera ID (empty = the first) and starts streaming. NotFound when absent.
-Expected<std::unique_ptr<InputSource>> open_libcamera_source(const std::string& id,
+MRGI_API Expected<std::unique_ptr<InputSource>> open_libcamera_source(const std::string& id,
                                                              const CameraSettings& settings = {});
 
 }  // namespace mrgi

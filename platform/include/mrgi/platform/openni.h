@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "mrgi/export.h"
 #include "mrgi/platform/source.h"
 
 namespace mrgi {
@@ -54,18 +55,18 @@ struct OpenNIDeviceEntry {
 };
 
 /// Initialises OpenNI2 once per process; the error names the drivers folder it looked in.
-Status openni_initialize();
+MRGI_API Status openni_initialize();
 
 /// Devices OpenNI2's drivers enumerate now (may be empty).
-Expected<std::vector<OpenNIDeviceEntry>> list_openni_devices();
+MRGI_API Expected<std::vector<OpenNIDeviceEntry>> list_openni_devices();
 
 /// URI: empty = the first device OpenNI2 finds; a path ending in .oni = playback; otherwise a
 /// device URI as list_openni_devices() gives. Errors: NotFound (no device, missing file),
 /// BadInput (corrupt or truncated file), Device (driver refused).
-Expected<std::unique_ptr<InputSource>> open_openni_source(const std::string& uri,
+MRGI_API Expected<std::unique_ptr<InputSource>> open_openni_source(const std::string& uri,
                                                           const OpenNISettings& settings = {});
 
 /// The report of a source made by open_openni_source (nullptr for other sources).
-const OpenNIStreamReport* openni_report(const InputSource& source);
+MRGI_API const OpenNIStreamReport* openni_report(const InputSource& source);
 
 }  // namespace mrgi

@@ -15,10 +15,11 @@
 #include <string>
 
 #include "mrgi/expected.h"
+#include "mrgi/export.h"
 
 namespace mrgi {
 
-class OutputDir {
+class MRGI_API OutputDir {
  public:
   static constexpr const char* kMarker = ".mrgi-output";
   /// `option` names the flag in messages ("--out").
@@ -43,6 +44,6 @@ class OutputDir {
 };
 
 /// Whether `path` is a directory this program may replace: empty, or holding the marker.
-bool is_replaceable_output(const std::string& path);
+MRGI_API bool is_replaceable_output(const std::string& path);
 
 }  // namespace mrgi

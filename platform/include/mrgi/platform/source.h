@@ -9,12 +9,13 @@
 #include <string>
 
 #include "mrgi/expected.h"
+#include "mrgi/export.h"
 #include "mrgi/frame.h"
 #include "mrgi/platform/capture.h"
 
 namespace mrgi {
 
-class InputSource {
+class MRGI_API InputSource {
  public:
   virtual ~InputSource() = default;
   virtual std::string name() const = 0;          ///< e.g. "openni:/path/x.oni"
@@ -27,6 +28,6 @@ class InputSource {
 /// Opens SOURCE: a capture folder path, "openni:", "openni:FILE.oni", "v4l2:/dev/videoN",
 /// "libcamera:ID". Adapters that are not built or whose device is absent return NotFound
 /// with the adapter's name.
-Expected<std::unique_ptr<InputSource>> open_source(const std::string& source);
+MRGI_API Expected<std::unique_ptr<InputSource>> open_source(const std::string& source);
 
 }  // namespace mrgi

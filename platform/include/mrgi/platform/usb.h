@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "mrgi/expected.h"
+#include "mrgi/export.h"
 
 namespace mrgi {
 
@@ -32,8 +33,8 @@ struct KnownUsbSensor {
 };
 
 /// The table above, in lookup order (a specific product before a vendor-wide entry).
-const std::vector<KnownUsbSensor>& known_usb_sensors();
-const KnownUsbSensor* match_usb_sensor(uint16_t vendor, uint16_t product);
+MRGI_API const std::vector<KnownUsbSensor>& known_usb_sensors();
+MRGI_API const KnownUsbSensor* match_usb_sensor(uint16_t vendor, uint16_t product);
 
 struct UsbDeviceEntry {
   uint16_t vendor = 0, product = 0;
@@ -49,6 +50,6 @@ struct UsbScan {
 };
 
 /// Never fails: no USB bus access (containers, CI) is an empty scan with the reason in `status`.
-UsbScan scan_usb();
+MRGI_API UsbScan scan_usb();
 
 }  // namespace mrgi

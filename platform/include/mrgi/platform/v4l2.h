@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "mrgi/export.h"
 #include "mrgi/platform/source.h"
 
 namespace mrgi {
@@ -49,12 +50,12 @@ struct V4L2NodeEntry {
 };
 
 /// Lists /dev/video* (sorted). An absent /dev or no nodes is an empty list, not an error.
-std::vector<V4L2NodeEntry> list_v4l2_nodes();
+MRGI_API std::vector<V4L2NodeEntry> list_v4l2_nodes();
 
 /// Opens DEVICE (/dev/videoN) and starts streaming. NotFound when the node is absent,
 /// BadInput when it offers no format mrgi converts (the message lists what it offers), Device
 /// for driver failures.
-Expected<std::unique_ptr<InputSource>> open_v4l2_source(const std::string& device,
+MRGI_API Expected<std::unique_ptr<InputSource>> open_v4l2_source(const std::string& device,
                                                         const CameraSettings& settings = {});
 
 }  // namespace mrgi
