@@ -195,7 +195,7 @@ void run_bench_command(BenchOptions& o) {
     auto wb = perf::write_baseline(o.write_baseline, perf::make_baseline(result));
     if (!wb.ok()) fail_with(wb.error());
   }
-  std::printf("bench: %zu runs on %s (LP_NUM_THREADS=%s), floor %.3f ms, %.1f s; wrote %s/{bench.json,bench.csv,report.md,passes.md,pareto.png,passes.png}\n",
+  std::printf("bench: %zu runs on %s (LP_NUM_THREADS=%s), floor %.3f ms, %.1f s; wrote %s/{bench.json,bench.csv,report.md,passes.md,pareto.png,passes.png,images/}\n",
               result.entries.size(), result.device.c_str(),
               result.lp_num_threads.empty() ? "unset" : result.lp_num_threads.c_str(), result.floor_median_ms,
               result.duration_s, o.out.c_str());
@@ -214,7 +214,7 @@ void setup(CLI::App& app) {
   opts->settings.suite = "perf/suite.json";
   CLI::App* cmd = app.add_subcommand(
       "bench", "Run every technique and quality level over the scene suite; write bench.json, bench.csv, "
-               "report.md, passes.md, pareto.png and passes.png; optionally check against a baseline");
+               "report.md, passes.md, pareto.png, passes.png and images/ (every level's output side by side); optionally check against a baseline");
   cmd->add_option("--suite", opts->settings.suite, "suite manifest (JSON); several comma-separated (perf/suite.json,perf/cycles-tuning.json) run as one, the report giving each set's accuracy apart")->capture_default_str();
   cmd->add_option("--techniques,-t", opts->settings.techniques, "techniques to run, comma-separated (default: all)")
       ->delimiter(',');

@@ -12,6 +12,7 @@
 #include "gpu/context.h"
 #include "gpu/floor_pass.h"
 #include "mrgi/perf/bench.h"
+#include "mrgi/perf/sample_sheet.h"
 #include "mrgi/perf/temporal.h"
 #include "mrgi/perf/stats.h"
 #include "mrgi/perf/suite.h"
@@ -272,9 +273,11 @@ Expected<RunSamples> run_one(const LoadedScene& l, const std::string& technique,
   r.cpu_ms = (end_cpu_ms - (start_cpu_ms >= 0.0 ? start_cpu_ms : loop_start_cpu_ms)) / double(measured);
 
   bool pooled_any = false;
+  const FrameOutput* sampled = nullptr;  // the last measured frame with a reference
   for (const FrameOutput& out : kept) {
     const size_t src = ping_pong(size_t(out.stats.frame_index), n);
     if (!l.references[src]) continue;
+    sampled = &out;
     // At another output size (--width/--height, --sizes) camera, reference and mask are resampled
     // to it, as `mrgi replay` does.
     const int w = out.image.width, h = out.image.height;
@@ -293,6 +296,10 @@ Expected<RunSamples> run_one(const LoadedScene& l, const std::string& technique,
     pooled_any = true;
   }
   e.has_reference = pooled_any;
+  if (sampled) {
+    e.sample = thumbnail(sampled->image, kSampleWidth);
+    e.sample_frame = int(ping_pong(size_t(sampled->stats.frame_index), n));
+  }
   MRGI_TRY(measure_stability(l, kept, e));
   kept.clear();
 
@@ -479,6 +486,13 @@ Expected<BenchResult> run_bench(const BenchSettings& s) {
       for (const std::string& name : r.pass_order)
         r.entry.passes.push_back(PassSummary{name, summarize(r.pass_ms[name], f.median_ms, f.min_ms),
                                              percentile(r.pass_cpu_ms[name], 50)});
+      const int frame = r.entry.sample_frame;
+      const bool have = std::any_of(result.samples.begin(), result.samples.end(), [&](const SceneSample& x) {
+        return x.scene == sc.name && x.frame == frame;
+      });
+      if (frame >= 0 && !have && loaded->references[size_t(frame)])
+        result.samples.push_back(SceneSample{sc.name, frame, thumbnail(loaded->frames[size_t(frame)].color, kSampleWidth),
+                                             thumbnail(*loaded->references[size_t(frame)], kSampleWidth)});
       result.entries.push_back(std::move(r.entry));
     }
   }

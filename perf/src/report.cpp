@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "mrgi/perf/pareto.h"
+#include "mrgi/perf/sample_sheet.h"
 #include "mrgi/perf/stats.h"
 
 namespace fs = std::filesystem;
@@ -378,6 +379,17 @@ std::string report_markdown(const BenchResult& r, const CheckReport* check) {
   for (size_t i : front)
     o << "- " << levels[i].technique << " level " << levels[i].level << " " << levels[i].level_name << ": "
       << fmt(levels[i].mean_median_ms, 2) << " ms, RDE " << fmt(levels[i].error.all.rde, 3) << "\n";
+  bool any_sample = false;
+  for (const SceneFloor& f : r.floors) {
+    if (std::none_of(r.entries.begin(), r.entries.end(),
+                     [&](const BenchEntry& e) { return e.scene == f.scene && e.sample_frame >= 0; }))
+      continue;
+    if (!any_sample)
+      o << "\n## What the levels look like\n\nPer scene, its last measured frame with a reference: the camera, the "
+           "reference and every technique level's output side by side, with the level's RDE and sustained ms.\n\n";
+    any_sample = true;
+    o << "- [" << f.scene << "](" << sample_sheet_path(f.scene) << ")\n";
+  }
   if (check) {
     o << "\n## Regression check\n\n```\n" << check->summary() << "```\n";
   }
@@ -510,6 +522,14 @@ Status write_bench_outputs(const std::string& dir_in, const BenchResult& r, cons
   MRGI_TRY(write_png(partial + "/pareto.png", render_pareto_plot(r)));
   MRGI_TRY(write_png(partial + "/passes.png", render_pass_plot(r)));
   MRGI_TRY(write_text(partial + "/passes.md", pass_table_markdown(r)));
+  for (const SceneFloor& f : r.floors) {
+    const std::optional<ImageRGB8> sheet = render_sample_sheet(r, f.scene);
+    if (!sheet) continue;
+    std::error_code ec;
+    fs::create_directories(partial + "/images", ec);
+    if (ec) return fail(ErrorKind::BadUsage, partial + "/images: cannot create the folder: " + ec.message());
+    MRGI_TRY(write_png(partial + "/" + sample_sheet_path(f.scene), *sheet));
+  }
   if (check) MRGI_TRY(write_text(partial + "/junit.xml", junit_xml(r, *check)));
   return out->commit();
 }

@@ -17,6 +17,7 @@
 #include "mrgi/perf/bench.h"
 #include "mrgi/perf/regression.h"
 #include "mrgi/perf/report.h"
+#include "mrgi/perf/sample_sheet.h"
 #include "mrgi/perf/suite.h"
 
 using mrgi::testing::TempDir;
@@ -131,6 +132,16 @@ void check_outputs(const perf::BenchResult& r) {
   ASSERT_TRUE(png.ok()) << png.error().message;
   EXPECT_EQ(png->width, 1640);
   EXPECT_TRUE(fs::exists(out + "/passes.md"));
+  // The side-by-side images: the scene's sampled frame from each level, linked from the report.
+  const perf::BenchEntry& first = r.entries.front();
+  if (first.has_reference) {
+    EXPECT_GE(first.sample_frame, 0);
+    EXPECT_EQ(first.sample.width, perf::kSampleWidth);
+    auto sheet = mrgi::load_png_rgb8(out + "/" + perf::sample_sheet_path(first.scene));
+    ASSERT_TRUE(sheet.ok()) << sheet.error().message;
+    EXPECT_GE(sheet->width, 2 * perf::kSampleWidth);
+    EXPECT_NE(md.find("(" + perf::sample_sheet_path(first.scene) + ")"), std::string::npos);
+  }
   // A second write replaces the earlier bench output; a folder that is not one is refused.
   EXPECT_TRUE(perf::write_bench_outputs(out, r, nullptr).ok());
   mrgi::testing::write_text(dir.file("precious/data.txt"), "x");

@@ -99,7 +99,17 @@ struct BenchEntry {
   // stability_pairs 0 = not measured (no depth or poses, another output size, one frame),
   // truth_stability < 0 = no references.
   size_t stability_pairs = 0;
-  double stability = 0.0, truth_stability = -1.0;
+  double stability = 0.0, truth_stability = -1.0;  // The last measured frame that has a reference, kSampleWidth wide (mrgi/perf/sample_sheet.h),
+  // and its frame in the capture; -1 = none kept (no references).
+  ImageRGB8 sample;
+  int sample_frame = -1;
+};
+
+// The camera frame and the reference of a scene's sampled frame, kSampleWidth wide.
+struct SceneSample {
+  std::string scene;
+  int frame = 0;
+  ImageRGB8 camera, reference;
 };
 
 struct SceneFloor {
@@ -112,6 +122,7 @@ struct SceneFloor {
 struct BenchResult {
   std::vector<BenchEntry> entries;       // scene-major, then technique, then level
   std::vector<SceneFloor> floors;        // one per scene
+  std::vector<SceneSample> samples;      // the inputs of the entries' samples, one per scene and frame
   double floor_median_ms = 0.0;          // over every floor sample of the run
   std::string device, driver;
   std::string lp_num_threads;            // the value in effect ("" = unset: not a valid timing)
