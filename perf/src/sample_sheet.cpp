@@ -7,7 +7,9 @@
 #include "mrgi/perf/canvas.h"
 
 namespace mrgi::perf {
-namespace {
+// A namespace of its own: the unity build (MRGI_UNITY_LIBS) puts this file beside the plots,
+// whose anonymous namespaces hold names like these.
+namespace sheet {
 
 constexpr int kMargin = 12, kGap = 10, kLabelHeight = 34;
 constexpr float kTextScale = 1.4f;
@@ -61,10 +63,10 @@ std::string figures_of(const BenchEntry& e) {
   return buf;
 }
 
-}  // namespace
+}  // namespace sheet
 
-ImageRGB8 thumbnail(const ImageRGB8& image, int width) { return box_average(image, width); }
-ImageRGB8 thumbnail(const ImageRGBA8& image, int width) { return box_average(image, width); }
+ImageRGB8 thumbnail(const ImageRGB8& image, int width) { return sheet::box_average(image, width); }
+ImageRGB8 thumbnail(const ImageRGBA8& image, int width) { return sheet::box_average(image, width); }
 
 std::string sample_sheet_path(const std::string& scene) {
   std::string name = scene;
@@ -74,7 +76,7 @@ std::string sample_sheet_path(const std::string& scene) {
 
 std::optional<ImageRGB8> render_sample_sheet(const BenchResult& result, const std::string& scene) {
   // Rows: the inputs, then one per technique in the run's order, its entries in level order.
-  std::vector<std::vector<Cell>> rows;
+  std::vector<std::vector<sheet::Cell>> rows;
   std::vector<std::string> techniques;
   int sample_frame = -1;
   for (const BenchEntry& e : result.entries) {
@@ -87,32 +89,32 @@ std::optional<ImageRGB8> render_sample_sheet(const BenchResult& result, const st
       t = techniques.end() - 1;
     }
     rows[size_t(t - techniques.begin())].push_back(
-        Cell{&e.sample, e.technique + " " + std::to_string(e.level) + " " + e.level_name, figures_of(e)});
+        sheet::Cell{&e.sample, e.technique + " " + std::to_string(e.level) + " " + e.level_name, sheet::figures_of(e)});
   }
   if (rows.empty()) return std::nullopt;
   const SceneSample* inputs = nullptr;
   for (const SceneSample& s : result.samples)
     if (s.scene == scene && s.frame == sample_frame) inputs = &s;
   if (inputs) {
-    rows.insert(rows.begin(), std::vector<Cell>{
-                                  Cell{&inputs->camera, "camera, frame " + std::to_string(sample_frame), ""},
-                                  Cell{&inputs->reference, "reference", "what RDE compares with"}});
+    rows.insert(rows.begin(), std::vector<sheet::Cell>{
+                                  sheet::Cell{&inputs->camera, "camera, frame " + std::to_string(sample_frame), ""},
+                                  sheet::Cell{&inputs->reference, "reference", "what RDE compares with"}});
   }
   size_t columns = 0;
   int cell_height = 0;
   for (const auto& row : rows) {
     columns = std::max(columns, row.size());
-    for (const Cell& c : row) cell_height = std::max(cell_height, c.image->height);
+    for (const sheet::Cell& c : row) cell_height = std::max(cell_height, c.image->height);
   }
-  const int title_height = 30;
-  const int width = 2 * kMargin + int(columns) * kSampleWidth + int(columns - 1) * kGap;
-  const int row_height = kLabelHeight + cell_height + kGap;
-  Canvas canvas(width, kMargin + title_height + int(rows.size()) * row_height + kMargin, kBackground);
-  canvas.text(float(kMargin), float(kMargin), scene + ": the same frame from every technique level", 2.0f, kInk);
+  const int title_height = 30, margin = sheet::kMargin, gap = sheet::kGap;
+  const int width = 2 * margin + int(columns) * kSampleWidth + int(columns - 1) * gap;
+  const int row_height = sheet::kLabelHeight + cell_height + gap;
+  Canvas canvas(width, margin + title_height + int(rows.size()) * row_height + margin, sheet::kBackground);
+  canvas.text(float(margin), float(margin), scene + ": the same frame from every technique level", 2.0f, sheet::kInk);
   for (size_t r = 0; r < rows.size(); ++r)
     for (size_t c = 0; c < rows[r].size(); ++c)
-      draw_cell(canvas, kMargin + int(c) * (kSampleWidth + kGap), kMargin + title_height + int(r) * row_height,
-                rows[r][c]);
+      sheet::draw_cell(canvas, margin + int(c) * (kSampleWidth + gap), margin + title_height + int(r) * row_height,
+                       rows[r][c]);
   return canvas.image();
 }
 
