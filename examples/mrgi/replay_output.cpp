@@ -208,7 +208,8 @@ Expected<nlohmann::json> ReplayOutput::finish() {
                       {"influenced", rde(pooled_->influenced)},
                       {"rest", rde(pooled_->rest)},
                       {"darkened", rde(pooled_->darkened)},
-                      {"brightened", rde(pooled_->brightened)}};
+                      {"brightened", rde(pooled_->brightened)},
+                      {"silhouette", rde(pooled_->silhouette)}};
     summary["error"] = perf::error_report_json(*pooled_);
   }
   MRGI_TRY(write_json(partial_ + "/stats.json", stats_));

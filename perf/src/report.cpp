@@ -143,7 +143,8 @@ nlohmann::json error_report_json(const RdeReport& r) {
           {"influenced", error_figures_json(r.influenced)},
           {"rest", error_figures_json(r.rest)},
           {"darkened", error_figures_json(r.darkened)},
-          {"brightened", error_figures_json(r.brightened)}};
+          {"brightened", error_figures_json(r.brightened)},
+          {"silhouette", error_figures_json(r.silhouette)}};
 }
 
 nlohmann::json bench_json(const BenchResult& r, const CheckReport* check) {
@@ -238,7 +239,7 @@ std::string bench_csv(const BenchResult& r) {
   std::ostringstream o;
   o << "scene,technique,level,level_name,width,height,frames,sustained_ms,sustained_ratio,interval_p95_ms,"
        "profiled_median_ms,floor_ms,"
-       "memory_mib,rde_all,rde_real,rde_virtual,delta_rms,rmse8,ssim";
+       "memory_mib,rde_all,rde_real,rde_virtual,rde_silhouette,delta_rms,rmse8,ssim";
   for (const std::string& p : pass_names)
     o << "," << csv_field("pass_" + p + "_median_ms") << "," << csv_field("pass_" + p + "_p95_ms") << ","
       << csv_field("pass_" + p + "_median_ratio");
@@ -253,7 +254,7 @@ std::string bench_csv(const BenchResult& r) {
       << "," << e.width << "," << e.height << "," << e.frame.samples << "," << fmt(e.sustained_ms, 4) << ","
       << fmt(e.sustained_ratio, 4) << "," << fmt(e.frame.p95_ms, 4) << "," << fmt(e.profiled.median_ms, 4) << ","
       << fmt(floor_of[e.scene], 4) << "," << fmt(e.memory_mib, 2) << "," << rde(e, e.error.all) << ","
-      << rde(e, e.error.real) << "," << rde(e, e.error.virtual_) << ","
+      << rde(e, e.error.real) << "," << rde(e, e.error.virtual_) << "," << rde(e, e.error.silhouette) << ","
       << (e.has_reference ? fmt(e.error.all.delta_rms, 6) : "") << ","
       << (e.has_reference ? fmt(e.error.all.rmse8, 4) : "") << "," << (e.has_reference ? fmt(e.error.all.ssim, 5) : "");
     for (const std::string& name : pass_names) {
@@ -335,16 +336,17 @@ std::string report_markdown(const BenchResult& r, const CheckReport* check) {
     }
     // Where the error is: the truth's regions (mrgi/metrics.h RdeReport::influenced, rest) and
     // how much light the output takes from or adds to the real pixels against the truth.
-    o << "\nError by region (RDE over the real pixels the virtual objects change in the truth, and over the "
-         "real pixels they leave; *real change*: the signed sum of output - camera over the real pixels and "
+    o << "\nError by region (RDE over the virtual pixels, over the silhouette band (within " << kSilhouetteBandPx
+      << " pixels of the reference mask's edge, either side), over the real pixels the virtual objects change in the "
+         "truth, and over the real pixels they leave; *real change*: the signed sum of output - camera over the real pixels and "
          "channels, linear, against the same sum of truth - camera):\n\n"
-         "| scene | level | RDE virtual | RDE influenced | RDE rest | real change | truth's | ratio |\n"
-         "|---|---|---:|---:|---:|---:|---:|---:|\n";
+         "| scene | level | RDE virtual | RDE silhouette | RDE influenced | RDE rest | real change | truth's | ratio |\n"
+         "|---|---|---:|---:|---:|---:|---:|---:|---:|\n";
     for (const BenchEntry& e : r.entries) {
       if (e.technique != t || !e.has_reference) continue;
       const ErrorFigures& real = e.error.real;
       o << "| " << e.scene << " | " << e.level << " " << e.level_name << " | " << rde_cell(true, e.error.virtual_)
-        << " | " << rde_cell(true, e.error.influenced) << " | " << rde_cell(true, e.error.rest) << " | "
+        << " | " << rde_cell(true, e.error.silhouette) << " | " << rde_cell(true, e.error.influenced) << " | " << rde_cell(true, e.error.rest) << " | "
         << fmt(real.change_sum, 1) << " | " << fmt(real.truth_change_sum, 1) << " | "
         << (std::abs(real.truth_change_sum) > 1e-9 ? fmt(real.change_sum / real.truth_change_sum, 2) : "-") << " |\n";
     }

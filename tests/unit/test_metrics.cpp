@@ -161,3 +161,44 @@ TEST(Metrics, TheTruthSplitsItsChangesIntoDarkenedAndBrightened) {
   EXPECT_NEAR(twice.brightened.truth_change_rgb[0], 2.0 * r->brightened.truth_change_rgb[0], 1e-12);
   EXPECT_EQ(twice.darkened.pixels, 2u);
 }
+
+// The silhouette band: pixels within kSilhouetteBandPx (Euclidean) of the other side of the mask,
+// on both sides; an error only there shows in the band's RDE and not outside it.
+TEST(Metrics, TheSilhouetteBandIsTheMaskEdgeWithinTwoPixels) {
+  const int w = 20, h = 20;
+  ImageRGB8 c = filled(w, h, 100), g = c, o = c;
+  ImageU8 mask(w, h, 0);
+  for (int y = 8; y < 12; ++y)
+    for (int x = 8; x < 12; ++x) mask.at(x, y)[0] = 255;  // a 4 x 4 virtual square
+  size_t expected = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const bool v = mask.at(x, y)[0] != 0;
+      bool edge = false;
+      for (int yy = 0; yy < h; ++yy)
+        for (int xx = 0; xx < w; ++xx)
+          edge = edge || ((mask.at(xx, yy)[0] != 0) != v && (xx - x) * (xx - x) + (yy - y) * (yy - y) <= 4);
+      expected += edge ? 1 : 0;
+    }
+  // The truth changes every pixel; the output is right everywhere but at one band pixel (the
+  // square's corner) and one pixel far from it.
+  for (auto& b : g.data) b = 60;
+  o = g;
+  o.at(8, 8)[0] = 200;   // on the edge
+  o.at(1, 1)[0] = 200;   // outside the band
+  auto r = measure_error(o, c, g, &mask);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  EXPECT_EQ(r->silhouette.pixels, expected);
+  // Every pixel of the square (none is more than 2 from outside it) and the 36 real ones of its
+  // dilation by a disc of radius 2 (rows of 4, 6, 8, 8, 8, 8, 6, 4 pixels less the 16 of the square).
+  EXPECT_EQ(expected, 52u);
+  const double d = double(srgb8_to_linear(200)) - double(srgb8_to_linear(60));
+  EXPECT_NEAR(r->silhouette.err2, d * d, 1e-12);  // the edge pixel only
+  EXPECT_NEAR(r->all.err2, 2.0 * d * d, 1e-12);
+  // Without a mask there is no silhouette.
+  auto no_mask = measure_error(o, c, g, nullptr);
+  ASSERT_TRUE(no_mask.ok());
+  EXPECT_EQ(no_mask->silhouette.pixels, 0u);
+  // Pooling sums the band as the other sets.
+  EXPECT_EQ(pool(*r, *r).silhouette.pixels, 2 * expected);
+}

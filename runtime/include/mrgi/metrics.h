@@ -45,7 +45,15 @@ struct RdeReport {
   /// environment), `brightened` where they add light (bounce and colour bleeding, caustics,
   /// their reflection in real surfaces).
   ErrorFigures darkened, brightened;
+  /// Pixels within kSilhouetteBandPx of the mask's edge, on either side: the virtual objects'
+  /// silhouettes, where a level's internal resolution below the output's shows first (a blocky
+  /// or haloed edge). Empty without a mask.
+  ErrorFigures silhouette;
 };
+
+/// The silhouette band's half width, output pixels (Euclidean distance to a pixel of the other
+/// side of the mask).
+inline constexpr int kSilhouetteBandPx = 2;
 
 /// virtual_mask: nullptr = every pixel is real; else one byte per pixel, non-zero = virtual.
 /// Different sizes are a BadInput error naming the sizes.

@@ -100,6 +100,25 @@ struct Accumulator {
   }
 };
 
+// 1 where a pixel of the other side of the mask lies within kSilhouetteBandPx (Euclidean).
+std::vector<uint8_t> silhouette_band(const ImageU8& mask) {
+  const int w = mask.width, h = mask.height, r = kSilhouetteBandPx;
+  std::vector<uint8_t> band(mask.pixel_count(), 0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const bool v = mask.data[size_t(y) * w + x] != 0;
+      bool edge = false;
+      for (int dy = -r; dy <= r && !edge; ++dy)
+        for (int dx = -r; dx <= r && !edge; ++dx) {
+          const int nx = x + dx, ny = y + dy;
+          if (dx * dx + dy * dy > r * r || nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
+          edge = (mask.data[size_t(ny) * w + nx] != 0) != v;
+        }
+      band[size_t(y) * w + x] = edge ? 1 : 0;
+    }
+  return band;
+}
+
 template <int CO>
 Expected<RdeReport> measure(const Image<uint8_t, CO>& o, const ImageRGB8& c, const ImageRGB8& g,
                             const ImageU8* mask) {
@@ -113,7 +132,8 @@ Expected<RdeReport> measure(const Image<uint8_t, CO>& o, const ImageRGB8& c, con
                                          ", reference is " + size(g.width, g.height));
   const auto& lin = srgb_table();
   const auto ssim = ssim_map(o, g);
-  Accumulator all, real, virt, influenced, rest, darkened, brightened;
+  const std::vector<uint8_t> band = mask ? silhouette_band(*mask) : std::vector<uint8_t>{};
+  Accumulator all, real, virt, influenced, rest, darkened, brightened, silhouette;
   const double luma[3] = {0.2126, 0.7152, 0.0722};  // Rec. 709, linear
   for (size_t i = 0; i < g.pixel_count(); ++i) {
     double e2 = 0.0, r2 = 0.0, m2 = 0.0, change = 0.0, truth_change = 0.0, truth_luma = 0.0;
@@ -138,7 +158,8 @@ Expected<RdeReport> measure(const Image<uint8_t, CO>& o, const ImageRGB8& c, con
     const bool is_virtual = mask && mask->data[i];
     Accumulator* split = is_virtual ? nullptr : (changed ? &influenced : &rest);
     Accumulator* effect = is_virtual || !changed ? nullptr : (truth_luma < 0.0 ? &darkened : &brightened);
-    for (Accumulator* acc : {&all, is_virtual ? &virt : &real, split, effect}) {
+    Accumulator* edge = mask && band[i] ? &silhouette : nullptr;
+    for (Accumulator* acc : {&all, is_virtual ? &virt : &real, split, effect, edge}) {
       if (!acc) continue;
       acc->err2 += e2;
       acc->ref2 += r2;
@@ -153,8 +174,8 @@ Expected<RdeReport> measure(const Image<uint8_t, CO>& o, const ImageRGB8& c, con
       acc->pixels += 1;
     }
   }
-  return RdeReport{all.finish(),        real.finish(), virt.finish(),     influenced.finish(),
-                   rest.finish(),       darkened.finish(), brightened.finish()};
+  return RdeReport{all.finish(),  real.finish(),     virt.finish(),       influenced.finish(),
+                   rest.finish(), darkened.finish(), brightened.finish(), silhouette.finish()};
 }
 
 }  // namespace
@@ -178,8 +199,9 @@ ErrorFigures pool(const ErrorFigures& a, const ErrorFigures& b) {
 }
 
 RdeReport pool(const RdeReport& a, const RdeReport& b) {
-  return {pool(a.all, b.all),   pool(a.real, b.real),         pool(a.virtual_, b.virtual_),   pool(a.influenced, b.influenced),
-          pool(a.rest, b.rest), pool(a.darkened, b.darkened), pool(a.brightened, b.brightened)};
+  return {pool(a.all, b.all),           pool(a.real, b.real),         pool(a.virtual_, b.virtual_),
+          pool(a.influenced, b.influenced), pool(a.rest, b.rest),         pool(a.darkened, b.darkened),
+          pool(a.brightened, b.brightened), pool(a.silhouette, b.silhouette)};
 }
 
 Expected<RdeReport> measure_error(const ImageRGB8& output, const ImageRGB8& camera,
