@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 #include "mrgi/perf/canvas.h"
@@ -41,10 +42,20 @@ struct Cell {
   std::string title, figures;
 };
 
+// A label within the cell's width: drawn smaller where it is long (a sweep's entry names its
+// knob values), cut with ".." where even that does not fit, so neighbours never overlap.
+void draw_label(Canvas& canvas, float x, float y, std::string s, Rgb colour) {
+  const float width = float(kSampleWidth) - 4.0f;
+  float scale = kTextScale;
+  if (Canvas::text_width(s, scale) > width) scale = std::max(1.0f, scale * width / Canvas::text_width(s, scale));
+  while (s.size() > 2 && Canvas::text_width(s, scale) > width) s = s.substr(0, s.size() - 3) + "..";
+  canvas.text(x, y, s, scale, colour);
+}
+
 void draw_cell(Canvas& canvas, int x, int y, const Cell& cell) {
-  canvas.text(float(x), float(y), cell.title, kTextScale, kInk);
+  draw_label(canvas, float(x), float(y), cell.title, kInk);
   if (!cell.figures.empty())
-    canvas.text(float(x), float(y) + Canvas::text_height(kTextScale) + 5.0f, cell.figures, kTextScale, kMuted);
+    draw_label(canvas, float(x), float(y) + Canvas::text_height(kTextScale) + 5.0f, cell.figures, kMuted);
   const ImageRGB8& img = *cell.image;
   const int top = y + kLabelHeight;
   for (int py = 0; py < img.height; ++py)

@@ -110,3 +110,20 @@ TEST(SampleSheet, NothingForASceneWithoutSamplesAndAFileNameForEveryScene) {
   EXPECT_EQ(perf::sample_sheet_path("room"), "images/room.png");
   EXPECT_EQ(perf::sample_sheet_path("light/courtyard_down"), "images/light-courtyard_down.png");
 }
+
+TEST(SampleSheet, LongLabelsStayInsideTheirCells) {
+  perf::BenchResult r;
+  r.entries = {entry("baseline", 0, 10), entry("baseline", 1, 20)};
+  for (perf::BenchEntry& e : r.entries) e.level_name += " internal_scale=0.75 shadow_map_size=2048 pcf_radius=1";
+  auto sheet = perf::render_sample_sheet(r, "room");
+  ASSERT_TRUE(sheet.has_value());
+  const Box left = find(*sheet, 10, 0, 200), right = find(*sheet, 20, 0, 200);
+  ASSERT_LT(left.x1, right.x0);
+  // The columns between the two cells hold nothing but the background, from the cells' labels
+  // (two lines above each image) down; the sheet's title above them spans the sheet.
+  for (int y = left.y0 - 40; y < sheet->height; ++y)
+    for (int x = left.x1 + 1; x < right.x0; ++x) {
+      const uint8_t* p = sheet->at(x, y);
+      ASSERT_TRUE(p[0] == 255 && p[1] == 255 && p[2] == 255) << "ink at " << x << "," << y;
+    }
+}
