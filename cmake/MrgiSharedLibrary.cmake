@@ -15,6 +15,12 @@ function(mrgi_shared_library_abi target)
   if(CMAKE_CXX_COMPILER_LINKER_ID MATCHES "GNU|LLD" OR NOT CMAKE_CXX_COMPILER_LINKER_ID)
     set(map ${PROJECT_SOURCE_DIR}/cmake/hide-third-party.map)
     target_link_options(${target} PRIVATE -Wl,--version-script=${map})
+    # Every symbol resolved at link time: a function the library uses from libmrgi.so that
+    # libmrgi.so does not export (hidden) fails the build here, not an app's link. Not in the
+    # sanitizer and fuzz builds, whose runtimes are linked into the executables only.
+    if(NOT MRGI_SANITIZE AND NOT MRGI_FUZZ)
+      target_link_options(${target} PRIVATE -Wl,--no-undefined)
+    endif()
     set_property(TARGET ${target} APPEND PROPERTY LINK_DEPENDS ${map})
   endif()
 endfunction()

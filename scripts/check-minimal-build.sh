@@ -17,6 +17,6 @@ if [ "${1:-}" = "--full" ]; then
   "$dir/bin/mrgi" devices
   exit 0
 fi
-objects=$(ninja -C "$dir" -t targets all | grep -oE '^(platform/CMakeFiles/mrgi_platform|examples/CMakeFiles/mrgi_tool)\.dir/[^:]*\.o' | sort -u)
+objects=$(ninja -C "$dir" -t targets all | grep -oE '^(platform/CMakeFiles/mrgi_platform_objects|examples/CMakeFiles/mrgi_tool)\.dir/[^:]*\.o' | sort -u)
 ninja -C "$dir" $objects
 echo "minimal build: configured and compiled $(echo "$objects" | wc -l) objects of mrgi_platform and the tool"

@@ -8,8 +8,11 @@
 #     carries and the dynamic linker merges;
 #   - the ELF markers every shared object defines (_init, _fini, _edata, _end, __bss_start).
 # It also checks that the entry points an app starts from are exported, so a library that
-# exports nothing fails too.
-# Usage: exported_symbols_test.sh LIBRARY HEADER_DIR [HEADER_DIR...] [-- REQUIRED_SYMBOL...]
+# exports nothing fails too. Names are compared without their parameters: an overload of a public
+# name passes. (What a library needs from libmrgi.so that it does not export fails their link:
+# -Wl,--no-undefined, cmake/MrgiSharedLibrary.cmake.)
+# Usage: exported_symbols_test.sh LIBRARY HEADERS [HEADERS...] [-- REQUIRED_SYMBOL...]
+#   HEADERS: header files, or folders searched for *.h
 set -euo pipefail
 lib=$1
 shift

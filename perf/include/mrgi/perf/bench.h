@@ -99,7 +99,8 @@ struct BenchEntry {
   // stability_pairs 0 = not measured (no depth or poses, another output size, one frame),
   // truth_stability < 0 = no references.
   size_t stability_pairs = 0;
-  double stability = 0.0, truth_stability = -1.0;  // The last measured frame that has a reference, kSampleWidth wide (mrgi/perf/sample_sheet.h),
+  double stability = 0.0, truth_stability = -1.0;
+  // The last measured frame that has a reference, kSampleWidth wide (mrgi/perf/sample_sheet.h),
   // and its frame in the capture; -1 = none kept (no references).
   ImageRGB8 sample;
   int sample_frame = -1;
