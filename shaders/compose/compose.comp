@@ -13,8 +13,9 @@
 //
 // Three pipelines from this file, chosen per frame by the runtime, specialised on whether the
 // camera and output sizes match (kSameSize): kCameraOnly (nothing virtual in view) writes the
-// camera frame, a byte copy when the sizes match; the others run the composite, kSameInternal
-// when the solutions are at the output size (one texel each instead of a bilinear four: 8 of
+// camera frame, a byte copy when the sizes match; the others run the composite (joint_taps up-
+// samples the solutions where they are smaller than the output), kSameInternal when the
+// solutions are at the output size (one texel each instead of a bilinear four: 8 of
 // the composite's 10 fetches on a full-resolution level). Not one shader
 // with branches: on lavapipe a shader costs about as much as all of its code, taken or not
 // (measured at 640x480, x2 threads: the copy alone 0.85 ms as its own pipeline, 8 ms with the
@@ -41,6 +42,10 @@ layout(set = 0, binding = 4, rgba32f) readonly uniform image2D virtual_position;
 // RGBA8 words, the virtual mask in alpha (mrgi_shared.h pack_output_word).
 layout(std430, set = 0, binding = 5) writeonly buffer Output { uint out_rgba8[]; };
 layout(std430, set = 0, binding = 7) readonly buffer Tiles { uint list[]; } tiles;
+// The virtual objects' coverage at the output resolution (recon::VirtualGBuffer::
+// output_coverage), read where the solutions are at a lower internal resolution: the mask at the
+// output's pixels. (The variants at the output's own size read virtual_position's w instead.)
+layout(set = 0, binding = 8, r8) readonly uniform image2D virtual_coverage;
 struct ParamsConstants {
   vec4 compose;      // x eps (linear camera units), y alpha_max
 };
@@ -68,21 +73,45 @@ vec3 camera_at(vec2 rel, ivec2 pixel) {
              mix(camera_linear(c0 + ivec2(0, 1)), camera_linear(c0 + ivec2(1, 1)), f.x), f.y);
 }
 
-// Bilinear fetch of the solution at the internal resolution, from texels of the used extent
-// only: texels outside it hold whatever an earlier level left (possibly NaN), and a filtered
-// fetch at the edge would give them weight 0, which still makes 0 * NaN = NaN.
+// Joint (mask-aware) up-sampling of the solutions from the internal resolution: the bilinear
+// taps of the pixel, weighted by the bilinear weights of those on the pixel's own side of the
+// virtual mask only, so a virtual pixel takes the object's lighting and a real pixel the real
+// surface's, and the silhouette is the output-resolution coverage's, not the internal texels'.
+// Taps come from the used extent only: texels outside it hold whatever an earlier level left
+// (possibly NaN), and a weight of 0 would still make 0 * NaN = NaN.
+struct Taps {
+  ivec2 a, b;    // texels (a.x, a.y), (b.x, a.y), (a.x, b.y), (b.x, b.y)
+  vec4 w;        // their weights, summing to 1
+  bool no_side;  // no tap on the pixel's side: plain bilinear weights
+};
+
+Taps joint_taps(vec2 rel, ivec2 used, float is_virtual) {
+  vec2 ipos = rel * vec2(used) - 0.5f;
+  ivec2 i0 = ivec2(floor(ipos));
+  vec2 f = ipos - vec2(i0);
+  Taps t;
+  t.a = clamp(i0, ivec2(0), used - 1);
+  t.b = clamp(i0 + 1, ivec2(0), used - 1);
+  vec4 bilinear = vec4((1.0f - f.x) * (1.0f - f.y), f.x * (1.0f - f.y), (1.0f - f.x) * f.y, f.x * f.y);
+  vec4 side = vec4(imageLoad(virtual_position, ivec2(t.a.x, t.a.y)).w > 0.5f ? 1.0f : 0.0f,
+                   imageLoad(virtual_position, ivec2(t.b.x, t.a.y)).w > 0.5f ? 1.0f : 0.0f,
+                   imageLoad(virtual_position, ivec2(t.a.x, t.b.y)).w > 0.5f ? 1.0f : 0.0f,
+                   imageLoad(virtual_position, ivec2(t.b.x, t.b.y)).w > 0.5f ? 1.0f : 0.0f);
+  vec4 w = bilinear * (vec4(1.0f) - abs(side - vec4(is_virtual)));
+  float sum = w.x + w.y + w.z + w.w;
+  t.no_side = !(sum > 0.0f);
+  t.w = t.no_side ? bilinear : w / sum;
+  return t;
+}
+
 // (A macro: GLSL image parameters cannot carry the format qualifier imageLoad needs.)
 #define SOLUTION_AT(NAME, S)                                                                  \
-  vec3 NAME(vec2 rel, ivec2 used, ivec2 pixel) {                                             \
+  vec3 NAME(Taps t, ivec2 pixel) {                                                           \
     if (kSameInternal) return finite3(imageLoad(S, pixel).rgb);                               \
-    vec2 ipos = rel * vec2(used) - 0.5f;                                                     \
-    ivec2 i0 = ivec2(floor(ipos));                                                           \
-    vec2 w = ipos - vec2(i0);                                                                \
-    ivec2 a = clamp(i0, ivec2(0), used - 1), b = clamp(i0 + 1, ivec2(0), used - 1);          \
-    return mix(mix(finite3(imageLoad(S, ivec2(a.x, a.y)).rgb),                                \
-                   finite3(imageLoad(S, ivec2(b.x, a.y)).rgb), w.x),                          \
-               mix(finite3(imageLoad(S, ivec2(a.x, b.y)).rgb),                                \
-                   finite3(imageLoad(S, ivec2(b.x, b.y)).rgb), w.x), w.y);                    \
+    return finite3(imageLoad(S, ivec2(t.a.x, t.a.y)).rgb) * t.w.x +                           \
+           finite3(imageLoad(S, ivec2(t.b.x, t.a.y)).rgb) * t.w.y +                           \
+           finite3(imageLoad(S, ivec2(t.a.x, t.b.y)).rgb) * t.w.z +                           \
+           finite3(imageLoad(S, ivec2(t.b.x, t.b.y)).rgb) * t.w.w;                            \
   }
 SOLUTION_AT(solution_rv, lit_rv)
 SOLUTION_AT(solution_r, lit_r)
@@ -110,10 +139,19 @@ void main() {
     return;
   }
   ivec2 used = frame.internal_output_size.xy;
-  vec3 rv = solution_rv(rel, used, pixel);
-  vec3 r = solution_r(rel, used, pixel);
-  ivec2 ip = kSameInternal ? pixel : min(ivec2(rel * vec2(used)), used - 1);
-  float is_virtual = imageLoad(virtual_position, ip).w > 0.5f ? 1.0f : 0.0f;
+  float is_virtual;
+  Taps taps;
+  if (kSameInternal) {
+    is_virtual = imageLoad(virtual_position, pixel).w > 0.5f ? 1.0f : 0.0f;
+  } else {
+    is_virtual = imageLoad(virtual_coverage, pixel).r > 0.5f ? 1.0f : 0.0f;
+    taps = joint_taps(rel, used, is_virtual);
+  }
+  vec3 rv = solution_rv(taps, pixel);
+  vec3 r = solution_r(taps, pixel);
+  // A real pixel among virtual texels only (a gap in an object thinner than a texel): nothing
+  // says how its light changes, so it keeps the camera's.
+  if (!kSameInternal && taps.no_side && is_virtual < 0.5f) rv = r;
   vec3 encoded = compose_encoded(camera_at(rel, pixel), r, rv, is_virtual, frame.camera.y,
                                  params.compose.x, params.compose.y);
   out_rgba8[index] = pack_output_word(encoded, is_virtual > 0.5f);

@@ -1,7 +1,8 @@
 #version 460
 // Compose's own tile list, for techniques that list none (Technique::compose_tiles): the 8 x 8
 // output tiles whose composite can differ visibly from the camera frame. One invocation per
-// solution texel (internal resolution, used extent); a texel that is virtual, or whose two
+// solution texel (internal resolution, used extent); a texel that is virtual (or holds the centre
+// of an output pixel the output-resolution coverage marks virtual), or whose two
 // solutions differ by more than compose_tile_invisible allows, marks every output tile whose
 // pixels read it (compose.comp: the bilinear taps floor(ipos), floor(ipos) + 1 with
 // ipos = (p + 0.5) * used / out - 0.5, and the nearest texel for the virtual mask), and the first
@@ -25,6 +26,9 @@ layout(set = 0, binding = 3, rgba32f) readonly uniform image2D virtual_position;
 // words 0..3: VkDispatchIndirectCommand (x, y, z) and a pad; then one flag per output tile.
 layout(std430, set = 0, binding = 4) coherent buffer TileState { uint words[]; };
 layout(std430, set = 0, binding = 5) writeonly buffer TileList { uint list[]; };
+// The coverage at the output resolution where the solutions are smaller (compose.comp's mask
+// there): an object thinner than a texel covers output pixels no texel centre of it falls in.
+layout(set = 0, binding = 6, r8) readonly uniform image2D virtual_coverage;
 struct ClassifyConstants {
   vec4 compose;  // x eps, y alpha_max (ComposeSettings), z tolerance (8-bit levels)
 };
@@ -44,6 +48,13 @@ void main() {
   ivec2 out_size = frame.internal_output_size.zw;
   if (any(greaterThanEqual(texel, used))) return;
   bool shows = imageLoad(virtual_position, texel).w > 0.5f;
+  vec2 s = vec2(out_size) / vec2(used);
+  if (!shows && used != out_size) {
+    // The output pixels whose centre falls in this texel: (p + 0.5) / s in [texel, texel + 1).
+    ivec2 q0 = ivec2(ceil(vec2(texel) * s - 0.5f)), q1 = min(ivec2(ceil(vec2(texel + 1) * s - 0.5f)), out_size);
+    for (int y = q0.y; y < q1.y && !shows; ++y)
+      for (int x = q0.x; x < q1.x; ++x) shows = shows || imageLoad(virtual_coverage, ivec2(x, y)).r > 0.5f;
+  }
   if (!shows) {
     float exposure = frame.camera.y;
     vec3 rv = clamp(finite3(imageLoad(lit_rv, texel).rgb) * exposure, vec3(0.0f), vec3(1.0f));
@@ -56,7 +67,6 @@ void main() {
   // pixel each way so rounding never loses one. At the output's own size only p = texel.
   ivec2 p0 = texel, p1 = texel;
   if (used != out_size) {
-    vec2 s = vec2(out_size) / vec2(used);
     p0 = max(ivec2(floor((vec2(texel) - 0.5f) * s - 0.5f)) - 1, ivec2(0));
     p1 = min(ivec2(ceil((vec2(texel) + 1.5f) * s - 0.5f)) + 1, out_size - 1);
   }

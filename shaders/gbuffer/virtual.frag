@@ -5,11 +5,12 @@
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
 #include "common/frame_constants.glsl"
+#include "gbuffer/hidden_by_real.glsl"
 
 layout(set = 0, binding = 2) uniform sampler2D real_position;         // xyz world, w depth
 layout(set = 0, binding = 3) uniform sampler2DArray base_color_maps;  // sRGB, decoded on fetch
                                                                       // (emissive maps too)
-layout(set = 0, binding = 4) uniform sampler2D real_normal;           // xyz world (step > 1)
+layout(set = 0, binding = 4) uniform sampler2D real_normal;           // xyz world (coarse texels)
 // Bindings 0 (frame constants), 1 (materials) and the push constants are read by virtual.vert,
 // which says why, and arrive as the flat inputs below.
 layout(location = 0) in vec3 in_world;
@@ -17,13 +18,13 @@ layout(location = 1) in vec3 in_normal;
 layout(location = 2) in vec2 in_uv;
 layout(location = 3) in float in_view_z;
 layout(location = 4) flat in vec4 in_base_color;
-layout(location = 5) flat in vec4 in_material;  // x metallic, y roughness, z base-colour layer,
-                                                // w real_step
+layout(location = 5) flat in vec4 in_material;  // x metallic, y roughness, z base-colour layer
 layout(location = 6) flat in vec4 in_emission;
 layout(location = 7) flat in vec4 in_k;
 layout(location = 8) flat in vec4 in_camera;    // xyz camera centre (world), w behind-real tolerance
 layout(location = 9) flat in mat3x4 in_to_camera;
 layout(location = 12) flat in float in_coverage;  // 1, or 2 + material of a specular one
+layout(location = 13) flat in vec2 in_real_scale; // real texels per pixel (x, y)
 layout(location = 0) out vec4 out_position;  // xyz world, w coverage: 1, or 2 + the material index
                                              // of a reflective or refractive material (readers
                                              // test w > 0.5 for virtual, w > 1.5 for specular)
@@ -32,23 +33,9 @@ layout(location = 2) out vec4 out_albedo;    // rgb linear base colour, w metall
 layout(location = 3) out vec4 out_emission;  // rgb emitted radiance (glTF emissive), w 0
 
 void main() {
-  ivec2 pixel = ivec2(gl_FragCoord.xy);
-  int real_step = int(in_material.w);
-  ivec2 texel = pixel / real_step;
-  vec4 real = texelFetch(real_position, texel, 0);
-  if (real_step > 1 && real.w > 0.0f) {
-    // A coarse texel: the depth of its tangent plane on this pixel's ray (exact on planes, so a
-    // virtual object resting on a sloped real surface is not cut by the texel-centre depth).
-    mat4 world_to_camera = mat4(transpose(in_to_camera));
-    world_to_camera[3][3] = 1.0f;
-    vec3 ray = unproject_pinhole(vec2(pixel), 1.0f, in_k);
-    vec3 p = (world_to_camera * vec4(real.xyz, 1.0f)).xyz;
-    vec3 n = mat3(world_to_camera) * texelFetch(real_normal, texel, 0).xyz;
-    real.w = tangent_plane_depth(ray, p, n, MRGI_DEPTH_EDGE_RELATIVE);
-  }
-  // Hidden when a valid real surface is in front by more than the tolerance (a fraction of
-  // the depth: sensor noise grows with distance; objects resting on a real surface stay seen).
-  if (real.w > 0.0f && real.w < in_view_z * (1.0f - in_camera.w)) discard;
+  if (hidden_by_real(real_position, real_normal, ivec2(gl_FragCoord.xy), in_k, in_to_camera, in_view_z,
+                     in_real_scale, in_camera.w))
+    discard;
 
   vec4 base = in_base_color;
   if (in_material.z >= 0.0f) base *= texture(base_color_maps, vec3(in_uv, in_material.z));

@@ -52,6 +52,14 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
   auto no_tiles = graph.create_buffer({"compose_no_tiles", 16}, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (!no_tiles) return no_tiles.error();
   c.no_tiles_ = *no_tiles;
+  gpu::ImageDesc none;
+  none.name = "compose_no_coverage";
+  none.format = VK_FORMAT_R8_UNORM;
+  none.size_mode = gpu::SizeMode::Absolute;
+  none.width = none.height = 1;
+  auto no_coverage = graph.create_image(none, VK_IMAGE_USAGE_STORAGE_BIT);
+  if (!no_coverage) return no_coverage.error();
+  c.no_coverage_ = *no_coverage;
   for (const auto& v : variants) {
     // Bindings and push constants from the shader (the passes bind by name).
     gpu::ComputePipelineDesc d{v.name, *spv, {}, 0,
@@ -95,6 +103,7 @@ void Compose::record_classify(gpu::FrameGraph& graph) {
         b.bind("lit_rv", in_.lit_rv);
         b.bind("lit_r", in_.lit_r);
         b.bind("virtual_position", in_.virtual_position);
+        b.bind("virtual_coverage", in_.virtual_coverage.valid() ? in_.virtual_coverage : no_coverage_);
         b.bind("TileState", classify_state_);
         b.bind("TileList", classify_list_);
       },
@@ -108,7 +117,7 @@ void Compose::record_classify(gpu::FrameGraph& graph) {
   in_.tiles_composed = false;
 }
 
-void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
+Status Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
   in_ = inputs;
   const bool listed = in_.tile_args.valid() && in_.tile_list.valid();
   if (!in_.camera_only && !listed && classify_state_.valid()) record_classify(graph);
@@ -124,6 +133,7 @@ void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
     b.bind("lit_rv", in_.lit_rv);
     b.bind("lit_r", in_.lit_r);
     b.bind("virtual_position", in_.virtual_position);
+    b.bind("virtual_coverage", in_.virtual_coverage.valid() ? in_.virtual_coverage : no_coverage_);
   };
   if (tiled_ && !host_camera) {
     // The camera frame everywhere, then the composite over the technique's tiles.
@@ -140,6 +150,14 @@ void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
   if (!composed) {
     const VkExtent2D used = graph.extent(in_.lit_r);
     const bool same_internal = used.width == width_ && used.height == height_;
+    if (!same_internal && !in_.camera_only && !in_.virtual_coverage.valid()) {
+      // The runtime passes the coverage at every reduced scale: without it the mask would be
+      // read from a 1x1 placeholder. Composite from the internal mask is not a fallback here.
+      return fail(ErrorKind::Internal,
+                  "compose: the solutions are " + std::to_string(used.width) + "x" + std::to_string(used.height) +
+                      ", the output " + std::to_string(width_) + "x" + std::to_string(height_) +
+                      ": the output-resolution coverage (ComposeInputs::virtual_coverage) is required");
+    }
     const gpu::Pipeline* pipe = tiled_                         ? (same_internal ? &*tiled_pipeline_ : &*tiled_scaled_pipeline_)
                                 : in_.camera_only              ? &*camera_pipeline_
                                 : same_internal                ? &*same_internal_pipeline_
@@ -165,7 +183,7 @@ void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
         [this, pipe](VkCommandBuffer cmd, gpu::PassContext& pass) { dispatch(cmd, pass, *pipe, tiled_); });
   }
   graph.mark_output(output_);
-  if (!host_camera) return;
+  if (!host_camera) return ok_status();
   // A technique's list may be smaller than this output's tile count (it lists only its used
   // extent's tiles); the count in args never exceeds what it holds.
   list_bytes_ = std::min<VkDeviceSize>(VkDeviceSize(max_tiles_) * 4,
@@ -184,6 +202,7 @@ void Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
         vkCmdCopyBuffer(cmd, pass.buffer(in_.tile_list), pass.buffer(tile_readback_), 1, &list);
       });
   graph.mark_output(tile_readback_);
+  return ok_status();
 }
 
 // tiled_pass: the composite over the listed tiles (their count in tile_args); otherwise every

@@ -1,7 +1,8 @@
 // Compose (docs/DESIGN.md "One frame, as data"): tone-maps L_rv and L_r with the camera's response and
 // adds their difference onto the camera frame per caustics-DIR eq. 1-2 (shaders/compose/
-// compose.comp says how and why in linear space), at the output resolution (the solutions are
-// upsampled bilinearly when the internal resolution is lower). Writes the RGBA8 sRGB frame with
+// compose.comp says how and why in linear space), at the output resolution (where the internal
+// resolution is lower, the mask is the output-resolution coverage and the solutions are
+// up-sampled from the texels on each pixel's side of it). Writes the RGBA8 sRGB frame with
 // the virtual-pixel mask in its alpha straight into this slot's readback buffer. A tiled frame at the
 // camera's size writes only the listed tiles there, with a copy of the tile list: read() takes
 // the camera frame from the upload on the host and lays the tiles over it (0.3 ms of host time
@@ -50,6 +51,10 @@ struct ComposeInputs {
   // readback, and lays the tiles over the camera frame on the host. Honoured only for a frame
   // at the camera's size whose solutions have the output's size (fusable()).
   bool tiles_composed = false;
+  // The virtual objects' coverage at the output resolution (recon::VirtualGBuffer::
+  // output_coverage), required where the solutions are smaller than the output: the mask and
+  // silhouettes at the output's pixels, and the side of it each pixel up-samples from.
+  gpu::ImageHandle virtual_coverage;
 };
 
 // `image` at w x h, reusing its storage when it already has that size (Runtime::recycle: no
@@ -73,7 +78,7 @@ class Compose {
                                   const ComposeSettings& settings = {});
   // Adds the pass "compose" (tiled at the camera's size: and "compose_tile_readback"; tiled at
   // another size: and "compose_camera" before it) and marks the readback buffers as outputs.
-  void record(gpu::FrameGraph& graph, const ComposeInputs& inputs);
+  Status record(gpu::FrameGraph& graph, const ComposeInputs& inputs);
   // Copies slot `slot`'s results (after its frame completed) into `image` and `mask`
   // (resized to the output size; non-zero mask = virtual pixel).
   Status read(const gpu::FrameGraph& graph, uint32_t slot, ImageRGBA8& image,
@@ -104,6 +109,7 @@ class Compose {
   gpu::PipelineHandle classify_pipeline_;
   gpu::BufferHandle classify_state_, classify_list_;
   gpu::BufferHandle no_tiles_;  // bound as the tile list when there is none (never read)
+  gpu::ImageHandle no_coverage_;  // 1x1, bound as virtual_coverage at the output's size (never read)
   bool tiled_ = false;          // this frame: camera copy + composite over the listed tiles
   bool same_size_as_camera_ = false;
   uint32_t max_tiles_ = 0;

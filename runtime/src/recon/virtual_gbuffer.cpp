@@ -15,14 +15,31 @@ constexpr VkFormat kNormalFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kAlbedoFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kEmissionFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
+constexpr VkFormat kCoverageFormat = VK_FORMAT_R8_UNORM;
 
+// virtual_vertex.glsl's push constant after the material index (which SceneGpu::draw pushes per
+// draw at offset 0): texels of the real geometry per raster pixel (x, y), at offset 8.
+constexpr uint32_t kRealScaleOffset = 8;
+
+// internal: at the internal resolution (follows the render scale), else at the output's.
 Expected<gpu::ImageHandle> gbuffer_image(gpu::FrameGraph& graph, const char* name, VkFormat format,
-                                          VkImageUsageFlags usage) {
+                                          VkImageUsageFlags usage, bool internal = true) {
   gpu::ImageDesc d;
   d.name = name;
   d.format = format;
   d.size_mode = gpu::SizeMode::OutputRelative;
+  d.follows_render_scale = internal;
   return graph.create_image(d, usage);
+}
+
+VkRenderingAttachmentInfo cleared_color(VkImageView view, VkImageLayout layout) {
+  VkRenderingAttachmentInfo a{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+  a.imageView = view;
+  a.imageLayout = layout;
+  a.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+  a.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+  a.clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
+  return a;
 }
 
 }  // namespace
@@ -54,6 +71,9 @@ Expected<VirtualGBuffer> VirtualGBuffer::create(gpu::Context& context, gpu::Fram
   auto d = gbuffer_image(graph, "virtual_depth", kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
   if (!d) return d.error();
   v.depth_ = *d;
+  auto c = gbuffer_image(graph, "virtual_coverage", kCoverageFormat, color, false);
+  if (!c) return c.error();
+  v.coverage_ = *c;
   v.color_layout_ =
       gpu::access_info(gpu::PassKind::Graphics, gpu::Access::ColorAttachmentWrite, true, false).layout;
   v.depth_layout_ =
@@ -93,6 +113,28 @@ Expected<VirtualGBuffer> VirtualGBuffer::create(gpu::Context& context, gpu::Fram
   auto two_sided = gpu::create_graphics_pipeline(context, desc);
   if (!two_sided) return two_sided.error();
   v.double_sided_pipeline_ = gpu::PipelineHandle(context, std::move(*two_sided));
+
+  // The output coverage: the same vertices and culling, one R8 target, no depth (any object
+  // covering a pixel covers it).
+  auto cvs = gpu::shader_spirv("gbuffer/virtual_coverage.vert");
+  if (!cvs) return cvs.error();
+  auto cfs = gpu::shader_spirv("gbuffer/virtual_coverage.frag");
+  if (!cfs) return cfs.error();
+  desc.name = "virtual_coverage";
+  desc.vertex_spirv = *cvs;
+  desc.fragment_spirv = *cfs;
+  desc.color_formats = {kCoverageFormat};
+  desc.depth_format = VK_FORMAT_UNDEFINED;
+  desc.depth_compare = VK_COMPARE_OP_ALWAYS;
+  desc.cull_mode = VK_CULL_MODE_BACK_BIT;
+  auto cov = gpu::create_graphics_pipeline(context, desc);
+  if (!cov) return cov.error();
+  v.coverage_pipeline_ = gpu::PipelineHandle(context, std::move(*cov));
+  desc.name = "virtual_coverage_double_sided";
+  desc.cull_mode = VK_CULL_MODE_NONE;
+  auto cov2 = gpu::create_graphics_pipeline(context, desc);
+  if (!cov2) return cov2.error();
+  v.coverage_double_sided_pipeline_ = gpu::PipelineHandle(context, std::move(*cov2));
   return v;
 }
 
@@ -106,7 +148,7 @@ void VirtualGBuffer::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_cons
   lod_.camera_world = glm::vec3(fc.camera_world);
   lod_.focal_px = fc.internal_k.x;
   lod_.max_error_px = mesh_error_px;
-  area_ = projected_area(graph.extent(position_), fc);
+  update_area(area_, graph.extent(position_), fc);
   const VkSampler nearest = graph.context().samplers().nearest_clamp;
   const VkSampler linear = graph.context().samplers().linear_repeat;
   graph.add_shader_pass(
@@ -127,12 +169,36 @@ void VirtualGBuffer::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_cons
         u.write(depth_, gpu::Access::DepthAttachmentWrite);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) { draw(cmd, pass); });
+  const VkExtent2D internal = graph.extent(position_), output = graph.extent(coverage_);
+  coverage_recorded_ = internal.width != output.width || internal.height != output.height;
+  if (!coverage_recorded_) {
+    coverage_area_.previous_extent = {0, 0};  // the next coverage frame clears all of it
+    return;
+  }
+  update_area(coverage_area_, output, fc);
+  record_coverage(graph);
 }
 
-VkRect2D VirtualGBuffer::projected_area(VkExtent2D e, const shader::FrameConstants& fc) {
+void VirtualGBuffer::record_coverage(gpu::FrameGraph& graph) {
+  const VkSampler nearest = graph.context().samplers().nearest_clamp;
+  graph.add_shader_pass(
+      "virtual_coverage", gpu::PassKind::Graphics, *coverage_pipeline_,
+      [this, nearest](gpu::ShaderPassBuilder& b) {
+        b.bind("FrameUbo", frame_constants_);
+        b.bind_sampled("real_position", real_.position, nearest);
+        b.bind_sampled("real_normal", real_.normal, nearest);
+        gpu::PassBuilder& u = b.uses();
+        u.read(scene_->virtual_objects.vertices, gpu::Access::VertexBuffer);
+        u.read(scene_->virtual_objects.indices, gpu::Access::IndexBuffer);
+        u.write(coverage_, gpu::Access::ColorAttachmentWrite);
+      },
+      [this](VkCommandBuffer cmd, gpu::PassContext& pass) { draw_coverage(cmd, pass); });
+}
+
+void VirtualGBuffer::update_area(RasterArea& a, VkExtent2D e, const shader::FrameConstants& fc) const {
   const VkRect2D full{{0, 0}, e};
-  const bool same_size = e.width == previous_extent_.width && e.height == previous_extent_.height;
-  previous_extent_ = e;
+  const bool same_size = e.width == a.previous_extent.width && e.height == a.previous_extent.height;
+  a.previous_extent = e;
   VkRect2D now{{0, 0}, {0, 0}};  // empty: no object
   if (!scene_->virtual_objects.empty()) {
     glm::vec2 lo(1e30f), hi(-1e30f);
@@ -156,7 +222,7 @@ VkRect2D VirtualGBuffer::projected_area(VkExtent2D e, const shader::FrameConstan
     const int y1 = int(std::clamp(std::ceil(hi.y) + 1.0f, 0.0f, float(e.height)));
     if (x1 > x0 && y1 > y0) now = {{x0, y0}, {uint32_t(x1 - x0), uint32_t(y1 - y0)}};
   }
-  VkRect2D area = same_size ? previous_ : full;
+  VkRect2D area = same_size ? a.previous : full;
   if (same_size && now.extent.width > 0) {
     if (area.extent.width == 0) {
       area = now;
@@ -167,10 +233,10 @@ VkRect2D VirtualGBuffer::projected_area(VkExtent2D e, const shader::FrameConstan
       area = {{x0, y0}, {uint32_t(x1 - x0), uint32_t(y1 - y0)}};
     }
   }
-  previous_ = now;
+  a.previous = now;
   // Vulkan needs a non-empty render area; a 1x1 clear of texel (0, 0) keeps it cleared.
   if (area.extent.width == 0 || area.extent.height == 0) area = {{0, 0}, {1, 1}};
-  return area;
+  a.now = area;
 }
 
 void VirtualGBuffer::draw(VkCommandBuffer cmd, gpu::PassContext& pass) {
@@ -178,14 +244,7 @@ void VirtualGBuffer::draw(VkCommandBuffer cmd, gpu::PassContext& pass) {
   VkRenderingAttachmentInfo colors[4];
   const gpu::ImageHandle targets[4] = {position_, normal_, albedo_, emission_};
   const uint32_t count = emission_.valid() ? 4 : 3;
-  for (uint32_t i = 0; i < count; ++i) {
-    colors[i] = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-    colors[i].imageView = pass.view(targets[i]);
-    colors[i].imageLayout = color_layout_;
-    colors[i].loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-    colors[i].storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-    colors[i].clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
-  }
+  for (uint32_t i = 0; i < count; ++i) colors[i] = cleared_color(pass.view(targets[i]), color_layout_);
   VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
   depth.imageView = pass.view(depth_);
   depth.imageLayout = depth_layout_;
@@ -193,7 +252,7 @@ void VirtualGBuffer::draw(VkCommandBuffer cmd, gpu::PassContext& pass) {
   depth.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
   depth.clearValue.depthStencil = {1.0f, 0};
   VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
-  ri.renderArea = area_;
+  ri.renderArea = area_.now;
   ri.layerCount = 1;
   ri.colorAttachmentCount = count;
   ri.pColorAttachments = colors;
@@ -201,13 +260,39 @@ void VirtualGBuffer::draw(VkCommandBuffer cmd, gpu::PassContext& pass) {
   pass.context().fn().cmd_begin_rendering(cmd, &ri);
   if (!scene_->virtual_objects.empty()) {
     const VkViewport vp{0.0f, 0.0f, float(e.width), float(e.height), 0.0f, 1.0f};
-    const VkRect2D sc = area_;
+    const VkRect2D sc = area_.now;
     vkCmdSetViewport(cmd, 0, 1, &vp);
     vkCmdSetScissor(cmd, 0, 1, &sc);
-    const int32_t step = int32_t(real_.step);
-    vkCmdPushConstants(cmd, pipeline_->layout, pipeline_->stages, sizeof(int32_t), sizeof(step),
-                       &step);
+    const float per_pixel = 1.0f / float(std::max<uint32_t>(real_.step, 1));
+    const glm::vec2 push(per_pixel);
+    vkCmdPushConstants(cmd, pipeline_->layout, pipeline_->stages, kRealScaleOffset, sizeof(push), &push);
     scene_->virtual_objects.draw(cmd, pass, &*pipeline_, &*double_sided_pipeline_, &lod_);
+  }
+  pass.context().fn().cmd_end_rendering(cmd);
+}
+
+void VirtualGBuffer::draw_coverage(VkCommandBuffer cmd, gpu::PassContext& pass) {
+  const VkExtent2D e = pass.extent(coverage_), internal = pass.extent(position_);
+  VkRenderingAttachmentInfo color = cleared_color(pass.view(coverage_), color_layout_);
+  VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+  ri.renderArea = coverage_area_.now;
+  ri.layerCount = 1;
+  ri.colorAttachmentCount = 1;
+  ri.pColorAttachments = &color;
+  pass.context().fn().cmd_begin_rendering(cmd, &ri);
+  if (!scene_->virtual_objects.empty()) {
+    const VkViewport vp{0.0f, 0.0f, float(e.width), float(e.height), 0.0f, 1.0f};
+    const VkRect2D sc = coverage_area_.now;
+    vkCmdSetViewport(cmd, 0, 1, &vp);
+    vkCmdSetScissor(cmd, 0, 1, &sc);
+    // An output pixel's centre in internal pixels, then in real texels (step internal pixels
+    // each): (p + 0.5) * internal / (output * step).
+    const float step = float(std::max<uint32_t>(real_.step, 1));
+    const glm::vec2 push(float(internal.width) / (float(e.width) * step),
+                         float(internal.height) / (float(e.height) * step));
+    vkCmdPushConstants(cmd, coverage_pipeline_->layout, coverage_pipeline_->stages, kRealScaleOffset,
+                       sizeof(push), &push);
+    scene_->virtual_objects.draw(cmd, pass, &*coverage_pipeline_, &*coverage_double_sided_pipeline_, &lod_);
   }
   pass.context().fn().cmd_end_rendering(cmd);
 }

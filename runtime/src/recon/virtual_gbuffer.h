@@ -6,6 +6,11 @@
 // real/virtual mask), virtual_normal (RGBA16F: xyz, w roughness), virtual_albedo (RGBA16F:
 // linear base colour, w metallic), virtual_emission (RGBA16F: emitted radiance, glTF emissive),
 // virtual_depth (D32, for the virtual objects among themselves).
+// At an internal resolution below the output's it also rasterises the objects' coverage at the
+// output resolution (virtual_coverage, R8: 1 where one is seen), with the same occlusion test by
+// the real geometry (shaders/gbuffer/hidden_by_real.glsl), so the mask and the silhouettes the
+// user sees come at the output's pixels whatever the internal scale (compose up-samples the
+// lighting from the texels on the same side of it).
 #pragma once
 #include "gpu/frame_graph.h"
 #include "gpu/pipelines.h"
@@ -19,7 +24,8 @@ class VirtualGBuffer {
  public:
   static Expected<VirtualGBuffer> create(gpu::Context& context, gpu::FrameGraph& graph,
                                          const frame::SceneGpu& scene);
-  // Adds the pass "virtual_gbuffer" (always: with no object it clears the mask).
+  // Adds the pass "virtual_gbuffer" (always: with no object it clears the mask) and, when the
+  // internal resolution is below the output's, "virtual_coverage".
   // Mesh ranges are drawn at the coarsest level of detail within `mesh_error_px` projected
   // internal pixels (QualityLevel::mesh_error_px; 0 = full detail).
   void record(gpu::FrameGraph& graph, gpu::BufferHandle frame_constants,
@@ -30,11 +36,25 @@ class VirtualGBuffer {
   gpu::ImageHandle albedo() const { return albedo_; }
   // Invalid when no virtual material emits (the target is then not allocated or drawn).
   gpu::ImageHandle emission() const { return emission_; }
+  // This frame's coverage at the output resolution; invalid when the G-buffer has the output's
+  // size (position()'s w is then the mask at the output's pixels).
+  gpu::ImageHandle output_coverage() const { return coverage_recorded_ ? coverage_ : gpu::ImageHandle{}; }
 
  private:
+  // The area a raster draws and clears this frame: the virtual objects' projected bounds united
+  // with the previous frame's (so what that frame drew is cleared), the whole image on the first
+  // frame, after a size change or when a bound's corner is behind the camera. Outside it every
+  // texel is still the clear value, so readers see an empty target there as before. Why: the
+  // four full-screen clears cost 1.4 ms of the G-buffer pass on lavapipe at 640x480.
+  struct RasterArea {
+    VkRect2D now{{0, 0}, {0, 0}}, previous{{0, 0}, {0, 0}};
+    VkExtent2D previous_extent{0, 0};
+  };
   void draw(VkCommandBuffer cmd, gpu::PassContext& pass);
-  // This frame's area_ (see there); updates previous_ and previous_extent_.
-  VkRect2D projected_area(VkExtent2D extent, const shader::FrameConstants& fc);
+  void draw_coverage(VkCommandBuffer cmd, gpu::PassContext& pass);
+  void record_coverage(gpu::FrameGraph& graph);
+  // Sets `a.now` for a raster of `extent` from this frame's constants; updates its history.
+  void update_area(RasterArea& a, VkExtent2D extent, const shader::FrameConstants& fc) const;
 
   const frame::SceneGpu* scene_ = nullptr;
   gpu::BufferHandle frame_constants_;
@@ -43,15 +63,12 @@ class VirtualGBuffer {
   // bunny, a few pixels per triangle at 640x480, cost 8.5 ms of this pass's 10; a quarter of
   // the triangles 1.7 ms).
   frame::LodView lod_;
-  // The area drawn and cleared this frame: the virtual objects' projected bounds united with
-  // the previous frame's (so what that frame drew is cleared), the whole image on the first
-  // frame, after a size change or when a bound's corner is behind the camera. Outside it every
-  // texel is still the clear value, so readers see an empty G-buffer there as before. Why: the
-  // four full-screen clears cost 1.4 ms of the pass on lavapipe at 640x480.
-  VkRect2D area_{{0, 0}, {0, 0}}, previous_{{0, 0}, {0, 0}};
-  VkExtent2D previous_extent_{0, 0};
+  RasterArea area_, coverage_area_;  // the G-buffer's, the output coverage's
   gpu::ImageHandle position_, normal_, albedo_, emission_, depth_;
+  gpu::ImageHandle coverage_;    // R8 at the output resolution
+  bool coverage_recorded_ = false;  // this frame
   gpu::PipelineHandle pipeline_, double_sided_pipeline_;  // back faces culled; both sides
+  gpu::PipelineHandle coverage_pipeline_, coverage_double_sided_pipeline_;
   VkImageLayout color_layout_ = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
   VkImageLayout depth_layout_ = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
 };

@@ -14,12 +14,14 @@
 //                     positions of its neighbours
 //   light             the light stage (host work: lamps, environment, estimate)
 //   technique geometry  a technique's own real geometry (ssrt), for the virtual depth test
-//   virtual G-buffer  raster of the virtual objects (3.9 / 5.4)
+//   virtual G-buffer  raster of the virtual objects (3.9 / 5.4); below the output's size also
+//                     their coverage at the output resolution (virtual_coverage), so the mask
+//                     and silhouettes compose shows are the output's, not stretched texels
 //   specular prepare  mirrors' and glass's impostors, back faces and caustic photons
 //   technique         its own passes (baseline: the direct-light block's caster mesh, shadow
 //                     maps and shading)
 //   specular finish   the mirrors' and glass's pixels over the technique's solutions
-//   compose           the only output-resolution pass (6.0 with the composite): it writes the
+//   compose           the output-resolution pass (6.0 with the composite): it writes the
 //                     frame the user sees
 // A frame nothing virtual affects runs no pass at all when the output has the camera's size:
 // upload and a host conversion of the camera frame (below 1 floor pass); at another size
@@ -153,8 +155,8 @@ Status RuntimeImpl::record_compose(FrameContext& f) {
       f.rec.skipped.push_back("compose tiles: caustics may light pixels outside them, every pixel composed");
     }
   }
-  compose_->record(*graph_, ci);
-  return ok_status();
+  if (f.affected) ci.virtual_coverage = virtual_gbuffer_->output_coverage();
+  return compose_->record(*graph_, ci);
 }
 
 }  // namespace mrgi::runtime_detail
