@@ -31,6 +31,10 @@ layout(std430, set = 0, binding = 5) writeonly buffer TileList { uint list[]; };
 layout(set = 0, binding = 6, r8) readonly uniform image2D virtual_coverage;
 struct ClassifyConstants {
   vec4 compose;  // x eps, y alpha_max (ComposeSettings), z tolerance (8-bit levels)
+  // The output pixels the coverage raster drew this frame (x0, y0, x1, y1: [x0, x1) x [y0, y1),
+  // VirtualGBuffer::output_coverage_area): outside it no pixel is covered, so texels there skip
+  // the footprint test. Empty at the output's own size.
+  ivec4 coverage_area;
 };
 layout(push_constant) uniform Classify { ClassifyConstants classify_block; };
 ClassifyConstants classify;
@@ -50,8 +54,10 @@ void main() {
   bool shows = imageLoad(virtual_position, texel).w > 0.5f;
   vec2 s = vec2(out_size) / vec2(used);
   if (!shows && used != out_size) {
-    // The output pixels whose centre falls in this texel: (p + 0.5) / s in [texel, texel + 1).
-    ivec2 q0 = ivec2(ceil(vec2(texel) * s - 0.5f)), q1 = min(ivec2(ceil(vec2(texel + 1) * s - 0.5f)), out_size);
+    // The output pixels whose centre falls in this texel: (p + 0.5) / s in [texel, texel + 1),
+    // within the area the coverage raster drew.
+    ivec2 q0 = max(ivec2(ceil(vec2(texel) * s - 0.5f)), classify.coverage_area.xy);
+    ivec2 q1 = min(ivec2(ceil(vec2(texel + 1) * s - 0.5f)), classify.coverage_area.zw);
     for (int y = q0.y; y < q1.y && !shows; ++y)
       for (int x = q0.x; x < q1.x; ++x) shows = shows || imageLoad(virtual_coverage, ivec2(x, y)).r > 0.5f;
   }

@@ -109,7 +109,13 @@ void Compose::record_classify(gpu::FrameGraph& graph) {
       },
       [this, pipe](VkCommandBuffer cmd, gpu::PassContext& pass) {
         const VkExtent2D used = pass.extent(in_.lit_r);
-        const glm::vec4 push(settings_.eps, settings_.alpha_max, settings_.tile_tolerance, 0.0f);
+        struct {
+          glm::vec4 compose;
+          glm::ivec4 coverage_area;
+        } push{{settings_.eps, settings_.alpha_max, settings_.tile_tolerance, 0.0f},
+               {in_.coverage_area.offset.x, in_.coverage_area.offset.y,
+                in_.coverage_area.offset.x + int(in_.coverage_area.extent.width),
+                in_.coverage_area.offset.y + int(in_.coverage_area.extent.height)}};
         gpu::push_and_dispatch(cmd, *pipe, &push, sizeof push, {(used.width + 7) / 8, (used.height + 7) / 8, 1});
       });
   in_.tile_args = classify_state_;

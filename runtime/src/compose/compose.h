@@ -55,6 +55,9 @@ struct ComposeInputs {
   // output_coverage), required where the solutions are smaller than the output: the mask and
   // silhouettes at the output's pixels, and the side of it each pixel up-samples from.
   gpu::ImageHandle virtual_coverage;
+  // The output pixels that raster drew and cleared this frame (VirtualGBuffer::
+  // output_coverage_area): the coverage is 0 outside it.
+  VkRect2D coverage_area{{0, 0}, {0, 0}};
 };
 
 // `image` at w x h, reusing its storage when it already has that size (Runtime::recycle: no

@@ -16,6 +16,9 @@ constexpr VkFormat kAlbedoFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kEmissionFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 constexpr VkFormat kCoverageFormat = VK_FORMAT_R8_UNORM;
+// The output coverage's largest projected mesh error, output pixels: half a pixel moves a
+// silhouette across at most one pixel centre.
+constexpr float kCoverageMeshErrorPx = 0.5f;
 
 // virtual_vertex.glsl's push constant after the material index (which SceneGpu::draw pushes per
 // draw at offset 0): texels of the real geometry per raster pixel (x, y), at offset 8.
@@ -176,6 +179,10 @@ void VirtualGBuffer::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_cons
     return;
   }
   update_area(coverage_area_, output, fc);
+  // The G-buffer's error in output pixels (0: full detail), or the coverage's own, the finer.
+  const float gbuffer_error_px = mesh_error_px * fc.output_k.x / std::max(fc.internal_k.x, 1e-6f);
+  coverage_lod_ = {lod_.camera_world, fc.output_k.x,
+                   mesh_error_px > 0.0f ? std::min(gbuffer_error_px, kCoverageMeshErrorPx) : kCoverageMeshErrorPx};
   record_coverage(graph);
 }
 
@@ -292,7 +299,8 @@ void VirtualGBuffer::draw_coverage(VkCommandBuffer cmd, gpu::PassContext& pass) 
                          float(internal.height) / (float(e.height) * step));
     vkCmdPushConstants(cmd, coverage_pipeline_->layout, coverage_pipeline_->stages, kRealScaleOffset,
                        sizeof(push), &push);
-    scene_->virtual_objects.draw(cmd, pass, &*coverage_pipeline_, &*coverage_double_sided_pipeline_, &lod_);
+    scene_->virtual_objects.draw(cmd, pass, &*coverage_pipeline_, &*coverage_double_sided_pipeline_,
+                                 &coverage_lod_);
   }
   pass.context().fn().cmd_end_rendering(cmd);
 }

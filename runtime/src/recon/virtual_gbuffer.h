@@ -39,6 +39,11 @@ class VirtualGBuffer {
   // This frame's coverage at the output resolution; invalid when the G-buffer has the output's
   // size (position()'s w is then the mask at the output's pixels).
   gpu::ImageHandle output_coverage() const { return coverage_recorded_ ? coverage_ : gpu::ImageHandle{}; }
+  // The output pixels this frame's coverage raster drew and cleared; outside it the coverage is
+  // 0 (empty without a coverage raster).
+  VkRect2D output_coverage_area() const {
+    return coverage_recorded_ ? coverage_area_.now : VkRect2D{{0, 0}, {0, 0}};
+  }
 
  private:
   // The area a raster draws and clears this frame: the virtual objects' projected bounds united
@@ -63,6 +68,10 @@ class VirtualGBuffer {
   // bunny, a few pixels per triangle at 640x480, cost 8.5 ms of this pass's 10; a quarter of
   // the triangles 1.7 ms).
   frame::LodView lod_;
+  // The output coverage's own level of detail: within kCoverageMeshErrorPx output pixels (what
+  // the silhouette needs), or the G-buffer's where that is finer. Why: lavapipe's triangle setup
+  // made a full-detail coverage raster of desk_spot's bunny cost 4-6 ms.
+  frame::LodView coverage_lod_;
   RasterArea area_, coverage_area_;  // the G-buffer's, the output coverage's
   gpu::ImageHandle position_, normal_, albedo_, emission_, depth_;
   gpu::ImageHandle coverage_;    // R8 at the output resolution

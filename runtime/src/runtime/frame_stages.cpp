@@ -155,7 +155,10 @@ Status RuntimeImpl::record_compose(FrameContext& f) {
       f.rec.skipped.push_back("compose tiles: caustics may light pixels outside them, every pixel composed");
     }
   }
-  if (f.affected) ci.virtual_coverage = virtual_gbuffer_->output_coverage();
+  if (f.affected) {
+    ci.virtual_coverage = virtual_gbuffer_->output_coverage();
+    ci.coverage_area = virtual_gbuffer_->output_coverage_area();
+  }
   return compose_->record(*graph_, ci);
 }
 
