@@ -127,6 +127,36 @@ TEST(CaptureWriter, RefusesToOverwriteAndInconsistentFrames) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("new")));
 }
 
+// A static environment camera's image, the same for every frame, is stored once and listed per
+// frame; a changed one is stored again, and a return to the first image is stored anew (only the
+// last image written is compared).
+TEST(CaptureWriter, AnUnchangedEnvironmentImageIsStoredOnce) {
+  TempDir dir;
+  auto writer = CaptureWriter::create(dir.file("cap"), small_info(), std::nullopt);
+  ASSERT_TRUE(writer.ok()) << writer.error().message;
+  std::vector<InputFrame> frames;
+  for (int i = 0; i < 4; ++i) {
+    frames.push_back(make_frame(i));
+    frames.back().env = make_frame(i == 2 ? 1 : 0).env;  // env images A A B A
+  }
+  for (const InputFrame& f : frames) ASSERT_TRUE(writer->add_frame(f).ok());
+  ASSERT_TRUE(writer->finish().ok());
+  size_t files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir.file("cap/env"))) files += e.is_regular_file();
+  EXPECT_EQ(files, 3u);  // frames 0, 2 and 3
+  EXPECT_FALSE(std::filesystem::exists(dir.file("cap/env/000001.exr")));
+  auto reader = CaptureReader::open(dir.file("cap"));
+  ASSERT_TRUE(reader.ok()) << reader.error().message;
+  ASSERT_EQ(reader->frame_count(), 4u);
+  EXPECT_EQ(reader->entry(1).env, reader->entry(0).env);
+  for (size_t i = 0; i < 4; ++i) {
+    auto f = reader->read_frame(i);
+    ASSERT_TRUE(f.ok()) << f.error().message;
+    ASSERT_TRUE(f->env.has_value());
+    EXPECT_EQ(f->env->data, frames[i].env->data) << "frame " << i;
+  }
+}
+
 TEST(CaptureWriter, FrameWithoutPoseOrEnvWritesNoGroundtruth) {
   TempDir dir;
   CaptureInfo info = small_info();

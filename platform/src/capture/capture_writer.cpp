@@ -1,12 +1,14 @@
 // Capture format v1 writer. Frames go to FOLDER.partial/{rgb,depth,env,reference}/NNNNNN.*, the
 // lists and JSON files are written by finish(), and only then is FOLDER.partial renamed to
 // FOLDER. Timestamps and poses are written in shortest round-trip decimal, so a reader gets back
-// bit-identical values. Env images are stored as 32-bit float OpenEXR. References are stored plain
+// bit-identical values. Env images are stored as 32-bit float OpenEXR, an image equal to the
+// last one written (a static environment camera) once: env.txt lists its file again. References are stored plain
 // or as deltas from the colour frame (ReferenceStorage, mrgi/platform/capture_references.h). After
 // every frame the lists so far go to FOLDER.partial/writer_progress.json, so resume() can continue
 // a write that was cut off (long path-traced renders).
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -206,10 +208,19 @@ Status CaptureWriter::add_frame(const InputFrame& frame, const ImageRGB8* refere
     gt_list_ += "\n";
   }
   if (frame.env) {
-    std::error_code ec;
-    fs::create_directories(dir / "env", ec);
-    const std::string env = "env/" + frame_name(count_, ".exr");
-    MRGI_TRY(write_exr((dir / env).string(), *frame.env));
+    const ImageRGBF& e = *frame.env;
+    const bool unchanged = !last_env_path_.empty() && e.width == last_env_.width && e.height == last_env_.height &&
+                           e.data.size() == last_env_.data.size() &&
+                           std::memcmp(e.data.data(), last_env_.data.data(), e.data.size() * sizeof(float)) == 0;
+    std::string env = last_env_path_;
+    if (!unchanged) {
+      std::error_code ec;
+      fs::create_directories(dir / "env", ec);
+      env = "env/" + frame_name(count_, ".exr");
+      MRGI_TRY(write_exr((dir / env).string(), e));
+      last_env_ = e;
+      last_env_path_ = env;
+    }
     if (env_list_.empty()) env_list_ = list_header("environment images (linear radiance)", "timestamp filename");
     env_list_ += ts + " " + env + "\n";
   }

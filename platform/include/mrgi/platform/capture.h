@@ -127,6 +127,10 @@ class MRGI_API CaptureWriter {
   ReferenceStorage reference_storage_ = ReferenceStorage::Plain;
   PngEffort png_effort_ = PngEffort::Fast;
   std::string rgb_list_, depth_list_, gt_list_, env_list_, ref_list_;
+  // The last environment image written and its file: an unchanged one (a static environment
+  // camera) is listed again for the frame, not stored again.
+  ImageRGBF last_env_;
+  std::string last_env_path_;
   size_t count_ = 0;
   double last_timestamp_ = 0.0;
 };
