@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <string>
 
 #include "common/frame_constants.glsl"
 #include "gpu/shaders.h"
@@ -33,6 +34,29 @@ Expected<gpu::ImageHandle> gbuffer_image(gpu::FrameGraph& graph, const char* nam
   d.size_mode = gpu::SizeMode::OutputRelative;
   d.follows_render_scale = internal;
   return graph.create_image(d, usage);
+}
+
+// The raster's two pipelines: back faces culled (single-sided materials), and both sides.
+Status culled_and_double_sided(gpu::Context& context, gpu::GraphicsPipelineDesc desc, const std::string& name,
+                               gpu::PipelineHandle& culled, gpu::PipelineHandle& both) {
+  desc.name = name;
+  desc.cull_mode = VK_CULL_MODE_BACK_BIT;
+  auto one = gpu::create_graphics_pipeline(context, desc);
+  if (!one) return one.error();
+  culled = gpu::PipelineHandle(context, std::move(*one));
+  desc.name = name + "_double_sided";
+  desc.cull_mode = VK_CULL_MODE_NONE;
+  auto two = gpu::create_graphics_pipeline(context, desc);
+  if (!two) return two.error();
+  both = gpu::PipelineHandle(context, std::move(*two));
+  return ok_status();
+}
+
+// The viewport over the whole raster of size e; the scissor on the area drawn this frame.
+void set_viewport(VkCommandBuffer cmd, VkExtent2D e, const VkRect2D& area) {
+  const VkViewport vp{0.0f, 0.0f, float(e.width), float(e.height), 0.0f, 1.0f};
+  vkCmdSetViewport(cmd, 0, 1, &vp);
+  vkCmdSetScissor(cmd, 0, 1, &area);
 }
 
 VkRenderingAttachmentInfo cleared_color(VkImageView view, VkImageLayout layout) {
@@ -87,10 +111,9 @@ Expected<VirtualGBuffer> VirtualGBuffer::create(gpu::Context& context, gpu::Fram
   auto fs = gpu::shader_spirv("gbuffer/virtual.frag");
   if (!fs) return fs.error();
   gpu::GraphicsPipelineDesc desc;
-  desc.name = "virtual_gbuffer";
   desc.vertex_spirv = *vs;
   desc.fragment_spirv = *fs;
-  // Bindings and push constants (material per draw, real geometry step) from the shaders.
+  // Bindings and push constants (material per draw, real geometry scale) from the shaders.
   desc.vertex_strides = {sizeof(frame::GpuVertex)};
   desc.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(frame::GpuVertex, position)},
                      {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(frame::GpuVertex, normal)},
@@ -106,16 +129,8 @@ Expected<VirtualGBuffer> VirtualGBuffer::create(gpu::Context& context, gpu::Fram
   // y-down projection keeps them counter-clockwise on screen in Vulkan's framebuffer
   // convention (checked: culling the other side makes desk_spot's bunny show its inside, RDE
   // 0.83 -> 0.98). Cost on lavapipe, desk_spot's 16k-triangle bunny: 7.7 -> 5.8 ms.
-  desc.cull_mode = VK_CULL_MODE_BACK_BIT;
   desc.front_face = VK_FRONT_FACE_COUNTER_CLOCKWISE;
-  auto pipe = gpu::create_graphics_pipeline(context, desc);
-  if (!pipe) return pipe.error();
-  v.pipeline_ = gpu::PipelineHandle(context, std::move(*pipe));
-  desc.name = "virtual_gbuffer_double_sided";
-  desc.cull_mode = VK_CULL_MODE_NONE;
-  auto two_sided = gpu::create_graphics_pipeline(context, desc);
-  if (!two_sided) return two_sided.error();
-  v.double_sided_pipeline_ = gpu::PipelineHandle(context, std::move(*two_sided));
+  MRGI_TRY(culled_and_double_sided(context, desc, "virtual_gbuffer", v.pipeline_, v.double_sided_pipeline_));
 
   // The output coverage: the same vertices and culling, one R8 target, no depth (any object
   // covering a pixel covers it).
@@ -123,21 +138,13 @@ Expected<VirtualGBuffer> VirtualGBuffer::create(gpu::Context& context, gpu::Fram
   if (!cvs) return cvs.error();
   auto cfs = gpu::shader_spirv("gbuffer/virtual_coverage.frag");
   if (!cfs) return cfs.error();
-  desc.name = "virtual_coverage";
   desc.vertex_spirv = *cvs;
   desc.fragment_spirv = *cfs;
   desc.color_formats = {kCoverageFormat};
   desc.depth_format = VK_FORMAT_UNDEFINED;
   desc.depth_compare = VK_COMPARE_OP_ALWAYS;
-  desc.cull_mode = VK_CULL_MODE_BACK_BIT;
-  auto cov = gpu::create_graphics_pipeline(context, desc);
-  if (!cov) return cov.error();
-  v.coverage_pipeline_ = gpu::PipelineHandle(context, std::move(*cov));
-  desc.name = "virtual_coverage_double_sided";
-  desc.cull_mode = VK_CULL_MODE_NONE;
-  auto cov2 = gpu::create_graphics_pipeline(context, desc);
-  if (!cov2) return cov2.error();
-  v.coverage_double_sided_pipeline_ = gpu::PipelineHandle(context, std::move(*cov2));
+  MRGI_TRY(culled_and_double_sided(context, desc, "virtual_coverage", v.coverage_pipeline_,
+                                   v.coverage_double_sided_pipeline_));
   return v;
 }
 
@@ -157,14 +164,10 @@ void VirtualGBuffer::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_cons
   graph.add_shader_pass(
       "virtual_gbuffer", gpu::PassKind::Graphics, *pipeline_,
       [this, nearest, linear](gpu::ShaderPassBuilder& b) {
-        b.bind("FrameUbo", frame_constants_);
+        bind_raster_inputs(b, nearest);
         b.bind("Materials", scene_->materials);
         b.bind_sampled("base_color_maps", scene_->base_color_maps, linear);
-        b.bind_sampled("real_position", real_.position, nearest);
-        b.bind_sampled("real_normal", real_.normal, nearest);
         gpu::PassBuilder& u = b.uses();
-        u.read(scene_->virtual_objects.vertices, gpu::Access::VertexBuffer);
-        u.read(scene_->virtual_objects.indices, gpu::Access::IndexBuffer);
         u.write(position_, gpu::Access::ColorAttachmentWrite);
         u.write(normal_, gpu::Access::ColorAttachmentWrite);
         u.write(albedo_, gpu::Access::ColorAttachmentWrite);
@@ -186,18 +189,23 @@ void VirtualGBuffer::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_cons
   record_coverage(graph);
 }
 
+// What both rasters read: the frame constants, the real geometry of the occlusion test, the
+// virtual objects' vertices.
+void VirtualGBuffer::bind_raster_inputs(gpu::ShaderPassBuilder& b, VkSampler nearest) const {
+  b.bind("FrameUbo", frame_constants_);
+  b.bind_sampled("real_position", real_.position, nearest);
+  b.bind_sampled("real_normal", real_.normal, nearest);
+  b.uses().read(scene_->virtual_objects.vertices, gpu::Access::VertexBuffer);
+  b.uses().read(scene_->virtual_objects.indices, gpu::Access::IndexBuffer);
+}
+
 void VirtualGBuffer::record_coverage(gpu::FrameGraph& graph) {
   const VkSampler nearest = graph.context().samplers().nearest_clamp;
   graph.add_shader_pass(
       "virtual_coverage", gpu::PassKind::Graphics, *coverage_pipeline_,
       [this, nearest](gpu::ShaderPassBuilder& b) {
-        b.bind("FrameUbo", frame_constants_);
-        b.bind_sampled("real_position", real_.position, nearest);
-        b.bind_sampled("real_normal", real_.normal, nearest);
-        gpu::PassBuilder& u = b.uses();
-        u.read(scene_->virtual_objects.vertices, gpu::Access::VertexBuffer);
-        u.read(scene_->virtual_objects.indices, gpu::Access::IndexBuffer);
-        u.write(coverage_, gpu::Access::ColorAttachmentWrite);
+        bind_raster_inputs(b, nearest);
+        b.uses().write(coverage_, gpu::Access::ColorAttachmentWrite);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) { draw_coverage(cmd, pass); });
 }
@@ -266,10 +274,7 @@ void VirtualGBuffer::draw(VkCommandBuffer cmd, gpu::PassContext& pass) {
   ri.pDepthAttachment = &depth;
   pass.context().fn().cmd_begin_rendering(cmd, &ri);
   if (!scene_->virtual_objects.empty()) {
-    const VkViewport vp{0.0f, 0.0f, float(e.width), float(e.height), 0.0f, 1.0f};
-    const VkRect2D sc = area_.now;
-    vkCmdSetViewport(cmd, 0, 1, &vp);
-    vkCmdSetScissor(cmd, 0, 1, &sc);
+    set_viewport(cmd, e, area_.now);
     const float per_pixel = 1.0f / float(std::max<uint32_t>(real_.step, 1));
     const glm::vec2 push(per_pixel);
     vkCmdPushConstants(cmd, pipeline_->layout, pipeline_->stages, kRealScaleOffset, sizeof(push), &push);
@@ -288,10 +293,7 @@ void VirtualGBuffer::draw_coverage(VkCommandBuffer cmd, gpu::PassContext& pass) 
   ri.pColorAttachments = &color;
   pass.context().fn().cmd_begin_rendering(cmd, &ri);
   if (!scene_->virtual_objects.empty()) {
-    const VkViewport vp{0.0f, 0.0f, float(e.width), float(e.height), 0.0f, 1.0f};
-    const VkRect2D sc = coverage_area_.now;
-    vkCmdSetViewport(cmd, 0, 1, &vp);
-    vkCmdSetScissor(cmd, 0, 1, &sc);
+    set_viewport(cmd, e, coverage_area_.now);
     // An output pixel's centre in internal pixels, then in real texels (step internal pixels
     // each): (p + 0.5) * internal / (output * step).
     const float step = float(std::max<uint32_t>(real_.step, 1));

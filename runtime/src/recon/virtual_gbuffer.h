@@ -58,6 +58,7 @@ class VirtualGBuffer {
   void draw(VkCommandBuffer cmd, gpu::PassContext& pass);
   void draw_coverage(VkCommandBuffer cmd, gpu::PassContext& pass);
   void record_coverage(gpu::FrameGraph& graph);
+  void bind_raster_inputs(gpu::ShaderPassBuilder& b, VkSampler nearest) const;
   // Sets `a.now` for a raster of `extent` from this frame's constants; updates its history.
   void update_area(RasterArea& a, VkExtent2D extent, const shader::FrameConstants& fc) const;
 
