@@ -14,9 +14,9 @@
 // Three pipelines from this file, chosen per frame by the runtime, specialised on whether the
 // camera and output sizes match (kSameSize): kCameraOnly (nothing virtual in view) writes the
 // camera frame, a byte copy when the sizes match; the others run the composite (joint_taps up-
-// samples the solutions where they are smaller than the output), kSameInternal when the
-// solutions are at the output size (one texel each instead of a bilinear four: 8 of
-// the composite's 10 fetches on a full-resolution level). Not one shader
+// samples the solutions where they are smaller than the output: four taps of each solution and
+// of virtual_position, and the coverage), kSameInternal when the solutions are at the output size
+// (one texel each and the mask from virtual_position: 3 fetches beside the camera's). Not one shader
 // with branches: on lavapipe a shader costs about as much as all of its code, taken or not
 // (measured at 640x480, x2 threads: the copy alone 0.85 ms as its own pipeline, 8 ms with the
 // composite behind a never-entered uniform `if`), so each path is compiled out of the other.
@@ -45,9 +45,13 @@ layout(std430, set = 0, binding = 7) readonly buffer Tiles { uint list[]; } tile
 // The virtual objects' coverage at the output resolution (recon::VirtualGBuffer::
 // output_coverage), read where the solutions are at a lower internal resolution: the mask at the
 // output's pixels. (The variants at the output's own size read virtual_position's w instead.)
-layout(set = 0, binding = 8, r8) readonly uniform image2D virtual_coverage;
+layout(set = 0, binding = 8, r32f) readonly uniform image2D virtual_coverage;
 struct ParamsConstants {
   vec4 compose;      // x eps (linear camera units), y alpha_max
+  // The output pixels the coverage raster drew and cleared this frame ([x, z) x [y, w),
+  // ComposeInputs::coverage_area): outside it the coverage is 0 whatever the image holds (its
+  // earlier contents are not kept by every driver).
+  ivec4 coverage_area;
 };
 layout(push_constant) uniform Params { ParamsConstants params_block; };
 ParamsConstants params;
@@ -144,7 +148,8 @@ void main() {
   if (kSameInternal) {
     is_virtual = imageLoad(virtual_position, pixel).w > 0.5f ? 1.0f : 0.0f;
   } else {
-    is_virtual = imageLoad(virtual_coverage, pixel).r > 0.5f ? 1.0f : 0.0f;
+    bool drawn = all(greaterThanEqual(pixel, params.coverage_area.xy)) && all(lessThan(pixel, params.coverage_area.zw));
+    is_virtual = drawn && imageLoad(virtual_coverage, pixel).r > 0.5f ? 1.0f : 0.0f;
     taps = joint_taps(rel, used, is_virtual);
   }
   vec3 rv = solution_rv(taps, pixel);

@@ -5,7 +5,7 @@
 // of an output pixel the output-resolution coverage marks virtual), or whose two
 // solutions differ by more than compose_tile_invisible allows, marks every output tile whose
 // pixels read it (compose.comp: the bilinear taps floor(ipos), floor(ipos) + 1 with
-// ipos = (p + 0.5) * used / out - 0.5, and the nearest texel for the virtual mask), and the first
+// ipos = (p + 0.5) * used / out - 0.5), and the first
 // to mark a tile appends it to the list. Outside the listed tiles compose writes the camera
 // frame (on the host when the output has the camera's size), so a technique whose solutions are
 // equal away from the virtual objects' influence (baseline, dlpv) pays for the composite only
@@ -28,7 +28,7 @@ layout(std430, set = 0, binding = 4) coherent buffer TileState { uint words[]; }
 layout(std430, set = 0, binding = 5) writeonly buffer TileList { uint list[]; };
 // The coverage at the output resolution where the solutions are smaller (compose.comp's mask
 // there): an object thinner than a texel covers output pixels no texel centre of it falls in.
-layout(set = 0, binding = 6, r8) readonly uniform image2D virtual_coverage;
+layout(set = 0, binding = 6, r32f) readonly uniform image2D virtual_coverage;
 struct ClassifyConstants {
   vec4 compose;  // x eps, y alpha_max (ComposeSettings), z tolerance (8-bit levels)
   // The output pixels the coverage raster drew this frame (x0, y0, x1, y1: [x0, x1) x [y0, y1),

@@ -12,7 +12,7 @@
 
 layout(set = 0, binding = 2) uniform sampler2D real_position;  // xyz world, w depth
 layout(set = 0, binding = 4) uniform sampler2D real_normal;    // xyz world (coarse texels)
-// virtual.vert's flat inputs this test reads (the others are not declared, and not read).
+// virtual_coverage.vert's outputs, all this test reads.
 layout(location = 3) in float in_view_z;
 layout(location = 7) flat in vec4 in_k;         // output intrinsics
 layout(location = 8) flat in vec4 in_camera;    // w behind-real tolerance

@@ -13,7 +13,12 @@ namespace {
 
 struct ComposePush {
   glm::vec4 compose;
+  glm::ivec4 coverage_area;  // x0, y0, x1, y1 (compose.comp ParamsConstants)
 };
+
+glm::ivec4 area_corners(const VkRect2D& r) {
+  return {r.offset.x, r.offset.y, r.offset.x + int(r.extent.width), r.offset.y + int(r.extent.height)};
+}
 
 }  // namespace
 
@@ -54,7 +59,7 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
   c.no_tiles_ = *no_tiles;
   gpu::ImageDesc none;
   none.name = "compose_no_coverage";
-  none.format = VK_FORMAT_R8_UNORM;
+  none.format = VK_FORMAT_R32_SFLOAT;
   none.size_mode = gpu::SizeMode::Absolute;
   none.width = none.height = 1;
   auto no_coverage = graph.create_image(none, VK_IMAGE_USAGE_STORAGE_BIT);
@@ -113,9 +118,7 @@ void Compose::record_classify(gpu::FrameGraph& graph) {
           glm::vec4 compose;
           glm::ivec4 coverage_area;
         } push{{settings_.eps, settings_.alpha_max, settings_.tile_tolerance, 0.0f},
-               {in_.coverage_area.offset.x, in_.coverage_area.offset.y,
-                in_.coverage_area.offset.x + int(in_.coverage_area.extent.width),
-                in_.coverage_area.offset.y + int(in_.coverage_area.extent.height)}};
+               area_corners(in_.coverage_area)};
         gpu::push_and_dispatch(cmd, *pipe, &push, sizeof push, {(used.width + 7) / 8, (used.height + 7) / 8, 1});
       });
   in_.tile_args = classify_state_;
@@ -216,6 +219,7 @@ Status Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
 void Compose::dispatch(VkCommandBuffer cmd, gpu::PassContext& pass, const gpu::Pipeline& pipeline, bool tiled_pass) {
   ComposePush pc;
   pc.compose = glm::vec4(settings_.eps, settings_.alpha_max, 0.0f, 0.0f);
+  pc.coverage_area = area_corners(in_.coverage_area);
   if (tiled_pass) {
     gpu::dispatch_indirect(cmd, pipeline, &pc, sizeof(pc), pass.buffer(in_.tile_args));
   } else {

@@ -89,8 +89,9 @@ inline void bind_shading_gbuffers(gpu::ShaderPassBuilder& b, const FrameResource
 // Real geometry as a G-buffer another stage reads (the virtual G-buffer's depth test: real
 // surfaces hide virtual ones): positions (xyz world, w camera depth in metres, all 0 = none)
 // with one texel per `step` x `step` internal pixels, and their normals (xyz world), which a
-// reader at step > 1 uses to take each pixel's depth on the texel's tangent plane
-// (tangent_plane_depth, shared/mrgi_shared.h). At step 1 `normal` may be the position image.
+// reader whose pixels are finer than the texels (step > 1, or the output-resolution coverage
+// below the internal size) uses to take each pixel's depth on the texel's tangent plane
+// (tangent_plane_depth, shared/mrgi_shared.h).
 struct RealGeometry {
   gpu::ImageHandle position, normal;
   uint32_t step = 1;

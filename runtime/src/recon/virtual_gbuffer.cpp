@@ -16,7 +16,8 @@ constexpr VkFormat kNormalFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kAlbedoFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kEmissionFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
-constexpr VkFormat kCoverageFormat = VK_FORMAT_R8_UNORM;
+// R32F: a storage format every Vulkan device supports (R8's storage use is optional).
+constexpr VkFormat kCoverageFormat = VK_FORMAT_R32_SFLOAT;
 // The output coverage's largest projected mesh error, output pixels: half a pixel moves a
 // silhouette across at most one pixel centre.
 constexpr float kCoverageMeshErrorPx = 0.5f;
@@ -132,7 +133,7 @@ Expected<VirtualGBuffer> VirtualGBuffer::create(gpu::Context& context, gpu::Fram
   desc.front_face = VK_FRONT_FACE_COUNTER_CLOCKWISE;
   MRGI_TRY(culled_and_double_sided(context, desc, "virtual_gbuffer", v.pipeline_, v.double_sided_pipeline_));
 
-  // The output coverage: the same vertices and culling, one R8 target, no depth (any object
+  // The output coverage: the same vertices and culling, one R32F target, no depth (any object
   // covering a pixel covers it).
   auto cvs = gpu::shader_spirv("gbuffer/virtual_coverage.vert");
   if (!cvs) return cvs.error();
@@ -182,7 +183,8 @@ void VirtualGBuffer::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_cons
     return;
   }
   update_area(coverage_area_, output, fc);
-  // The G-buffer's error in output pixels (0: full detail), or the coverage's own, the finer.
+  // Within kCoverageMeshErrorPx output pixels, or a simplified G-buffer's error where finer
+  // (a full-detail G-buffer, mesh_error_px 0, is finer than the coverage needs).
   const float gbuffer_error_px = mesh_error_px * fc.output_k.x / std::max(fc.internal_k.x, 1e-6f);
   coverage_lod_ = {lod_.camera_world, fc.output_k.x,
                    mesh_error_px > 0.0f ? std::min(gbuffer_error_px, kCoverageMeshErrorPx) : kCoverageMeshErrorPx};

@@ -6,8 +6,8 @@
 // real/virtual mask), virtual_normal (RGBA16F: xyz, w roughness), virtual_albedo (RGBA16F:
 // linear base colour, w metallic), virtual_emission (RGBA16F: emitted radiance, glTF emissive),
 // virtual_depth (D32, for the virtual objects among themselves).
-// At an internal resolution below the output's it also rasterises the objects' coverage at the
-// output resolution (virtual_coverage, R8: 1 where one is seen), with the same occlusion test by
+// At an internal resolution other than the output's it also rasterises the objects' coverage at
+// the output resolution (virtual_coverage, R32F: 1 where one is seen), with the same occlusion test by
 // the real geometry (shaders/gbuffer/hidden_by_real.glsl), so the mask and the silhouettes the
 // user sees come at the output's pixels whatever the internal scale (compose up-samples the
 // lighting from the texels on the same side of it).
@@ -25,7 +25,7 @@ class VirtualGBuffer {
   static Expected<VirtualGBuffer> create(gpu::Context& context, gpu::FrameGraph& graph,
                                          const frame::SceneGpu& scene);
   // Adds the pass "virtual_gbuffer" (always: with no object it clears the mask) and, when the
-  // internal resolution is below the output's, "virtual_coverage".
+  // internal resolution differs from the output's, "virtual_coverage".
   // Mesh ranges are drawn at the coarsest level of detail within `mesh_error_px` projected
   // internal pixels (QualityLevel::mesh_error_px; 0 = full detail).
   void record(gpu::FrameGraph& graph, gpu::BufferHandle frame_constants,
@@ -70,12 +70,13 @@ class VirtualGBuffer {
   // the triangles 1.7 ms).
   frame::LodView lod_;
   // The output coverage's own level of detail: within kCoverageMeshErrorPx output pixels (what
-  // the silhouette needs), or the G-buffer's where that is finer. Why: lavapipe's triangle setup
+  // the silhouette needs; coarser than a full-detail G-buffer), or the G-buffer's where a
+  // simplified G-buffer is finer than that. Why: lavapipe's triangle setup
   // made a full-detail coverage raster of desk_spot's bunny cost 4-6 ms.
   frame::LodView coverage_lod_;
   RasterArea area_, coverage_area_;  // the G-buffer's, the output coverage's
   gpu::ImageHandle position_, normal_, albedo_, emission_, depth_;
-  gpu::ImageHandle coverage_;    // R8 at the output resolution
+  gpu::ImageHandle coverage_;    // R32F at the output resolution
   bool coverage_recorded_ = false;  // this frame
   gpu::PipelineHandle pipeline_, double_sided_pipeline_;  // back faces culled; both sides
   gpu::PipelineHandle coverage_pipeline_, coverage_double_sided_pipeline_;

@@ -108,7 +108,7 @@ Status RuntimeImpl::record_virtual_gbuffer(FrameContext& f) {
                                          ": skips the reconstruction but gives no real geometry "
                                          "for the virtual objects' depth test");
   virtual_gbuffer_->record(*graph_, frame_constants_,
-                           own ? *own : frame::RealGeometry{recon_->position(), recon_->position(), 1},
+                           own ? *own : frame::RealGeometry{recon_->position(), recon_->normal(), 1},
                            f.level.mesh_error_px);
   return ok_status();
 }
