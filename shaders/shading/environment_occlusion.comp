@@ -5,7 +5,10 @@
 // sphere proxies hide from it of the occludable ambient light (its radiance SH), per
 // shared/occlusion_math.h, less what their objects' surfaces send it instead (albedo / pi x
 // the ambient irradiance facing the point), plus what they hide of the broad regions kept apart
-// from the SH (the part of each region's cone their caps cover). Written as rgb = that net irradiance taken away
+// from the SH (the part of each region's cone their caps cover). Near field (occlusion_math.h):
+// where the ray past the spheres crosses a real surface within the reach, that surface's
+// radiance (the camera's, as the real albedo image holds it) is what they hide instead of the
+// sky's, and the regions beyond it were not reaching the point. Written as rgb = that net irradiance taken away
 // (W/m^2, negative where an object gives more than it hides), a = the surface's key:
 // its distance to the camera, negative on a virtual surface, 0 where there is none (the
 // direct-light pass up-samples by it).
@@ -24,6 +27,26 @@ layout(set = 0, binding = 3, rgba16f) readonly uniform image2D real_normal;
 layout(set = 0, binding = 4, rgba32f) readonly uniform image2D virtual_position;
 layout(set = 0, binding = 5, rgba16f) readonly uniform image2D virtual_normal;
 layout(set = 0, binding = 6, rgba16f) writeonly uniform image2D env_occlusion;
+layout(set = 0, binding = 7, rgba16f) readonly uniform image2D real_albedo;  // rgb the camera's radiance
+
+// The radiance of the first real surface the ray from p along w crosses between `start` (the
+// sphere's far side) and `reach` metres (a march step behind the real G-buffer's surface), rgb;
+// w 1 where it crosses one, 0 where the ray leaves the view or reaches no surface (the
+// environment lies that way).
+vec4 real_surface_beyond(vec3 p, vec3 w, float start, float reach, int steps) {
+  const ivec2 used = frame.internal_output_size.xy;
+  for (int k = 0; k < steps; ++k) {
+    vec3 x = p + w * near_field_march_t(start, reach, k, steps);
+    vec3 c = (frame.world_to_camera * vec4(x, 1.0f)).xyz;
+    if (!(c.z > 1e-3f)) return vec4(0.0f);
+    vec2 ip = project_pinhole(c, frame.internal_k);
+    if (any(lessThan(ip, vec2(0.0f))) || any(greaterThanEqual(ip, vec2(used)))) return vec4(0.0f);
+    ivec2 q = ivec2(ip);
+    float depth = imageLoad(real_position, q).w;
+    if (depth > 0.0f && c.z > depth) return vec4(imageLoad(real_albedo, q).rgb, 1.0f);
+  }
+  return vec4(0.0f);
+}
 
 // Spheres farther than this many radii are skipped: each would hide less than 1 / 64^2 of the
 // sky (0.02 %). At 16 radii (0.4 % each) the many far terms of an object together were a
@@ -71,21 +94,30 @@ void main() {
     float s2 = r2 / l2;
     float f = sphere_form_factor(dot(n, w), s2);
     if (f > 1e-5f) {
-      // What the sphere hides (the sky's cap) less what it shows instead: the object's own
-      // surface facing the point, lit by the same ambient (albedo / pi x E(-w)).
-      vec3 hidden = sh_cap_mean_radiance(sh_r, sh_g, sh_b, w, sqrt(1.0f - s2));
+      // What the sphere hides (the sky's cap, or the real surface beyond it in the near field)
+      // less what it shows instead: the object's own surface facing the point, lit by the same
+      // ambient (albedo / pi x E(-w)).
+      // (Marched from real points only, towards a centre above the point's horizon: a sphere
+      // crossing it hides a sliver of sky near the horizon, not what lies beyond its centre
+      // below it, such as the real surface under a thin plate's own proxies; and a virtual
+      // point's own object, inscribed spheres standing in for its surface, would see real
+      // surfaces through gaps the mesh does not have.)
+      const int steps = is_virtual ? 0 : occluders.count.w;
+      vec4 beyond = steps > 0 && f > 1e-3f && dot(n, w) > 0.0f ? real_surface_beyond(p, w, sqrt(l2) + s.w, occluders.near_field.x, steps) : vec4(0.0f);
+      vec3 hidden = beyond.w > 0.5f ? beyond.rgb : sh_cap_mean_radiance(sh_r, sh_g, sh_b, w, sqrt(1.0f - s2));
       vec3 e_facing = sh_irradiance16(sh_r, sh_g, sh_b, -w);
       if (regions > 0) {
-        // The part of each region's cone the sphere's cap covers; the object is lit by the
-        // regions too.
+        // The part of each region's cone the sphere's cap covers (none where a real surface lies
+        // beyond it: the region never reached the point); the object is lit by the regions too.
         float cap = asin(sqrt(s2)), vers_cap = 1.0f - sqrt(1.0f - s2);
+        float open_beyond = beyond.w > 0.5f ? 0.0f : 1.0f;
         [[unroll]] for (int k = 0; k < MRGI_MAX_OCCLUSION_REGIONS; ++k) {
           if (k >= regions) break;
           vec4 region = occluders.regions[k];
           float cos_theta = dot(w, region.xyz);
           e_facing += occluders.region_irradiance[k].rgb * max(-cos_theta, 0.0f);
           float theta = acos(clamp(cos_theta, -1.0f, 1.0f));
-          region_open[k] *= 1.0f - cap_covered_fraction_v(theta, cap, occluders.region_irradiance[k].w, vers_cap, region.w);
+          region_open[k] *= 1.0f - open_beyond * cap_covered_fraction_v(theta, cap, occluders.region_irradiance[k].w, vers_cap, region.w);
         }
       }
       vec3 shown = occluders.albedo[i].rgb * e_facing * (1.0f / MRGI_PI);

@@ -21,6 +21,14 @@
 // (overlapping spheres of one object would count their shared part twice if summed), and the
 // blocked radiance is the f-weighted mean of their caps' radiance (sphere_occlusion_add /
 // sphere_occlusion_irradiance).
+//
+// Near field: what a sphere hides is the environment only where nothing real lies beyond it. A
+// wall of a room corner looks through the object at the floor or the other wall, whose radiance
+// (what the camera sees there) is what the object takes from it, not the sky's; and a bright
+// region beyond a real surface was never reaching the point (the camera already shows that
+// shadow). The pass marches each sphere's ray from past its far side (near_field_march_t)
+// through the real G-buffer, and where it crosses a real surface that surface's radiance is the
+// sphere's cap radiance and the sphere hides none of the regions.
 #ifndef MRGI_OCCLUSION_MATH_H
 #define MRGI_OCCLUSION_MATH_H
 
@@ -153,6 +161,13 @@ MRGI_FN SphereOcclusion sphere_occlusion_add(SphereOcclusion o, float fraction, 
   o.weighted += radiance * fraction;
   return o;
 }
+// Near field: the distance along a sphere's direction of march step k (0..steps-1), from its far
+// side (`start`, metres from the point) out to `reach`: denser near the object, where the
+// surfaces that matter most lie; nowhere past the far side when the reach is inside it.
+MRGI_FN float near_field_march_t(float start, float reach, int k, int steps) {
+  float u = float(k + 1) / float(max(steps, 1));
+  return start + max(reach - start, 0.0f) * u * u;
+}
 // The irradiance (W/m^2 per channel) the spheres hide from the point: pi x the blocked fraction
 // x the fraction-weighted mean radiance of their caps.
 MRGI_FN vec3 sphere_occlusion_irradiance(SphereOcclusion o) {
@@ -164,7 +179,9 @@ MRGI_FN vec3 sphere_occlusion_irradiance(SphereOcclusion o) {
 #define MRGI_MAX_OCCLUDER_SPHERES 64
 #define MRGI_MAX_OCCLUSION_REGIONS 4
 struct EnvOcclusionSet {
-  ivec4 count;                                   // x spheres; y divisor (internal pixels a texel side)
+  ivec4 count;                                   // x spheres; y divisor (internal pixels a texel side);
+                                                 // z regions (below); w near-field march steps (0 = off)
+  vec4 near_field;                               // x how far the march reaches (metres)
   vec4 radiance[12];                             // radiance SH16 of the occludable light: r c0..c3, g, b
                                                  // (without the regions below)
   vec4 spheres[MRGI_MAX_OCCLUDER_SPHERES];       // world xyz centre, w radius (metres)
@@ -177,7 +194,7 @@ struct EnvOcclusionSet {
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(EnvOcclusionSet) == 16 * (1 + 12 + 2 * MRGI_MAX_OCCLUDER_SPHERES + 2 * MRGI_MAX_OCCLUSION_REGIONS),
+static_assert(sizeof(EnvOcclusionSet) == 16 * (2 + 12 + 2 * MRGI_MAX_OCCLUDER_SPHERES + 2 * MRGI_MAX_OCCLUSION_REGIONS),
               "std140 mirror");
 #undef MRGI_FN
 }  // namespace mrgi::shader

@@ -364,5 +364,58 @@ TEST_F(BaselineTest, AVirtualObjectUnderASkyCastsAContactShadow) {
   EXPECT_NEAR(far_ratio, 1.0, 0.03) << "open floor changed";
 }
 
+// The environment occlusion's near field (shading/environment_occlusion.h): what a virtual
+// object hides from a floor point is the sky only where nothing real lies beyond it. A black
+// virtual box (it shows nothing in place of what it hides) stands beside a dark, tall real
+// block under a bright uniform sky: floor points on the far side of the box from the block look
+// through it at the block (near field: they lose the block's radiance, a tenth of the sky's),
+// floor points on the side facing the camera look through it at the open sky and lose the
+// sky's. Without the rule both sides darken alike (the box, the sky and the distances are
+// symmetric).
+TEST(BaselineNearField, AnObjectHidesTheRealSurfaceBeyondItNotTheSky) {
+  mrgi::testing::TempDir dir;
+  SyntheticScene scene = SyntheticScene::create(dir.str(), glm::vec3(0.0f), glm::vec3(0.0f));
+  scene.scene.lights.clear();
+  scene.lamp.intensity = 0.0f;
+  scene.box_albedo = 0.1f;
+  scene.real_box = {{0.25f, 0.0f, -1.0f}, {0.6f, 0.8f, -0.2f}};  // beyond the box's +x face (0.05 m gap)
+  scene.scene.virtual_objects.resize(1);                        // the box on the floor only
+  scene.virtual_boxes.resize(1);
+  const uint8_t level = 188;
+  ImageRGB8 sky(16, 8, level);
+  ASSERT_TRUE(write_png(scene.scene.environment.image, sky).ok());
+  scene.ambient = shader::srgb_decode1(float(level) / 255.0f);
+  const Box& box = scene.virtual_boxes[0];  // x, z in [-0.2, 0.2] x [-0.8, -0.4]
+  for (int level_index : {0, 1}) {
+    const auto outs = run_synthetic_frames(scene, settings_for(level_index), 1);
+    ASSERT_EQ(outs.size(), 1u);
+    const InputFrame input = scene.frame(0);
+    double toward_block = 0.0, toward_sky = 0.0;
+    int n_block = 0, n_sky = 0;
+    for (int v = 0; v < 48; ++v)
+      for (int u = 0; u < 64; ++u) {
+        const SurfaceHit h = scene.trace(u, v, true);
+        if (h.kind != SurfaceKind::Floor) continue;
+        const float gx = box.lo.x - h.point.x;  // beside the -x face: looks along +x at the block
+        const float gz = h.point.z - box.hi.z;  // beside the +z face: looks along -z at the sky
+        const double darkening = 1.0 - (lin(outs[0].image.at(u, v)[1]) + 1e-3) / (lin(input.color.at(u, v)[1]) + 1e-3);
+        if (gx > 0.04f && gx < 0.16f && h.point.z > -0.68f && h.point.z < -0.52f) {
+          toward_block += darkening;
+          ++n_block;
+        } else if (gz > 0.04f && gz < 0.16f && std::abs(h.point.x) < 0.08f) {
+          toward_sky += darkening;
+          ++n_sky;
+        }
+      }
+    ASSERT_GT(n_block, 3);
+    ASSERT_GT(n_sky, 3);
+    toward_block /= n_block;
+    toward_sky /= n_sky;
+    EXPECT_GT(toward_sky, 0.03) << "level " << level_index << ": no occlusion of the sky beside the box";
+    EXPECT_LT(toward_block, 0.6 * toward_sky)
+        << "level " << level_index << ": the block beyond the box was hidden as if it were the sky";
+  }
+}
+
 }  // namespace
 }  // namespace mrgi::test

@@ -195,4 +195,20 @@ TEST(OcclusionMath, DisjointSpheresUnderAUniformSkyBlockTheirSolidAngle) {
   EXPECT_EQ(sphere_occlusion_irradiance(sphere_occlusion_none()).x, 0.0f);
 }
 
+// The near-field march starts past the sphere's far side, grows monotonically and ends at the
+// reach; a reach inside the object marches nowhere past its far side.
+TEST(OcclusionMath, NearFieldMarchRunsFromTheFarSideToTheReach) {
+  const int steps = 8;
+  float last = 0.6f;
+  for (int k = 0; k < steps; ++k) {
+    const float t = near_field_march_t(0.6f, 3.0f, k, steps);
+    EXPECT_GT(t, last) << "step " << k;
+    last = t;
+  }
+  EXPECT_NEAR(last, 3.0f, 1e-5f);
+  // Denser near the object: the first half of the steps covers a quarter of the way.
+  EXPECT_NEAR(near_field_march_t(0.6f, 3.0f, steps / 2 - 1, steps), 0.6f + 2.4f * 0.25f, 1e-5f);
+  EXPECT_NEAR(near_field_march_t(0.6f, 0.1f, steps - 1, steps), 0.6f, 1e-6f);
+}
+
 }  // namespace

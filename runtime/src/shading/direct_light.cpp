@@ -322,12 +322,15 @@ Status DirectLightBlock::record(const frame::FrameInfo& info, const DirectLightL
   const EnvOcclusionLevel& occ = level.env_occlusion;
   if (occ.divisor < 1 || occ.divisor > 8 || occ.spheres_per_object < 0 ||
       occ.spheres_per_object > frame::SceneGpu::kOccluderSpheres || occ.regions < 0 ||
-      occ.regions > MRGI_MAX_OCCLUSION_REGIONS)
+      occ.regions > MRGI_MAX_OCCLUSION_REGIONS || occ.near_field_steps < 0 || occ.near_field_steps > 64 ||
+      !(occ.near_field_m >= 0.0f && occ.near_field_m <= 100.0f))
     return fail(ErrorKind::BadUsage, "direct light: env_occlusion divisor " + std::to_string(occ.divisor) +
                                          " (1..8), spheres " + std::to_string(occ.spheres_per_object) + " (0.." +
-                                         std::to_string(frame::SceneGpu::kOccluderSpheres) + ") or regions " +
+                                         std::to_string(frame::SceneGpu::kOccluderSpheres) + "), regions " +
                                          std::to_string(occ.regions) + " (0.." +
-                                         std::to_string(MRGI_MAX_OCCLUSION_REGIONS) + ") out of range");
+                                         std::to_string(MRGI_MAX_OCCLUSION_REGIONS) + "), near-field steps " +
+                                         std::to_string(occ.near_field_steps) + " (0..64) or reach " +
+                                         std::to_string(occ.near_field_m) + " m (0..100) out of range");
   m.shadow_size_ = level.shadow_map_size;
   m.pcf_radius_ = level.pcf_radius;
   m.indirect_ = indirect;
@@ -590,10 +593,10 @@ Expected<std::unique_ptr<DirectLightBlock>> DirectLightBlock::create(const frame
 
 const std::array<DirectLightLevel, 4>& direct_light_levels() {
   static const std::array<DirectLightLevel, 4> levels = {{
-      {2048, 1, 2.0, 4, {1, 16, 4}},  // high
-      {1024, 1, 2.0, 4, {2, 16, 4}},  // medium
-      {512, 1, 2.0, 2, {4, 8, 1}},    // low
-      {256, 0, 2.0, 1, {4, 4, 0}},    // lowest
+      {2048, 1, 2.0, 4, {1, 16, 4, 12}},  // high
+      {1024, 1, 2.0, 4, {2, 16, 4, 10}},  // medium
+      {512, 1, 2.0, 2, {4, 8, 1, 8}},     // low
+      {256, 0, 2.0, 1, {4, 4, 0, 6}},     // lowest
   }};
   return levels;
 }

@@ -89,7 +89,9 @@ void EnvironmentOcclusion::record(const EnvOcclusionLevel& level, const light::S
     set->regions[k] = glm::vec4(glm::vec3(r.direction), float(1.0 - std::cos(r.half_angle_rad)));
     set->region_irradiance[k] = glm::vec4(glm::vec3(r.irradiance), float(r.half_angle_rad));
   }
-  set->count = glm::ivec4(int(std::min<size_t>(m.spheres_.size(), MRGI_MAX_OCCLUDER_SPHERES)), m.divisor_, kept, 0);
+  set->count = glm::ivec4(int(std::min<size_t>(m.spheres_.size(), MRGI_MAX_OCCLUDER_SPHERES)), m.divisor_, kept,
+                          std::clamp(level.near_field_steps, 0, 64));
+  set->near_field = glm::vec4(std::max(level.near_field_m, 0.0f), 0.0f, 0.0f, 0.0f);
   for (int c = 0; c < 3; ++c)
     for (int k = 0; k < 4; ++k) {
       const size_t i = size_t(k * 4);
@@ -111,6 +113,7 @@ void EnvironmentOcclusion::record(const EnvOcclusionLevel& level, const light::S
         b.bind("real_normal", r.real_normal);
         b.bind("virtual_position", r.virtual_position);
         b.bind("virtual_normal", r.virtual_normal);
+        b.bind("real_albedo", r.real_albedo);
         b.bind("env_occlusion", m.image_);
       },
       [&m, divisor](VkCommandBuffer cmd, gpu::PassContext& pass) {

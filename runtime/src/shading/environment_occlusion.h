@@ -27,6 +27,12 @@
 // the SH and hidden as cones, the exact part of each a proxy's cap covers
 // (cap_overlap_solid_angle), so the soft shadow falls away from them as in the truth instead
 // of spreading round the object as the SH's 4 bands do.
+//
+// What an object hides from a point is the environment only where nothing real lies beyond it:
+// in a room corner a wall looks through the object at the floor or the other wall. The pass
+// marches one ray past the objects through the real G-buffer and, where it crosses a real
+// surface within the near-field reach, the object hides that surface's radiance (the camera's)
+// instead of the sky's, and no region beyond it (EnvOcclusionLevel::near_field_steps).
 #pragma once
 #include <memory>
 #include <string>
@@ -46,6 +52,11 @@ struct EnvOcclusionLevel {
   // Of the light stage's broad bright regions (light::Lighting::ambient_regions), at most this
   // many are hidden as cones (exact cap overlap) instead of through the SH; 0..4.
   int regions = 4;
+  // Near field (shaders/shared/occlusion_math.h): march steps of the ray past the objects that
+  // looks for a real surface beyond them (0 = off: they always hide the environment), out to
+  // near_field_m metres (a room: what lies farther is the environment the env camera sees).
+  int near_field_steps = 8;
+  float near_field_m = 3.0f;
 };
 
 class EnvironmentOcclusion {

@@ -24,11 +24,15 @@ const KnobField<BaselineLevel> kBaselineKnobs[] = {
      &BaselineLevel::env_occlusion_spheres},
     {"env_occlusion_regions", "broad bright regions of the ambient light the objects hide as cones, not through its SH (0-4)",
      &BaselineLevel::env_occlusion_regions},
+    {"env_occlusion_near_field",
+     "march steps of the ray past the objects that finds a real surface beyond them, whose radiance they hide instead "
+     "of the environment's (0 = off, at most 64)",
+     &BaselineLevel::env_occlusion_near_field},
 };
 
 shading::DirectLightLevel direct_level(const BaselineLevel& l) {
   return {l.shadow_map_size, l.pcf_radius, l.caster_cell_shadow_texels, l.shadowed_estimated_lights,
-          {l.env_occlusion_divisor, l.env_occlusion_spheres, l.env_occlusion_regions}};
+          {l.env_occlusion_divisor, l.env_occlusion_spheres, l.env_occlusion_regions, l.env_occlusion_near_field}};
 }
 
 class Baseline final : public Laddered<BaselineLevel> {
@@ -58,7 +62,7 @@ const std::array<BaselineLevel, 4>& baseline_levels() {
     for (size_t i = 0; i < 4; ++i)
       out[i] = {names[i], d[i].shadow_map_size, scales[i], d[i].pcf_radius, d[i].caster_cell_shadow_texels,
                 d[i].shadowed_estimated_lights, d[i].env_occlusion.divisor, d[i].env_occlusion.spheres_per_object,
-                d[i].env_occlusion.regions};
+                d[i].env_occlusion.regions, d[i].env_occlusion.near_field_steps};
     return out;
   }();
   return levels;
