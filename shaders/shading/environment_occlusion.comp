@@ -6,9 +6,10 @@
 // shared/occlusion_math.h, less what their objects' surfaces send it instead (albedo / pi x
 // the ambient irradiance facing the point), plus what they hide of the broad regions kept apart
 // from the SH (the part of each region's cone their caps cover). Near field (occlusion_math.h):
-// where the ray past the spheres crosses a real surface within the reach, that surface's
-// radiance (the camera's, as the real albedo image holds it) is what they hide instead of the
-// sky's, and the regions beyond it were not reaching the point. Written as rgb = that net irradiance taken away
+// where a sphere's ray past it meets a real surface within the reach, that surface's radiance
+// (the camera's) is what the sphere hides instead of the sky's, and the regions beyond it were
+// not reaching the point (real points only; spheres hiding at least 0.1 % of the hemisphere:
+// the march is the pass's main cost, and a farther sphere hides the sky as before). Written as rgb = that net irradiance taken away
 // (W/m^2, negative where an object gives more than it hides), a = the surface's key:
 // its distance to the camera, negative on a virtual surface, 0 where there is none (the
 // direct-light pass up-samples by it).
@@ -27,23 +28,41 @@ layout(set = 0, binding = 3, rgba16f) readonly uniform image2D real_normal;
 layout(set = 0, binding = 4, rgba32f) readonly uniform image2D virtual_position;
 layout(set = 0, binding = 5, rgba16f) readonly uniform image2D virtual_normal;
 layout(set = 0, binding = 6, rgba16f) writeonly uniform image2D env_occlusion;
-layout(set = 0, binding = 7, rgba16f) readonly uniform image2D real_albedo;  // rgb the camera's radiance
+layout(set = 0, binding = 7, r32ui) readonly uniform uimageBuffer color_words;  // the camera's RGB8 words
+#define MRGI_UPLOAD_COLOR_ONLY
+#include "common/upload_gather.glsl"
 
-// The radiance of the first real surface the ray from p along w crosses between `start` (the
-// sphere's far side) and `reach` metres (a march step behind the real G-buffer's surface), rgb;
-// w 1 where it crosses one, 0 where the ray leaves the view or reaches no surface (the
-// environment lies that way).
+// A march step meets a real surface where it lies behind the real G-buffer's depth by more than
+// this (metres): the depth camera's noise is not a surface.
+const float kNearFieldTolerance_m = 0.03f;
+
+// The radiance the camera measured through internal pixel q (its colour decoded and divided by
+// the exposure; not clamped, unlike the real albedo estimate, so a surface brighter than 1 counts
+// in full up to the camera's saturation).
+vec3 camera_radiance(ivec2 q) {
+  vec2 cp = project_pinhole(unproject_pinhole(vec2(q), 1.0f, frame.internal_k), frame.color_k);
+  ivec2 size = frame.color_depth_size.xy;
+  ivec2 c = clamp(ivec2(floor(cp + 0.5f)), ivec2(0), size - 1);
+  return camera_to_radiance(vec3(color_rgb8(uint(c.y * size.x + c.x))) / 255.0f, frame.camera.y);
+}
+
+// The radiance of the first real surface the ray from p along w meets between `start` (the
+// sphere's far side) and `reach` metres (a march step behind the real G-buffer's depth at its
+// nearest internal pixel by more than the tolerance; the G-buffer's surfaces are taken as
+// solid behind, as the camera cannot see past them), rgb; w 1 where it meets one, 0 where the
+// ray leaves the view or meets nothing within the reach (the environment lies that way). A
+// sphere whose far side is beyond the reach marches nowhere.
 vec4 real_surface_beyond(vec3 p, vec3 w, float start, float reach, int steps) {
+  if (!(start < reach)) return vec4(0.0f);
   const ivec2 used = frame.internal_output_size.xy;
   for (int k = 0; k < steps; ++k) {
     vec3 x = p + w * near_field_march_t(start, reach, k, steps);
     vec3 c = (frame.world_to_camera * vec4(x, 1.0f)).xyz;
     if (!(c.z > 1e-3f)) return vec4(0.0f);
-    vec2 ip = project_pinhole(c, frame.internal_k);
-    if (any(lessThan(ip, vec2(0.0f))) || any(greaterThanEqual(ip, vec2(used)))) return vec4(0.0f);
-    ivec2 q = ivec2(ip);
+    ivec2 q = ivec2(floor(project_pinhole(c, frame.internal_k) + 0.5f));
+    if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, used))) return vec4(0.0f);
     float depth = imageLoad(real_position, q).w;
-    if (depth > 0.0f && c.z > depth) return vec4(imageLoad(real_albedo, q).rgb, 1.0f);
+    if (depth > 0.0f && c.z > depth + kNearFieldTolerance_m) return vec4(camera_radiance(q), 1.0f);
   }
   return vec4(0.0f);
 }

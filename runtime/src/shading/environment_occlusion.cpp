@@ -113,7 +113,7 @@ void EnvironmentOcclusion::record(const EnvOcclusionLevel& level, const light::S
         b.bind("real_normal", r.real_normal);
         b.bind("virtual_position", r.virtual_position);
         b.bind("virtual_normal", r.virtual_normal);
-        b.bind("real_albedo", r.real_albedo);
+        b.bind("color_words", r.color_upload);
         b.bind("env_occlusion", m.image_);
       },
       [&m, divisor](VkCommandBuffer cmd, gpu::PassContext& pass) {

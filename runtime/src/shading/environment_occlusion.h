@@ -29,10 +29,13 @@
 // of spreading round the object as the SH's 4 bands do.
 //
 // What an object hides from a point is the environment only where nothing real lies beyond it:
-// in a room corner a wall looks through the object at the floor or the other wall. The pass
-// marches one ray past the objects through the real G-buffer and, where it crosses a real
-// surface within the near-field reach, the object hides that surface's radiance (the camera's)
-// instead of the sky's, and no region beyond it (EnvOcclusionLevel::near_field_steps).
+// in a room corner a wall looks through the object at the floor or the other wall. From each
+// real point the pass marches a ray per sphere proxy (towards its centre, from its far side)
+// through the real G-buffer and, where it meets a real surface within the near-field reach,
+// that sphere hides the surface's radiance (the camera's) instead of the sky's, and none of the
+// regions beyond it (EnvOcclusionLevel::near_field_steps). Virtual points keep the sky: the
+// inscribed spheres of their own object would show real surfaces through gaps the mesh does
+// not have.
 #pragma once
 #include <memory>
 #include <string>
