@@ -26,6 +26,14 @@ uvec3 color_rgb8(uint pixel) {
   uint v = shift == 0u ? lo : (lo >> shift) | (hi << (32u - shift));
   return uvec3(v & 0xffu, (v >> 8u) & 0xffu, (v >> 16u) & 0xffu);
 }
+#ifdef MRGI_FRAME_CONSTANTS_GLSL
+// The radiance the camera measured at colour pixel cp (inside the colour image): its sRGB value
+// decoded and divided by the exposure, not clamped (camera_at clamps it to a reflectance).
+vec3 camera_radiance(ivec2 cp) {
+  vec3 encoded = vec3(color_rgb8(uint(cp.y * frame.color_depth_size.x + cp.x))) / 255.0f;
+  return camera_to_radiance(encoded, frame.camera.y);
+}
+#endif
 #ifndef MRGI_UPLOAD_COLOR_ONLY
 uint depth_value(uint index) { return (imageLoad(depth_words, int(index >> 1)).x >> ((index & 1u) * 16u)) & 0xffffu; }
 
@@ -50,11 +58,7 @@ vec4 camera_at(vec2 p) {
   vec3 ray = unproject_pinhole(p, 1.0f, frame.internal_k);
   ivec2 cp = nearest_pixel(ray, frame.color_k, frame.color_depth_size.xy);
   ivec2 dp = nearest_pixel(ray, frame.depth_k, frame.color_depth_size.zw);
-  vec3 albedo = vec3(0.0f);
-  if (cp.x >= 0) {
-    vec3 encoded = vec3(color_rgb8(uint(cp.y * frame.color_depth_size.x + cp.x))) / 255.0f;
-    albedo = clamp(camera_to_radiance(encoded, frame.camera.y), vec3(0.0f), vec3(1.0f));
-  }
+  vec3 albedo = cp.x >= 0 ? clamp(camera_radiance(cp), vec3(0.0f), vec3(1.0f)) : vec3(0.0f);
   bool measured = dp.x >= 0 && depth_value(uint(dp.y * frame.color_depth_size.z + dp.x)) != 0u;
   return vec4(albedo, measured ? 1.0f : 0.0f);
 }

@@ -36,14 +36,12 @@ layout(set = 0, binding = 7, r32ui) readonly uniform uimageBuffer color_words;  
 // this (metres): the depth camera's noise is not a surface.
 const float kNearFieldTolerance_m = 0.03f;
 
-// The radiance the camera measured through internal pixel q (its colour decoded and divided by
-// the exposure; not clamped, unlike the real albedo estimate, so a surface brighter than 1 counts
-// in full up to the camera's saturation).
-vec3 camera_radiance(ivec2 q) {
+// The radiance the camera measured through internal pixel q (upload_gather.glsl's, at the
+// nearest colour pixel; not clamped, unlike the real albedo estimate, so a surface brighter than
+// 1 counts in full up to the camera's saturation).
+vec3 camera_radiance_through(ivec2 q) {
   vec2 cp = project_pinhole(unproject_pinhole(vec2(q), 1.0f, frame.internal_k), frame.color_k);
-  ivec2 size = frame.color_depth_size.xy;
-  ivec2 c = clamp(ivec2(floor(cp + 0.5f)), ivec2(0), size - 1);
-  return camera_to_radiance(vec3(color_rgb8(uint(c.y * size.x + c.x))) / 255.0f, frame.camera.y);
+  return camera_radiance(clamp(ivec2(floor(cp + 0.5f)), ivec2(0), frame.color_depth_size.xy - 1));
 }
 
 // The radiance of the first real surface the ray from p along w meets between `start` (the
@@ -62,7 +60,7 @@ vec4 real_surface_beyond(vec3 p, vec3 w, float start, float reach, int steps) {
     ivec2 q = ivec2(floor(project_pinhole(c, frame.internal_k) + 0.5f));
     if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, used))) return vec4(0.0f);
     float depth = imageLoad(real_position, q).w;
-    if (depth > 0.0f && c.z > depth + kNearFieldTolerance_m) return vec4(camera_radiance(q), 1.0f);
+    if (depth > 0.0f && c.z > depth + kNearFieldTolerance_m) return vec4(camera_radiance_through(q), 1.0f);
   }
   return vec4(0.0f);
 }

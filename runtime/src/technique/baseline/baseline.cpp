@@ -25,8 +25,8 @@ const KnobField<BaselineLevel> kBaselineKnobs[] = {
     {"env_occlusion_regions", "broad bright regions of the ambient light the objects hide as cones, not through its SH (0-4)",
      &BaselineLevel::env_occlusion_regions},
     {"env_occlusion_near_field",
-     "march steps of the ray past the objects that finds a real surface beyond them, whose radiance they hide instead "
-     "of the environment's (0 = off, at most 64)",
+     "march steps of each sphere proxy's ray past it that looks for a real surface beyond, whose radiance the proxy "
+     "hides instead of the environment's",
      &BaselineLevel::env_occlusion_near_field},
 };
 

@@ -37,7 +37,7 @@ struct BaselineLevel {
   int env_occlusion_divisor;        // internal pixels a texel side of the environment occlusion
   int env_occlusion_spheres;        // sphere proxies an object that occlude the ambient (0 = off)
   int env_occlusion_regions;        // broad bright regions of the ambient occluded as cones (0..4)
-  int env_occlusion_near_field;     // march steps looking for a real surface beyond the objects (0 = off)
+  int env_occlusion_near_field;     // march steps looking for a real surface beyond each proxy
 };
 const std::array<BaselineLevel, 4>& baseline_levels();  // the defaults
 // The defaults with RuntimeSettings::knobs applied (technique/knobs.h; BadUsage for a refused one).
