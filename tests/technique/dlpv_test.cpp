@@ -191,3 +191,45 @@ TEST(Dlpv, AblationsRunAndChangeTheFrame) {
 
 }  // namespace
 }  // namespace mrgi::test
+
+namespace mrgi::test {
+namespace {
+
+// Where the ambient already holds the real scene's bounce (lamps alone: the residual estimate),
+// the levels below the paper shade virtual pixels with it and propagate no V^rho
+// (DlpvLevel::rho_beside_bounce_ambient): the high level's frame is then the one it makes with
+// V^rho switched off, and keeping V^rho (the knob at 1, the paper's way) changes it.
+TEST(Dlpv, BelowThePaperVirtualPixelsTakeAnAmbientThatHoldsTheBounce) {
+  mrgi::testing::TempDir dir;
+  SyntheticScene scene = SyntheticScene::create(dir.str());
+  scene.scene.environment.present = false;  // lamps alone: the residual estimate
+  auto first_frame = [&](const std::vector<KnobSetting>& knobs) {
+    RuntimeSettings s;
+    s.device.validate = true;
+    s.technique = "dlpv";
+    s.level = 1;
+    s.knobs = knobs;
+    std::vector<uint8_t> last;
+    auto rt = create_runtime(s, scene.cameras(), scene.scene);
+    EXPECT_TRUE(rt.ok()) << (rt.ok() ? "" : rt.error().message);
+    if (!rt.ok()) return last;
+    auto o = (*rt)->process(scene.frame(0));
+    EXPECT_TRUE(o.ok());
+    auto rest = (*rt)->flush();
+    EXPECT_TRUE(rest.ok());
+    if (o.ok())
+      for (auto& x : *o) last = x.image.data;
+    if (rest.ok())
+      for (auto& x : *rest) last = x.image.data;
+    return last;
+  };
+  const std::vector<uint8_t> by_default = first_frame({});
+  const std::vector<uint8_t> no_rho = first_frame({{"rho_volume", 0.0}});
+  const std::vector<uint8_t> with_rho = first_frame({{"rho_beside_bounce_ambient", 1.0}});
+  ASSERT_FALSE(by_default.empty());
+  EXPECT_EQ(by_default, no_rho);
+  EXPECT_NE(by_default, with_rho);
+}
+
+}  // namespace
+}  // namespace mrgi::test

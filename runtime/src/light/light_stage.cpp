@@ -332,6 +332,7 @@ void LightStage::set_ambient_regions() {
 }
 
 void LightStage::set_probeless_lighting() {
+  lighting_.ambient_holds_real_bounce = true;
   const LightEstimate& est = estimator_->estimate();
   const ShRgb& l = estimator_->filtered();
   lighting_.lights.clear();
@@ -372,6 +373,7 @@ void LightStage::set_residual_lighting() {
     lighting_.ambient_real[size_t(i)] = i < kept ? l[size_t(i)] : glm::dvec3(0.0);
   lighting_.ambient_real[0] = glm::max(lighting_.ambient_real[0], glm::dvec3(0.0));
   lighting_.ambient_is_residual = true;
+  lighting_.ambient_holds_real_bounce = true;
   finish_declared();
 }
 
@@ -443,6 +445,7 @@ Status LightStage::update(const InputFrame& frame, const glm::dmat4& camera_to_w
       mark_near_regions(frame, camera_to_world);
       set_environment_lighting(env.real);
       lighting_.source = LightSourceKind::Environment;
+      lighting_.ambient_holds_real_bounce = settings_.unseen_from_camera && cameras_.env_camera.has_value();
     } else {
       // No environment image yet: the lamps alone (or nothing).
       lighting_.lights.resize(size_t(declared_));

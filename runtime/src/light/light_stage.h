@@ -202,6 +202,13 @@ struct Lighting {
   // ambient_real is the residual estimate (LightStageSettings::residual_light): all of the
   // real light but the lamps' direct light, the real scene's own bounce included.
   bool ambient_is_residual = false;
+  // The ambient already holds the real scene's own bounce: the residual estimate, an env
+  // camera's image whose unseen lower hemisphere is the colour camera's mean radiance
+  // (LightStageSettings::unseen_from_camera), the probeless estimate (fitted to what the camera
+  // sees); not an environment image file's ambient, which knows nothing of the real surfaces
+  // round the objects. (A technique's own bounce volume would count that bounce twice:
+  // technique/dlpv/dlpv.h rho_beside_bounce_ambient.)
+  bool ambient_holds_real_bounce = false;
   // Every real light as an estimate (SH, dominant light, confidence), the public form.
   LightEstimate estimate;
   // Bumped whenever `lights` changed (shadow maps are re-planned on a change only).

@@ -20,11 +20,11 @@ namespace mrgi::technique {
 
 const std::array<DlpvLevel, 5>& dlpv_levels() {
   static const std::array<DlpvLevel, 5> levels = {{
-      {"paper", 32, 32, 512, 4, true, 1.0f, true, 0},
-      {"high", 32, 32, 512, 4, true, 1.0f, false, 0},
-      {"medium", 16, 16, 256, 2, true, 1.0f, false, 1},
-      {"fast", 8, 8, 128, 1, false, 0.5f, false, 3},
-      {"fastest", 8, 4, 64, 1, false, 0.5f, false, 3},
+      {"paper", 32, 32, 512, 4, true, 1.0f, true, 0, true},
+      {"high", 32, 32, 512, 4, true, 1.0f, false, 0, false},
+      {"medium", 16, 16, 256, 2, true, 1.0f, false, 1, false},
+      {"fast", 8, 8, 128, 1, false, 0.5f, false, 3, false},
+      {"fastest", 8, 4, 64, 1, false, 0.5f, false, 3, false},
   }};
   return levels;
 }
@@ -40,6 +40,10 @@ const KnobField<DlpvLevel> kDlpvKnobs[] = {
     {"antiradiance_shadows", "1: shadows as the volume's antiradiance (Algorithm 1); 0: the direct-light block's shadow maps",
      &DlpvLevel::antiradiance_shadows},
     {"baseline_level", "the direct-light block's level for the shadow maps", &DlpvLevel::baseline_level},
+    {"rho_beside_bounce_ambient",
+     "1: V^rho on virtual pixels also where the ambient already holds the real bounce (residual estimate, env camera); "
+     "0: the ambient there",
+     &DlpvLevel::rho_beside_bounce_ambient},
 };
 }  // namespace
 
@@ -82,7 +86,7 @@ class Dlpv final : public Laddered<DlpvLevel> {
   };
   Status record_volumes(const frame::FrameInfo& info, const DlpvLevel& level, MadeVolumes& made,
                         std::vector<std::string>& skipped);
-  uint32_t inject_lamps(const DlpvLevel& level, float radius, uint32_t stride, std::vector<std::string>& skipped);
+  uint32_t inject_lamps(const DlpvLevel& level, bool rho, float radius, uint32_t stride, std::vector<std::string>& skipped);
   void add_merge_pass(const MergePush& push, gpu::ImageHandle env_occlusion);
 
   frame::FrameResources shared_;
@@ -250,13 +254,15 @@ Status Dlpv::record_volumes(const frame::FrameInfo& info, const DlpvLevel& level
         reuse_.add_lamp(lighting.lights[i]);
         ++n;
       }
-    const bool reuse = reuse_.close();
+    // V^rho this frame (DlpvLevel::rho_beside_bounce_ambient).
+    const bool rho = level.rho_volume && (level.rho_beside_bounce_ambient || !lighting.ambient_holds_real_bounce);
+    const bool reuse = reuse_.close() && (two || source_rho_ == rho);
     uint32_t lamps = 0;
     if (reuse) {
       lamps = uint32_t(reuse_.lamp_count());
       skipped.push_back("dlpv maps and volumes: reused (level, pose, depth and lamps within tolerance of the frame that made them)");
     }
-    if (!reuse) lamps = inject_lamps(level, radius, stride, skipped);
+    if (!reuse) lamps = inject_lamps(level, rho, radius, stride, skipped);
     if (reuse) {
       delta_present = source_delta_;
       rho_present = source_rho_;
@@ -271,7 +277,7 @@ Status Dlpv::record_volumes(const frame::FrameInfo& info, const DlpvLevel& level
     } else {
       delta_->add_propagate(graph, level.steps);
       delta_present = true;
-      if (level.rho_volume) {
+      if (rho) {
         rho_->add_propagate(graph, level.steps);
         rho_present = true;
       }
@@ -279,6 +285,8 @@ Status Dlpv::record_volumes(const frame::FrameInfo& info, const DlpvLevel& level
     if (!level.rho_volume)
       skipped.push_back("dlpv rho volume: level '" + std::string(level.name) +
                         "' shades virtual pixels with lamps and ambient only");
+    else if (!rho && !two)
+      skipped.push_back("dlpv rho volume: the ambient already holds the real scene's bounce; virtual pixels take it");
     if (!reuse) {
       // Remembered only when made from a depth frame the next one can be compared with.
       reuse_.remember();
@@ -294,7 +302,8 @@ Status Dlpv::record_volumes(const frame::FrameInfo& info, const DlpvLevel& level
 // Each real lamp's map pair (strongest first, the level's number) injected: V^Delta from the
 // texels the objects change, V^rho (and V^mu in the ablation), V^Delta's antiradiance at the
 // paper level. Returns the lamps injected.
-uint32_t Dlpv::inject_lamps(const DlpvLevel& level, float radius, uint32_t stride, std::vector<std::string>& skipped) {
+uint32_t Dlpv::inject_lamps(const DlpvLevel& level, bool rho, float radius, uint32_t stride,
+                            std::vector<std::string>& skipped) {
   gpu::FrameGraph& graph = *shared_.graph;
   const bool antiradiance = level.antiradiance_shadows;
   const bool two = mu_.has_value();  // DlpvAblation::two_volumes
@@ -315,7 +324,7 @@ uint32_t Dlpv::inject_lamps(const DlpvLevel& level, float radius, uint32_t strid
         mu_->add_clear(graph);
       } else {
         delta_->add_clear(graph);
-        if (level.rho_volume) rho_->add_clear(graph);
+        if (rho) rho_->add_clear(graph);
       }
       rsm_->add_grid(graph, stride);
       grid_added = true;
@@ -327,7 +336,7 @@ uint32_t Dlpv::inject_lamps(const DlpvLevel& level, float radius, uint32_t strid
     // V^Delta = R^rho's VPLs - R^mu's, from the texels the virtual objects cover (the rest
     // cancel exactly, rsm.h), in one pass.
     if (!two) delta_->add_inject(graph, "delta " + id, rho_map, view->lpv, gi::InjectKind::Indirect, 1.0f, &mu_map);
-    if (level.rho_volume || two)
+    if (rho || two)
       rho_->add_inject(graph, "rho " + id, rho_map, view->lpv,
                        !two && ablation_.no_virtual_self_bounce ? gi::InjectKind::IndirectFromReal
                                                                             : gi::InjectKind::Indirect,

@@ -4,15 +4,18 @@
 // one volume centred on the virtual objects as +R^rho - R^mu, VPLs (eq. 12-13) and direct light
 // (Sec. 4.3.2, the antiradiance that shadows), propagated (gi/light_propagation.h), and merged
 // as Algorithm 1 (shaders/dlpv/merge.comp). The best levels also propagate V^rho (R^rho alone)
-// for the virtual pixels' bounce light.
+// for the virtual pixels' bounce light: the paper level always, high and medium only where the
+// light stage's ambient does not already hold the real scene's bounce (an environment image
+// file's ambient); elsewhere their virtual pixels take that ambient (rho_beside_bounce_ambient).
 //
 // Quality ladder (best first; DlpvLevel below, with units):
 //   level    volume  steps  RSM    RSM lamps  V^rho  internal scale  shadows
 //   paper    32^3    32     512^2  4          yes    1.0             antiradiance (Algorithm 1)
-//   high     32^3    32     512^2  4          yes    1.0             baseline high's shadow maps
-//   medium   16^3    16     256^2  2          yes    1.0             baseline medium's
+//   high     32^3    32     512^2  4          (1)    1.0             baseline high's shadow maps
+//   medium   16^3    16     256^2  2          (1)    1.0             baseline medium's
 //   fast      8^3     8     128^2  1          no     0.5             baseline lowest's (the reduced-volume fast path)
 //   fastest   8^3     4      64^2  1          no     0.5             baseline lowest's
+// (1) where the ambient is an environment image file's (rho_beside_bounce_ambient).
 // "paper" is the published method with its settings (Sec. 5); the others keep its volume and
 // light the scene directly with shadow maps (Sec. 7's alternative), because the antiradiance
 // shadow is coarse (a 32^3 volume over twice the object) and cut off where the volume ends.
@@ -81,6 +84,17 @@ struct DlpvLevel {
   // carrying the bounce light's change only (the paper's Sec. 7 alternative).
   bool antiradiance_shadows;
   int baseline_level;      // the direct-light block's level for the shadow maps (when not antiradiance)
+  // V^rho (with rho_volume) on virtual pixels also where the light stage's ambient already holds
+  // the real scene's bounce (light::Lighting::ambient_holds_real_bounce: the lamps' residual
+  // estimate, an env camera's unseen lower hemisphere lit by the colour camera's mean radiance,
+  // the probeless estimate): the paper's. false: there the virtual pixels take that ambient, as
+  // baseline's do, and V^rho is not propagated; it is kept where the ambient is an environment
+  // image's, which knows nothing of the real surfaces round the object. Why: V^rho added to
+  // such an ambient counts the bounce twice, and in its place it loses the room's further
+  // bounces, while the volume, which does not block its own light, lets a convex object's lit
+  // face light the object's other faces (spot_in_fisheye, a white box under a spot: virtual-pixel
+  // RDE 0.68 with V^rho, 0.17 with the ambient; corner 0.43 / 0.29; desk_spot 0.35 / 0.19).
+  bool rho_beside_bounce_ambient;
 };
 const std::array<DlpvLevel, 5>& dlpv_levels();  // the defaults
 // The defaults with RuntimeSettings::knobs applied (technique/knobs.h; BadUsage for a refused one).
