@@ -96,6 +96,9 @@ void main() {
         if ((flags & MRGI_VPL_VALID) == 0) continue;
         bool real_only = (flags & MRGI_VPL_REAL_ONLY) != 0;
         if (real_only && (is_virtual || kNoRealOnly)) continue;  // ir(VPL): real surfaces only
+        // The real surfaces' bounce is already in the ambient's lower hemisphere (params.lighting.w).
+        if (is_virtual && params.lighting.w > 0.5f && (flags & (MRGI_VPL_REAL_PATH | MRGI_VPL_DIRECTIONAL)) == MRGI_VPL_REAL_PATH)
+          continue;
         vec3 e = vpl_incident(v, p, n, params.lighting.x);
         if (!any(greaterThan(e, vec3(0.0f)))) continue;
         vec2 stored;

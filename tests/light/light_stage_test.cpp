@@ -522,3 +522,55 @@ TEST(LightStage, BrightNearSurfacesAreNotDistantLights) {
   EXPECT_GE(lights_with_wall_at(4.2), 1u);
 }
 }  // namespace
+
+namespace {
+// Which ambients already hold the real scene's bounce (Lighting::ambient_holds_real_bounce,
+// ambient_below_from_camera): an env camera's image, whose unseen lower hemisphere is the colour
+// camera's mean radiance, does (and not without that prior); an environment image file does not;
+// the lamps' residual estimate holds it but not from the camera's view below.
+TEST(LightStage, SaysWhetherItsAmbientHoldsTheRealBounce) {
+  const int w = 64, h = 32;
+  ImageRGBF env(w, h, 0.2f);
+  CameraSetup setup;
+  setup.color = setup.depth = Intrinsics{64, 48, 50.0, 50.0, 31.5, 23.5};
+  setup.depth_scale = 1000.0;
+  EnvCamera cam;
+  cam.position = glm::dvec3(0.0);
+  setup.env_camera = cam;
+  auto lighting_after_a_frame = [&](const SceneDesc& scene, const LightStageSettings& settings) {
+    auto stage = LightStage::create(settings, scene, setup);
+    EXPECT_TRUE(stage.ok()) << (stage.ok() ? "" : stage.error().message);
+    InputFrame f;
+    if (scene.environment.from_env_camera) f.env = env;
+    f.color = ImageRGB8(64, 48, 128);
+    f.depth = ImageU16(64, 48, uint16_t(2000));
+    std::vector<std::string> notes;
+    EXPECT_TRUE((*stage)->update(f, glm::dmat4(1.0), notes).ok());
+    return (*stage)->lighting();
+  };
+  auto expect_flags = [](const Lighting& l, bool holds, bool below, const char* what) {
+    EXPECT_EQ(l.ambient_holds_real_bounce, holds) << what;
+    EXPECT_EQ(l.ambient_below_from_camera, below) << what;
+  };
+  SceneDesc camera_env;
+  camera_env.environment.present = true;
+  camera_env.environment.from_env_camera = true;
+  expect_flags(lighting_after_a_frame(camera_env, {}), true, true, "env camera");
+  LightStageSettings no_prior;
+  no_prior.unseen_from_camera = false;
+  expect_flags(lighting_after_a_frame(camera_env, no_prior), false, false, "env camera, dark below");
+  const std::string path = ::testing::TempDir() + "light_stage_bounce_file.exr";
+  ASSERT_TRUE(write_exr(path, env).ok());
+  SceneDesc file_env;
+  file_env.environment.present = true;
+  file_env.environment.image = path;
+  expect_flags(lighting_after_a_frame(file_env, {}), false, false, "environment file");
+  SceneDesc lamps;
+  LightDesc lamp;
+  lamp.position = glm::vec3(0.0f, 1.0f, 1.0f);
+  lamps.lights.push_back(lamp);
+  const Lighting residual = lighting_after_a_frame(lamps, {});
+  ASSERT_TRUE(residual.ambient_is_residual);
+  expect_flags(residual, true, false, "residual estimate");
+}
+}  // namespace

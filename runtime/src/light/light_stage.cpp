@@ -446,6 +446,7 @@ Status LightStage::update(const InputFrame& frame, const glm::dmat4& camera_to_w
       set_environment_lighting(env.real);
       lighting_.source = LightSourceKind::Environment;
       lighting_.ambient_holds_real_bounce = settings_.unseen_from_camera && cameras_.env_camera.has_value();
+      lighting_.ambient_below_from_camera = lighting_.ambient_holds_real_bounce;
     } else {
       // No environment image yet: the lamps alone (or nothing).
       lighting_.lights.resize(size_t(declared_));

@@ -209,6 +209,11 @@ struct Lighting {
   // round the objects. (A technique's own bounce volume would count that bounce twice:
   // technique/dlpv/dlpv.h rho_beside_bounce_ambient.)
   bool ambient_holds_real_bounce = false;
+  // Of those, an env camera's image whose unseen lower hemisphere is the colour camera's mean
+  // radiance (LightStageSettings::unseen_from_camera): the real surfaces' light, local bounce
+  // included, is the ambient's light from below (technique/dir/dir.h
+  // real_bounce_beside_camera_ambient).
+  bool ambient_below_from_camera = false;
   // Every real light as an estimate (SH, dominant light, confidence), the public form.
   LightEstimate estimate;
   // Bumped whenever `lights` changed (shadow maps are re-planned on a change only).

@@ -22,11 +22,11 @@ namespace mrgi::technique {
 
 const std::array<DirLevel, 5>& dir_levels() {
   static const std::array<DirLevel, 5> levels = {{
-      {"paper", 256, 64, 16, 128, 1024, 512, 4, 4, 1, 1.0f, 0.0f, -1, 0},
-      {"high", 256, 64, 0, 64, 512, 256, 4, 4, 1, 1.0f, 0.0f, -1, 0},
-      {"medium", 64, 16, 0, 64, 512, 256, 2, 4, 1, 1.0f, 0.0f, -1, 1},
-      {"fast", 32, 0, 0, 32, 256, 64, 1, 4, 2, 0.5f, 0.5f, 0, 3},
-      {"fastest", 16, 0, 0, 32, 128, 64, 1, 4, 2, 0.5f, 0.5f, 0, 3},
+      {"paper", 256, 64, 16, 128, 1024, 512, 4, 4, 1, 1.0f, 0.0f, -1, 0, true},
+      {"high", 256, 64, 0, 64, 512, 256, 4, 4, 1, 1.0f, 0.0f, -1, 0, false},
+      {"medium", 64, 16, 0, 64, 512, 256, 2, 4, 1, 1.0f, 0.0f, -1, 1, false},
+      {"fast", 32, 0, 0, 32, 256, 64, 1, 4, 2, 0.5f, 0.5f, 0, 3, false},
+      {"fastest", 16, 0, 0, 32, 128, 64, 1, 4, 2, 0.5f, 0.5f, 0, 3, false},
   }};
   return levels;
 }
@@ -47,6 +47,10 @@ const KnobField<DirLevel> kDirKnobs[] = {
      &DirLevel::mesh_error_px},
     {"shadowed_env", "environment regions the direct-light block shadows with maps (-1: its level's)", &DirLevel::shadowed_env},
     {"baseline_level", "the direct-light block's level for the direct light", &DirLevel::baseline_level},
+    {"real_bounce_beside_camera_ambient",
+     "1: virtual pixels take the real-path VPLs' bounce also where the ambient's lower hemisphere is the colour "
+     "camera's light (env camera); 0: the ambient's there",
+     &DirLevel::real_bounce_beside_camera_ambient},
 };
 }  // namespace
 
@@ -475,7 +479,11 @@ Expected<shading::ScreenIndirect> Dir::record_vpl_light(const frame::FrameInfo& 
   const VkExtent2D low = graph.extent(indirect_);
   const DirPush push{glm::ivec4(int(level.vpls), int(level.ism_size), int(ism_->tiles_per_row(level.vpls)),
                                 int(level.interleave)),
-                     glm::vec4(clamp_m, kIsmBiasRelative, kIsmBiasMetres, 0.0f),
+                     glm::vec4(clamp_m, kIsmBiasRelative, kIsmBiasMetres,
+                               !level.real_bounce_beside_camera_ambient &&
+                                       shared_.light_stage->lighting().ambient_below_from_camera
+                                   ? 1.0f
+                                   : 0.0f),
                      glm::ivec4(int(low.width), int(low.height), int(level.indirect_divisor), int(level.vpls - slots.env))};
   const frame::FrameResources& r = shared_;
   const gpu::Pipeline* shade = &*shade_;
