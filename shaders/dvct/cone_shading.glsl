@@ -2,7 +2,9 @@
 // (the levels that light directly with the direct-light block's shadow maps) and shade.comp (the paper's
 // level, shadow cones too). Needs, declared before it: shared/mrgi_shared.h, shared/vct_math.h,
 // gi/vct_trace.glsl, common/light_set.glsl, common/surface_shading.glsl, the samplers
-// light_volume, delta_volume, scene_visibility, object_visibility, `DvctParams params`,
+// light_volume, delta_volume, scene_visibility, object_visibility, object_light (the objects'
+// ambient and emission, read by the specular cone alone), `DvctParams params`,
+// common/env_grid.glsl (its env_cells buffer),
 // `DvctRealMaterials real_materials`,
 // `AmbientIrradiance ambient_rv`, and the specialisation constants kDiffuseCones (cones in the
 // diffuse set, 0 none) and kSpecular (the specular cone compiled in).
@@ -60,7 +62,7 @@ DvctGather dvct_diffuse(vec3 p, vec3 n, int flags) {
   for (int i = 0; i < kDiffuseCones; ++i) {
     const VctCone c = vct_diffuse_cone(i, kDiffuseCones);
     const vec3 dir = normalize(t * c.dir.x + b * c.dir.y + n * c.dir.z);
-    const VctResult r = vct_trace_cone(light_volume, delta_volume, scene_visibility, object_visibility, v, apex, dir,
+    const VctResult r = vct_trace_cone(light_volume, delta_volume, scene_visibility, object_visibility, object_light, v, apex, dir,
                                        c.aperture, params.cones.z, flags);
     g.with += c.weight * r.light_with;
     g.without += c.weight * r.light_without;
@@ -82,17 +84,25 @@ DvctSpecular dvct_specular(vec3 p, vec3 n, vec3 view, vec3 f0, float roughness, 
   const float nv = dot(n, view);
   if (!kSpecular || roughness >= params.cones.w || nv <= 0.0f) return s;
   const vec3 refl = reflect(-view, n);
+  const float aperture = vct_specular_aperture(roughness, params.cones.y);
   // A glancing mirror direction runs along the surface it leaves, inside that surface's own voxels
   // (trilinear reads spread it over a voxel either side): the cone starts where its axis is two
   // voxels above the surface (at most 8 voxels along it), so a glossy table at the camera's
   // glancing angle is not occluded by itself before the reflected object.
   const float lift = 2.0f / max(dot(refl, n), 0.25f) - 1.0f;
-  const VctResult r = vct_trace_cone(light_volume, delta_volume, scene_visibility, object_visibility, dvct_volume(),
+  const VctResult r = vct_trace_cone(light_volume, delta_volume, scene_visibility, object_visibility, object_light, dvct_volume(),
                                      dvct_apex(p, n) + refl * (lift * params.volume.w),
-                                     refl, vct_specular_aperture(roughness, params.cones.y), params.cones.z, flags);
-  // The ambient seen along the mirror direction: its irradiance there over pi (a radiance the
-  // SH bands 0..2 hold only smoothly, the same light the diffuse term uses).
-  const vec3 env = ambient_irradiance(ambient_rv, refl) * (1.0f / MRGI_PI);
+                                     refl, aperture, params.cones.z,
+                                     params.mode.w != 0 ? flags | VCT_OBJECT_LIGHT : flags);
+  // The environment seen along the mirror direction: the environment grid's mean radiance over
+  // the cone (common/env_grid.glsl). Not the ambient's irradiance over pi (the cosine-weighted
+  // mean over the hemisphere around it), which it falls back to without an environment image: a
+  // glancing reflection on a floor looks at the horizon, and that mean takes in the bright sky
+  // above it, which an object in the reflection was then measured to hide (a glossy floor under
+  // a room's light: the reflection darkened where the truth brightens).
+  const vec3 env = params.texture.y > 0.5f
+                       ? env_grid_cone(refl, 0.5f * aperture, int(params.texture.y), int(params.texture.z))
+                       : ambient_irradiance(ambient_rv, refl) * (1.0f / MRGI_PI);
   const vec3 w = vct_specular_weight(f0, roughness, nv);
   s.with = w * (r.light_with + env * r.trans_with);
   s.without = w * (r.light_without + env * r.trans_without);

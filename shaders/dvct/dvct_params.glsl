@@ -18,9 +18,12 @@ struct DvctParams {
                  // specular cone is traced (the diffuse cones hold that light)
   ivec4 mode;    // x: G-buffer pixels per indirect texel (indirect.comp); y: 1 the volumes hold
                  // this frame's light (0: no virtual object or lamp: nothing changes); z: the
-                 // environment occlusion's divisor (shade.comp; 0: none this frame); w unused
+                 // environment occlusion's divisor (shade.comp; 0: none this frame); w: 1 the
+                 // specular cone sees the objects' own light volume (their ambient and emission)
   vec4 texture;  // x: voxels per side allocated (a cheaper level uses a corner of each mip
-                 // level: texture coordinates divide by this); y, z, w unused
+                 // level: texture coordinates divide by this); y: the environment grid's width
+                 // (EnvCells, common/env_grid.glsl; 0: none, the ambient's irradiance stands in);
+                 // z: its pyramid's levels; w unused
 };
 
 // The real material regions (scene.json real_materials, mrgi/scene.h RealMaterialRegion): a real

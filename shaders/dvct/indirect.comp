@@ -41,6 +41,9 @@ layout(set = 0, binding = 10) uniform sampler3D scene_visibility;
 layout(set = 0, binding = 11) uniform sampler3D object_visibility;
 layout(set = 0, binding = 12, rgba32ui) writeonly uniform uimage2D indirect;
 layout(std140, set = 0, binding = 13) uniform RealMaterialUbo { DvctRealMaterials real_materials; };
+layout(set = 0, binding = 14) uniform sampler3D object_light;  // the objects' ambient and emission (mode.w)
+layout(std430, set = 0, binding = 15) readonly buffer EnvCells { vec4 env_cells[]; };  // params.texture.y
+#include "common/env_grid.glsl"
 layout(push_constant) uniform Params { DvctParams params_block; };
 DvctParams params;
 layout(constant_id = 0) const int kDiffuseCones = 9;

@@ -43,6 +43,9 @@ layout(push_constant) uniform Params { DvctParams params_block; };
 // per params.mode.z internal pixels (0: none this frame): the ambient is unshadowed here as in
 // baseline, and its occlusion by the objects is the block's, not the cones'.
 layout(set = 0, binding = 16, rgba16f) readonly uniform image2D env_occlusion;
+layout(set = 0, binding = 17) uniform sampler3D object_light;  // the objects' ambient and emission (mode.w)
+layout(std430, set = 0, binding = 18) readonly buffer EnvCells { vec4 env_cells[]; };  // params.texture.y
+#include "common/env_grid.glsl"
 DvctParams params;
 layout(constant_id = 0) const int kDiffuseCones = 9;
 layout(constant_id = 1) const bool kSpecular = true;
@@ -92,7 +95,7 @@ void main() {
     float t_with = 1.0f, t_without = 1.0f;
     if (volumes) {
       const float reach = int(L.position_type.w) == MRGI_LIGHT_DIRECTIONAL ? 1e6f : distance(L.position_type.xyz, p);
-      const VctResult s = vct_trace_cone(light_volume, delta_volume, scene_visibility, object_visibility, v, apex, wi,
+      const VctResult s = vct_trace_cone(light_volume, delta_volume, scene_visibility, object_visibility, object_light, v, apex, wi,
                                          params.cones.x, reach, 0);
       t_with = s.trans_with;
       t_without = s.trans_without;

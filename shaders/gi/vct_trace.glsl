@@ -41,11 +41,17 @@ struct VctResult {
 
 const int VCT_LIGHT = 1;    // gather light (else: occlusion only, a shadow cone)
 const int VCT_WITHOUT = 2;  // also the accumulation without the objects
+// With VCT_LIGHT: the objects' own light volume (their ambient and emission,
+// voxel_inject_surfaces.comp) adds to the light "with" them; "without" never holds it. Only the
+// specular cone reads it: the diffuse cones' share of that light is the direct-light block's
+// (its environment occlusion gives back the objects' ambient-lit surfaces).
+const int VCT_OBJECT_LIGHT = 4;
 
 VctResult vct_trace_cone(sampler3D light_volume, sampler3D delta_volume, sampler3D scene_visibility,
-                         sampler3D object_visibility, VctVolume v, vec3 origin, vec3 dir, float aperture,
-                         float max_distance, int flags) {
+                         sampler3D object_visibility, sampler3D object_light, VctVolume v, vec3 origin, vec3 dir,
+                         float aperture, float max_distance, int flags) {
   const bool want_light = (flags & VCT_LIGHT) != 0, want_without = (flags & VCT_WITHOUT) != 0;
+  const bool want_object_light = want_light && (flags & VCT_OBJECT_LIGHT) != 0;
   const float ratio = vct_diameter_ratio(aperture);
   const float min_diameter = 0.5f;                        // voxels
   const vec3 start = (origin - v.origin) / v.voxel_size;  // voxel units
@@ -77,8 +83,9 @@ VctResult vct_trace_cone(sampler3D light_volume, sampler3D delta_volume, sampler
     const float a_with = 1.0f - (1.0f - a_s) * (1.0f - a_o);
     if (want_light) {
       const vec3 light = textureLod(light_volume, uvw, lod).rgb;
+      const vec3 light_with = want_object_light ? light + textureLod(object_light, uvw, lod).rgb : light;
       const vec4 both = vec4(vis_s.xyz + vis_o.xyz, min(vis_s.w + vis_o.w, 1.0f));
-      const vec4 s = vct_sample(light, both, dir, v.occlusion_floor, lod);
+      const vec4 s = vct_sample(light_with, both, dir, v.occlusion_floor, lod);
       r.light_with += vct_light_for_step(s, v.step_scale) * r.trans_with;
       if (want_without) {
         const vec3 scene_light = light - textureLod(delta_volume, uvw, lod).rgb;

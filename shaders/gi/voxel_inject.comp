@@ -29,13 +29,7 @@ layout(push_constant) uniform InjectParams {
   vec4 sign;    // x: +1 or -1
 } params_block;
 
-void add_flux(vec3 at, vec3 flux, vec4 region, int n) {
-  const ivec3 c = ivec3(floor((at - region.xyz) / region.w));
-  if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(n)))) return;
-  const int base = ((c.z * n + c.y) * n + c.x) * 3;
-  for (int ch = 0; ch < 3; ++ch)
-    if (flux[ch] != 0.0) imageAtomicAdd(cells, base + ch, flux[ch]);
-}
+#include "gi/voxel_flux.glsl"
 
 void main() {
   const vec4 region = params_block.region;  // copied first: MRGI_UNIFORM_COPIES

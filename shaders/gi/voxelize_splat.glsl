@@ -8,6 +8,10 @@
 // cost follows the surface area inside the region (samples outside it are dropped).
 // Needs: GL_EXT_shader_atomic_float, an r32f imageBuffer `cells` (4 floats a cell: normal x
 // area xyz, area; area in voxel^2), and the push block's `region` and `cells_per_side`.
+// A shader that splats something else per sample (voxel_inject_surfaces.comp: a material's
+// light) defines MRGI_SPLAT_VISIT(world, bary, g, sub_area) before including this: `bary` the
+// sample's weights of p1 and p2, `g` the oriented unit face normal, `sub_area` in voxel^2; such a
+// shader drops degenerate triangles (nothing to light).
 
 // Sub-triangles per edge at most: a triangle longer than kMaxSplit / 2 voxels is sampled more
 // sparsely than half a voxel (holes between samples possible); at a 64^3 volume that is a
@@ -15,6 +19,7 @@
 // region as a plane the samples still cover at 2 voxels' spacing or less.
 const int kMaxSplit = 128;
 
+#ifndef MRGI_SPLAT_VISIT
 void splat_sample(vec3 world, vec3 normal_area, float area, vec4 region, int n) {
   const ivec3 c = ivec3(floor((world - region.xyz) / region.w));
   if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(n)))) return;
@@ -25,6 +30,12 @@ void splat_sample(vec3 world, vec3 normal_area, float area, vec4 region, int n) 
   imageAtomicAdd(cells, base + 3, area);
 }
 
+#define MRGI_SPLAT_VISIT(world, bary, g, sub_area) splat_sample(world, g * sub_area, sub_area, region, n)
+#define MRGI_SPLAT_DEGENERATE(p0) splat_sample(p0, vec3(0.0), 1e-6, region, n)
+#else
+#define MRGI_SPLAT_DEGENERATE(p0)
+#endif
+
 // `oriented`: a normal on the triangle's front side (the geometric normal is turned to agree).
 void splat_triangle(vec3 p0, vec3 p1, vec3 p2, vec3 oriented, vec4 region, int n) {
   const vec3 e1 = (p1 - p0) / region.w, e2 = (p2 - p0) / region.w;  // voxels
@@ -32,7 +43,7 @@ void splat_triangle(vec3 p0, vec3 p1, vec3 p2, vec3 oriented, vec4 region, int n
   const float twice_area = length(g);
   if (!(twice_area > 0.0)) {
     // Degenerate (a line or a point): its vertices still mark their voxels as occupied.
-    splat_sample(p0, vec3(0.0), 1e-6, region, n);
+    MRGI_SPLAT_DEGENERATE(p0);
     return;
   }
   g /= twice_area;
@@ -50,8 +61,8 @@ void splat_triangle(vec3 p0, vec3 p1, vec3 p2, vec3 oriented, vec4 region, int n
       // The sub-triangle (i, j), (i + 1, j), (i, j + 1) and, but on the last diagonal, the
       // flipped one (i + 1, j), (i + 1, j + 1), (i, j + 1): their centroids.
       const vec3 base = p0 + float(i) * a + float(j) * b;
-      splat_sample(base + (a + b) / 3.0, g * sub_area, sub_area, region, n);
-      if (j < k - i - 1) splat_sample(base + 2.0 * (a + b) / 3.0, g * sub_area, sub_area, region, n);
+      MRGI_SPLAT_VISIT(base + (a + b) / 3.0, (vec2(i, j) + 1.0 / 3.0) / float(k), g, sub_area);
+      if (j < k - i - 1) MRGI_SPLAT_VISIT(base + 2.0 * (a + b) / 3.0, (vec2(i, j) + 2.0 / 3.0) / float(k), g, sub_area);
     }
   }
 }

@@ -34,8 +34,9 @@ void main() {
   v.occlusion_floor = sizes.z;
   v.step_scale = sizes.w;
   const vec4 a = cones[4u * i], b = cones[4u * i + 1u];
-  const VctResult r = vct_trace_cone(light_volume, delta_volume, scene_visibility, object_visibility, v, a.xyz,
-                                     normalize(b.xyz), a.w, b.w, flags);
+  // No objects' own light volume here (the flag is masked off; delta_volume only fills the slot).
+  const VctResult r = vct_trace_cone(light_volume, delta_volume, scene_visibility, object_visibility, delta_volume, v, a.xyz,
+                                     normalize(b.xyz), a.w, b.w, flags & ~VCT_OBJECT_LIGHT);
   cones[4u * i + 2u] = vec4(r.light_with, r.trans_with);
   cones[4u * i + 3u] = vec4(r.light_without, r.trans_without);
 }

@@ -70,6 +70,7 @@ layout(set = 0, binding = 19, rgba16f) uniform image2D lit_r;
 // The light stage's environment grid (light/env_sampler.h: world-space equirectangular cells
 // of filtered radiance, u = 0.5 + atan2(x, -z) / 2 pi, v = acos(y) / pi), flags.z cells wide.
 layout(std430, set = 0, binding = 20) readonly buffer EnvGrid { vec4 env_cells[]; };
+#include "common/env_grid.glsl"
 // The spot lamps' caustics on the surfaces the camera sees (caustics.h; flags.w 1 when written
 // this frame): rgb irradiance.
 layout(set = 0, binding = 21, rgba16f) readonly uniform image2D caustics;
@@ -117,12 +118,6 @@ vec4 back_project(vec3 x) {
   return vec4(srgb_decode(vec3(color_rgb8(uint(q.y * size.x + q.x))) / 255.0f), 1.0f);
 }
 
-vec3 env_cell(int x, int y, int w) {
-  x = x - w * int(floor(float(x) / float(w)));  // wraps around in longitude
-  y = clamp(y, 0, w / 2 - 1);
-  return env_cells[y * w + x].rgb;
-}
-
 // The internal pixel where the camera sees x itself (a real surface, or a diffuse virtual one as
 // `real` says): inside the view, the G-buffer's depth there within the tolerance of x's; for a
 // real x, no virtual object in front of it there (a specular one allowed when `under_specular`:
@@ -165,14 +160,7 @@ vec3 caustic_at(vec3 x, bool real) {
 vec3 environment_radiance(vec3 d) {
   d = normalize(d);
   int w = specular.flags.z;
-  if (w > 0) {
-    vec2 uv = vec2(0.5f + atan(d.x, -d.z) / (2.0f * MRGI_PI), acos(clamp(d.y, -1.0f, 1.0f)) / MRGI_PI);
-    vec2 c = uv * vec2(float(w), float(w / 2)) - 0.5f;
-    ivec2 c0 = ivec2(floor(c));
-    vec2 f = c - vec2(c0);
-    return mix(mix(env_cell(c0.x, c0.y, w), env_cell(c0.x + 1, c0.y, w), f.x),
-               mix(env_cell(c0.x, c0.y + 1, w), env_cell(c0.x + 1, c0.y + 1, w), f.x), f.y);
-  }
+  if (w > 0) return env_grid_bilinear(d, w, 0);
   SH16 y = sh_basis16(d);
   vec3 sum = vec3(0.0f);
   for (int i = 0; i < 16; ++i) sum += specular.env_sh[i].rgb * sh_get(y, i);

@@ -181,6 +181,47 @@ TEST(EnvSampler, FisheyeLookingUpSeesTheSunWhereItIs) {
   }
 }
 
+// The grid's pyramid for cones wider than a cell (what dvct's specular cone reads of the
+// environment): every level holds the grid's energy (sum of L dw with each level's exact cell
+// solid angles) within 1 %, a uniform sky stays uniform, and the sun stays in its direction: the
+// brightest cell of every level is the one holding the sun.
+TEST(EnvSampler, ConePyramidKeepsTheEnergyAndTheSunsDirection) {
+  const Sky sky;
+  auto s = EnvSampler::create({});
+  ASSERT_TRUE(s.ok()) << s.error().message;
+  ASSERT_TRUE(s->update(sky.image(), EnvCamera{}, glm::dquat(1, 0, 0, 0)).ok());
+  std::vector<glm::vec4> cells;
+  const int w0 = s->settings().grid_width;
+  ASSERT_EQ(s->cone_pyramid(5, cells), 5);
+  ASSERT_EQ(cells.size(), EnvSampler::cone_pyramid_cells(w0, 5));
+  ASSERT_EQ(cells.size(), size_t(64 * 32 + 32 * 16 + 16 * 8 + 8 * 4 + 4 * 2));
+  size_t first = 0;
+  glm::dvec3 level0(0.0);
+  for (int l = 0; l < 5; ++l) {
+    const int w = w0 >> l, h = w / 2;
+    glm::dvec3 energy(0.0);
+    size_t brightest = first;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const size_t i = first + size_t(y) * w + size_t(x);
+        const double dw = (std::cos(kPi * y / h) - std::cos(kPi * (y + 1) / h)) * 2.0 * kPi / w;
+        energy += glm::dvec3(cells[i]) * dw;
+        if (cells[i].g > cells[brightest].g) brightest = i;
+      }
+    if (l == 0) level0 = energy;
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(energy[c], level0[c], 0.01 * level0[c]) << "level " << l;
+    const int bx = int(brightest - first) % w, by = int(brightest - first) / w;
+    const glm::dvec3 centre = equirect_direction(bx, by, w, h);
+    EXPECT_LT(angle_deg(centre, sky.sun), 0.75 * 180.0 / h + 1.0) << "level " << l;
+    first += size_t(w) * size_t(h);
+  }
+  auto flat = EnvSampler::create({});
+  ASSERT_TRUE(flat.ok());
+  ASSERT_TRUE(flat->update(ImageRGBF(128, 64, 0.25f), EnvCamera{}, glm::dquat(1, 0, 0, 0)).ok());
+  ASSERT_EQ(flat->cone_pyramid(5, cells), 5);
+  for (const glm::vec4& c : cells) EXPECT_NEAR(c.r, 0.25f, 1e-4f);
+}
+
 TEST(EnvSampler, RefusesBadSettingsAndImages) {
   EXPECT_FALSE(EnvSampler::create({63, 16, 2.0}).ok());
   EXPECT_FALSE(EnvSampler::create({64, 12, 2.0}).ok());

@@ -258,6 +258,36 @@ TEST(Dvct, AGlossyRealRegionReflectsTheBoxes) {
   EXPECT_GT(g.x, g.y + 0.001) << "the red boxes' reflection";
 }
 
+// Under an environment alone (no lamp: no reflective shadow map puts light on the objects), a
+// glossy floor reflects the objects with their own light (DvctLevel::object_light: their
+// emission and ambient injected into the volume the specular cone reads), not as black: the
+// floor beside orange-glowing boxes gains red over green, and more than without that volume,
+// where the boxes hide the environment's reflection and give nothing back.
+TEST(Dvct, AGlossyFloorUnderAnEnvironmentReflectsTheObjectsWithTheirOwnLight) {
+  mrgi::testing::TempDir dir;
+  SyntheticScene glowing = SyntheticScene::create(dir.str(), glm::vec3(0.6f, 0.25f, 0.0f));
+  glowing.scene.lights.clear();
+  const SyntheticScene glossy = with_glossy_region(glowing, glm::vec3(-5.0f, -0.02f, -5.0f), glm::vec3(5.0f, 0.02f, 5.0f));
+  auto run = [&](double object_light) {
+    RuntimeSettings s;
+    s.technique = "dvct";
+    s.level = 2;
+    s.device.validate = true;
+    s.knobs = {{"object_light", object_light}};
+    return run_synthetic_frames(glossy, s, 3);
+  };
+  const std::vector<FrameOutput> with = run(1.0), without = run(0.0);
+  ASSERT_EQ(with.size(), 3u);
+  ASSERT_EQ(without.size(), 3u);
+  EXPECT_FALSE(has_note(with.back(), "dvct specular cone"));
+  const glm::dvec3 g = floor_gain_near_boxes(glowing, with.back(), without.back());
+  ASSERT_GT(g.z, 0.0);
+  std::printf("glossy floor within 10 cm of glowing boxes (%d px), object light on over off: red %+.4f, green %+.4f\n",
+              int(g.z), g.x, g.y);
+  EXPECT_GT(g.x, 0.002) << "the boxes' glow in the floor";
+  EXPECT_GT(g.x, g.y + 0.001) << "in the boxes' colour";
+}
+
 // The specular-cone skip (dvct.h "Skips"): a glossy real region outside the camera's view
 // compiles the cone out ("no glossy material in view") and the frame is the one the same scene
 // without the region gives, bit for bit (no glossy pixel: nothing the cone would have added).

@@ -12,6 +12,11 @@ struct VoxelInjectPush {
   glm::ivec4 sizes;  // cells, map width, height
   glm::vec4 sign;
 };
+struct VoxelSurfacePush {
+  glm::vec4 region;
+  glm::ivec4 range;     // cells, first index, triangles, vertex offset
+  glm::ivec4 material;  // material, emission on
+};
 struct VoxelLightResolvePush {
   glm::ivec4 cells;
   glm::vec4 scale;
@@ -55,6 +60,11 @@ Expected<VoxelLight> VoxelLight::create(gpu::FrameGraph& graph, const VoxelLight
   auto resolve = gpu::load_compute_pipeline(ctx, "gi/voxel_light_resolve.comp", {});
   if (!resolve) return resolve.error();
   v.resolve_ = std::move(*resolve);
+  if (s.surfaces) {
+    auto surfaces = gpu::load_compute_pipeline(ctx, "gi/voxel_inject_surfaces.comp", {});
+    if (!surfaces) return surfaces.error();
+    v.surfaces_ = std::move(*surfaces);
+  }
   return v;
 }
 
@@ -90,6 +100,34 @@ void VoxelLight::add_inject(gpu::FrameGraph& graph, const std::string& label, co
       },
       [pipe, push, rsm](VkCommandBuffer cmd, gpu::PassContext&) {
         gpu::push_and_dispatch(cmd, *pipe, &push, sizeof push, {(rsm.width + 7) / 8, (rsm.height + 7) / 8, 1});
+      });
+}
+
+void VoxelLight::add_inject_surfaces(gpu::FrameGraph& graph, const std::string& label,
+                                     const SurfaceLightSource& source) const {
+  const gpu::Pipeline* pipe = &*surfaces_;
+  const gpu::BufferHandle sums = sums_;
+  const glm::vec4 region(region_.origin, region_.voxel_size);
+  const int n = int(cells());
+  const VkSampler linear = graph.context().samplers().linear_repeat;
+  graph.add_shader_pass(
+      settings_.name + " inject " + label, gpu::PassKind::Compute, *pipe,
+      [source, sums, linear](gpu::ShaderPassBuilder& b) {
+        b.bind("Vertices", source.vertices);
+        b.bind("Indices", source.indices);
+        b.bind("Materials", source.materials);
+        b.bind_sampled("base_color_maps", source.base_color_maps, linear);
+        b.bind("LightUbo", source.light_set);
+        b.bind("cells", sums);
+      },
+      [pipe, region, n, ranges = source.ranges, emission = source.emission](VkCommandBuffer cmd, gpu::PassContext&) {
+        for (const SurfaceLightSource::Range& r : ranges) {
+          const uint32_t triangles = r.index_count / 3;
+          if (triangles == 0) continue;
+          const VoxelSurfacePush push{region, glm::ivec4(n, int(r.first_index), int(triangles), r.vertex_offset),
+                                      glm::ivec4(r.material, emission ? 1 : 0, 0, 0)};
+          gpu::push_and_dispatch(cmd, *pipe, &push, sizeof push, {(triangles + 63) / 64, 1, 1});
+        }
       });
 }
 

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "gi/light_propagation.h"
 #include "gi/volume.h"
@@ -26,6 +27,21 @@ namespace mrgi::gi {
 struct VoxelLightSettings {
   std::string name = "voxel light";
   uint32_t resolution = 64;  // cells per side allocated, 2..256
+  bool surfaces = false;     // add_inject_surfaces is used (its pipeline is created)
+};
+
+// What add_inject_surfaces lights: the virtual objects' mesh set (frame/scene_gpu.h), its
+// materials and base-colour maps, and the light set whose ambient lights it.
+struct SurfaceLightSource {
+  gpu::BufferHandle vertices, indices, materials;  // GpuVertex[], uint32 indices, GpuMaterial[]
+  gpu::ImageHandle base_color_maps;
+  gpu::BufferHandle light_set;  // shader::LightSet (uniform), its ambient_rv
+  struct Range {
+    uint32_t first_index = 0, index_count = 0;
+    int32_t vertex_offset = 0, material = 0;
+  };
+  std::vector<Range> ranges;
+  bool emission = false;  // add the materials' emission (some material emits)
 };
 
 class VoxelLight {
@@ -43,6 +59,10 @@ class VoxelLight {
   // where the two differ (voxel_inject.comp). One pass, "<name> inject <label>".
   void add_inject(gpu::FrameGraph& graph, const std::string& label, const RsmImages& rsm, float sign,
                   const RsmImages* other = nullptr) const;
+  // The virtual surfaces' own light (voxel_inject_surfaces.comp): the ambient's irradiance on
+  // each surface x its diffuse albedo, plus its emission, over the area it has in each voxel.
+  // One pass, "<name> inject <label>". Needs settings.surfaces.
+  void add_inject_surfaces(gpu::FrameGraph& graph, const std::string& label, const SurfaceLightSource& source) const;
   void add_resolve(gpu::FrameGraph& graph);
   // RGBA16F, every mip level: rgb radiance x coverage (W / (sr m^2)), a unused.
   const VoxelVolume& volume() const { return *volume_; }
@@ -54,6 +74,7 @@ class VoxelLight {
   std::optional<VoxelVolume> volume_;
   gpu::BufferHandle sums_;  // 3 floats a cell: flux rgb (W)
   gpu::PipelineHandle inject_[2], resolve_;  // inject_[1]: the delta pair
+  gpu::PipelineHandle surfaces_;             // settings.surfaces only
 };
 
 }  // namespace mrgi::gi

@@ -299,4 +299,33 @@ void EnvSampler::find_sources() {
   }
 }
 
+size_t EnvSampler::cone_pyramid_cells(int width, int levels) {
+  size_t cells = 0;
+  for (int l = 0; l < levels && (width >> l) >= 4; ++l) cells += size_t(width >> l) * size_t((width >> l) / 2);
+  return cells;
+}
+
+int EnvSampler::cone_pyramid(int levels, std::vector<glm::vec4>& out) const {
+  const int w0 = settings_.grid_width;
+  out.resize(cone_pyramid_cells(w0, levels));
+  for (size_t i = 0; i < radiance_.size(); ++i) out[i] = glm::vec4(glm::vec3(radiance_[i]), 0.0f);
+  size_t first = 0;
+  int written = 1;
+  for (int l = 1; l < levels && (w0 >> l) >= 4; ++l, ++written) {
+    const int w = w0 >> l, h = w / 2, wp = w0 >> (l - 1);
+    const size_t next = first + size_t(wp) * size_t(wp / 2);
+    for (int y = 0; y < h; ++y) {
+      // A row's solid angle is proportional to the sine of its colatitude.
+      const double s0 = std::sin((2 * y + 0.5) * kPi / (2 * h)), s1 = std::sin((2 * y + 1.5) * kPi / (2 * h));
+      for (int x = 0; x < w; ++x) {
+        const glm::vec4 a = out[first + size_t(2 * y) * wp + size_t(2 * x)] + out[first + size_t(2 * y) * wp + size_t(2 * x + 1)];
+        const glm::vec4 b = out[first + size_t(2 * y + 1) * wp + size_t(2 * x)] + out[first + size_t(2 * y + 1) * wp + size_t(2 * x + 1)];
+        out[next + size_t(y) * w + size_t(x)] = (a * float(s0) + b * float(s1)) / float(2.0 * (s0 + s1));
+      }
+    }
+    first = next;
+  }
+  return written;
+}
+
 }  // namespace mrgi::light

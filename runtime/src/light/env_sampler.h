@@ -93,6 +93,13 @@ class EnvSampler {
   // Unit world direction of the centre of grid cell (x, y) (the equirectangular convention of
   // light_from_environment: u = 0.5 + atan2(x, -z) / 2 pi, v = acos(y) / pi).
   glm::dvec3 cell_direction(double x, double y) const;
+  // The grid and its pyramid for cones wider than a cell (shaders/common/env_grid.glsl): level
+  // 0 is the grid, each next level half as wide, a cell the solid-angle-weighted mean of the
+  // 2 x 2 cells below it, down to `levels` levels or a level 4 cells wide; the levels one after
+  // the other in `out` (rgb radiance, a 0), resized to fit. Returns the levels written.
+  int cone_pyramid(int levels, std::vector<glm::vec4>& out) const;
+  // The cells cone_pyramid writes for `levels` levels of a grid `width` cells wide.
+  static size_t cone_pyramid_cells(int width, int levels);
 
  private:
   explicit EnvSampler(const EnvSamplerSettings& s) : settings_(s) {}

@@ -24,11 +24,11 @@ namespace mrgi::technique {
 
 const std::array<DvctLevel, 5>& dvct_levels() {
   static const std::array<DvctLevel, 5> levels = {{
-      {"paper", 128, 9, true, 512, 4, 1, 1.0f, true, 0, 0.03f, 0.5f},
-      {"high", 64, 9, true, 512, 4, 2, 1.0f, false, 0, 0.1f, 0.5f},
-      {"medium", 64, 5, true, 256, 2, 4, 1.0f, false, 1, 0.1f, 0.5f},
-      {"fast", 16, 3, false, 64, 1, 4, 0.5f, false, 3, 0.1f, 0.5f},
-      {"fastest", 16, 1, false, 64, 1, 4, 0.5f, false, 3, 0.1f, 0.5f},
+      {"paper", 128, 9, true, 512, 4, 1, 1.0f, true, 0, 0.03f, 0.5f, true},
+      {"high", 64, 9, true, 512, 4, 2, 1.0f, false, 0, 0.1f, 0.5f, true},
+      {"medium", 64, 5, true, 256, 2, 4, 1.0f, false, 1, 0.1f, 0.5f, true},
+      {"fast", 16, 3, false, 64, 1, 4, 0.5f, false, 3, 0.1f, 0.5f, false},
+      {"fastest", 16, 1, false, 64, 1, 4, 0.5f, false, 3, 0.1f, 0.5f, false},
   }};
   return levels;
 }
@@ -47,6 +47,8 @@ const KnobField<DvctLevel> kDvctKnobs[] = {
     {"baseline_level", "the direct-light block's level for the shadow maps", &DvctLevel::baseline_level},
     {"shadow_aperture", "full aperture of a shadow cone, radians", &DvctLevel::shadow_aperture},
     {"step_scale", "fraction of the touching-footprint step the cones take", &DvctLevel::step_scale},
+    {"object_light", "1: the specular cone sees the objects lit by the ambient and emitting (0: the lamps' light only)",
+     &DvctLevel::object_light},
 };
 
 // The region's side is never under this (metres): a flat or tiny object still gets room for its
@@ -59,6 +61,9 @@ constexpr float kSpecularRoughnessLimit = frame::SceneGpu::kGlossyRoughness;
 constexpr float kMinSpecularAperture = 0.05f;
 // vct_directional_occlusion's floor for a surface seen edge-on (reconstruction noise).
 constexpr float kOcclusionFloor = 0.1f;
+// Levels of the environment grid's pyramid the specular cone reads (64 cells wide: down to 4,
+// cells of 90 degrees, as wide as the roughest cone traced).
+constexpr int kEnvLevels = 5;
 
 }  // namespace
 
@@ -94,14 +99,25 @@ class Dvct final : public Laddered<DvctLevel> {
   // `env_occlusion`: the block's environment occlusion, read by the shadow-cone level's shading.
   void add_cone_pass(const DvctLevel& level, const shader::DvctParams& params, bool specular,
                      gpu::ImageHandle env_occlusion);
+  void record_object_light(std::vector<std::string>& skipped);
+  glm::vec2 write_environment();
 
   frame::FrameResources shared_;
   gpu::BufferHandle lights_;  // shader::LightSet, one per frame slot (the paper level's shading)
   gpu::BufferHandle real_materials_;  // shader::DvctRealMaterials, one per frame slot
+  // The light stage's environment grid and its pyramid (common/env_grid.glsl), one per frame
+  // slot: what the specular cone sees where it leaves the region open.
+  gpu::BufferHandle env_cells_;
+  int env_width_ = 0;                    // the grid's width the buffer is sized for (0: none)
+  std::vector<glm::vec4> env_scratch_;   // the pyramid before its upload (allocated at init)
   shader::DvctRealMaterials real_material_table_{};  // scene.json's regions, as the shaders read them
   std::optional<gi::ReflectiveShadowMaps> rsm_;
   std::optional<gi::Voxelizer> scene_visibility_, object_visibility_;
   std::optional<gi::VoxelLight> light_, delta_;
+  // The objects' own light (ambient and emission), read by the specular cone alone
+  // (DvctLevel::object_light); valid_ while it holds this frame's volumes' objects.
+  std::optional<gi::VoxelLight> object_light_;
+  bool object_light_valid_ = false;
   std::map<Variant, gpu::PipelineHandle> indirect_, shade_;
   gpu::ImageHandle indirect_image_;  // RGBA32UI, gi/indirect_pack.glsl
   // Direct light with shadow maps (not the shadow-cone levels), the cones' light as its screen input.
@@ -146,6 +162,13 @@ Status Dvct::init() {
                                        VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   if (!materials) return materials.error();
   real_materials_ = *materials;
+  env_width_ = shared_.light_stage->environment_grid_width();
+  const size_t env_cells = std::max<size_t>(light::EnvSampler::cone_pyramid_cells(env_width_, kEnvLevels), 1);
+  auto env = graph.create_buffer({"dvct environment grid", env_cells * sizeof(glm::vec4), gpu::MemoryUsage::Upload, true},
+                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  if (!env) return env.error();
+  env_cells_ = *env;
+  env_scratch_.reserve(env_cells);
   // Without virtual objects the volumes are the smallest allowed, allocated only so the shading
   // passes bind images of the kinds they declare (mode.y 0: they read none of them).
   uint32_t cells = 2, rsm_size = 16;
@@ -172,6 +195,17 @@ Status Dvct::init() {
     auto v = gi::VoxelLight::create(graph, s);
     if (!v) return v.error();
     (k == 0 ? light_ : delta_).emplace(std::move(*v));
+  }
+  {
+    gi::VoxelLightSettings s;
+    s.name = "dvct object light";
+    // Only the specular cone reads it: without a glossy material in the scene it is never
+    // injected, and the smallest volume stands in for the binding.
+    s.resolution = glossy_ ? cells : 2;
+    s.surfaces = has_virtual_ && glossy_;
+    auto v = gi::VoxelLight::create(graph, s);
+    if (!v) return v.error();
+    object_light_.emplace(std::move(*v));
   }
   if (has_virtual_) {
     gi::RsmSettings rs;
@@ -221,12 +255,14 @@ Status Dvct::record_volumes(const DvctLevel& level, const frame::FrameInfo& info
   MRGI_TRY(object_visibility_->set_cells(graph, level.volume_cells));
   MRGI_TRY(light_->set_cells(graph, level.volume_cells));
   MRGI_TRY(delta_->set_cells(graph, level.volume_cells));
+  if (glossy_) MRGI_TRY(object_light_->set_cells(graph, level.volume_cells));
   const gi::VoxelRegion region =
       gi::doubled_box_region(sg.virtual_objects.bounds_min, sg.virtual_objects.bounds_max, level.volume_cells, kMinRegionSide);
   scene_visibility_->set_region(region);
   object_visibility_->set_region(region);
   light_->set_region(region);
   delta_->set_region(region);
+  object_light_->set_region(region);
 
   const light::Lighting& lighting = shared_.light_stage->lighting();
   reuse_.set_frame(info.level, info.camera_to_world, info.input, sg.revision());
@@ -240,6 +276,7 @@ Status Dvct::record_volumes(const DvctLevel& level, const frame::FrameInfo& info
     return ok_status();
   }
   reuse_.remember();
+  object_light_valid_ = false;  // record_object_light injects it again where a cone reads it
   // Visibility: the real scene as the reconstruction sees it plus its proxy meshes; the objects.
   const VkExtent2D g = graph.extent(shared_.real_position);
   scene_visibility_->add_clear(graph);
@@ -338,6 +375,41 @@ bool Dvct::glossy_in_view(const frame::FrameInfo& info) const {
   return false;
 }
 
+// The objects' own light for the specular cone (DvctLevel::object_light), injected once per
+// rebuild of the volumes (record_volumes clears object_light_valid_).
+void Dvct::record_object_light(std::vector<std::string>& skipped) {
+  if (object_light_valid_) {
+    skipped.push_back("dvct object light: reused with the volumes");
+    return;
+  }
+  gpu::FrameGraph& graph = *shared_.graph;
+  const frame::SceneGpu& sg = *shared_.scene_gpu;
+  gi::SurfaceLightSource source;
+  source.vertices = sg.virtual_objects.vertices;
+  source.indices = sg.virtual_objects.indices;
+  source.materials = sg.materials;
+  source.base_color_maps = sg.base_color_maps;
+  source.light_set = lights_;
+  source.emission = sg.emissive;
+  for (const frame::DrawRange& r : sg.virtual_objects.draws)
+    source.ranges.push_back({r.first_index, r.index_count, r.vertex_offset, r.material});
+  object_light_->add_clear(graph);
+  object_light_->add_inject_surfaces(graph, "objects", source);
+  object_light_->add_resolve(graph);
+  object_light_valid_ = true;
+}
+
+// The environment grid's pyramid into this slot's buffer for the specular cone; returns its
+// (width, levels), (0, 0) without a grid this frame (the cone takes the ambient's irradiance).
+glm::vec2 Dvct::write_environment() {
+  const light::EnvSampler* grid = shared_.light_stage->environment_grid();
+  if (!grid || grid->settings().grid_width != env_width_ || env_width_ < 4) return glm::vec2(0.0f);
+  const int levels = grid->cone_pyramid(kEnvLevels, env_scratch_);
+  gpu::FrameGraph& graph = *shared_.graph;
+  std::copy(env_scratch_.begin(), env_scratch_.end(), static_cast<glm::vec4*>(graph.mapped(env_cells_, graph.slot())));
+  return glm::vec2(float(env_width_), float(levels));
+}
+
 void Dvct::add_cone_pass(const DvctLevel& level, const shader::DvctParams& params, bool specular,
                          gpu::ImageHandle env_occlusion) {
   gpu::FrameGraph& graph = *shared_.graph;
@@ -346,14 +418,15 @@ void Dvct::add_cone_pass(const DvctLevel& level, const shader::DvctParams& param
   const frame::FrameResources& r = shared_;
   const VkSampler linear = shared_.context->samplers().linear_clamp;
   const gpu::ImageHandle light = light_->volume().image(0), delta = delta_->volume().image(0);
+  const gpu::ImageHandle object_light = object_light_->volume().image(0);
   const gpu::ImageHandle scene = scene_visibility_->volume().image(0), object = object_visibility_->volume().image(0);
   const bool full = level.shadow_cones;
   const gpu::ImageHandle indirect = indirect_image_;
-  const gpu::BufferHandle lights = lights_, materials = real_materials_;
+  const gpu::BufferHandle lights = lights_, materials = real_materials_, env = env_cells_;
   const uint32_t divisor = std::max(1u, level.trace_divisor);
   graph.add_shader_pass(
       full ? "dvct shade" : "dvct cones", gpu::PassKind::Compute, *pipe,
-      [&, full, indirect, lights, materials, env_occlusion](gpu::ShaderPassBuilder& b) {
+      [&, full, indirect, lights, materials, env, env_occlusion](gpu::ShaderPassBuilder& b) {
         if (full) {
           frame::bind_shading_gbuffers(b, r);
           b.bind("env_occlusion", env_occlusion);
@@ -363,10 +436,12 @@ void Dvct::add_cone_pass(const DvctLevel& level, const shader::DvctParams& param
         }
         b.bind("LightUbo", lights);
         b.bind("RealMaterialUbo", materials);
+        b.bind("EnvCells", env);
         b.bind_sampled("light_volume", light, linear);
         b.bind_sampled("delta_volume", delta, linear);
         b.bind_sampled("scene_visibility", scene, linear);
         b.bind_sampled("object_visibility", object, linear);
+        b.bind_sampled("object_light", object_light, linear);
       },
       [pipe, params, lit = r.lit_rv, divisor](VkCommandBuffer cmd, gpu::PassContext& p) {
         const VkExtent2D e = p.extent(lit);
@@ -386,6 +461,7 @@ Status Dvct::record(const frame::FrameInfo& info, std::vector<std::string>& skip
   *static_cast<shader::DvctRealMaterials*>(graph.mapped(real_materials_, graph.slot())) = real_material_table_;
   shader::DvctParams params{};
   const bool volumes = has_virtual_ && shared_.scene_gpu->any_visible();
+  const bool specular = level.specular_cone && glossy_ && glossy_in_view(info);
   if (volumes) {
     MRGI_TRY(record_volumes(level, info, skipped));
     const gi::VoxelRegion& region = light_->region();
@@ -394,7 +470,8 @@ Status Dvct::record(const frame::FrameInfo& info, std::vector<std::string>& skip
                              level.step_scale);
     params.cones = glm::vec4(level.shadow_aperture, kMinSpecularAperture,
                              region.voxel_size * float(level.volume_cells) * std::sqrt(3.0f), kSpecularRoughnessLimit);
-    params.texture = glm::vec4(float(light_->volume().settings().resolution), 0.0f, 0.0f, 0.0f);
+    const glm::vec2 env = specular ? write_environment() : glm::vec2(0.0f);
+    params.texture = glm::vec4(float(light_->volume().settings().resolution), env.x, env.y, 0.0f);
     params.mode = glm::ivec4(int(std::max(1u, level.trace_divisor)), 1, 0, 0);
   } else {
     reuse_.forget();
@@ -404,13 +481,16 @@ Status Dvct::record(const frame::FrameInfo& info, std::vector<std::string>& skip
     params.texture = glm::vec4(2.0f, 0.0f, 0.0f, 0.0f);
     params.mode = glm::ivec4(int(std::max(1u, level.trace_divisor)), 0, 0, 0);
   }
-  const bool specular = level.specular_cone && glossy_ && glossy_in_view(info);
   if (!level.specular_cone)
     skipped.push_back("dvct specular cone: level '" + std::string(level.name) + "' traces none");
   else if (!glossy_)
     skipped.push_back("dvct specular cone: no glossy material in the scene (virtual: metallic > 0.1 or roughness < 0.7; real: no such scene.json real_materials region)");
   else if (!specular)
     skipped.push_back("dvct specular cone: no glossy material in view (compiled out this frame)");
+  if (specular && volumes && level.object_light) {
+    record_object_light(skipped);
+    params.mode.w = 1;
+  }
   if (level.shadow_cones) {
     // The cones shadow the lamps; the ambient's occlusion by the objects is the block's.
     const shading::DirectLightLevel& direct = shading::direct_light_levels()[size_t(level.baseline_level)];

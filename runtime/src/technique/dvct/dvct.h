@@ -41,12 +41,24 @@
 //     as a wall across the footprint), so the cones do not occlude the ambient: at every level
 //     that is the direct-light block's environment occlusion (shading/environment_occlusion.h;
 //     the paper level's shading reads it through DirectLightBlock::record_env_occlusion).
+//   - the specular cone sees the objects with their own light and the environment as it is in
+//     that direction: the objects' surfaces lit by the ambient, and their emission, are injected
+//     into a fifth volume only that cone reads (object_light, gi::VoxelLight::add_inject_surfaces;
+//     the paper injects lamp light only, so under an environment alone a glossy floor reflected
+//     the objects black), and where the cone leaves the region it takes the light stage's
+//     environment grid averaged over its width (common/env_grid.glsl), not the ambient's
+//     irradiance over pi, which at a floor's glancing reflection takes in the bright sky above
+//     the horizon the reflection looks at. The diffuse cones do not read the fifth volume: the
+//     direct-light block's environment occlusion already gives back the objects' ambient-lit
+//     surfaces to the real pixels near them.
 //
 // Skips (each in FrameStats::skipped):
 //   - no virtual object: no volumes, no cones (the solutions are baseline's, or the paper
 //     level's lamps and ambient unshadowed by any object);
 //   - the volumes are reused, with nothing voxelised, drawn or injected, while what made them
 //     stays within gi/input_reuse.h's tolerances (pose, depth, lamps, objects);
+//   - the objects' own light volume is injected only in frames that trace the specular cone, once
+//     per rebuild of the volumes;
 //   - the objects' visibility volume is kept while they have not moved (frame::SceneGpu::revision) at
 //     the same level: it depends on nothing else (1.5 ms a frame at fast on desk_spot's bunny);
 //   - the reconstruction is voxelised from a grid of about two points a voxel where the region
@@ -89,6 +101,10 @@ struct DvctLevel {
   int baseline_level;
   float shadow_aperture;   // full aperture of a shadow cone, radians (the penumbra's spread)
   float step_scale;        // fraction of the touching-footprint step the cones take (vct_step)
+  // true: the objects' own light (their surfaces lit by the ambient, and their emission) is
+  // injected into a volume the specular cone reads, so a glossy real surface reflects an object
+  // under environment light as lit, not black (the light volume holds the lamps' maps only).
+  bool object_light;
 };
 const std::array<DvctLevel, 5>& dvct_levels();  // the defaults
 Expected<std::vector<DvctLevel>> dvct_levels(const std::vector<KnobSetting>& knobs);
