@@ -4,7 +4,8 @@
 // ranged or documented in two places.
 //
 // A knob may be set anywhere in the span its technique's ladder covers (lowest to highest value
-// over the levels): the values the technique's allocations, shaders and tests are built for.
+// over the levels; a switch, 0 or 1): the values the technique's allocations, shaders and tests
+// are built for.
 // A knob that must be a power of two (a map's side) says so. Beyond that span a value is refused:
 // a bigger map or more VPLs than the top level would need shader limits and memory budgets
 // nobody has measured. Each setting pins the knob at every level, from start-up, and the
@@ -56,9 +57,12 @@ bool knob_is_integer(const KnobField<L>& f) {
   return !std::holds_alternative<float L::*>(f.member) && !std::holds_alternative<double L::*>(f.member);
 }
 
-// The span of field f over the default ladder.
+// The span of field f over the default ladder; a switch (a bool field) spans 0..1 whatever the
+// ladder holds: each level builds both of its paths, so turning one on or off is always measured
+// ground (an A/B of the feature at any level).
 template <class L, class Levels>
 std::pair<double, double> knob_span(const Levels& defaults, const KnobField<L>& f) {
+  if (std::holds_alternative<bool L::*>(f.member)) return {0.0, 1.0};
   double lo = knob_value(defaults[0], f), hi = lo;
   for (const L& l : defaults) {
     lo = std::min(lo, knob_value(l, f));
