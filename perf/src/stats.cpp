@@ -19,4 +19,10 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+size_t drop_unresolved_times(std::vector<double>& v) {
+  const size_t before = v.size();
+  v.erase(std::remove_if(v.begin(), v.end(), [](double ms) { return !(ms > 0.0); }), v.end());
+  return before - v.size();
+}
+
 }  // namespace mrgi::perf

@@ -41,6 +41,15 @@ TEST(Pareto, NonFiniteNeverOnFrontNorDominates) {
 TEST(Stats, PercentileNearestRank) {
   EXPECT_EQ(perf::percentile({}, 50), 0.0);
   EXPECT_EQ(perf::percentile({3, 1, 2}, 50), 2.0);
+}
+
+// Unresolved timestamps (0 ms, or a negative or NaN difference) leave the sample before its
+// median: the bench's floor pass keeps its ratios instead of dividing by 0.
+TEST(Stats, UnresolvedTimesLeaveTheSample) {
+  std::vector<double> times{2.0, 0.0, 1.5, -1.0, std::nan(""), 0.0, 3.0};
+  EXPECT_EQ(perf::drop_unresolved_times(times), 4u);
+  EXPECT_EQ(times, (std::vector<double>{2.0, 1.5, 3.0}));
+  EXPECT_EQ(perf::percentile(times, 50), 2.0);
   EXPECT_EQ(perf::percentile({1, 2, 3, 4}, 50), 2.0);
   std::vector<double> v;
   for (int i = 1; i <= 100; ++i) v.push_back(i);
