@@ -84,7 +84,9 @@ while IFS= read -r line; do
   fi
 done < "$work/exports"
 for r in "${required[@]}"; do
-  if ! cut -d' ' -f3- "$work/exports" | grep -q -- "^$r("; then
+  # (grep without -q: it reads to the end, so cut never dies of SIGPIPE, which pipefail would
+  # take for a missing symbol)
+  if ! cut -d' ' -f3- "$work/exports" | grep -- "^$r(" > /dev/null; then
     echo "the public entry point $r is not exported"; bad=$((bad + 1))
   fi
 done

@@ -394,7 +394,7 @@ class FrameGraph {
   // each pass its own submission, host-timed. BadUsage when the graph was made without it.
   Status set_profiling(bool on);
   bool profiling() const { return profiling_; }
-  // What one empty submission costs from submit to fence here (median of a few, measured at
+  // What one empty submission costs from submit to fence here (the fastest of a few, measured at
   // start-up when profiling is allowed): subtracted from every profiled pass, so a pass's time
   // is its work and a frame of many short passes does not read longer than it runs.
   double submission_overhead_ms() const { return submission_overhead_ms_; }
