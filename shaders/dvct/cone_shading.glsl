@@ -70,6 +70,22 @@ DvctGather dvct_diffuse(vec3 p, vec3 n, int flags) {
   return g;
 }
 
+// A real glossy pixel's normal for its mirror direction: the mean of the G-buffer's normals at
+// `pixel` and 2 pixels away on each side that face within 25 degrees of its own. The depth
+// camera's noise tilts single normals by a few degrees, which a near-mirror cone turns into
+// speckle in the objects' reflection (glossy_floor_white_sphere). Needs `real_normal` and `frame`.
+vec3 dvct_mirror_normal(ivec2 pixel, vec3 n) {
+  const ivec2 last = frame.internal_output_size.xy - 1;
+  vec3 sum = n;
+  for (int k = 0; k < 4; ++k) {
+    const ivec2 o = k < 2 ? ivec2(k == 0 ? -2 : 2, 0) : ivec2(0, k == 2 ? -2 : 2);
+    const vec3 m = imageLoad(real_normal, clamp(pixel + o, ivec2(0), last)).xyz;
+    const float len = length(m);
+    if (len > 0.0f && dot(m, n) > 0.9f * len) sum += m / len;
+  }
+  return normalize(sum);
+}
+
 // The specular cone around v's mirror direction: reflected radiance with and without the objects
 // (the cone's light plus the ambient's radiance where the cone leaves the region open, both
 // times the lobe's directional albedo vct_specular_weight).

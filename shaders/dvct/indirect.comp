@@ -90,7 +90,8 @@ void main() {
       rv = alb.rgb * (1.0f / MRGI_PI) * d.with;
       r = alb.rgb * (1.0f / MRGI_PI) * d.without;
       const vec2 rm = dvct_real_material(p);
-      const DvctSpecular s = dvct_specular(p, n, view, mix(vec3(0.04f), alb.rgb, rm.y), rm.x, VCT_LIGHT | VCT_WITHOUT);
+      const DvctSpecular s = dvct_specular(p, dvct_mirror_normal(pixel, n), view, mix(vec3(0.04f), alb.rgb, rm.y), rm.x,
+                                             VCT_LIGHT | VCT_WITHOUT);
       rv += s.with;
       r += s.without;
     }
