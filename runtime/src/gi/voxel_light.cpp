@@ -112,20 +112,20 @@ void VoxelLight::add_inject_surfaces(gpu::FrameGraph& graph, const std::string& 
   const VkSampler linear = graph.context().samplers().linear_repeat;
   graph.add_shader_pass(
       settings_.name + " inject " + label, gpu::PassKind::Compute, *pipe,
-      [source, sums, linear](gpu::ShaderPassBuilder& b) {
-        b.bind("Vertices", source.vertices);
-        b.bind("Indices", source.indices);
-        b.bind("Materials", source.materials);
-        b.bind_sampled("base_color_maps", source.base_color_maps, linear);
-        b.bind("LightUbo", source.light_set);
+      [src = &source, sums, linear](gpu::ShaderPassBuilder& b) {
+        b.bind("Vertices", src->vertices);
+        b.bind("Indices", src->indices);
+        b.bind("Materials", src->materials);
+        b.bind_sampled("base_color_maps", src->base_color_maps, linear);
+        b.bind("LightUbo", src->light_set);
         b.bind("cells", sums);
       },
-      [pipe, region, n, ranges = source.ranges, emission = source.emission](VkCommandBuffer cmd, gpu::PassContext&) {
-        for (const SurfaceLightSource::Range& r : ranges) {
+      [pipe, region, n, src = &source](VkCommandBuffer cmd, gpu::PassContext&) {
+        for (const SurfaceLightSource::Range& r : src->ranges) {
           const uint32_t triangles = r.index_count / 3;
           if (triangles == 0) continue;
           const VoxelSurfacePush push{region, glm::ivec4(n, int(r.first_index), int(triangles), r.vertex_offset),
-                                      glm::ivec4(r.material, emission ? 1 : 0, 0, 0)};
+                                      glm::ivec4(r.material, src->emission ? 1 : 0, 0, 0)};
           gpu::push_and_dispatch(cmd, *pipe, &push, sizeof push, {(triangles + 63) / 64, 1, 1});
         }
       });

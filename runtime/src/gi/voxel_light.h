@@ -61,7 +61,9 @@ class VoxelLight {
                   const RsmImages* other = nullptr) const;
   // The virtual surfaces' own light (voxel_inject_surfaces.comp): the ambient's irradiance on
   // each surface x its diffuse albedo, plus its emission, over the area it has in each voxel.
-  // One pass, "<name> inject <label>". Needs settings.surfaces.
+  // One pass, "<name> inject <label>". Needs settings.surfaces. The pass reads `source` when
+  // it is recorded and run: it must outlive the frame's submission (its owner keeps it, made
+  // once at start-up, so nothing is copied per frame).
   void add_inject_surfaces(gpu::FrameGraph& graph, const std::string& label, const SurfaceLightSource& source) const;
   void add_resolve(gpu::FrameGraph& graph);
   // RGBA16F, every mip level: rgb radiance x coverage (W / (sr m^2)), a unused.

@@ -117,6 +117,7 @@ class Dvct final : public Laddered<DvctLevel> {
   // The objects' own light (ambient and emission), read by the specular cone alone
   // (DvctLevel::object_light); valid_ while it holds this frame's volumes' objects.
   std::optional<gi::VoxelLight> object_light_;
+  gi::SurfaceLightSource object_surfaces_;  // what it is injected from (made at init)
   bool object_light_valid_ = false;
   std::map<Variant, gpu::PipelineHandle> indirect_, shade_;
   gpu::ImageHandle indirect_image_;  // RGBA32UI, gi/indirect_pack.glsl
@@ -206,6 +207,14 @@ Status Dvct::init() {
     auto v = gi::VoxelLight::create(graph, s);
     if (!v) return v.error();
     object_light_.emplace(std::move(*v));
+    object_surfaces_.vertices = sg.virtual_objects.vertices;
+    object_surfaces_.indices = sg.virtual_objects.indices;
+    object_surfaces_.materials = sg.materials;
+    object_surfaces_.base_color_maps = sg.base_color_maps;
+    object_surfaces_.light_set = lights_;
+    object_surfaces_.emission = sg.emissive;
+    for (const frame::DrawRange& r : sg.virtual_objects.draws)
+      object_surfaces_.ranges.push_back({r.first_index, r.index_count, r.vertex_offset, r.material});
   }
   if (has_virtual_) {
     gi::RsmSettings rs;
@@ -383,18 +392,8 @@ void Dvct::record_object_light(std::vector<std::string>& skipped) {
     return;
   }
   gpu::FrameGraph& graph = *shared_.graph;
-  const frame::SceneGpu& sg = *shared_.scene_gpu;
-  gi::SurfaceLightSource source;
-  source.vertices = sg.virtual_objects.vertices;
-  source.indices = sg.virtual_objects.indices;
-  source.materials = sg.materials;
-  source.base_color_maps = sg.base_color_maps;
-  source.light_set = lights_;
-  source.emission = sg.emissive;
-  for (const frame::DrawRange& r : sg.virtual_objects.draws)
-    source.ranges.push_back({r.first_index, r.index_count, r.vertex_offset, r.material});
   object_light_->add_clear(graph);
-  object_light_->add_inject_surfaces(graph, "objects", source);
+  object_light_->add_inject_surfaces(graph, "objects", object_surfaces_);
   object_light_->add_resolve(graph);
   object_light_valid_ = true;
 }
