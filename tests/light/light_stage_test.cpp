@@ -343,7 +343,9 @@ static std::optional<Lighting> lighting_of(double cap_deg, double contrast, cons
 // window's regions, most concentrated first, pointing at it; none in a uniform environment once
 // the rule asks for more than its mean; never a region that is a shadowed light.
 TEST(LightStage, AmbientRegionsAreTheBroadBrightParts) {
-  auto broad = lighting_of(30.0, 20.0, "regions_broad");
+  LightStageSettings cut;
+  cut.occlusion_regions_from_sources = false;
+  auto broad = lighting_of(30.0, 20.0, "regions_broad", cut);
   ASSERT_TRUE(broad);
   ASSERT_FALSE(broad->ambient_regions.empty());
   EXPECT_LE(broad->ambient_regions.size(), size_t(Lighting::kMaxOcclusionRegions));
@@ -354,7 +356,7 @@ TEST(LightStage, AmbientRegionsAreTheBroadBrightParts) {
     EXPECT_LT(r.half_angle_rad, 30.0 * kDeg);  // a median cut splits it
     EXPECT_GT(luminance(r.irradiance), 0.0);
   }
-  LightStageSettings strict;
+  LightStageSettings strict = cut;
   strict.occlusion_region_min_contrast = 2.0;
   auto uniform = lighting_of(0.0, 1.0, "regions_uniform", strict);
   ASSERT_TRUE(uniform);
@@ -363,11 +365,37 @@ TEST(LightStage, AmbientRegionsAreTheBroadBrightParts) {
   ASSERT_TRUE(still);
   EXPECT_FALSE(still->ambient_regions.empty());
   // A compact bright source is a shadowed light, not also an ambient region.
-  auto compact = lighting_of(6.0, 200.0, "regions_compact");
+  auto compact = lighting_of(6.0, 200.0, "regions_compact", cut);
   ASSERT_TRUE(compact);
   ASSERT_FALSE(compact->lights.empty());
   for (const Lighting::AmbientRegion& r : compact->ambient_regions)
     EXPECT_GT(angle_deg(r.direction, -glm::dvec3(compact->lights[0].direction)), 1e-3);
+}
+
+// By default the cones are the environment's light sources gathered whole
+// (LightStageSettings::occlusion_regions_from_sources): a broad bright window is one cone
+// pointing at its centre, as wide as it (not the median cut's pieces of it), holding its whole
+// light; none where no cell stands out.
+TEST(LightStage, AmbientRegionsAreTheEnvironmentsSourcesWhole) {
+  auto broad = lighting_of(30.0, 20.0, "sources_broad");
+  ASSERT_TRUE(broad);
+  EXPECT_TRUE(broad->lights.empty());
+  ASSERT_EQ(broad->ambient_regions.size(), size_t(1));
+  const Lighting::AmbientRegion& r = broad->ambient_regions[0];
+  EXPECT_LT(angle_deg(r.direction, kCapDirection), 1.0);
+  EXPECT_NEAR(r.half_angle_rad / kDeg, 30.0, 2.5);  // the cap's own width, to a grid cell
+  // Its whole light: the cap's radiance 2.0 times its solid angle 2 pi (1 - cos 30 deg).
+  const double whole = 2.0 * 2.0 * kPi * (1.0 - std::cos(30.0 * kDeg));
+  EXPECT_NEAR(r.irradiance.y, whole, 0.08 * whole);
+  // The window is 2.0 / 0.227 = 8.8 times the environment's mean radiance (0.1 elsewhere).
+  LightStageSettings strict;
+  strict.occlusion_region_min_contrast = 10.0;
+  auto none = lighting_of(30.0, 20.0, "sources_strict", strict);
+  ASSERT_TRUE(none);
+  EXPECT_TRUE(none->ambient_regions.empty());
+  auto uniform = lighting_of(0.0, 1.0, "sources_uniform");
+  ASSERT_TRUE(uniform);
+  EXPECT_TRUE(uniform->ambient_regions.empty());  // no cell 3x the mean: no source
 }
 
 // The shadowed lights of lighting_of's environment.

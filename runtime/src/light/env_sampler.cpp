@@ -53,6 +53,11 @@ Expected<EnvSampler> EnvSampler::create(const EnvSamplerSettings& s) {
   e.frame_moment_.assign(cells, glm::dvec3(0.0));
   e.energy_sat_.assign(size_t(w + 1) * size_t(h + 1), 0.0);
   e.lights_.reserve(size_t(s.samples));
+  e.light_rects_.reserve(size_t(s.samples) * 2);
+  e.light_order_.reserve(size_t(s.samples) * 2);
+  e.source_sum_.reserve(cells);
+  e.source_moment_.reserve(cells);
+  e.cell_excluded_.assign(cells, 0);
   e.regions_.reserve(size_t(s.samples) * 2);
   e.next_regions_.reserve(size_t(s.samples) * 2);
   return e;
@@ -257,9 +262,54 @@ void EnvSampler::cut() {
                       : cell_direction(0.5 * (r.x0 + r.x1), 0.5 * (r.y0 + r.y1));
     lights_.push_back(l);
   }
+  // Strongest first; light_rects_ follows the same order.
+  light_order_.clear();
+  for (size_t i = 0; i < lights_.size(); ++i) light_order_.push_back(i);
+  std::stable_sort(light_order_.begin(), light_order_.end(), [&](size_t a, size_t b) {
+    return luminance(lights_[a].irradiance) > luminance(lights_[b].irradiance);
+  });
+  light_rects_.clear();
+  for (size_t i : light_order_) light_rects_.push_back(regions_[i]);
   std::stable_sort(lights_.begin(), lights_.end(), [](const EnvLight& a, const EnvLight& b) {
     return luminance(a.irradiance) > luminance(b.irradiance);
   });
+}
+
+void EnvSampler::sources_outside(const std::vector<size_t>& excluded, size_t count, std::vector<EnvSource>& out) const {
+  out.clear();
+  const size_t sources = source_solid_angle_.size();
+  if (sources == 0 || count == 0) return;
+  const int w = settings_.grid_width;
+  std::fill(cell_excluded_.begin(), cell_excluded_.end(), uint8_t(0));
+  for (size_t k : excluded) {
+    if (k >= light_rects_.size()) continue;
+    const RegionRect& r = light_rects_[k];
+    for (int y = r.y0; y < r.y1; ++y)
+      for (int x = r.x0; x < r.x1; ++x) cell_excluded_[size_t(y) * w + x] = 1;
+  }
+  source_sum_.assign(sources, EnvSource{});
+  source_moment_.assign(sources, glm::dvec3(0.0));
+  for (size_t c = 0; c < cell_source_.size(); ++c) {
+    if (cell_source_[c] < 0 || cell_excluded_[c]) continue;
+    EnvSource& s = source_sum_[size_t(cell_source_[c])];
+    s.irradiance += radiance_[c] * cell_solid_angle_[c];
+    s.solid_angle_sr += cell_solid_angle_[c];
+    source_moment_[size_t(cell_source_[c])] += moment_[c];
+    for (int i = 0; i < kMaxShCoeffs; ++i) s.sh[size_t(i)] += radiance_[c] * double(cell_sh_[c][size_t(i)]);
+  }
+  for (size_t i = 0; i < sources; ++i) {
+    EnvSource& s = source_sum_[i];
+    const double len = glm::length(source_moment_[i]);
+    if (!(s.solid_angle_sr > 0.0) || !(luminance(s.irradiance) > 0.0) || !(len > 0.0) || !std::isfinite(len)) continue;
+    s.direction = source_moment_[i] / len;
+    // Keep the `count` strongest: insertion into the sorted list.
+    if (out.size() == count && luminance(out.back().irradiance) >= luminance(s.irradiance)) continue;
+    if (out.size() == count) out.pop_back();
+    auto at = std::find_if(out.begin(), out.end(), [&](const EnvSource& o) {
+      return luminance(o.irradiance) < luminance(s.irradiance);
+    });
+    out.insert(at, s);
+  }
 }
 
 void EnvSampler::find_sources() {

@@ -61,6 +61,15 @@ struct EnvLight {
   ShRgb region_sh{};
 };
 
+// A light source of the environment (EnvSamplerSettings::source_contrast): its connected cells
+// at least that many times the mean radiance, gathered whole, however a median cut splits it.
+struct EnvSource {
+  glm::dvec3 direction{0.0, 1.0, 0.0};  // unit, world, luminance-weighted, towards it
+  glm::dvec3 irradiance{0.0};           // W/m^2 per linear RGB channel at normal incidence
+  double solid_angle_sr = 0.0;          // of its cells
+  ShRgb sh{};                           // radiance SH (4 bands) of its cells
+};
+
 class EnvSampler {
  public:
   // BadUsage naming the field when a setting is out of range.
@@ -80,6 +89,10 @@ class EnvSampler {
   bool valid() const { return have_history_; }
   // The lights, strongest (luminance of the irradiance) first.
   const std::vector<EnvLight>& lights() const { return lights_; }
+  // The light sources' parts outside the regions `excluded` (indices into lights(): those drawn
+  // as lights apart), strongest (luminance of the irradiance) first, at most `count`; `out` is
+  // cleared first (reserve it: nothing is allocated when it holds `count`).
+  void sources_outside(const std::vector<size_t>& excluded, size_t count, std::vector<EnvSource>& out) const;
   // Radiance SH (4 bands) of the whole filtered grid.
   const ShRgb& radiance_sh() const { return sh_; }
   // Mean luminance of the radiance over the cells holding light (what the image saw), 0 when
@@ -130,6 +143,8 @@ class EnvSampler {
     int x0, x1, y0, y1;
   };
   std::vector<RegionRect> regions_, next_regions_;
+  std::vector<RegionRect> light_rects_;        // lights_'s regions, in lights_'s order
+  std::vector<size_t> light_order_;            // cut()'s sort of the regions by luminance
   std::vector<double> cell_solid_angle_;       // grid geometry
   std::vector<glm::dvec3> cell_sum_;           // this frame: sum of L dw per cell
   std::vector<double> cell_seen_;              // this frame: sum of dw per cell
@@ -145,6 +160,10 @@ class EnvSampler {
   std::vector<int32_t> cell_source_;
   std::vector<double> source_solid_angle_;
   std::vector<int32_t> flood_;
+  // sources_outside()'s scratch, one entry a source, reserved at start-up.
+  mutable std::vector<EnvSource> source_sum_;
+  mutable std::vector<glm::dvec3> source_moment_;
+  mutable std::vector<uint8_t> cell_excluded_;
   void find_sources();
   ShRgb sh_{};
   std::vector<ShVector> cell_sh_;              // Y_i(cell centre) * cell dw

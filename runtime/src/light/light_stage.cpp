@@ -126,6 +126,7 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
   s.lighting_.foldable.reserve(kMaxStageLights);
   s.lighting_.ambient_regions.reserve(Lighting::kMaxOcclusionRegions);
   s.region_order_.reserve(size_t(settings.environment.samples));  // one entry a region at most
+  s.sources_.reserve(size_t(Lighting::kMaxOcclusionRegions));
   for (const LightDesc& l : scene.lights) {
     s.lighting_.lights.push_back(l);
     s.lighting_.light_sh.push_back(ShRgb{});
@@ -310,6 +311,19 @@ void LightStage::set_ambient_regions() {
   const auto& regions = env_->lights();
   const double mean = env_->mean_lit_luminance();
   if (!(mean > 0.0)) return;
+  if (settings_.occlusion_regions_from_sources) {
+    env_->sources_outside(shadowed_regions_, size_t(Lighting::kMaxOcclusionRegions), sources_);
+    for (const EnvSource& src : sources_) {
+      if (luminance(src.irradiance) / src.solid_angle_sr / mean < settings_.occlusion_region_min_contrast) continue;
+      Lighting::AmbientRegion a;
+      a.direction = src.direction;
+      a.irradiance = src.irradiance;
+      a.half_angle_rad = std::acos(std::clamp(1.0 - src.solid_angle_sr / (2.0 * kPi), 0.0, 1.0));
+      a.sh = src.sh;
+      lighting_.ambient_regions.push_back(a);
+    }
+    return;
+  }
   region_order_.clear();
   for (size_t k = 0; k < regions.size(); ++k) {
     const EnvLight& r = regions[k];

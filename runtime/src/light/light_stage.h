@@ -71,6 +71,13 @@ struct LightStageSettings {
   // (Lighting::ambient_regions): a region brighter than the mean is where the objects' soft
   // shadow points; at or below it, the SH's blur loses little. >= 0.
   double occlusion_region_min_contrast = 1.0;
+  // The cones come from the environment's light sources (EnvSamplerSettings::source_contrast:
+  // connected cells at least that many times the mean radiance), each gathered whole, strongest
+  // first, instead of from the median cut's regions: a median cut splits an extended bright
+  // source (a sunlit wall, a window, a hazy low sun) into pieces joined with broad dim parts
+  // around it, and the pieces that pass the contrast rule are the small ones, so the objects'
+  // soft shadow pointed at whatever small bright regions the sky had. false: the regions.
+  bool occlusion_regions_from_sources = true;
   // What an env camera cannot see (below an upward fisheye's horizon: the floor and the room
   // around the virtual objects) lights them as the mean radiance the colour camera sees, not as
   // darkness. Why: the light from below is what the real surfaces reflect, and the camera
@@ -185,11 +192,14 @@ struct Lighting {
   // Radiance SH (4 bands) of the light not in `lights`: real (lights real and virtual surfaces)
   // and virtual (a virtual environment: lights virtual surfaces only).
   ShRgb ambient_real{}, ambient_virtual{};
-  // The broadest-bright parts of the ambient's environment, kept as cones for the virtual
-  // objects' occlusion of it (shading/environment_occlusion.h: their shadows fall in their
-  // direction, which the SH blurs): the regions not drawn as lights whose mean radiance is at
-  // least LightStageSettings::occlusion_region_min_contrast x the environment's, most
-  // concentrated first, at most kMaxOcclusionRegions. Their light stays in the ambient SH too
+  // The bright parts of the ambient's environment, kept as cones for the virtual objects'
+  // occlusion of it (shading/environment_occlusion.h: their shadows fall in their direction,
+  // which the SH blurs): the environment's light sources (EnvSource: connected cells brighter
+  // than EnvSamplerSettings::source_contrast x the mean), each whole but for the regions drawn
+  // as lights, whose mean radiance is at least LightStageSettings::occlusion_region_min_contrast
+  // x the environment's, strongest first, at most kMaxOcclusionRegions (with
+  // occlusion_regions_from_sources false: the median cut's regions not drawn as lights, most
+  // concentrated first). Their light stays in the ambient SH too
   // (`sh` is its part). Empty without an environment.
   struct AmbientRegion {
     glm::dvec3 direction{0.0, 1.0, 0.0};  // unit, world, towards the region
@@ -292,6 +302,7 @@ class LightStage {
   glm::dvec3 mean_camera_radiance(const InputFrame& frame) const;
   std::vector<size_t> shadowed_regions_;  // this frame's, indices into the sampler's lights
   std::vector<std::pair<double, size_t>> region_order_;  // set_ambient_regions' (contrast, index)
+  std::vector<EnvSource> sources_;        // set_ambient_regions' (occlusion_regions_from_sources)
   LampRemoval lamp_removal_;
   ImageRGBF env_scratch_;                 // the env image with the declared lamps taken out
   int lamps_removed_ = 0;                 // this frame's

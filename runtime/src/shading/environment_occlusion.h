@@ -22,9 +22,9 @@
 // virtual) so an object's edge does not bleed onto the floor behind it.
 //
 // The light it occludes is the ambient only (the light stage's SH after its shadowed lights are
-// taken out): shadowed lights already have their shadow maps. The ambient's broad bright
-// regions (a low sun behind haze, a window: light::Lighting::ambient_regions) are taken out of
-// the SH and hidden as cones, the exact part of each a proxy's cap covers
+// taken out): shadowed lights already have their shadow maps. The ambient's bright sources,
+// each whole (a low sun behind haze, a sunlit wall, a window: light::Lighting::ambient_regions),
+// are taken out of the SH and hidden as cones, the exact part of each a proxy's cap covers
 // (cap_overlap_solid_angle), so the soft shadow falls away from them as in the truth instead
 // of spreading round the object as the SH's 4 bands do.
 //
@@ -52,7 +52,7 @@ namespace mrgi::shading {
 struct EnvOcclusionLevel {
   int divisor = 2;             // internal pixels per texel side, 1..8
   int spheres_per_object = 8;  // the first this many of each object's proxies; 0 = off
-  // Of the light stage's broad bright regions (light::Lighting::ambient_regions), at most this
+  // Of the light stage's bright sources (light::Lighting::ambient_regions), at most this
   // many are hidden as cones (exact cap overlap) instead of through the SH; 0..4.
   int regions = 4;
   // Near field (shaders/shared/occlusion_math.h): march steps of the ray past the objects that
