@@ -9,9 +9,12 @@
 #include <iostream>
 #include <optional>
 
+#include <unistd.h>
+
 #include "mrgi/platform/output_dir.h"
 #include "ablation_names.h"
 #include "commands.h"
+#include "mrgi/perf/ab_compare.h"
 #include "mrgi/perf/bench.h"
 #include "mrgi/perf/regression.h"
 #include "mrgi/perf/report.h"
@@ -27,7 +30,13 @@ struct BenchOptions {
   std::vector<std::string> sweeps;  // --sweep NAME=V1,V2,... (one technique)
   std::vector<std::string> specular_ablation;  // --specular-ablation
   bool quiet = false;
-  int confirm = 1;  // re-runs of an entry whose only finding is its frame time, before failing
+  int confirm = 1;
+  bool serve = false;            // --serve: a worker of an A/B comparison (ab_compare.h)
+  std::string compare;           // --compare BASE: the base build's mrgi
+  std::string candidate;         // --candidate: the candidate's (default: this executable)
+  std::string compare_manifest = "perf/compare.json", compare_set = "quick";
+  int pairs = 12;
+  bool frames_set = false, warmup_set = false, profile_set = false;  // re-runs of an entry whose only finding is its frame time, before failing
 };
 
 std::pair<int, int> parse_size(const std::string& text) {
@@ -209,6 +218,77 @@ void run_bench_command(BenchOptions& o) {
   }
 }
 
+// --compare BASE: this build (the candidate) against BASE, entry by entry, interleaved.
+void run_compare_command(BenchOptions& o) {
+  perf::ensure_lp_num_threads();
+  if (!o.check.empty() || !o.write_baseline.empty() || !o.sizes.empty() || !o.knobs.empty() || !o.sweeps.empty())
+    throw CommandFailure(2, "--compare cannot be combined with --check, --write-baseline, --sizes, --knob or --sweep");
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_regular_file(o.compare, ec) || access(o.compare.c_str(), X_OK) != 0)
+    throw CommandFailure(2, "--compare " + o.compare + ": not an executable file (the base build's mrgi)");
+  perf::AbSettings a;
+  a.suite = resolve_suites(o.settings.suite);
+  a.base_binary = fs::absolute(o.compare, ec).string();
+  if (!o.candidate.empty()) {
+    if (!fs::is_regular_file(o.candidate, ec) || access(o.candidate.c_str(), X_OK) != 0)
+      throw CommandFailure(2, "--candidate " + o.candidate + ": not an executable file");
+    a.candidate_binary = fs::absolute(o.candidate, ec).string();
+  } else {
+    a.candidate_binary = fs::read_symlink("/proc/self/exe", ec).string();
+    if (ec) throw CommandFailure(1, "--compare: cannot find this executable (/proc/self/exe)");
+  }
+  a.pairs = o.pairs;
+  a.frames = o.frames_set ? o.settings.frames : 8;
+  a.warmup = o.warmup_set ? o.settings.warmup : 2;
+  a.profile_frames = o.profile_set ? o.settings.profile_frames : 4;
+  a.device = o.settings.device.device;
+  if (!o.settings.scenes.empty() || !o.settings.techniques.empty() || !o.settings.levels.empty()) {
+    if (o.settings.scenes.empty() || o.settings.techniques.empty() || o.settings.levels.empty())
+      throw CommandFailure(2, "--compare with an explicit subset needs --scenes, --techniques and --levels (each "
+                              "combination is an entry); without them the set --compare-set of --compare-manifest");
+    for (const auto& sc : o.settings.scenes)
+      for (const auto& t : o.settings.techniques)
+        for (const auto& l : o.settings.levels) a.entries.push_back({sc, t, l});
+  } else {
+    a.entries = take(perf::load_compare_set(resolve_suites(o.compare_manifest), o.compare_set));
+  }
+  if (!o.quiet) a.progress = [](const std::string& what, size_t done, size_t total, double elapsed) {
+    progress("compare " + what, done, total, elapsed);
+  };
+  OutputDir out = take(OutputDir::begin(o.out, "--out"));
+  perf::AbResult result = take(perf::run_ab_compare(a));
+  auto st = perf::write_ab_outputs(out.partial(), result);
+  if (!st.ok()) fail_with(st.error());
+  auto committed = out.commit();
+  if (!committed.ok()) fail_with(committed.error());
+  const size_t needed = perf::min_pairs_for(result.quantities.size(), result.rule.alpha);
+  std::printf("compare: %zu entries, %zu quantities, %d pairs each, %.0f s on %s; %zu alarm(s); wrote %s/{compare.md,compare.json,junit.xml,ratios.png}\n",
+              a.entries.size(), result.quantities.size(), result.pairs, result.duration_s, result.device.c_str(),
+              result.alarms(), o.out.c_str());
+  if (size_t(result.pairs) < needed)
+    std::fprintf(stderr, "compare: with %d pairs no quantity of %zu can alarm (needs %zu): raise --pairs\n", result.pairs,
+                 result.quantities.size(), needed);
+  for (const perf::AbQuantity& q : result.quantities)
+    if (q.judgement.alarm)
+      std::printf("  slower: %s %s x%.3f (%.3f-%.3f), Holm p %.2g\n", (q.scene + "/" + q.technique + "/" + q.level_name).c_str(),
+                  q.metric.c_str(), q.judgement.median_ratio, q.judgement.ratio_low, q.judgement.ratio_high,
+                  q.judgement.p_adjusted);
+  if (result.alarms() > 0)
+    throw CommandFailure(1, "compare: the candidate is slower than the base (" + std::to_string(result.alarms()) +
+                                " alarm(s); see " + o.out + "/compare.md)");
+}
+
+void run_bench_or_serve(BenchOptions& o) {
+  if (o.serve) {
+    // A worker: answers on stdout, nothing else written there.
+    std::exit(perf::serve_bench_worker(std::cin, std::cout, o.settings.device.device));
+  }
+  if (o.out.empty()) throw CommandFailure(2, "--out is required");
+  if (!o.compare.empty()) return run_compare_command(o);
+  run_bench_command(o);
+}
+
 void setup(CLI::App& app) {
   auto opts = std::make_shared<BenchOptions>();
   opts->settings.suite = "perf/suite.json";
@@ -223,16 +303,20 @@ void setup(CLI::App& app) {
       ->delimiter(',');
   cmd->add_option("--scenes,-s", opts->settings.scenes, "suite scenes to run, comma-separated (default: all)")
       ->delimiter(',');
-  cmd->add_option("--frames,-n", opts->settings.frames, "measured frames per run")
+  cmd->add_option("--frames,-n", opts->settings.frames, "measured frames per run (--compare: per measurement, default 8)")
       ->check(CLI::Range(1, 100000))
-      ->capture_default_str();
-  cmd->add_option("--warmup", opts->settings.warmup, "frames run before measuring, per run")
+      ->capture_default_str()
+      ->each([opts](const std::string&) { opts->frames_set = true; });
+  cmd->add_option("--warmup", opts->settings.warmup, "frames run before measuring, per run (--compare: default 2)")
       ->check(CLI::Range(0, 100000))
-      ->capture_default_str();
+      ->capture_default_str()
+      ->each([opts](const std::string&) { opts->warmup_set = true; });
   cmd->add_option("--profile-frames", opts->settings.profile_frames,
-                  "frames per run in profiling mode (each pass alone, host-timed) for the per-pass split; 0 = none")
+                  "frames per run in profiling mode (each pass alone, host-timed) for the per-pass split; 0 = none "
+                  "(--compare: default 4)")
       ->check(CLI::Range(0, 100000))
-      ->capture_default_str();
+      ->capture_default_str()
+      ->each([opts](const std::string&) { opts->profile_set = true; });
   cmd->add_option("--frames-in-flight", opts->settings.frames_in_flight,
                   "frames in flight in the sustained phase (a live device runs 2)")
       ->check(CLI::Range(1, 3))
@@ -250,7 +334,25 @@ void setup(CLI::App& app) {
   cmd->add_option("--floor-per-frame", opts->settings.floor_per_frame, "floor-pass samples after each profiled frame")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
-  cmd->add_option("--out,-o", opts->out, "output folder (built as DIR.partial, renamed at the end)")->required();
+  cmd->add_option("--out,-o", opts->out, "output folder (built as DIR.partial, renamed at the end); required");
+  cmd->add_option("--compare", opts->compare,
+                  "A/B: judge this build (the candidate) against BASE, another build's mrgi, measured one after the "
+                  "other entry by entry (perf/README.md: the rule); writes compare.md, compare.json, junit.xml, "
+                  "ratios.png; exit 1 when the candidate is slower on any quantity");
+  cmd->add_option("--candidate", opts->candidate,
+                  "--compare: the candidate build's mrgi (default: this one), e.g. a script that runs a build "
+                  "with a test hook set");
+  cmd->add_option("--compare-manifest", opts->compare_manifest, "--compare: the entry sets' manifest")
+      ->capture_default_str();
+  cmd->add_option("--compare-set", opts->compare_set,
+                  "--compare: which set of the manifest (quick: under 10 minutes on 2 cores; full)")
+      ->capture_default_str();
+  cmd->add_option("--pairs", opts->pairs, "--compare: measurements of each build per entry")
+      ->check(CLI::Range(2, 1000))
+      ->capture_default_str();
+  cmd->add_flag("--serve", opts->serve,
+                "run as one build's worker of an A/B comparison (--compare starts two): JSON requests on stdin, "
+                "answers on stdout (perf/include/mrgi/perf/ab_compare.h)");
   cmd->add_option("--confirm", opts->confirm,
                   "re-runs of an entry whose only regression finding is its frame time, before "
                   "the check fails (0 = fail at once)")
@@ -280,7 +382,7 @@ void setup(CLI::App& app) {
                   "set one quality knob of the (one) technique at every level, NAME=VALUE (repeatable; mrgi info "
                   "--technique T lists them with their spans)");
   cmd->add_flag("--quiet,-q", opts->quiet, "no progress on stderr");
-  cmd->callback([opts] { run_bench_command(*opts); });
+  cmd->callback([opts] { run_bench_or_serve(*opts); });
 }
 
 }  // namespace

@@ -49,12 +49,13 @@ size_t ping_pong(size_t k, size_t n) {
 // Every frame of a run built before it starts (inputs preloaded, as on a live device where the
 // sensor delivers frames): frame k is capture frame ping_pong(k) with index k and timestamps
 // continued, so feeding one costs the bench nothing inside the timed loop.
-std::vector<InputFrame> preload_run(const LoadedScene& l, size_t count) {
+std::vector<InputFrame> preload_run(const LoadedScene& l, size_t count, size_t first) {
   std::vector<InputFrame> frames(count);
   const double t_first = l.frames.front().timestamp;
-  for (size_t k = 0; k < count; ++k) {
+  for (size_t i = 0; i < count; ++i) {
+    const size_t k = first + i;
     const InputFrame& src = l.frames[ping_pong(k, l.frames.size())];
-    InputFrame& f = frames[k];
+    InputFrame& f = frames[i];
     f = src;
     f.index = int64_t(k);
     f.timestamp = t_first + double(k) * l.frame_interval_s;

@@ -27,7 +27,8 @@ Expected<LoadedScene> load_scene(const SuiteScene& s);
 // Replay order forth and back: 0..n-1, n-2..1, 0..; keeps motion continuous for temporal filters.
 size_t ping_pong(size_t k, size_t n);
 
-// Frame k is capture frame ping_pong(k) with index k and timestamps continued.
-std::vector<InputFrame> preload_run(const LoadedScene& l, size_t count);
+// Frame k is capture frame ping_pong(k) with index k and timestamps continued; the run holds
+// frames first .. first + count - 1 (a runtime fed several runs takes them one after the other).
+std::vector<InputFrame> preload_run(const LoadedScene& l, size_t count, size_t first = 0);
 
 }  // namespace mrgi::perf

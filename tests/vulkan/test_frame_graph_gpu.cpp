@@ -1,10 +1,12 @@
 // The frame graph on lavapipe with validation (and synchronization validation) on: a real graph
 // of compute and transfer passes with readback, timestamps without stalls, the floor pass, and
 // no allocation after start-up.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <map>
 
 #include "gpu/floor_pass.h"
 #include "gpu/frame_graph.h"
@@ -226,6 +228,56 @@ TEST_F(VulkanTest, ProfilingModeTimesEachPassAloneAndTheyAddUpToTheFrame) {
   }
   // The output is the same in both modes.
   EXPECT_EQ(wrong_pixels(ctx(), t, got.back().slot), 0);
+}
+
+// The regression checks' test hook (frame_graph.h): MRGI_PLANT_SLOWDOWN=PASS:FACTOR[,...] makes
+// each named pass take FACTOR times as long in profiling mode, the others unchanged; a malformed
+// list is refused naming the part at fault.
+TEST_F(VulkanTest, PlantedSlowdownLengthensOnlyTheNamedPasses) {
+  auto median_ms = [&](const char* plant) {
+    if (plant) setenv("MRGI_PLANT_SLOWDOWN", plant, 1);
+    InvertGraph t = InvertGraph::make(ctx());
+    unsetenv("MRGI_PLANT_SLOWDOWN");
+    EXPECT_TRUE(t.graph->set_profiling(true).ok());
+    std::map<std::string, std::vector<double>> ms;
+    auto take = [&](const FrameTimings& f) {
+      for (const PassTiming& p : f.passes) ms[p.name].push_back(p.gpu_ms);
+    };
+    for (int i = 0; i < 9; ++i) {
+      auto begun = t.graph->begin_frame();
+      EXPECT_TRUE(begun.ok());
+      if (begun.ok() && *begun) take(**begun);
+      EXPECT_TRUE(t.record_frame().ok());
+    }
+    auto rest = t.graph->flush();
+    EXPECT_TRUE(rest.ok());
+    if (rest.ok())
+      for (const FrameTimings& f : *rest) take(f);
+    std::map<std::string, double> med;
+    for (auto& [name, v] : ms) {
+      std::sort(v.begin(), v.end());
+      med[name] = v[v.size() / 2];
+    }
+    return med;
+  };
+  const auto plain = median_ms(nullptr);
+  const auto planted = median_ms("invert_back:4,readback:1");
+  ASSERT_TRUE(plain.count("invert_back") && planted.count("invert_back"));
+  // 4x the pass's whole submission, less the submission overhead subtracted afterwards: well
+  // above 2x; the unnamed pass is not lengthened that way.
+  EXPECT_GT(planted.at("invert_back"), 2.0 * plain.at("invert_back"));
+  EXPECT_LT(planted.at("invert"), 2.0 * plain.at("invert") + 0.5);
+  for (const char* bad : {"invert_back", "invert_back:0.5", ":2", "invert_back:2,readback"}) {
+    setenv("MRGI_PLANT_SLOWDOWN", bad, 1);
+    FrameGraphSettings fs;
+    fs.max_output_width = W;
+    fs.max_output_height = H;
+    auto g = FrameGraph::create(ctx(), fs);
+    unsetenv("MRGI_PLANT_SLOWDOWN");
+    ASSERT_FALSE(g.ok()) << bad;
+    EXPECT_EQ(g.error().kind, ErrorKind::BadUsage);
+    EXPECT_NE(g.error().message.find("PASS:FACTOR"), std::string::npos) << g.error().message;
+  }
 }
 
 TEST_F(VulkanTest, ProfilingModeNeedsItsCommandBuffersAllocated) {

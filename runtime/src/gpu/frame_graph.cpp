@@ -131,13 +131,18 @@ Status FrameGraph::init() {
   executes_.reserve(settings_.max_passes);
   shader_passes_.reserve(settings_.max_passes);
   if (const char* plant = std::getenv("MRGI_PLANT_SLOWDOWN")) {
-    const std::string spec = plant;
-    const size_t colon = spec.rfind(':');
-    const double factor = colon == std::string::npos ? 0.0 : std::atof(spec.c_str() + colon + 1);
-    if (colon == std::string::npos || colon == 0 || !(factor >= 1.0 && factor <= 100.0))
-      return fail(ErrorKind::BadUsage, "MRGI_PLANT_SLOWDOWN='" + spec + "': must be PASS:FACTOR with FACTOR in [1, 100]");
-    plant_pass_ = spec.substr(0, colon);
-    plant_factor_ = factor;
+    const std::string list = plant;
+    for (size_t at = 0; at <= list.size();) {
+      const size_t comma = std::min(list.find(',', at), list.size());
+      const std::string spec = list.substr(at, comma - at);
+      at = comma + 1;
+      const size_t colon = spec.rfind(':');
+      const double factor = colon == std::string::npos ? 0.0 : std::atof(spec.c_str() + colon + 1);
+      if (colon == std::string::npos || colon == 0 || !(factor >= 1.0 && factor <= 100.0))
+        return fail(ErrorKind::BadUsage, "MRGI_PLANT_SLOWDOWN='" + list + "': '" + spec +
+                                             "' must be PASS:FACTOR with FACTOR in [1, 100] (several: comma-separated)");
+      plants_.emplace_back(spec.substr(0, colon), factor);
+    }
   }
   return ok_status();
 }
@@ -644,8 +649,10 @@ Expected<double> FrameGraph::submit_and_wait(VkCommandBuffer cmd, const std::str
                                         " s (profiling mode)");
   VK_CHECK(w);
   VK_CHECK(vkResetFences(dev, 1, &profile_fence_));
-  if (pass && !plant_pass_.empty() && *pass == plant_pass_) {  // test hook: see frame_graph.h
-    const auto until = t0 + (t1 - t0) * plant_factor_;
+  const auto planted = pass ? std::find_if(plants_.begin(), plants_.end(), [&](const auto& p) { return p.first == *pass; })
+                            : plants_.end();
+  if (planted != plants_.end()) {  // test hook: see frame_graph.h
+    const auto until = t0 + (t1 - t0) * planted->second;
     while (std::chrono::steady_clock::now() < until) {
     }
     t1 = std::chrono::steady_clock::now();

@@ -21,6 +21,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "gpu/context.h"
@@ -468,11 +469,10 @@ class FrameGraph {
   VkFence profile_fence_ = VK_NULL_HANDLE;
   bool profiling_ = false;
   double submission_overhead_ms_ = 0.0;
-  // Test hook for the regression check (perf/README.md): MRGI_PLANT_SLOWDOWN=PASS:FACTOR makes
-  // pass PASS take FACTOR times as long in profiling mode (the host waits the extra time after
-  // its fence). Read once at creation; empty = off.
-  std::string plant_pass_;
-  double plant_factor_ = 1.0;
+  // Test hook for the regression checks (perf/README.md): MRGI_PLANT_SLOWDOWN=PASS:FACTOR[,...]
+  // makes each pass PASS take FACTOR times as long in profiling mode (the host spins the extra
+  // time after its fence). Read once at creation; empty = off.
+  std::vector<std::pair<std::string, double>> plants_;
   Status submit_profiled();
   Status measure_submission_overhead();
   // Submits `cmd` alone with the profiling fence and waits: host ms from submit to fence.

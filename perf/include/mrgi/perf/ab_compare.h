@@ -1,0 +1,79 @@
+// A/B comparison of two builds of mrgi (`mrgi bench --compare BASE`): the base and the
+// candidate each run as a worker process (`mrgi bench --serve`), measured one after the other
+// on the same entry and the same preloaded inputs, ABAB... (the order alternating pair to pair
+// so a machine speeding up or slowing down over the run moves both alike), never both at once;
+// each quantity (an entry's sustained ms and process CPU ms per frame, each main pass's
+// profiled ms) is judged by mrgi/perf/ab_stats.h's rule over all quantities together.
+//
+// The worker protocol (one JSON object per line; the worker answers each request with one
+// line): on start the worker writes {"ok":true,"protocol":1,"device":...,"commit":...}; a
+// request {"op":"measure","suite":PATH,"scene":NAME,"technique":T,"level":NAME_OR_INDEX,
+// "frames":F,"warmup":W,"profile_frames":P,"device":SELECTOR} runs W + F frames back to back
+// (2 in flight) and P frames in profiling mode on the entry's runtime (made on the first request
+// for the entry and kept while the requests stay on it) and answers {"ok":true,"level_name":...,
+// "sustained_ms":...,"cpu_ms":...,"profiled_ms":...,"passes":{"NAME":median ms,...}} or
+// {"ok":false,"error":...}; {"op":"quit"} ends it.
+#pragma once
+#include <functional>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "mrgi/expected.h"
+#include "mrgi/perf/ab_stats.h"
+
+namespace mrgi::perf {
+
+// One entry of a comparison: a suite scene at one technique's level (a name, an index or
+// "last").
+struct AbEntry {
+  std::string scene, technique, level;
+};
+
+// The entry sets of a comparison manifest (perf/compare.json): {"version":1,"sets":{NAME:
+// [{"scene":...,"technique":...,"level":...},...],...}}. BadInput naming the file, the field and
+// the rule.
+Expected<std::vector<AbEntry>> load_compare_set(const std::string& path, const std::string& set);
+
+struct AbSettings {
+  std::string suite;                 // suite manifests, comma-separated, holding the entries' scenes
+  std::vector<AbEntry> entries;
+  std::string base_binary, candidate_binary;  // mrgi executables with `bench --serve`
+  int pairs = 12;                    // measurements of each build per entry (see min_pairs_for)
+  int frames = 8, warmup = 2;        // per measurement: sustained frames after warm-up frames
+  int profile_frames = 4;            // per measurement: profiling-mode frames (0 = no pass judged)
+  // Passes judged: those taking at least this share of the base's profiled frame (below it a
+  // pass's time is mostly noise and the family grows for nothing).
+  double pass_min_share = 0.10;
+  std::string device;                // Vulkan device selector for both workers
+  AbRule rule;
+  std::function<void(const std::string&, size_t, size_t, double)> progress;  // optional
+};
+
+// One judged quantity with its samples (base[i] and candidate[i] measured one after the other).
+struct AbQuantity {
+  std::string scene, technique, level_name, metric;  // metric: sustained_ms, cpu_ms, pass:NAME
+  std::vector<double> base, candidate;
+  AbJudgement judgement;
+};
+
+struct AbResult {
+  std::vector<AbQuantity> quantities;
+  std::string base_binary, candidate_binary, base_commit, candidate_commit, device, lp_num_threads;
+  int pairs = 0, frames = 0, warmup = 0, profile_frames = 0;
+  AbRule rule;
+  double duration_s = 0.0;
+  size_t alarms() const;
+};
+
+Expected<AbResult> run_ab_compare(const AbSettings& settings);
+
+// compare.md (the paired figures per quantity and the verdict), compare.json, junit.xml (a test
+// case per quantity, failed where it alarms) and ratios.png (each quantity's median ratio with
+// its interval) into `dir`.
+Status write_ab_outputs(const std::string& dir, const AbResult& result);
+
+// The worker's loop over `in` (requests) and `out` (answers); returns the process exit status.
+int serve_bench_worker(std::istream& in, std::ostream& out, const std::string& device);
+
+}  // namespace mrgi::perf

@@ -1,0 +1,118 @@
+// The A/B comparison (mrgi/perf/ab_compare.h): its manifest's sets and refusals, and a short
+// comparison of the built mrgi against itself through `bench --compare` (both workers, the
+// interleaved measurements, the four outputs, no alarm), and a base that is no mrgi worker
+// refused by name.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "capture/temp_dir.h"
+#include "mrgi/perf/ab_compare.h"
+#include "mrgi/perf/suite.h"
+#include "mrgi/runtime.h"
+
+using mrgi::testing::TempDir;
+namespace fs = std::filesystem;
+namespace perf = mrgi::perf;
+
+namespace {
+
+void write(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
+
+}  // namespace
+
+// Both sets of the repository's manifest name suite scenes and levels the techniques have; the
+// quick set holds every technique.
+TEST(AbCompare, ManifestSetsNameRealEntries) {
+  const std::string manifest = std::string(MRGI_SOURCE_DIR) + "/perf/compare.json";
+  auto suite = perf::load_suites(std::string(MRGI_SOURCE_DIR) + "/perf/suite.json");
+  ASSERT_TRUE(suite.ok()) << suite.error().message;
+  for (const char* set : {"quick", "full"}) {
+    auto entries = perf::load_compare_set(manifest, set);
+    ASSERT_TRUE(entries.ok()) << entries.error().message;
+    std::set<std::string> techniques;
+    for (const perf::AbEntry& e : *entries) {
+      EXPECT_TRUE(perf::select_scenes(*suite, {e.scene}).ok()) << set << ": " << e.scene;
+      auto levels = mrgi::technique_levels(e.technique);
+      ASSERT_TRUE(levels.ok()) << e.technique;
+      EXPECT_NE(std::find(levels->begin(), levels->end(), e.level), levels->end()) << e.technique << " " << e.level;
+      techniques.insert(e.technique);
+    }
+    EXPECT_EQ(techniques.size(), mrgi::technique_names().size()) << set;
+  }
+}
+
+TEST(AbCompare, ManifestRefusalsNameTheFieldAndRule) {
+  TempDir dir;
+  const fs::path p = fs::path(dir.str()) / "compare.json";
+  auto refused = [&](const std::string& text, const std::string& set, const std::string& expected) {
+    write(p, text);
+    auto r = perf::load_compare_set(p.string(), set);
+    ASSERT_FALSE(r.ok()) << text;
+    EXPECT_NE(r.error().message.find(expected), std::string::npos) << r.error().message;
+    EXPECT_NE(r.error().message.find(p.string()), std::string::npos) << r.error().message;
+  };
+  refused("{", "quick", "not JSON");
+  refused(R"({"version":2,"sets":{}})", "quick", "'version' must be 1");
+  refused(R"({"version":1})", "quick", "'sets'");
+  refused(R"({"version":1,"sets":{"full":[{"scene":"a","technique":"b","level":"c"}]}})", "quick",
+          "no set 'quick' (sets: full)");
+  refused(R"({"version":1,"sets":{"quick":[]}})", "quick", "non-empty array");
+  refused(R"({"version":1,"sets":{"quick":[{"scene":"a","technique":"b"}]}})", "quick", "sets.quick[0].level");
+  auto missing = perf::load_compare_set((fs::path(dir.str()) / "absent.json").string(), "quick");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.error().message.find("cannot be read"), std::string::npos);
+}
+
+// The built mrgi against itself on one entry, as a user runs it: exit 0, the four outputs, the
+// quantities judged (sustained and CPU ms and the main passes), no alarm. Two pairs cannot alarm
+// in a family this size (the report says so), so this checks the machinery, not the machine.
+TEST(AbCompare, BuildAgainstItselfWritesTheReport) {
+  if (!fs::exists(MRGI_TOOL)) GTEST_SKIP() << "mrgi tool not built at " << MRGI_TOOL;
+  TempDir dir;
+  const fs::path out = fs::path(dir.str()) / "compare";
+  const std::string cmd = std::string("cd ") + MRGI_SOURCE_DIR + " && LP_NUM_THREADS=2 timeout 300 " + MRGI_TOOL +
+                          " bench --compare " + MRGI_TOOL +
+                          " --scenes desk_spot --techniques baseline --levels lowest --pairs 2 --frames 2 --warmup 1"
+                          " --profile-frames 1 -q -o " + out.string() + " > " + (fs::path(dir.str()) / "log").string() + " 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << std::ifstream(fs::path(dir.str()) / "log").rdbuf();
+  for (const char* f : {"compare.md", "compare.json", "junit.xml", "ratios.png"}) EXPECT_TRUE(fs::exists(out / f)) << f;
+  const nlohmann::json j = nlohmann::json::parse(std::ifstream(out / "compare.json"));
+  EXPECT_EQ(j["alarms"], 0);
+  EXPECT_EQ(j["pairs"], 2);
+  std::set<std::string> metrics;
+  for (const auto& q : j["quantities"]) {
+    metrics.insert(q["metric"].get<std::string>());
+    EXPECT_EQ(q["base_ms"].size(), size_t(2));
+    EXPECT_EQ(q["candidate_ms"].size(), size_t(2));
+  }
+  EXPECT_TRUE(metrics.count("sustained_ms"));
+  EXPECT_TRUE(metrics.count("cpu_ms"));
+  EXPECT_TRUE(metrics.count("pass:shade_direct"));
+  std::stringstream md;
+  md << std::ifstream(out / "compare.md").rdbuf();
+  EXPECT_NE(md.str().find("no quantity of a family"), std::string::npos);  // 2 pairs cannot alarm
+}
+
+// A base that does not speak the worker protocol is refused naming it; nothing is written.
+TEST(AbCompare, BaseThatIsNoWorkerIsRefused) {
+  if (!fs::exists(MRGI_TOOL)) GTEST_SKIP() << "mrgi tool not built at " << MRGI_TOOL;
+  TempDir dir;
+  const fs::path out = fs::path(dir.str()) / "compare";
+  const fs::path log = fs::path(dir.str()) / "log";
+  const std::string cmd = std::string("cd ") + MRGI_SOURCE_DIR + " && timeout 120 " + MRGI_TOOL +
+                          " bench --compare /bin/true --scenes desk_spot --techniques baseline --levels lowest -q -o " +
+                          out.string() + " > " + log.string() + " 2>&1";
+  EXPECT_NE(std::system(cmd.c_str()), 0);
+  std::stringstream text;
+  text << std::ifstream(log).rdbuf();
+  EXPECT_NE(text.str().find("/bin/true: did not answer as an mrgi bench worker"), std::string::npos) << text.str();
+  EXPECT_FALSE(fs::exists(out));
+}
