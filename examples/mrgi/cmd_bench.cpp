@@ -35,7 +35,7 @@ struct BenchOptions {
   std::string compare;           // --compare BASE: the base build's mrgi
   std::string candidate;         // --candidate: the candidate's (default: this executable)
   std::string compare_manifest = "perf/compare.json", compare_set = "quick";
-  int pairs = 12;
+  int pairs = 14;
   bool frames_set = false, warmup_set = false, profile_set = false;  // re-runs of an entry whose only finding is its frame time, before failing
 };
 
@@ -241,7 +241,7 @@ void run_compare_command(BenchOptions& o) {
   a.pairs = o.pairs;
   a.frames = o.frames_set ? o.settings.frames : 8;
   a.warmup = o.warmup_set ? o.settings.warmup : 2;
-  a.profile_frames = o.profile_set ? o.settings.profile_frames : 4;
+  a.profile_frames = o.profile_set ? o.settings.profile_frames : 6;
   a.device = o.settings.device.device;
   if (!o.settings.scenes.empty() || !o.settings.techniques.empty() || !o.settings.levels.empty()) {
     if (o.settings.scenes.empty() || o.settings.techniques.empty() || o.settings.levels.empty())
@@ -313,7 +313,7 @@ void setup(CLI::App& app) {
       ->each([opts](const std::string&) { opts->warmup_set = true; });
   cmd->add_option("--profile-frames", opts->settings.profile_frames,
                   "frames per run in profiling mode (each pass alone, host-timed) for the per-pass split; 0 = none "
-                  "(--compare: default 4)")
+                  "(--compare: default 6)")
       ->check(CLI::Range(0, 100000))
       ->capture_default_str()
       ->each([opts](const std::string&) { opts->profile_set = true; });

@@ -130,13 +130,13 @@ std::string git_head(const std::string& dir) {
 struct EntrySamples {
   std::string level_name;
   std::vector<json> answers[2];
-  // The field (or pass) of every answer of one side, NaN where an answer lacks it (a pass a
-  // frame skipped): judge_pairs leaves such pairs out.
+  // The field (or the pass's entry in the object `field`) of every answer of one side, NaN where
+  // an answer lacks it (a pass a frame skipped): judge_pairs leaves such pairs out.
   std::vector<double> series(int side, const std::string& field, const std::string& pass = "") const {
     std::vector<double> v;
     for (const json& a : answers[side]) {
       const json* at = pass.empty() ? (a.contains(field) ? &a[field] : nullptr)
-                                    : (a.contains("passes") && a["passes"].contains(pass) ? &a["passes"][pass] : nullptr);
+                                    : (a.contains(field) && a[field].contains(pass) ? &a[field][pass] : nullptr);
       v.push_back(at && at->is_number() ? at->get<double>() : std::nan(""));
     }
     return v;
@@ -262,8 +262,9 @@ Expected<AbResult> run_ab_compare(const AbSettings& s) {
     for (const json& a : es.answers[0])
       if (a.contains("passes"))
         for (auto& [name, ms] : a["passes"].items()) names.insert(name);
+    // A pass is judged on its fastest profiled frame of each measurement (load only adds time).
     for (const std::string& name : names) {
-      std::vector<double> b = es.series(0, "", name), c = es.series(1, "", name);
+      std::vector<double> b = es.series(0, "passes_min", name), c = es.series(1, "passes_min", name);
       std::vector<double> kept = b;
       drop_unresolved_times(kept);
       if (kept.empty() || !(median(kept) >= s.pass_min_share * median(frame))) continue;

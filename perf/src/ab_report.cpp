@@ -10,6 +10,7 @@
 
 #include "mrgi/perf/ab_compare.h"
 #include "mrgi/perf/canvas.h"
+#include "mrgi/perf/regression.h"
 #include "mrgi/perf/stats.h"
 #include "mrgi/image.h"
 
@@ -20,20 +21,6 @@ std::string fmt(const char* f, double v) {
   char b[64];
   std::snprintf(b, sizeof b, f, v);
   return b;
-}
-
-std::string xml_escape(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    switch (c) {
-      case '&': o += "&amp;"; break;
-      case '<': o += "&lt;"; break;
-      case '>': o += "&gt;"; break;
-      case '"': o += "&quot;"; break;
-      default: o += c;
-    }
-  }
-  return o;
 }
 
 std::vector<double> finite(const std::vector<double>& v) {

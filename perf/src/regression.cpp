@@ -311,7 +311,6 @@ std::string CheckReport::summary() const {
   return s;
 }
 
-namespace {
 std::string xml_escape(const std::string& t) {
   std::string o;
   for (char c : t) {
@@ -325,7 +324,6 @@ std::string xml_escape(const std::string& t) {
   }
   return o;
 }
-}  // namespace
 
 std::string junit_xml(const BenchResult& result, const CheckReport& report) {
   // One test case per run entry (its findings name it first: "scene/technique/level: ..."),

@@ -13,6 +13,18 @@
 namespace mrgi::light {
 namespace {
 
+// A cone of the ambient for the objects' occlusion: its direction, light, and the cone of its
+// solid angle (at most a hemisphere).
+Lighting::AmbientRegion ambient_region(const glm::dvec3& direction, const glm::dvec3& irradiance, double solid_angle_sr,
+                                       const ShRgb& sh) {
+  Lighting::AmbientRegion a;
+  a.direction = direction;
+  a.irradiance = irradiance;
+  a.half_angle_rad = std::acos(std::clamp(1.0 - solid_angle_sr / (2.0 * kPi), 0.0, 1.0));
+  a.sh = sh;
+  return a;
+}
+
 // The lights' colour and intensity in scene.json's convention: colour times intensity per
 // channel, the colour's largest channel 1.
 void set_rgb(LightDesc& l, const glm::dvec3& rgb) {
@@ -313,15 +325,9 @@ void LightStage::set_ambient_regions() {
   if (!(mean > 0.0)) return;
   if (settings_.occlusion_regions_from_sources) {
     env_->sources_outside(shadowed_regions_, size_t(Lighting::kMaxOcclusionRegions), sources_);
-    for (const EnvSource& src : sources_) {
-      if (luminance(src.irradiance) / src.solid_angle_sr / mean < settings_.occlusion_region_min_contrast) continue;
-      Lighting::AmbientRegion a;
-      a.direction = src.direction;
-      a.irradiance = src.irradiance;
-      a.half_angle_rad = std::acos(std::clamp(1.0 - src.solid_angle_sr / (2.0 * kPi), 0.0, 1.0));
-      a.sh = src.sh;
-      lighting_.ambient_regions.push_back(a);
-    }
+    for (const EnvSource& src : sources_)
+      if (luminance(src.irradiance) / src.solid_angle_sr / mean >= settings_.occlusion_region_min_contrast)
+        lighting_.ambient_regions.push_back(ambient_region(src.direction, src.irradiance, src.solid_angle_sr, src.sh));
     return;
   }
   region_order_.clear();
@@ -335,13 +341,7 @@ void LightStage::set_ambient_regions() {
   std::sort(region_order_.begin(), region_order_.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
   for (size_t i = 0; i < region_order_.size() && i < size_t(Lighting::kMaxOcclusionRegions); ++i) {
     const EnvLight& r = regions[region_order_[i].second];
-    Lighting::AmbientRegion a;
-    a.direction = r.direction;
-    a.irradiance = r.irradiance;
-    // The cone of the region's solid angle (at most a hemisphere).
-    a.half_angle_rad = std::acos(std::clamp(1.0 - r.solid_angle_sr / (2.0 * kPi), 0.0, 1.0));
-    a.sh = r.region_sh;
-    lighting_.ambient_regions.push_back(a);
+    lighting_.ambient_regions.push_back(ambient_region(r.direction, r.irradiance, r.solid_angle_sr, r.region_sh));
   }
 }
 

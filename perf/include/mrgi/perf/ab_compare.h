@@ -1,5 +1,6 @@
 // A/B comparison of two builds of mrgi (`mrgi bench --compare BASE`): the base and the
-// candidate each run as a worker process (`mrgi bench --serve`), measured one after the other
+// candidate each run as a worker process (`mrgi bench --serve`, which keeps the inputs loaded),
+// measured one after the other
 // on the same entry and the same preloaded inputs, ABAB... (the order alternating pair to pair
 // so a machine speeding up or slowing down over the run moves both alike), never both at once;
 // each quantity (an entry's sustained ms and process CPU ms per frame, each main pass's
@@ -8,10 +9,12 @@
 // The worker protocol (one JSON object per line; the worker answers each request with one
 // line): on start the worker writes {"ok":true,"protocol":1,"device":...,"commit":...}; a
 // request {"op":"measure","suite":PATH,"scene":NAME,"technique":T,"level":NAME_OR_INDEX,
-// "frames":F,"warmup":W,"profile_frames":P,"device":SELECTOR} runs W + F frames back to back
-// (2 in flight) and P frames in profiling mode on the entry's runtime (made on the first request
-// for the entry and kept while the requests stay on it) and answers {"ok":true,"level_name":...,
-// "sustained_ms":...,"cpu_ms":...,"profiled_ms":...,"passes":{"NAME":median ms,...}} or
+// "frames":F,"warmup":W,"profile_frames":P,"fresh":true} runs W + F frames back to back (2 in
+// flight) and P frames in profiling mode on a runtime made for the request (its creation not
+// timed; with "fresh":false the entry's runtime is kept while the requests stay on it) and
+// answers {"ok":true,"level_name":...,
+// "sustained_ms":...,"cpu_ms":...,"profiled_ms":...,"passes":{"NAME":median ms,...},
+// "passes_min":{"NAME":fastest frame's ms,...}} or
 // {"ok":false,"error":...}; {"op":"quit"} ends it.
 #pragma once
 #include <functional>
@@ -39,9 +42,9 @@ struct AbSettings {
   std::string suite;                 // suite manifests, comma-separated, holding the entries' scenes
   std::vector<AbEntry> entries;
   std::string base_binary, candidate_binary;  // mrgi executables with `bench --serve`
-  int pairs = 12;                    // measurements of each build per entry (see min_pairs_for)
+  int pairs = 14;                    // measurements of each build per entry (see min_pairs_for)
   int frames = 8, warmup = 2;        // per measurement: sustained frames after warm-up frames
-  int profile_frames = 4;            // per measurement: profiling-mode frames (0 = no pass judged)
+  int profile_frames = 6;            // per measurement: profiling-mode frames (0 = no pass judged)
   // Passes judged: those taking at least this share of the base's profiled frame (below it a
   // pass's time is mostly noise and the family grows for nothing).
   double pass_min_share = 0.10;

@@ -88,5 +88,7 @@ CheckReport check_against(const BenchResult& result, const Baseline& baseline);
 // a test case per run entry, one for the run-wide pass rule, one for the run itself; each finding
 // a <failure> of the case it names.
 std::string junit_xml(const BenchResult& result, const CheckReport& report);
+// Text escaped for an XML attribute or element (&, <, >, ").
+std::string xml_escape(const std::string& text);
 
 }  // namespace mrgi::perf
