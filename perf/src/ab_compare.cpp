@@ -143,6 +143,32 @@ struct EntrySamples {
   }
 };
 
+// An entry's judged quantities: sustained ms, CPU ms, and each pass taking at least
+// pass_min_share of the base's profiled frame, on its fastest profiled frame of each
+// measurement (load only adds time).
+void add_quantities(const AbEntry& entry, const EntrySamples& es, const AbSettings& s, std::vector<AbQuantity>& out) {
+  auto add = [&](const std::string& metric, const std::vector<double>& b, const std::vector<double>& c) {
+    AbQuantity q{entry.scene, entry.technique, es.level_name, metric, b, c, {}};
+    q.judgement = judge_pairs(entry.scene + "/" + entry.technique + "/" + es.level_name + " " + metric, b, c, s.rule);
+    out.push_back(std::move(q));
+  };
+  add("sustained_ms", es.series(0, "sustained_ms"), es.series(1, "sustained_ms"));
+  add("cpu_ms", es.series(0, "cpu_ms"), es.series(1, "cpu_ms"));
+  std::vector<double> frame = es.series(0, "profiled_ms");
+  drop_unresolved_times(frame);
+  std::set<std::string> names;
+  for (const json& a : es.answers[0])
+    if (a.contains("passes"))
+      for (auto& [name, ms] : a["passes"].items()) names.insert(name);
+  for (const std::string& name : names) {
+    std::vector<double> b = es.series(0, "passes_min", name), c = es.series(1, "passes_min", name);
+    std::vector<double> kept = b;
+    drop_unresolved_times(kept);
+    if (kept.empty() || !(median(kept) >= s.pass_min_share * median(frame))) continue;
+    add("pass:" + name, b, c);
+  }
+}
+
 }  // namespace
 
 size_t AbResult::alarms() const {
@@ -246,31 +272,7 @@ Expected<AbResult> run_ab_compare(const AbSettings& s) {
       }
     }
   }
-  for (size_t e = 0; e < s.entries.size(); ++e) {
-    const EntrySamples& es = samples[e];
-    const AbEntry& entry = s.entries[e];
-    auto add = [&](const std::string& metric, const std::vector<double>& b, const std::vector<double>& c) {
-      AbQuantity q{entry.scene, entry.technique, es.level_name, metric, b, c, {}};
-      q.judgement = judge_pairs(entry.scene + "/" + entry.technique + "/" + es.level_name + " " + metric, b, c, s.rule);
-      result.quantities.push_back(std::move(q));
-    };
-    add("sustained_ms", es.series(0, "sustained_ms"), es.series(1, "sustained_ms"));
-    add("cpu_ms", es.series(0, "cpu_ms"), es.series(1, "cpu_ms"));
-    std::vector<double> frame = es.series(0, "profiled_ms");
-    drop_unresolved_times(frame);
-    std::set<std::string> names;
-    for (const json& a : es.answers[0])
-      if (a.contains("passes"))
-        for (auto& [name, ms] : a["passes"].items()) names.insert(name);
-    // A pass is judged on its fastest profiled frame of each measurement (load only adds time).
-    for (const std::string& name : names) {
-      std::vector<double> b = es.series(0, "passes_min", name), c = es.series(1, "passes_min", name);
-      std::vector<double> kept = b;
-      drop_unresolved_times(kept);
-      if (kept.empty() || !(median(kept) >= s.pass_min_share * median(frame))) continue;
-      add("pass:" + name, b, c);
-    }
-  }
+  for (size_t e = 0; e < s.entries.size(); ++e) add_quantities(s.entries[e], samples[e], s, result.quantities);
   std::vector<AbJudgement> family;
   for (const AbQuantity& q : result.quantities) family.push_back(q.judgement);
   judge_family(family, s.rule);
