@@ -216,16 +216,10 @@ Expected<AbResult> run_ab_compare(const AbSettings& s) {
     return fail(ErrorKind::BadUsage, "--frames >= 1, --warmup and --profile-frames >= 0");
   // Every entry's technique and level must exist (in this build's registry) before hours of work.
   for (const AbEntry& e : s.entries) {
-    auto names = technique_levels(e.technique);
-    if (!names.ok()) return fail(ErrorKind::BadUsage, "entry " + e.scene + "/" + e.technique + "/" + e.level + ": " + names.error().message);
-    const bool index = !e.level.empty() && e.level.find_first_not_of("0123456789") == std::string::npos &&
-                       std::stoul(e.level) < names->size();
-    if (!index && e.level != "last" && std::find(names->begin(), names->end(), e.level) == names->end()) {
-      std::string known;
-      for (const std::string& n : *names) known += (known.empty() ? "" : ", ") + n;
-      return fail(ErrorKind::BadUsage, "entry " + e.scene + "/" + e.technique + "/" + e.level + ": technique '" +
-                                           e.technique + "' has levels " + known);
-    }
+    auto levels = resolve_levels(e.technique, {e.level});
+    if (!levels.ok() || levels->size() != 1)
+      return fail(ErrorKind::BadUsage, "entry " + e.scene + "/" + e.technique + "/" + e.level + ": " +
+                                           (levels.ok() ? "name one level" : levels.error().message));
   }
   AbResult result;
   result.base_binary = s.base_binary;

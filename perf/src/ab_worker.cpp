@@ -36,18 +36,12 @@ struct WorkerEntry {
   size_t next_frame = 0;  // frames fed so far: the next run continues the capture's timeline
 };
 
+// The one level an entry names (an index, a name or "last").
 Expected<int> level_index(const std::string& technique, const std::string& level) {
-  auto names = technique_levels(technique);
-  if (!names.ok()) return names.error();
-  const int n = int(names->size());
-  if (level == "last" && n > 0) return n - 1;
-  for (int i = 0; i < n; ++i)
-    if ((*names)[size_t(i)] == level) return i;
-  if (!level.empty() && level.find_first_not_of("0123456789") == std::string::npos && std::stol(level) < n)
-    return int(std::stol(level));
-  std::string known;
-  for (int i = 0; i < n; ++i) known += (i ? ", " : "") + (*names)[size_t(i)];
-  return fail(ErrorKind::BadUsage, "level '" + level + "': technique '" + technique + "' has levels " + known);
+  auto levels = resolve_levels(technique, {level});
+  if (!levels.ok()) return levels.error();
+  if (levels->size() != 1) return fail(ErrorKind::BadUsage, "level '" + level + "': name one level of '" + technique + "'");
+  return levels->front();
 }
 
 // W + F frames back to back, then P in profiling mode, on the entry's runtime.

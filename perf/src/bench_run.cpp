@@ -92,34 +92,6 @@ std::string utc_now() {
 }
 
 // Resolves the --levels items for one technique into level indices, best first.
-Expected<std::vector<int>> resolve_levels(const std::string& technique, const std::vector<std::string>& items) {
-  auto names = technique_levels(technique);
-  if (!names.ok()) return names.error();
-  const int n = int(names->size());
-  if (n == 0) return fail(ErrorKind::Internal, "technique '" + technique + "' declares no quality levels");
-  std::set<int> picked;
-  const bool all = items.empty() || (items.size() == 1 && items[0] == "all");
-  for (int i = 0; all && i < n; ++i) picked.insert(i);
-  for (size_t k = 0; !all && k < items.size(); ++k) {
-    const std::string& it = items[k];
-    int index = -1;
-    if (it == "last") index = n - 1;
-    for (int i = 0; i < n && index < 0; ++i)
-      if ((*names)[i] == it) index = i;
-    if (index < 0 && !it.empty() && it.find_first_not_of("0123456789") == std::string::npos) {
-      const long v = std::strtol(it.c_str(), nullptr, 10);
-      if (v < n) index = int(v);
-    }
-    if (index < 0) {
-      std::string known;
-      for (int i = 0; i < n; ++i) known += (i ? ", " : "") + std::to_string(i) + "=" + (*names)[i];
-      return fail(ErrorKind::BadUsage, "--levels '" + it + "': technique '" + technique + "' has levels " + known +
-                                           " (or 'last', 'all')");
-    }
-    picked.insert(index);
-  }
-  return std::vector<int>(picked.begin(), picked.end());
-}
 
 TimeSummary summarize(const std::vector<double>& ms, double floor_ms, double floor_min_ms) {
   TimeSummary t;
@@ -340,6 +312,35 @@ Expected<RunSamples> run_one(const LoadedScene& l, const std::string& technique,
 }
 
 }  // namespace
+
+Expected<std::vector<int>> resolve_levels(const std::string& technique, const std::vector<std::string>& items) {
+  auto names = technique_levels(technique);
+  if (!names.ok()) return names.error();
+  const int n = int(names->size());
+  if (n == 0) return fail(ErrorKind::Internal, "technique '" + technique + "' declares no quality levels");
+  std::set<int> picked;
+  const bool all = items.empty() || (items.size() == 1 && items[0] == "all");
+  for (int i = 0; all && i < n; ++i) picked.insert(i);
+  for (size_t k = 0; !all && k < items.size(); ++k) {
+    const std::string& it = items[k];
+    int index = -1;
+    if (it == "last") index = n - 1;
+    for (int i = 0; i < n && index < 0; ++i)
+      if ((*names)[i] == it) index = i;
+    if (index < 0 && !it.empty() && it.find_first_not_of("0123456789") == std::string::npos) {
+      const long v = std::strtol(it.c_str(), nullptr, 10);
+      if (v < n) index = int(v);
+    }
+    if (index < 0) {
+      std::string known;
+      for (int i = 0; i < n; ++i) known += (i ? ", " : "") + std::to_string(i) + "=" + (*names)[i];
+      return fail(ErrorKind::BadUsage, "--levels '" + it + "': technique '" + technique + "' has levels " + known +
+                                           " (or 'last', 'all')");
+    }
+    picked.insert(index);
+  }
+  return std::vector<int>(picked.begin(), picked.end());
+}
 
 std::string ensure_lp_num_threads() {
   setenv("LP_NUM_THREADS", "2", /*overwrite=*/0);

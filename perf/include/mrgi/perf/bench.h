@@ -139,6 +139,9 @@ struct BenchResult {
 // Sets LP_NUM_THREADS=2 when it is unset (lavapipe reads it when a device is created, so call this
 // before any Vulkan instance exists) and returns the value now in effect.
 std::string ensure_lp_num_threads();
+// A technique's levels named by `items` (indices, level names, "last" = the cheapest; empty or
+// {"all"} = every level), sorted; BadUsage naming the item and listing the levels.
+Expected<std::vector<int>> resolve_levels(const std::string& technique, const std::vector<std::string>& items);
 
 Expected<BenchResult> run_bench(const BenchSettings& settings);
 
