@@ -4,7 +4,8 @@
 // virtual one where there is one, else the real one) and the irradiance the virtual objects'
 // sphere proxies hide from it of the occludable ambient light (its radiance SH), per
 // shared/occlusion_math.h, less what their objects' surfaces send it instead (albedo / pi x
-// the ambient irradiance facing the point), plus what they hide of the broad regions kept apart
+// the ambient irradiance facing the point, and the shadowed lights' light off as much of the
+// object's surface as faces the point, where the level asks for it), plus what they hide of the broad regions kept apart
 // from the SH (the part of each region's cone their caps cover). Near field (occlusion_math.h):
 // where a sphere's ray past it meets a real surface within the reach, that surface's radiance
 // (the camera's) is what the sphere hides instead of the sky's, and the regions beyond it were
@@ -65,6 +66,16 @@ vec4 real_surface_beyond(vec3 p, vec3 w, float start, float reach, int steps) {
   return vec4(0.0f);
 }
 
+// What lit object k sends point p from its oriented patches (occlusion_math.h lit_patch_term).
+vec3 object_lit_radiance(int k, vec3 p) {
+  vec3 v = normalize(p - occluders.lit_centre[k].xyz);
+  const int base = k * MRGI_LIT_PATCHES;
+  vec4 sum = vec4(0.0f);
+  [[unroll]] for (int j = 0; j < MRGI_LIT_PATCHES; ++j)
+    sum += lit_patch_term(occluders.lit_normal[base + j], occluders.lit_radiance[base + j].rgb, v);
+  return lit_object_radiance(sum);
+}
+
 // Spheres farther than this many radii are skipped: each would hide less than 1 / 64^2 of the
 // sky (0.02 %). At 16 radii (0.4 % each) the many far terms of an object together were a
 // visible part of the truth's broad darkening of a room (window_room_duck: the real-pixel change
@@ -99,6 +110,9 @@ void main() {
   // (Loops over the regions run to the constant bound, unrolled, so every index is a constant:
   // on lavapipe a dynamically indexed local or uniform array is gathered lane by lane.)
   vec4 region_open = vec4(1.0f);
+  const bool lit = occluders.near_field.y > 0.5f;
+  int lit_object = -1;
+  vec3 lit_shown = vec3(0.0f);
   for (int i = 0; i < count; ++i) {
     vec4 s = occluders.spheres[i];
     vec3 d = s.xyz - p;
@@ -138,6 +152,19 @@ void main() {
         }
       }
       vec3 shown = occluders.albedo[i].rgb * e_facing * (1.0f / MRGI_PI);
+      const int object = int(occluders.albedo[i].w);
+      if (lit && object >= 0 && !(is_virtual && distance(p, occluders.lit_centre[object].xyz) < occluders.lit_centre[object].w)) {
+        // ... and by the shadowed lights, as much of its lit surface as faces the point (a
+        // sunlit object sends its sunlight on to the wall beside it): once per object a texel.
+        // Not on a virtual point within the object's bounding sphere, its own surface most
+        // likely: its proxies (the sliver of an inscribed sphere above the point's horizon)
+        // would light it with its own lit faces; other objects' light reaches it.
+        if (object != lit_object) {
+          lit_object = object;
+          lit_shown = object_lit_radiance(object, p);
+        }
+        shown += lit_shown;
+      }
       o = sphere_occlusion_add(o, f, hidden - shown);
     }
   }

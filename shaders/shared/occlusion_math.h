@@ -89,6 +89,32 @@ MRGI_FN vec3 sh_irradiance16(SH16 r, SH16 g, SH16 b, vec3 n) {
   return max(vec3(sh_dot(r, y), sh_dot(g, y), sh_dot(b, y)), vec3(0.0f));
 }
 
+// A diffuse sphere lit by a directional light (irradiance E at normal incidence, from unit
+// direction l) shows a viewer in direction v (unit, from the sphere) the mean radiance
+// albedo E / pi x lambert_sphere_phase(dot(l, v)) over its visible disk: the Lambert sphere's
+// phase function, (2 / 3 pi) (sin a + (pi - a) cos a), 2/3 face-on (limb darkening), 0 from
+// behind, 2 / 3 pi side-on, where a flat plate facing the viewer would show nothing (the limit
+// the oriented patches below are tested against).
+MRGI_FN float lambert_sphere_phase(float cos_a) {
+  float c = clamp(cos_a, -1.0f, 1.0f);
+  float a = acos(c);
+  return (2.0f / (3.0f * MRGI_PI)) * (sqrt(max(1.0f - c * c, 0.0f)) + (MRGI_PI - a) * c);
+}
+// What a lit virtual object sends a viewer in unit direction v, from its surface gathered into
+// oriented patches (frame/surface_orientation.h; convex: no patch shades another): each patch's
+// radiance weighted by its projected area towards v. lit_patch_term is one patch's part,
+// vec4(radiance x w, w) with w = area x max(dot(n, v), 0); the object's radiance is the sum's
+// rgb over its w (lit_object_radiance). For a sphere's many patches under a directional light it
+// tends to albedo E / pi x lambert_sphere_phase; a box lit from above shows a viewer beside it
+// its unlit sides.
+MRGI_FN vec4 lit_patch_term(vec4 normal_area, vec3 radiance, vec3 v) {
+  float w = normal_area.w * max(dot(vec3(normal_area.x, normal_area.y, normal_area.z), v), 0.0f);
+  return vec4(radiance * w, w);
+}
+MRGI_FN vec3 lit_object_radiance(vec4 sum) {
+  return sum.w > 1e-12f ? vec3(sum.x, sum.y, sum.z) / sum.w : vec3(0.0f);
+}
+
 // Solid angle (sr) shared by two caps on the unit sphere with half-angles a and b (0..pi/2),
 // given by their cosines and sines, whose centres' directions have dot product x. The lune of
 // two small circles: 2 [pi - acos((x - cos a cos b) / (sin a sin b))
@@ -178,23 +204,37 @@ MRGI_FN vec3 sphere_occlusion_irradiance(SphereOcclusion o) {
 // The environment-occlusion pass's uniform block (shading/environment_occlusion.h), std140.
 #define MRGI_MAX_OCCLUDER_SPHERES 64
 #define MRGI_MAX_OCCLUSION_REGIONS 4
+#define MRGI_MAX_LIT_OBJECTS 8
+#define MRGI_LIT_PATCHES 8
 struct EnvOcclusionSet {
   ivec4 count;                                   // x spheres; y divisor (internal pixels a texel side);
                                                  // z regions (below); w near-field march steps (0 = off)
-  vec4 near_field;                               // x how far the march reaches (metres)
+  vec4 near_field;                               // x how far the march reaches (metres); y 1 where
+                                                 // the objects' lit radiance (below) is added
   vec4 radiance[12];                             // radiance SH16 of the occludable light: r c0..c3, g, b
                                                  // (without the regions below)
   vec4 spheres[MRGI_MAX_OCCLUDER_SPHERES];       // world xyz centre, w radius (metres)
-  vec4 albedo[MRGI_MAX_OCCLUDER_SPHERES];        // rgb the sphere's object's mean diffuse albedo
+  vec4 albedo[MRGI_MAX_OCCLUDER_SPHERES];        // rgb the sphere's object's mean diffuse albedo; w
+                                                 // its object among the lit ones below (-1 none)
   // count.z broad regions kept apart from `radiance` (cap_covered_fraction): xyz the unit
   // direction towards the region, w 1 - the cosine of its cone's half-angle; rgb its irradiance
   // at normal incidence (W/m^2), w the half-angle (radians).
   vec4 regions[MRGI_MAX_OCCLUSION_REGIONS];
   vec4 region_irradiance[MRGI_MAX_OCCLUSION_REGIONS];
+  // The objects lit by the shadowed lights (lamps, shadowed environment sources), where
+  // near_field.y is 1: object k's oriented patches at k * MRGI_LIT_PATCHES + j, xyz the world
+  // unit normal, w the area (0: no patch), and each patch's radiance (rgb albedo x E / pi);
+  // lit_centre[k] xyz the object's centre (world, metres), w the radius (metres) within which
+  // a virtual point is taken to be on its surface and gets none of it. A sphere's object is albedo[i].w
+  // (-1: none of these).
+  vec4 lit_normal[MRGI_MAX_LIT_OBJECTS * MRGI_LIT_PATCHES];
+  vec4 lit_radiance[MRGI_MAX_LIT_OBJECTS * MRGI_LIT_PATCHES];
+  vec4 lit_centre[MRGI_MAX_LIT_OBJECTS];
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(EnvOcclusionSet) == 16 * (2 + 12 + 2 * MRGI_MAX_OCCLUDER_SPHERES + 2 * MRGI_MAX_OCCLUSION_REGIONS),
+static_assert(sizeof(EnvOcclusionSet) == 16 * (2 + 12 + 2 * MRGI_MAX_OCCLUDER_SPHERES + 2 * MRGI_MAX_OCCLUSION_REGIONS +
+                                              (2 * MRGI_LIT_PATCHES + 1) * MRGI_MAX_LIT_OBJECTS),
               "std140 mirror");
 #undef MRGI_FN
 }  // namespace mrgi::shader

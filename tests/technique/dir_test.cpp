@@ -27,9 +27,10 @@ namespace {
 float lin(uint8_t c) { return shader::srgb_decode1(float(c) / 255.0f); }
 
 std::vector<FrameOutput> run(const SyntheticScene& scene, const std::string& technique, int level, int frames,
-                             bool validate, const DirAblation& ablation = {}) {
+                             bool validate, const DirAblation& ablation = {}, const std::vector<KnobSetting>& knobs = {}) {
   RuntimeSettings s;
   s.device.validate = validate;
+  s.knobs = knobs;
   auto research = std::make_shared<ResearchSettings>();
   research->dir = ablation;
   s.research = research;
@@ -66,7 +67,7 @@ void aim_at_the_virtual_box(SyntheticScene& scene) {
   }
 }
 
-TEST(Dir, EveryLevelRunsAndItsVplsLightTheObjectBeyondBaseline) {
+TEST(Dir, EveryLevelRunsAndItsVplsLightTheObjectBeyondDirectLight) {
   mrgi::testing::TempDir dir;
   SyntheticScene scene = SyntheticScene::create(dir.str());
   aim_at_the_virtual_box(scene);
@@ -83,15 +84,17 @@ TEST(Dir, EveryLevelRunsAndItsVplsLightTheObjectBeyondBaseline) {
       diffuse_note |= k.find("dir glossy VPLs: no glossy virtual material") != std::string::npos;
     }
     EXPECT_TRUE(diffuse_note) << "diffuse cubes: the glossy VPLs are skipped and said so";
-    const std::vector<FrameOutput> base =
-        run(scene, "baseline", technique::dir_levels()[size_t(level)].baseline_level, 3, false);
+    // Direct light without any bounce: baseline without the lamps' bounce off the objects that
+    // its environment occlusion adds (shading/environment_occlusion.h lights_bounce).
+    const std::vector<FrameOutput> base = run(scene, "baseline", technique::dir_levels()[size_t(level)].baseline_level, 3,
+                                              false, {}, {{"env_occlusion_lights_bounce", 0}});
     ASSERT_EQ(base.size(), 3u);
     const double with_vpls = virtual_light(scene, outs.back()), direct = virtual_light(scene, base.back());
     // The camera looks down on the boxes' tops, which the floor's bounce (from below) hardly
     // reaches: light is added, not much (measured +0.6 %).
     EXPECT_GT(with_vpls, direct) << "the floor's bounce must add light to the boxes";
     // The red boxes' bounce onto the lit floor around them (VPL 2 of the paper's Fig. 6,
-    // L_r D_v D_r E, only in L_rv): redder than baseline's there.
+    // L_r D_v D_r E, only in L_rv): redder than direct light's there.
     const Box& box = scene.virtual_boxes[0];
     const int w = scene.intrinsics.width, h = scene.intrinsics.height;
     double red = 0.0, green = 0.0, env_change = 0.0;

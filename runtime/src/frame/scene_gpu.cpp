@@ -170,70 +170,105 @@ void MeshSet::draw(VkCommandBuffer cmd, const gpu::PassContext& pass,
 
 namespace {
 
-// The object's mean diffuse albedo (linear RGB): each primitive's base colour factor times its
-// texture's mean, weighted by the primitive's surface area; metals reflect little diffusely.
-glm::vec3 mean_albedo(const Model& model) {
+// A primitive's diffuse albedo (linear RGB): its base colour factor times its texture's mean;
+// metals reflect little diffusely.
+glm::dvec3 primitive_albedo(const Model& model, const MeshPrimitive& prim) {
+  glm::dvec3 albedo(1.0);
+  float metallic = 1.0f;
+  if (prim.material >= 0 && size_t(prim.material) < model.materials.size()) {
+    const Material& mat = model.materials[size_t(prim.material)];
+    albedo = glm::dvec3(glm::vec3(mat.base_color_factor));
+    metallic = mat.metallic;
+    if (mat.base_color_texture >= 0 && size_t(mat.base_color_texture) < model.textures.size()) {
+      const ImageRGBA8& img = model.textures[size_t(mat.base_color_texture)].image;
+      glm::dvec3 t(0.0);
+      size_t n = 0;
+      for (size_t i = 0; i < img.pixel_count(); i += 7, ++n)
+        t += glm::dvec3(srgb8_to_linear(img.data[i * 4]), srgb8_to_linear(img.data[i * 4 + 1]),
+                        srgb8_to_linear(img.data[i * 4 + 2]));
+      if (n) albedo *= t / double(n);
+    }
+  }
+  return albedo * double(1.0f - std::clamp(metallic, 0.0f, 1.0f));
+}
+
+// The object's primitives as one mesh (model space) with each triangle's primitive albedo.
+struct ObjectMesh {
+  std::vector<glm::vec3> positions;
+  std::vector<uint32_t> indices;
+  std::vector<glm::vec3> triangle_albedo;
+};
+ObjectMesh object_mesh(const Model& model) {
+  ObjectMesh m;
+  for (const MeshPrimitive& prim : model.primitives) {
+    const uint32_t base = uint32_t(m.positions.size());
+    m.positions.insert(m.positions.end(), prim.positions.begin(), prim.positions.end());
+    const glm::vec3 albedo(primitive_albedo(model, prim));
+    for (size_t t = 0; t + 2 < prim.indices.size(); t += 3) {
+      for (int k = 0; k < 3; ++k) m.indices.push_back(base + prim.indices[t + size_t(k)]);
+      m.triangle_albedo.push_back(albedo);
+    }
+  }
+  return m;
+}
+
+// The object's mean diffuse albedo (linear RGB), weighted by the triangles' surface area.
+glm::vec3 mean_albedo(const ObjectMesh& mesh) {
   glm::dvec3 sum(0.0);
   double area = 0.0;
-  for (const MeshPrimitive& prim : model.primitives) {
-    double a = 0.0;
-    for (size_t t = 0; t + 2 < prim.indices.size(); t += 3) {
-      if (prim.indices[t] >= prim.positions.size() || prim.indices[t + 1] >= prim.positions.size() ||
-          prim.indices[t + 2] >= prim.positions.size())
-        continue;
-      const glm::vec3 p0 = prim.positions[prim.indices[t]], p1 = prim.positions[prim.indices[t + 1]],
-                      p2 = prim.positions[prim.indices[t + 2]];
-      a += 0.5 * double(glm::length(glm::cross(p1 - p0, p2 - p0)));
-    }
-    glm::dvec3 albedo(1.0);
-    float metallic = 1.0f;
-    if (prim.material >= 0 && size_t(prim.material) < model.materials.size()) {
-      const Material& mat = model.materials[size_t(prim.material)];
-      albedo = glm::dvec3(glm::vec3(mat.base_color_factor));
-      metallic = mat.metallic;
-      if (mat.base_color_texture >= 0 && size_t(mat.base_color_texture) < model.textures.size()) {
-        const ImageRGBA8& img = model.textures[size_t(mat.base_color_texture)].image;
-        glm::dvec3 t(0.0);
-        size_t n = 0;
-        for (size_t i = 0; i < img.pixel_count(); i += 7, ++n)
-          t += glm::dvec3(srgb8_to_linear(img.data[i * 4]), srgb8_to_linear(img.data[i * 4 + 1]),
-                          srgb8_to_linear(img.data[i * 4 + 2]));
-        if (n) albedo *= t / double(n);
-      }
-    }
-    sum += a * albedo * double(1.0f - std::clamp(metallic, 0.0f, 1.0f));
+  for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+    const uint32_t i0 = mesh.indices[t], i1 = mesh.indices[t + 1], i2 = mesh.indices[t + 2];
+    if (i0 >= mesh.positions.size() || i1 >= mesh.positions.size() || i2 >= mesh.positions.size()) continue;
+    const glm::vec3 p0 = mesh.positions[i0];
+    const double a = 0.5 * double(glm::length(glm::cross(mesh.positions[i1] - p0, mesh.positions[i2] - p0)));
+    sum += a * glm::dvec3(mesh.triangle_albedo[t / 3]);
     area += a;
   }
   return area > 0.0 && std::isfinite(area) ? glm::vec3(sum / area) : glm::vec3(0.0f);
 }
 
-// The object's primitives as one mesh, fitted with sphere proxies (model space).
-std::vector<glm::vec4> fit_model_occluders(const Model& model) {
-  std::vector<glm::vec3> positions;
-  std::vector<uint32_t> indices;
-  for (const MeshPrimitive& prim : model.primitives) {
-    const uint32_t base = uint32_t(positions.size());
-    positions.insert(positions.end(), prim.positions.begin(), prim.positions.end());
-    for (uint32_t i : prim.indices) indices.push_back(base + i);
-  }
+// The object's mesh fitted with sphere proxies (model space).
+std::vector<glm::vec4> fit_model_occluders(const ObjectMesh& mesh) {
   OccluderFitSettings fit;
   fit.max_spheres = SceneGpu::kOccluderSpheres;
-  return fit_occluder_spheres(positions, indices, fit);
+  return fit_occluder_spheres(mesh.positions, mesh.indices, fit);
 }
 
 }  // namespace
 
-void SceneGpu::occluder_spheres(int per_object, std::vector<glm::vec4>& out, std::vector<glm::vec4>* albedo) const {
+void SceneGpu::occluder_spheres(int per_object, std::vector<glm::vec4>& out, std::vector<glm::vec4>* albedo,
+                                std::vector<int>* object) const {
+  int ordinal = 0;
   for (const ObjectSpan& o : objects_) {
     if (!o.visible) continue;
+    const int this_object = ordinal++;
     const glm::mat4 m = o.placement.matrix();
     const float grow = std::max({o.placement.scale.x, o.placement.scale.y, o.placement.scale.z});
     const size_t n = std::min(o.occluders.size(), size_t(std::max(per_object, 0)));
     for (size_t k = 0; k < n; ++k) {
       out.emplace_back(glm::vec3(m * glm::vec4(glm::vec3(o.occluders[k]), 1.0f)), o.occluders[k].w * grow);
       if (albedo) albedo->emplace_back(o.albedo, 0.0f);
+      if (object) object->push_back(this_object);
     }
   }
+}
+
+int SceneGpu::oriented_patches(size_t ordinal, OrientedPatch* out) const {
+  size_t seen = 0;
+  for (const ObjectSpan& o : objects_) {
+    if (!o.visible || seen++ != ordinal) continue;
+    // Normals by the inverse transpose of the placement's linear part (a non-uniform scale
+    // tilts them); areas as loaded (a patch's share is what counts).
+    const glm::mat3 normals = glm::transpose(glm::inverse(glm::mat3(o.placement.matrix())));
+    const int n = int(std::min(o.patches.size(), size_t(kOrientedPatches)));
+    for (int k = 0; k < n; ++k) {
+      out[k] = o.patches[size_t(k)];
+      const glm::vec3 w = normals * o.patches[size_t(k)].normal;
+      out[k].normal = glm::length(w) > 0.0f ? glm::normalize(w) : o.patches[size_t(k)].normal;
+    }
+    return n;
+  }
+  return 0;
 }
 
 Expected<std::unique_ptr<SceneGpu>> SceneGpu::create(gpu::Context& context, gpu::FrameGraph& graph,
@@ -286,8 +321,10 @@ Expected<std::unique_ptr<SceneGpu>> SceneGpu::create(gpu::Context& context, gpu:
     span.vertex_count = uint32_t(virtual_data.vertices.size()) - span.first_vertex;
     span.draw_count = virtual_data.draws.size() - span.first_draw;
     span.placement = scene.virtual_objects[out->objects_.size()].placement;
-    span.occluders = fit_model_occluders(m);
-    span.albedo = mean_albedo(m);
+    const ObjectMesh mesh = object_mesh(m);
+    span.occluders = fit_model_occluders(mesh);
+    span.albedo = mean_albedo(mesh);
+    span.patches = cluster_surface_orientations(mesh.positions, mesh.indices, mesh.triangle_albedo, kOrientedPatches);
     out->objects_.push_back(span);
   }
   for (const DrawRange& d : virtual_data.draws) {

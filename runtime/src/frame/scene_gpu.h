@@ -25,6 +25,7 @@
 #include "mrgi/expected.h"
 #include "mrgi/scene.h"
 #include "frame/lod_view.h"
+#include "frame/surface_orientation.h"
 
 namespace mrgi::frame {
 
@@ -137,8 +138,15 @@ class SceneGpu {
   // the first `per_object` of each (the radius scaled by the placement's largest scale), and
   // with `albedo` each sphere's object's mean diffuse albedo (linear rgb; base colour x texture
   // mean x (1 - metallic), area-weighted).
+  // With `object`, each sphere's object as its ordinal among the visible objects.
   static constexpr int kOccluderSpheres = 16;
-  void occluder_spheres(int per_object, std::vector<glm::vec4>& out, std::vector<glm::vec4>* albedo = nullptr) const;
+  void occluder_spheres(int per_object, std::vector<glm::vec4>& out, std::vector<glm::vec4>* albedo = nullptr,
+                        std::vector<int>* object = nullptr) const;
+  // The `ordinal`-th visible object's surface by orientation (frame/surface_orientation.h),
+  // gathered at load into at most kOrientedPatches patches, normals in world space at its newest
+  // placement: written to out[0, n), n returned (0 for an ordinal past the visible objects).
+  static constexpr int kOrientedPatches = 8;
+  int oriented_patches(size_t ordinal, OrientedPatch* out) const;
 
  private:
   explicit SceneGpu(gpu::Context& context) : context_(context) {}
@@ -150,6 +158,7 @@ class SceneGpu {
     Placement placement;
     bool visible = true;
     std::vector<glm::vec4> occluders;  // model space, most important first
+    std::vector<OrientedPatch> patches;  // model space (oriented_patches)
     glm::vec3 albedo{0.0f};            // mean diffuse albedo (occluder_spheres)
   };
   size_t visible_count_ = 0;

@@ -42,6 +42,7 @@
 #include <vector>
 
 #include "frame/frame_resources.h"
+#include "frame/surface_orientation.h"
 #include "gpu/frame_graph.h"
 #include "light/light_stage.h"
 #include "light/sh_tools.h"
@@ -60,20 +61,39 @@ struct EnvOcclusionLevel {
   // near_field_m metres (a room: what lies farther is the environment the env camera sees).
   int near_field_steps = 8;
   float near_field_m = 3.0f;
+  // What an object shows in place of what it hides includes the shadowed lights' (lamps,
+  // shadowed environment sources) first bounce off its surface, as much of it as faces the point
+  // (its oriented patches, occlusion_math.h lit_patch_term): a sunlit object brightens the wall
+  // beside it. A technique whose own bounce (VPLs, volumes) carries that light leaves it off.
+  // Off by default: measured on the independent (Cycles) scenes it made baseline high's
+  // all-pixel RDE worse on three of eight (window_room_duck +0.008, area_window_orange_box
+  // +0.003, spot_in_fisheye +0.0025; corner_blue_yellow -0.001) and moved their real-pixel
+  // change away from the truth's (0.78 -> 0.55 of it, 1.71 -> 0.40): the objects' occlusion of
+  // the light around them is weaker there than the truth's, which the missing bounce offset.
+  // Perf/results/env-occlusion/lights-bounce-2026-12-06/.
+  bool lights_bounce = false;
 };
+
+// The radiance (linear RGB: albedo x E / pi) of a virtual object's oriented patch
+// (frame/surface_orientation.h, world-space normal) lit by `lights` at the object's `centre`
+// (world, metres): each light's irradiance there on the patch's orientation, no shadowing.
+glm::vec3 lit_patch_radiance(const frame::OrientedPatch& patch, const glm::vec3& centre,
+                             const std::vector<LightDesc>& lights);
 
 class EnvironmentOcclusion {
  public:
   static Expected<std::unique_ptr<EnvironmentOcclusion>> create(const frame::FrameResources& frame);
   ~EnvironmentOcclusion();
   // Adds this frame's pass, or leaves it out (appending "env_occlusion: reason" to `skipped`)
-  // when nothing is occluded: the level turns it off, no virtual object is visible or the
-  // ambient is black. `ambient` is the occludable light's radiance SH (4 bands, world axes);
-  // `regions` the parts of it kept as cones (their SH is in `ambient`).
+  // when nothing is occluded or bounced: the level turns it off, no virtual object is visible,
+  // or the ambient is black and no light bounces. `ambient` is the occludable light's radiance SH
+  // (4 bands, world axes); `regions` the parts of it kept as cones (their SH is in `ambient`). `lights`: the shadowed
+  // lights whose bounce off the objects the pass adds (level.lights_bounce); with
+  // `occlude_ambient` false only that bounce is drawn (an ambient that is not to be occluded,
+  // such as the lamps' residual estimate, hides nothing).
   void record(const EnvOcclusionLevel& level, const light::ShRgb& ambient,
-              const std::vector<light::Lighting::AmbientRegion>& regions, std::vector<std::string>& skipped);
-  // Leaves this frame's pass out (image() is then the zero stand-in).
-  void skip();
+              const std::vector<light::Lighting::AmbientRegion>& regions, const std::vector<LightDesc>& lights,
+              bool occlude_ambient, std::vector<std::string>& skipped);
   // This frame's result (RGBA16F, rgb the irradiance the objects take away, W/m^2, negative
   // where they give more than they hide; a the surface key) and its divisor;
   // a 1x1 zero image with divisor 0 when the pass was left out.

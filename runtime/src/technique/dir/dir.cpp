@@ -345,6 +345,8 @@ Status Dir::record(const frame::FrameInfo& info, std::vector<std::string>& skipp
   // Environment VPLs (ISM-shadowed) carry the objects' occlusion of the environment: the block
   // then leaves it to them (with both, moving's real-pixel RDE at dir high went 0.44 -> 0.54).
   if (slots.env > 0) direct.env_occlusion.spheres_per_object = 0;
+  // The VPLs carry the lamps' bounce off the objects: the block's occlusion leaves it out.
+  direct.env_occlusion.lights_bounce = false;
   return direct_->record(info, direct, *light, skipped);
 }
 

@@ -190,8 +190,10 @@ Status Dlpv::record(const frame::FrameInfo& info, std::vector<std::string>& skip
   if (antiradiance) {
     // The volume's antiradiance shadows the lamps it injects; the ambient's occlusion by the
     // objects is the direct-light block's, as at the other levels.
-    const shading::DirectLightLevel& direct = shading::direct_light_levels()[size_t(level.baseline_level)];
-    const auto occlusion = direct_->record_env_occlusion(direct.env_occlusion, skipped);
+    // V^Delta carries the lamps' bounce off the objects: the block's occlusion leaves it out.
+    shading::EnvOcclusionLevel occlusion_level = shading::direct_light_levels()[size_t(level.baseline_level)].env_occlusion;
+    occlusion_level.lights_bounce = false;
+    const auto occlusion = direct_->record_env_occlusion(occlusion_level, skipped);
     made.push.occlusion.x = occlusion.divisor;
     add_merge_pass(made.push, occlusion.image);
     return ok_status();
@@ -202,8 +204,10 @@ Status Dlpv::record(const frame::FrameInfo& info, std::vector<std::string>& skip
   // solutions, recorded after the volumes so that its shading adds their bounce light in the
   // same pass (its volume input): V^Delta on real pixels (the two-volume ablation: V^rho minus
   // V^mu), V^rho on virtual ones.
-  const shading::DirectLightLevel& direct = shading::direct_light_levels()[size_t(level.baseline_level)];
+  shading::DirectLightLevel direct = shading::direct_light_levels()[size_t(level.baseline_level)];
   if (!(made.delta || made.rho)) return direct_->record(info, direct, {}, skipped);
+  // The volumes carry the lamps' bounce off the objects: the block's occlusion leaves it out.
+  direct.env_occlusion.lights_bounce = false;
   shading::VolumeIndirect bounce;
   bounce.real_term = two ? shading::VolumeIndirect::RealTerm::Difference : shading::VolumeIndirect::RealTerm::One;
   bounce.virtual_present = made.rho;

@@ -492,14 +492,17 @@ Status Dvct::record(const frame::FrameInfo& info, std::vector<std::string>& skip
   }
   if (level.shadow_cones) {
     // The cones shadow the lamps; the ambient's occlusion by the objects is the block's.
-    const shading::DirectLightLevel& direct = shading::direct_light_levels()[size_t(level.baseline_level)];
-    const auto occlusion = direct_->record_env_occlusion(direct.env_occlusion, skipped);
+    // The voxels' cones carry the lamps' bounce off the objects: the block's occlusion leaves it out.
+    shading::EnvOcclusionLevel occlusion_level = shading::direct_light_levels()[size_t(level.baseline_level)].env_occlusion;
+    occlusion_level.lights_bounce = occlusion_level.lights_bounce && !volumes;
+    const auto occlusion = direct_->record_env_occlusion(occlusion_level, skipped);
     params.mode.z = occlusion.divisor;
     add_cone_pass(level, params, specular, occlusion.image);
     return ok_status();
   }
-  const shading::DirectLightLevel& direct = shading::direct_light_levels()[size_t(level.baseline_level)];
+  shading::DirectLightLevel direct = shading::direct_light_levels()[size_t(level.baseline_level)];
   if (!volumes) return direct_->record(info, direct, {}, skipped);
+  direct.env_occlusion.lights_bounce = false;  // the cones carry it
   add_cone_pass(level, params, specular, {});
   return direct_->record(info, direct, shading::ScreenIndirect{indirect_image_, int(std::max(1u, level.trace_divisor))},
                          skipped);
