@@ -126,6 +126,19 @@ std::string git_head(const std::string& dir) {
   return s;
 }
 
+}  // namespace
+
+double pass_over_rest(const std::map<std::string, double>& passes, const std::string& pass) {
+  double own = std::nan(""), rest = 0.0;
+  for (const auto& [name, ms] : passes) {
+    if (name == pass) own = ms;
+    else if (std::isfinite(ms)) rest += ms;
+  }
+  return rest > 0.0 ? own / rest : std::nan("");
+}
+
+namespace {
+
 // One entry's answers from both builds, pair by pair.
 struct EntrySamples {
   std::string level_name;
@@ -141,11 +154,29 @@ struct EntrySamples {
     }
     return v;
   }
+  // A pass's fastest profiled frame over the rest of the measurement's passes (each by its
+  // fastest frame) for every answer of one side, NaN where the pass is missing: the machine
+  // speeding up or slowing down between measurements moves a pass and the rest of its frame
+  // alike, so the ratio keeps a change of this pass and drops the drift (a small pass's raw time
+  // spread 15-25 % between measurements of one build; a slowdown of another pass lowers this
+  // ratio, never raises it, so it raises no alarm here).
+  std::vector<double> pass_relative(int side, const std::string& pass) const {
+    std::vector<double> v;
+    std::map<std::string, double> passes;
+    for (const json& a : answers[side]) {
+      passes.clear();
+      if (a.contains("passes_min") && a["passes_min"].is_object())
+        for (auto& [name, ms] : a["passes_min"].items())
+          if (ms.is_number()) passes[name] = ms.get<double>();
+      v.push_back(pass_over_rest(passes, pass));
+    }
+    return v;
+  }
 };
 
 // An entry's judged quantities: sustained ms, CPU ms, and each pass taking at least
-// pass_min_share of the base's profiled frame, on its fastest profiled frame of each
-// measurement (load only adds time).
+// pass_min_share of the base's profiled frame, as its fastest profiled frame of each
+// measurement (load only adds time) over the rest of that measurement's passes (pass_relative).
 void add_quantities(const AbEntry& entry, const EntrySamples& es, const AbSettings& s, std::vector<AbQuantity>& out) {
   auto add = [&](const std::string& metric, const std::vector<double>& b, const std::vector<double>& c) {
     AbQuantity q{entry.scene, entry.technique, es.level_name, metric, b, c, {}};
@@ -161,11 +192,10 @@ void add_quantities(const AbEntry& entry, const EntrySamples& es, const AbSettin
     if (a.contains("passes"))
       for (auto& [name, ms] : a["passes"].items()) names.insert(name);
   for (const std::string& name : names) {
-    std::vector<double> b = es.series(0, "passes_min", name), c = es.series(1, "passes_min", name);
-    std::vector<double> kept = b;
+    std::vector<double> kept = es.series(0, "passes_min", name);
     drop_unresolved_times(kept);
     if (kept.empty() || !(median(kept) >= s.pass_min_share * median(frame))) continue;
-    add("pass:" + name, b, c);
+    add("pass:" + name, es.pass_relative(0, name), es.pass_relative(1, name));
   }
 }
 

@@ -55,12 +55,16 @@ std::string markdown(const AbResult& r) {
        << " can alarm (it needs " << needed << "): raise --pairs**\n";
   md << "\n**" << (r.alarms() ? std::to_string(r.alarms()) + " alarm" + (r.alarms() > 1 ? "s" : "") : "No alarm")
      << "** over " << r.quantities.size() << " quantities.\n\n";
-  md << "| entry | quantity | base ms (median) | candidate ms (median) | ratio (median) | 95 % interval | p | Holm p | alarm |\n";
+  md << "Base and candidate: medians over the pairs; ms for sustained_ms and cpu_ms, and for a pass its fastest "
+        "profiled frame over the rest of the measurement's passes (the machine's drift between measurements "
+        "moves both alike).\n\n";
+  md << "| entry | quantity | base (median) | candidate (median) | ratio (median) | 95 % interval | p | Holm p | alarm |\n";
   md << "|---|---|---:|---:|---:|---|---:|---:|---|\n";
   for (const AbQuantity& q : r.quantities) {
     const AbJudgement& j = q.judgement;
     md << "| " << q.scene << "/" << q.technique << "/" << q.level_name << " | " << q.metric << " | "
-       << fmt("%.2f", median(finite(q.base))) << " | " << fmt("%.2f", median(finite(q.candidate))) << " | "
+       << fmt(q.metric.rfind("pass:", 0) == 0 ? "%.4f" : "%.2f", median(finite(q.base))) << " | "
+       << fmt(q.metric.rfind("pass:", 0) == 0 ? "%.4f" : "%.2f", median(finite(q.candidate))) << " | "
        << fmt("%.3f", j.median_ratio) << " | " << fmt("%.3f", j.ratio_low) << "-" << fmt("%.3f", j.ratio_high) << " | "
        << fmt("%.2g", j.p_value) << " | " << fmt("%.2g", j.p_adjusted) << " | " << (j.alarm ? "**slower**" : "") << " |\n";
   }
@@ -89,7 +93,8 @@ nlohmann::json to_json(const AbResult& r) {
       return o;
     };
     qs.push_back({{"scene", q.scene}, {"technique", q.technique}, {"level", q.level_name}, {"metric", q.metric},
-                  {"base_ms", samples(q.base)}, {"candidate_ms", samples(q.candidate)}, {"pairs", a.pairs},
+                  {"unit", q.metric.rfind("pass:", 0) == 0 ? "the pass's fastest profiled frame over the rest of the measurement's passes" : "ms"},
+                  {"base", samples(q.base)}, {"candidate", samples(q.candidate)}, {"pairs", a.pairs},
                   {"median_ratio", a.median_ratio}, {"ratio_low", a.ratio_low}, {"ratio_high", a.ratio_high},
                   {"p", a.p_value}, {"p_holm", a.p_adjusted}, {"alarm", a.alarm}});
   }

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -90,8 +91,8 @@ TEST(AbCompare, BuildAgainstItselfWritesTheReport) {
   std::set<std::string> metrics;
   for (const auto& q : j["quantities"]) {
     metrics.insert(q["metric"].get<std::string>());
-    EXPECT_EQ(q["base_ms"].size(), size_t(2));
-    EXPECT_EQ(q["candidate_ms"].size(), size_t(2));
+    EXPECT_EQ(q["base"].size(), size_t(2));
+    EXPECT_EQ(q["candidate"].size(), size_t(2));
   }
   EXPECT_TRUE(metrics.count("sustained_ms"));
   EXPECT_TRUE(metrics.count("cpu_ms"));
@@ -115,4 +116,23 @@ TEST(AbCompare, BaseThatIsNoWorkerIsRefused) {
   text << std::ifstream(log).rdbuf();
   EXPECT_NE(text.str().find("/bin/true: did not answer as an mrgi bench worker"), std::string::npos) << text.str();
   EXPECT_FALSE(fs::exists(out));
+}
+
+// A pass over the rest of its measurement: the machine's drift (every pass 30 % slower) leaves
+// it, a 10 % slower pass raises it by 10 %, another pass slowing lowers it; a missing pass is NaN.
+TEST(AbCompare, PassOverRestKeepsThePassAndDropsTheDrift) {
+  const std::map<std::string, double> base = {{"a", 2.0}, {"b", 6.0}, {"c", 2.0}};
+  const double r = perf::pass_over_rest(base, "a");
+  EXPECT_DOUBLE_EQ(r, 0.25);
+  std::map<std::string, double> drift = base;
+  for (auto& [name, ms] : drift) ms *= 1.3;
+  EXPECT_NEAR(perf::pass_over_rest(drift, "a"), r, 1e-12);
+  std::map<std::string, double> slower = base;
+  slower["a"] *= 1.1;
+  EXPECT_NEAR(perf::pass_over_rest(slower, "a") / r, 1.1, 1e-12);
+  std::map<std::string, double> other = base;
+  other["b"] *= 1.1;
+  EXPECT_LT(perf::pass_over_rest(other, "a"), r);
+  EXPECT_TRUE(std::isnan(perf::pass_over_rest(base, "missing")));
+  EXPECT_TRUE(std::isnan(perf::pass_over_rest({{"a", 1.0}}, "a")));
 }

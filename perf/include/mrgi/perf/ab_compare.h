@@ -4,7 +4,8 @@
 // on the same entry and the same preloaded inputs, ABAB... (the order alternating pair to pair
 // so a machine speeding up or slowing down over the run moves both alike), never both at once;
 // each quantity (an entry's sustained ms and process CPU ms per frame, each main pass's
-// profiled ms) is judged by mrgi/perf/ab_stats.h's rule over all quantities together.
+// fastest profiled frame over the rest of the measurement's passes) is judged by
+// mrgi/perf/ab_stats.h's rule over all quantities together.
 //
 // The worker protocol (one JSON object per line; the worker answers each request with one
 // line): on start the worker writes {"ok":true,"protocol":1,"device":...,"commit":...}; a
@@ -19,6 +20,7 @@
 #pragma once
 #include <functional>
 #include <iosfwd>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -37,6 +39,12 @@ struct AbEntry {
 // [{"scene":...,"technique":...,"level":...},...],...}}. BadInput naming the file, the field and
 // the rule.
 Expected<std::vector<AbEntry>> load_compare_set(const std::string& path, const std::string& set);
+
+// A pass's time over the rest of one measurement's passes (`passes`: name -> ms, each pass by
+// its fastest profiled frame): what the comparison judges a pass by. The machine speeding up
+// or slowing down between measurements moves the pass and the rest alike and drops out; NaN
+// where the pass is missing or the rest is 0.
+double pass_over_rest(const std::map<std::string, double>& passes, const std::string& pass);
 
 struct AbSettings {
   std::string suite;                 // suite manifests, comma-separated, holding the entries' scenes
