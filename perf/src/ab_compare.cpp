@@ -201,6 +201,30 @@ void add_quantities(const AbEntry& entry, const EntrySamples& es, const AbSettin
 
 }  // namespace
 
+std::vector<AbQuantity> pool_pass_quantities(const std::vector<AbQuantity>& quantities, const AbRule& rule) {
+  std::map<std::string, AbQuantity> pooled;
+  std::map<std::string, int> entries;
+  for (const AbQuantity& q : quantities) {
+    if (q.metric.rfind("pass:", 0) != 0 || q.scene == "every entry") continue;
+    AbQuantity& p = pooled[q.metric];
+    p.scene = "every entry";
+    p.technique = "";
+    p.level_name = "";
+    p.metric = q.metric;
+    p.base.insert(p.base.end(), q.base.begin(), q.base.end());
+    p.candidate.insert(p.candidate.end(), q.candidate.begin(), q.candidate.end());
+    ++entries[q.metric];
+  }
+  std::vector<AbQuantity> out;
+  for (auto& [metric, p] : pooled) {
+    if (entries[metric] < 2) continue;
+    p.level_name = std::to_string(entries[metric]) + " entries";
+    p.judgement = judge_pairs("every entry " + metric, p.base, p.candidate, rule);
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
 size_t AbResult::alarms() const {
   size_t n = 0;
   for (const AbQuantity& q : quantities) n += q.judgement.alarm ? 1 : 0;
@@ -297,6 +321,8 @@ Expected<AbResult> run_ab_compare(const AbSettings& s) {
     }
   }
   for (size_t e = 0; e < s.entries.size(); ++e) add_quantities(s.entries[e], samples[e], s, result.quantities);
+  const std::vector<AbQuantity> pooled = pool_pass_quantities(result.quantities, s.rule);
+  result.quantities.insert(result.quantities.end(), pooled.begin(), pooled.end());
   std::vector<AbJudgement> family;
   for (const AbQuantity& q : result.quantities) family.push_back(q.judgement);
   judge_family(family, s.rule);

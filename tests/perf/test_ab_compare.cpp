@@ -136,3 +136,31 @@ TEST(AbCompare, PassOverRestKeepsThePassAndDropsTheDrift) {
   EXPECT_TRUE(std::isnan(perf::pass_over_rest(base, "missing")));
   EXPECT_TRUE(std::isnan(perf::pass_over_rest({{"a", 1.0}}, "a")));
 }
+
+// A pass judged in several entries gets one more quantity with all their pairs; a pass judged in
+// one entry, and the entries' other quantities, do not.
+TEST(AbCompare, PooledPassQuantityHoldsEveryEntrysPairs) {
+  auto q = [](const std::string& scene, const std::string& metric, double ratio) {
+    perf::AbQuantity x;
+    x.scene = scene;
+    x.technique = "baseline";
+    x.level_name = "lowest";
+    x.metric = metric;
+    for (int i = 0; i < 8; ++i) {
+      x.base.push_back(1.0 + 0.01 * i);
+      x.candidate.push_back((1.0 + 0.01 * i) * ratio);
+    }
+    return x;
+  };
+  const std::vector<perf::AbQuantity> quantities = {q("desk_spot", "pass:shade_direct", 1.1), q("corner", "pass:shade_direct", 1.1),
+                                                    q("corner", "pass:recon_positions", 1.0), q("corner", "cpu_ms", 1.0)};
+  const auto pooled = perf::pool_pass_quantities(quantities, perf::AbRule{});
+  ASSERT_EQ(pooled.size(), 1u);
+  EXPECT_EQ(pooled[0].metric, "pass:shade_direct");
+  EXPECT_EQ(pooled[0].scene, "every entry");
+  EXPECT_EQ(pooled[0].level_name, "2 entries");
+  EXPECT_EQ(pooled[0].base.size(), 16u);
+  EXPECT_EQ(pooled[0].judgement.pairs, 16u);
+  EXPECT_NEAR(pooled[0].judgement.median_ratio, 1.1, 1e-9);
+  EXPECT_LT(pooled[0].judgement.p_value, 1e-4);
+}

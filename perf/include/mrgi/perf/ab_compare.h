@@ -68,6 +68,13 @@ struct AbQuantity {
   AbJudgement judgement;
 };
 
+// For each pass judged in at least two entries, one more quantity: its pairs from every such
+// entry together ("every entry", level_name "N entries"). A pass slowed wherever it runs (the
+// direct-light block's, a reconstruction step's) shows in N x pairs pairs, where each entry's
+// own pairs leave a 10 % change short of the family's bar; a change to one entry's use of it is
+// still judged on that entry. Judged by `rule` alone (the family's adjustment comes after).
+std::vector<AbQuantity> pool_pass_quantities(const std::vector<AbQuantity>& quantities, const AbRule& rule);
+
 struct AbResult {
   std::vector<AbQuantity> quantities;
   std::string base_binary, candidate_binary, base_commit, candidate_commit, device, lp_num_threads;
