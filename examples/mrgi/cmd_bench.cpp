@@ -271,7 +271,7 @@ void run_compare_command(BenchOptions& o) {
                  result.quantities.size(), needed);
   for (const perf::AbQuantity& q : result.quantities)
     if (q.judgement.alarm)
-      std::printf("  slower: %s %s x%.3f (%.3f-%.3f), Holm p %.2g\n", (q.scene + "/" + q.technique + "/" + q.level_name).c_str(),
+      std::printf("  slower: %s %s x%.3f (%.3f-%.3f), Holm p %.2g\n", q.entry().c_str(),
                   q.metric.c_str(), q.judgement.median_ratio, q.judgement.ratio_low, q.judgement.ratio_high,
                   q.judgement.p_adjusted);
   if (result.alarms() > 0)

@@ -219,7 +219,7 @@ std::vector<AbQuantity> pool_pass_quantities(const std::vector<AbQuantity>& quan
   for (auto& [metric, p] : pooled) {
     if (entries[metric] < 2) continue;
     p.level_name = std::to_string(entries[metric]) + " entries";
-    p.judgement = judge_pairs("every entry " + metric, p.base, p.candidate, rule);
+    p.judgement = judge_pairs(p.entry() + " " + metric, p.base, p.candidate, rule);
     out.push_back(std::move(p));
   }
   return out;

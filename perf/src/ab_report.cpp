@@ -17,11 +17,6 @@
 namespace mrgi::perf {
 namespace {
 
-// "scene/technique/level", or "every entry (N entries)" for a pass pooled over entries.
-std::string entry_label(const AbQuantity& q) {
-  return q.technique.empty() ? q.scene + " (" + q.level_name + ")" : q.scene + "/" + q.technique + "/" + q.level_name;
-}
-
 std::string fmt(const char* f, double v) {
   char b[64];
   std::snprintf(b, sizeof b, f, v);
@@ -67,7 +62,7 @@ std::string markdown(const AbResult& r) {
   md << "|---|---|---:|---:|---:|---|---:|---:|---|\n";
   for (const AbQuantity& q : r.quantities) {
     const AbJudgement& j = q.judgement;
-    md << "| " << entry_label(q) << " | " << q.metric << " | "
+    md << "| " << q.entry() << " | " << q.metric << " | "
        << fmt(q.metric.rfind("pass:", 0) == 0 ? "%.4f" : "%.2f", median(finite(q.base))) << " | "
        << fmt(q.metric.rfind("pass:", 0) == 0 ? "%.4f" : "%.2f", median(finite(q.candidate))) << " | "
        << fmt("%.3f", j.median_ratio) << " | " << fmt("%.3f", j.ratio_low) << "-" << fmt("%.3f", j.ratio_high) << " | "
@@ -160,7 +155,7 @@ ImageRGB8 ratio_plot(const AbResult& r) {
     const AbQuantity& q = r.quantities[i];
     const float y = float(top + row * int(i) + row / 2);
     const Rgb col = q.judgement.alarm ? red : blue;
-    c.text(10, y - 4, entry_label(q) + " " + q.metric, 1.0f, black);
+    c.text(10, y - 4, q.entry() + " " + q.metric, 1.0f, black);
     c.line(x_of(q.judgement.ratio_low), y, x_of(q.judgement.ratio_high), y, 2.0f, col);
     c.marker(x_of(q.judgement.median_ratio), y, Marker::Circle, 3.5f, col, black);
   }

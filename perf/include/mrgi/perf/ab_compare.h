@@ -66,6 +66,10 @@ struct AbQuantity {
   std::string scene, technique, level_name, metric;  // metric: sustained_ms, cpu_ms, pass:NAME
   std::vector<double> base, candidate;
   AbJudgement judgement;
+  // "scene/technique/level", or "every entry (N entries)" for a pass pooled over entries.
+  std::string entry() const {
+    return technique.empty() ? scene + " (" + level_name + ")" : scene + "/" + technique + "/" + level_name;
+  }
 };
 
 // For each pass judged in at least two entries, one more quantity: its pairs from every such
