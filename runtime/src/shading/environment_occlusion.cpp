@@ -125,8 +125,8 @@ void EnvironmentOcclusion::record(const EnvOcclusionLevel& level, const light::S
   const bool bounce = level.lights_bounce && !lights.empty();
   // The ambient's mean radiance (band 0) is what any sphere can hide at most on average.
   if (!(std::max({ambient[0].x, ambient[0].y, ambient[0].z}) > 0.0) && !bounce) {
-    skipped.push_back(occlude_ambient ? "env_occlusion: no ambient light to occlude and no light bouncing"
-                                      : "env_occlusion: the ambient is not occluded and no light bounces");
+    // (With the ambient not to be occluded, the caller has said why already.)
+    if (occlude_ambient) skipped.push_back("env_occlusion: no ambient light to occlude and no light bouncing");
     return;
   }
   m.spheres_.clear();
