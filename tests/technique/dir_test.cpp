@@ -339,3 +339,24 @@ INSTANTIATE_TEST_SUITE_P(Variants, DirStressMultiBounce, ::testing::Values(0),
 
 }  // namespace
 }  // namespace mrgi::test
+
+// The environment VPLs take every region the direct-light block does not draw with a shadow
+// map, wherever the light stage's shadowed regions lie in the cut (only compact, bright, distant
+// ones are shadowed): no region both mapped and a VPL, none left with neither.
+TEST(Dir, EnvironmentVplsTakeEveryRegionWithoutAShadowMap) {
+  using mrgi::technique::environment_vpl_regions;
+  uint32_t out[16];
+  // Regions 0 and 5 of 8 shadowed, both with maps: the VPLs are 1-4, 6, 7.
+  ASSERT_EQ(environment_vpl_regions(8, {0, 5}, 2, 16, out), 6u);
+  EXPECT_EQ(std::vector<uint32_t>(out, out + 6), (std::vector<uint32_t>{1, 2, 3, 4, 6, 7}));
+  // Only the first of them has a map at this level: 5 is a VPL again.
+  ASSERT_EQ(environment_vpl_regions(8, {0, 5}, 1, 16, out), 7u);
+  EXPECT_EQ(std::vector<uint32_t>(out, out + 7), (std::vector<uint32_t>{1, 2, 3, 4, 5, 6, 7}));
+  // At most `most`, strongest first; none mapped: every region.
+  ASSERT_EQ(environment_vpl_regions(8, {3}, 1, 3, out), 3u);
+  EXPECT_EQ(std::vector<uint32_t>(out, out + 3), (std::vector<uint32_t>{0, 1, 2}));
+  EXPECT_EQ(environment_vpl_regions(4, {}, 0, 16, out), 4u);
+  EXPECT_EQ(environment_vpl_regions(0, {0, 1}, 2, 16, out), 0u);
+  // More mapped than shadowed: the shadowed ones only.
+  EXPECT_EQ(environment_vpl_regions(3, {1}, 4, 16, out), 2u);
+}

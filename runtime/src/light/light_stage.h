@@ -264,6 +264,10 @@ class LightStage {
   // VPLs); their region_sh add up to the environment's SH. `environment_real()`: scene.json's
   // environment.real.
   const std::vector<EnvLight>& environment_regions() const;
+  // Of those, the ones drawn as shadowed lights this frame (indices into environment_regions(),
+  // in the order of their lights in Lighting::lights after the declared lamps): not the
+  // strongest first few but the compact, bright, distant ones (shadowable_region).
+  const std::vector<size_t>& shadowed_environment_regions() const { return shadowed_regions_; }
   bool environment_real() const { return scene_.environment.real; }
   // This frame's filtered environment grid (EnvSampler: world-space equirectangular radiance),
   // nullptr without an environment image or before its first one; for what sees the

@@ -118,7 +118,9 @@ class Dir final : public Laddered<DirLevel> {
   // The VPL buffer's slots this frame (the lamps' VPLs take the rest).
   struct VplSlots {
     uint32_t bounce = 0, env = 0;  // bounce VPLs, environment VPLs
-    size_t first_region = 0;       // the first of the light stage's regions with an environment VPL
+    // The light stage's regions (indices into environment_regions()) with an environment VPL,
+    // env of them: every region without a shadow map, strongest first.
+    std::array<uint32_t, kMaxEnvVpls> region{};
     bool env_override = false;     // the level's shadowed_env holds: the VPLs shadow the regions
   };
   VplSlots plan_vpl_slots(const DirLevel& level, int level_shadowed);
@@ -359,8 +361,10 @@ Dir::VplSlots Dir::plan_vpl_slots(const DirLevel& level, int level_shadowed) {
   const light::Lighting& lighting = shared_.light_stage->lighting();
   VplSlots slots;
   slots.bounce = bounce_ ? level.bounce_vpls : 0;
-  // The regions the direct-light block shades with shadow maps at its level come first in the
-  // cut; the VPLs take the next ones, whose light the block adds unshadowed in its SH ambient.
+  // The regions the direct-light block shades with shadow maps at its level (the first of the
+  // light stage's shadowed regions, which may lie anywhere in the cut: only compact, bright,
+  // distant ones are shadowed) keep them; the VPLs take the others, strongest first, whose
+  // light the block adds unshadowed in its SH ambient.
   size_t shadowed = 0;
   for (uint8_t f : lighting.foldable) shadowed += f != 0 ? 1 : 0;
   // A level that leaves the regions' shadows to the VPLs (shadowed_env >= 0) does so only when
@@ -368,17 +372,17 @@ Dir::VplSlots Dir::plan_vpl_slots(const DirLevel& level, int level_shadowed) {
   slots.env_override =
       level.shadowed_env >= 0 && level.env_vpls > 0 && !ablation_.no_environment_vpls && !regions.empty();
   const int map_shadowed = slots.env_override ? level.shadowed_env : level_shadowed;
+  const std::vector<size_t>& with_lights = shared_.light_stage->shadowed_environment_regions();
   shadowed = std::min(shadowed, size_t(std::max(0, map_shadowed)));
-  slots.first_region = std::min(shadowed, regions.size());
-  slots.env =
-      ablation_.no_environment_vpls
-          ? 0u
-          : std::min({level.env_vpls, uint32_t(regions.size() - slots.first_region), level.vpls - slots.bounce - 1});
+  const uint32_t most = ablation_.no_environment_vpls
+                            ? 0u
+                            : std::min({level.env_vpls, kMaxEnvVpls, level.vpls - slots.bounce - 1});
+  slots.env = environment_vpl_regions(regions.size(), with_lights, shadowed, most, slots.region.data());
   for (uint32_t k = 0; k < slots.env; ++k) {
     LightDesc l;
     l.type = LightType::Directional;
-    l.direction = glm::vec3(-regions[slots.first_region + k].direction);
-    l.color = glm::vec3(regions[slots.first_region + k].irradiance);
+    l.direction = glm::vec3(-regions[slots.region[k]].direction);
+    l.color = glm::vec3(regions[slots.region[k]].irradiance);
     reuse_.add_lamp(l);
   }
   return slots;
@@ -425,7 +429,7 @@ Status Dir::make_vpls(const frame::FrameInfo& info, const DirLevel& level, const
     const float flags = float(MRGI_VPL_VALID | MRGI_VPL_DIRECTIONAL |
                               (shared_.light_stage->environment_real() ? MRGI_VPL_REAL_PATH : 0));
     for (uint32_t k = 0; k < slots.env; ++k) {
-      const light::EnvLight& r = regions[slots.first_region + k];
+      const light::EnvLight& r = regions[slots.region[k]];
       env[k] = {glm::vec4(centre_, flags), glm::vec4(glm::vec3(r.direction), radius_), glm::vec4(glm::vec3(r.irradiance), 0.0f),
                 glm::vec4(0.0f, 0.0f, 1.0f, -1.0f), glm::vec4(0.0f)};
     }
@@ -569,6 +573,15 @@ Expected<std::unique_ptr<Technique>> create_dir(const frame::FrameResources& sha
   auto t = std::make_unique<Dir>(shared, std::move(*levels), options.research.dir);
   MRGI_TRY(t->init());
   return std::unique_ptr<Technique>(std::move(t));
+}
+
+uint32_t environment_vpl_regions(size_t regions, const std::vector<size_t>& shadowed, size_t mapped, uint32_t most,
+                                 uint32_t* out) {
+  const auto mapped_end = shadowed.begin() + std::ptrdiff_t(std::min(mapped, shadowed.size()));
+  uint32_t n = 0;
+  for (size_t r = 0; r < regions && n < most; ++r)
+    if (std::find(shadowed.begin(), mapped_end, r) == mapped_end) out[n++] = uint32_t(r);
+  return n;
 }
 
 }  // namespace mrgi::technique

@@ -138,6 +138,14 @@ struct DirLevel {
   bool real_bounce_beside_camera_ambient;
 };
 const std::array<DirLevel, 5>& dir_levels();  // the defaults
+
+// The regions of the light stage's environment cut (`regions` of them, strongest first) that
+// get environment VPLs: every one but the first `mapped` of `shadowed` (the regions drawn as
+// shadowed lights, light::LightStage::shadowed_environment_regions, whose shadow maps the
+// direct-light block draws: they lie anywhere in the cut), in the cut's order, at most `most`.
+// Written to out[0, n); n returned.
+uint32_t environment_vpl_regions(size_t regions, const std::vector<size_t>& shadowed, size_t mapped, uint32_t most,
+                                 uint32_t* out);
 // The defaults with RuntimeSettings::knobs applied (technique/knobs.h; BadUsage for a refused one).
 Expected<std::vector<DirLevel>> dir_levels(const std::vector<KnobSetting>& knobs);
 Expected<std::vector<QualityLevel>> dir_ladder(const std::vector<KnobSetting>& knobs);
