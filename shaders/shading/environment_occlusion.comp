@@ -3,14 +3,17 @@
 // a grid of `divisor` x `divisor` internal pixels, the surface at the texel's centre pixel (the
 // virtual one where there is one, else the real one) and the irradiance the virtual objects'
 // sphere proxies hide from it of the occludable ambient light (its radiance SH), per
-// shared/occlusion_math.h, less what their objects' surfaces send it instead (albedo / pi x
+// shared/occlusion_math.h (each scaled to its object's silhouette far off: far_field_scale),
+// less what their objects' surfaces send it instead (albedo / pi x
 // the ambient irradiance facing the point, and the shadowed lights' light off as much of the
 // object's surface as faces the point, where the level asks for it), plus what they hide of the broad regions kept apart
 // from the SH (the part of each region's cone their caps cover). Near field (occlusion_math.h):
 // where a sphere's ray past it meets a real surface within the reach, that surface's radiance
 // (the camera's) is what the sphere hides instead of the sky's, and the regions beyond it were
 // not reaching the point (real points only; spheres hiding at least 0.1 % of the hemisphere:
-// the march is the pass's main cost, and a farther sphere hides the sky as before). Written as rgb = that net irradiance taken away
+// the march is the pass's main cost, and a farther sphere hides the sky as before). On real
+// points, where the level asks for it, the objects' surroundings, darkened by them, light the
+// point less (real_bounce_loss). Written as rgb = that net irradiance taken away
 // (W/m^2, negative where an object gives more than it hides), a = the surface's key:
 // its distance to the camera, negative on a virtual surface, 0 where there is none (the
 // direct-light pass up-samples by it).
@@ -68,12 +71,26 @@ vec4 real_surface_beyond(vec3 p, vec3 w, float start, float reach, int steps) {
 
 // What lit object k sends point p from its oriented patches (occlusion_math.h lit_patch_term).
 vec3 object_lit_radiance(int k, vec3 p) {
-  vec3 v = normalize(p - occluders.lit_centre[k].xyz);
-  const int base = k * MRGI_LIT_PATCHES;
+  vec3 v = normalize(p - occluders.object_centre[k].xyz);
+  const int base = k * MRGI_OBJECT_PATCHES;
   vec4 sum = vec4(0.0f);
-  [[unroll]] for (int j = 0; j < MRGI_LIT_PATCHES; ++j)
-    sum += lit_patch_term(occluders.lit_normal[base + j], occluders.lit_radiance[base + j].rgb, v);
+  [[unroll]] for (int j = 0; j < MRGI_OBJECT_PATCHES; ++j)
+    sum += lit_patch_term(occluders.object_patch[base + j], occluders.patch_radiance[base + j].rgb, v);
   return lit_object_radiance(sum);
+}
+
+// The far-field scale of object k's spheres seen from p (occlusion_math.h far_field_scale): its
+// silhouette towards p from its oriented patches over its spheres' disc area.
+float object_far_field_scale(int k, vec3 p) {
+  vec3 d = occluders.object_centre[k].xyz - p;
+  float l = length(d);
+  vec4 far = occluders.object_far[k];
+  if (!(far.x > 0.0f) || !(far.y > 0.0f) || !(l > 0.0f)) return 1.0f;
+  vec3 w = d / l;
+  const int base = k * MRGI_OBJECT_PATCHES;
+  float silhouette = 0.0f;
+  [[unroll]] for (int j = 0; j < MRGI_OBJECT_PATCHES; ++j) silhouette += silhouette_area_term(occluders.object_patch[base + j], w);
+  return far_field_scale(silhouette, far.x, l / far.y);
 }
 
 // Spheres farther than this many radii are skipped: each would hide less than 1 / 64^2 of the
@@ -111,7 +128,10 @@ void main() {
   // on lavapipe a dynamically indexed local or uniform array is gathered lane by lane.)
   vec4 region_open = vec4(1.0f);
   const bool lit = occluders.near_field.y > 0.5f;
-  int lit_object = -1;
+  // Per object, once a texel (the spheres come object by object): its far-field scale and,
+  // where lit, the light its surface sends the point.
+  int seen_object = -1;
+  float object_scale = 1.0f;
   vec3 lit_shown = vec3(0.0f);
   for (int i = 0; i < count; ++i) {
     vec4 s = occluders.spheres[i];
@@ -123,7 +143,13 @@ void main() {
     float inv_l = inversesqrt(l2);
     vec3 w = d * inv_l;
     float s2 = r2 / l2;
-    float f = sphere_form_factor(dot(n, w), s2);
+    const int object = int(occluders.albedo[i].w);
+    if (object >= 0 && object != seen_object) {
+      seen_object = object;
+      object_scale = object_far_field_scale(object, p);
+      lit_shown = lit ? object_lit_radiance(object, p) : vec3(0.0f);
+    }
+    float f = sphere_form_factor(dot(n, w), s2) * (object >= 0 ? object_scale : 1.0f);
     if (f > 1e-5f) {
       // What the sphere hides (the sky's cap, or the real surface beyond it in the near field)
       // less what it shows instead: the object's own surface facing the point, lit by the same
@@ -152,17 +178,12 @@ void main() {
         }
       }
       vec3 shown = occluders.albedo[i].rgb * e_facing * (1.0f / MRGI_PI);
-      const int object = int(occluders.albedo[i].w);
-      if (lit && object >= 0 && !(is_virtual && distance(p, occluders.lit_centre[object].xyz) < occluders.lit_centre[object].w)) {
+      if (lit && object >= 0 && !(is_virtual && distance(p, occluders.object_centre[object].xyz) < occluders.object_centre[object].w)) {
         // ... and by the shadowed lights, as much of its lit surface as faces the point (a
         // sunlit object sends its sunlight on to the wall beside it): once per object a texel.
         // Not on a virtual point within the object's bounding sphere, its own surface most
         // likely: its proxies (the sliver of an inscribed sphere above the point's horizon)
         // would light it with its own lit faces; other objects' light reaches it.
-        if (object != lit_object) {
-          lit_object = object;
-          lit_shown = object_lit_radiance(object, p);
-        }
         shown += lit_shown;
       }
       o = sphere_occlusion_add(o, f, hidden - shown);
@@ -170,6 +191,14 @@ void main() {
   }
   float key = distance(p, frame.camera_world.xyz);
   vec3 hidden = sphere_occlusion_irradiance(o);
+  if (occluders.near_field.w > 0.5f && !is_virtual) {
+    // The objects' surroundings, darkened by them, light this real point less.
+    const int objects = int(occluders.near_field.z);
+    [[unroll]] for (int k = 0; k < MRGI_MAX_OCCLUSION_OBJECTS; ++k) {
+      if (k >= objects) break;
+      hidden += real_bounce_loss(occluders.object_loss[k].rgb, occluders.object_base[k].xyz, occluders.object_loss[k].w, p, n);
+    }
+  }
   if (regions > 0) {
     [[unroll]] for (int k = 0; k < MRGI_MAX_OCCLUSION_REGIONS; ++k) {
       if (k >= regions) break;

@@ -201,16 +201,52 @@ MRGI_FN vec3 sphere_occlusion_irradiance(SphereOcclusion o) {
   return o.weighted * (MRGI_PI * (1.0f - o.open) / o.weight);
 }
 
+// An object's proxies against its silhouette. Spheres fitted inside a solid overlap, and seen
+// from afar their caps lie over one another: the independent-occluder sum of a box's or a
+// duck's 16 proxies is 1.3-2x the form factor of the mesh itself beyond a few radii (ray-cast
+// against the triangles; at 1.3 radii it is 0.9-1.6x, the spheres' own 1 - prod(1 - f) saturating).
+// Far off, an object hides its silhouette area A(w) seen along w (silhouette_area_term summed
+// over its oriented patches: half of each patch's facing area x |dot(n, w)|, exact for a convex
+// mesh with flat patches), the spheres sum(pi r^2): each sphere's fraction is scaled by
+// far_field_scale, their ratio (at most 4) taken in full beyond 4 bounding radii, not at all
+// within 1.5 (the proxies' own near-field estimate), linearly between.
+MRGI_FN float silhouette_area_term(vec4 normal_facing, vec3 w) {
+  return 0.5f * normal_facing.w * abs(dot(vec3(normal_facing.x, normal_facing.y, normal_facing.z), w));
+}
+MRGI_FN float far_field_scale(float silhouette_m2, float disc_area_m2, float distance_over_radius) {
+  if (!(disc_area_m2 > 0.0f) || !(silhouette_m2 > 0.0f)) return 1.0f;
+  float t = clamp((distance_over_radius - 1.5f) / 2.5f, 0.0f, 1.0f);
+  return mix(1.0f, min(silhouette_m2 / disc_area_m2, 4.0f), t);
+}
+
+// The real surfaces round an object, darkened by it, reflect less light on to the rest of the
+// scene (the second bounce of the occlusion): the object takes `flux` (W per channel) that they
+// would have reflected. It is lost as from a diffuse emitter lying on the ground at the object's
+// base (facing up, world +y), spread over `spread` metres (the shadow's reach: the distance
+// is softened by it, so the base's neighbourhood does not see an infinite peak). The
+// irradiance (W/m^2) a real point p with unit normal n loses:
+//   flux x max(cos at the emitter, 0) x max(cos at p, 0) / (pi (d^2 + spread^2)).
+MRGI_FN vec3 real_bounce_loss(vec3 flux, vec3 base, float spread, vec3 p, vec3 n) {
+  vec3 d = p - base;
+  float d2 = dot(d, d);
+  float inv_d = 1.0f / sqrt(max(d2, 1e-8f));
+  float cos_e = max(d.y * inv_d, 0.0f);
+  float cos_p = max(-dot(n, d) * inv_d, 0.0f);
+  return flux * (cos_e * cos_p / (MRGI_PI * (d2 + spread * spread)));
+}
+
 // The environment-occlusion pass's uniform block (shading/environment_occlusion.h), std140.
 #define MRGI_MAX_OCCLUDER_SPHERES 64
 #define MRGI_MAX_OCCLUSION_REGIONS 4
-#define MRGI_MAX_LIT_OBJECTS 8
-#define MRGI_LIT_PATCHES 8
+#define MRGI_MAX_OCCLUSION_OBJECTS 8
+#define MRGI_OBJECT_PATCHES 8
 struct EnvOcclusionSet {
   ivec4 count;                                   // x spheres; y divisor (internal pixels a texel side);
                                                  // z regions (below); w near-field march steps (0 = off)
   vec4 near_field;                               // x how far the march reaches (metres); y 1 where
-                                                 // the objects' lit radiance (below) is added
+                                                 // the objects' lit radiance (below) is added; z the
+                                                 // objects (below); w 1 where their real bounce
+                                                 // loss (object_loss) is taken
   vec4 radiance[12];                             // radiance SH16 of the occludable light: r c0..c3, g, b
                                                  // (without the regions below)
   vec4 spheres[MRGI_MAX_OCCLUDER_SPHERES];       // world xyz centre, w radius (metres)
@@ -221,20 +257,26 @@ struct EnvOcclusionSet {
   // at normal incidence (W/m^2), w the half-angle (radians).
   vec4 regions[MRGI_MAX_OCCLUSION_REGIONS];
   vec4 region_irradiance[MRGI_MAX_OCCLUSION_REGIONS];
-  // The objects lit by the shadowed lights (lamps, shadowed environment sources), where
-  // near_field.y is 1: object k's oriented patches at k * MRGI_LIT_PATCHES + j, xyz the world
-  // unit normal, w the area (0: no patch), and each patch's radiance (rgb albedo x E / pi);
-  // lit_centre[k] xyz the object's centre (world, metres), w the radius (metres) within which
-  // a virtual point is taken to be on its surface and gets none of it. A sphere's object is albedo[i].w
-  // (-1: none of these).
-  vec4 lit_normal[MRGI_MAX_LIT_OBJECTS * MRGI_LIT_PATCHES];
-  vec4 lit_radiance[MRGI_MAX_LIT_OBJECTS * MRGI_LIT_PATCHES];
-  vec4 lit_centre[MRGI_MAX_LIT_OBJECTS];
+  // The objects (near_field.z of them, at most MRGI_MAX_OCCLUSION_OBJECTS; a sphere's object is
+  // albedo[i].w, -1 none of these): object k's oriented patches at k * MRGI_OBJECT_PATCHES + j,
+  // xyz the world unit normal, w the facing area (m^2; 0: no patch); where near_field.y is 1,
+  // each patch's radiance lit by the shadowed lights (rgb albedo x E / pi). object_centre[k]
+  // xyz the object's centre (world, metres), w the radius (metres) within which a virtual
+  // point is taken to be on its surface and gets none of its light. object_far[k] x the sum of
+  // pi r^2 over its spheres here (m^2), y its bounding radius (m) (far_field_scale).
+  // object_loss[k] rgb the flux its surroundings reflect less (W, real_bounce_loss), w the
+  // spread (m); object_base[k] xyz where that loss is emitted from (world, metres).
+  vec4 object_patch[MRGI_MAX_OCCLUSION_OBJECTS * MRGI_OBJECT_PATCHES];
+  vec4 patch_radiance[MRGI_MAX_OCCLUSION_OBJECTS * MRGI_OBJECT_PATCHES];
+  vec4 object_centre[MRGI_MAX_OCCLUSION_OBJECTS];
+  vec4 object_far[MRGI_MAX_OCCLUSION_OBJECTS];
+  vec4 object_loss[MRGI_MAX_OCCLUSION_OBJECTS];
+  vec4 object_base[MRGI_MAX_OCCLUSION_OBJECTS];
 };
 
 #ifdef __cplusplus
 static_assert(sizeof(EnvOcclusionSet) == 16 * (2 + 12 + 2 * MRGI_MAX_OCCLUDER_SPHERES + 2 * MRGI_MAX_OCCLUSION_REGIONS +
-                                              (2 * MRGI_LIT_PATCHES + 1) * MRGI_MAX_LIT_OBJECTS),
+                                              (2 * MRGI_OBJECT_PATCHES + 4) * MRGI_MAX_OCCLUSION_OBJECTS),
               "std140 mirror");
 #undef MRGI_FN
 }  // namespace mrgi::shader

@@ -6,38 +6,15 @@
 #include <vector>
 
 #include "frame/occluder_spheres.h"
+#include "test_meshes.h"
 
 namespace {
 using mrgi::frame::fit_occluder_spheres;
 using mrgi::frame::occluder_coverage;
 
-struct Mesh {
-  std::vector<glm::vec3> p;
-  std::vector<uint32_t> i;
-};
-
-Mesh box(glm::vec3 lo, glm::vec3 hi) {
-  Mesh m;
-  for (int k = 0; k < 8; ++k) m.p.emplace_back(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z);
-  const uint32_t f[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
-  for (const auto& q : f) m.i.insert(m.i.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
-  return m;
-}
-
-Mesh uv_sphere(glm::vec3 c, float r, int rings = 24, int segments = 48) {
-  Mesh m;
-  for (int a = 0; a <= rings; ++a)
-    for (int b = 0; b <= segments; ++b) {
-      const float t = 3.14159265f * a / rings, ph = 6.2831853f * b / segments;
-      m.p.push_back(c + r * glm::vec3(std::sin(t) * std::cos(ph), std::cos(t), std::sin(t) * std::sin(ph)));
-    }
-  for (int a = 0; a < rings; ++a)
-    for (int b = 0; b < segments; ++b) {
-      const uint32_t i0 = uint32_t(a * (segments + 1) + b), i1 = i0 + 1, i2 = i0 + uint32_t(segments + 1), i3 = i2 + 1;
-      m.i.insert(m.i.end(), {i0, i2, i1, i1, i2, i3});
-    }
-  return m;
-}
+using Mesh = mrgi::test::TestMesh;
+Mesh box(glm::vec3 lo, glm::vec3 hi) { return mrgi::test::box_mesh(lo, hi); }
+Mesh uv_sphere(glm::vec3 c, float r) { return mrgi::test::uv_sphere_mesh(c, r); }
 
 TEST(OccluderSpheres, ASphereIsFittedByOneSphereOfItsSize) {
   const Mesh m = uv_sphere(glm::vec3(0.2f, 1.0f, -0.5f), 0.3f);

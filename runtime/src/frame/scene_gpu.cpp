@@ -258,13 +258,18 @@ int SceneGpu::oriented_patches(size_t ordinal, OrientedPatch* out) const {
   for (const ObjectSpan& o : objects_) {
     if (!o.visible || seen++ != ordinal) continue;
     // Normals by the inverse transpose of the placement's linear part (a non-uniform scale
-    // tilts them); areas as loaded (a patch's share is what counts).
-    const glm::mat3 normals = glm::transpose(glm::inverse(glm::mat3(o.placement.matrix())));
+    // tilts them); areas as area vectors, by the cofactor matrix det(M) M^-T: square metres.
+    const glm::mat3 linear(o.placement.matrix());
+    const glm::mat3 normals = glm::transpose(glm::inverse(linear));
+    const float det = std::abs(glm::determinant(linear));
     const int n = int(std::min(o.patches.size(), size_t(kOrientedPatches)));
     for (int k = 0; k < n; ++k) {
       out[k] = o.patches[size_t(k)];
       const glm::vec3 w = normals * o.patches[size_t(k)].normal;
       out[k].normal = glm::length(w) > 0.0f ? glm::normalize(w) : o.patches[size_t(k)].normal;
+      const float to_world = std::isfinite(det) ? det * glm::length(w) : 0.0f;
+      out[k].area = o.patches[size_t(k)].area * to_world;
+      out[k].facing_area = o.patches[size_t(k)].facing_area * to_world;
     }
     return n;
   }

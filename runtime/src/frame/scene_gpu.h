@@ -143,8 +143,9 @@ class SceneGpu {
   void occluder_spheres(int per_object, std::vector<glm::vec4>& out, std::vector<glm::vec4>* albedo = nullptr,
                         std::vector<int>* object = nullptr) const;
   // The `ordinal`-th visible object's surface by orientation (frame/surface_orientation.h),
-  // gathered at load into at most kOrientedPatches patches, normals in world space at its newest
-  // placement: written to out[0, n), n returned (0 for an ordinal past the visible objects).
+  // gathered at load into at most kOrientedPatches patches, normals and areas in world space
+  // (square metres) at its newest placement: written to out[0, n), n returned (0 for an
+  // ordinal past the visible objects).
   static constexpr int kOrientedPatches = 8;
   int oriented_patches(size_t ordinal, OrientedPatch* out) const;
 

@@ -108,7 +108,8 @@ std::vector<OrientedPatch> cluster_surface_orientations(const std::vector<glm::v
   std::vector<OrientedPatch> out;
   for (const Accumulator& p : patches) {
     if (!(p.area > 0.0)) continue;
-    out.push_back({glm::vec3(p.mean_normal()), float(p.area), glm::vec3(p.albedo_area / p.area)});
+    out.push_back({glm::vec3(p.mean_normal()), float(p.area), glm::vec3(p.albedo_area / p.area),
+                   float(glm::length(p.normal_area))});
   }
   std::sort(out.begin(), out.end(), [](const OrientedPatch& a, const OrientedPatch& b) { return a.area > b.area; });
   return out;

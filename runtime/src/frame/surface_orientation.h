@@ -19,6 +19,11 @@ struct OrientedPatch {
   glm::vec3 normal{0.0f, 1.0f, 0.0f};  // unit, the mesh's space
   float area = 0.0f;                   // the mesh's units squared
   glm::vec3 albedo{0.0f};              // area-weighted mean diffuse albedo, linear RGB
+  // |sum of the triangles' area x unit normal|: the area the patch shows a distant viewer
+  // along its normal (= area for a flat patch, less for a curved one). Half the sum over the
+  // patches of facing_area x |dot(normal, w)| is the object's silhouette area seen from
+  // direction w, exact for a convex mesh whose patches are flat.
+  float facing_area = 0.0f;
 };
 
 // Patches of the triangles (positions indexed by `indices`, three a triangle; out-of-range

@@ -1,6 +1,7 @@
 #include "shading/environment_occlusion.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "frame/scene_gpu.h"
@@ -10,27 +11,109 @@
 
 namespace mrgi::shading {
 
+namespace {
+
+// Irradiance (W/m^2 per channel) light `l` gives a surface at `at` with unit `normal`, no
+// shadowing; `to_light` the unit direction towards it.
+glm::dvec3 light_irradiance(const LightDesc& l, const glm::dvec3& at, const glm::dvec3& normal, glm::dvec3& to_light) {
+  to_light = -glm::dvec3(l.direction);
+  double scale = double(l.intensity);
+  if (l.type != LightType::Directional) {
+    const glm::dvec3 d = glm::dvec3(l.position) - at;
+    const double dist = std::max(glm::length(d), 1e-3);
+    to_light = d / dist;
+    scale /= dist * dist;
+    if (l.type == LightType::Spot) {
+      const float cos_inner = std::cos(glm::radians(l.inner_angle_deg));
+      const float cos_outer = std::cos(glm::radians(l.outer_angle_deg));
+      scale *= double(shader::spot_falloff(float(glm::dot(glm::dvec3(l.direction), -to_light)), cos_outer, cos_inner));
+    }
+  }
+  const double facing = std::max(glm::dot(normal, to_light), 0.0);
+  return std::isfinite(scale) && scale > 0.0 ? glm::dvec3(l.color) * (scale * facing) : glm::dvec3(0.0);
+}
+
+// Directions spread evenly over the sphere (a Fibonacci lattice, +y the axis) with their SH
+// basis: the quadrature of real_bounce_flux.
+constexpr size_t kFluxDirections = 256;
+struct FluxDirections {
+  std::array<glm::dvec3, kFluxDirections> w;
+  std::array<std::array<double, 16>, kFluxDirections> basis;
+};
+const FluxDirections& flux_directions() {
+  static const FluxDirections d = [] {
+    FluxDirections out{};
+    const double golden = M_PI * (3.0 - std::sqrt(5.0));
+    for (size_t i = 0; i < kFluxDirections; ++i) {
+      const double y = 1.0 - (2.0 * double(i) + 1.0) / double(kFluxDirections);
+      const double r = std::sqrt(std::max(1.0 - y * y, 0.0)), phi = golden * double(i);
+      out.w[i] = glm::dvec3(r * std::cos(phi), y, r * std::sin(phi));
+      const shader::SH16 b = shader::sh_basis16(glm::vec3(out.w[i]));
+      for (int k = 0; k < 16; ++k) out.basis[i][size_t(k)] = double(shader::sh_get(b, k));
+    }
+    return out;
+  }();
+  return d;
+}
+
+}  // namespace
+
 glm::vec3 lit_patch_radiance(const frame::OrientedPatch& patch, const glm::vec3& centre,
                              const std::vector<LightDesc>& lights) {
-  glm::dvec3 e(0.0);
-  for (const LightDesc& l : lights) {
-    glm::dvec3 to_light = -glm::dvec3(l.direction);
-    double scale = double(l.intensity);
-    if (l.type != LightType::Directional) {
-      const glm::dvec3 d = glm::dvec3(l.position) - glm::dvec3(centre);
-      const double dist = std::max(glm::length(d), 1e-3);
-      to_light = d / dist;
-      scale /= dist * dist;
-      if (l.type == LightType::Spot) {
-        const float cos_inner = std::cos(glm::radians(l.inner_angle_deg));
-        const float cos_outer = std::cos(glm::radians(l.outer_angle_deg));
-        scale *= double(shader::spot_falloff(float(glm::dot(glm::dvec3(l.direction), -to_light)), cos_outer, cos_inner));
-      }
-    }
-    const double facing = std::max(glm::dot(glm::dvec3(patch.normal), to_light), 0.0);
-    if (std::isfinite(scale) && scale > 0.0) e += glm::dvec3(l.color) * (scale * facing);
-  }
+  glm::dvec3 e(0.0), to_light;
+  for (const LightDesc& l : lights) e += light_irradiance(l, glm::dvec3(centre), glm::dvec3(patch.normal), to_light);
   return glm::vec3(glm::dvec3(patch.albedo) * e / M_PI);
+}
+
+glm::vec3 real_bounce_flux(const frame::OrientedPatch* patches, int count, const light::ShRgb& ambient,
+                           const std::vector<LightDesc>& lights, const glm::vec3& centre, const glm::vec3& base) {
+  const FluxDirections& dirs = flux_directions();
+  const double d_omega = 4.0 * M_PI / double(kFluxDirections);
+  std::array<glm::dvec3, kFluxDirections> radiance;
+  glm::dvec3 below(0.0), e_up(0.0), to_light;
+  size_t below_count = 0;
+  for (size_t i = 0; i < kFluxDirections; ++i) {
+    glm::dvec3 l(0.0);
+    for (size_t k = 0; k < 16; ++k) l += ambient[k] * dirs.basis[i][k];
+    radiance[i] = glm::max(l, glm::dvec3(0.0));  // SH ringing is no light
+    if (dirs.w[i].y < 0.0) {
+      below += radiance[i];
+      ++below_count;
+    } else {
+      e_up += radiance[i] * (dirs.w[i].y * d_omega);
+    }
+  }
+  for (const LightDesc& l : lights) e_up += light_irradiance(l, glm::dvec3(base), glm::dvec3(0.0, 1.0, 0.0), to_light);
+  // What the object takes from the light travelling down (which would have reached the ground
+  // and the walls round it), less the part of its own reflection that goes down.
+  glm::dvec3 intercepted(0.0), reflected(0.0);
+  for (int j = 0; j < count; ++j) {
+    const glm::dvec3 n(patches[j].normal);
+    const double area = double(patches[j].area);
+    if (!(area > 0.0)) continue;
+    glm::dvec3 e_all(0.0), e_down(0.0);
+    for (size_t i = 0; i < kFluxDirections; ++i) {
+      const double c = glm::dot(n, dirs.w[i]);
+      if (c <= 0.0) continue;
+      const glm::dvec3 e = radiance[i] * (c * d_omega);
+      e_all += e;
+      if (dirs.w[i].y > 0.0) e_down += e;
+    }
+    for (const LightDesc& l : lights) {
+      const glm::dvec3 e = light_irradiance(l, glm::dvec3(centre), n, to_light);
+      e_all += e;
+      if (to_light.y > 0.0) e_down += e;
+    }
+    intercepted += area * e_down;
+    reflected += area * glm::dvec3(patches[j].albedo) * e_all * (0.5 * (1.0 - n.y));
+  }
+  // The surroundings' albedo: what the ground sends up (the ambient's mean radiance from below)
+  // over the irradiance reaching it, pi L / E; at most 0.9.
+  below /= double(std::max<size_t>(below_count, 1));
+  glm::dvec3 albedo(0.0);
+  for (int c = 0; c < 3; ++c) albedo[c] = e_up[c] > 1e-9 ? std::clamp(M_PI * below[c] / e_up[c], 0.0, 0.9) : 0.0;
+  const glm::dvec3 flux = albedo * (intercepted - reflected);
+  return std::isfinite(flux.x + flux.y + flux.z) ? glm::vec3(flux) : glm::vec3(0.0f);
 }
 
 struct EnvironmentOcclusion::Impl {
@@ -41,7 +124,8 @@ struct EnvironmentOcclusion::Impl {
   int divisor_ = 0;                // this frame's; 0: left out
   std::vector<glm::vec4> spheres_, albedo_;  // reserved at start-up
   std::vector<int> object_;                  // each sphere's object ordinal
-  void write_lit_objects(shader::EnvOcclusionSet& set, const std::vector<LightDesc>& lights) const;
+  void write_objects(shader::EnvOcclusionSet& set, const std::vector<LightDesc>& lights, const light::ShRgb& ambient,
+                     bool bounce, bool loss, bool loss_lights) const;
 };
 
 EnvironmentOcclusion::EnvironmentOcclusion(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -74,33 +158,51 @@ Expected<std::unique_ptr<EnvironmentOcclusion>> EnvironmentOcclusion::create(con
   return std::unique_ptr<EnvironmentOcclusion>(new EnvironmentOcclusion(std::move(m)));
 }
 
-// Each lit object's centre (its proxies' centres weighted by their volume), its oriented patches
-// and their radiance under `lights` there.
-void EnvironmentOcclusion::Impl::write_lit_objects(shader::EnvOcclusionSet& set, const std::vector<LightDesc>& lights) const {
+// Each object's centre (its proxies' centres weighted by their volume), bounding radius, the
+// disc area of its proxies (far_field_scale) and its oriented patches; with `bounce`, the
+// patches' radiance under `lights`; with `loss`, the flux its surroundings reflect less
+// (real_bounce_flux, of the lights too where `loss_lights`) and where from.
+void EnvironmentOcclusion::Impl::write_objects(shader::EnvOcclusionSet& set, const std::vector<LightDesc>& lights,
+                                               const light::ShRgb& ambient, bool bounce, bool loss,
+                                               bool loss_lights) const {
   const int spheres = set.count.x;
-  glm::vec4 centre[MRGI_MAX_LIT_OBJECTS] = {};
+  glm::vec4 centre[MRGI_MAX_OCCLUSION_OBJECTS] = {};
+  float discs[MRGI_MAX_OCCLUSION_OBJECTS] = {}, lowest[MRGI_MAX_OCCLUSION_OBJECTS] = {};
+  int objects = 0;
   for (int i = 0; i < spheres; ++i) {
     const int k = object_[size_t(i)];
-    if (k >= MRGI_MAX_LIT_OBJECTS) continue;
-    const float volume = spheres_[size_t(i)].w * spheres_[size_t(i)].w * spheres_[size_t(i)].w;
-    centre[k] += glm::vec4(glm::vec3(spheres_[size_t(i)]) * volume, volume);
+    if (k >= MRGI_MAX_OCCLUSION_OBJECTS) continue;
+    const glm::vec4 s = spheres_[size_t(i)];
+    const float volume = s.w * s.w * s.w;
+    lowest[k] = centre[k].w > 0.0f ? std::min(lowest[k], s.y - s.w) : s.y - s.w;
+    centre[k] += glm::vec4(glm::vec3(s) * volume, volume);
+    discs[k] += float(M_PI) * s.w * s.w;
+    objects = std::max(objects, k + 1);
   }
+  set.near_field.z = float(objects);
   frame::OrientedPatch patches[frame::SceneGpu::kOrientedPatches];
-  static_assert(frame::SceneGpu::kOrientedPatches == MRGI_LIT_PATCHES, "one patch count");
-  for (int k = 0; k < MRGI_MAX_LIT_OBJECTS; ++k) {
+  static_assert(frame::SceneGpu::kOrientedPatches == MRGI_OBJECT_PATCHES, "one patch count");
+  for (int k = 0; k < MRGI_MAX_OCCLUSION_OBJECTS; ++k) {
     const int n = centre[k].w > 0.0f ? frame_.scene_gpu->oriented_patches(size_t(k), patches) : 0;
-    const glm::vec3 c = n > 0 ? glm::vec3(centre[k]) / centre[k].w : glm::vec3(0.0f);
-    // The bounding sphere of the object's proxies, grown by a quarter for the surface beyond
-    // the inscribed spheres: a virtual point inside it takes none of the object's light.
+    const glm::vec3 c = centre[k].w > 0.0f ? glm::vec3(centre[k]) / centre[k].w : glm::vec3(0.0f);
+    // The bounding sphere of the object's proxies; grown by a quarter for the surface beyond
+    // the inscribed spheres, a virtual point inside it takes none of the object's light.
     float reach = 0.0f;
-    for (int i = 0; i < spheres && n > 0; ++i)
+    for (int i = 0; i < spheres; ++i)
       if (object_[size_t(i)] == k) reach = std::max(reach, glm::distance(glm::vec3(spheres_[size_t(i)]), c) + spheres_[size_t(i)].w);
-    set.lit_centre[k] = glm::vec4(c, 1.25f * reach);
-    for (int j = 0; j < MRGI_LIT_PATCHES; ++j) {
-      const size_t slot = size_t(k * MRGI_LIT_PATCHES + j);
-      set.lit_normal[slot] = j < n ? glm::vec4(patches[j].normal, patches[j].area) : glm::vec4(0.0f);
-      set.lit_radiance[slot] = j < n ? glm::vec4(lit_patch_radiance(patches[j], c, lights), 0.0f) : glm::vec4(0.0f);
+    set.object_centre[k] = glm::vec4(c, 1.25f * reach);
+    set.object_far[k] = glm::vec4(n > 0 ? discs[k] : 0.0f, reach, 0.0f, 0.0f);
+    for (int j = 0; j < MRGI_OBJECT_PATCHES; ++j) {
+      const size_t slot = size_t(k * MRGI_OBJECT_PATCHES + j);
+      set.object_patch[slot] = j < n ? glm::vec4(patches[j].normal, patches[j].facing_area) : glm::vec4(0.0f);
+      set.patch_radiance[slot] =
+          bounce && j < n ? glm::vec4(lit_patch_radiance(patches[j], c, lights), 0.0f) : glm::vec4(0.0f);
     }
+    const glm::vec3 base(c.x, lowest[k], c.z);
+    set.object_base[k] = glm::vec4(base, 0.0f);
+    static const std::vector<LightDesc> kNoLights;
+    set.object_loss[k] = loss && n > 0 ? glm::vec4(real_bounce_flux(patches, n, ambient, loss_lights ? lights : kNoLights, c, base), reach)
+                                       : glm::vec4(0.0f);
   }
 }
 
@@ -155,7 +257,8 @@ void EnvironmentOcclusion::record(const EnvOcclusionLevel& level, const light::S
   // Without an occluded ambient there is nothing beyond a sphere to hide: no march.
   set->count = glm::ivec4(int(std::min<size_t>(m.spheres_.size(), MRGI_MAX_OCCLUDER_SPHERES)), m.divisor_, kept,
                           occlude_ambient ? std::clamp(level.near_field_steps, 0, 64) : 0);
-  set->near_field = glm::vec4(std::max(level.near_field_m, 0.0f), bounce ? 1.0f : 0.0f, 0.0f, 0.0f);
+  const bool loss = level.real_bounce_loss;
+  set->near_field = glm::vec4(std::max(level.near_field_m, 0.0f), bounce ? 1.0f : 0.0f, 0.0f, loss ? 1.0f : 0.0f);
   for (int c = 0; c < 3; ++c)
     for (int k = 0; k < 4; ++k) {
       const size_t i = size_t(k * 4);
@@ -164,9 +267,9 @@ void EnvironmentOcclusion::record(const EnvOcclusionLevel& level, const light::S
     }
   for (size_t i = 0; i < size_t(set->count.x); ++i) {
     set->spheres[i] = m.spheres_[i];
-    set->albedo[i] = glm::vec4(glm::vec3(m.albedo_[i]), bounce && m.object_[i] < MRGI_MAX_LIT_OBJECTS ? float(m.object_[i]) : -1.0f);
+    set->albedo[i] = glm::vec4(glm::vec3(m.albedo_[i]), m.object_[i] < MRGI_MAX_OCCLUSION_OBJECTS ? float(m.object_[i]) : -1.0f);
   }
-  if (bounce) m.write_lit_objects(*set, lights);
+  m.write_objects(*set, lights, ambient, bounce, loss, level.real_bounce_loss_lights);
   const frame::FrameResources& r = m.frame_;
   const int divisor = m.divisor_;
   r.graph->add_shader_pass(

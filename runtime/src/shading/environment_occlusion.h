@@ -16,7 +16,12 @@
 // Each object is stood in for by sphere proxies fitted at load (frame/occluder_spheres.h); per
 // texel, each sphere's cap of the sky is weighted by its exact cosine-weighted solid angle and
 // the mean radiance of the ambient SH over the cap (shaders/shared/occlusion_math.h), less the
-// object's radiance towards the point. The pass
+// object's radiance towards the point. Inscribed spheres overlap, and from a few radii away
+// their caps lie over one another: each sphere's part is scaled by the object's silhouette
+// (from its oriented patches) over its spheres' disc area (far_field_scale), so an object
+// hides what its silhouette covers, not up to twice that. The real surfaces the objects darken
+// reflect less light on to the rest of the scene: that second bounce is taken off every real
+// point as from a diffuse emitter at each object's base (EnvOcclusionLevel::real_bounce_loss). The pass
 // (shaders/shading/environment_occlusion.comp) runs on a grid of `divisor` x `divisor` internal
 // pixels; the shading pass up-samples it with the surface key (distance to the camera, real or
 // virtual) so an object's edge does not bleed onto the floor behind it.
@@ -65,13 +70,28 @@ struct EnvOcclusionLevel {
   // shadowed environment sources) first bounce off its surface, as much of it as faces the point
   // (its oriented patches, occlusion_math.h lit_patch_term): a sunlit object brightens the wall
   // beside it. A technique whose own bounce (VPLs, volumes) carries that light leaves it off.
-  // Off by default: measured on the independent (Cycles) scenes it made baseline high's
-  // all-pixel RDE worse on three of eight (window_room_duck +0.008, area_window_orange_box
-  // +0.003, spot_in_fisheye +0.0025; corner_blue_yellow -0.001) and moved their real-pixel
-  // change away from the truth's (0.78 -> 0.55 of it, 1.71 -> 0.40): the objects' occlusion of
-  // the light around them is weaker there than the truth's, which the missing bounce offset.
-  // Perf/results/env-occlusion/lights-bounce-2026-12-06/.
+  // Off by default: measured on the independent (Cycles) tuning half it makes baseline high's
+  // all-pixel RDE worse where it acts (spot_in_fisheye +0.0022, window_room_duck +0.0003) while
+  // it helps the suite (corner -0.0067, moving -0.0044, desk_spot -0.0023; glass_mirror
+  // +0.0024): the bounce is too strong within a few centimetres of the object and too weak
+  // beyond (spot_in_fisheye), though it brings the real-pixel change nearer the truth's there
+  // (2.25 -> 1.11 of it). Perf/results/env-occlusion/far-field-and-real-bounce-2026-12-06/.
   bool lights_bounce = false;
+  // The real surfaces round an object, darkened by it, light the rest of the scene less (the
+  // occlusion's second bounce): the flux the object takes from the light travelling down,
+  // less what its own surface reflects down, times the surroundings' albedo (the ambient's
+  // light from below over the irradiance reaching the ground), is taken off every real point
+  // as from a diffuse emitter on the ground at the object's base (occlusion_math.h
+  // real_bounce_loss). On by default: with it, the objects' broad darkening of a room's walls
+  // comes out as in the truth where the proxies' far-field over-count (far_field_scale) had
+  // stood in for it (Cycles window_room_duck: real-pixel change 0.78 of the truth's before
+  // the scale, 0.65 with the scale alone, 0.90 with both; all-pixel RDE +0.0055 with the scale
+  // alone, +0.0012 with both; perf/results/env-occlusion/far-field-and-real-bounce-2026-12-06/).
+  bool real_bounce_loss = true;
+  // The loss includes the shadowed lights' share (their light the object keeps from the
+  // ground). A technique whose bounce (VPLs, volumes, cones) already loses the lamps' light
+  // where the objects shadow it leaves this off.
+  bool real_bounce_loss_lights = true;
 };
 
 // The radiance (linear RGB: albedo x E / pi) of a virtual object's oriented patch
@@ -79,6 +99,16 @@ struct EnvOcclusionLevel {
 // (world, metres): each light's irradiance there on the patch's orientation, no shadowing.
 glm::vec3 lit_patch_radiance(const frame::OrientedPatch& patch, const glm::vec3& centre,
                              const std::vector<LightDesc>& lights);
+
+// The flux (W per linear RGB channel) the real surfaces round a virtual object reflect less
+// because of it (EnvOcclusionLevel::real_bounce_loss): of its `count` oriented patches (world
+// normals and areas), the light travelling down they intercept (from the `ambient` radiance SH
+// and `lights` at the object's `centre`) less what they reflect down, times the surroundings'
+// albedo pi L_below / E_up (the ambient's mean radiance from below over the irradiance on the
+// ground at `base`, lights included; at most 0.9). Negative where the object sends down more
+// than it takes (a bright object under light from below).
+glm::vec3 real_bounce_flux(const frame::OrientedPatch* patches, int count, const light::ShRgb& ambient,
+                           const std::vector<LightDesc>& lights, const glm::vec3& centre, const glm::vec3& base);
 
 class EnvironmentOcclusion {
  public:

@@ -31,12 +31,15 @@ const KnobField<BaselineLevel> kBaselineKnobs[] = {
     {"env_occlusion_lights_bounce",
      "what the objects show in place of what they hide includes the shadowed lights' bounce off them (0 = off, 1 = on)",
      &BaselineLevel::env_occlusion_lights_bounce},
+    {"env_occlusion_real_bounce",
+     "the real surfaces round the objects, darkened by them, light the rest of the scene less (0 = off, 1 = on)",
+     &BaselineLevel::env_occlusion_real_bounce},
 };
 
 shading::DirectLightLevel direct_level(const BaselineLevel& l) {
   return {l.shadow_map_size, l.pcf_radius, l.caster_cell_shadow_texels, l.shadowed_estimated_lights,
           {l.env_occlusion_divisor, l.env_occlusion_spheres, l.env_occlusion_regions, l.env_occlusion_near_field,
-           shading::EnvOcclusionLevel{}.near_field_m, l.env_occlusion_lights_bounce}};
+           shading::EnvOcclusionLevel{}.near_field_m, l.env_occlusion_lights_bounce, l.env_occlusion_real_bounce}};
 }
 
 class Baseline final : public Laddered<BaselineLevel> {
@@ -66,7 +69,8 @@ const std::array<BaselineLevel, 4>& baseline_levels() {
     for (size_t i = 0; i < 4; ++i)
       out[i] = {names[i], d[i].shadow_map_size, scales[i], d[i].pcf_radius, d[i].caster_cell_shadow_texels,
                 d[i].shadowed_estimated_lights, d[i].env_occlusion.divisor, d[i].env_occlusion.spheres_per_object,
-                d[i].env_occlusion.regions, d[i].env_occlusion.near_field_steps, d[i].env_occlusion.lights_bounce};
+                d[i].env_occlusion.regions, d[i].env_occlusion.near_field_steps, d[i].env_occlusion.lights_bounce,
+                d[i].env_occlusion.real_bounce_loss};
     return out;
   }();
   return levels;

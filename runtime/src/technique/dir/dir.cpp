@@ -349,6 +349,7 @@ Status Dir::record(const frame::FrameInfo& info, std::vector<std::string>& skipp
   if (slots.env > 0) direct.env_occlusion.spheres_per_object = 0;
   // The VPLs carry the lamps' bounce off the objects: the block's occlusion leaves it out.
   direct.env_occlusion.lights_bounce = false;
+  direct.env_occlusion.real_bounce_loss_lights = false;  // the lamps' VPLs in the objects' shadow are gone
   return direct_->record(info, direct, *light, skipped);
 }
 

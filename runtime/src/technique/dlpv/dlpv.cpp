@@ -193,6 +193,7 @@ Status Dlpv::record(const frame::FrameInfo& info, std::vector<std::string>& skip
     // V^Delta carries the lamps' bounce off the objects: the block's occlusion leaves it out.
     shading::EnvOcclusionLevel occlusion_level = shading::direct_light_levels()[size_t(level.baseline_level)].env_occlusion;
     occlusion_level.lights_bounce = false;
+    occlusion_level.real_bounce_loss_lights = false;
     const auto occlusion = direct_->record_env_occlusion(occlusion_level, skipped);
     made.push.occlusion.x = occlusion.divisor;
     add_merge_pass(made.push, occlusion.image);
@@ -208,6 +209,7 @@ Status Dlpv::record(const frame::FrameInfo& info, std::vector<std::string>& skip
   if (!(made.delta || made.rho)) return direct_->record(info, direct, {}, skipped);
   // The volumes carry the lamps' bounce off the objects: the block's occlusion leaves it out.
   direct.env_occlusion.lights_bounce = false;
+  direct.env_occlusion.real_bounce_loss_lights = false;  // and V^Delta the light the shadows keep from the ground
   shading::VolumeIndirect bounce;
   bounce.real_term = two ? shading::VolumeIndirect::RealTerm::Difference : shading::VolumeIndirect::RealTerm::One;
   bounce.virtual_present = made.rho;

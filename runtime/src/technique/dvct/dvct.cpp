@@ -495,6 +495,7 @@ Status Dvct::record(const frame::FrameInfo& info, std::vector<std::string>& skip
     // The voxels' cones carry the lamps' bounce off the objects: the block's occlusion leaves it out.
     shading::EnvOcclusionLevel occlusion_level = shading::direct_light_levels()[size_t(level.baseline_level)].env_occlusion;
     occlusion_level.lights_bounce = occlusion_level.lights_bounce && !volumes;
+    occlusion_level.real_bounce_loss_lights = occlusion_level.real_bounce_loss_lights && !volumes;
     const auto occlusion = direct_->record_env_occlusion(occlusion_level, skipped);
     params.mode.z = occlusion.divisor;
     add_cone_pass(level, params, specular, occlusion.image);
@@ -503,6 +504,7 @@ Status Dvct::record(const frame::FrameInfo& info, std::vector<std::string>& skip
   shading::DirectLightLevel direct = shading::direct_light_levels()[size_t(level.baseline_level)];
   if (!volumes) return direct_->record(info, direct, {}, skipped);
   direct.env_occlusion.lights_bounce = false;  // the cones carry it
+  direct.env_occlusion.real_bounce_loss_lights = false;  // and the light the shadows keep from the ground
   add_cone_pass(level, params, specular, {});
   return direct_->record(info, direct, shading::ScreenIndirect{indirect_image_, int(std::max(1u, level.trace_divisor))},
                          skipped);
