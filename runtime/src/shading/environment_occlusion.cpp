@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "frame/scene_gpu.h"
+#include "light/probeless.h"
 #include "gpu/pipelines.h"
 #include "gpu/shaders.h"
 #include "shared/occlusion_math.h"
@@ -14,23 +15,12 @@ namespace mrgi::shading {
 namespace {
 
 // Irradiance (W/m^2 per channel) light `l` gives a surface at `at` with unit `normal`, no
-// shadowing; `to_light` the unit direction towards it.
+// shadowing (light::lamp_irradiance at normal incidence times the cosine); `to_light` the unit
+// direction towards it.
 glm::dvec3 light_irradiance(const LightDesc& l, const glm::dvec3& at, const glm::dvec3& normal, glm::dvec3& to_light) {
-  to_light = -glm::dvec3(l.direction);
-  double scale = double(l.intensity);
-  if (l.type != LightType::Directional) {
-    const glm::dvec3 d = glm::dvec3(l.position) - at;
-    const double dist = std::max(glm::length(d), 1e-3);
-    to_light = d / dist;
-    scale /= dist * dist;
-    if (l.type == LightType::Spot) {
-      const float cos_inner = std::cos(glm::radians(l.inner_angle_deg));
-      const float cos_outer = std::cos(glm::radians(l.outer_angle_deg));
-      scale *= double(shader::spot_falloff(float(glm::dot(glm::dvec3(l.direction), -to_light)), cos_outer, cos_inner));
-    }
-  }
-  const double facing = std::max(glm::dot(normal, to_light), 0.0);
-  return std::isfinite(scale) && scale > 0.0 ? glm::dvec3(l.color) * (scale * facing) : glm::dvec3(0.0);
+  const glm::dvec3 normal_incidence = light::lamp_irradiance(l, at, to_light);  // sets to_light first
+  const glm::dvec3 e = normal_incidence * std::max(glm::dot(normal, to_light), 0.0);
+  return std::isfinite(e.x + e.y + e.z) ? glm::max(e, glm::dvec3(0.0)) : glm::dvec3(0.0);
 }
 
 // Directions spread evenly over the sphere (a Fibonacci lattice, +y the axis) with their SH
@@ -43,11 +33,8 @@ struct FluxDirections {
 const FluxDirections& flux_directions() {
   static const FluxDirections d = [] {
     FluxDirections out{};
-    const double golden = M_PI * (3.0 - std::sqrt(5.0));
     for (size_t i = 0; i < kFluxDirections; ++i) {
-      const double y = 1.0 - (2.0 * double(i) + 1.0) / double(kFluxDirections);
-      const double r = std::sqrt(std::max(1.0 - y * y, 0.0)), phi = golden * double(i);
-      out.w[i] = glm::dvec3(r * std::cos(phi), y, r * std::sin(phi));
+      out.w[i] = light::fibonacci_direction(int(i), int(kFluxDirections));
       const shader::SH16 b = shader::sh_basis16(glm::vec3(out.w[i]));
       for (int k = 0; k < 16; ++k) out.basis[i][size_t(k)] = double(shader::sh_get(b, k));
     }
