@@ -30,7 +30,9 @@ struct Vpl {
   vec4 lobe;      // xyz unit direction its light arrived from; w the lobe's roughness, < 0 none
                   // (a diffuse VPL: every real surface's, the paper's real specular is 0)
   vec4 specular;  // rgb Phi_in F0 (W), w Phi_in's luminance (W), as flux divided by the
-                  // probability of drawing it (vpl_math.h vpl_glossy_split); 0 without a lobe
+                  // probability of drawing it (vpl_math.h vpl_glossy_split); 0 without a lobe.
+                  // Directional: x its part j, y the parts n of its region (n <= 1: whole):
+                  // it shades the interleaving block's pixels of class j mod n, times n
 };
 
 #ifdef __cplusplus

@@ -85,10 +85,20 @@ void main() {
     int first = params.vpls.w > 1 ? (texel.x % params.vpls.w) + params.vpls.w * (texel.y % params.vpls.w) : 0;
     // The lamps' and the bounce's VPLs interleaved, each standing for `step` (the merge
     // averages the block); the environment's (slots [extent.w, count): the direct light of the
-    // environment, the dominant term where it shines) at every pixel, each for itself.
+    // environment, the dominant term where it shines) at every pixel, each for itself, or,
+    // a region split into parts, each part at its class of the block for all of them.
     int environment = min(params.extent.w, count);
     for (int k = 0; k < 2; ++k) {
       int begin = k == 0 ? first : environment, end = k == 0 ? environment : count, stride = k == 0 ? step : 1;
+      if (k == 1 && environment < count) {
+        // The regions split into parts (common/vpl.glsl; every region alike, region-major):
+        // a real pixel takes its class's part of each, for all of them.
+        int parts = max(int(vpls[environment].specular.y), 1);
+        if (parts > 1 && !is_virtual) {
+          begin = environment + first % parts;
+          stride = parts;
+        }
+      }
       float weight = float(stride);
       for (int j = begin; j < end; j += stride) {
         Vpl v = vpls[j];

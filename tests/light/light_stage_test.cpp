@@ -4,6 +4,7 @@
 // and the probeless estimate of a rendered room corner (direction and colour of its sun).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <optional>
 #include <random>
@@ -111,6 +112,72 @@ TEST(EnvSampler, MedianCutConservesEnergyAndFindsTheSun) {
   // indivisible cells.
   for (size_t k = 1; k < s->lights().size(); ++k)
     EXPECT_LE(luminance(s->lights()[k].irradiance), luminance(top.irradiance) + 1e-9);
+}
+
+TEST(EnvSampler, SplitLightCarriesTheCutOnInsideItsRegion) {
+  const Sky sky;
+  auto s = EnvSampler::create({});
+  ASSERT_TRUE(s.ok()) << s.error().message;
+  ASSERT_TRUE(s->update(sky.image(), EnvCamera{}, glm::dquat(1, 0, 0, 0)).ok());
+  std::array<EnvPart, 4> parts{};
+  double widest = 0.0;
+  for (size_t k = 0; k < s->lights().size(); ++k) {
+    const EnvLight& l = s->lights()[k];
+    ASSERT_EQ(s->split_light(k, 4, parts.data()), 4);
+    glm::dvec3 sum(0.0);
+    double solid = 0.0, spread = 0.0;
+    for (const EnvPart& p : parts) {
+      sum += p.irradiance;
+      solid += p.solid_angle_sr;
+      spread = std::max(spread, angle_deg(p.direction, l.direction));
+    }
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(sum[c], l.irradiance[c], 1e-9 * (1.0 + l.irradiance[c])) << k;
+    EXPECT_NEAR(solid, l.solid_angle_sr, 1e-9) << k;
+    if (l.solid_angle_sr > 0.5) widest = std::max(widest, spread);
+  }
+  // A broad region's parts spread over it (the point of splitting it): the sky's broad regions
+  // span tens of degrees.
+  EXPECT_GT(widest, 5.0);
+  // The halving is the cut's: a uniform environment as one region falls into four lunes of 90
+  // degrees of azimuth, equal in light, their lights on the horizon 90 degrees apart.
+  ImageRGBF uniform = sky.image();
+  for (float& v : uniform.data) v = 1.0f;
+  EnvSamplerSettings one;
+  one.samples = 1;
+  auto u = EnvSampler::create(one);
+  ASSERT_TRUE(u.ok());
+  ASSERT_TRUE(u->update(uniform, EnvCamera{}, glm::dquat(1, 0, 0, 0)).ok());
+  ASSERT_EQ(u->lights().size(), 1u);
+  ASSERT_EQ(u->split_light(0, 4, parts.data()), 4);
+  const double each = luminance(u->lights()[0].irradiance) / 4.0;
+  for (size_t i = 0; i < parts.size(); ++i) {
+    EXPECT_NEAR(luminance(parts[i].irradiance), each, 1e-6 * each) << i;
+    EXPECT_NEAR(parts[i].direction.y, 0.0, 1e-6) << i;
+    EXPECT_NEAR(parts[i].solid_angle_sr, kPi, 1e-6) << i;
+    for (size_t j = 0; j < i; ++j) EXPECT_GT(angle_deg(parts[i].direction, parts[j].direction), 89.0) << i << " " << j;
+  }
+  // A single cell stands for every part, with an equal share of its light: a cut of more
+  // regions than the grid has cells leaves some at one cell (the polar row's cells: 0.230 sr).
+  EnvSamplerSettings cells;
+  cells.grid_width = 8;
+  cells.samples = 64;
+  auto c = EnvSampler::create(cells);
+  ASSERT_TRUE(c.ok()) << c.error().message;
+  ASSERT_TRUE(c->update(sky.image(), EnvCamera{}, glm::dquat(1, 0, 0, 0)).ok());
+  size_t cell = 0;
+  for (size_t k = 1; k < c->lights().size(); ++k)
+    if (c->lights()[k].solid_angle_sr < c->lights()[cell].solid_angle_sr) cell = k;
+  const EnvLight& single = c->lights()[cell];
+  ASSERT_NEAR(single.solid_angle_sr, 2.0 * kPi * (1.0 - std::sqrt(0.5)) / 8.0, 1e-3);
+  ASSERT_EQ(c->split_light(cell, 4, parts.data()), 4);
+  for (const EnvPart& p : parts) {
+    EXPECT_LT(angle_deg(p.direction, single.direction), 1e-6);
+    EXPECT_NEAR(luminance(p.irradiance), 0.25 * luminance(single.irradiance), 1e-9 * luminance(single.irradiance));
+  }
+  // Refused: a count not a power of two, a light that is not there.
+  EXPECT_EQ(s->split_light(0, 3, parts.data()), 0);
+  EXPECT_EQ(s->split_light(0, 0, parts.data()), 0);
+  EXPECT_EQ(s->split_light(s->lights().size(), 4, parts.data()), 0);
 }
 
 TEST(EnvSampler, LightsStayPutUnderFrameNoise) {

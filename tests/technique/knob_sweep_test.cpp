@@ -69,6 +69,8 @@ TEST(KnobSweep, RefusedKnobsNameThemselves) {
       {"dir", {"ism_size", 48}, "power of two"},
       {"dir", {"rsm_lamps", 1.5}, "whole number"},
       {"dir", {"bounce_vpls", 64}, "must be below vpls"},  // at the fastest level, vpls 16
+      {"dir", {"env_parts", 8}, "outside 1..4"},
+      {"dir", {"env_parts", 3}, "power of two"},
       {"baseline", {"vpls", 64}, "has no such knob"},
       {"dlpv", {"volume_cells", -1}, "outside 8..32"},
       {"ssrt", {"directions", std::nan("")}, "outside"},

@@ -1,6 +1,7 @@
 #include "light/env_sampler.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -173,6 +174,61 @@ Status EnvSampler::update(const ImageRGBF& image, const EnvCamera& camera,
   return ok_status();
 }
 
+double EnvSampler::rect_energy(const RegionRect& r) const {
+  const size_t stride = size_t(settings_.grid_width + 1);
+  auto sat = [&](int x, int y) { return energy_sat_[size_t(y) * stride + size_t(x)]; };
+  return sat(r.x1, r.y1) - sat(r.x0, r.y1) - sat(r.x1, r.y0) + sat(r.x0, r.y0);
+}
+
+bool EnvSampler::split_rect(const RegionRect& r, RegionRect& a, RegionRect& b) const {
+  const int nx = r.x1 - r.x0, ny = r.y1 - r.y0;
+  if (nx == 1 && ny == 1) return false;
+  // Angular extents: a row of cells narrows with sin(theta) towards the poles (Debevec's
+  // cos(latitude) scaling of the width).
+  const int h = grid_height();
+  const double mid_theta = kPi * 0.5 * (r.y0 + r.y1) / h;
+  const double width = nx * (2.0 * kPi / settings_.grid_width) * std::sin(mid_theta), height = ny * (kPi / h);
+  const bool split_x = ny == 1 || (nx > 1 && width >= height);
+  const int lo = split_x ? r.x0 : r.y0, hi = split_x ? r.x1 : r.y1;
+  const double total = rect_energy(r);
+  int at = (lo + hi) / 2;
+  if (total > 0.0) {
+    double best = 1e300;
+    for (int k = lo + 1; k < hi; ++k) {
+      const double part = split_x ? rect_energy({r.x0, k, r.y0, r.y1}) : rect_energy({r.x0, r.x1, r.y0, k});
+      const double diff = std::abs(part - 0.5 * total);
+      if (diff < best) {
+        best = diff;
+        at = k;
+      }
+    }
+  }
+  a = split_x ? RegionRect{r.x0, at, r.y0, r.y1} : RegionRect{r.x0, r.x1, r.y0, at};
+  b = split_x ? RegionRect{at, r.x1, r.y0, r.y1} : RegionRect{r.x0, r.x1, at, r.y1};
+  return true;
+}
+
+// The region's light: its irradiance and solid angle summed, at its energy-weighted mean
+// direction (the rect's centre when it holds none).
+void EnvSampler::collapse(const RegionRect& r, EnvLight& l, bool with_sh) const {
+  const int w = settings_.grid_width;
+  glm::dvec3 moment(0.0);
+  for (int y = r.y0; y < r.y1; ++y) {
+    for (int x = r.x0; x < r.x1; ++x) {
+      const size_t c = size_t(y) * w + x;
+      l.irradiance += radiance_[c] * cell_solid_angle_[c];
+      l.solid_angle_sr += cell_solid_angle_[c];
+      if (luminance(radiance_[c]) > 0.0) l.lit_solid_angle_sr += cell_solid_angle_[c];
+      moment += moment_[c];
+      if (with_sh)
+        for (int i = 0; i < kMaxShCoeffs; ++i) l.region_sh[size_t(i)] += radiance_[c] * double(cell_sh_[c][size_t(i)]);
+    }
+  }
+  const double len = glm::length(moment);
+  l.direction = len > 0.0 && std::isfinite(len) ? moment / len
+                                                : cell_direction(0.5 * (r.x0 + r.x1), 0.5 * (r.y0 + r.y1));
+}
+
 void EnvSampler::cut() {
   const int w = settings_.grid_width, h = grid_height();
   // Summed-area table of the energy (luminance x solid angle) for O(1) region sums.
@@ -185,45 +241,18 @@ void EnvSampler::cut() {
       sat(x + 1, y + 1) = sat(x + 1, y) + row;
     }
   }
-  auto energy = [&](int x0, int x1, int y0, int y1) {
-    return sat(x1, y1) - sat(x0, y1) - sat(x1, y0) + sat(x0, y0);
-  };
   regions_.clear();
   regions_.push_back({0, w, 0, h});
   for (int level = 1; level < settings_.samples; level *= 2) {
     next_regions_.clear();
     for (const RegionRect& r : regions_) {
-      const int nx = r.x1 - r.x0, ny = r.y1 - r.y0;
-      if (nx == 1 && ny == 1) {
+      RegionRect a{}, b{};
+      if (!split_rect(r, a, b)) {
         next_regions_.push_back(r);
         continue;
       }
-      // Angular extents: a row of cells narrows with sin(theta) towards the poles (Debevec's
-      // cos(latitude) scaling of the width).
-      const double mid_theta = kPi * 0.5 * (r.y0 + r.y1) / h;
-      const double width = nx * (2.0 * kPi / w) * std::sin(mid_theta), height = ny * (kPi / h);
-      const bool split_x = ny == 1 || (nx > 1 && width >= height);
-      const int lo = split_x ? r.x0 : r.y0, hi = split_x ? r.x1 : r.y1;
-      const double total = energy(r.x0, r.x1, r.y0, r.y1);
-      int at = (lo + hi) / 2;
-      if (total > 0.0) {
-        double best = 1e300;
-        for (int k = lo + 1; k < hi; ++k) {
-          const double part = split_x ? energy(r.x0, k, r.y0, r.y1) : energy(r.x0, r.x1, r.y0, k);
-          const double diff = std::abs(part - 0.5 * total);
-          if (diff < best) {
-            best = diff;
-            at = k;
-          }
-        }
-      }
-      if (split_x) {
-        next_regions_.push_back({r.x0, at, r.y0, r.y1});
-        next_regions_.push_back({at, r.x1, r.y0, r.y1});
-      } else {
-        next_regions_.push_back({r.x0, r.x1, r.y0, at});
-        next_regions_.push_back({r.x0, r.x1, at, r.y1});
-      }
+      next_regions_.push_back(a);
+      next_regions_.push_back(b);
     }
     std::swap(regions_, next_regions_);
   }
@@ -235,18 +264,7 @@ void EnvSampler::cut() {
   lights_.clear();
   for (const RegionRect& r : regions_) {
     EnvLight l;
-    glm::dvec3 moment(0.0);
-    for (int y = r.y0; y < r.y1; ++y) {
-      for (int x = r.x0; x < r.x1; ++x) {
-        const size_t c = size_t(y) * w + x;
-        l.irradiance += radiance_[c] * cell_solid_angle_[c];
-        l.solid_angle_sr += cell_solid_angle_[c];
-        if (luminance(radiance_[c]) > 0.0) l.lit_solid_angle_sr += cell_solid_angle_[c];
-        moment += moment_[c];
-        for (int i = 0; i < kMaxShCoeffs; ++i)
-          l.region_sh[size_t(i)] += radiance_[c] * double(cell_sh_[c][size_t(i)]);
-      }
-    }
+    collapse(r, l, true);
     double brightest = -1.0;
     for (int y = r.y0; y < r.y1; ++y)
       for (int x = r.x0; x < r.x1; ++x) {
@@ -256,10 +274,6 @@ void EnvSampler::cut() {
           l.source_solid_angle_sr = cell_source_[c] >= 0 ? source_solid_angle_[size_t(cell_source_[c])] : 0.0;
         }
       }
-    const double len = glm::length(moment);
-    l.direction = len > 0.0 && std::isfinite(len)
-                      ? moment / len
-                      : cell_direction(0.5 * (r.x0 + r.x1), 0.5 * (r.y0 + r.y1));
     lights_.push_back(l);
   }
   // Strongest first; light_rects_ follows the same order.
@@ -273,6 +287,42 @@ void EnvSampler::cut() {
   std::stable_sort(lights_.begin(), lights_.end(), [](const EnvLight& a, const EnvLight& b) {
     return luminance(a.irradiance) > luminance(b.irradiance);
   });
+}
+
+int EnvSampler::split_light(size_t index, int parts, EnvPart* out) const {
+  if (index >= light_rects_.size() || parts < 1 || (parts & (parts - 1)) != 0) return 0;
+  // Breadth-first halving of the region, as the cut's: rects[0, n) each with its share of the
+  // region's light (1, or halved where a single cell stands in for both halves). A fixed array:
+  // nothing is allocated per frame.
+  constexpr int kMost = 64;
+  parts = std::min(parts, kMost);
+  std::array<RegionRect, kMost> rects{};
+  std::array<double, kMost> share{};
+  rects[0] = light_rects_[index];
+  share[0] = 1.0;
+  for (int n = 1; n < parts; n *= 2) {
+    for (int i = n - 1; i >= 0; --i) {
+      RegionRect a{}, b{};
+      if (split_rect(rects[size_t(i)], a, b)) {
+        rects[size_t(2 * i)] = a;
+        rects[size_t(2 * i + 1)] = b;
+        share[size_t(2 * i + 1)] = share[size_t(i)];
+      } else {
+        rects[size_t(2 * i + 1)] = rects[size_t(i)];
+        rects[size_t(2 * i)] = rects[size_t(i)];
+        share[size_t(2 * i + 1)] = share[size_t(i)] *= 0.5;
+      }
+      share[size_t(2 * i)] = share[size_t(i)];
+    }
+  }
+  for (int i = 0; i < parts; ++i) {
+    EnvLight l;
+    collapse(rects[size_t(i)], l, false);
+    out[i].direction = l.direction;
+    out[i].irradiance = l.irradiance * share[size_t(i)];
+    out[i].solid_angle_sr = l.solid_angle_sr * share[size_t(i)];
+  }
+  return parts;
 }
 
 void EnvSampler::sources_outside(const std::vector<size_t>& excluded, size_t count, std::vector<EnvSource>& out) const {

@@ -70,6 +70,14 @@ struct EnvSource {
   ShRgb sh{};                           // radiance SH (4 bands) of its cells
 };
 
+// A part of a region (EnvSampler::split_light): a sub-region of equal energy collapsed to a
+// directional light.
+struct EnvPart {
+  glm::dvec3 direction{0.0, 1.0, 0.0};  // unit, world, towards the light
+  glm::dvec3 irradiance{0.0};           // W/m^2 per linear RGB channel at normal incidence
+  double solid_angle_sr = 0.0;          // of its cells
+};
+
 class EnvSampler {
  public:
   // BadUsage naming the field when a setting is out of range.
@@ -93,6 +101,12 @@ class EnvSampler {
   // as lights apart), strongest (luminance of the irradiance) first, at most `count`; `out` is
   // cleared first (reserve it: nothing is allocated when it holds `count`).
   void sources_outside(const std::vector<size_t>& excluded, size_t count, std::vector<EnvSource>& out) const;
+  // Light `index` (into lights()) as `parts` lights (a power of two, at most 64), by carrying
+  // the median cut on inside its region: equal-energy parts at their own mean directions, whose
+  // irradiances add up to the light's; a single cell that cannot be halved again stands for both
+  // halves with half its light each. For a broad region drawn as several shadowed lights (soft
+  // shadows), not one. Written to out[0, parts); returns parts (0 for a bad index or count).
+  int split_light(size_t index, int parts, EnvPart* out) const;
   // Radiance SH (4 bands) of the whole filtered grid.
   const ShRgb& radiance_sh() const { return sh_; }
   // Mean luminance of the radiance over the cells holding light (what the image saw), 0 when
@@ -143,6 +157,11 @@ class EnvSampler {
     int x0, x1, y0, y1;
   };
   std::vector<RegionRect> regions_, next_regions_;
+  // The cut's tools: a rect's energy (from energy_sat_, as of the last cut), its median split
+  // (false for a single cell), and its light (region_sh only with `with_sh`).
+  double rect_energy(const RegionRect& r) const;
+  bool split_rect(const RegionRect& r, RegionRect& a, RegionRect& b) const;
+  void collapse(const RegionRect& r, EnvLight& l, bool with_sh) const;
   std::vector<RegionRect> light_rects_;        // lights_'s regions, in lights_'s order
   std::vector<size_t> light_order_;            // cut()'s sort of the regions by luminance
   std::vector<double> cell_solid_angle_;       // grid geometry

@@ -22,11 +22,11 @@ namespace mrgi::technique {
 
 const std::array<DirLevel, 5>& dir_levels() {
   static const std::array<DirLevel, 5> levels = {{
-      {"paper", 256, 64, 16, 128, 1024, 512, 4, 4, 1, 1.0f, 0.0f, -1, 0, true},
-      {"high", 256, 64, 0, 64, 512, 256, 4, 4, 1, 1.0f, 0.0f, -1, 0, false},
-      {"medium", 64, 16, 0, 64, 512, 256, 2, 4, 1, 1.0f, 0.0f, -1, 1, false},
-      {"fast", 32, 0, 0, 32, 256, 64, 1, 4, 2, 0.5f, 0.5f, 0, 3, false},
-      {"fastest", 16, 0, 0, 32, 128, 64, 1, 4, 2, 0.5f, 0.5f, 0, 3, false},
+      {"paper", 256, 64, 16, 4, 128, 1024, 512, 4, 4, 1, 1.0f, 0.0f, -1, 0, true},
+      {"high", 256, 64, 0, 1, 64, 512, 256, 4, 4, 1, 1.0f, 0.0f, -1, 0, false},
+      {"medium", 64, 16, 0, 1, 64, 512, 256, 2, 4, 1, 1.0f, 0.0f, -1, 1, false},
+      {"fast", 32, 0, 0, 1, 32, 256, 64, 1, 4, 2, 0.5f, 0.5f, 0, 3, false},
+      {"fastest", 16, 0, 0, 1, 32, 128, 64, 1, 4, 2, 0.5f, 0.5f, 0, 3, false},
   }};
   return levels;
 }
@@ -36,6 +36,8 @@ const KnobField<DirLevel> kDirKnobs[] = {
     {"vpls", "virtual point lights", &DirLevel::vpls},
     {"bounce_vpls", "of them, the bounce light source's (0: one bounce)", &DirLevel::bounce_vpls},
     {"env_vpls", "of them, at most this many environment regions' (directional VPLs)", &DirLevel::env_vpls},
+    {"env_parts", "VPLs each environment region is split into (at most interleave^2; interleaved)",
+     &DirLevel::env_parts, true},
     {"ism_size", "texels per side of each VPL's imperfect shadow maps", &DirLevel::ism_size, true},
     {"points_per_vpl", "points splatted into each of a VPL's two maps", &DirLevel::points_per_vpl},
     {"rsm_size", "texels per side of each reflective shadow map", &DirLevel::rsm_size, true},
@@ -54,6 +56,9 @@ const KnobField<DirLevel> kDirKnobs[] = {
 };
 }  // namespace
 
+// Environment VPLs allocated (the most any level places: regions times parts).
+constexpr uint32_t kMaxEnvVpls = 64;
+
 Expected<std::vector<DirLevel>> dir_levels(const std::vector<KnobSetting>& knobs) {
   auto levels = apply_knobs<DirLevel>("dir", dir_levels(), kDirKnobs, knobs);
   if (!levels) return levels;
@@ -62,6 +67,14 @@ Expected<std::vector<DirLevel>> dir_levels(const std::vector<KnobSetting>& knobs
       return fail(ErrorKind::BadUsage, std::string("dir level ") + l.name + ": bounce_vpls " +
                                            std::to_string(l.bounce_vpls) + " must be below vpls " +
                                            std::to_string(l.vpls) + " (the lamps keep at least one VPL)");
+  for (const DirLevel& l : *levels) {
+    const uint32_t p = l.env_parts;
+    if (p == 0 || p > std::max(1u, l.interleave * l.interleave) || p > kMaxEnvVpls)
+      return fail(ErrorKind::BadUsage, std::string("dir level ") + l.name + ": env_parts " + std::to_string(p) +
+                                           " must be at most interleave^2 (" +
+                                           std::to_string(l.interleave * l.interleave) +
+                                           "): each part shades one class of the interleaving block");
+  }
   return levels;
 }
 
@@ -89,8 +102,6 @@ constexpr float kIsmBiasRelative = 0.05f, kIsmBiasMetres = 0.01f;
 // Frames the bounce runs on still inputs before the VPLs are reused: each adds a bounce to the
 // last (the light of the lamps' VPLs, then 2, 3, 4 bounces: a path tracer's depth 5).
 constexpr int kBounceGenerations = 3;
-// Environment VPLs allocated (the most any level places).
-constexpr uint32_t kMaxEnvVpls = 16;
 // Temporal smoothing (shaders/dir/temporal.comp): the share of the history kept at full
 // confidence (a time constant of about 1 / (1 - 0.8) = 5 frames, the flicker of a VPL set
 // averaged over that many), and the relative luminance change where the confidence starts to
@@ -117,9 +128,11 @@ class Dir final : public Laddered<DirLevel> {
   Status create_gi_blocks(uint32_t top_vpls, uint32_t top_ism, uint32_t top_rsm, uint32_t top_bounce);
   // The VPL buffer's slots this frame (the lamps' VPLs take the rest).
   struct VplSlots {
-    uint32_t bounce = 0, env = 0;  // bounce VPLs, environment VPLs
-    // The light stage's regions (indices into environment_regions()) with an environment VPL,
-    // env of them: every region without a shadow map, strongest first.
+    uint32_t bounce = 0, env = 0;  // bounce VPLs, environment VPLs (regions x parts)
+    // The light stage's regions (indices into environment_regions()) with environment VPLs,
+    // `regions` of them: every region without a shadow map, strongest first; each drawn as
+    // `parts` VPLs (DirLevel::env_parts).
+    uint32_t regions = 0, parts = 1;
     std::array<uint32_t, kMaxEnvVpls> region{};
     bool env_override = false;     // the level's shadowed_env holds: the VPLs shadow the regions
   };
@@ -375,11 +388,14 @@ Dir::VplSlots Dir::plan_vpl_slots(const DirLevel& level, int level_shadowed) {
   const int map_shadowed = slots.env_override ? level.shadowed_env : level_shadowed;
   const std::vector<size_t>& with_lights = shared_.light_stage->shadowed_environment_regions();
   shadowed = std::min(shadowed, size_t(std::max(0, map_shadowed)));
+  slots.parts = level.interleave > 1 ? level.env_parts : 1u;  // parts need the interleaving block
   const uint32_t most = ablation_.no_environment_vpls
                             ? 0u
-                            : std::min({level.env_vpls, kMaxEnvVpls, level.vpls - slots.bounce - 1});
-  slots.env = environment_vpl_regions(regions.size(), with_lights, shadowed, most, slots.region.data());
-  for (uint32_t k = 0; k < slots.env; ++k) {
+                            : std::min({level.env_vpls, kMaxEnvVpls / slots.parts,
+                                        (level.vpls - slots.bounce - 1) / slots.parts});
+  slots.regions = environment_vpl_regions(regions.size(), with_lights, shadowed, most, slots.region.data());
+  slots.env = slots.regions * slots.parts;
+  for (uint32_t k = 0; k < slots.regions; ++k) {
     LightDesc l;
     l.type = LightType::Directional;
     l.direction = glm::vec3(-regions[slots.region[k]].direction);
@@ -429,10 +445,21 @@ Status Dir::make_vpls(const frame::FrameInfo& info, const DirLevel& level, const
     auto* env = static_cast<shader::Vpl*>(graph.mapped(env_vpls_, graph.slot()));
     const float flags = float(MRGI_VPL_VALID | MRGI_VPL_DIRECTIONAL |
                               (shared_.light_stage->environment_real() ? MRGI_VPL_REAL_PATH : 0));
-    for (uint32_t k = 0; k < slots.env; ++k) {
+    // Each region as slots.parts equal-energy parts over its extent, part j shading the
+    // interleaving block's class j (common/vpl.glsl: specular.xy of a directional VPL).
+    const light::EnvSampler* sampler = shared_.light_stage->environment_grid();
+    std::array<light::EnvPart, kMaxEnvVpls> parts{};
+    for (uint32_t k = 0; k < slots.regions; ++k) {
       const light::EnvLight& r = regions[slots.region[k]];
-      env[k] = {glm::vec4(centre_, flags), glm::vec4(glm::vec3(r.direction), radius_), glm::vec4(glm::vec3(r.irradiance), 0.0f),
-                glm::vec4(0.0f, 0.0f, 1.0f, -1.0f), glm::vec4(0.0f)};
+      if (slots.parts == 1 || sampler == nullptr ||
+          sampler->split_light(slots.region[k], int(slots.parts), parts.data()) != int(slots.parts)) {
+        for (uint32_t j = 0; j < slots.parts; ++j) parts[j] = {r.direction, r.irradiance, r.solid_angle_sr / slots.parts};
+        for (uint32_t j = 0; j < slots.parts; ++j) parts[j].irradiance /= double(slots.parts);
+      }
+      for (uint32_t j = 0; j < slots.parts; ++j)
+        env[k * slots.parts + j] = {glm::vec4(centre_, flags), glm::vec4(glm::vec3(parts[j].direction), radius_),
+                                    glm::vec4(glm::vec3(parts[j].irradiance), 0.0f), glm::vec4(0.0f, 0.0f, 1.0f, -1.0f),
+                                    glm::vec4(float(j), float(slots.parts), 0.0f, 0.0f)};
     }
     MRGI_TRY(vpls_->add_copy(graph, "environment", env_vpls_, lamp_vpls + slots.bounce, slots.env));
   }

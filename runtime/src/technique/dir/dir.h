@@ -117,6 +117,11 @@ struct DirLevel {
   uint32_t vpls;            // VPL slots shaded
   uint32_t bounce_vpls;     // of them, the bounce light source's (0: one bounce)
   uint32_t env_vpls;        // of them, at most this many environment regions' (directional)
+  // VPLs each of those regions is drawn as (a power of two, at most interleave^2): its light
+  // split into equal-energy parts over its extent (light::EnvSampler::split_light), each part
+  // shading one of that many classes of the interleaving block with the light of all (the merge
+  // averages them), so a broad region casts a soft shadow at the cost of one VPL a pixel.
+  uint32_t env_parts;
   uint32_t ism_size;        // texels per side of each VPL's imperfect shadow maps
   uint32_t points_per_vpl;  // points splatted into each of a VPL's two maps
   uint32_t rsm_size;        // texels per side of each reflective shadow map
