@@ -154,6 +154,16 @@ struct EntrySamples {
     }
     return v;
   }
+  // kSchedulerMetric of every answer of one side (NaN where an answer lacks the counts).
+  std::vector<double> frames_per_frame_within_budget(int side) const {
+    std::vector<double> v;
+    for (const json& a : answers[side]) {
+      const bool has = a.contains("budget_frames") && a.contains("within_budget_frames");
+      v.push_back(has ? (a["budget_frames"].get<double>() + 2.0) / (a["within_budget_frames"].get<double>() + 1.0)
+                      : std::nan(""));
+    }
+    return v;
+  }
   // A pass's fastest profiled frame over the rest of the measurement's passes (each by its
   // fastest frame) for every answer of one side, NaN where the pass is missing: the machine
   // speeding up or slowing down between measurements moves a pass and the rest of its frame
@@ -183,6 +193,12 @@ void add_quantities(const AbEntry& entry, const EntrySamples& es, const AbSettin
     q.judgement = judge_pairs(entry.scene + "/" + entry.technique + "/" + es.level_name + " " + metric, b, c, s.rule);
     out.push_back(std::move(q));
   };
+  if (entry.level == "auto") {
+    // The scheduler holds the frame time by trading quality: its time says nothing; its share
+    // of frames within the budget does (kSchedulerMetric).
+    add(kSchedulerMetric, es.frames_per_frame_within_budget(0), es.frames_per_frame_within_budget(1));
+    return;
+  }
   add("sustained_ms", es.series(0, "sustained_ms"), es.series(1, "sustained_ms"));
   add("cpu_ms", es.series(0, "cpu_ms"), es.series(1, "cpu_ms"));
   std::vector<double> frame = es.series(0, "profiled_ms");
@@ -270,6 +286,12 @@ Expected<AbResult> run_ab_compare(const AbSettings& s) {
     return fail(ErrorKind::BadUsage, "--frames >= 1, --warmup and --profile-frames >= 0");
   // Every entry's technique and level must exist (in this build's registry) before hours of work.
   for (const AbEntry& e : s.entries) {
+    if (e.level == "auto") {
+      auto levels = resolve_levels(e.technique, {"0"});
+      if (!levels.ok())
+        return fail(ErrorKind::BadUsage, "entry " + e.scene + "/" + e.technique + "/auto: " + levels.error().message);
+      continue;
+    }
     auto levels = resolve_levels(e.technique, {e.level});
     if (!levels.ok() || levels->size() != 1)
       return fail(ErrorKind::BadUsage, "entry " + e.scene + "/" + e.technique + "/" + e.level + ": " +
@@ -300,9 +322,15 @@ Expected<AbResult> run_ab_compare(const AbSettings& s) {
   size_t done = 0;
   for (size_t e = 0; e < s.entries.size(); ++e) {
     const AbEntry& entry = s.entries[e];
-    const json request = {{"op", "measure"},       {"suite", s.suite},       {"scene", entry.scene},
-                          {"technique", entry.technique}, {"level", entry.level}, {"frames", s.frames},
-                          {"warmup", s.warmup},    {"profile_frames", s.profile_frames}};
+    const bool scheduled = entry.level == "auto";
+    const json request = {{"op", "measure"},
+                          {"suite", s.suite},
+                          {"scene", entry.scene},
+                          {"technique", entry.technique},
+                          {"level", entry.level},
+                          {"frames", scheduled ? s.scheduler_frames : s.frames},
+                          {"warmup", scheduled ? s.scheduler_warmup : s.warmup},
+                          {"profile_frames", scheduled ? 0 : s.profile_frames}};
     const std::string what = entry.scene + "/" + entry.technique + "/" + entry.level;
     // A first, unrecorded measurement of each: the runtime's creation and first frames.
     for (int pair = -1; pair < s.pairs; ++pair) {

@@ -57,7 +57,8 @@ std::string markdown(const AbResult& r) {
      << "** over " << r.quantities.size() << " quantities.\n\n";
   md << "Base and candidate: medians over the pairs; ms for sustained_ms and cpu_ms, and for a pass its fastest "
         "profiled frame over the rest of the measurement's passes (the machine's drift between measurements "
-        "moves both alike).\n\n";
+        "moves both alike); for the scheduler (level auto) " << kSchedulerMetric << ", (n + 2) / (k + 1) for k of "
+        "n frames within the budget (1.05: 95 %), larger worse as a time is.\n\n";
   md << "| entry | quantity | base (median) | candidate (median) | ratio (median) | 95 % interval | p | Holm p | alarm |\n";
   md << "|---|---|---:|---:|---:|---|---:|---:|---|\n";
   for (const AbQuantity& q : r.quantities) {
@@ -93,7 +94,9 @@ nlohmann::json to_json(const AbResult& r) {
       return o;
     };
     qs.push_back({{"scene", q.scene}, {"technique", q.technique}, {"level", q.level_name}, {"metric", q.metric},
-                  {"unit", q.metric.rfind("pass:", 0) == 0 ? "the pass's fastest profiled frame over the rest of the measurement's passes" : "ms"},
+                  {"unit", q.metric.rfind("pass:", 0) == 0 ? "the pass's fastest profiled frame over the rest of the measurement's passes"
+                           : q.metric == kSchedulerMetric ? "(n + 2) / (k + 1) for k of n frames within the budget"
+                                                          : "ms"},
                   {"base", samples(q.base)}, {"candidate", samples(q.candidate)}, {"pairs", a.pairs},
                   {"median_ratio", a.median_ratio}, {"ratio_low", a.ratio_low}, {"ratio_high", a.ratio_high},
                   {"p", a.p_value}, {"p_holm", a.p_adjusted}, {"alarm", a.alarm}});

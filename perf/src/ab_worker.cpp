@@ -33,6 +33,7 @@ struct WorkerEntry {
   const LoadedScene* scene = nullptr;
   std::unique_ptr<Runtime> runtime;
   std::string level_name;
+  bool scheduled = false;  // level "auto": the scheduler chooses
   size_t next_frame = 0;  // frames fed so far: the next run continues the capture's timeline
 };
 
@@ -50,14 +51,18 @@ Expected<json> measure(WorkerEntry& e, int frames, int warmup, int profile_frame
   const size_t total = size_t(warmup + frames), count = total + size_t(profile_frames);
   const std::vector<InputFrame> run = preload_run(*e.scene, count, e.next_frame);
   e.next_frame += count;
-  size_t seen = 0;
-  double start_s = -1.0, end_s = -1.0, start_cpu = -1.0;
+  size_t seen = 0, within = 0;
+  double start_s = -1.0, end_s = -1.0, start_cpu = -1.0, level_sum = 0.0;
   auto take = [&](std::vector<FrameOutput>& outs) {
     for (FrameOutput& out : outs) {
       ++seen;
       if (seen == size_t(warmup)) {
         start_s = out.stats.completed_s;
         start_cpu = gpu::process_cpu_ms();
+      }
+      if (seen > size_t(warmup) && seen <= total) {  // the sustained frames: the scheduler's figures
+        within += out.stats.cost_ms <= out.stats.budget_ms ? 1 : 0;
+        level_sum += out.stats.level;
       }
       if (seen == total) end_s = out.stats.completed_s;
       rt.recycle(std::move(out));
@@ -82,6 +87,11 @@ Expected<json> measure(WorkerEntry& e, int frames, int warmup, int profile_frame
                  {"device", rt.device().name},
                  {"sustained_ms", 1000.0 * (end_s - start_s) / double(frames)},
                  {"cpu_ms", (end_cpu - (start_cpu >= 0.0 ? start_cpu : loop_cpu)) / double(frames)}};
+  if (e.scheduled) {
+    answer["budget_frames"] = frames;
+    answer["within_budget_frames"] = within;
+    answer["mean_level"] = level_sum / double(frames);
+  }
   if (profile_frames > 0) {
     MRGI_TRY(rt.set_profiling(true));
     std::map<std::string, std::vector<double>> passes;
@@ -142,7 +152,8 @@ Expected<json> handle(const json& req, std::map<std::string, LoadedScene>& scene
   // both starts alike.
   if (current.key != key || !current.runtime || req.value("fresh", true)) {
     current = WorkerEntry{};
-    auto index = level_index(technique, level);
+    const bool scheduled = level == "auto";
+    auto index = scheduled ? Expected<int>(kAutoLevel) : level_index(technique, level);
     if (!index.ok()) return index.error();
     const LoadedScene& l = loaded->second;
     RuntimeSettings rs;
@@ -156,8 +167,9 @@ Expected<json> handle(const json& req, std::map<std::string, LoadedScene>& scene
     current.runtime = std::move(rt).value();
     current.key = key;
     current.scene = &l;
+    current.scheduled = scheduled;
     const auto names = current.runtime->level_names();
-    current.level_name = size_t(*index) < names.size() ? names[size_t(*index)] : level;
+    current.level_name = !scheduled && size_t(*index) < names.size() ? names[size_t(*index)] : level;
   }
   return measure(current, frames, warmup, profile);
 }

@@ -39,14 +39,18 @@ TEST(AbCompare, ManifestSetsNameRealEntries) {
     auto entries = perf::load_compare_set(manifest, set);
     ASSERT_TRUE(entries.ok()) << entries.error().message;
     std::set<std::string> techniques;
+    int schedulers = 0;
     for (const perf::AbEntry& e : *entries) {
       EXPECT_TRUE(perf::select_scenes(*suite, {e.scene}).ok()) << set << ": " << e.scene;
       auto levels = mrgi::technique_levels(e.technique);
       ASSERT_TRUE(levels.ok()) << e.technique;
-      EXPECT_NE(std::find(levels->begin(), levels->end(), e.level), levels->end()) << e.technique << " " << e.level;
+      if (e.level != "auto")  // the scheduler's entry
+        EXPECT_NE(std::find(levels->begin(), levels->end(), e.level), levels->end()) << e.technique << " " << e.level;
+      schedulers += e.level == "auto" ? 1 : 0;
       techniques.insert(e.technique);
     }
     EXPECT_EQ(techniques.size(), mrgi::technique_names().size()) << set;
+    EXPECT_EQ(schedulers, 1) << set << ": the scheduler's share on the sample (desk_spot)";
   }
 }
 
@@ -100,6 +104,31 @@ TEST(AbCompare, BuildAgainstItselfWritesTheReport) {
   std::stringstream md;
   md << std::ifstream(out / "compare.md").rdbuf();
   EXPECT_NE(md.str().find("no quantity of a family"), std::string::npos);  // 2 pairs cannot alarm
+}
+
+// The scheduler's entry (level auto) on the sample: judged by its frames per frame within the
+// budget alone ((n + 2) / (k + 1) of each measurement's n = 40 frames), not by time.
+TEST(AbCompare, SchedulerEntryIsJudgedByItsShareWithinTheBudget) {
+  if (!fs::exists(MRGI_TOOL)) GTEST_SKIP() << "mrgi tool not built at " << MRGI_TOOL;
+  TempDir dir;
+  const fs::path out = fs::path(dir.str()) / "compare";
+  const std::string cmd = std::string("cd ") + MRGI_SOURCE_DIR + " && LP_NUM_THREADS=2 timeout 300 " + MRGI_TOOL +
+                          " bench --compare " + MRGI_TOOL + " --scenes desk_spot --techniques baseline --levels auto --pairs 2 -q -o " +
+                          out.string() + " > " + (fs::path(dir.str()) / "log").string() + " 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << std::ifstream(fs::path(dir.str()) / "log").rdbuf();
+  const nlohmann::json j = nlohmann::json::parse(std::ifstream(out / "compare.json"));
+  ASSERT_EQ(j["quantities"].size(), 1u);
+  const auto& q = j["quantities"][0];
+  EXPECT_EQ(q["metric"], perf::kSchedulerMetric);
+  EXPECT_EQ(q["level"], "auto");
+  for (const char* side : {"base", "candidate"}) {
+    ASSERT_EQ(q[side].size(), 2u) << side;
+    for (const auto& v : q[side]) {
+      ASSERT_TRUE(v.is_number()) << side;
+      EXPECT_GE(v.get<double>(), 42.0 / 41.0) << side;  // all 40 within: (40 + 2) / (40 + 1)
+      EXPECT_LE(v.get<double>(), 42.0) << side;         // none within
+    }
+  }
 }
 
 // A base that does not speak the worker protocol is refused naming it; nothing is written.

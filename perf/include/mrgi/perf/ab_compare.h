@@ -9,13 +9,15 @@
 //
 // The worker protocol (one JSON object per line; the worker answers each request with one
 // line): on start the worker writes {"ok":true,"protocol":1,"device":...,"commit":...}; a
-// request {"op":"measure","suite":PATH,"scene":NAME,"technique":T,"level":NAME_OR_INDEX,
+// request {"op":"measure","suite":PATH,"scene":NAME,"technique":T,"level":NAME_OR_INDEX_OR_auto,
 // "frames":F,"warmup":W,"profile_frames":P,"fresh":true} runs W + F frames back to back (2 in
 // flight) and P frames in profiling mode on a runtime made for the request (its creation not
 // timed; with "fresh":false the entry's runtime is kept while the requests stay on it) and
 // answers {"ok":true,"level_name":...,
 // "sustained_ms":...,"cpu_ms":...,"profiled_ms":...,"passes":{"NAME":median ms,...},
-// "passes_min":{"NAME":fastest frame's ms,...}} or
+// "passes_min":{"NAME":fastest frame's ms,...}} (level "auto": also "budget_frames" and
+// "within_budget_frames", the sustained frames and those whose cost was within the budget, and
+// "mean_level", the scheduler's mean level index over them) or
 // {"ok":false,"error":...}; {"op":"quit"} ends it.
 #pragma once
 #include <functional>
@@ -30,7 +32,8 @@
 namespace mrgi::perf {
 
 // One entry of a comparison: a suite scene at one technique's level (a name, an index or
-// "last").
+// "last"), or "auto": the frame-budget scheduler choosing the level (kAutoLevel, the default
+// budget), judged by its share of frames within the budget (kSchedulerMetric), not by time.
 struct AbEntry {
   std::string scene, technique, level;
 };
@@ -53,6 +56,10 @@ struct AbSettings {
   int pairs = 14;                    // measurements of each build per entry (see min_pairs_for)
   int frames = 8, warmup = 2;        // per measurement: sustained frames after warm-up frames
   int profile_frames = 6;            // per measurement: profiling-mode frames (0 = no pass judged)
+  // Per measurement of an "auto" entry: frames whose cost is compared with the budget, after
+  // warm-up frames in which the scheduler settles from its priors (no profiling-mode frames:
+  // they would time the passes apart and mislead it).
+  int scheduler_frames = 40, scheduler_warmup = 10;
   // Passes judged: those taking at least this share of the base's profiled frame (below it a
   // pass's time is mostly noise and the family grows for nothing).
   double pass_min_share = 0.10;
@@ -60,6 +67,12 @@ struct AbSettings {
   AbRule rule;
   std::function<void(const std::string&, size_t, size_t, double)> progress;  // optional
 };
+
+// The quantity an "auto" entry is judged by: frames run per frame within the budget, (n + 2) /
+// (k + 1) for k of n frames within it (1.05: 95 % within; Laplace's +1 keeps a run with none
+// within finite). Larger is worse, as a time is, so the same rule judges it: a candidate whose
+// scheduler holds the budget in fewer frames alarms.
+inline constexpr const char* kSchedulerMetric = "frames_per_frame_within_budget";
 
 // One judged quantity with its samples (base[i] and candidate[i] measured one after the other).
 struct AbQuantity {
