@@ -32,7 +32,8 @@ struct Vpl {
   vec4 specular;  // rgb Phi_in F0 (W), w Phi_in's luminance (W), as flux divided by the
                   // probability of drawing it (vpl_math.h vpl_glossy_split); 0 without a lobe.
                   // Directional: x its part j, y the parts n of its region (n <= 1: whole):
-                  // it shades the interleaving block's pixels of class j mod n, times n
+                  // on real pixels it shades the interleaving block's class j, times n (the
+                  // parts stored region by region); virtual pixels take every part
 };
 
 #ifdef __cplusplus
