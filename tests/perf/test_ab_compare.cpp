@@ -44,8 +44,9 @@ TEST(AbCompare, ManifestSetsNameRealEntries) {
       EXPECT_TRUE(perf::select_scenes(*suite, {e.scene}).ok()) << set << ": " << e.scene;
       auto levels = mrgi::technique_levels(e.technique);
       ASSERT_TRUE(levels.ok()) << e.technique;
-      if (e.level != "auto")  // the scheduler's entry
+      if (e.level != "auto") {  // the scheduler's entry
         EXPECT_NE(std::find(levels->begin(), levels->end(), e.level), levels->end()) << e.technique << " " << e.level;
+      }
       schedulers += e.level == "auto" ? 1 : 0;
       techniques.insert(e.technique);
     }
