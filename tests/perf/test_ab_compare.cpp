@@ -126,8 +126,11 @@ TEST(AbCompare, SchedulerEntryIsJudgedByItsShareWithinTheBudget) {
     ASSERT_EQ(q[side].size(), 2u) << side;
     for (const auto& v : q[side]) {
       ASSERT_TRUE(v.is_number()) << side;
-      EXPECT_GE(v.get<double>(), 42.0 / 41.0) << side;  // all 40 within: (40 + 2) / (40 + 1)
-      EXPECT_LE(v.get<double>(), 42.0) << side;         // none within
+      // (40 + 2) / (k + 1) for a whole count k of 0..40 frames within the budget.
+      const double k = 42.0 / v.get<double>() - 1.0;
+      EXPECT_NEAR(k, std::round(k), 1e-9) << side << " " << v;
+      EXPECT_GE(k, -1e-9) << side;
+      EXPECT_LE(k, 40.0 + 1e-9) << side;
     }
   }
 }
