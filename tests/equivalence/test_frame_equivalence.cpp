@@ -18,6 +18,7 @@
 // writes the frames into DIR (then copy the stored frame's files over tests/data/frame_equivalence).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -142,6 +143,40 @@ std::map<std::string, std::vector<double>> read_rde_table(const std::string& pat
 
 double rde_or_nan(const ErrorFigures& f) { return f.rde_defined ? f.rde : std::nan(""); }
 
+// What the check finds in one frame against its record: the pixels more than kLevels off (and
+// whether few enough are), and each RDE (all / real / virtual) moved by more than kRdeTolerance
+// or defined only once.
+struct FrameFindings {
+  size_t off = 0;
+  int worst = 0;
+  bool pixels_match = true;
+  std::vector<std::string> rde_moved;
+};
+
+FrameFindings check_frame(const ImageRGB8& now, const double rde[3], const ImageRGB8& expected,
+                          const std::vector<double>& recorded_rde) {
+  FrameFindings f;
+  for (size_t p = 0; p < now.pixel_count(); ++p) {
+    int d = 0;
+    for (int ch = 0; ch < 3; ++ch)
+      d = std::max(d, std::abs(int(now.data[p * 3 + size_t(ch)]) - int(expected.data[p * 3 + size_t(ch)])));
+    f.worst = std::max(f.worst, d);
+    f.off += d > kLevels ? 1 : 0;
+  }
+  f.pixels_match = 1.0 - double(f.off) / double(now.pixel_count()) >= kPixelShare;
+  const char* set[3] = {"all", "real", "virtual"};
+  for (size_t k = 0; k < 3; ++k) {
+    const double was = recorded_rde[k];
+    if (std::isnan(was) || std::isnan(rde[k])) {
+      if (std::isnan(was) != std::isnan(rde[k])) f.rde_moved.push_back(std::string("RDE ") + set[k] + " defined only once");
+      continue;
+    }
+    if (std::abs(rde[k] - was) > kRdeTolerance)
+      f.rde_moved.push_back(std::string("RDE ") + set[k] + " " + std::to_string(rde[k]) + ", recorded " + std::to_string(was));
+  }
+  return f;
+}
+
 struct Case {
   std::string scene, technique;
 };
@@ -188,31 +223,14 @@ TEST_P(FrameEquivalence, MatchesTheRecordedFrames) {
       ASSERT_TRUE(expected.ok()) << expected.error().message;
       ASSERT_EQ(expected->width, now.image.width);
       ASSERT_EQ(expected->height, now.image.height);
-      size_t off = 0;
-      int worst = 0;
-      for (size_t p = 0; p < now.image.pixel_count(); ++p) {
-        int d = 0;
-        for (int ch = 0; ch < 3; ++ch)
-          d = std::max(d, std::abs(int(now.image.data[p * 3 + size_t(ch)]) - int(expected->data[p * 3 + size_t(ch)])));
-        worst = std::max(worst, d);
-        off += d > kLevels ? 1 : 0;
-      }
-      const double share = 1.0 - double(off) / double(now.image.pixel_count());
-      std::printf("%s %s level %d frame %zu: %zu pixels off by more than %d/255, worst %d\n", c.scene.c_str(),
-                  c.technique.c_str(), level, i, off, kLevels, worst);
-      EXPECT_GE(share, kPixelShare) << "frame " << i << ": " << off << " pixels differ by more than " << kLevels
-                                    << "/255 (worst " << worst << ") from " << path;
       const auto it = recorded_rde.find(std::to_string(level) + " " + std::to_string(i));
       ASSERT_NE(it, recorded_rde.end()) << "no recorded RDE for level " << level << " frame " << i;
-      const char* set[3] = {"all", "real", "virtual"};
-      for (int k = 0; k < 3; ++k) {
-        const double was = it->second[size_t(k)];
-        if (std::isnan(was) || std::isnan(rde[k])) {
-          EXPECT_EQ(std::isnan(was), std::isnan(rde[k])) << "frame " << i << " RDE " << set[k] << " defined only once";
-          continue;
-        }
-        EXPECT_NEAR(rde[k], was, kRdeTolerance) << "frame " << i << " RDE " << set[k];
-      }
+      const FrameFindings f = check_frame(now.image, rde, *expected, it->second);
+      std::printf("%s %s level %d frame %zu: %zu pixels off by more than %d/255, worst %d\n", c.scene.c_str(),
+                  c.technique.c_str(), level, i, f.off, kLevels, f.worst);
+      EXPECT_TRUE(f.pixels_match) << "frame " << i << ": " << f.off << " pixels differ by more than " << kLevels
+                                  << "/255 (worst " << f.worst << ") from " << path;
+      for (const std::string& m : f.rde_moved) ADD_FAILURE() << "frame " << i << " " << m;
     }
   }
   if (record) {
@@ -231,6 +249,69 @@ std::vector<Case> every_case() {
 
 INSTANTIATE_TEST_SUITE_P(Suite, FrameEquivalence, testing::ValuesIn(every_case()),
                          [](const testing::TestParamInfo<Case>& i) { return i.param.scene + "_" + i.param.technique; });
+
+// The output moved away from the truth by t: O + t (O - G) per channel in 8-bit sRGB, clamped.
+ImageRGB8 pushed_from_truth(const ImageRGB8& out, const ImageRGB8& truth, double t) {
+  ImageRGB8 moved = out;
+  for (size_t k = 0; k < out.data.size(); ++k) {
+    const double v = double(out.data[k]) + t * (double(out.data[k]) - double(truth.data[k]));
+    moved.data[k] = uint8_t(std::clamp(std::lround(v), 0L, 255L));
+  }
+  return moved;
+}
+
+// The check catches what it is there for: each technique's fast level on desk_spot, its stored
+// frame pushed away from the truth until its all-pixel RDE is 0.020-0.022 above what the build
+// renders, fails the check by its RDE, every technique; the frame as rendered passes it.
+TEST(FrameEquivalenceCheck, APlantedRdeRiseOfTwoHundredthsFailsEveryTechnique) {
+  const std::string scene = "desk_spot";
+  auto capture = CaptureReader::open(suite_dir() + scene);
+  ASSERT_TRUE(capture.ok()) << capture.error().message;
+  auto camera = capture->read_frame(kStoredFrame);
+  auto truth = capture->read_reference(kStoredFrame);
+  auto mask = capture->read_reference_mask(kStoredFrame);
+  ASSERT_TRUE(camera.ok() && truth.ok() && mask.ok());
+  for (const char* technique : kTechniques) {
+    SCOPED_TRACE(technique);
+    auto levels = technique_levels(technique);
+    ASSERT_TRUE(levels.ok()) << levels.error().message;
+    const auto fast = std::find(levels->begin(), levels->end(), std::string("fast"));
+    const int level = fast != levels->end() ? int(fast - levels->begin()) : int(levels->size()) - 1;
+    std::vector<FrameRecord> frames;
+    run_frames(*capture, technique, level, frames);
+    if (HasFatalFailure()) return;
+    const FrameRecord& now = frames[kStoredFrame];
+    const auto recorded = read_rde_table(rde_file(recorded_dir(), scene, technique));
+    const auto it = recorded.find(std::to_string(level) + " " + std::to_string(kStoredFrame));
+    ASSERT_NE(it, recorded.end());
+    auto delta = load_png_rgb8(frame_file(recorded_dir(), scene, technique, level, kStoredFrame));
+    ASSERT_TRUE(delta.ok()) << delta.error().message;
+    auto expected = decode_reference_delta(*delta, camera->color);
+    ASSERT_TRUE(expected.ok()) << expected.error().message;
+    const double as_rendered[3] = {rde_or_nan(now.rde.all), rde_or_nan(now.rde.real), rde_or_nan(now.rde.virtual_)};
+    EXPECT_TRUE(check_frame(now.image, as_rendered, *expected, it->second).rde_moved.empty());
+
+    // Bisect t for a rise of 0.020-0.022 (8-bit rounding makes the RDE a step function of t).
+    double lo = 0.0, hi = 1.0, rise = 0.0, planted_t = 0.0;
+    RdeReport planted;
+    for (int step = 0; step < 40; ++step) {
+      const double t = 0.5 * (lo + hi);
+      auto r = measure_error(pushed_from_truth(now.image, *truth, t), camera->color, *truth, &*mask);
+      ASSERT_TRUE(r.ok()) << r.error().message;
+      rise = r->all.rde - now.rde.all.rde;
+      planted = *r;
+      planted_t = t;
+      if (rise >= 0.020 && rise <= 0.022) break;
+      (rise < 0.020 ? lo : hi) = t;
+    }
+    ASSERT_GE(rise, 0.020);
+    ASSERT_LE(rise, 0.022);
+    const double rde[3] = {rde_or_nan(planted.all), rde_or_nan(planted.real), rde_or_nan(planted.virtual_)};
+    const FrameFindings f = check_frame(pushed_from_truth(now.image, *truth, planted_t), rde, *expected, it->second);
+    ASSERT_FALSE(f.rde_moved.empty()) << "a rise of " << rise << " passed the check";
+    EXPECT_NE(f.rde_moved[0].find("RDE all"), std::string::npos) << f.rde_moved[0];
+  }
+}
 
 }  // namespace
 }  // namespace mrgi
