@@ -25,6 +25,10 @@ struct OccluderFitSettings {
   int max_spheres = 16;      // 1..64
   double coverage = 0.95;    // stop once this fraction of the solid voxels is inside a sphere
   int candidates = 48;       // the largest-radius uncovered voxels scored per step
+  // The reference path: every voxel's winding number summed over every triangle, where the fit
+  // sums distant groups of triangles by their first-order term (and exactly near the 1/2
+  // threshold). Both classify the voxels alike; for tests.
+  bool exact_winding = false;
 };
 
 // Spheres (xyz centre, w radius; the mesh's own space and units), most important first. Empty
