@@ -4,7 +4,9 @@
 # from the current build, for the scenes and techniques given (default: all), and shows what
 # changed. Run it when a change is meant to change what a user sees, and commit the records with
 # the change, saying why: the test command fails on any frame or RDE that differs from them
-# (1/255 on 99.9 % of the pixels, RDE within 0.002).
+# (1/255 on 99.9 % of the pixels, RDE within 0.002; the test command checks every level on
+# desk_spot and the two cheapest elsewhere, `MRGI_FRAME_EQUIVALENCE_LEVELS=all ctest --test-dir
+# build -R FrameEquivalence` every level everywhere).
 #   scripts/record-frame-equivalence.sh [SCENE|all] [TECHNIQUE|all]
 # e.g. scripts/record-frame-equivalence.sh env_fisheye dvct
 set -euo pipefail

@@ -18,4 +18,6 @@ bash scripts/check-minimal-build.sh
 # The aarch64 cross build configures against a sysroot of Debian arm64 packages (README "aarch64
 # devices"; the full cross build and the qemu run are scripts/run-sample-aarch64.sh).
 bash scripts/build-aarch64.sh --configure-only
-[ "${SKIP_SANITIZERS:-0}" = 1 ] || bash scripts/sanitize.sh
+# Each fuzz target for 5 s here (their seed corpora also run in CTest; `bash scripts/fuzz.sh 600`
+# is the long run).
+[ "${SKIP_SANITIZERS:-0}" = 1 ] || FUZZ_SECONDS="${FUZZ_SECONDS:-5}" bash scripts/sanitize.sh
