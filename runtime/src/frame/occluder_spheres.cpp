@@ -183,8 +183,10 @@ void fill_inside_by_winding(SolidGrid& g, const std::vector<glm::vec3>& p, const
   tree.tri = &tri;
   tree.order.resize(tri.size() / 3);
   std::iota(tree.order.begin(), tree.order.end(), 0u);
-  tree.nodes.reserve(2 * tree.order.size() / kLeafTriangles + 2);
-  tree.build(0, uint32_t(tree.order.size()));
+  if (!exact) {  // the reference path sums every triangle and needs no tree
+    tree.nodes.reserve(2 * tree.order.size() / kLeafTriangles + 2);
+    tree.build(0, uint32_t(tree.order.size()));
+  }
   constexpr double kHalf = 2.0 * 3.14159265358979;  // |w| = |sum| / 4 pi >= 1/2
   std::vector<uint32_t> stack;
   for (size_t i = 0; i < g.solid.size(); ++i) {
