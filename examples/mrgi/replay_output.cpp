@@ -3,6 +3,7 @@
 #include "mrgi/perf/canvas.h"
 #include "mrgi/perf/report.h"
 #include "mrgi/perf/stats.h"
+#include "mrgi/overlay.h"
 
 #include <algorithm>
 #include <cmath>
@@ -73,10 +74,26 @@ nlohmann::json light_json(const LightEstimate& e) {
           {"sh_radiance", sh}};
 }
 
+Status ReplayOutput::set_images(bool composite, bool overlay) {
+  if (!composite && !overlay) return fail(ErrorKind::BadUsage, "--output: name at least one of composite, overlay");
+  write_composite_ = composite;
+  write_overlay_ = overlay;
+  std::error_code ec;
+  if (!composite) fs::remove(partial_ + "/frames", ec);
+  if (overlay) fs::create_directories(partial_ + "/overlay", ec);
+  if (ec) return fail(ErrorKind::BadInput, partial_ + "/overlay: cannot create output folder: " + ec.message());
+  return ok_status();
+}
+
 Status ReplayOutput::add(const FrameOutput& out, const ImageRGB8& camera, const ImageRGB8* reference,
                          const ImageU8* mask, const LightEstimate* light_truth) {
   const size_t i = frame_ms_.size();
-  MRGI_TRY(write_png(partial_ + "/frames/" + frame_name(i), out.image));
+  if (write_composite_) MRGI_TRY(write_png(partial_ + "/frames/" + frame_name(i), out.image));
+  if (write_overlay_) {
+    auto overlay = make_overlay(out.image, out.virtual_mask, camera);
+    if (!overlay) return overlay.error();
+    MRGI_TRY(write_png(partial_ + "/overlay/" + frame_name(i), *overlay));
+  }
   if (video_) MRGI_TRY(video_->add(out.image));
   nlohmann::json s;
   s["frame"] = out.stats.frame_index;

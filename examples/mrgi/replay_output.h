@@ -1,5 +1,8 @@
 // What `mrgi replay` and `mrgi live` write to --out DIR:
-//   DIR/frames/NNNNNN.png   composited RGBA8 frames
+//   DIR/frames/NNNNNN.png   composited RGBA8 frames (--output composite, the default)
+//   DIR/overlay/NNNNNN.png  the composite as a premultiplied overlay for a passthrough
+//                           compositor (--output overlay; mrgi/overlay.h: the blend, what it
+//                           cannot express)
 //   DIR/stats.json          per frame: each pass's ms, total ms, record ms, level, internal scale,
 //                           cost, predicted cost and budget (the scheduler's view), skipped passes,
 //                           notes (a priming run, a missing pose), the frame's error figures
@@ -72,12 +75,16 @@ class ReplayOutput {
     int frames_in_flight = 0;
   };
   void set_sustained(const Sustained& s) { sustained_ = s; }
+  // Which images each frame writes: the composite (frames/), the passthrough overlay
+  // (overlay/, mrgi/overlay.h); at least one.
+  Status set_images(bool composite, bool overlay);
   // The composited frames also go to this clip (--video), finished with the rest.
   void set_video(VideoOutput&& video) { video_.emplace(std::move(video)); }
 
  private:
   std::optional<OutputDir> output_;
   std::optional<VideoOutput> video_;
+  bool write_composite_ = true, write_overlay_ = false;
   std::string dir_, partial_;
   ReplayMeta meta_;
   nlohmann::json stats_ = nlohmann::json::array();

@@ -85,6 +85,36 @@ TEST_F(ToolCommands, ReplaySideBySideHasFourLabelledPanels) {
   }
 }
 
+// replay --output: overlay/ holds the passthrough overlay (premultiplied RGBA, mrgi/overlay.h)
+// beside frames/, only the overlay when composite is not named, and an unknown image is refused
+// with exit 2 before anything runs.
+TEST_F(ToolCommands, ReplayOutputWritesTheOverlayItNames) {
+  test::TempDir dir("overlay");
+  const std::string replay = std::string("LP_NUM_THREADS=2 timeout 300 ") + MRGI_TOOL + " replay " + MRGI_SOURCE_DIR +
+                             "/data/sample --technique baseline --level last --frames 2 -q";
+  const std::string both = dir.file("both"), only = dir.file("only");
+  ASSERT_EQ(run(replay + " --out " + both + " --output composite,overlay > /dev/null 2> " + dir.file("err.txt")), 0)
+      << slurp(dir.file("err.txt"));
+  EXPECT_EQ(count_files(both + "/frames"), 2u);
+  EXPECT_EQ(count_files(both + "/overlay"), 2u);
+  auto overlay = load_png_rgba8(both + "/overlay/000000.png");
+  ASSERT_TRUE(overlay.ok()) << overlay.error().message;
+  size_t opaque = 0, clear = 0;
+  for (size_t p = 0; p < overlay->data.size() / 4; ++p) {
+    opaque += overlay->data[4 * p + 3] == 255;
+    clear += overlay->data[4 * p + 3] == 0;
+  }
+  EXPECT_GT(opaque, 1000u) << "the virtual object";
+  EXPECT_GT(clear, overlay->data.size() / 8) << "the real pixels it leaves as they are";
+  ASSERT_EQ(run(replay + " --out " + only + " --output overlay > /dev/null 2> " + dir.file("err.txt")), 0)
+      << slurp(dir.file("err.txt"));
+  EXPECT_FALSE(std::filesystem::exists(only + "/frames"));
+  EXPECT_EQ(count_files(only + "/overlay"), 2u);
+  EXPECT_EQ(run(replay + " --out " + dir.file("bad") + " --output overlay,mask > /dev/null 2> " + dir.file("err.txt")), 2);
+  EXPECT_NE(slurp(dir.file("err.txt")).find("mask not in {composite,overlay}"), std::string::npos) << slurp(dir.file("err.txt"));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("bad")));
+}
+
 // replay --video: the composited frames as an animated PNG whose still image is frame 0; names
 // it cannot write are refused before anything runs.
 TEST_F(ToolCommands, ReplayVideoIsAClipOfTheComposites) {
