@@ -183,11 +183,13 @@ void VirtualGBuffer::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_cons
     return;
   }
   update_area(coverage_area_, output, fc);
-  // Within kCoverageMeshErrorPx output pixels, or a simplified G-buffer's error where finer
-  // (a full-detail G-buffer, mesh_error_px 0, is finer than the coverage needs).
-  const float gbuffer_error_px = mesh_error_px * fc.output_k.x / std::max(fc.internal_k.x, 1e-6f);
-  coverage_lod_ = {lod_.camera_world, fc.output_k.x,
-                   mesh_error_px > 0.0f ? std::min(gbuffer_error_px, kCoverageMeshErrorPx) : kCoverageMeshErrorPx};
+  // Within kCoverageMeshErrorPx output pixels whatever the G-buffer's level of detail. Not
+  // finer where a simplified G-buffer is (it had been, so that both drew the same mesh): that
+  // made the coverage raster 2-5 CPU-ms dearer at baseline lowest's 0.2 internal pixels (0.4
+  // output) for no change of the frames' error (desk_spot, env_fisheye, glossy_table within
+  // 0.0002 RDE; perf/results/direct-light-block/mesh-lod-lowest-2026-12-06.md), as with a
+  // full-detail G-buffer, whose silhouette differs from the coverage's by as much.
+  coverage_lod_ = {lod_.camera_world, fc.output_k.x, kCoverageMeshErrorPx};
   record_coverage(graph);
 }
 

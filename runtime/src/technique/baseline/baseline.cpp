@@ -31,6 +31,8 @@ const KnobField<BaselineLevel> kBaselineKnobs[] = {
     {"env_occlusion_lights_bounce",
      "what the objects show in place of what they hide includes the shadowed lights' bounce off them (0 = off, 1 = on)",
      &BaselineLevel::env_occlusion_lights_bounce},
+    {"mesh_error_px", "largest projected error of the virtual meshes' level of detail (internal pixels; 0 = full detail)",
+     &BaselineLevel::mesh_error_px},
     {"env_occlusion_real_bounce",
      "the real surfaces round the objects, darkened by them, light the rest of the scene less (0 = off, 1 = on)",
      &BaselineLevel::env_occlusion_real_bounce},
@@ -65,12 +67,18 @@ const std::array<BaselineLevel, 4>& baseline_levels() {
     const auto& d = shading::direct_light_levels();
     const char* names[4] = {"high", "medium", "low", "lowest"};
     const float scales[4] = {1.0f, 1.0f, 0.75f, 0.5f};
+    // The lowest level draws the virtual G-buffer at the meshes' level of detail within 0.2
+    // internal pixels: the sample's bunny (16k triangles) costs 6-10 CPU-ms at full detail, 4-6
+    // at 0.2, for +0.0002-0.0066 RDE (glossy_table's glossy bunny the most: its shading normals
+    // spread over larger triangles); 0.3 costs glossy_table +0.026, 0.5 +0.059.
+    // Perf/results/direct-light-block/mesh-lod-lowest-2026-12-06.md.
+    const float mesh_error_px[4] = {0.0f, 0.0f, 0.0f, 0.2f};
     std::array<BaselineLevel, 4> out{};
     for (size_t i = 0; i < 4; ++i)
       out[i] = {names[i], d[i].shadow_map_size, scales[i], d[i].pcf_radius, d[i].caster_cell_shadow_texels,
                 d[i].shadowed_estimated_lights, d[i].env_occlusion.divisor, d[i].env_occlusion.spheres_per_object,
                 d[i].env_occlusion.regions, d[i].env_occlusion.near_field_steps, d[i].env_occlusion.lights_bounce,
-                d[i].env_occlusion.real_bounce_loss};
+                d[i].env_occlusion.real_bounce_loss, mesh_error_px[i]};
     return out;
   }();
   return levels;
