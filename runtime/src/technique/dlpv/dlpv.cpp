@@ -20,11 +20,11 @@ namespace mrgi::technique {
 
 const std::array<DlpvLevel, 5>& dlpv_levels() {
   static const std::array<DlpvLevel, 5> levels = {{
-      {"paper", 32, 32, 512, 4, true, 1.0f, true, 0, true},
-      {"high", 32, 32, 512, 4, true, 1.0f, false, 0, false},
-      {"medium", 16, 16, 256, 2, true, 1.0f, false, 1, false},
-      {"fast", 8, 8, 128, 1, false, 0.5f, false, 3, false},
-      {"fastest", 8, 4, 64, 1, false, 0.5f, false, 3, false},
+      {"paper", 32, 32, 512, 4, true, 1.0f, true, 0, true, 0.0f},
+      {"high", 32, 32, 512, 4, true, 1.0f, false, 0, false, 0.0f},
+      {"medium", 16, 16, 256, 2, true, 1.0f, false, 1, false, 0.0f},
+      {"fast", 8, 8, 128, 1, false, 0.5f, false, 3, false, 0.2f},
+      {"fastest", 8, 4, 64, 1, false, 0.5f, false, 3, false, 0.2f},
   }};
   return levels;
 }
@@ -44,6 +44,8 @@ const KnobField<DlpvLevel> kDlpvKnobs[] = {
      "1: V^rho on virtual pixels also where the ambient already holds the real bounce (residual estimate, env camera); "
      "0: the ambient there",
      &DlpvLevel::rho_beside_bounce_ambient},
+    {"mesh_error_px", "largest projected error of the virtual meshes' level of detail (internal pixels; 0 = full detail)",
+     &DlpvLevel::mesh_error_px},
 };
 }  // namespace
 

@@ -16,6 +16,8 @@
 //   fast      8^3     8     128^2  1          no     0.5             baseline lowest's (the reduced-volume fast path)
 //   fastest   8^3     4      64^2  1          no     0.5             baseline lowest's
 // (1) where the ambient is an environment image file's (rho_beside_bounce_ambient).
+// fast and fastest draw the virtual G-buffer at the meshes' level of detail within 0.2 internal
+// pixels, as baseline lowest does (mesh_error_px).
 // "paper" is the published method with its settings (Sec. 5); the others keep its volume and
 // light the scene directly with shadow maps (Sec. 7's alternative), because the antiradiance
 // shadow is coarse (a 32^3 volume over twice the object) and cut off where the volume ends.
@@ -95,6 +97,7 @@ struct DlpvLevel {
   // face light the object's other faces (spot_in_fisheye, a white box under a spot: virtual-pixel
   // RDE 0.68 with V^rho, 0.17 with the ambient; corner 0.43 / 0.29; desk_spot 0.35 / 0.19).
   bool rho_beside_bounce_ambient;
+  float mesh_error_px;     // QualityLevel::mesh_error_px: the virtual G-buffer's level of detail (baseline lowest's at fast)
 };
 const std::array<DlpvLevel, 5>& dlpv_levels();  // the defaults
 // The defaults with RuntimeSettings::knobs applied (technique/knobs.h; BadUsage for a refused one).

@@ -24,11 +24,11 @@ namespace mrgi::technique {
 
 const std::array<DvctLevel, 5>& dvct_levels() {
   static const std::array<DvctLevel, 5> levels = {{
-      {"paper", 128, 9, true, 512, 4, 1, 1.0f, true, 0, 0.03f, 0.5f, true},
-      {"high", 64, 9, true, 512, 4, 2, 1.0f, false, 0, 0.1f, 0.5f, true},
-      {"medium", 64, 5, true, 256, 2, 4, 1.0f, false, 1, 0.1f, 0.5f, true},
-      {"fast", 16, 3, false, 64, 1, 4, 0.5f, false, 3, 0.1f, 0.5f, false},
-      {"fastest", 16, 1, false, 64, 1, 4, 0.5f, false, 3, 0.1f, 0.5f, false},
+      {"paper", 128, 9, true, 512, 4, 1, 1.0f, true, 0, 0.03f, 0.5f, true, 0.0f},
+      {"high", 64, 9, true, 512, 4, 2, 1.0f, false, 0, 0.1f, 0.5f, true, 0.0f},
+      {"medium", 64, 5, true, 256, 2, 4, 1.0f, false, 1, 0.1f, 0.5f, true, 0.0f},
+      {"fast", 16, 3, false, 64, 1, 4, 0.5f, false, 3, 0.1f, 0.5f, false, 0.2f},
+      {"fastest", 16, 1, false, 64, 1, 4, 0.5f, false, 3, 0.1f, 0.5f, false, 0.2f},
   }};
   return levels;
 }
@@ -49,6 +49,8 @@ const KnobField<DvctLevel> kDvctKnobs[] = {
     {"step_scale", "fraction of the touching-footprint step the cones take", &DvctLevel::step_scale},
     {"object_light", "1: the specular cone sees the objects lit by the ambient and emitting (0: the lamps' light only)",
      &DvctLevel::object_light},
+    {"mesh_error_px", "largest projected error of the virtual meshes' level of detail (internal pixels; 0 = full detail)",
+     &DvctLevel::mesh_error_px},
 };
 
 // The region's side is never under this (metres): a flat or tiny object still gets room for its

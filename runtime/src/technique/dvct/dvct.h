@@ -16,6 +16,8 @@
 //   medium    64^3   5        yes       256^2  2      1 in 4x4    1.0       baseline medium's
 //   fast      16^3   3        no         64^2  1      1 in 4x4    0.5       baseline lowest's
 //   fastest   16^3   1        no         64^2  1      1 in 4x4    0.5       baseline lowest's
+// fast and fastest draw the virtual G-buffer at the meshes' level of detail within 0.2 internal
+// pixels, as baseline lowest does (mesh_error_px).
 // "paper" shades every pixel with cones alone (shaders/dvct/shade.comp). The others trace the
 // cones at one pixel in a block (shaders/dvct/indirect.comp) into dir's packed indirect image,
 // which the direct-light block's shading pass up-samples by surface and adds as it lights the pixel with
@@ -105,6 +107,7 @@ struct DvctLevel {
   // injected into a volume the specular cone reads, so a glossy real surface reflects an object
   // under environment light as lit, not black (the light volume holds the lamps' maps only).
   bool object_light;
+  float mesh_error_px;     // QualityLevel::mesh_error_px: the virtual G-buffer's level of detail (baseline lowest's at fast)
 };
 const std::array<DvctLevel, 5>& dvct_levels();  // the defaults
 Expected<std::vector<DvctLevel>> dvct_levels(const std::vector<KnobSetting>& knobs);
