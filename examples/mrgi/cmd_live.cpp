@@ -38,6 +38,7 @@ void on_sigint(int) { g_stop = true; }
 struct LiveOptions {
   std::string source, scene, out, device, env, env_model;
   QualityOptions quality;
+  OutputImagesOption output_images;
   int frames = 0, timeout_ms = 3000;
   bool quiet = false;
 };
@@ -237,6 +238,8 @@ void run_live(const LiveOptions& o) {
                   level == kAutoLevel ? "auto" : runtime->level_names()[size_t(level)], runtime->device().name,
                   runtime->device().type == "cpu", runtime->memory_mib(), out_w, out_h};
   ReplayOutput output = take(ReplayOutput::create(o.out, meta));
+  if (Status st = output.set_images(o.output_images.wants("composite"), o.output_images.wants("overlay")); !st.ok())
+    fail_with(st.error());
 
   std::signal(SIGINT, on_sigint);
   std::map<int64_t, ImageRGB8> cameras_by_frame;
@@ -315,6 +318,7 @@ void setup(CLI::App& app) {
   cmd->add_option("source", o->source, "openni:, openni:FILE.oni, v4l2:/dev/videoN, libcamera:ID, or a capture folder")->required();
   o->quality.add(*cmd);
   cmd->add_option("--scene", o->scene, "scene.json (default: a 15 cm box in front of the camera, one real light)");
+  o->output_images.add(*cmd);
   cmd->add_option("--out,-o", o->out, "output folder (frames/, stats.json, summary.json, side_by_side.png); "
                                       "no preview window is implemented, so it is required")->required();
   cmd->add_option("--frames,-n", o->frames, "stop after N frames (0 = until the stream ends or Ctrl-C)")->check(CLI::NonNegativeNumber);

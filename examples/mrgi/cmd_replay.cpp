@@ -23,7 +23,7 @@ struct ReplayOptions {
   std::vector<std::string> dlpv_ablation;
   std::vector<std::string> dir_ablation;
   std::vector<std::string> specular_ablation;
-  std::vector<std::string> output_images{"composite"};  // --output: composite, overlay
+  OutputImagesOption output_images;
   int frames = 0, width = 0, height = 0, preload_frames = 0;
   bool validate = false, quiet = false, vulkan_1_2 = false, no_residual_light = false, profile = false;
 };
@@ -299,10 +299,8 @@ void run_replay(const ReplayOptions& o) {
                   runtime->device().name, runtime->device().type == "cpu",
                   runtime->memory_mib(), out_w, out_h};
   ReplayOutput output = take(ReplayOutput::create(o.out, meta));
-  const auto wants = [&](const char* image) {
-    return std::find(o.output_images.begin(), o.output_images.end(), image) != o.output_images.end();
-  };
-  if (Status st = output.set_images(wants("composite"), wants("overlay")); !st.ok()) fail_with(st.error());
+  if (Status st = output.set_images(o.output_images.wants("composite"), o.output_images.wants("overlay")); !st.ok())
+    fail_with(st.error());
   if (!o.video.empty()) {
     std::vector<double> stamps;
     for (size_t i = 0; i < frames; ++i) stamps.push_back(capture.entry(i).timestamp);
@@ -348,12 +346,7 @@ void setup(CLI::App& app) {
   opts->quality.add(*cmd);
   cmd->add_option("--out,-o", opts->out, "output folder (frames/, stats.json, summary.json, side_by_side.png)")->required();
   cmd->add_option("--frames,-n", opts->frames, "replay at most N frames (0 = all)")->check(CLI::NonNegativeNumber);
-  cmd->add_option("--output", opts->output_images,
-                  "images written per frame, comma-separated: composite (frames/: the camera frame with the "
-                  "objects and their light, default), overlay (overlay/: premultiplied RGBA for a passthrough "
-                  "compositor to blend over its own video; mrgi/overlay.h gives the blend)")
-      ->delimiter(',')
-      ->check(CLI::IsMember({"composite", "overlay"}));
+  opts->output_images.add(*cmd);
   cmd->add_option("--video", opts->video,
                   "also write the composited frames as a clip: FILE.png (animated PNG, lossless) or "
                   "FILE.mp4/.mkv/.webm (needs ffmpeg on PATH), at the capture's frame rate");

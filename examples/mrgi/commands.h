@@ -63,6 +63,14 @@ struct QualityOptions {
   void apply(RuntimeSettings& settings) const;  // technique, level, frame_budget_ms, knobs
 };
 
+// --output: the images a replay or live run writes per frame (composite, overlay), for
+// ReplayOutput::set_images.
+struct OutputImagesOption {
+  std::vector<std::string> images{"composite"};
+  void add(CLI::App& cmd);
+  bool wants(const char* image) const;
+};
+
 // --budget-ms's rule, said in words (CLI11's range check prints its raw bounds): a frame budget
 // in ms, at least 0.1 and at most 1e6.
 CLI::Validator frame_budget_ms_check();

@@ -1,6 +1,7 @@
 // mrgi: the command-line tool. Sub-commands live in cmd_*.cpp and register themselves.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
@@ -76,6 +77,19 @@ std::vector<KnobSetting> parse_knobs(const std::string& technique, const std::ve
   // Refused here, before a capture is opened or a device started, with the knob's span.
   take(technique_ladder(technique, knobs));
   return knobs;
+}
+
+void OutputImagesOption::add(CLI::App& cmd) {
+  cmd.add_option("--output", images,
+                 "images written per frame, comma-separated: composite (frames/: the camera frame with the objects and "
+                 "their light, default), overlay (overlay/: premultiplied RGBA for a passthrough compositor to blend "
+                 "over its own video; mrgi/overlay.h gives the blend)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"composite", "overlay"}));
+}
+
+bool OutputImagesOption::wants(const char* image) const {
+  return std::find(images.begin(), images.end(), image) != images.end();
 }
 
 void QualityOptions::add(CLI::App& cmd) {

@@ -268,9 +268,11 @@ TEST_F(ToolCommands, LiveRendersEveryFrameOfTheOniWithTheDefaultObject) {
   test::TempDir dir("live");
   const std::string out = dir.file("out");
   const std::string cmd = std::string("LP_NUM_THREADS=2 timeout 300 ") + MRGI_TOOL + " live openni:" + kOni +
-                          " --technique baseline --out " + out + " -q > " + dir.file("summary.txt") + " 2> " + dir.file("err.txt");
+                          " --technique baseline --output composite,overlay --out " + out + " -q > " + dir.file("summary.txt") +
+                          " 2> " + dir.file("err.txt");
   ASSERT_EQ(run(cmd), 0) << slurp(dir.file("err.txt"));
   EXPECT_EQ(count_files(out + "/frames"), 12u);
+  EXPECT_EQ(count_files(out + "/overlay"), 12u) << "--output overlay: the passthrough overlay of every frame";
   const auto summary = nlohmann::json::parse(slurp(out + "/summary.json"));
   EXPECT_EQ(summary["frames"].get<int>(), 12);
   EXPECT_TRUE(std::filesystem::exists(out + "/stats.json"));
