@@ -156,8 +156,10 @@ void Replay::run_preloaded() {
     const size_t last = std::min(frames, first + chunk);
     for (size_t i = first; i < last; ++i) in_flight[i] = decode_one(i);
     // Completion to completion, as the bench's sustained phase: the window opens when the
-    // chunk's first output comes back (the pipeline filled, frame 0's start-up behind it) and
-    // closes at the flush; the outputs after the first are the frames it holds.
+    // chunk's first outputs come back (the pipeline filled, frame 0's start-up behind it) and
+    // closes at the flush; the outputs after that first batch are the frames it holds (a chunk
+    // whose outputs all come back at once, as the flush of a run no longer than the frames in
+    // flight, holds none: no sustained figure rather than 0 ms).
     std::optional<std::chrono::steady_clock::time_point> wall0;
     double cpu0 = 0.0;
     auto collect = [&](std::vector<FrameOutput>&& outs) {
@@ -165,7 +167,6 @@ void Replay::run_preloaded() {
       if (!wall0) {
         wall0 = std::chrono::steady_clock::now();
         cpu0 = process_cpu_seconds();
-        sustained_frames += outs.size() - 1;
       } else {
         sustained_frames += outs.size();
       }
