@@ -79,9 +79,14 @@ Status ReplayOutput::set_images(bool composite, bool overlay) {
   write_composite_ = composite;
   write_overlay_ = overlay;
   std::error_code ec;
-  if (!composite) fs::remove(partial_ + "/frames", ec);
-  if (overlay) fs::create_directories(partial_ + "/overlay", ec);
-  if (ec) return fail(ErrorKind::BadInput, partial_ + "/overlay: cannot create output folder: " + ec.message());
+  if (!composite) {
+    fs::remove(partial_ + "/frames", ec);
+    if (ec) return fail(ErrorKind::BadInput, partial_ + "/frames: cannot remove the empty folder: " + ec.message());
+  }
+  if (overlay) {
+    fs::create_directories(partial_ + "/overlay", ec);
+    if (ec) return fail(ErrorKind::BadInput, partial_ + "/overlay: cannot create output folder: " + ec.message());
+  }
   return ok_status();
 }
 
