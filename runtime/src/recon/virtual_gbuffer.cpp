@@ -183,12 +183,12 @@ void VirtualGBuffer::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_cons
     return;
   }
   update_area(coverage_area_, output, fc);
-  // Within kCoverageMeshErrorPx output pixels whatever the G-buffer's level of detail. Not
-  // finer where a simplified G-buffer is (it had been, so that both drew the same mesh): that
-  // made the coverage raster 2-5 CPU-ms dearer at baseline lowest's 0.2 internal pixels (0.4
-  // output) for no change of the frames' error (desk_spot, env_fisheye, glossy_table within
-  // 0.0002 RDE; perf/results/direct-light-block/mesh-lod-lowest-2026-12-06.md), as with a
-  // full-detail G-buffer, whose silhouette differs from the coverage's by as much.
+  // Within kCoverageMeshErrorPx output pixels whatever the G-buffer's level of detail. Drawing
+  // the coverage as finely as a simplified G-buffer (the same mesh in both) makes it 2-5 CPU-ms
+  // dearer at baseline lowest's 0.2 internal pixels (0.4 output) for no change of the frames'
+  // error (desk_spot, env_fisheye, glossy_table within 0.0002 RDE;
+  // perf/results/direct-light-block/mesh-lod-lowest-2026-12-06.md): the silhouettes differ by
+  // as much beside a full-detail G-buffer.
   coverage_lod_ = {lod_.camera_world, fc.output_k.x, kCoverageMeshErrorPx};
   record_coverage(graph);
 }
