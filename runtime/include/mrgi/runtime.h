@@ -28,6 +28,7 @@ struct RuntimeSettings;
 struct DeviceInfo;
 struct FrameOutput;
 struct ResearchSettings;  // mrgi/research.h
+struct AppVulkanDevice;   // mrgi/vulkan_device.h
 
 // ---------------------------------------------------------------------------------------------
 // 1-2. Creating a runtime and running frames
@@ -203,6 +204,11 @@ struct DeviceSettings {
   /// headsets often ship one); with `validate`, a 1.3-only call is reported. For testing that path
   /// on a 1.3 device.
   bool vulkan_1_2 = false;
+  /// The app's own Vulkan instance, device and queue (mrgi/vulkan_device.h): mrgi runs on them
+  /// instead of creating its own (`device` is then ignored), checks that they have what it needs
+  /// (BadUsage naming each missing extension and feature), waits only on its own fences and
+  /// destroys none of them. Read during create_runtime only (copied). Null: mrgi's own device.
+  const AppVulkanDevice* app_device = nullptr;
 };
 
 /// The frame-budget scheduler's constants (scheduler/scheduler.h says how it decides). The

@@ -9,7 +9,9 @@
 #include <cstring>
 #include <optional>
 
+#include "gpu/device_requirements.h"
 #include "gpu/vk_check.h"
+#include "mrgi/vulkan_device.h"
 
 #if defined(__GLIBC__)
 #include <malloc.h>
@@ -66,16 +68,6 @@ bool layer_available(const char* name) {
   if (vkEnumerateInstanceLayerProperties(&n, layers.data()) != VK_SUCCESS) return false;
   for (const auto& l : layers)
     if (std::strcmp(l.layerName, name) == 0) return true;
-  return false;
-}
-
-bool device_has_extension(VkPhysicalDevice pd, const char* name) {
-  uint32_t n = 0;
-  if (vkEnumerateDeviceExtensionProperties(pd, nullptr, &n, nullptr) != VK_SUCCESS) return false;
-  std::vector<VkExtensionProperties> exts(n);
-  if (vkEnumerateDeviceExtensionProperties(pd, nullptr, &n, exts.data()) != VK_SUCCESS) return false;
-  for (const auto& e : exts)
-    if (std::strcmp(e.extensionName, name) == 0) return true;
   return false;
 }
 
@@ -250,6 +242,7 @@ Status Context::init(const DeviceSettings& settings) {
   validate_ = settings.validate;
   const char* poison_env = std::getenv("MRGI_POISON_MEMORY");
   poison_memory_ = settings.poison_memory || (poison_env != nullptr && std::string(poison_env) == "1");
+  if (settings.app_device) return init_app_device(settings);
   MRGI_TRY(init_instance(settings));
   MRGI_TRY(select_physical_device(settings));
   const std::string who = "device " + std::to_string(info_.index) + " '" + info_.name + "'";
@@ -324,106 +317,82 @@ Status Context::choose_queue_family(const std::string& who) {
   return ok_status();
 }
 
-// The extensions mrgi requires, into `extensions`. sync2 and dynamic rendering are core in 1.3
-// and extensions in 1.2.
-Status Context::require_extensions(const std::string& who, std::vector<const char*>& extensions) {
-  const bool is13 = api_1_3_;
-  auto require = [&](const char* ext) -> Status {
-    if (!device_has_extension(physical_, ext))
-      return fail(ErrorKind::Device, who + " lacks " + ext + ", which mrgi requires");
-    extensions.push_back(ext);
-    return ok_status();
-  };
-  MRGI_TRY(require(VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME));
-  if (!is13) {
-    MRGI_TRY(require(VK_KHR_SYNCHRONIZATION_2_EXTENSION_NAME));
-    MRGI_TRY(require(VK_KHR_DYNAMIC_RENDERING_EXTENSION_NAME));
-  }
-  return ok_status();
-}
-
 // Extensions and features: the device with what the techniques use, where it has it, and its
 // queue.
 Status Context::create_device(const std::string& who) {
-  std::vector<const char*> extensions;
-  MRGI_TRY(require_extensions(who, extensions));
-  VkPhysicalDeviceSynchronization2Features sync2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SYNCHRONIZATION_2_FEATURES};
-  VkPhysicalDeviceDynamicRenderingFeatures dynr{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DYNAMIC_RENDERING_FEATURES};
-  VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
-  VkPhysicalDeviceVulkan11Features f11{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES};
-  // Float atomics (optional): the light propagation volumes sum VPLs into cells with
-  // imageAtomicAdd on R32F texel buffers (gi/lpv_inject.comp). Lavapipe and desktop GPUs have it.
-  VkPhysicalDeviceShaderAtomicFloatFeaturesEXT atomic_float{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_ATOMIC_FLOAT_FEATURES_EXT};
-  const bool has_atomic_float = device_has_extension(physical_, VK_EXT_SHADER_ATOMIC_FLOAT_EXTENSION_NAME);
-  VkPhysicalDeviceFeatures2 have{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
-  have.pNext = &sync2;
-  sync2.pNext = &dynr;
-  dynr.pNext = &f12;
-  f12.pNext = &f11;
-  if (has_atomic_float) f11.pNext = &atomic_float;
-  vkGetPhysicalDeviceFeatures2(physical_, &have);
-  if (!sync2.synchronization2) return fail(ErrorKind::Device, who + " lacks the synchronization2 feature");
-  if (!dynr.dynamicRendering) return fail(ErrorKind::Device, who + " lacks the dynamicRendering feature");
-
-  // Enable only what the techniques use, where the device has it.
-  VkPhysicalDeviceFeatures2 want{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
-  const VkPhysicalDeviceFeatures& h = have.features;
-  VkPhysicalDeviceFeatures& w = want.features;
-  w.fragmentStoresAndAtomics = h.fragmentStoresAndAtomics;
-  w.vertexPipelineStoresAndAtomics = h.vertexPipelineStoresAndAtomics;
-  w.shaderStorageImageWriteWithoutFormat = h.shaderStorageImageWriteWithoutFormat;
-  w.shaderStorageImageReadWithoutFormat = h.shaderStorageImageReadWithoutFormat;
-  w.largePoints = h.largePoints;
-  large_points_ = h.largePoints == VK_TRUE;
-  w.depthClamp = h.depthClamp;
-  w.depthBiasClamp = h.depthBiasClamp;
-  w.independentBlend = h.independentBlend;
-  w.multiDrawIndirect = h.multiDrawIndirect;
-  w.drawIndirectFirstInstance = h.drawIndirectFirstInstance;
-  w.imageCubeArray = h.imageCubeArray;
-  w.shaderInt16 = h.shaderInt16;
-  w.samplerAnisotropy = h.samplerAnisotropy;
-  VkPhysicalDeviceSynchronization2Features sync2_on{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SYNCHRONIZATION_2_FEATURES};
-  sync2_on.synchronization2 = VK_TRUE;
-  VkPhysicalDeviceDynamicRenderingFeatures dynr_on{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DYNAMIC_RENDERING_FEATURES};
-  dynr_on.dynamicRendering = VK_TRUE;
-  VkPhysicalDeviceVulkan12Features f12_on{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
-  f12_on.scalarBlockLayout = f12.scalarBlockLayout;
-  f12_on.hostQueryReset = f12.hostQueryReset;
-  f12_on.shaderFloat16 = f12.shaderFloat16;
-  f12_on.storageBuffer8BitAccess = f12.storageBuffer8BitAccess;
-  f12_on.uniformAndStorageBuffer8BitAccess = f12.uniformAndStorageBuffer8BitAccess;
-  f12_on.shaderInt8 = f12.shaderInt8;
-  VkPhysicalDeviceVulkan11Features f11_on{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES};
-  f11_on.shaderDrawParameters = f11.shaderDrawParameters;
-  f11_on.storageBuffer16BitAccess = f11.storageBuffer16BitAccess;
-  want.pNext = &sync2_on;
-  sync2_on.pNext = &dynr_on;
-  dynr_on.pNext = &f12_on;
-  f12_on.pNext = &f11_on;
-  VkPhysicalDeviceShaderAtomicFloatFeaturesEXT atomic_float_on{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_ATOMIC_FLOAT_FEATURES_EXT};
-  if (has_atomic_float && atomic_float.shaderImageFloat32AtomicAdd) {
-    atomic_float_on.shaderImageFloat32Atomics = VK_TRUE;
-    atomic_float_on.shaderImageFloat32AtomicAdd = VK_TRUE;
-    f11_on.pNext = &atomic_float_on;
-    extensions.push_back(VK_EXT_SHADER_ATOMIC_FLOAT_EXTENSION_NAME);
-    image_float_atomic_add_ = true;
-  }
-
+  (void)who;  // vulkan_device_requirements names the device itself
+  auto req = vulkan_device_requirements(instance_, physical_, !api_1_3_);
+  if (!req) return req.error();
+  large_points_ = req->features.features.largePoints == VK_TRUE;
+  image_float_atomic_add_ = req->atomic_float_present;
   const float priority = 1.0f;
   VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
   qci.queueFamilyIndex = queue_family_;
   qci.queueCount = 1;
   qci.pQueuePriorities = &priority;
   VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
-  dci.pNext = &want;
+  dci.pNext = req->chain();
   dci.queueCreateInfoCount = 1;
   dci.pQueueCreateInfos = &qci;
-  dci.enabledExtensionCount = uint32_t(extensions.size());
-  dci.ppEnabledExtensionNames = extensions.data();
+  dci.enabledExtensionCount = uint32_t(req->device_extensions.size());
+  dci.ppEnabledExtensionNames = req->device_extensions.data();
   VK_CHECK(vkCreateDevice(physical_, &dci, nullptr, &device_));
   vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
   return ok_status();
+}
+
+// The app's objects (mrgi/vulkan_device.h), checked for what mrgi needs, in place of an
+// instance and a device of mrgi's own.
+Status Context::init_app_device(const DeviceSettings& settings) {
+  const AppVulkanDevice& app = *settings.app_device;
+  if (settings.validate)
+    return fail(ErrorKind::BadUsage, "DeviceSettings::validate with DeviceSettings::app_device: validation layers "
+                                     "belong to the app's instance (enable VK_LAYER_KHRONOS_validation there)");
+  auto enabled = check_app_device(app, settings.vulkan_1_2);
+  if (!enabled) return enabled.error();
+  owns_device_ = false;
+  instance_ = app.instance;
+  physical_ = app.physical_device;
+  device_ = app.device;
+  queue_ = app.queue;
+  queue_family_ = app.queue_family;
+  lock_queue_ = app.lock_queue;
+  unlock_queue_ = app.unlock_queue;
+  api_1_3_ = enabled->api_1_3;
+  large_points_ = enabled->large_points;
+  image_float_atomic_add_ = enabled->image_float_atomic_add;
+  auto pds = physical_devices(instance_);
+  if (!pds) return pds.error();
+  const std::vector<DeviceInfo> devices = describe_all(*pds);
+  for (size_t i = 0; i < pds->size(); ++i)
+    if ((*pds)[i] == physical_) info_ = devices[i];
+  info_.selected = true;
+  vkGetPhysicalDeviceProperties(physical_, &properties_);
+  vkGetPhysicalDeviceMemoryProperties(physical_, &memory_properties_);
+  uint32_t nq = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_, &nq, nullptr);
+  std::vector<VkQueueFamilyProperties> families(nq);
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_, &nq, families.data());
+  timestamp_valid_bits_ = families[queue_family_].timestampValidBits;
+  const std::string who = "the app's device '" + info_.name + "'";
+  MRGI_TRY(load_device_functions(who));
+  MRGI_TRY(create_upload_pool());
+  MRGI_TRY(create_samplers());
+  return ok_status();
+}
+
+VkResult Context::queue_submit2(const VkSubmitInfo2& submit, VkFence fence) const {
+  if (lock_queue_) lock_queue_();
+  const VkResult r = fn_.queue_submit2(queue_, 1, &submit, fence);
+  if (unlock_queue_) unlock_queue_();
+  return r;
+}
+
+VkResult Context::queue_submit(const VkSubmitInfo& submit, VkFence fence) const {
+  if (lock_queue_) lock_queue_();
+  const VkResult r = vkQueueSubmit(queue_, 1, &submit, fence);
+  if (unlock_queue_) unlock_queue_();
+  return r;
 }
 
 // The entry points that are core in 1.3 and extensions in 1.2, and push descriptors.
@@ -479,19 +448,21 @@ Status Context::create_samplers() {
 
 Context::~Context() {
   if (device_) {
-    vkDeviceWaitIdle(device_);
+    // An app's device may be busy with the app's own work: mrgi's work has completed by now (the
+    // frame graph waited for its fences; start-up submissions wait for theirs).
+    if (owns_device_) vkDeviceWaitIdle(device_);
     for (VkSampler s : {samplers_.linear_clamp, samplers_.nearest_clamp, samplers_.linear_repeat,
                         samplers_.shadow_compare})
       if (s) vkDestroySampler(device_, s, nullptr);
     if (upload_pool_) vkDestroyCommandPool(device_, upload_pool_, nullptr);
-    vkDestroyDevice(device_, nullptr);
+    if (owns_device_) vkDestroyDevice(device_, nullptr);
   }
   if (messenger_) {
     auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
         vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
     if (destroy) destroy(instance_, messenger_, nullptr);
   }
-  if (instance_) vkDestroyInstance(instance_, nullptr);
+  if (instance_ && owns_device_) vkDestroyInstance(instance_, nullptr);
 }
 
 void Context::record_validation_message(std::string message) {

@@ -105,6 +105,13 @@ class Context {
   VkDevice device() const { return device_; }
   VkQueue queue() const { return queue_; }
   uint32_t queue_family() const { return queue_family_; }
+  // The device is the app's (DeviceSettings::app_device): mrgi destroys none of the Vulkan
+  // objects it was given and waits only on its own fences (mrgi/vulkan_device.h).
+  bool app_device() const { return !owns_device_; }
+  // vkQueueSubmit2 / vkQueueSubmit on queue(), inside the app's queue lock where it gave one.
+  // Every submission of mrgi's goes through these.
+  VkResult queue_submit2(const VkSubmitInfo2& submit, VkFence fence) const;
+  VkResult queue_submit(const VkSubmitInfo& submit, VkFence fence) const;
   const DeviceInfo& info() const { return info_; }
   const VkPhysicalDeviceProperties& properties() const { return properties_; }
   // Nanoseconds per timestamp tick (VkPhysicalDeviceLimits::timestampPeriod).
@@ -162,11 +169,12 @@ class Context {
  private:
   Context() = default;
   Status init(const DeviceSettings& settings);
+  // init() for DeviceSettings::app_device: the app's objects, checked, instead of new ones.
+  Status init_app_device(const DeviceSettings& settings);
   // init()'s steps, in its order.
   Status init_instance(const DeviceSettings& settings);
   Status select_physical_device(const DeviceSettings& settings);
   Status choose_queue_family(const std::string& who);
-  Status require_extensions(const std::string& who, std::vector<const char*>& extensions);
   Status create_device(const std::string& who);
   Status load_device_functions(const std::string& who);
   Status create_upload_pool();
@@ -175,6 +183,8 @@ class Context {
                                     bool* coherent);
 
   VkInstance instance_ = VK_NULL_HANDLE;
+  bool owns_device_ = true;  // false: instance_, device_ and queue_ are the app's
+  std::function<void()> lock_queue_, unlock_queue_;  // AppVulkanDevice's (app devices only)
   VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
   VkPhysicalDevice physical_ = VK_NULL_HANDLE;
   VkDevice device_ = VK_NULL_HANDLE;

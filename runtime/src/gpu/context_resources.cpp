@@ -229,7 +229,7 @@ Status Context::submit_and_wait(const std::function<void(VkCommandBuffer)>& reco
     VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
     si.commandBufferCount = 1;
     si.pCommandBuffers = &cmd;
-    VK_CHECK(vkQueueSubmit(queue_, 1, &si, fence));
+    VK_CHECK(queue_submit(si, fence));
     const VkResult w = vkWaitForFences(device_, 1, &fence, VK_TRUE, kUploadTimeoutNs);
     if (w == VK_TIMEOUT) return fail(ErrorKind::Timeout, "start-up upload did not finish within 30 s");
     VK_CHECK(w);

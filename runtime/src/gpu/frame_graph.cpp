@@ -149,7 +149,7 @@ Status FrameGraph::init() {
 
 FrameGraph::~FrameGraph() {
   VkDevice dev = context_.device();
-  vkDeviceWaitIdle(dev);
+  (void)wait_submitted();  // a frame that fails to finish here cannot be helped: release anyway
   if (profile_fence_) vkDestroyFence(dev, profile_fence_, nullptr);
   for (Slot& s : slots_) {
     if (s.fence) vkDestroyFence(dev, s.fence, nullptr);
@@ -320,7 +320,7 @@ Status FrameGraph::upload_image(ImageHandle image, const void* texels, VkDeviceS
   if (in_frame_) return fail(ErrorKind::BadUsage, "upload_image('" + images_[image.id].desc.name +
                                                       "'): start-up only, not inside a frame");
   // Previous frames may still use it.
-  VK_CHECK(vkQueueWaitIdle(context_.queue()));
+  MRGI_TRY(wait_submitted());
   ImageEntry& e = images_[image.id];
   // Leave it in the layout its usage allows, so the first pass's barrier is a valid transition.
   const VkImageLayout layout = (e.gpu.usage & VK_IMAGE_USAGE_SAMPLED_BIT) ? VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL
@@ -398,6 +398,19 @@ VkFormat FrameGraph::texel_format(BufferHandle buffer) const {
 void* FrameGraph::mapped(BufferHandle buffer, uint32_t slot) const { return gpu_buffer(buffer, slot).mapped; }
 
 // --- frames --------------------------------------------------------------------------------------
+
+Status FrameGraph::wait_submitted() const {
+  VkDevice dev = context_.device();
+  for (const Slot& s : slots_) {
+    if (!s.submitted) continue;
+    const VkResult w = vkWaitForFences(dev, 1, &s.fence, VK_TRUE, kFrameTimeoutNs);
+    if (w == VK_TIMEOUT)
+      return fail(ErrorKind::Timeout, "frame " + std::to_string(s.frame_index) + " did not finish on the GPU within " +
+                                          std::to_string(kFrameTimeoutS) + " s (device hung or far too slow)");
+    VK_CHECK(w);
+  }
+  return ok_status();
+}
 
 Expected<std::optional<FrameTimings>> FrameGraph::collect(uint32_t index) {
   Slot& s = slots_[index];
@@ -640,7 +653,7 @@ Expected<double> FrameGraph::submit_and_wait(VkCommandBuffer cmd, const std::str
   si.commandBufferInfoCount = 1;
   si.pCommandBufferInfos = &cbi;
   const auto t0 = std::chrono::steady_clock::now();
-  VK_CHECK(context_.fn().queue_submit2(context_.queue(), 1, &si, profile_fence_));
+  VK_CHECK(context_.queue_submit2(si, profile_fence_));
   const VkResult w = vkWaitForFences(dev, 1, &profile_fence_, VK_TRUE, kFrameTimeoutNs);
   auto t1 = std::chrono::steady_clock::now();
   if (w == VK_TIMEOUT)
@@ -688,7 +701,7 @@ Status FrameGraph::submit_profiled() {
                                          std::to_string(profile_cmds_.size()) + " profiling command buffers");
   // The frame that used this slot before has completed (begin_frame waited), but the other
   // slots' frames may still run: wait for them, so the first pass's time is its own.
-  VK_CHECK(vkQueueWaitIdle(context_.queue()));
+  MRGI_TRY(wait_submitted());
   Slot& slot = slots_[slot_];
   slot.host_ms.assign(n, 0.0);
   slot.cpu_ms.assign(n, 0.0);
@@ -714,7 +727,7 @@ Status FrameGraph::submit_profiled() {
   finish_execute(true);
   // The slot's fence marks the frame done, as in normal mode (an empty submission signals it).
   VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-  VK_CHECK(context_.fn().queue_submit2(context_.queue(), 1, &si, slot.fence));
+  VK_CHECK(context_.queue_submit2(si, slot.fence));
   slot.submitted = true;
   in_frame_ = false;
   return ok_status();
@@ -735,7 +748,7 @@ Status FrameGraph::submit() {
   VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
   si.commandBufferInfoCount = 1;
   si.pCommandBufferInfos = &cbi;
-  VK_CHECK(context_.fn().queue_submit2(context_.queue(), 1, &si, slot.fence));
+  VK_CHECK(context_.queue_submit2(si, slot.fence));
   slot.submitted = true;
   in_frame_ = false;
   return ok_status();

@@ -391,6 +391,10 @@ class FrameGraph {
   Status submit();
   // Waits for every frame in flight; returns their timings oldest first.
   Expected<std::vector<FrameTimings>> flush();
+  // Waits until every frame submitted and not yet collected has completed (their slots' fences;
+  // never the whole queue, which may be the app's: mrgi/vulkan_device.h). Timeout naming the
+  // frame where one does not finish.
+  Status wait_submitted() const;
   // Profiling mode from the next submit() on (FrameGraphSettings::allow_profiling must be set):
   // each pass its own submission, host-timed. BadUsage when the graph was made without it.
   Status set_profiling(bool on);

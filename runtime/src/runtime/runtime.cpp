@@ -17,7 +17,8 @@ namespace mrgi {
 namespace runtime_detail {
 
 RuntimeImpl::~RuntimeImpl() {
-  if (context_ && context_->device() != VK_NULL_HANDLE) vkDeviceWaitIdle(context_->device());
+  // Only mrgi's own frames (the queue and device may be the app's, busy with its work).
+  if (graph_) (void)graph_->wait_submitted();
   compose_.reset();
   specular_.reset();
   technique_.reset();

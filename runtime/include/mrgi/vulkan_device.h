@@ -1,0 +1,88 @@
+/// \file
+/// Running mrgi on the app's own Vulkan device. An app that already renders with Vulkan (a
+/// tablet app, a headset's compositor client) hands create_runtime() its instance, physical
+/// device, device and queue (DeviceSettings::app_device); mrgi then creates no instance or
+/// device of its own, allocates only from the app's device, submits to the app's queue and
+/// destroys none of them. In the order an app needs it:
+///  1. vulkan_device_requirements(): the API version, device extensions and features to enable
+///     when the app creates its device (merge them into its own);
+///  2. vkCreateDevice with them, then an AppVulkanDevice naming the objects and what was enabled;
+///  3. RuntimeSettings::device.app_device pointing to it: create_runtime() checks it and refuses
+///     with BadUsage naming every missing extension or feature.
+///
+/// Waiting: mrgi waits only on fences of its own submissions, never on the whole queue or device
+/// (no vkQueueWaitIdle, no vkDeviceWaitIdle), so the app's own work in flight never stalls it.
+/// Queue access: Vulkan requires a queue's submissions to be externally synchronised. mrgi submits
+/// from the thread that calls create_runtime, process() and flush() (and destroys from the one
+/// that destroys the runtime); an app that submits to the same queue from another thread passes
+/// lock_queue / unlock_queue, which mrgi calls around each of its vkQueueSubmit calls.
+/// Validation: layers belong to the app's instance; DeviceSettings::validate must stay false with
+/// an app device (enable VK_LAYER_KHRONOS_validation and a debug messenger on the instance).
+/// Needs the Vulkan headers (Debian: libvulkan-dev); mrgi/runtime.h does not.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include "mrgi/expected.h"
+#include "mrgi/export.h"
+
+namespace mrgi {
+
+/// What mrgi needs enabled on a device it runs on. Holds its own feature structures; chain()
+/// links them for VkDeviceCreateInfo::pNext (the pointers point into this object: do not copy or
+/// move it between chain() and vkCreateDevice).
+struct VulkanDeviceRequirements {
+  /// VK_API_VERSION_1_3, or 1_2 where the device has only 1.2 or `vulkan_1_2` was asked for
+  /// (synchronization2 and dynamic rendering then come from their KHR extensions).
+  uint32_t api_version = 0;
+  /// Device extensions to enable: VK_KHR_push_descriptor always; on 1.2 VK_KHR_synchronization2
+  /// and VK_KHR_dynamic_rendering; VK_EXT_shader_atomic_float where the device has image float
+  /// atomic add (optional: the light propagation volumes use it when it is enabled).
+  std::vector<const char*> device_extensions;
+  /// The features to enable, each only where the physical device has it (mrgi's techniques use
+  /// them; create_runtime refuses an app device without one the physical device offers).
+  VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  VkPhysicalDeviceVulkan11Features vulkan11{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES};
+  VkPhysicalDeviceVulkan12Features vulkan12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  /// synchronization2 and dynamicRendering: VkPhysicalDeviceVulkan13Features on 1.3, the
+  /// extensions' own structures on 1.2 (chain() links the right ones).
+  VkPhysicalDeviceVulkan13Features vulkan13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  VkPhysicalDeviceSynchronization2Features synchronization2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SYNCHRONIZATION_2_FEATURES};
+  VkPhysicalDeviceDynamicRenderingFeatures dynamic_rendering{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DYNAMIC_RENDERING_FEATURES};
+  VkPhysicalDeviceShaderAtomicFloatFeaturesEXT atomic_float{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_ATOMIC_FLOAT_FEATURES_EXT};
+  bool atomic_float_present = false;  ///< the device has it: device_extensions lists it, chain() links it
+  /// Links the structures above (`next` appended at the end) and returns &features.
+  MRGI_API VkPhysicalDeviceFeatures2* chain(void* next = nullptr);
+};
+
+/// The requirements for `physical` (of `instance`). Device (naming what is missing) where the
+/// device cannot run mrgi at all: Vulkan below 1.2, no push descriptors, no synchronization2 or
+/// dynamic rendering, no queue family with graphics and compute.
+MRGI_API Expected<VulkanDeviceRequirements> vulkan_device_requirements(VkInstance instance, VkPhysicalDevice physical,
+                                                                        bool vulkan_1_2 = false);
+
+/// The app's Vulkan objects for DeviceSettings::app_device. create_runtime copies this; the
+/// objects must outlive the runtime.
+struct AppVulkanDevice {
+  VkInstance instance = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_device = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  VkQueue queue = VK_NULL_HANDLE;  ///< a queue of `queue_family`
+  uint32_t queue_family = 0;       ///< must have graphics and compute
+  /// VkApplicationInfo::apiVersion the instance was created with (the version the app may use).
+  uint32_t api_version = VK_API_VERSION_1_3;
+  /// What the app passed to vkCreateDevice: its enabled device extensions and its feature chain
+  /// (VkPhysicalDeviceFeatures2 and the structures linked from it, or null for none), read only
+  /// during create_runtime. Vulkan has no query for what a device was created with.
+  std::vector<std::string> enabled_extensions;
+  const VkPhysicalDeviceFeatures2* enabled_features = nullptr;
+  /// Optional: called around each of mrgi's queue submissions when the app submits to the same
+  /// queue from another thread (both or neither).
+  std::function<void()> lock_queue, unlock_queue;
+};
+
+}  // namespace mrgi
