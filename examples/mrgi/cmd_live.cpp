@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "live_view.h"
 #include "mrgi/platform/apriltag.h"
 #include "mrgi/platform/devices.h"
 #include "mrgi/runtime.h"
@@ -36,11 +37,11 @@ std::atomic<bool> g_stop{false};
 void on_sigint(int) { g_stop = true; }
 
 struct LiveOptions {
-  std::string source, scene, out, device, env, env_model;
+  std::string source, scene, out, device, env, env_model, view_screenshot;
   QualityOptions quality;
   OutputImagesOption output_images;
   int frames = 0, timeout_ms = 3000;
-  bool quiet = false;
+  bool quiet = false, view = false;
 };
 
 // A unit-centred box of edge `edge` metres as a binary glTF (positions, normals, indices; one
@@ -232,14 +233,25 @@ void run_live(const LiveOptions& o) {
   settings.device.device = o.device;
   settings.exposure = info.exposure;
   CameraSetup cameras{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera};
-  auto runtime = take(create_runtime(settings, cameras, scene));
   const int out_w = info.color.width, out_h = info.color.height;
-  ReplayMeta meta{source->name(), runtime->technique(), level,
-                  level == kAutoLevel ? "auto" : runtime->level_names()[size_t(level)], runtime->device().name,
-                  runtime->device().type == "cpu", runtime->memory_mib(), out_w, out_h};
-  ReplayOutput output = take(ReplayOutput::create(o.out, meta));
-  if (Status st = output.set_images(o.output_images.wants("composite"), o.output_images.wants("overlay")); !st.ok())
-    fail_with(st.error());
+  // --view: the window's own device (the view is the app), mrgi on it; declared before the
+  // runtime so that it outlives it.
+  std::unique_ptr<LiveView> view;
+  if (o.view) {
+    view = take(LiveView::open("mrgi live " + source->name(), out_w, out_h, o.device));
+    settings.device.app_device = &view->device();
+  }
+  std::unique_ptr<Runtime> runtime = take(create_runtime(settings, cameras, scene));
+  // Without --out (only with --view) nothing is written.
+  std::optional<ReplayOutput> output;
+  if (!o.out.empty()) {
+    ReplayMeta meta{source->name(), runtime->technique(), level,
+                    level == kAutoLevel ? "auto" : runtime->level_names()[size_t(level)], runtime->device().name,
+                    runtime->device().type == "cpu", runtime->memory_mib(), out_w, out_h};
+    output.emplace(take(ReplayOutput::create(o.out, meta)));
+    if (Status st = output->set_images(o.output_images.wants("composite"), o.output_images.wants("overlay")); !st.ok())
+      fail_with(st.error());
+  }
 
   std::signal(SIGINT, on_sigint);
   std::map<int64_t, ImageRGB8> cameras_by_frame;
@@ -258,8 +270,10 @@ void run_live(const LiveOptions& o) {
   StageThread encode(
       [&] {
         while (auto f = finished.pop()) {
-          auto st = output.add(f->output, f->camera, nullptr, nullptr);
-          if (!st.ok()) fail_with(st.error());
+          if (output) {
+            auto st = output->add(f->output, f->camera, nullptr, nullptr);
+            if (!st.ok()) fail_with(st.error());
+          }
           encoded.put(std::move(f->output));
           ++written;
           if (!o.quiet)
@@ -274,10 +288,18 @@ void run_live(const LiveOptions& o) {
     BoundedQueue<Finished>& q;
     ~CloseOnExit() { q.close(); }
   } close_on_exit{finished};
+  bool technique_requested = false;
   auto consume = [&](std::vector<FrameOutput>&& outs) {
     for (FrameOutput& f : outs) {
       auto cam = cameras_by_frame.find(f.stats.frame_index);
       if (cam == cameras_by_frame.end()) throw CommandFailure(1, "internal: output for unknown frame " + std::to_string(f.stats.frame_index));
+      if (view) {  // on this thread: the window belongs to it
+        if (Status st = view->show(f.image, cam->second, view_status(*runtime, f.stats)); !st.ok()) fail_with(st.error());
+        const ViewRequests r = view->poll();
+        if (r.quit) g_stop = true;
+        technique_requested = technique_requested || r.next_technique;
+        if (Status st = step_level(*runtime, f.stats, r.level_step); !st.ok()) fail_with(st.error());
+      }
       Finished item{std::move(f), std::move(cam->second)};
       cameras_by_frame.erase(cam);
       if (!finished.push(std::move(item))) encode.join();  // the encoder failed: rethrow its error
@@ -292,6 +314,14 @@ void run_live(const LiveOptions& o) {
     cameras_by_frame[frame.index] = resize_bilinear(frame.color, out_w, out_h);
     for (FrameOutput& done : encoded.take_all()) runtime->recycle(std::move(done));
     consume(take(runtime->process(frame)));
+    if (technique_requested) {  // the view's T: this runtime's frames out, the next one on the same device
+      consume(take(runtime->flush()));
+      const RuntimeSettings next = take(next_technique_settings(settings, runtime->technique()));
+      runtime.reset();
+      runtime = take(create_runtime(next, cameras, scene));
+      technique_requested = false;
+      std::cerr << "mrgi live: view: technique " << next.technique << " from frame " << submitted << "\n";
+    }
   }
   consume(take(runtime->flush()));
   finished.close();
@@ -299,17 +329,23 @@ void run_live(const LiveOptions& o) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (written != submitted)
     throw CommandFailure(1, "internal: " + std::to_string(written) + " of " + std::to_string(submitted) + " frames came back");
-  output.set_achieved({written, seconds, "from the first frame to the last encoded, sensor waits included"});
+  if (output) output->set_achieved({written, seconds, "from the first frame to the last encoded, sensor waits included"});
   if (!o.quiet && seconds > 0.0)
     std::cerr << "mrgi live: " << written << " frames in " << seconds << " s: " << double(written) / seconds
               << " fps achieved\n";
-  nlohmann::json summary = take(output.finish());
+  nlohmann::json summary = output ? take(output->finish()) : nlohmann::json{{"frames", written}, {"written", "nothing (no --out)"}};
   if (!tracking_states.empty()) {
     std::cerr << "mrgi live: AprilTag tracking:";
     for (auto& [state, n] : tracking_states) std::cerr << " " << state << " " << n;
     std::cerr << "\n";
   }
   std::cout << summary.dump(2) << "\n";
+  if (view && !o.view_screenshot.empty()) {
+    if (Status st = write_png(o.view_screenshot, take(view->screenshot())); !st.ok()) fail_with(st.error());
+  } else if (view && !g_stop) {
+    std::cerr << "mrgi live: view: the last frame stays up until the window is closed (Q or Esc)\n";
+    view->hold();
+  }
 }
 
 void setup(CLI::App& app) {
@@ -320,14 +356,25 @@ void setup(CLI::App& app) {
   cmd->add_option("--scene", o->scene, "scene.json (default: a 15 cm box in front of the camera, one real light)");
   o->output_images.add(*cmd);
   cmd->add_option("--out,-o", o->out, "output folder (frames/, stats.json, summary.json, side_by_side.png); "
-                                      "no preview window is implemented, so it is required")->required();
+                                      "required unless --view shows the frames instead");
+  cmd->add_flag("--view", o->view,
+                "show each composite in a window as it comes back (the window's own Vulkan device, mrgi running on "
+                "it). Keys: T next technique, [ ] a cheaper / better level, S the camera frame beside it, I the "
+                "frame's figures in the title, Space pause, Q or Esc quit. Needs a display ($DISPLAY)");
+  cmd->add_option("--view-screenshot", o->view_screenshot,
+                  "with --view: at the end of the stream, write the window's pixels as the X server holds them to "
+                  "FILE (PNG) and close, instead of keeping the window up");
   cmd->add_option("--frames,-n", o->frames, "stop after N frames (0 = until the stream ends or Ctrl-C)")->check(CLI::NonNegativeNumber);
   cmd->add_option("--device", o->device, "Vulkan device: index, cpu / lavapipe, gpu, or name part");
   cmd->add_option("--env", o->env, "fisheye environment camera, v4l2:/dev/videoN or libcamera:ID (needs a calibrated model)");
   cmd->add_option("--env-model", o->env_model, "capture.json whose env_camera (fisheye equidistant) and exposure calibrate --env");
   cmd->add_option("--timeout-ms", o->timeout_ms, "longest wait for one frame before failing (ms)")->check(CLI::Range(1, 600000))->capture_default_str();
   cmd->add_flag("--quiet,-q", o->quiet, "no progress on stderr");
-  cmd->callback([o] { run_live(*o); });
+  cmd->callback([o] {
+    if (o->out.empty() && !o->view) throw CommandFailure(2, "live: --out is required (or --view to show the frames instead)");
+    if (!o->view_screenshot.empty() && !o->view) throw CommandFailure(2, "live: --view-screenshot: only with --view");
+    run_live(*o);
+  });
 }
 
 }  // namespace

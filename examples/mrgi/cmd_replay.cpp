@@ -8,6 +8,7 @@
 
 #include "ablation_names.h"
 #include "commands.h"
+#include "live_view.h"
 #include "mrgi/platform/apriltag.h"
 #include "mrgi/platform/capture.h"
 #include "mrgi/runtime.h"
@@ -26,6 +27,8 @@ struct ReplayOptions {
   OutputImagesOption output_images;
   int frames = 0, width = 0, height = 0, preload_frames = 0;
   bool validate = false, quiet = false, vulkan_1_2 = false, no_residual_light = false, profile = false;
+  bool view = false;
+  std::string view_screenshot;
 };
 
 // The settings the options give beyond the quality (o.quality.apply): device, output size,
@@ -76,7 +79,7 @@ struct Replay {
   const size_t frames;
   const int out_w, out_h;
   const double env_intensity;
-  Runtime& runtime;
+  Runtime* runtime;
   ReplayOutput& output;
   std::optional<AprilTagTracker>& tracker;
   size_t tracked = 0, untracked = 0;
@@ -90,6 +93,11 @@ struct Replay {
   // Outputs come back frames_in_flight calls late (Runtime::process): each input's camera frame
   // and true light wait here until then.
   std::vector<std::optional<Decoded>> in_flight;
+  // --view: the window each composite is shown in as it is written, and the runtime with the
+  // next technique for its T key (made on the view's device; the current one's frames flushed).
+  LiveView* view = nullptr;
+  std::function<Runtime*()> next_technique;
+  bool technique_requested = false, stopped = false;
 
   // One frame's input side (PNG reads, AprilTag, the environment's true light) and output side
   // (the reference read, error figures, PNG write), shared by both I/O modes.
@@ -122,6 +130,16 @@ struct Replay {
     if (!o.quiet)
       progress("replay " + o.quality.technique, written, frames,
                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    if (view) present(f);
+  }
+  // Shows the frame and takes the keys' requests: a level applies from the next frame on, a
+  // technique between chunks (the view runs chunks of one frame), quit ends the replay there.
+  void present(const Finished& f) {
+    if (Status s = view->show(f.output.image, f.camera, view_status(*runtime, f.output.stats)); !s.ok()) fail_with(s.error());
+    const ViewRequests r = view->poll();
+    stopped = stopped || r.quit;
+    technique_requested = technique_requested || r.next_technique;
+    if (Status s = step_level(*runtime, f.output.stats, r.level_step); !s.ok()) fail_with(s.error());
   }
   Finished finish(FrameOutput&& f) {
     const size_t i = size_t(f.stats.frame_index);
@@ -143,7 +161,9 @@ void Replay::run_preloaded() {
   const size_t in_px = size_t(info.color.width) * size_t(info.color.height);
   const size_t out_px = size_t(out_w) * size_t(out_h);
   const size_t frame_bytes = in_px * 5 + out_px * 8 + 1;
-  const size_t chunk = o.preload_frames > 0 ? std::min(size_t(o.preload_frames), frames)
+  // With --view a chunk is one frame: each is shown as it completes and the keys act at once.
+  const size_t chunk = view ? 1
+                     : o.preload_frames > 0 ? std::min(size_t(o.preload_frames), frames)
                                             : std::clamp<size_t>(kChunkBytes / frame_bytes, 4, frames);
   std::vector<FrameOutput> spares(chunk + 4);
   for (FrameOutput& s : spares) {
@@ -152,7 +172,7 @@ void Replay::run_preloaded() {
   }
   std::vector<Finished> done;
   done.reserve(chunk + 4);
-  for (size_t first = 0; first < frames; first += chunk) {
+  for (size_t first = 0; first < frames && !stopped; first += chunk) {
     const size_t last = std::min(frames, first + chunk);
     for (size_t i = first; i < last; ++i) in_flight[i] = decode_one(i);
     // Completion to completion, as the bench's sustained phase: the window opens when the
@@ -174,14 +194,14 @@ void Replay::run_preloaded() {
     };
     for (size_t i = first; i < last; ++i) {
       if (!spares.empty()) {
-        runtime.recycle(std::move(spares.back()));
+        runtime->recycle(std::move(spares.back()));
         spares.pop_back();
       }
-      auto outs = take(runtime.process(in_flight[i]->frame));
+      auto outs = take(runtime->process(in_flight[i]->frame));
       in_flight[i]->frame = InputFrame{};
       collect(std::move(outs));
     }
-    collect(take(runtime.flush()));
+    collect(take(runtime->flush()));
     if (wall0) {
       frames_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - *wall0).count();
       frames_cpu_seconds += process_cpu_seconds() - cpu0;
@@ -191,6 +211,10 @@ void Replay::run_preloaded() {
       spares.push_back(std::move(f.output));
     }
     done.clear();
+    if (technique_requested && next_technique) {
+      runtime = next_technique();
+      technique_requested = false;
+    }
   }
 }
 
@@ -230,13 +254,13 @@ void Replay::run_overlapped() {
       auto d = decoded.pop();
       if (!d) break;
       const size_t i = size_t(d->frame.index);
-      for (FrameOutput& done : encoded.take_all()) runtime.recycle(std::move(done));
-      auto outs = runtime.process(d->frame);
+      for (FrameOutput& done : encoded.take_all()) runtime->recycle(std::move(done));
+      auto outs = runtime->process(d->frame);
       in_flight[i] = std::move(d);
       in_flight[i]->frame = InputFrame{};
       ok = hand_on(take(std::move(outs)));
     }
-    if (ok) hand_on(take(runtime.flush()));
+    if (ok) hand_on(take(runtime->flush()));
   } catch (...) {
     decoded.close();
     finished.close();
@@ -293,9 +317,19 @@ void run_replay(const ReplayOptions& o) {
     scene.lights.clear();
     scene.environment = EnvironmentDesc{};
   }
-  auto runtime = take(create_runtime(settings, cameras, scene));
-
   const int out_w = o.width ? o.width : info.color.width, out_h = o.height ? o.height : info.color.height;
+  // --view: the window's own device (the view is the app), mrgi on it; declared before the
+  // runtime so that it outlives it.
+  std::unique_ptr<LiveView> view;
+  if (o.view) {
+    if (o.io == "overlapped") throw CommandFailure(2, "--view: frames are shown as they complete with --io preloaded only");
+    view = take(LiveView::open("mrgi replay " + o.capture, out_w, out_h, o.device));
+    settings.device.app_device = &view->device();
+  } else if (!o.view_screenshot.empty()) {
+    throw CommandFailure(2, "--view-screenshot: only with --view");
+  }
+  std::unique_ptr<Runtime> runtime = take(create_runtime(settings, cameras, scene));
+
   ReplayMeta meta{o.capture, runtime->technique(), level, level == kAutoLevel ? "auto" : runtime->level_names()[size_t(level)],
                   runtime->device().name, runtime->device().type == "cpu",
                   runtime->memory_mib(), out_w, out_h};
@@ -313,17 +347,26 @@ void run_replay(const ReplayOptions& o) {
   std::optional<AprilTagTracker> tracker;
   if (info.apriltag) tracker = take(AprilTagTracker::create(*info.apriltag, info.color));
 
-  Replay replay{o, capture, info, frames, out_w, out_h, env_intensity, *runtime, output, tracker};
+  Replay replay{o, capture, info, frames, out_w, out_h, env_intensity, runtime.get(), output, tracker};
+  replay.view = view.get();
+  replay.next_technique = [&]() -> Runtime* {
+    const RuntimeSettings next = take(next_technique_settings(settings, runtime->technique()));
+    runtime.reset();  // its frames were flushed with the chunk
+    runtime = take(create_runtime(next, cameras, scene));
+    std::cerr << "mrgi: view: technique " << next.technique << " from frame " << replay.written << "\n";
+    return runtime.get();
+  };
   replay.t0 = std::chrono::steady_clock::now();
   replay.in_flight.resize(frames);
   const bool preloaded = o.io != "overlapped";
   if (preloaded) replay.run_preloaded();
   else replay.run_overlapped();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - replay.t0).count();
-  if (replay.written != frames)
+  if (replay.written != frames && !replay.stopped)
     throw CommandFailure(1, "internal: " + std::to_string(replay.written) + " of " + std::to_string(frames) +
                                 " frames came back");
-  output.set_achieved({frames, seconds,
+  if (replay.stopped) std::cerr << "mrgi: view: stopped after " << replay.written << " of " << frames << " frames\n";
+  output.set_achieved({replay.written, seconds,
                        preloaded ? "decode a chunk of frames, process them back to back, encode them (PNG I/O included, "
                                    "never beside a frame)"
                                  : "decode, process and encode every frame, overlapped (PNG I/O included)"});
@@ -338,6 +381,12 @@ void run_replay(const ReplayOptions& o) {
     std::cerr << "mrgi: AprilTag tracking gave a pose for " << replay.tracked << " frames, none for "
               << replay.untracked << " (capture has no groundtruth.txt pose for them)\n";
   std::cout << replay_line(summary, o.out) << "\n";
+  if (view && !o.view_screenshot.empty()) {
+    if (Status st = write_png(o.view_screenshot, take(view->screenshot())); !st.ok()) fail_with(st.error());
+  } else if (view && !replay.stopped) {
+    std::cerr << "mrgi: view: the last frame stays up until the window is closed (Q or Esc)\n";
+    view->hold();
+  }
 }
 
 void setup(CLI::App& app) {
@@ -383,6 +432,14 @@ void setup(CLI::App& app) {
       ->check(CLI::IsMember(ablation_names(kDirAblations)));
   cmd->add_option("--device", opts->device, "Vulkan device: index, cpu / lavapipe, gpu, or name part (default $MRGI_DEVICE, else lavapipe)");
   cmd->add_flag("--validate", opts->validate, "enable Vulkan validation layers");
+  cmd->add_flag("--view", opts->view,
+                "show each composite in a window as it is written (the window's own Vulkan device, mrgi running on "
+                "it; frames one at a time). Keys: T next technique, [ ] a cheaper / better level, S the camera frame "
+                "beside it, I the frame's figures in the title, Space pause, Q or Esc quit. Needs a display "
+                "($DISPLAY; xvfb-run without one)");
+  cmd->add_option("--view-screenshot", opts->view_screenshot,
+                  "with --view: after the last frame, write the window's pixels as the X server holds them to FILE "
+                  "(PNG) and close, instead of keeping the window up");
   cmd->add_flag("--profile", opts->profile,
                 "profiling mode: each pass submitted alone and host-timed, so stats.json's per-pass times add up "
                 "to the frame on any device (without it, a CPU device's GPU timestamps do not time passes); "
