@@ -105,6 +105,35 @@ MRGI_FN vec3 srgb_decode(vec3 encoded) {
   return vec3(srgb_decode1(encoded.x), srgb_decode1(encoded.y), srgb_decode1(encoded.z));
 }
 
+// Y'CbCr camera frames (mrgi/frame.h YuvImage), converted by recon/yuv_to_rgb.comp and read
+// where the host needs the colour (light/camera_color.h): the layouts and matrices by number.
+#define MRGI_YUV_NV12 0
+#define MRGI_YUV_YUYV 1
+#define MRGI_YUV_BT601 0
+#define MRGI_YUV_BT709 1
+
+// One Y'CbCr sample (8-bit codes y, cb, cr) as the R'G'B' the colour frame holds (gamma-encoded,
+// taken as sRGB), [0, 1] per channel: ITU-R BT.601 or BT.709 luma coefficients (Kr, Kb), limited
+// range (Y' 16-235 and Cb Cr 16-240 span 219 and 224 codes) or full (0-255, JFIF):
+//   R' = Y' + 2 (1 - Kr) Pr,  B' = Y' + 2 (1 - Kb) Pb,  G' = Y' - (2 Kb (1 - Kb) Pb + 2 Kr (1 - Kr) Pr) / Kg.
+MRGI_FN vec3 yuv_to_encoded_rgb(float y, float cb, float cr, int matrix, bool full_range) {
+  float kr = matrix == MRGI_YUV_BT709 ? 0.2126f : 0.299f;
+  float kb = matrix == MRGI_YUV_BT709 ? 0.0722f : 0.114f;
+  float kg = 1.0f - kr - kb;
+  float luma = full_range ? y / 255.0f : (y - 16.0f) / 219.0f;
+  float pb = (cb - 128.0f) / (full_range ? 255.0f : 224.0f);
+  float pr = (cr - 128.0f) / (full_range ? 255.0f : 224.0f);
+  vec3 rgb = vec3(luma + 2.0f * (1.0f - kr) * pr, luma - (2.0f * kb * (1.0f - kb) * pb + 2.0f * kr * (1.0f - kr) * pr) / kg,
+                  luma + 2.0f * (1.0f - kb) * pb);
+  return clamp(rgb, vec3(0.0f), vec3(1.0f));
+}
+
+// The same as 8-bit codes packed r | g << 8 | b << 16 (rounded to nearest).
+MRGI_FN uint yuv_to_rgb8_packed(float y, float cb, float cr, int matrix, bool full_range) {
+  vec3 c = floor(yuv_to_encoded_rgb(y, cb, cr, matrix, full_range) * 255.0f + vec3(0.5f));
+  return uint(c.x) | (uint(c.y) << 8u) | (uint(c.z) << 16u);
+}
+
 // ---- microfacet BRDF -----------------------------------------------------------------------
 
 // GGX (Trowbridge-Reitz) distribution times Smith's height-correlated visibility, D(h) V(l, v),

@@ -1,5 +1,7 @@
 #include "light/light_stage.h"
 
+#include "light/camera_color.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -222,13 +224,13 @@ const std::vector<EnvLight>& LightStage::environment_regions() const {
 }
 
 glm::dvec3 LightStage::mean_camera_radiance(const InputFrame& frame) const {
-  const ImageRGB8& c = frame.color;
+  const CameraColor c(frame);
   if (c.empty() || !(cameras_.exposure > 0.0)) return glm::dvec3(0.0);
   glm::dvec3 sum(0.0);
   size_t n = 0;
-  for (int y = 4; y < c.height; y += 8)
-    for (int x = 4; x < c.width; x += 8) {
-      const uint8_t* p = c.at(x, y);
+  for (int y = 4; y < c.height(); y += 8)
+    for (int x = 4; x < c.width(); x += 8) {
+      const std::array<uint8_t, 3> p = c.at(x, y);
       sum += glm::dvec3(srgb8_to_linear(p[0]), srgb8_to_linear(p[1]), srgb8_to_linear(p[2]));
       ++n;
     }

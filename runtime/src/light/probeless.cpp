@@ -1,5 +1,7 @@
 #include "light/probeless.h"
 
+#include "light/camera_color.h"
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -179,8 +181,9 @@ void ProbelessBuilder::build_normals(const glm::mat3& rot) {
 
 Status ProbelessBuilder::add_part(const InputFrame& frame, const glm::dmat4& camera_to_world,
                                   double exposure, int part, LightSystem& system) {
+  const CameraColor camera(frame);
   if (frame.depth.width != depth_.width || frame.depth.height != depth_.height ||
-      frame.color.width != color_.width || frame.color.height != color_.height)
+      camera.width() != color_.width || camera.height() != color_.height)
     return fail(ErrorKind::BadInput, "probeless light estimation: frame " + std::to_string(frame.index) +
                                          " does not have the cameras' sizes");
   if (part < 0 || part >= settings_.parts)
@@ -234,9 +237,8 @@ Status ProbelessBuilder::add_part(const InputFrame& frame, const glm::dmat4& cam
       int count = 0;
       bool saturated = false;
       for (int y = cy0; y < cy1 && !saturated; ++y) {
-        const uint8_t* row = frame.color.data.data() + (size_t(y) * size_t(color_.width)) * 3;
         for (int x = cx0; x < cx1; ++x) {
-          const uint8_t* px = row + size_t(x) * 3;
+          const std::array<uint8_t, 3> px = camera.at(x, y);
           if (px[0] >= kSaturated || px[1] >= kSaturated || px[2] >= kSaturated) {
             saturated = true;
             break;

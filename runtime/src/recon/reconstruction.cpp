@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "gpu/shaders.h"
+#include "shared/mrgi_shared.h"
 
 namespace mrgi::recon {
 namespace {
@@ -64,7 +65,8 @@ Expected<Reconstruction> Reconstruction::create(gpu::Context& context, gpu::Fram
   r.settings_ = settings;
   r.color_bytes_ = size_t(color.width) * color.height * 3;
   r.depth_bytes_ = size_t(depth.width) * depth.height * 2;
-  const gpu::BufferDesc cb = camera_upload_desc("color_upload", r.color_bytes_);
+  // Whole groups of 4 pixels (12 bytes): what the Y'CbCr conversion writes at a time.
+  const gpu::BufferDesc cb = camera_upload_desc("color_upload", (r.color_bytes_ + 11) / 12 * 12);
   auto c = graph.create_buffer(cb, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (!c) return c.error();
   r.color_upload_ = *c;
@@ -72,6 +74,10 @@ Expected<Reconstruction> Reconstruction::create(gpu::Context& context, gpu::Fram
   auto d = graph.create_buffer(db, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (!d) return d.error();
   r.depth_upload_ = *d;
+  const gpu::BufferDesc yb = camera_upload_desc("color_yuv_upload", size_t(color.width) * size_t(color.height) * 2);
+  auto y = graph.create_buffer(yb, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  if (!y) return y.error();
+  r.yuv_upload_ = *y;
 
   // Transfer source: tests and debug tools read the reconstruction back.
   const VkImageUsageFlags usage =
@@ -103,16 +109,45 @@ Expected<Reconstruction> Reconstruction::create(gpu::Context& context, gpu::Fram
   auto wpp = gpu::load_compute_pipeline(context, "recon/warp_depth.comp", {});
   if (!wpp) return wpp.error();
   r.warp_pipeline_ = std::move(*wpp);
+  auto ypp = gpu::load_compute_pipeline(context, "recon/yuv_to_rgb.comp", {});
+  if (!ypp) return ypp.error();
+  r.yuv_pipeline_ = std::move(*ypp);
   return r;
 }
 
 void Reconstruction::upload(const gpu::FrameGraph& graph, const InputFrame& frame) {
-  std::memcpy(graph.mapped(color_upload_, graph.slot()), frame.color.data.data(), color_bytes_);
+  yuv_push_.frame.x = 0;
+  if (const std::optional<YuvImage>& yuv = frame.color_yuv) {
+    std::memcpy(graph.mapped(yuv_upload_, graph.slot()), yuv->data.data(), yuv->expected_bytes());
+    constexpr int kGroupsPerRow = 256;  // the dispatch's row of 4-pixel groups
+    yuv_push_.frame = glm::ivec4(yuv->width, yuv->height,
+                                 yuv->layout == YuvImage::Layout::Yuyv ? MRGI_YUV_YUYV : MRGI_YUV_NV12, kGroupsPerRow);
+    yuv_push_.format = glm::ivec4(yuv->matrix == YuvImage::Matrix::Bt709 ? MRGI_YUV_BT709 : MRGI_YUV_BT601,
+                                  yuv->range == YuvImage::Range::Full ? 1 : 0, 0, 0);
+  } else {
+    std::memcpy(graph.mapped(color_upload_, graph.slot()), frame.color.data.data(), color_bytes_);
+  }
   std::memcpy(graph.mapped(depth_upload_, graph.slot()), frame.depth.data.data(), depth_bytes_);
   // Same rule as the runtime's frame constants: no pose = the last known one (not moved).
   if (frame.pose) {
     pose_ = frame.pose->matrix();
   }
+}
+
+void Reconstruction::record_camera_input(gpu::FrameGraph& graph) {
+  if (yuv_push_.frame.x == 0) return;
+  graph.add_shader_pass(
+      "camera_yuv_to_rgb", gpu::PassKind::Compute, *yuv_pipeline_,
+      [this](gpu::ShaderPassBuilder& b) {
+        b.bind("yuv_words", yuv_upload_);
+        b.bind("rgb_words", color_upload_);
+      },
+      [this](VkCommandBuffer cmd, gpu::PassContext&) {
+        const uint32_t groups = (uint32_t(yuv_push_.frame.x) * uint32_t(yuv_push_.frame.y) + 3) / 4;
+        const uint32_t row = uint32_t(yuv_push_.frame.w);
+        gpu::dispatch_2d(cmd, *yuv_pipeline_, &yuv_push_, sizeof(yuv_push_), row, (groups + row - 1) / row);
+      });
+  graph.mark_output(color_upload_);  // the host reads the camera frame from it where nothing virtual shows
 }
 
 void Reconstruction::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_constants) {

@@ -52,8 +52,15 @@ class Reconstruction {
                                          const Intrinsics& color, const Intrinsics& depth,
                                          const ReconstructionSettings& settings = {});
   // Copies the frame's images into the current slot's upload buffers (sizes checked by the
-  // caller) and takes the frame's pose. Call between FrameGraph::begin_frame and submit.
+  // caller) and takes the frame's pose: the RGB8 colour as it is, a Y'CbCr colour
+  // (InputFrame::color_yuv) as the camera delivered it, for record_camera_input to convert. Call
+  // between FrameGraph::begin_frame and submit.
   void upload(const gpu::FrameGraph& graph, const InputFrame& frame);
+  // Adds camera_yuv_to_rgb where this frame's colour came as Y'CbCr: the RGB8 words of
+  // color_upload() from it on the GPU (shaders/recon/yuv_to_rgb.comp), before any pass reads
+  // them, kept for the host's reads too (the camera frame where nothing virtual shows). Nothing
+  // for an RGB8 frame. Every frame, whether or not the reconstruction runs.
+  void record_camera_input(gpu::FrameGraph& graph);
   // Adds recon_warp (when there is a history), recon_positions and recon_normals.
   void record(gpu::FrameGraph& graph, gpu::BufferHandle frame_constants);
   // A frame on which the reconstruction is not recorded (nothing virtual in view): the temporal
@@ -74,6 +81,14 @@ class Reconstruction {
   gpu::ImageHandle position_, normal_, albedo_, filtered_depth_, warped_;
   gpu::PipelineHandle warp_pipeline_, positions_pipeline_, normals_pipeline_;
   size_t color_bytes_ = 0, depth_bytes_ = 0;
+  // Y'CbCr colour: its upload (sized for YUYV, the larger layout), the conversion, and this
+  // frame's layout and format (yuv_to_rgb.comp ConvertConstants; frame.x 0: an RGB8 frame).
+  gpu::BufferHandle yuv_upload_;
+  gpu::PipelineHandle yuv_pipeline_;
+  struct YuvPush {
+    glm::ivec4 frame{0};
+    glm::ivec4 format{0};
+  } yuv_push_;
   ReconstructionSettings settings_;
   // Poses (camera-to-world) of this frame and the last recorded one; the history is usable
   // when a frame was recorded before at the same internal extent.

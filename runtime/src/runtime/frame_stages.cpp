@@ -5,7 +5,9 @@
 // The stages, and why each full-resolution pass is there (profiled ms at 640x480 on lavapipe x2,
 // baseline on desk_spot; floor pass about 1.2 ms):
 //   (upload)          host memcpy of colour and depth into this slot's buffers (in host_ms, <1)
-//   reconstruction    recon_warp: the temporal history warped into this frame's camera, internal
+//   reconstruction    camera_yuv_to_rgb, only for a Y'CbCr colour frame (InputFrame::color_yuv)
+//                     and on every such frame: its RGB8 words, which every later reader of the
+//                     camera takes; recon_warp: the temporal history warped into this frame's camera, internal
 //                     resolution (0.7 at lowest's 320x240, 2.5 at high's 640x480), the merge
 //                     needs it; recon_positions: depth decode, 3x3 same-surface median, temporal
 //                     merge, positions, albedo, fused in one pass (2.5 / 7.8): every technique
@@ -23,8 +25,9 @@
 //   specular finish   the mirrors' and glass's pixels over the technique's solutions
 //   compose           the output-resolution pass (6.0 with the composite): it writes the
 //                     frame the user sees
-// A frame nothing virtual affects runs no pass at all when the output has the camera's size:
-// upload and a host conversion of the camera frame (below 1 floor pass); at another size
+// A frame nothing virtual affects runs no pass at all when the output has the camera's size
+// (camera_yuv_to_rgb only, for a Y'CbCr frame): upload and a host conversion of the camera
+// frame (below 1 floor pass); at another size
 // compose's camera-copy pipeline resamples it (2-3 ms). Reconstruction and the technique are
 // not added.
 #include <string>
@@ -73,6 +76,7 @@ Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, 
 // is not needed for it; its temporal history restarts on the next affected frame (one frame of
 // unfiltered depth).
 Status RuntimeImpl::record_reconstruction(FrameContext& f) {
+  recon_->record_camera_input(*graph_);
   if (f.affected && f.recon_used) {
     recon_->record(*graph_, frame_constants_);
     return ok_status();

@@ -43,12 +43,33 @@ Status RuntimeImpl::check_frame(const InputFrame& frame) const {
   const Intrinsics& c = cameras_.color;
   const Intrinsics& d = cameras_.depth;
   const std::string where = "frame " + std::to_string(frame.index) + ": ";
-  if (frame.color.width != c.width || frame.color.height != c.height ||
-      frame.color.data.size() != size_t(c.width) * c.height * 3)
+  if (const std::optional<YuvImage>& yuv = frame.color_yuv) {
+    const std::string field = where + "InputFrame::color_yuv: ";
+    if (yuv->width != c.width || yuv->height != c.height)
+      return fail(ErrorKind::BadInput, field + "image is " + size_text(yuv->width, yuv->height) +
+                                           "; every frame must have the colour intrinsics' size " +
+                                           size_text(c.width, c.height) + " given at set-up");
+    const bool nv12 = yuv->layout == YuvImage::Layout::Nv12;
+    if (!nv12 && yuv->layout != YuvImage::Layout::Yuyv)
+      return fail(ErrorKind::BadInput, field + "layout is neither NV12 nor YUYV");
+    if (yuv->matrix != YuvImage::Matrix::Bt601 && yuv->matrix != YuvImage::Matrix::Bt709)
+      return fail(ErrorKind::BadInput, field + "matrix is neither BT.601 nor BT.709");
+    if (yuv->range != YuvImage::Range::Limited && yuv->range != YuvImage::Range::Full)
+      return fail(ErrorKind::BadInput, field + "range is neither limited nor full");
+    if (yuv->width % 2 != 0 || (nv12 && yuv->height % 2 != 0))
+      return fail(ErrorKind::BadInput, field + (nv12 ? "NV12 (4:2:0) needs an even width and height"
+                                                     : "YUYV (4:2:2) needs an even width"));
+    if (yuv->data.size() != yuv->expected_bytes())
+      return fail(ErrorKind::BadInput, field + "holds " + std::to_string(yuv->data.size()) + " bytes; " +
+                                           (nv12 ? "NV12" : "YUYV") + " at " + size_text(yuv->width, yuv->height) +
+                                           " is " + std::to_string(yuv->expected_bytes()));
+  } else if (frame.color.width != c.width || frame.color.height != c.height ||
+             frame.color.data.size() != size_t(c.width) * c.height * 3) {
     return fail(ErrorKind::BadInput, where + "colour image is " +
                                          size_text(frame.color.width, frame.color.height) +
                                          "; every frame must have the colour intrinsics' size " +
                                          size_text(c.width, c.height) + " given at set-up");
+  }
   if (frame.depth.width != d.width || frame.depth.height != d.height ||
       frame.depth.data.size() != size_t(d.width) * d.height)
     return fail(ErrorKind::BadInput, where + "depth image is " +
