@@ -9,6 +9,7 @@
 
 #include "common/camera_stream.h"
 #include "mrgi/platform/devices.h"
+#include "mrgi/runtime.h"
 #include "test_support.h"
 
 #define STB_IMAGE_WRITE_STATIC
@@ -250,6 +251,52 @@ TEST(CameraStream, StateMachineStreamsTimesOutAndLosesTheDevice) {
   EXPECT_EQ(after.error().kind, ErrorKind::Device);
   EXPECT_NE(after.error().message.find("unplugged"), std::string::npos) << after.error().message;
   EXPECT_EQ(rec->releases, 2);
+}
+
+// CameraSettings::yuv_to_runtime: YUYV and NV12 buffers go on as the camera delivered them (the
+// stride dropped), and the runtime's GPU conversion of them matches the host conversion of the
+// same buffer (platform/src/common/pixel_convert.cpp) within its rounding.
+TEST(CameraStream, YuvFramesGoToTheRuntimeAsDeliveredAndConvertThereAsOnTheHost) {
+  const ImageRGB8 src = test_pattern(64, 48);
+  for (const PixelFormat format : {PixelFormat::YUYV, PixelFormat::NV12}) {
+    SCOPED_TRACE(to_string(format));
+    auto backend = std::make_unique<RecordedBackend>();
+    RecordedBackend* rec = backend.get();
+    rec->offered.supported = {{format, 64, 48}};
+    rec->buffers = {format == PixelFormat::YUYV ? encode_yuyv(src) : encode_nv12(src)};
+    using E = RecordedBackend::Event;
+    rec->script = {E::Frame};
+    CameraSettings settings;
+    settings.width = 64;
+    settings.height = 48;
+    settings.yuv_to_runtime = true;
+    auto opened = CameraStreamSource::open(std::move(backend), settings);
+    ASSERT_TRUE(opened.ok()) << opened.error().message;
+    auto f = (*opened)->next(std::chrono::milliseconds(10));
+    ASSERT_TRUE(f.ok()) << f.error().message;
+    ASSERT_TRUE(f->color_yuv.has_value());
+    EXPECT_TRUE(f->color.empty());
+    EXPECT_EQ(f->color_yuv->layout, format == PixelFormat::YUYV ? YuvImage::Layout::Yuyv : YuvImage::Layout::Nv12);
+    EXPECT_EQ(f->color_yuv->data, rec->buffers[0]);
+    // Through a runtime with nothing virtual: its output is the converted camera frame.
+    ImageRGB8 host;
+    ASSERT_TRUE(convert_to_rgb8(RawFrame{format, 64, 48, 0, rec->buffers[0].data(), rec->buffers[0].size(), 0.0, 0}, host).ok());
+    RuntimeSettings rs;
+    rs.device.validate = true;
+    CameraSetup cams{(*opened)->info().color, (*opened)->info().depth, 5000.0, 1.0, std::nullopt};
+    auto rt = create_runtime(rs, cams, SceneDesc{});
+    ASSERT_TRUE(rt.ok()) << rt.error().message;
+    auto outs = (*rt)->process(*f);
+    ASSERT_TRUE(outs.ok()) << outs.error().message;
+    auto rest = (*rt)->flush();
+    ASSERT_TRUE(rest.ok());
+    const ImageRGBA8& gpu = (outs->empty() ? *rest : *outs).front().image;
+    int worst = 0;
+    for (int y = 0; y < 48; ++y)
+      for (int x = 0; x < 64; ++x)
+        for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(int(gpu.at(x, y)[c]) - int(host.at(x, y)[c])));
+    EXPECT_LE(worst, 1);
+  }
 }
 
 TEST(CameraStream, EndOfRecordingClosesAndCorruptFrameIsSkippable) {

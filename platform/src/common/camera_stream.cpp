@@ -153,7 +153,10 @@ Expected<InputFrame> CameraStreamSource::next(std::chrono::milliseconds timeout)
                                          to_string(format_.format) + " " + std::to_string(format_.width) + "x" +
                                          std::to_string(format_.height));
   }
-  const Status converted = convert_to_rgb8(frame, color_);
+  const bool pass_yuv =
+      settings_.yuv_to_runtime && (frame.format == PixelFormat::YUYV || frame.format == PixelFormat::NV12);
+  InputFrame out;
+  const Status converted = pass_yuv ? copy_yuv(frame, out.color_yuv.emplace()) : convert_to_rgb8(frame, color_);
   const Status released = backend_->release();
   if (!converted.ok()) return fail(converted.error().kind, name_ + ": " + converted.error().message);
   if (!released.ok()) {
@@ -161,11 +164,10 @@ Expected<InputFrame> CameraStreamSource::next(std::chrono::milliseconds timeout)
     shut_down(CameraState::Lost);
     return released.error();
   }
-  InputFrame out;
   out.index = emitted_++;
   out.timestamp = frame.timestamp;
   out.depth_timestamp = frame.timestamp;
-  out.color = color_;
+  if (!pass_yuv) out.color = color_;
   out.depth = ImageU16(color_.width, color_.height, 0);  // colour-only camera: nothing measured
   return out;
 }

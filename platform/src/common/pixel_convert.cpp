@@ -235,6 +235,32 @@ Status convert_to_rgb8(const RawFrame& f, ImageRGB8& out) {
   return fail(ErrorKind::BadInput, describe(f) + ": unsupported pixel format");
 }
 
+Status copy_yuv(const RawFrame& f, YuvImage& out) {
+  const bool nv12 = f.format == PixelFormat::NV12;
+  if (!nv12 && f.format != PixelFormat::YUYV)
+    return fail(ErrorKind::BadInput, describe(f) + ": only YUYV and NV12 are handed on as Y'CbCr");
+  if (f.width <= 0 || f.height <= 0 || f.width > 16384 || f.height > 16384)
+    return fail(ErrorKind::BadInput, describe(f) + ": frame size out of range 1..16384");
+  if (!f.data) return fail(ErrorKind::BadInput, describe(f) + ": no data");
+  if (f.width % 2 || (nv12 && f.height % 2))
+    return fail(ErrorKind::BadInput, describe(f) + (nv12 ? ": 4:2:0 needs an even width and height" : ": packed 4:2:2 needs an even width"));
+  const size_t row = nv12 ? size_t(f.width) : size_t(f.width) * 2;
+  const size_t stride = f.stride ? size_t(f.stride) : row;
+  const size_t rows = nv12 ? size_t(f.height) * 3 / 2 : size_t(f.height);
+  const size_t needed = stride * (rows - 1) + row;
+  if (f.size < needed)
+    return fail(ErrorKind::BadInput, describe(f) + ": buffer holds " + std::to_string(f.size) + " bytes, needs " +
+                                         std::to_string(needed) + " (short or truncated frame)");
+  out.layout = nv12 ? YuvImage::Layout::Nv12 : YuvImage::Layout::Yuyv;
+  out.matrix = YuvImage::Matrix::Bt601;
+  out.range = YuvImage::Range::Limited;
+  out.width = f.width;
+  out.height = f.height;
+  out.data.resize(row * rows);
+  for (size_t r = 0; r < rows; ++r) std::memcpy(out.data.data() + r * row, f.data + r * stride, row);
+  return ok_status();
+}
+
 std::vector<uint8_t> encode_yuyv(const ImageRGB8& rgb) {
   std::vector<uint8_t> out(size_t(rgb.width) * rgb.height * 2);
   for (int y = 0; y < rgb.height; ++y)

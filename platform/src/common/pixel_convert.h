@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "mrgi/expected.h"
+#include "mrgi/frame.h"
 #include "mrgi/image.h"
 
 namespace mrgi {
@@ -34,6 +35,11 @@ struct RawFrame {
   double timestamp = 0.0;      // seconds, the device's clock
   uint64_t sequence = 0;       // the driver's frame counter
 };
+
+// A YUYV or NV12 frame into `out` as it is (rows packed tightly, the stride dropped), BT.601
+// limited range: for the runtime to convert on the GPU (CameraSettings::yuv_to_runtime).
+// BadInput as convert_to_rgb8 for a short buffer, an odd size or another format.
+Status copy_yuv(const RawFrame& frame, YuvImage& out);
 
 // Converts into `out`, which is resized only when the frame size changes. Errors (BadInput) name
 // the format, the size and what is wrong (short buffer, corrupt JPEG, size mismatch).

@@ -32,6 +32,11 @@ struct CameraSettings {
   std::optional<Intrinsics> intrinsics;
   double nominal_hfov_deg = 60.0;
   double exposure = 1.0;        ///< capture.json exposure to report in info()
+  /// YUYV and NV12 frames handed on as the camera delivered them (InputFrame::color_yuv, BT.601
+  /// limited range, what UVC and most sensor pipelines send), for the runtime to convert on the
+  /// GPU, instead of converted to RGB here; `color` is then empty. For an app whose only reader
+  /// of the colour is the runtime. Other formats are converted as before.
+  bool yuv_to_runtime = false;
 };
 
 struct V4L2FormatEntry {
