@@ -37,11 +37,12 @@ std::atomic<bool> g_stop{false};
 void on_sigint(int) { g_stop = true; }
 
 struct LiveOptions {
-  std::string source, scene, out, device, env, env_model, view_screenshot;
+  std::string source, scene, out, device, env, env_model;
+  ViewOptions view;
   QualityOptions quality;
   OutputImagesOption output_images;
   int frames = 0, timeout_ms = 3000;
-  bool quiet = false, view = false;
+  bool quiet = false;
 };
 
 // A unit-centred box of edge `edge` metres as a binary glTF (positions, normals, indices; one
@@ -237,7 +238,7 @@ void run_live(const LiveOptions& o) {
   // --view: the window's own device (the view is the app), mrgi on it; declared before the
   // runtime so that it outlives it.
   std::unique_ptr<LiveView> view;
-  if (o.view) {
+  if (o.view.view) {
     view = take(LiveView::open("mrgi live " + source->name(), out_w, out_h, o.device));
     settings.device.app_device = &view->device();
   }
@@ -340,8 +341,8 @@ void run_live(const LiveOptions& o) {
     std::cerr << "\n";
   }
   std::cout << summary.dump(2) << "\n";
-  if (view && !o.view_screenshot.empty()) {
-    if (Status st = write_png(o.view_screenshot, take(view->screenshot())); !st.ok()) fail_with(st.error());
+  if (view && !o.view.screenshot.empty()) {
+    if (Status st = write_png(o.view.screenshot, take(view->screenshot())); !st.ok()) fail_with(st.error());
   } else if (view && !g_stop) {
     std::cerr << "mrgi live: view: the last frame stays up until the window is closed (Q or Esc)\n";
     view->hold();
@@ -357,13 +358,7 @@ void setup(CLI::App& app) {
   o->output_images.add(*cmd);
   cmd->add_option("--out,-o", o->out, "output folder (frames/, stats.json, summary.json, side_by_side.png); "
                                       "required unless --view shows the frames instead");
-  cmd->add_flag("--view", o->view,
-                "show each composite in a window as it comes back (the window's own Vulkan device, mrgi running on "
-                "it). Keys: T next technique, [ ] a cheaper / better level, S the camera frame beside it, I the "
-                "frame's figures in the title, Space pause, Q or Esc quit. Needs a display ($DISPLAY)");
-  cmd->add_option("--view-screenshot", o->view_screenshot,
-                  "with --view: at the end of the stream, write the window's pixels as the X server holds them to "
-                  "FILE (PNG) and close, instead of keeping the window up");
+  o->view.add(*cmd, "as it comes back", "at the end of the stream");
   cmd->add_option("--frames,-n", o->frames, "stop after N frames (0 = until the stream ends or Ctrl-C)")->check(CLI::NonNegativeNumber);
   cmd->add_option("--device", o->device, "Vulkan device: index, cpu / lavapipe, gpu, or name part");
   cmd->add_option("--env", o->env, "fisheye environment camera, v4l2:/dev/videoN or libcamera:ID (needs a calibrated model)");
@@ -371,8 +366,8 @@ void setup(CLI::App& app) {
   cmd->add_option("--timeout-ms", o->timeout_ms, "longest wait for one frame before failing (ms)")->check(CLI::Range(1, 600000))->capture_default_str();
   cmd->add_flag("--quiet,-q", o->quiet, "no progress on stderr");
   cmd->callback([o] {
-    if (o->out.empty() && !o->view) throw CommandFailure(2, "live: --out is required (or --view to show the frames instead)");
-    if (!o->view_screenshot.empty() && !o->view) throw CommandFailure(2, "live: --view-screenshot: only with --view");
+    if (o->out.empty() && !o->view.view) throw CommandFailure(2, "live: --out is required (or --view to show the frames instead)");
+    if (!o->view.screenshot.empty() && !o->view.view) throw CommandFailure(2, "live: --view-screenshot: only with --view");
     run_live(*o);
   });
 }

@@ -27,8 +27,7 @@ struct ReplayOptions {
   OutputImagesOption output_images;
   int frames = 0, width = 0, height = 0, preload_frames = 0;
   bool validate = false, quiet = false, vulkan_1_2 = false, no_residual_light = false, profile = false;
-  bool view = false;
-  std::string view_screenshot;
+  ViewOptions view;
 };
 
 // The settings the options give beyond the quality (o.quality.apply): device, output size,
@@ -321,11 +320,11 @@ void run_replay(const ReplayOptions& o) {
   // --view: the window's own device (the view is the app), mrgi on it; declared before the
   // runtime so that it outlives it.
   std::unique_ptr<LiveView> view;
-  if (o.view) {
+  if (o.view.view) {
     if (o.io == "overlapped") throw CommandFailure(2, "--view: frames are shown as they complete with --io preloaded only");
     view = take(LiveView::open("mrgi replay " + o.capture, out_w, out_h, o.device));
     settings.device.app_device = &view->device();
-  } else if (!o.view_screenshot.empty()) {
+  } else if (!o.view.screenshot.empty()) {
     throw CommandFailure(2, "--view-screenshot: only with --view");
   }
   std::unique_ptr<Runtime> runtime = take(create_runtime(settings, cameras, scene));
@@ -381,8 +380,8 @@ void run_replay(const ReplayOptions& o) {
     std::cerr << "mrgi: AprilTag tracking gave a pose for " << replay.tracked << " frames, none for "
               << replay.untracked << " (capture has no groundtruth.txt pose for them)\n";
   std::cout << replay_line(summary, o.out) << "\n";
-  if (view && !o.view_screenshot.empty()) {
-    if (Status st = write_png(o.view_screenshot, take(view->screenshot())); !st.ok()) fail_with(st.error());
+  if (view && !o.view.screenshot.empty()) {
+    if (Status st = write_png(o.view.screenshot, take(view->screenshot())); !st.ok()) fail_with(st.error());
   } else if (view && !replay.stopped) {
     std::cerr << "mrgi: view: the last frame stays up until the window is closed (Q or Esc)\n";
     view->hold();
@@ -432,14 +431,7 @@ void setup(CLI::App& app) {
       ->check(CLI::IsMember(ablation_names(kDirAblations)));
   cmd->add_option("--device", opts->device, "Vulkan device: index, cpu / lavapipe, gpu, or name part (default $MRGI_DEVICE, else lavapipe)");
   cmd->add_flag("--validate", opts->validate, "enable Vulkan validation layers");
-  cmd->add_flag("--view", opts->view,
-                "show each composite in a window as it is written (the window's own Vulkan device, mrgi running on "
-                "it; frames one at a time). Keys: T next technique, [ ] a cheaper / better level, S the camera frame "
-                "beside it, I the frame's figures in the title, Space pause, Q or Esc quit. Needs a display "
-                "($DISPLAY; xvfb-run without one)");
-  cmd->add_option("--view-screenshot", opts->view_screenshot,
-                  "with --view: after the last frame, write the window's pixels as the X server holds them to FILE "
-                  "(PNG) and close, instead of keeping the window up");
+  opts->view.add(*cmd, "as it is written (frames one at a time)", "after the last frame");
   cmd->add_flag("--profile", opts->profile,
                 "profiling mode: each pass submitted alone and host-timed, so stats.json's per-pass times add up "
                 "to the frame on any device (without it, a CPU device's GPU timestamps do not time passes); "

@@ -63,6 +63,14 @@ struct QualityOptions {
   void apply(RuntimeSettings& settings) const;  // technique, level, frame_budget_ms, knobs
 };
 
+// --view and --view-screenshot (live_view.h: the window, its keys), as replay and live take them;
+// `frames` says how that command's frames reach the window, `end` when the screenshot is taken.
+struct ViewOptions {
+  bool view = false;
+  std::string screenshot;
+  void add(CLI::App& cmd, const std::string& frames, const std::string& end);
+};
+
 // --output: the images a replay or live run writes per frame (composite, overlay), for
 // ReplayOutput::set_images.
 struct OutputImagesOption {

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "commands.h"
 #include "live_view.h"
 
 namespace mrgi::tool {
@@ -34,6 +35,18 @@ Expected<RuntimeSettings> next_technique_settings(const RuntimeSettings& current
   if (!levels) return levels.error();
   if (next.level != kAutoLevel) next.level = std::min(next.level, int(levels->size()) - 1);
   return next;
+}
+
+void ViewOptions::add(CLI::App& cmd, const std::string& frames, const std::string& end) {
+  cmd.add_flag("--view", view,
+               "show each composite in a window " + frames +
+                   " (the window's own Vulkan device, mrgi running on it). Keys: T next technique, [ ] a cheaper / "
+                   "better level, S the camera frame beside it, I the frame's figures in the title, Space pause, Q "
+                   "or Esc quit. Needs a display ($DISPLAY; xvfb-run without one)");
+  cmd.add_option("--view-screenshot", screenshot,
+                 "with --view: " + end +
+                     ", write the window's pixels as the X server holds them to FILE (PNG) and close, instead of "
+                     "keeping the window up");
 }
 
 }  // namespace mrgi::tool

@@ -1,6 +1,7 @@
 // Helpers shared by the platform tests: temp folders and a watchdog so that a hang fails the test
 // binary loudly instead of blocking CI.
 #pragma once
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -8,6 +9,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <functional>
 #include <future>
 #include <string>
@@ -38,6 +41,18 @@ struct TempDir {
     return c;
   }
 };
+
+// A shell command's exit status (-1 when it did not exit normally).
+inline int run_command(const std::string& cmd) {
+  const int rc = std::system(cmd.c_str());
+  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+
+// A text file's contents (empty when it cannot be read).
+inline std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  return std::string((std::istreambuf_iterator<char>(in)), {});
+}
 
 // Runs fn on another thread; if it has not returned after `limit`, the process aborts with a
 // message (a hang is a failure, and a hung thread cannot be cancelled).

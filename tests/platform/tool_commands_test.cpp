@@ -17,15 +17,8 @@ namespace {
 
 const std::string kOni = test::shared_data("openni/kinect-12frames.oni");
 
-int run(const std::string& cmd) {
-  const int rc = std::system(cmd.c_str());
-  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  return std::string((std::istreambuf_iterator<char>(in)), {});
-}
+int run(const std::string& cmd) { return test::run_command(cmd); }
+std::string slurp(const std::string& path) { return test::read_text(path); }
 
 size_t count_files(const std::string& dir) {
   size_t n = 0;

@@ -14,15 +14,8 @@
 namespace mrgi {
 namespace {
 
-int run(const std::string& cmd) {
-  const int rc = std::system(cmd.c_str());
-  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  return std::string((std::istreambuf_iterator<char>(in)), {});
-}
+int run(const std::string& cmd) { return test::run_command(cmd); }
+std::string slurp(const std::string& path) { return test::read_text(path); }
 
 const std::string kReplay = std::string("env LP_NUM_THREADS=2 timeout 300 ") + MRGI_TOOL + " replay " + MRGI_SOURCE_DIR +
                             "/data/sample --technique baseline -q";
