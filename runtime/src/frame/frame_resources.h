@@ -4,6 +4,7 @@
 // stage it creates; the FrameInfo of each frame to every stage it records.
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -125,6 +126,10 @@ struct FrameInfo {
   glm::dmat4 camera_to_world{1.0};   // this frame's pose (the previous one when none was given)
   const InputFrame* input = nullptr; // the host copy of this frame's images (valid during record)
   const CausticPhotons* caustics = nullptr;  // this frame's, written before record(); or none
+  // The internal pixels where a virtual pixel can be this frame (recon::VirtualGBuffer::
+  // objects_area); outside it every pixel is real, so a pass may run a variant without the
+  // virtual surfaces' code there. nullopt: not known (every pixel may be virtual).
+  std::optional<VkRect2D> virtual_area;
 };
 
 }  // namespace mrgi::frame

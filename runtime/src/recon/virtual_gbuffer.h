@@ -39,6 +39,10 @@ class VirtualGBuffer {
   // This frame's coverage at the output resolution; invalid when the G-buffer has the output's
   // size (position()'s w is then the mask at the output's pixels).
   gpu::ImageHandle output_coverage() const { return coverage_recorded_ ? coverage_ : gpu::ImageHandle{}; }
+  // The internal pixels where this frame's virtual pixels can be: the visible objects' projected
+  // bounds with a pixel of margin (the whole image when a bound's corner is behind the camera),
+  // empty without an object. Valid after record(); outside it every pixel is real.
+  VkRect2D objects_area() const { return area_.previous; }
   // The output pixels this frame's coverage raster drew and cleared; outside it the coverage is
   // 0 (empty without a coverage raster).
   VkRect2D output_coverage_area() const {
@@ -52,6 +56,8 @@ class VirtualGBuffer {
   // texel is still the clear value, so readers see an empty target there as before. Why: the
   // four full-screen clears cost 1.4 ms of the G-buffer pass on lavapipe at 640x480.
   struct RasterArea {
+    // now: the area drawn and cleared; previous: after update_area, this frame's objects' bounds
+    // (what the next frame must clear).
     VkRect2D now{{0, 0}, {0, 0}}, previous{{0, 0}, {0, 0}};
     VkExtent2D previous_extent{0, 0};
   };

@@ -114,6 +114,7 @@ Status RuntimeImpl::record_virtual_gbuffer(FrameContext& f) {
   virtual_gbuffer_->record(*graph_, frame_constants_,
                            own ? *own : frame::RealGeometry{recon_->position(), recon_->normal(), 1},
                            f.level.mesh_error_px);
+  f.info.virtual_area = virtual_gbuffer_->objects_area();
   return ok_status();
 }
 

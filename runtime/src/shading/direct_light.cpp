@@ -12,6 +12,7 @@
 #include "gpu/shaders.h"
 #include "gpu/vk_check.h"
 #include "light/light_stage.h"
+#include "shading/shade_dispatch.h"
 #include "shading/shadow_plan.h"
 #include "shared/occlusion_math.h"
 #include "specular/caustic_receiver.glsl"
@@ -57,16 +58,19 @@ struct ShadePush {
   glm::vec4 shadow;
   VolumeIndirect::Constants volume;
   glm::ivec4 indirect;
+  glm::ivec4 rect;  // this dispatch's pixels [x0, x1) x [y0, y1)
 };
 
 // direct_light.comp's specialisation constants, in constant_id order: the indirect encoding
 // (0 none, 1 ScreenIndirect, 2 VolumeIndirect), kOneShadowMap, kCausticReceivers,
-// kVolumeDifference, kVolumeVirtual.
+// kVolumeDifference, kVolumeVirtual; kRealOnly (constant_id 6) for the pixels outside the
+// objects' bounds.
 struct ShadeVariant {
   uint32_t indirect = 0;
-  bool difference = false, virtual_volume = false, caustics = false;
+  bool difference = false, virtual_volume = false, caustics = false, real_only = false;
   uint32_t key() const {
-    return indirect | (difference ? 4u : 0u) | (virtual_volume ? 8u : 0u) | (caustics ? 16u : 0u);
+    return indirect | (difference ? 4u : 0u) | (virtual_volume ? 8u : 0u) | (caustics ? 16u : 0u) |
+           (real_only ? 32u : 0u);
   }
 };  // (kEnvOcclusion, constant_id 5, is the block's: on whenever the scene has virtual objects)
 
@@ -133,7 +137,10 @@ struct DirectLightBlock::Impl {
   // (only that bounce where the ambient is the residual estimate), or left out.
   void record_occlusion(const EnvOcclusionLevel& level, const light::ShRgb& ambient, const std::vector<LightDesc>& lights,
                         std::vector<std::string>& skipped);
-  void add_shade_pass(const gpu::Pipeline& pipeline);
+  // shade_direct: `general` over `virtual_area` (the whole image when not known), `real_only`
+  // over the bands around it.
+  void add_shade_pass(const gpu::Pipeline& general, const gpu::Pipeline& real_only,
+                      const std::optional<VkRect2D>& virtual_area);
   void render_faces(VkCommandBuffer cmd, gpu::PassContext& pass, const std::vector<ShadowFace>& faces,
                     const std::vector<VkImageView>& layer_views);
   // direct_light.comp's LevelConstants::shadow at this frame's level.
@@ -275,16 +282,20 @@ Status DirectLightBlock::Impl::create_pipelines() {
     for (const bool difference : {false, true})
       for (const bool virtual_volume : {false, true}) variants.push_back({2, difference, virtual_volume, false});
   const bool specular = frame_.scene_gpu->specular;
+  // Each also as kRealOnly, for the pixels no virtual object can cover.
   for (ShadeVariant v : variants) {
     for (const bool caustics : {false, true}) {
       if (caustics && !specular) continue;
       v.caustics = caustics;
-      auto sp = gpu::create_compute_pipeline(
-          ctx, {"direct_light_" + std::to_string(v.key()), *shade_spv, {}, sizeof(ShadePush),
-                {v.indirect, options_.one_shadow_map ? 1u : 0u, caustics ? 1u : 0u, v.difference ? 1u : 0u,
-                 v.virtual_volume ? 1u : 0u, occlusion_ ? 1u : 0u}});
-      if (!sp) return sp.error();
-      shade_pipelines_[v.key()] = gpu::PipelineHandle(ctx, std::move(*sp));
+      for (const bool real_only : {false, true}) {
+        v.real_only = real_only;
+        auto sp = gpu::create_compute_pipeline(
+            ctx, {"direct_light_" + std::to_string(v.key()), *shade_spv, {}, sizeof(ShadePush),
+                  {v.indirect, options_.one_shadow_map ? 1u : 0u, caustics ? 1u : 0u, v.difference ? 1u : 0u,
+                   v.virtual_volume ? 1u : 0u, occlusion_ ? 1u : 0u, real_only ? 1u : 0u}});
+        if (!sp) return sp.error();
+        shade_pipelines_[v.key()] = gpu::PipelineHandle(ctx, std::move(*sp));
+      }
     }
   }
   return ok_status();
@@ -344,7 +355,10 @@ Status DirectLightBlock::record(const frame::FrameInfo& info, const DirectLightL
   m.receiver_lamps_ = m.caustics_ ? info.caustics->receiver_lamps : m.no_receiver_lamps_;
   m.add_shadow_passes(skipped);
   m.record_occlusion(level.env_occlusion, m.ambient_rv_, m.drawn_, skipped);
-  m.add_shade_pass(*m.shade_pipelines_.at(variant_of(indirect, m.caustics_).key()));
+  ShadeVariant v = variant_of(indirect, m.caustics_);
+  const gpu::Pipeline& general = *m.shade_pipelines_.at(v.key());
+  v.real_only = true;
+  m.add_shade_pass(general, *m.shade_pipelines_.at(v.key()), info.virtual_area);
   return ok_status();
 }
 
@@ -399,7 +413,8 @@ void DirectLightBlock::Impl::add_shadow_passes(std::vector<std::string>& skipped
   }
 }
 
-void DirectLightBlock::Impl::add_shade_pass(const gpu::Pipeline& pipeline) {
+void DirectLightBlock::Impl::add_shade_pass(const gpu::Pipeline& pipeline, const gpu::Pipeline& real_only,
+                                            const std::optional<VkRect2D>& virtual_area) {
   const VkSampler compare = frame_.context->samplers().shadow_compare;
   const VkSampler linear = frame_.context->samplers().linear_clamp;
   const VkSampler nearest = frame_.context->samplers().nearest_clamp;
@@ -428,14 +443,18 @@ void DirectLightBlock::Impl::add_shade_pass(const gpu::Pipeline& pipeline) {
         b.bind("caustic_receivers", receivers_);
         b.bind("CausticReceiverLamps", receiver_lamps_);
       },
-      [this, &pipeline](VkCommandBuffer cmd, gpu::PassContext& pass) {
+      [this, &pipeline, &real_only, virtual_area](VkCommandBuffer cmd, gpu::PassContext& pass) {
         ShadePush pc{};
         pc.shadow = shadow_constants();
         if (const auto* volume = std::get_if<VolumeIndirect>(&indirect_)) pc.volume = volume->constants;
         if (const auto* screen = std::get_if<ScreenIndirect>(&indirect_)) pc.indirect.y = screen->divisor;
         pc.indirect.z = occlusion_ ? occlusion_->divisor() : 0;
         const VkExtent2D e = pass.extent(frame_.lit_rv);
-        gpu::dispatch_2d(cmd, pipeline, &pc, sizeof(pc), e.width, e.height);
+        for (const ShadeDispatch& d : shade_dispatches(e, virtual_area)) {
+          pc.rect = d.rect;
+          gpu::dispatch_2d(cmd, d.real_only ? real_only : pipeline, &pc, sizeof(pc), uint32_t(d.rect.z - d.rect.x),
+                           uint32_t(d.rect.w - d.rect.y));
+        }
       });
 }
 
