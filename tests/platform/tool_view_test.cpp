@@ -80,6 +80,38 @@ TEST_F(ToolView, LiveViewShowsTheLastFrameWithOrWithoutOutput) {
   EXPECT_NE(slurp(dir.file("err3.txt")).find("--out is required (or --view"), std::string::npos) << slurp(dir.file("err3.txt"));
 }
 
+// The keys, pressed with xdotool while the replay is paused (Space) so that each acts on a known
+// frame: [ a cheaper level from the next frame on, T the next technique, S the camera frame beside
+// the composite (the window twice as wide).
+TEST_F(ToolView, TheKeysChangeLevelTechniqueAndSideBySide) {
+  if (!have_xvfb()) GTEST_SKIP() << "xvfb-run not installed (Debian: xvfb)";
+  if (run("command -v xdotool > /dev/null 2>&1") != 0) GTEST_SKIP() << "xdotool not installed (Debian: xdotool): no keys to press";
+  test::TempDir dir("view_keys");
+  const std::string out = dir.file("out"), shot = dir.file("shot.png"), err = dir.file("err.txt");
+  std::ofstream script(dir.file("keys.sh"));
+  script << kReplay << " --level medium --frames 8 --out " << out << " --view --view-screenshot " << shot << " 2> " << err
+         << " &\n"
+         << "pid=$!\n"
+         << "for i in $(seq 300); do w=$(xdotool search --name 'mrgi replay' 2>/dev/null | head -1); [ -n \"$w\" ] && break; sleep 0.1; done\n"
+         << "[ -n \"$w\" ] || { kill $pid; exit 3; }\n"
+         << "frame() { xdotool getwindowname $w | sed -n 's/.*| frame \\([0-9]*\\) .*/\\1/p'; }\n"
+         << "xdotool key --window $w space bracketleft; sleep 0.3; f=$(frame); xdotool key --window $w space\n"
+         // Until a frame after the one that took the level has been shown (the title says which).
+         << "for i in $(seq 600); do n=$(frame); [ -n \"$n\" ] && [ \"$n\" -ge $((f + 2)) ] && break; sleep 0.05; done\n"
+         << "xdotool key --window $w space t s space\n"
+         << "wait $pid\n";
+  script.close();
+  ASSERT_EQ(run("xvfb-run -a -s '-screen 0 1600x1200x24' bash " + dir.file("keys.sh") + " > /dev/null 2>&1"), 0)
+      << slurp(err);
+  const std::string log = slurp(err);
+  EXPECT_NE(log.find("mrgi: view: technique ssrt from frame"), std::string::npos) << log;
+  const std::string stats = slurp(out + "/stats.json");
+  EXPECT_NE(stats.find("\"level\": 2"), std::string::npos) << "no frame at the cheaper level";
+  auto seen = load_png_rgb8(shot);
+  ASSERT_TRUE(seen.ok()) << seen.error().message;
+  EXPECT_EQ(seen->width, 2 * 640) << "side by side: the camera frame beside the composite";
+}
+
 TEST_F(ToolView, NoDisplayIsAClearErrorAndWritesNothing) {
   test::TempDir dir("view_no_display");
   const std::string out = dir.file("out");
