@@ -26,7 +26,9 @@ void expect_partition(VkExtent2D e, const std::optional<VkRect2D>& area) {
       ASSERT_EQ(hits[size_t(y) * e.width + x], 1) << "pixel " << x << "," << y;
       const bool in_area = !area || (int(x) >= area->offset.x && int(x) < area->offset.x + int(area->extent.width) &&
                                      int(y) >= area->offset.y && int(y) < area->offset.y + int(area->extent.height));
-      if (in_area) ASSERT_EQ(general[size_t(y) * e.width + x], 1) << "virtual-capable pixel " << x << "," << y;
+      if (in_area) {
+        ASSERT_EQ(general[size_t(y) * e.width + x], 1) << "virtual-capable pixel " << x << "," << y;
+      }
     }
 }
 
