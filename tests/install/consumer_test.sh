@@ -46,10 +46,16 @@ cp -r "$src/examples/frames_from_memory" "$work/consumer"
 cmake -S "$work/consumer" -B "$work/consumer-build" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release > "$work/configure.log"
 cmake --build "$work/consumer-build" -j2 > "$work/build.log"
 "$work/consumer-build/frames_from_memory" "$sample" "$work/cmake.ppm"
+# An app on its own Vulkan device (mrgi/vulkan_device.h, the platform library's capture reader),
+# built against the prefix like any app.
+cp -r "$src/examples/app_device" "$work/app_device"
+cmake -S "$work/app_device" -B "$work/app_device-build" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release > "$work/app_device-configure.log"
+cmake --build "$work/app_device-build" -j2 > "$work/app_device-build.log"
+"$work/app_device-build/app_device" "$src/data/sample" 2 | grep -q "the app's device still works after the runtime"
 # pkg-config consumer.
 export PKG_CONFIG_PATH="$prefix/lib/pkgconfig"
 test "$(pkg-config --modversion mrgi)" = "$(sed -n 's/^project(mrgi VERSION \([0-9.]*\).*/\1/p' "$src/CMakeLists.txt")"
 c++ -std=c++20 -O1 "$work/consumer/main.cpp" -o "$work/pc_consumer" $(pkg-config --cflags --libs mrgi)
 "$work/pc_consumer" "$sample" "$work/pc.ppm"
 cmp "$work/cmake.ppm" "$work/pc.ppm"
-echo "consumer built and ran against $prefix (CMake and pkg-config)"
+echo "consumers built and ran against $prefix (CMake and pkg-config; an app's own Vulkan device)"
