@@ -158,6 +158,10 @@ class GlfwView final : public LiveView {
     XSync(display, False);
     XImage* shot = XGetImage(display, window, 0, 0, unsigned(width_), unsigned(height_), AllPlanes, ZPixmap);
     if (!shot) return fail(ErrorKind::Device, "live view: XGetImage of the window failed");
+    if (!shot->red_mask || !shot->green_mask || !shot->blue_mask) {
+      XDestroyImage(shot);
+      return fail(ErrorKind::Device, "live view: the window's visual has no RGB masks (not TrueColor): no screenshot");
+    }
     ImageRGB8 out(width_, height_);
     for (int y = 0; y < height_; ++y)
       for (int x = 0; x < width_; ++x) {
