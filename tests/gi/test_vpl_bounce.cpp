@@ -41,7 +41,7 @@ std::vector<shader::Vpl> bounce(gpu::Context& ctx, const shader::Vpl& source_vpl
   gi::VplBounceSettings bs;
   bs.max_slots = kSlots;
   bs.glossy = glossy;
-  auto b = gi::VplBounce::create(*r.graph, *r.scene, ism->virtual_triangles(), {r.real.position, r.real.normal, r.real.albedo}, bs);
+  auto b = gi::VplBounce::create(*r.graph, *r.scene, {r.real.position, r.real.normal, r.real.albedo}, bs);
   EXPECT_TRUE(b.ok()) << b.error().message;
   gpu::BufferDesc vd{"source vpls", sizeof(shader::Vpl), gpu::MemoryUsage::Upload};
   const gpu::BufferHandle source = *r.graph->create_buffer(vd, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);

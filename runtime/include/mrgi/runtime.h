@@ -95,16 +95,34 @@ class MRGI_API Runtime {
   virtual Status set_frame_budget_ms(double budget_ms) = 0;
   /// Profiling mode from the next frame on (RuntimeSettings::profile_passes); never allocates.
   virtual Status set_profiling(bool on) = 0;
-  /// The virtual objects: scene.json's (SceneDesc::virtual_objects), in its order; the capacity
-  /// is fixed at start-up. set_object_placement moves one from the next process() on (an app's
-  /// object moving), replacing its scene.json motion from then on; it never allocates. BadUsage
-  /// for an index out of range, a non-finite placement or a scale that is not positive.
+  /// The virtual objects by slot: scene.json's (SceneDesc::virtual_objects) in its order, then
+  /// RuntimeSettings::objects.objects slots for objects added at run time; the slots are fixed
+  /// at start-up (object_count()), a slot holds an object or is empty (has_object).
+  /// set_object_placement moves one from the next process() on (an app's object moving),
+  /// replacing its scene.json motion from then on; it never allocates. BadUsage for an index out
+  /// of range or an empty slot, a non-finite placement or a scale that is not positive.
   virtual size_t object_count() const = 0;
+  virtual bool has_object(size_t object) const = 0;
   virtual Status set_object_placement(size_t object, const Placement& placement) = 0;
-  /// Adds (true) or removes (false) object i from the next process() on, within that capacity:
-  /// a removed object is not drawn, lit, shadowed or reflected; with none shown, frames are the
-  /// camera frame. BadUsage for an index out of range.
+  /// Shows (true) or hides (false) object i from the next process() on, keeping its room: a
+  /// hidden object is not drawn, lit, shadowed or reflected; with none shown, frames are the
+  /// camera frame. BadUsage for an index out of range or an empty slot.
   virtual Status set_object_visible(size_t object, bool visible) = 0;
+  /// Loads a glTF (.gltf / .glb) and places it in the first empty slot, shown from the next
+  /// process() on, within the room stated at creation (RuntimeSettings::objects: slots, meshes,
+  /// triangles, vertices, textures); returns the slot. Its data for every technique (vertices,
+  /// levels of detail, materials, textures, sphere proxies, the ISMs' triangle list, voxelisation)
+  /// is ready for that frame; nothing the frames use is allocated. Host work on the calling
+  /// thread (loading, simplification: tens of ms for a 10k-triangle model) and one transfer of
+  /// its textures, waited for on its own fence. Errors: NotFound or BadInput naming the file for a
+  /// glTF that is missing or cannot be read; BadUsage naming the capacity that is full (no slot, meshes, triangles,
+  /// vertices, texture layers), a material the runtime was not prepared for (glossy, emissive:
+  /// ObjectCapacity) or a mirror or glass material; the runtime is unchanged after any error.
+  virtual Expected<size_t> add_object(const std::string& gltf_path, const Placement& placement) = 0;
+  /// Takes object i out from the next process() on and frees its room (an added object's or
+  /// scene.json's) for later add_object calls; frames still on the device keep what they were
+  /// recorded with. BadUsage for an index out of range or an empty slot.
+  virtual Status remove_object(size_t object) = 0;
   /// The lamps: scene.json's (SceneDesc::lights), in its order, capacity fixed at start-up.
   /// set_lamp changes lamp i from the next process() on: moved, turned, recoloured, dimmed to 0
   /// (off: an app that adds lamps later declares them dark at start-up) or back; its kind (type,
@@ -291,6 +309,8 @@ struct RuntimeSettings {
   /// values the technique is built and tested for. create_runtime refuses (BadUsage naming the
   /// knob and its span) a knob the technique does not have or a value outside its span.
   std::vector<KnobSetting> knobs;
+  /// Room for virtual objects added at run time (Runtime::add_object), beyond scene.json's.
+  ObjectCapacity objects;
   int output_width = 0;                ///< 0 = the colour camera's width
   int output_height = 0;
   /// Camera exposure (linear radiance -> linear camera value) for albedo and the tone curve;

@@ -115,6 +115,29 @@ struct SceneDesc {
   std::vector<RealMaterialRegion> real_materials;
 };
 
+/// Room for virtual objects an app adds while the runtime runs (Runtime::add_object), beyond
+/// scene.json's: stated when the runtime is created, allocated then and never grown. A removed
+/// object's room (scene.json's or an added one's) is free for the next added object. The
+/// default (all 0) is scene.json's objects only.
+struct ObjectCapacity {
+  int objects = 0;          ///< added objects present at once
+  int meshes = 0;           ///< their glTF primitives (draw ranges), in all
+  uint32_t triangles = 0;   ///< their triangles at full detail, in all (levels of detail, at most
+                            ///< as many again, are reserved beside them)
+  uint32_t vertices = 0;    ///< their vertices, in all
+  int textures = 0;         ///< their base-colour and emissive textures (one array layer each)
+  /// Texels a side of each texture layer when scene.json's objects have no larger ones (added
+  /// textures are resampled to the array's side), 1..1024.
+  int texture_side = 512;
+  /// Whether added objects may be glossy (metallic above 0.1 or roughness below 0.7) or emit
+  /// light: the passes for them are prepared at start-up (dir's glossy VPLs cost every pixel
+  /// whether or not a glossy object is shown). An object needing what was not prepared is
+  /// refused, naming its material. Mirrors and glass (specular materials) cannot be added: declare
+  /// them in scene.json and show or hide them (Runtime::set_object_visible).
+  bool glossy = false;
+  bool emissive = false;
+};
+
 /// Parses and validates scene.json. Unknown keys, wrong types, non-unit quaternions, NaNs,
 /// negative intensities or spot angles with inner > outer are refused, naming file, key and rule.
 MRGI_API Expected<SceneDesc> load_scene_json(const std::string& path);

@@ -4,116 +4,62 @@
 #include <cmath>
 #include <cstring>
 
-#include <meshoptimizer.h>
-
 #define STB_IMAGE_RESIZE_STATIC
 #define STB_IMAGE_RESIZE_IMPLEMENTATION
 #include <stb/stb_image_resize.h>
 
-#include "common/scene_materials.glsl"
-#include "frame/occluder_spheres.h"
 #include "shared/specular_math.h"
 #include "gpu/vk_check.h"
-#include "mrgi/metrics.h"
 
 namespace mrgi::frame {
 namespace {
 
-struct MeshData {
+// The real proxies: world space (their placement applied by load_gltf), no levels of detail,
+// material 0; device-local, uploaded once.
+struct ProxyData {
   std::vector<GpuVertex> vertices;
   std::vector<uint32_t> indices;
   std::vector<DrawRange> draws;
   glm::vec3 lo{1e30f}, hi{-1e30f};
 };
 
-// Levels of detail per virtual primitive: each halves the previous one's triangle count
-// (simplified from the original, not from the previous level), down to kMinLodTriangles, and
-// stops where meshoptimizer cannot reach 80 % of the previous count (the mesh is as coarse as
-// its topology allows) or the error would exceed kMaxLodRelativeError of the mesh's extent.
-constexpr int kMaxLods = 6;
-constexpr size_t kMinLodTriangles = 64;
-constexpr float kMaxLodRelativeError = 0.05f;
-
-void append_lods(const MeshPrimitive& prim, DrawRange& range, std::vector<uint32_t>& indices) {
-  range.lods.push_back({range.first_index, range.index_count, 0.0f});
-  const size_t n = prim.indices.size();
-  const float* positions = &prim.positions[0].x;
-  const float scale = meshopt_simplifyScale(positions, prim.positions.size(), sizeof(glm::vec3));
-  std::vector<uint32_t> lod(n);
-  size_t previous = n;
-  for (int k = 1; k < kMaxLods; ++k) {
-    const size_t target = previous / 6 * 3;  // half the triangles
-    if (target < 3 * kMinLodTriangles) break;
-    float error = 0.0f;
-    const size_t m = meshopt_simplify(lod.data(), prim.indices.data(), n, positions,
-                                      prim.positions.size(), sizeof(glm::vec3), target,
-                                      kMaxLodRelativeError, 0, &error);
-    if (m < 3 || m > previous * 8 / 10) break;
-    range.lods.push_back({uint32_t(indices.size()), uint32_t(m), error * scale});
-    indices.insert(indices.end(), lod.begin(), lod.begin() + std::ptrdiff_t(m));
-    previous = m;
-  }
-}
-
-// Appends a model's primitives; material indices are offset by `material_base`. With `lods`,
-// each primitive also gets its levels of detail (append_lods).
-void append_model(const Model& model, int material_base, MeshData& out, bool lods) {
+void append_proxy(const Model& model, ProxyData& out) {
   for (const MeshPrimitive& prim : model.primitives) {
     if (prim.indices.empty() || prim.positions.empty()) continue;
     DrawRange range;
     range.first_index = uint32_t(out.indices.size());
     range.index_count = uint32_t(prim.indices.size());
     range.vertex_offset = int32_t(out.vertices.size());
-    range.material = prim.material < 0 ? 0 : material_base + prim.material;
-    range.double_sided = prim.material >= 0 && size_t(prim.material) < model.materials.size() &&
-                         model.materials[size_t(prim.material)].double_sided;
     range.bounds_min = glm::vec3(1e30f);
     range.bounds_max = glm::vec3(-1e30f);
     for (size_t i = 0; i < prim.positions.size(); ++i) {
-      GpuVertex v;
-      v.position = prim.positions[i];
-      v.normal = i < prim.normals.size() ? prim.normals[i] : glm::vec3(0.0f, 1.0f, 0.0f);
-      v.uv = i < prim.uvs.size() ? prim.uvs[i] : glm::vec2(0.0f);
-      out.lo = glm::min(out.lo, v.position);
-      out.hi = glm::max(out.hi, v.position);
+      GpuVertex v{prim.positions[i], i < prim.normals.size() ? prim.normals[i] : glm::vec3(0.0f, 1.0f, 0.0f),
+                  i < prim.uvs.size() ? prim.uvs[i] : glm::vec2(0.0f)};
       range.bounds_min = glm::min(range.bounds_min, v.position);
       range.bounds_max = glm::max(range.bounds_max, v.position);
       out.vertices.push_back(v);
     }
+    out.lo = glm::min(out.lo, range.bounds_min);
+    out.hi = glm::max(out.hi, range.bounds_max);
     out.indices.insert(out.indices.end(), prim.indices.begin(), prim.indices.end());
-    if (lods) append_lods(prim, range, out.indices);
     out.draws.push_back(range);
   }
 }
 
-// `per_slot_vertices`: the vertex buffer host-visible with a copy per frame slot, written by
-// the caller (the moving virtual objects); else device-local and uploaded here.
-Expected<MeshSet> upload_meshes(gpu::Context& ctx, gpu::FrameGraph& graph, const MeshData& data,
-                                const std::string& name, bool per_slot_vertices) {
+Expected<MeshSet> upload_proxies(gpu::Context& ctx, gpu::FrameGraph& graph, const ProxyData& data) {
   MeshSet set;
-  // Never zero-sized (Vulkan forbids it); an empty set simply has no draws.
+  // Never zero-sized (Vulkan forbids it); an empty set simply has no draws. Storage too:
+  // compute passes read the meshes as lists (gi/voxelize.h).
   const VkDeviceSize vbytes = std::max<VkDeviceSize>(64, data.vertices.size() * sizeof(GpuVertex));
   const VkDeviceSize ibytes = std::max<VkDeviceSize>(64, data.indices.size() * sizeof(uint32_t));
-  // Storage too: compute passes read the meshes as lists (gi/ism.h samples points on them).
-  gpu::BufferDesc vdesc{name + "_vertices", vbytes};
-  if (per_slot_vertices) {
-    vdesc.memory = gpu::MemoryUsage::Upload;
-    vdesc.per_frame_copies = true;
-  }
-  auto vb = graph.create_buffer(vdesc, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT |
-                                                              VK_BUFFER_USAGE_TRANSFER_DST_BIT |
-                                                              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  const VkBufferUsageFlags common = VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  auto vb = graph.create_buffer({"real_proxies_vertices", vbytes}, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | common);
   if (!vb) return vb.error();
-  auto ib = graph.create_buffer({name + "_indices", ibytes}, VK_BUFFER_USAGE_INDEX_BUFFER_BIT |
-                                                             VK_BUFFER_USAGE_TRANSFER_DST_BIT |
-                                                             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  auto ib = graph.create_buffer({"real_proxies_indices", ibytes}, VK_BUFFER_USAGE_INDEX_BUFFER_BIT | common);
   if (!ib) return ib.error();
   if (!data.vertices.empty()) {
-    if (!per_slot_vertices)
-      MRGI_TRY(ctx.upload_buffer(graph.gpu_buffer(*vb, 0), data.vertices.data(),
-                                 data.vertices.size() * sizeof(GpuVertex)));
-    MRGI_TRY(ctx.upload_buffer(graph.gpu_buffer(*ib, 0), data.indices.data(),
-                               data.indices.size() * sizeof(uint32_t)));
+    MRGI_TRY(ctx.upload_buffer(graph.gpu_buffer(*vb, 0), data.vertices.data(), data.vertices.size() * sizeof(GpuVertex)));
+    MRGI_TRY(ctx.upload_buffer(graph.gpu_buffer(*ib, 0), data.indices.data(), data.indices.size() * sizeof(uint32_t)));
   }
   set.vertices = *vb;
   set.indices = *ib;
@@ -123,6 +69,53 @@ Expected<MeshSet> upload_meshes(gpu::Context& ctx, gpu::FrameGraph& graph, const
     set.bounds_max = data.hi;
   }
   return set;
+}
+
+// A host-visible buffer with one copy per frame in flight (never zero-sized).
+Expected<gpu::BufferHandle> per_slot_buffer(gpu::FrameGraph& graph, const std::string& name, size_t bytes,
+                                            VkBufferUsageFlags usage) {
+  gpu::BufferDesc d{name, std::max<VkDeviceSize>(64, VkDeviceSize(bytes))};
+  d.memory = gpu::MemoryUsage::Upload;
+  d.per_frame_copies = true;
+  return graph.create_buffer(d, usage);
+}
+
+// glTF's default material (white, metallic 1, roughness 1 per the spec): material 0.
+const shader::GpuMaterial kDefaultMaterial{glm::vec4(1.0f), glm::vec4(1.0f, 1.0f, -1.0f, 0.0f), glm::vec4(0.0f),
+                                           glm::vec4(0.0f, 1.5f, 0.0f, 0.0f), glm::vec4(1.0f)};
+
+bool glossy_material(const Material& m) {
+  return m.metallic > SceneGpu::kGlossyMetallic || m.roughness < SceneGpu::kGlossyRoughness;
+}
+bool emissive_material(const Material& m) { return m.emissive.x > 0.0f || m.emissive.y > 0.0f || m.emissive.z > 0.0f; }
+
+Status check_placement(size_t object, const Placement& p) {
+  const glm::vec4 q(p.rotation.x, p.rotation.y, p.rotation.z, p.rotation.w);
+  bool finite = true;
+  for (int i = 0; i < 3; ++i) finite = finite && std::isfinite(p.position[i]) && std::isfinite(p.scale[i]);
+  for (int i = 0; i < 4; ++i) finite = finite && std::isfinite(q[i]);
+  if (!finite || !(glm::length(q) > 1e-6f))
+    return fail(ErrorKind::BadUsage, "virtual object " + std::to_string(object) +
+                                         ": placement must be finite with a non-zero rotation quaternion");
+  if (!(p.scale.x > 0.0f && p.scale.y > 0.0f && p.scale.z > 0.0f))
+    return fail(ErrorKind::BadUsage, "virtual object " + std::to_string(object) + ": scale must be positive");
+  return ok_status();
+}
+
+Status check_room(const ObjectCapacity& room) {
+  auto bad = [](const std::string& field, const std::string& rule) {
+    return fail(ErrorKind::BadUsage, "RuntimeSettings::objects." + field + ": " + rule);
+  };
+  if (room.objects < 0 || room.objects > 4096) return bad("objects", "must be 0..4096");
+  if (room.meshes < 0 || room.meshes > 65536) return bad("meshes", "must be 0..65536");
+  if (room.textures < 0 || room.textures > 256) return bad("textures", "must be 0..256");
+  if (room.triangles > (1u << 24)) return bad("triangles", "must be at most 16777216");
+  if (room.vertices > (1u << 24)) return bad("vertices", "must be at most 16777216");
+  if (room.texture_side < 1 || room.texture_side > kMaxTextureSide)
+    return bad("texture_side", "must be 1.." + std::to_string(kMaxTextureSide) + " texels");
+  if (room.objects == 0 && (room.meshes > 0 || room.triangles > 0 || room.vertices > 0 || room.textures > 0))
+    return bad("objects", "is 0 while meshes, triangles, vertices or textures are not: no object could use them");
+  return ok_status();
 }
 
 }  // namespace
@@ -168,74 +161,6 @@ void MeshSet::draw(VkCommandBuffer cmd, const gpu::PassContext& pass,
   }
 }
 
-namespace {
-
-// A primitive's diffuse albedo (linear RGB): its base colour factor times its texture's mean;
-// metals reflect little diffusely.
-glm::dvec3 primitive_albedo(const Model& model, const MeshPrimitive& prim) {
-  glm::dvec3 albedo(1.0);
-  float metallic = 1.0f;
-  if (prim.material >= 0 && size_t(prim.material) < model.materials.size()) {
-    const Material& mat = model.materials[size_t(prim.material)];
-    albedo = glm::dvec3(glm::vec3(mat.base_color_factor));
-    metallic = mat.metallic;
-    if (mat.base_color_texture >= 0 && size_t(mat.base_color_texture) < model.textures.size()) {
-      const ImageRGBA8& img = model.textures[size_t(mat.base_color_texture)].image;
-      glm::dvec3 t(0.0);
-      size_t n = 0;
-      for (size_t i = 0; i < img.pixel_count(); i += 7, ++n)
-        t += glm::dvec3(srgb8_to_linear(img.data[i * 4]), srgb8_to_linear(img.data[i * 4 + 1]),
-                        srgb8_to_linear(img.data[i * 4 + 2]));
-      if (n) albedo *= t / double(n);
-    }
-  }
-  return albedo * double(1.0f - std::clamp(metallic, 0.0f, 1.0f));
-}
-
-// The object's primitives as one mesh (model space) with each triangle's primitive albedo.
-struct ObjectMesh {
-  std::vector<glm::vec3> positions;
-  std::vector<uint32_t> indices;
-  std::vector<glm::vec3> triangle_albedo;
-};
-ObjectMesh object_mesh(const Model& model) {
-  ObjectMesh m;
-  for (const MeshPrimitive& prim : model.primitives) {
-    const uint32_t base = uint32_t(m.positions.size());
-    m.positions.insert(m.positions.end(), prim.positions.begin(), prim.positions.end());
-    const glm::vec3 albedo(primitive_albedo(model, prim));
-    for (size_t t = 0; t + 2 < prim.indices.size(); t += 3) {
-      for (int k = 0; k < 3; ++k) m.indices.push_back(base + prim.indices[t + size_t(k)]);
-      m.triangle_albedo.push_back(albedo);
-    }
-  }
-  return m;
-}
-
-// The object's mean diffuse albedo (linear RGB), weighted by the triangles' surface area.
-glm::vec3 mean_albedo(const ObjectMesh& mesh) {
-  glm::dvec3 sum(0.0);
-  double area = 0.0;
-  for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
-    const uint32_t i0 = mesh.indices[t], i1 = mesh.indices[t + 1], i2 = mesh.indices[t + 2];
-    if (i0 >= mesh.positions.size() || i1 >= mesh.positions.size() || i2 >= mesh.positions.size()) continue;
-    const glm::vec3 p0 = mesh.positions[i0];
-    const double a = 0.5 * double(glm::length(glm::cross(mesh.positions[i1] - p0, mesh.positions[i2] - p0)));
-    sum += a * glm::dvec3(mesh.triangle_albedo[t / 3]);
-    area += a;
-  }
-  return area > 0.0 && std::isfinite(area) ? glm::vec3(sum / area) : glm::vec3(0.0f);
-}
-
-// The object's mesh fitted with sphere proxies (model space).
-std::vector<glm::vec4> fit_model_occluders(const ObjectMesh& mesh) {
-  OccluderFitSettings fit;
-  fit.max_spheres = SceneGpu::kOccluderSpheres;
-  return fit_occluder_spheres(mesh.positions, mesh.indices, fit);
-}
-
-}  // namespace
-
 void SceneGpu::occluder_spheres(int per_object, std::vector<glm::vec4>& out, std::vector<glm::vec4>* albedo,
                                 std::vector<int>* object) const {
   int ordinal = 0;
@@ -244,10 +169,10 @@ void SceneGpu::occluder_spheres(int per_object, std::vector<glm::vec4>& out, std
     const int this_object = ordinal++;
     const glm::mat4 m = o.placement.matrix();
     const float grow = std::max({o.placement.scale.x, o.placement.scale.y, o.placement.scale.z});
-    const size_t n = std::min(o.occluders.size(), size_t(std::max(per_object, 0)));
+    const size_t n = std::min(o.meshes.occluders.size(), size_t(std::max(per_object, 0)));
     for (size_t k = 0; k < n; ++k) {
-      out.emplace_back(glm::vec3(m * glm::vec4(glm::vec3(o.occluders[k]), 1.0f)), o.occluders[k].w * grow);
-      if (albedo) albedo->emplace_back(o.albedo, 0.0f);
+      out.emplace_back(glm::vec3(m * glm::vec4(glm::vec3(o.meshes.occluders[k]), 1.0f)), o.meshes.occluders[k].w * grow);
+      if (albedo) albedo->emplace_back(o.meshes.albedo, 0.0f);
       if (object) object->push_back(this_object);
     }
   }
@@ -262,27 +187,104 @@ int SceneGpu::oriented_patches(size_t ordinal, OrientedPatch* out) const {
     const glm::mat3 linear(o.placement.matrix());
     const glm::mat3 normals = glm::transpose(glm::inverse(linear));
     const float det = std::abs(glm::determinant(linear));
-    const int n = int(std::min(o.patches.size(), size_t(kOrientedPatches)));
+    const int n = int(std::min(o.meshes.patches.size(), size_t(kOrientedPatches)));
     for (int k = 0; k < n; ++k) {
-      out[k] = o.patches[size_t(k)];
-      const glm::vec3 w = normals * o.patches[size_t(k)].normal;
-      out[k].normal = glm::length(w) > 0.0f ? glm::normalize(w) : o.patches[size_t(k)].normal;
+      out[k] = o.meshes.patches[size_t(k)];
+      const glm::vec3 w = normals * o.meshes.patches[size_t(k)].normal;
+      out[k].normal = glm::length(w) > 0.0f ? glm::normalize(w) : o.meshes.patches[size_t(k)].normal;
       const float to_world = std::isfinite(det) ? det * glm::length(w) : 0.0f;
-      out[k].area = o.patches[size_t(k)].area * to_world;
-      out[k].facing_area = o.patches[size_t(k)].facing_area * to_world;
+      out[k].area = o.meshes.patches[size_t(k)].area * to_world;
+      out[k].facing_area = o.meshes.patches[size_t(k)].facing_area * to_world;
     }
     return n;
   }
   return 0;
 }
 
+void SceneGpu::set_materials(ObjectSpan& span, const std::vector<uint32_t>& layers) const {
+  span.materials.clear();
+  span.material_kinds.clear();
+  auto layer_of = [&](int texture) {
+    return texture >= 0 && size_t(texture) < layers.size() ? float(layers[size_t(texture)]) : -1.0f;
+  };
+  for (const Material& mat : span.meshes.materials) {
+    const int kind = shader::specular_kind(mat.metallic, mat.roughness, mat.transmission);
+    span.materials.push_back({mat.base_color_factor, glm::vec4(mat.metallic, mat.roughness, layer_of(mat.base_color_texture), 0.0f),
+                              glm::vec4(glm::max(mat.emissive, glm::vec3(0.0f)), layer_of(mat.emissive_texture)),
+                              glm::vec4(float(kind), mat.ior, mat.attenuation_distance, mat.transmission),
+                              glm::vec4(mat.attenuation_color, 0.0f)});
+    span.material_kinds.push_back(kind);
+  }
+}
+
+SceneGpu::Totals SceneGpu::totals(const ObjectMeshes* extra) const {
+  Totals t;
+  auto add = [&](const ObjectMeshes& m) {
+    t.vertices += m.vertices.size();
+    t.triangles += m.triangles;
+    t.indices += m.indices.size();
+    t.draws += m.draws.size();
+    t.materials += m.materials.size();
+  };
+  for (const ObjectSpan& o : objects_)
+    if (o.present) add(o.meshes);
+  if (extra) add(*extra);
+  return t;
+}
+
+void SceneGpu::pack() {
+  local_vertices_.clear();
+  packed_indices_.clear();
+  local_lod_errors_.clear();
+  virtual_objects.draws.clear();
+  packed_materials_.assign(1, kDefaultMaterial);
+  material_specular_kind.assign(1, 0);
+  packed_ranges_.clear();
+  packed_range_materials_.clear();
+  glossy_now_ = false;
+  uint32_t triangles_before = 0;
+  for (ObjectSpan& o : objects_) {
+    o.first_vertex = uint32_t(local_vertices_.size());
+    o.first_draw = virtual_objects.draws.size();
+    o.vertex_count = 0;
+    o.draw_count = 0;
+    if (!o.present) continue;
+    const uint32_t index_base = uint32_t(packed_indices_.size());
+    const int material_base = int(packed_materials_.size());
+    local_vertices_.insert(local_vertices_.end(), o.meshes.vertices.begin(), o.meshes.vertices.end());
+    packed_indices_.insert(packed_indices_.end(), o.meshes.indices.begin(), o.meshes.indices.end());
+    for (size_t r = 0; r < o.meshes.draws.size(); ++r) {
+      DrawRange d = o.meshes.draws[r];
+      d.first_index += index_base;
+      for (DrawRange::Lod& l : d.lods) l.first_index += index_base;
+      d.vertex_offset += int32_t(o.first_vertex);
+      d.material = d.material < 0 ? 0 : material_base + d.material;
+      const uint32_t triangles = d.index_count / 3;
+      if (triangles > 0) {
+        packed_ranges_.emplace_back(int(d.first_index), int(triangles), d.vertex_offset, int(triangles_before));
+        packed_range_materials_.push_back(d.material);
+        triangles_before += triangles;
+      }
+      virtual_objects.draws.push_back(std::move(d));
+      local_lod_errors_.push_back(o.meshes.lod_errors[r]);
+    }
+    packed_materials_.insert(packed_materials_.end(), o.materials.begin(), o.materials.end());
+    material_specular_kind.insert(material_specular_kind.end(), o.material_kinds.begin(), o.material_kinds.end());
+    for (const Material& m : o.meshes.materials) glossy_now_ = glossy_now_ || glossy_material(m);
+    o.vertex_count = uint32_t(local_vertices_.size()) - o.first_vertex;
+    o.draw_count = virtual_objects.draws.size() - o.first_draw;
+  }
+  triangles_.triangles = triangles_before;
+  triangles_.range_count = uint32_t(packed_ranges_.size());
+  ++revision_;
+  ++layout_revision_;
+}
+
 Expected<std::unique_ptr<SceneGpu>> SceneGpu::create(gpu::Context& context, gpu::FrameGraph& graph,
-                                                     const SceneDesc& scene) {
+                                                     const SceneDesc& scene, const ObjectCapacity& room) {
+  MRGI_TRY(check_room(room));
   std::unique_ptr<SceneGpu> out(new SceneGpu(context));
-  MeshData virtual_data, proxy_data;
-  std::vector<shader::GpuMaterial> materials;
-  std::vector<const ImageRGBA8*> textures;
-  std::vector<Model> models;  // kept until the textures are resampled
+  std::vector<Model> models;  // kept until the textures are uploaded
   models.reserve(scene.virtual_objects.size());
   for (const VirtualObjectDesc& obj : scene.virtual_objects) {
     // Model space (the placement is applied per frame, commit()); checked like set_placement.
@@ -290,100 +292,106 @@ Expected<std::unique_ptr<SceneGpu>> SceneGpu::create(gpu::Context& context, gpu:
     if (!model) return model.error();
     models.push_back(std::move(*model));
   }
-  // Material 0 is the glTF default material (white, metallic 1, roughness 1 per the spec).
-  materials.push_back({glm::vec4(1.0f), glm::vec4(1.0f, 1.0f, -1.0f, 0.0f), glm::vec4(0.0f),
-                       glm::vec4(0.0f, 1.5f, 0.0f, 0.0f), glm::vec4(1.0f)});
-  out->material_specular_kind.push_back(0);
-  for (const Model& m : models) {
-    const int material_base = int(materials.size());
-    const int texture_base = int(textures.size());
-    for (const Material& mat : m.materials) {
-      const float layer = mat.base_color_texture >= 0 &&
-                                  mat.base_color_texture < int(m.textures.size())
-                              ? float(texture_base + mat.base_color_texture)
-                              : -1.0f;
-      const float emissive_layer = mat.emissive_texture >= 0 &&
-                                           mat.emissive_texture < int(m.textures.size())
-                                       ? float(texture_base + mat.emissive_texture)
-                                       : -1.0f;
-      const int kind = shader::specular_kind(mat.metallic, mat.roughness, mat.transmission);
-      materials.push_back({mat.base_color_factor,
-                           glm::vec4(mat.metallic, mat.roughness, layer, 0.0f),
-                           glm::vec4(glm::max(mat.emissive, glm::vec3(0.0f)), emissive_layer),
-                           glm::vec4(float(kind), mat.ior, mat.attenuation_distance, mat.transmission),
-                           glm::vec4(mat.attenuation_color, 0.0f)});
-      out->specular = out->specular || kind != shader::SPECULAR_NONE;
-      out->material_specular_kind.push_back(kind);
-      const glm::vec3 e = materials.back().emission;
-      out->emissive = out->emissive || e.x > 0.0f || e.y > 0.0f || e.z > 0.0f;
-      out->glossy = out->glossy || mat.metallic > kGlossyMetallic || mat.roughness < kGlossyRoughness;
+  out->scene_objects_ = models.size();
+  out->may_have_objects_ = !models.empty() || room.objects > 0;
+  out->objects_.resize(models.size() + size_t(room.objects));
+  for (ObjectSpan& o : out->objects_) o.visible = false;
+  std::vector<const ImageRGBA8*> textures;
+  uint32_t side = room.textures > 0 ? uint32_t(room.texture_side) : 1;
+  for (size_t i = 0; i < models.size(); ++i) {
+    ObjectSpan& span = out->objects_[i];
+    span.meshes = object_meshes(models[i]);
+    for (const ImageRGBA8* t : span.meshes.textures) {
+      span.layers.push_back(uint32_t(textures.size()));
+      textures.push_back(t);
+      side = std::max<uint32_t>(side, uint32_t(std::max(t->width, t->height)));
     }
-    for (const Texture& t : m.textures) textures.push_back(&t.image);
-    ObjectSpan span;
-    span.first_vertex = uint32_t(virtual_data.vertices.size());
-    span.first_draw = virtual_data.draws.size();
-    append_model(m, material_base, virtual_data, true);
-    span.vertex_count = uint32_t(virtual_data.vertices.size()) - span.first_vertex;
-    span.draw_count = virtual_data.draws.size() - span.first_draw;
-    span.placement = scene.virtual_objects[out->objects_.size()].placement;
-    const ObjectMesh mesh = object_mesh(m);
-    span.occluders = fit_model_occluders(mesh);
-    span.albedo = mean_albedo(mesh);
-    span.patches = cluster_surface_orientations(mesh.positions, mesh.indices, mesh.triangle_albedo, kOrientedPatches);
-    out->objects_.push_back(span);
+    span.meshes.textures.clear();
+    out->set_materials(span, span.layers);
+    for (const Material& m : span.meshes.materials) {
+      out->glossy = out->glossy || glossy_material(m);
+      out->emissive = out->emissive || emissive_material(m);
+    }
+    for (int kind : span.material_kinds) out->specular = out->specular || kind != shader::SPECULAR_NONE;
+    span.present = span.visible = true;
+    MRGI_TRY(check_placement(i, scene.virtual_objects[i].placement));  // refuses a bad scene.json pose
+    span.placement = scene.virtual_objects[i].placement;
   }
-  for (const DrawRange& d : virtual_data.draws) {
-    std::vector<float> errors;
-    for (const DrawRange::Lod& l : d.lods) errors.push_back(l.error_m);
-    out->local_lod_errors_.push_back(std::move(errors));
-  }
-  out->local_vertices_ = virtual_data.vertices;
+  out->glossy = out->glossy || room.glossy;
+  out->emissive = out->emissive || room.emissive;
+  out->visible_count_ = models.size();
+  out->texture_side_ = std::min<uint32_t>(side, kMaxTextureSide);
+  const uint32_t layers = std::max<uint32_t>(1, uint32_t(textures.size()) + uint32_t(room.textures));
+  // The room's layers, lowest last (taken first). Not the white stand-in layer of a scene with
+  // no texture and no room for one.
+  for (uint32_t l = uint32_t(textures.size()) + uint32_t(room.textures); l-- > uint32_t(textures.size());)
+    out->free_layers_.push_back(l);
+
+  // The buffers: scene.json's objects and the room (its levels of detail at most as many
+  // indices again as its triangles' own).
+  Totals cap = out->totals(nullptr);
+  cap.vertices += room.vertices;
+  cap.triangles += room.triangles;
+  cap.indices += size_t(room.triangles) * 6;
+  cap.draws += size_t(room.meshes);
+  cap.materials += size_t(room.meshes);
+  out->capacity_ = cap;
+  out->local_vertices_.reserve(cap.vertices);
+  out->packed_indices_.reserve(cap.indices);
+  out->packed_materials_.reserve(cap.materials);
+  out->packed_ranges_.reserve(cap.draws);
+  out->packed_range_materials_.reserve(cap.draws);
+  out->virtual_objects.draws.reserve(cap.draws);
+  out->local_lod_errors_.reserve(cap.draws);
+  out->material_specular_kind.reserve(cap.materials);
+  out->pack();
+
+  const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  auto vb = per_slot_buffer(graph, "virtual_objects_vertices", cap.vertices * sizeof(GpuVertex),
+                            VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | storage);
+  if (!vb) return vb.error();
+  auto ib = per_slot_buffer(graph, "virtual_objects_indices", cap.indices * sizeof(uint32_t),
+                            VK_BUFFER_USAGE_INDEX_BUFFER_BIT | storage);
+  if (!ib) return ib.error();
+  auto mb = per_slot_buffer(graph, "virtual_materials", cap.materials * sizeof(shader::GpuMaterial), storage);
+  if (!mb) return mb.error();
+  auto rb = per_slot_buffer(graph, "virtual_triangle_ranges", cap.draws * sizeof(glm::ivec4), storage);
+  if (!rb) return rb.error();
+  auto rmb = per_slot_buffer(graph, "virtual_triangle_range_materials", cap.draws * sizeof(int32_t), storage);
+  if (!rmb) return rmb.error();
+  out->virtual_objects.vertices = *vb;
+  out->virtual_objects.indices = *ib;
+  out->materials = *mb;
+  out->triangles_.ranges = *rb;
+  out->triangles_.materials = *rmb;
+  out->slot_revision_.assign(graph.frames_in_flight(), ~uint64_t(0));
+  out->slot_layout_.assign(graph.frames_in_flight(), ~uint64_t(0));
+  out->bounds_revision_ = ~uint64_t(0);
+  out->commit(graph);  // bounds now; each slot's copies are written the first time it is current
+
+  ProxyData proxies;
   for (const RealGeometryDesc& proxy : scene.real_geometry) {
     auto model = load_gltf(proxy.gltf, proxy.placement);
     if (!model) return model.error();
-    append_model(*model, 0, proxy_data, false);
+    append_proxy(*model, proxies);
   }
-
-  for (size_t i = 0; i < out->objects_.size(); ++i)
-    MRGI_TRY(out->set_placement(i, out->objects_[i].placement));  // refuses a bad scene.json pose
-  out->visible_count_ = out->objects_.size();
-  auto vset = upload_meshes(context, graph, virtual_data, "virtual_objects", true);
-  if (!vset) return vset.error();
-  out->virtual_objects = std::move(*vset);
-  out->slot_revision_.assign(graph.frames_in_flight(), ~uint64_t(0));
-  out->revision_ = 0;
-  out->bounds_revision_ = ~uint64_t(0);
-  out->commit(graph);  // bounds now; each slot's copy is written the first time it is current
-  auto pset = upload_meshes(context, graph, proxy_data, "real_proxies", false);
+  auto pset = upload_proxies(context, graph, proxies);
   if (!pset) return pset.error();
   out->real_proxies = std::move(*pset);
 
-  auto mb = graph.create_buffer({"virtual_materials", materials.size() * sizeof(shader::GpuMaterial)},
-                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-  if (!mb) return mb.error();
-  MRGI_TRY(context.upload_buffer(graph.gpu_buffer(*mb, 0), materials.data(),
-                                 materials.size() * sizeof(shader::GpuMaterial)));
-  out->materials = *mb;
-
-  // Texture array: one square side for all layers.
-  uint32_t side = 1;
-  for (const ImageRGBA8* t : textures)
-    side = std::max<uint32_t>(side, uint32_t(std::max(t->width, t->height)));
-  side = std::min<uint32_t>(side, kMaxTextureSide);
-  const uint32_t layers = std::max<uint32_t>(1, uint32_t(textures.size()));
-  std::vector<uint8_t> texels(size_t(side) * side * 4 * layers, 255);
+  // Texture array: one square side for all layers; the room's layers white until used.
+  const size_t layer_bytes = size_t(out->texture_side_) * out->texture_side_ * 4;
+  std::vector<uint8_t> texels(layer_bytes * layers, 255);
   for (size_t i = 0; i < textures.size(); ++i) {
     const ImageRGBA8& t = *textures[i];
     if (t.empty()) continue;
-    uint8_t* dst = texels.data() + size_t(side) * side * 4 * i;
-    if (!stbir_resize_uint8_srgb(t.data.data(), t.width, t.height, 0, dst, int(side), int(side), 0,
-                                 4, 3, 0))
-      return fail(ErrorKind::Internal, "scene_gpu: resampling base-colour texture " +
-                                           std::to_string(i) + " failed");
+    if (!stbir_resize_uint8_srgb(t.data.data(), t.width, t.height, 0, texels.data() + layer_bytes * i,
+                                 int(out->texture_side_), int(out->texture_side_), 0, 4, 3, 0))
+      return fail(ErrorKind::Internal, "scene_gpu: resampling base-colour texture " + std::to_string(i) + " failed");
   }
   gpu::ImageCreateDesc desc;
   desc.format = VK_FORMAT_R8G8B8A8_SRGB;
-  desc.width = desc.height = side;
+  desc.width = desc.height = out->texture_side_;
   desc.layers = layers;
   desc.array_view = true;  // sampler2DArray, also with one layer
   desc.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
@@ -394,22 +402,119 @@ Expected<std::unique_ptr<SceneGpu>> SceneGpu::create(gpu::Context& context, gpu:
   MRGI_TRY(context.upload_image(out->texture_array_, texels.data(), texels.size()));
   out->base_color_maps = graph.import_image("base_color_maps", out->texture_array_,
                                             VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, true);
+  if (room.textures > 0) {
+    auto staging = context.create_buffer(layer_bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, gpu::MemoryUsage::Upload,
+                                         "object texture staging");
+    if (!staging) return staging.error();
+    out->texture_staging_ = *staging;
+  }
   return out;
 }
 
-Status SceneGpu::set_placement(size_t object, const Placement& p) {
-  if (object >= objects_.size())
-    return fail(ErrorKind::BadUsage, "virtual object " + std::to_string(object) + ": the scene has " +
-                                         std::to_string(objects_.size()) + " (indices from 0)");
-  const glm::vec4 q(p.rotation.x, p.rotation.y, p.rotation.z, p.rotation.w);
-  bool finite = true;
-  for (int i = 0; i < 3; ++i) finite = finite && std::isfinite(p.position[i]) && std::isfinite(p.scale[i]);
-  for (int i = 0; i < 4; ++i) finite = finite && std::isfinite(q[i]);
-  if (!finite || !(glm::length(q) > 1e-6f))
+Status SceneGpu::upload_layers(const std::vector<const ImageRGBA8*>& textures, const std::vector<uint32_t>& layers) {
+  for (size_t i = 0; i < textures.size(); ++i) {
+    const ImageRGBA8& t = *textures[i];
+    uint8_t* dst = static_cast<uint8_t*>(texture_staging_.mapped);
+    const int side = int(texture_side_);
+    if (t.empty()) {
+      std::memset(dst, 255, size_t(side) * size_t(side) * 4);
+    } else if (!stbir_resize_uint8_srgb(t.data.data(), t.width, t.height, 0, dst, side, side, 0, 4, 3, 0)) {
+      return fail(ErrorKind::Internal, "scene_gpu: resampling an added object's texture " + std::to_string(i) + " failed");
+    }
+    MRGI_TRY(context_.upload_image_layer(texture_array_, layers[i], texture_staging_));
+  }
+  return ok_status();
+}
+
+Expected<size_t> SceneGpu::add_object(const Model& model, const Placement& placement, const std::string& what) {
+  size_t slot = objects_.size();
+  for (size_t i = 0; i < objects_.size() && slot == objects_.size(); ++i)
+    if (!objects_[i].present) slot = i;
+  const std::string where = what + ": ";
+  if (slot == objects_.size())
+    return fail(ErrorKind::BadUsage, where + "every object slot is taken (" + std::to_string(objects_.size()) + ": " +
+                                         std::to_string(scene_objects_) + " of scene.json, " +
+                                         std::to_string(objects_.size() - scene_objects_) +
+                                         " of RuntimeSettings::objects.objects); remove an object first");
+  MRGI_TRY(check_placement(slot, placement));
+  for (size_t m = 0; m < model.materials.size(); ++m) {
+    const Material& mat = model.materials[m];
+    const std::string name = where + "material " + std::to_string(m) + " ";
+    if (shader::specular_kind(mat.metallic, mat.roughness, mat.transmission) != shader::SPECULAR_NONE)
+      return fail(ErrorKind::BadUsage, name + "is a mirror or glass (metallic " + std::to_string(mat.metallic) +
+                                           ", roughness " + std::to_string(mat.roughness) + ", transmission " +
+                                           std::to_string(mat.transmission) +
+                                           "): such objects cannot be added at run time; declare them in scene.json "
+                                           "and show or hide them");
+    if (glossy_material(mat) && !glossy)
+      return fail(ErrorKind::BadUsage, name + "is glossy (metallic " + std::to_string(mat.metallic) + ", roughness " +
+                                           std::to_string(mat.roughness) +
+                                           ") and the runtime was not prepared for glossy objects "
+                                           "(RuntimeSettings::objects.glossy)");
+    if (emissive_material(mat) && !emissive)
+      return fail(ErrorKind::BadUsage, name + "emits light and the runtime was not prepared for emissive objects "
+                                           "(RuntimeSettings::objects.emissive)");
+  }
+  ObjectMeshes meshes = object_meshes(model);
+  const Totals need = totals(&meshes);
+  // `free`: what the room has left of it with every present object in.
+  auto full = [&](const char* field, size_t has, size_t free) {
+    return fail(ErrorKind::BadUsage, where + "the object needs " + std::to_string(has) + " " + field + ", " +
+                                         std::to_string(free) + " are free (RuntimeSettings::objects." + field + ")");
+  };
+  const Totals used = totals(nullptr);
+  if (need.vertices > capacity_.vertices)
+    return full("vertices", meshes.vertices.size(), capacity_.vertices - used.vertices);
+  if (need.triangles > capacity_.triangles)
+    return full("triangles", meshes.triangles, capacity_.triangles - used.triangles);
+  // The levels of detail take at most as many indices again as the triangles' own (the room
+  // reserves that); a mesh whose simplification keeps more is told in the same unit.
+  if (need.indices > capacity_.indices)
+    return full("triangles (with their levels of detail)", meshes.indices.size() / 3,
+                (capacity_.indices - used.indices) / 3);
+  if (need.draws > capacity_.draws) return full("meshes", meshes.draws.size(), capacity_.draws - used.draws);
+  if (need.materials > capacity_.materials)
+    return full("meshes", meshes.materials.size(), capacity_.materials - used.materials);
+  if (meshes.textures.size() > free_layers_.size()) return full("textures", meshes.textures.size(), free_layers_.size());
+  std::vector<uint32_t> layers(free_layers_.end() - std::ptrdiff_t(meshes.textures.size()), free_layers_.end());
+  std::reverse(layers.begin(), layers.end());
+  MRGI_TRY(upload_layers(meshes.textures, layers));
+  free_layers_.resize(free_layers_.size() - layers.size());
+  meshes.textures.clear();
+  ObjectSpan& span = objects_[slot];
+  span = ObjectSpan{};
+  span.meshes = std::move(meshes);
+  span.layers = std::move(layers);
+  set_materials(span, span.layers);
+  span.placement = placement;
+  span.present = span.visible = true;
+  ++visible_count_;
+  pack();
+  return slot;
+}
+
+Status SceneGpu::remove_object(size_t object) {
+  if (!present(object))
     return fail(ErrorKind::BadUsage, "virtual object " + std::to_string(object) +
-                                         ": placement must be finite with a non-zero rotation quaternion");
-  if (!(p.scale.x > 0.0f && p.scale.y > 0.0f && p.scale.z > 0.0f))
-    return fail(ErrorKind::BadUsage, "virtual object " + std::to_string(object) + ": scale must be positive");
+                                         (object < objects_.size() ? ": the slot is empty"
+                                                                   : ": the scene has " + std::to_string(objects_.size()) +
+                                                                         " slots (indices from 0)"));
+  ObjectSpan& o = objects_[object];
+  free_layers_.insert(free_layers_.end(), o.layers.rbegin(), o.layers.rend());
+  if (o.visible) --visible_count_;
+  o = ObjectSpan{};
+  o.visible = false;
+  pack();
+  return ok_status();
+}
+
+Status SceneGpu::set_placement(size_t object, const Placement& p) {
+  if (!present(object))
+    return fail(ErrorKind::BadUsage, "virtual object " + std::to_string(object) +
+                                         (object < objects_.size() ? ": the slot is empty"
+                                                                   : ": the scene has " + std::to_string(objects_.size()) +
+                                                                         " (indices from 0)"));
+  MRGI_TRY(check_placement(object, p));
   Placement& cur = objects_[object].placement;
   if (cur.position == p.position && cur.rotation == p.rotation && cur.scale == p.scale) return ok_status();
   cur = p;
@@ -418,9 +523,11 @@ Status SceneGpu::set_placement(size_t object, const Placement& p) {
 }
 
 Status SceneGpu::set_visible(size_t object, bool visible) {
-  if (object >= objects_.size())
-    return fail(ErrorKind::BadUsage, "virtual object " + std::to_string(object) + ": the scene has " +
-                                         std::to_string(objects_.size()) + " (indices from 0)");
+  if (!present(object))
+    return fail(ErrorKind::BadUsage, "virtual object " + std::to_string(object) +
+                                         (object < objects_.size() ? ": the slot is empty"
+                                                                   : ": the scene has " + std::to_string(objects_.size()) +
+                                                                         " (indices from 0)"));
   if (objects_[object].visible == visible) return ok_status();
   objects_[object].visible = visible;
   visible_count_ = visible ? visible_count_ + 1 : visible_count_ - 1;
@@ -430,6 +537,7 @@ Status SceneGpu::set_visible(size_t object, bool visible) {
 
 void SceneGpu::write_vertices(GpuVertex* out) const {
   for (const ObjectSpan& o : objects_) {
+    if (!o.present) continue;
     if (!o.visible) {
       for (uint32_t i = o.first_vertex; i < o.first_vertex + o.vertex_count; ++i)
         out[i] = GpuVertex{glm::vec3(0.0f, -kHiddenDepth_m, 0.0f), glm::vec3(0.0f, 1.0f, 0.0f), glm::vec2(0.0f)};
@@ -456,6 +564,7 @@ void SceneGpu::update_bounds() {
   set.bounds_min = glm::vec3(1e30f);
   set.bounds_max = glm::vec3(-1e30f);
   for (const ObjectSpan& o : objects_) {
+    if (!o.present) continue;
     if (!o.visible) {
       for (size_t d = o.first_draw; d < o.first_draw + o.draw_count; ++d)
         set.draws[d].bounds_min = set.draws[d].bounds_max = glm::vec3(0.0f, -kHiddenDepth_m, 0.0f);
@@ -494,12 +603,29 @@ void SceneGpu::commit(gpu::FrameGraph& graph) {
     bounds_revision_ = revision_;
   }
   const uint32_t slot = graph.slot();
-  if (slot >= slot_revision_.size() || slot_revision_[slot] == revision_) return;
-  write_vertices(static_cast<GpuVertex*>(graph.mapped(virtual_objects.vertices, slot)));
-  slot_revision_[slot] = revision_;
+  if (slot >= slot_revision_.size()) return;
+  if (slot_revision_[slot] != revision_) {
+    write_vertices(static_cast<GpuVertex*>(graph.mapped(virtual_objects.vertices, slot)));
+    slot_revision_[slot] = revision_;
+  }
+  if (slot_layout_[slot] != layout_revision_) {
+    auto copy = [&](gpu::BufferHandle h, const auto& list) {
+      if (!list.empty()) std::memcpy(graph.mapped(h, slot), list.data(), list.size() * sizeof(list[0]));
+    };
+    copy(virtual_objects.indices, packed_indices_);
+    copy(materials, packed_materials_);
+    copy(triangles_.ranges, packed_ranges_);
+    copy(triangles_.materials, packed_range_materials_);
+    if (packed_ranges_.empty()) {  // the shaders' arrays hold at least one entry
+      std::memset(graph.mapped(triangles_.ranges, slot), 0, sizeof(glm::ivec4));
+      std::memset(graph.mapped(triangles_.materials, slot), 0, sizeof(int32_t));
+    }
+    slot_layout_[slot] = layout_revision_;
+  }
 }
 
 SceneGpu::~SceneGpu() {
+  context_.destroy(texture_staging_);
   context_.destroy(texture_array_);
 }
 

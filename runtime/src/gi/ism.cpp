@@ -66,35 +66,6 @@ Expected<ImperfectShadowMaps> ImperfectShadowMaps::create(gpu::FrameGraph& graph
   if (!dist) return dist.error();
   m.distances_ = *dist;
 
-  // The virtual meshes' draw ranges at full detail, with the triangles before each, for the
-  // binary search of gi/virtual_points.glsl, and each range's material.
-  std::vector<glm::ivec4> ranges;
-  std::vector<int32_t> materials;
-  for (const frame::DrawRange& d : scene.virtual_objects.draws) {
-    const uint32_t triangles = d.index_count / 3;
-    if (triangles == 0) continue;
-    ranges.push_back(glm::ivec4(int(d.first_index), int(triangles), d.vertex_offset, int(m.virtual_.triangles)));
-    materials.push_back(d.material);
-    m.virtual_.triangles += triangles;
-  }
-  m.virtual_.range_count = uint32_t(ranges.size());
-  if (ranges.empty()) {
-    ranges.push_back(glm::ivec4(0));
-    materials.push_back(0);
-  }
-  auto upload = [&](const std::string& what, const void* data, VkDeviceSize bytes) -> Expected<gpu::BufferHandle> {
-    auto b = graph.create_buffer({s.name + " " + what, bytes, gpu::MemoryUsage::Upload}, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    if (!b) return b.error();
-    std::memcpy(graph.mapped(*b, 0), data, size_t(bytes));
-    return *b;
-  };
-  auto rb = upload("virtual ranges", ranges.data(), VkDeviceSize(ranges.size() * sizeof(glm::ivec4)));
-  if (!rb) return rb.error();
-  m.virtual_.ranges = *rb;
-  auto mb = upload("virtual range materials", materials.data(), VkDeviceSize(materials.size() * sizeof(int32_t)));
-  if (!mb) return mb.error();
-  m.virtual_.materials = *mb;
-
   const gpu::Context& ctx = graph.context();
   struct Load {
     const char* shader;
@@ -154,12 +125,14 @@ Status ImperfectShadowMaps::add_build(gpu::FrameGraph& graph, gpu::BufferHandle 
       [=](VkCommandBuffer cmd, gpu::PassContext&) {
         gpu::push_and_dispatch(cmd, *splat_real, &real_push, sizeof real_push, {(points + 63) / 64, 1, 1});
       });
-  if (virtual_.triangles > 0) {
-    const IsmPush virtual_push{real_push.tiles, glm::ivec4(int(virtual_.triangles), int(virtual_.range_count), 0, 0),
+  // The objects present this frame (frame::SceneGpu::virtual_triangles, current for its slot).
+  const frame::VirtualTriangles& tri = scene_->virtual_triangles();
+  if (tri.triangles > 0) {
+    const IsmPush virtual_push{real_push.tiles, glm::ivec4(int(tri.triangles), int(tri.range_count), 0, 0),
                                glm::vec4(0.0f)};
     const gpu::Pipeline* splat_virtual = &*splat_virtual_pipe_;
     const frame::MeshSet& mesh = scene_->virtual_objects;
-    const gpu::BufferHandle vertices = mesh.vertices, indices = mesh.indices, ranges = virtual_.ranges;
+    const gpu::BufferHandle vertices = mesh.vertices, indices = mesh.indices, ranges = tri.ranges;
     graph.add_shader_pass(
         settings_.name + " splat virtual", gpu::PassKind::Compute, *splat_virtual_pipe_,
         [=](gpu::ShaderPassBuilder& b) {

@@ -29,15 +29,6 @@ struct IsmSettings {
   bool history = false;
 };
 
-// The virtual meshes' triangles at full detail as shaders/gi/virtual_points.glsl reads them
-// (uploaded once by ImperfectShadowMaps::create; the bounce light source reads them too).
-struct VirtualTriangles {
-  gpu::BufferHandle ranges;     // ivec4 per draw range: first index, triangles, vertex offset, triangles before
-  gpu::BufferHandle materials;  // int per draw range: its index into frame::SceneGpu::materials
-  uint32_t triangles = 0;       // over every range
-  uint32_t range_count = 0;     // ranges with triangles (the buffers hold at least one entry)
-};
-
 // What one frame's maps are made of.
 struct IsmFrame {
   uint32_t vpls = 0;              // slots [0, vpls) of the VPL buffer (empty slots splat nothing)
@@ -60,7 +51,6 @@ class ImperfectShadowMaps {
   gpu::ImageHandle distances() const { return distances_; }  // RG32F, level 0 the maps
   uint32_t tiles_per_row(uint32_t vpls) const;
   const IsmSettings& settings() const { return settings_; }
-  const VirtualTriangles& virtual_triangles() const { return virtual_; }
 
  private:
   ImperfectShadowMaps() = default;
@@ -68,7 +58,6 @@ class ImperfectShadowMaps {
   const frame::SceneGpu* scene_ = nullptr;
   gpu::ImageHandle real_position_, real_normal_;
   gpu::ImageHandle splat_real_, splat_virtual_, distances_;
-  VirtualTriangles virtual_;
   gpu::PipelineHandle clear_, splat_real_pipe_, splat_virtual_pipe_, pull_splat_, pull_, push_, resolve_;
 };
 

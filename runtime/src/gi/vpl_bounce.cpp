@@ -18,14 +18,12 @@ struct BouncePush {
 }  // namespace
 
 Expected<VplBounce> VplBounce::create(gpu::FrameGraph& graph, const frame::SceneGpu& scene,
-                                      const VirtualTriangles& triangles, const BounceGBuffer& gbuffer,
-                                      const VplBounceSettings& s) {
+                                      const BounceGBuffer& gbuffer, const VplBounceSettings& s) {
   if (s.name.empty()) return fail(ErrorKind::BadUsage, "VplBounceSettings.name: must not be empty");
   if (s.max_slots < 1 || s.max_slots > 1024) return fail(ErrorKind::BadUsage, "VplBounceSettings.max_slots: must be 1..1024");
   VplBounce b;
   b.settings_ = s;
   b.scene_ = &scene;
-  b.triangles_ = triangles;
   b.gbuffer_ = gbuffer;
   // Transfer source: tests read the slots back.
   auto buffer = graph.create_buffer({s.name + " slots", VkDeviceSize(s.max_slots) * sizeof(shader::Vpl)},
@@ -51,13 +49,15 @@ Status VplBounce::add_bounce(gpu::FrameGraph& graph, gpu::BufferHandle previous_
   if (!(f.radius > 0.0f) || !(f.focal_px.x > 0.0f) || !(f.focal_px.y > 0.0f) || !(f.clamp_m > 0.0f))
     return fail(ErrorKind::BadUsage, "vpl bounce '" + settings_.name + "': radius, focal lengths and clamp must be > 0");
   const VkExtent2D g = graph.extent(gbuffer_.position);
+  // The objects present this frame (frame::SceneGpu::virtual_triangles, current for its slot).
+  const frame::VirtualTriangles& triangles = scene_->virtual_triangles();
   const BouncePush push{glm::ivec4(int(f.source_vpls), int(f.source_ism_size), int(f.source_tiles_per_row), int(f.slots)),
-                        glm::ivec4(int(g.width), int(g.height), int(triangles_.triangles), int(triangles_.range_count)),
+                        glm::ivec4(int(g.width), int(g.height), int(triangles.triangles), int(triangles.range_count)),
                         glm::vec4(f.centre, f.radius), glm::vec4(f.clamp_m, f.bias_relative, f.bias_m, 0.0f),
                         glm::vec4(f.focal_px, 0.0f, 0.0f)};
   const gpu::Pipeline* pipe = &*pipeline_;
   const frame::SceneGpu* sg = scene_;
-  const VirtualTriangles tri = triangles_;
+  const frame::VirtualTriangles tri = triangles;
   const BounceGBuffer gb = gbuffer_;
   const gpu::BufferHandle out = bounce_;
   const VkSampler linear = graph.context().samplers().linear_repeat;

@@ -57,8 +57,7 @@ class VplBounce {
   static constexpr uint32_t kMaxSources = 256;  // MRGI_BOUNCE_MAX_SOURCES of vpl_bounce.comp
   // BadUsage naming the field for settings out of range.
   static Expected<VplBounce> create(gpu::FrameGraph& graph, const frame::SceneGpu& scene,
-                                    const VirtualTriangles& triangles, const BounceGBuffer& gbuffer,
-                                    const VplBounceSettings& settings);
+                                    const BounceGBuffer& gbuffer, const VplBounceSettings& settings);
   // Pass "<name>": reads `previous_vpls` (gi/vpl.h's buffer) and `previous_ism` (gi/ism.h's
   // distances) as the last frame left them, writes buffer()[0, frame.slots).
   Status add_bounce(gpu::FrameGraph& graph, gpu::BufferHandle previous_vpls, gpu::ImageHandle previous_ism,
@@ -70,7 +69,6 @@ class VplBounce {
   VplBounce() = default;
   VplBounceSettings settings_;
   const frame::SceneGpu* scene_ = nullptr;
-  VirtualTriangles triangles_;
   BounceGBuffer gbuffer_;
   gpu::BufferHandle bounce_;
   gpu::PipelineHandle pipeline_;

@@ -160,6 +160,12 @@ class Context {
   Status upload_image(const GpuImage& dst, const void* texels, VkDeviceSize size,
                       VkImageLayout final_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
 
+  // Copies mip 0 of one layer from `staging` (tightly packed, its first bytes) while frames may
+  // be on the queue: ordered after every earlier submission (a frame still reading the layer's
+  // old contents finishes first), the layer left in SHADER_READ_ONLY_OPTIMAL. Nothing is
+  // allocated; waits on its own fence only. For an object added at run time.
+  Status upload_image_layer(const GpuImage& dst, uint32_t layer, const GpuBuffer& staging);
+
   // Debug names through VK_EXT_debug_utils when validation is on (no-op otherwise).
   void set_name(VkObjectType type, uint64_t handle, const std::string& name) const;
 

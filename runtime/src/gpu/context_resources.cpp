@@ -312,6 +312,41 @@ Status Context::upload_image(const GpuImage& dst, const void* texels, VkDeviceSi
   return s;
 }
 
+Status Context::upload_image_layer(const GpuImage& dst, uint32_t layer, const GpuBuffer& staging) {
+  const VkDeviceSize bytes = VkDeviceSize(dst.extent.width) * dst.extent.height * bytes_per_texel(dst.format);
+  if (layer >= dst.layers || staging.size < bytes)
+    return fail(ErrorKind::Internal, "image layer upload: layer " + std::to_string(layer) + " of " +
+                                         std::to_string(dst.layers) + ", staging " + std::to_string(staging.size) +
+                                         " bytes for " + std::to_string(bytes));
+  return submit_and_wait([&](VkCommandBuffer cmd) {
+    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+    // All commands before: a frame submitted earlier may still sample this layer's old object.
+    b.srcStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+    b.dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+    b.dstAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = dst.image;
+    b.subresourceRange = {dst.aspect, 0, 1, layer, 1};
+    VkDependencyInfo di{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    di.imageMemoryBarrierCount = 1;
+    di.pImageMemoryBarriers = &b;
+    fn_.cmd_pipeline_barrier2(cmd, &di);
+    VkBufferImageCopy region{};
+    region.imageSubresource = {dst.aspect, 0, layer, 1};
+    region.imageExtent = {dst.extent.width, dst.extent.height, 1};
+    vkCmdCopyBufferToImage(cmd, staging.buffer, dst.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    b.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+    b.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+    b.dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+    b.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT;
+    b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    fn_.cmd_pipeline_barrier2(cmd, &di);
+  });
+}
+
 bool is_depth_format(VkFormat f) {
   switch (f) {
     case VK_FORMAT_D16_UNORM:

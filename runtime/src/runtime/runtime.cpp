@@ -120,7 +120,7 @@ Expected<SlotRecord*> RuntimeImpl::begin_slot(const InputFrame& frame,
   // (unless the app placed the object), then the slot's vertex copy brought up to date.
   for (size_t i = 0; i < scene_.virtual_objects.size(); ++i) {
     const auto& motion = scene_.virtual_objects[i].motion;
-    if (!motion.empty() && !app_placed_[i])
+    if (!motion.empty() && !app_placed_[i] && scene_gpu_->present(i))
       MRGI_TRY(scene_gpu_->set_placement(i, placement_at(motion, frame.timestamp)));
   }
   // The lamps where scene.json's motion has them at this frame's timestamp.
@@ -325,6 +325,23 @@ Status RuntimeImpl::set_frame_budget_ms(double budget_ms) {
   if (!std::isfinite(budget_ms) || budget_ms <= 0.0 || budget_ms > 1e6)
     return fail(ErrorKind::BadUsage, "set_frame_budget_ms(" + std::to_string(budget_ms) + "): must be in (0, 1e6] ms");
   scheduler_->set_budget_ms(budget_ms);
+  return ok_status();
+}
+
+// An app's object: loaded in model space here, on the calling thread, then packed into the
+// scene's room (SceneGpu::add_object); the slot takes no scene.json motion.
+Expected<size_t> RuntimeImpl::add_object(const std::string& gltf_path, const Placement& placement) {
+  auto model = load_gltf(gltf_path, Placement{});
+  if (!model) return model.error();
+  auto slot = scene_gpu_->add_object(*model, placement, gltf_path);
+  if (!slot) return slot.error();
+  app_placed_[*slot] = 1;
+  return *slot;
+}
+
+Status RuntimeImpl::remove_object(size_t object) {
+  MRGI_TRY(scene_gpu_->remove_object(object));
+  app_placed_[object] = 1;  // scene.json's motion was its object's, not the slot's
   return ok_status();
 }
 

@@ -92,9 +92,12 @@ class RuntimeImpl final : public Runtime {
     keep_lamp(lamp);
     return ok_status();
   }
+  bool has_object(size_t object) const override { return scene_gpu_->present(object); }
   Status set_object_visible(size_t object, bool visible) override {
     return scene_gpu_->set_visible(object, visible);
   }
+  Expected<size_t> add_object(const std::string& gltf_path, const Placement& placement) override;
+  Status remove_object(size_t object) override;
   Status set_object_placement(size_t object, const Placement& placement) override {
     MRGI_TRY(scene_gpu_->set_placement(object, placement));
     app_placed_[object] = 1;

@@ -137,7 +137,7 @@ Status RuntimeImpl::create_device(const RuntimeSettings& settings, const std::ve
 // The stages every technique shares: the scene's GPU meshes, the light stage, the
 // reconstruction, the virtual G-buffer and compose.
 Status RuntimeImpl::create_shared_stages(const RuntimeSettings& settings) {
-  auto sg = frame::SceneGpu::create(*context_, *graph_, scene_);
+  auto sg = frame::SceneGpu::create(*context_, *graph_, scene_, settings.objects);
   if (!sg) return sg.error();
   scene_gpu_ = std::move(*sg);
   app_placed_.assign(scene_gpu_->object_count(), 0);

@@ -156,7 +156,7 @@ Status DirectLightBlock::Impl::init() {
   if (!sg.virtual_objects.empty()) bounds_.add(sg.virtual_objects.bounds_min, sg.virtual_objects.bounds_max);
   if (!sg.real_proxies.empty()) bounds_.add(sg.real_proxies.bounds_min, sg.real_proxies.bounds_max);
   MRGI_TRY(create_maps());
-  if (!sg.virtual_objects.empty()) {
+  if (sg.may_have_objects()) {
     auto occlusion = EnvironmentOcclusion::create(frame_);
     if (!occlusion) return occlusion.error();
     occlusion_ = std::move(*occlusion);
@@ -181,7 +181,7 @@ Status DirectLightBlock::Impl::create_maps() {
   MRGI_TRY(plan_shadow_maps(largest, bounds_, frame_.scene->path + ": lights", plan_));
   const size_t primary_layers = plan_.primary.size();
   // Nothing virtual: no virtual-caster map is ever drawn (update_lights).
-  const size_t virtual_layers = sg.virtual_objects.empty() ? 0 : plan_.virtual_only.size();
+  const size_t virtual_layers = sg.may_have_objects() ? plan_.virtual_only.size() : 0;
   plan_.primary.reserve(primary_layers);
   plan_.virtual_only.reserve(plan_.virtual_only.size());
   drawn_.reserve(largest.size());

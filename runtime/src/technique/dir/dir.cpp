@@ -184,6 +184,7 @@ class Dir final : public Laddered<DirLevel> {
   bool has_virtual_ = false;
   glm::vec3 centre_{0.0f};
   float radius_ = 1.0f;
+  uint64_t sized_for_layout_ = ~uint64_t(0);  // the SceneGpu::layout_revision radius_ was set for
 };
 
 // The GI blocks sized for the top level: the map pairs, the VPL sampler, the ISMs and the
@@ -195,6 +196,7 @@ Status Dir::create_gi_blocks(uint32_t top_vpls, uint32_t top_ism, uint32_t top_r
   centre_ = 0.5f * (sg.virtual_objects.bounds_max + sg.virtual_objects.bounds_min);
   const float side = std::max(kMinInfluenceSide, 2.0f * std::max({size.x, size.y, size.z}));
   radius_ = 0.5f * side * std::sqrt(3.0f);
+  sized_for_layout_ = sg.layout_revision();
   gi::RsmSettings rs;
   rs.name = "dir rsm";
   rs.size = top_rsm;
@@ -223,8 +225,7 @@ Status Dir::create_gi_blocks(uint32_t top_vpls, uint32_t top_ism, uint32_t top_r
     bs.name = "dir bounce";
     bs.max_slots = top_bounce;
     bs.glossy = sg.glossy;
-    auto bounce = gi::VplBounce::create(graph, sg, ism_->virtual_triangles(),
-                                        {shared_.real_position, shared_.real_normal, shared_.real_albedo}, bs);
+    auto bounce = gi::VplBounce::create(graph, sg, {shared_.real_position, shared_.real_normal, shared_.real_albedo}, bs);
     if (!bounce) return bounce.error();
     bounce_.emplace(std::move(*bounce));
   }
@@ -235,7 +236,7 @@ Status Dir::init() {
   gpu::FrameGraph& graph = *shared_.graph;
   const frame::SceneGpu& sg = *shared_.scene_gpu;
   if (!shared_.light_stage) return fail(ErrorKind::Internal, "dir: no light stage");
-  has_virtual_ = !sg.virtual_objects.empty();
+  has_virtual_ = sg.may_have_objects();
   uint32_t top_vpls = 1, top_ism = 8, top_rsm = 16, top_lamps = 1, top_bounce = 0;
   for (const DirLevel& l : levels_) {
     top_vpls = std::max(top_vpls, l.vpls);
@@ -319,8 +320,15 @@ Status Dir::record(const frame::FrameInfo& info, std::vector<std::string>& skipp
     history_.valid = false;
     return direct_->record(info, direct, {}, skipped);
   }
-  // The maps follow the objects (their side, radius_, is fixed at start-up: rigid motion keeps it).
-  centre_ = 0.5f * (shared_.scene_gpu->virtual_objects.bounds_max + shared_.scene_gpu->virtual_objects.bounds_min);
+  // The maps follow the objects. Their side (radius_) is set when the objects are (start-up, an
+  // object added or removed: SceneGpu::layout_revision), not as they move: rigid motion keeps it.
+  const frame::SceneGpu& sg = *shared_.scene_gpu;
+  centre_ = 0.5f * (sg.virtual_objects.bounds_max + sg.virtual_objects.bounds_min);
+  if (sized_for_layout_ != sg.layout_revision()) {
+    const glm::vec3 size = sg.virtual_objects.empty() ? glm::vec3(0.0f) : sg.virtual_objects.bounds_max - sg.virtual_objects.bounds_min;
+    radius_ = 0.5f * std::max(kMinInfluenceSide, 2.0f * std::max({size.x, size.y, size.z})) * std::sqrt(3.0f);
+    sized_for_layout_ = sg.layout_revision();
+  }
   for (size_t i = 0; i < lighting.lights.size() && planned_.size() < level.rsm_lamps; ++i) {
     auto view = gi::rsm_view(lighting.lights[i], centre_, radius_, level.rsm_size);
     if (!view) {

@@ -106,6 +106,7 @@ class Dlpv final : public Laddered<DlpvLevel> {
   bool has_virtual_ = false;
   glm::vec3 centre_{0.0f};
   float side_ = 1.0f;
+  uint64_t sized_for_layout_ = ~uint64_t(0);  // the SceneGpu::layout_revision side_ was set for
 };
 
 Status Dlpv::init() {
@@ -116,12 +117,13 @@ Status Dlpv::init() {
                                     VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   if (!lights) return lights.error();
   lights_ = *lights;
-  has_virtual_ = !sg.virtual_objects.empty();
+  has_virtual_ = sg.may_have_objects();
   uint32_t top_cells = 2, top_rsm = 16;
   if (has_virtual_) {
     const glm::vec3 size = sg.virtual_objects.bounds_max - sg.virtual_objects.bounds_min;
     centre_ = 0.5f * (sg.virtual_objects.bounds_max + sg.virtual_objects.bounds_min);
     side_ = std::max(kMinVolumeSide, 2.0f * std::max({size.x, size.y, size.z}));
+    sized_for_layout_ = sg.layout_revision();
     for (const DlpvLevel& l : levels_) {
       top_cells = std::max(top_cells, l.volume_cells);
       top_rsm = std::max(top_rsm, l.rsm_size);
@@ -240,9 +242,15 @@ Status Dlpv::record_volumes(const frame::FrameInfo& info, const DlpvLevel& level
   } else {
     MRGI_TRY(delta_->set_cells(graph, level.volume_cells));
     MRGI_TRY(rho_->set_cells(graph, level.volume_cells));
-    // The volumes follow the objects (their side is fixed at start-up: rigid motion keeps it).
+    // The volumes follow the objects. Their side is set when the objects are (start-up, an
+    // object added or removed: SceneGpu::layout_revision), not as they move: rigid motion keeps it.
     const frame::SceneGpu& sg = *shared_.scene_gpu;
     centre_ = 0.5f * (sg.virtual_objects.bounds_max + sg.virtual_objects.bounds_min);
+    if (sized_for_layout_ != sg.layout_revision()) {
+      const glm::vec3 size = sg.virtual_objects.empty() ? glm::vec3(0.0f) : sg.virtual_objects.bounds_max - sg.virtual_objects.bounds_min;
+      side_ = std::max(kMinVolumeSide, 2.0f * std::max({size.x, size.y, size.z}));
+      sized_for_layout_ = sg.layout_revision();
+    }
     const gi::LpvGrid grid{centre_ - glm::vec3(0.5f * side_), side_ / float(level.volume_cells)};
     delta_->set_grid(grid);
     rho_->set_grid(grid);

@@ -120,6 +120,15 @@ class Dvct final : public Laddered<DvctLevel> {
   // (DvctLevel::object_light); valid_ while it holds this frame's volumes' objects.
   std::optional<gi::VoxelLight> object_light_;
   gi::SurfaceLightSource object_surfaces_;  // what it is injected from (made at init)
+  uint64_t surfaces_layout_ = 0;            // the SceneGpu::layout_revision its ranges are of
+  // object_surfaces_'s ranges from the objects present now (capacity reserved at init).
+  void set_object_ranges() {
+    const frame::SceneGpu& sg = *shared_.scene_gpu;
+    object_surfaces_.ranges.clear();
+    for (const frame::DrawRange& r : sg.virtual_objects.draws)
+      object_surfaces_.ranges.push_back({r.first_index, r.index_count, r.vertex_offset, r.material});
+    surfaces_layout_ = sg.layout_revision();
+  }
   bool object_light_valid_ = false;
   std::map<Variant, gpu::PipelineHandle> indirect_, shade_;
   gpu::ImageHandle indirect_image_;  // RGBA32UI, gi/indirect_pack.glsl
@@ -146,7 +155,7 @@ Status Dvct::init() {
                                     VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   if (!lights) return lights.error();
   lights_ = *lights;
-  has_virtual_ = !sg.virtual_objects.empty();
+  has_virtual_ = sg.may_have_objects();
   glossy_ = sg.glossy;
   // The real material regions: a real surface with a glossy hint gets the specular cone too.
   const std::vector<RealMaterialRegion>& regions = shared_.scene->real_materials;
@@ -215,8 +224,8 @@ Status Dvct::init() {
     object_surfaces_.base_color_maps = sg.base_color_maps;
     object_surfaces_.light_set = lights_;
     object_surfaces_.emission = sg.emissive;
-    for (const frame::DrawRange& r : sg.virtual_objects.draws)
-      object_surfaces_.ranges.push_back({r.first_index, r.index_count, r.vertex_offset, r.material});
+    object_surfaces_.ranges.reserve(sg.virtual_objects.draws.capacity());
+    set_object_ranges();
   }
   if (has_virtual_) {
     gi::RsmSettings rs;
@@ -379,7 +388,7 @@ bool Dvct::glossy_in_view(const frame::FrameInfo& info) const {
     return std::count(std::begin(outside), std::end(outside), 8) == 0;
   };
   const frame::SceneGpu& sg = *shared_.scene_gpu;
-  if (sg.glossy && info.virtual_objects_present && box_in_view(sg.virtual_objects.bounds_min, sg.virtual_objects.bounds_max))
+  if (sg.has_glossy() && info.virtual_objects_present && box_in_view(sg.virtual_objects.bounds_min, sg.virtual_objects.bounds_max))
     return true;
   for (const RealMaterialRegion& r : glossy_regions_)
     if (box_in_view(r.min, r.max)) return true;
@@ -395,6 +404,7 @@ void Dvct::record_object_light(std::vector<std::string>& skipped) {
   }
   gpu::FrameGraph& graph = *shared_.graph;
   object_light_->add_clear(graph);
+  if (surfaces_layout_ != shared_.scene_gpu->layout_revision()) set_object_ranges();  // objects added or removed
   object_light_->add_inject_surfaces(graph, "objects", object_surfaces_);
   object_light_->add_resolve(graph);
   object_light_valid_ = true;

@@ -30,10 +30,12 @@ Status Ssrt::write_geometry_constants() {
 Status Ssrt::record_real_geometry(const frame::FrameInfo& info, const SsrtLevel& level,
                                   std::vector<std::string>& skipped) {
   MRGI_TRY(write_geometry_constants());
-  if (!volume_center_) {
-    // The workspace cube sits on the virtual objects (where occluders matter); a scene without
-    // one keeps the cube in front of the first pose.
-    const frame::SceneGpu& sg = *shared_.scene_gpu;
+  const frame::SceneGpu& sg = *shared_.scene_gpu;
+  if (!volume_center_ || centred_for_layout_ != sg.layout_revision()) {
+    // The workspace cube sits on the virtual objects (where occluders matter), placed when they
+    // are (the first frame, an object added or removed: the volume then starts again), not as
+    // they move; a scene without one keeps the cube in front of the pose of that frame.
+    centred_for_layout_ = sg.layout_revision();
     if (!sg.virtual_objects.empty()) {
       volume_center_ = 0.5f * (sg.virtual_objects.bounds_min + sg.virtual_objects.bounds_max);
     } else {

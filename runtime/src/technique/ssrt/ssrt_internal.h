@@ -189,6 +189,7 @@ class Ssrt final : public Laddered<SsrtLevel> {
   gpu::BufferHandle geo_constants_;
   std::vector<gpu::ImageHandle> geo_images_;
   std::optional<glm::vec3> volume_center_;
+  uint64_t centred_for_layout_ = 0;  // the SceneGpu::layout_revision the cube was placed for
   std::vector<uint32_t> sample_base_;  // per level: first sample of its sets
   std::vector<float> chi_;             // per level
   gpu::BufferHandle samples_, light_, partials_, result_;
