@@ -29,6 +29,7 @@ struct DeviceInfo;
 struct FrameOutput;
 struct ResearchSettings;  // mrgi/research.h
 struct AppVulkanDevice;   // mrgi/vulkan_device.h
+struct AppOutputImage;    // mrgi/vulkan_device.h
 
 // ---------------------------------------------------------------------------------------------
 // 1-2. Creating a runtime and running frames
@@ -76,6 +77,13 @@ class MRGI_API Runtime {
   /// driver's first use of pipelines and slot memory would otherwise be charged to the budget).
   /// That call returns the frames still in flight at once, and the frame's stats note the runs.
   virtual Expected<std::vector<FrameOutput>> process(const InputFrame& frame) = 0;
+  /// process(), with the frame's composite written into the app's image on the app's device
+  /// (mrgi/vulkan_device.h AppOutputImage) instead of read back: zero host copies of the
+  /// output. The outputs returned are earlier frames', as process()'s; one whose frame went to
+  /// an app image has no image or mask. BadUsage on a runtime not made on the app's device
+  /// (DeviceSettings::app_device), for a null image, a format other than R8G8B8A8 UNORM / SRGB
+  /// or a final layout an image cannot be left in.
+  virtual Expected<std::vector<FrameOutput>> process(const InputFrame& frame, const AppOutputImage& target) = 0;
   virtual Expected<std::vector<FrameOutput>> flush() = 0;
   /// Hands a delivered frame back once the caller is done with it: a later process() or flush()
   /// fills its image and mask instead of allocating new ones. Optional, but a live loop should:
@@ -163,6 +171,10 @@ struct FrameStats {
   /// On a CPU device this competes with the passes for the same cores, so a frame's sustained
   /// wall clock is about its passes plus this.
   double host_ms = 0.0;
+  /// Bytes of frame images the host copied between the app and the runtime for this frame: the
+  /// input's colour and depth into the upload buffers and, unless the composite went to an app
+  /// image (Runtime::process with an AppOutputImage), the output's image and mask back.
+  uint64_t host_copy_bytes = 0;
   /// CPU time of the light stage this frame (light/light_stage.h: environment sampling or the
   /// probeless system's part and solve) on the calling thread, ms; inside record_ms and host_ms.
   double light_ms = 0.0;

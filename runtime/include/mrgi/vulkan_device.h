@@ -85,4 +85,28 @@ struct AppVulkanDevice {
   std::function<void()> lock_queue, unlock_queue;
 };
 
+/// Where a frame's composite goes on the app's device instead of host memory
+/// (Runtime::process(frame, target); a runtime on DeviceSettings::app_device only): the app's
+/// image, written by a copy at the end of the frame's own submission on the runtime's queue, so
+/// an app that presents or samples it never copies it. The frame's FrameOutput then carries its
+/// stats and light estimate but no image or mask (FrameStats::host_copy_bytes counts only the
+/// input's upload). The image holds the composite's sRGB-encoded bytes and, in alpha, the
+/// virtual mask (255 on the objects' pixels, 0 elsewhere).
+struct AppOutputImage {
+  /// The output's size, one mip level and layer, created with VK_IMAGE_USAGE_TRANSFER_DST_BIT.
+  VkImage image = VK_NULL_HANDLE;
+  /// VK_FORMAT_R8G8B8A8_UNORM (the bytes as they are) or VK_FORMAT_R8G8B8A8_SRGB (a sampler
+  /// decodes them to linear); others are refused.
+  VkFormat format = VK_FORMAT_R8G8B8A8_UNORM;
+  /// Its layout when the copy starts (UNDEFINED: the old contents are not kept) and the layout
+  /// the copy leaves it in (not UNDEFINED or PREINITIALIZED; PRESENT_SRC_KHR for a swapchain).
+  VkImageLayout old_layout = VK_IMAGE_LAYOUT_UNDEFINED;
+  VkImageLayout final_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+  /// Optional binary semaphores: waited for before the copy (a swapchain image's acquire), and
+  /// signalled when the image is written (what the app's present or draw waits for). Earlier
+  /// work on the same queue is ordered before the copy without one.
+  VkSemaphore wait = VK_NULL_HANDLE;
+  VkSemaphore signal = VK_NULL_HANDLE;
+};
+
 }  // namespace mrgi

@@ -38,8 +38,9 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
   c.tile_readback_ = *tiles;
   c.slot_host_camera_.assign(graph.frames_in_flight(), 0);
   const VkDeviceSize bytes = VkDeviceSize(width) * height * 4;
+  // Transfer source: copied into an app's image (AppOutputImage) instead of read back.
   auto out = graph.create_buffer({"output_rgba8", bytes, gpu::MemoryUsage::Readback, true},
-                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
   if (!out) return out.error();
   c.output_ = *out;
   auto spv = gpu::shader_spirv("compose/compose.comp");
@@ -131,7 +132,7 @@ Status Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
   const bool listed = in_.tile_args.valid() && in_.tile_list.valid();
   if (!in_.camera_only && !listed && classify_state_.valid()) record_classify(graph);
   tiled_ = !in_.camera_only && in_.tile_args.valid() && in_.tile_list.valid();
-  const bool host_camera = tiled_ && same_size_as_camera_;
+  const bool host_camera = tiled_ && same_size_as_camera_ && !in_.device_output;
   slot_host_camera_[graph.slot()] = host_camera ? 1 : 0;
   const bool composed = host_camera && in_.tiles_composed;
   // Every variant declares the same bindings (compose.comp's paths are compiled out of each
@@ -172,7 +173,7 @@ Status Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
                                 : same_internal                ? &*same_internal_pipeline_
                                                                : &*pipeline_;
     // Over the camera pass's output (tiles only): declared read-write so that pass is kept.
-    const bool over = tiled_ && !same_size_as_camera_;
+    const bool over = tiled_ && !host_camera;
     graph.add_shader_pass(
         "compose", gpu::PassKind::Compute, *pipe,
         [this, bind_inputs, over](gpu::ShaderPassBuilder& b) {

@@ -58,6 +58,9 @@ struct ComposeInputs {
   // The output pixels that raster drew and cleared this frame (VirtualGBuffer::
   // output_coverage_area): the coverage is 0 outside it.
   VkRect2D coverage_area{{0, 0}, {0, 0}};
+  // The output stays on the device (an app's image): the camera frame around the tiles is
+  // written by the camera pass, not laid on the host.
+  bool device_output = false;
 };
 
 // `image` at w x h, reusing its storage when it already has that size (Runtime::recycle: no

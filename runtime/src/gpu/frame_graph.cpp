@@ -694,6 +694,22 @@ Status FrameGraph::measure_submission_overhead() {
   return ok_status();
 }
 
+void FrameGraph::add_submit_semaphores(VkSubmitInfo2& si, VkSemaphoreSubmitInfo& wait, VkSemaphoreSubmitInfo& signal) {
+  if (submit_wait_) {
+    wait.semaphore = submit_wait_;
+    wait.stageMask = submit_wait_stage_;
+    si.waitSemaphoreInfoCount = 1;
+    si.pWaitSemaphoreInfos = &wait;
+  }
+  if (submit_signal_) {
+    signal.semaphore = submit_signal_;
+    signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+    si.signalSemaphoreInfoCount = 1;
+    si.pSignalSemaphoreInfos = &signal;
+  }
+  submit_wait_ = submit_signal_ = VK_NULL_HANDLE;
+}
+
 Status FrameGraph::submit_profiled() {
   const uint32_t n = uint32_t(compiled_.passes.size());
   if (n > profile_cmds_.size())
@@ -702,6 +718,24 @@ Status FrameGraph::submit_profiled() {
   // The frame that used this slot before has completed (begin_frame waited), but the other
   // slots' frames may still run: wait for them, so the first pass's time is its own.
   MRGI_TRY(wait_submitted());
+  if (submit_wait_) {
+    // The passes are submitted one by one: the frame's wait semaphore is waited for first, by an
+    // empty submission the host waits on, so every pass runs after it.
+    VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+    VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+    wait.semaphore = submit_wait_;
+    wait.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+    si.waitSemaphoreInfoCount = 1;
+    si.pWaitSemaphoreInfos = &wait;
+    VK_CHECK(context_.queue_submit2(si, profile_fence_));
+    const VkResult w = vkWaitForFences(context_.device(), 1, &profile_fence_, VK_TRUE, kFrameTimeoutNs);
+    if (w == VK_TIMEOUT)
+      return fail(ErrorKind::Timeout, "the frame's wait semaphore was not signalled within " +
+                                          std::to_string(kFrameTimeoutS) + " s (profiling mode)");
+    VK_CHECK(w);
+    VK_CHECK(vkResetFences(context_.device(), 1, &profile_fence_));
+    submit_wait_ = VK_NULL_HANDLE;
+  }
   Slot& slot = slots_[slot_];
   slot.host_ms.assign(n, 0.0);
   slot.cpu_ms.assign(n, 0.0);
@@ -725,8 +759,11 @@ Status FrameGraph::submit_profiled() {
     slot.cpu_ms[i] = process_cpu_ms() - cpu0;
   }
   finish_execute(true);
-  // The slot's fence marks the frame done, as in normal mode (an empty submission signals it).
+  // The slot's fence marks the frame done, as in normal mode (an empty submission signals it,
+  // and the frame's semaphores: the passes' submissions before it have all completed).
   VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+  VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO}, signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+  add_submit_semaphores(si, wait, signal);
   VK_CHECK(context_.queue_submit2(si, slot.fence));
   slot.submitted = true;
   in_frame_ = false;
@@ -748,6 +785,8 @@ Status FrameGraph::submit() {
   VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
   si.commandBufferInfoCount = 1;
   si.pCommandBufferInfos = &cbi;
+  VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO}, signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+  add_submit_semaphores(si, wait, signal);
   VK_CHECK(context_.queue_submit2(si, slot.fence));
   slot.submitted = true;
   in_frame_ = false;

@@ -115,10 +115,12 @@ Expected<Reconstruction> Reconstruction::create(gpu::Context& context, gpu::Fram
   return r;
 }
 
-void Reconstruction::upload(const gpu::FrameGraph& graph, const InputFrame& frame) {
+size_t Reconstruction::upload(const gpu::FrameGraph& graph, const InputFrame& frame) {
   yuv_push_.frame.x = 0;
+  size_t bytes = depth_bytes_;
   if (const std::optional<YuvImage>& yuv = frame.color_yuv) {
     std::memcpy(graph.mapped(yuv_upload_, graph.slot()), yuv->data.data(), yuv->expected_bytes());
+    bytes += yuv->expected_bytes();
     constexpr int kGroupsPerRow = 256;  // the dispatch's row of 4-pixel groups
     yuv_push_.frame = glm::ivec4(yuv->width, yuv->height,
                                  yuv->layout == YuvImage::Layout::Yuyv ? MRGI_YUV_YUYV : MRGI_YUV_NV12, kGroupsPerRow);
@@ -126,12 +128,14 @@ void Reconstruction::upload(const gpu::FrameGraph& graph, const InputFrame& fram
                                   yuv->range == YuvImage::Range::Full ? 1 : 0, 0, 0);
   } else {
     std::memcpy(graph.mapped(color_upload_, graph.slot()), frame.color.data.data(), color_bytes_);
+    bytes += color_bytes_;
   }
   std::memcpy(graph.mapped(depth_upload_, graph.slot()), frame.depth.data.data(), depth_bytes_);
   // Same rule as the runtime's frame constants: no pose = the last known one (not moved).
   if (frame.pose) {
     pose_ = frame.pose->matrix();
   }
+  return bytes;
 }
 
 void Reconstruction::record_camera_input(gpu::FrameGraph& graph) {

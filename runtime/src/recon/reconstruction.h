@@ -55,7 +55,8 @@ class Reconstruction {
   // caller) and takes the frame's pose: the RGB8 colour as it is, a Y'CbCr colour
   // (InputFrame::color_yuv) as the camera delivered it, for record_camera_input to convert. Call
   // between FrameGraph::begin_frame and submit.
-  void upload(const gpu::FrameGraph& graph, const InputFrame& frame);
+  // Returns the bytes copied (FrameStats::host_copy_bytes).
+  size_t upload(const gpu::FrameGraph& graph, const InputFrame& frame);
   // Adds camera_yuv_to_rgb where this frame's colour came as Y'CbCr: the RGB8 words of
   // color_upload() from it on the GPU (shaders/recon/yuv_to_rgb.comp), before any pass reads
   // them, kept for the host's reads too (the camera frame where nothing virtual shows). Nothing

@@ -45,18 +45,21 @@ const RuntimeImpl::FrameStageEntry RuntimeImpl::kFrameStages[] = {
     {"technique", &RuntimeImpl::record_technique},
     {"specular finish", &RuntimeImpl::record_specular_finish},
     {"compose", &RuntimeImpl::record_compose},
+    {"app output", &RuntimeImpl::record_app_output},
 };
 
-Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, bool affected) {
+Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, bool affected,
+                                      const AppOutputImage* target) {
   const technique::QualityLevel& level = technique_->levels()[size_t(level_)];
   rec.scale_factor = auto_level_ ? scheduler_->choice().scale : 1.0f;
   rec.internal_scale = level.internal_scale * rec.scale_factor;
   MRGI_TRY(graph_->set_render_scale(rec.internal_scale));
   rec.technique_ran = affected;
   write_constants(last_pose_);
-  recon_->upload(*graph_, frame);
+  rec.host_copy_bytes = recon_->upload(*graph_, frame);
+  rec.app_output = target != nullptr;
 
-  FrameContext f{frame, rec, affected, false, false, level, {}};
+  FrameContext f{frame, rec, affected, false, false, level, {}, target};
   f.has_objects = !scene_gpu_->virtual_objects.empty() && scene_gpu_->any_visible();
   // The specular stage's impostors and back-projection read the reconstruction's G-buffer, so it
   // runs for a technique without one (ssrt) when a mirror or glass object is in the scene.
@@ -142,13 +145,14 @@ Status RuntimeImpl::record_specular_finish(FrameContext& f) {
 // frame, which the host converts from the upload buffer when the (empty) frame completes (0.3 ms
 // of host time against 2-3 ms for compose's camera-copy pass on lavapipe).
 Status RuntimeImpl::record_compose(FrameContext& f) {
-  f.rec.camera_copy = !f.affected && output_w_ == cameras_.color.width && output_h_ == cameras_.color.height;
+  f.rec.camera_copy = !f.affected && !f.target && output_w_ == cameras_.color.width && output_h_ == cameras_.color.height;
   if (f.rec.camera_copy) {
     f.rec.skipped.push_back("compose: nothing virtual in view, the camera frame is copied on the host");
     return ok_status();
   }
   compose::ComposeInputs ci{frame_constants_, recon_->color_upload(), lit_rv_, lit_r_, virtual_gbuffer_->position(),
                             !f.affected};
+  ci.device_output = f.target != nullptr;
   if (f.affected) {
     const technique::Technique::ComposeTiles tiles = technique_->compose_tiles();
     // Caustics land where the technique's tiles may not reach: then every pixel is composed.
@@ -165,6 +169,53 @@ Status RuntimeImpl::record_compose(FrameContext& f) {
     ci.coverage_area = virtual_gbuffer_->output_coverage_area();
   }
   return compose_->record(*graph_, ci);
+}
+
+// The composite into the app's image: a copy of compose's output words (RGBA8, the mask in
+// alpha) at the end of the frame, the image taken from the app's layout to the one it asked for;
+// the frame's submission waits for and signals the app's semaphores.
+Status RuntimeImpl::record_app_output(FrameContext& f) {
+  if (!f.target) return ok_status();
+  const AppOutputImage target = *f.target;
+  const gpu::BufferHandle words = compose_->output();
+  const uint32_t w = uint32_t(output_w_), h = uint32_t(output_h_);
+  const gpu::Context* ctx = context_.get();
+  graph_->add_pass(
+      "output_to_app_image", gpu::PassKind::Transfer,
+      [words](gpu::PassBuilder& b) {
+        b.read(words, gpu::Access::TransferSrc);
+        b.side_effect();  // writes the app's image, outside the graph
+      },
+      [target, words, w, h, ctx](VkCommandBuffer cmd, gpu::PassContext& pass) {
+        VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+        // Whatever the app did with the image before (on this queue) completes first.
+        b.srcStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+        b.srcAccessMask = VK_ACCESS_2_MEMORY_WRITE_BIT;
+        b.dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+        b.dstAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+        b.oldLayout = target.old_layout;
+        b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+        b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        b.image = target.image;
+        b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+        VkDependencyInfo di{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+        di.imageMemoryBarrierCount = 1;
+        di.pImageMemoryBarriers = &b;
+        ctx->fn().cmd_pipeline_barrier2(cmd, &di);
+        VkBufferImageCopy region{};
+        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        region.imageExtent = {w, h, 1};
+        vkCmdCopyBufferToImage(cmd, pass.buffer(words), target.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+        b.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+        b.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+        b.dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+        b.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT;
+        b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+        b.newLayout = target.final_layout;
+        ctx->fn().cmd_pipeline_barrier2(cmd, &di);
+      });
+  graph_->set_submit_semaphores(target.wait, VK_PIPELINE_STAGE_2_COPY_BIT, target.signal);
+  return ok_status();
 }
 
 }  // namespace mrgi::runtime_detail

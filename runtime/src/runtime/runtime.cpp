@@ -146,7 +146,23 @@ Expected<SlotRecord*> RuntimeImpl::begin_slot(const InputFrame& frame,
   return &rec;
 }
 
-Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame) {
+Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame, const AppOutputImage& target) {
+  const std::string where = "frame " + std::to_string(frame.index) + ": AppOutputImage::";
+  if (!context_->app_device())
+    return fail(ErrorKind::BadUsage, where + "image: the runtime was not made on the app's device "
+                                             "(DeviceSettings::app_device); its images are not the runtime's to write");
+  if (target.image == VK_NULL_HANDLE) return fail(ErrorKind::BadUsage, where + "image is null");
+  if (target.format != VK_FORMAT_R8G8B8A8_UNORM && target.format != VK_FORMAT_R8G8B8A8_SRGB)
+    return fail(ErrorKind::BadUsage, where + "format must be VK_FORMAT_R8G8B8A8_UNORM or _SRGB (the "
+                                             "composite's bytes are copied as they are), not " +
+                                             std::to_string(int(target.format)));
+  if (target.final_layout == VK_IMAGE_LAYOUT_UNDEFINED || target.final_layout == VK_IMAGE_LAYOUT_PREINITIALIZED)
+    return fail(ErrorKind::BadUsage, where + "final_layout must be a layout an image can be left in "
+                                             "(not UNDEFINED or PREINITIALIZED)");
+  return process_frame(frame, &target);
+}
+
+Expected<std::vector<FrameOutput>> RuntimeImpl::process_frame(const InputFrame& frame, const AppOutputImage* target) {
   const auto t0 = std::chrono::steady_clock::now();
   MRGI_TRY(check_frame(frame));
   const double check_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -215,7 +231,7 @@ Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame)
     choice_reason_.clear();
   }
   rec->notes.insert(rec->notes.end(), notes.begin(), notes.end());
-  MRGI_TRY(record_and_submit(frame, *rec, affected));
+  MRGI_TRY(record_and_submit(frame, *rec, affected, target));
   const auto t1 = std::chrono::steady_clock::now();
   rec->record_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
   rec->host_work_ms = std::max(0.0, check_ms) + std::chrono::duration<double, std::milli>(t1 - t_work).count();
@@ -259,7 +275,12 @@ Expected<FrameOutput> RuntimeImpl::collect(const gpu::FrameTimings& timings) {
     spare_outputs_.pop_back();
   }
   const auto read_start = std::chrono::steady_clock::now();
-  if (rec.camera_copy) {
+  uint64_t copied = rec.host_copy_bytes;
+  if (rec.app_output) {
+    // Nothing comes back: the composite is in the app's image.
+    out.image = ImageRGBA8();
+    out.virtual_mask = Image<uint8_t, 1>();
+  } else if (rec.camera_copy) {
     const auto* rgb = static_cast<const uint8_t*>(graph_->mapped(recon_->color_upload(), timings.slot));
     compose::reuse_or_allocate(out.image, output_w_, output_h_, false);  // all written
     compose::reuse_or_allocate(out.virtual_mask, output_w_, output_h_);  // zero: no virtual pixel
@@ -274,6 +295,7 @@ Expected<FrameOutput> RuntimeImpl::collect(const gpu::FrameTimings& timings) {
   } else {
     MRGI_TRY(compose_->read(*graph_, timings.slot, out.image, out.virtual_mask));
   }
+  if (!rec.app_output) copied += out.image.data.size() + out.virtual_mask.data.size();
   const double readback_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - read_start).count();
   out.stats.frame_index = rec.frame_index;
@@ -294,6 +316,7 @@ Expected<FrameOutput> RuntimeImpl::collect(const gpu::FrameTimings& timings) {
   out.stats.cost_ms = cpu_device_ ? timings.total_ms + host_work : std::max(timings.total_ms, host_work);
   if (!rec.priming) scheduler_->observe(rec.level, rec.scale_factor, out.stats.cost_ms, rec.technique_ran && !timings.profiled);
   out.stats.light_ms = rec.light_ms;
+  out.stats.host_copy_bytes = copied;
   out.stats.skipped = rec.skipped;
   for (const std::string& c : timings.culled) out.stats.skipped.push_back(c + ": culled (nothing reads it)");
   out.stats.notes = rec.notes;

@@ -20,6 +20,7 @@
 #include "gpu/frame_graph.h"
 #include "light/light_stage.h"
 #include "mrgi/runtime.h"
+#include "mrgi/vulkan_device.h"
 #include "recon/reconstruction.h"
 #include "recon/virtual_gbuffer.h"
 #include "scheduler/scheduler.h"
@@ -62,6 +63,10 @@ struct SlotRecord {
   // Nothing virtual in view and the output has the camera's size: the output is the camera
   // frame, converted on the host from this slot's colour upload when the frame completes.
   bool camera_copy = false;
+  // The composite went to an app's image (Runtime::process with an AppOutputImage): nothing to
+  // read back.
+  bool app_output = false;
+  uint64_t host_copy_bytes = 0;  // the input's upload (FrameStats::host_copy_bytes)
   double light_ms = 0.0;
   std::vector<std::string> skipped;
   std::vector<std::string> notes;
@@ -73,7 +78,10 @@ class RuntimeImpl final : public Runtime {
   ~RuntimeImpl() override;
   Status init(const RuntimeSettings& settings, const CameraSetup& cameras, const SceneDesc& scene);
 
-  Expected<std::vector<FrameOutput>> process(const InputFrame& frame) override;
+  Expected<std::vector<FrameOutput>> process(const InputFrame& frame) override {
+    return process_frame(frame, nullptr);
+  }
+  Expected<std::vector<FrameOutput>> process(const InputFrame& frame, const AppOutputImage& target) override;
   Expected<std::vector<FrameOutput>> flush() override;
   void recycle(FrameOutput&& done) override;
   const DeviceInfo& device() const override { return context_->info(); }
@@ -113,7 +121,10 @@ class RuntimeImpl final : public Runtime {
   // that slot's record for `frame`.
   Expected<SlotRecord*> begin_slot(const InputFrame& frame, std::vector<FrameOutput>& outputs);
   // Records the frame's passes into the current slot and submits them.
-  Status record_and_submit(const InputFrame& frame, SlotRecord& rec, bool affected);
+  // `target`: the app's image the composite goes to (null: read back into host memory).
+  Status record_and_submit(const InputFrame& frame, SlotRecord& rec, bool affected,
+                           const AppOutputImage* target = nullptr);
+  Expected<std::vector<FrameOutput>> process_frame(const InputFrame& frame, const AppOutputImage* target);
   // The technique's priming run (Technique::Needs::estimate_from_frames): this frame run once,
   // waited for, its output dropped; the frames still in flight before it are collected into
   // `outputs`.
@@ -138,6 +149,7 @@ class RuntimeImpl final : public Runtime {
     bool recon_used;        // the reconstruction's G-buffer is read this frame
     const technique::QualityLevel& level;
     frame::FrameInfo info;
+    const AppOutputImage* target = nullptr;  // where the composite goes (null: host memory)
   };
   using FrameStage = Status (RuntimeImpl::*)(FrameContext&);
   struct FrameStageEntry {
@@ -153,6 +165,8 @@ class RuntimeImpl final : public Runtime {
   Status record_technique(FrameContext& f);
   Status record_specular_finish(FrameContext& f);
   Status record_compose(FrameContext& f);
+  // The composite copied into the app's image (AppOutputImage), after compose.
+  Status record_app_output(FrameContext& f);
 
   RuntimeSettings settings_;
   CameraSetup cameras_;
