@@ -3,12 +3,20 @@
 // needs itself), hands the objects to create_runtime, plays a recorded capture through the
 // runtime, and goes on using its device after the runtime is gone.
 //
-//   app_device CAPTURE_DIR [FRAMES]
+//   app_device CAPTURE_DIR [FRAMES] [--output host|image] [--technique NAME] [--level N]
 //
-// Prints the device, what was enabled for mrgi and each frame's output. Exit 0 when every frame
-// came back and the device still works afterwards.
+// --output image: the composites go straight into the app's images (mrgi::AppOutputImage), with
+// the semaphore the app's "present" waits for; no readback. --output host (the default): they
+// come back in host memory and the app copies each into its image (as an app that presents them
+// must); the bytes the host copied a frame count both. Prints the device, what was enabled
+// for mrgi, each frame's output (up to 8 frames) and the sustained wall and CPU ms a frame after
+// a 4-frame warm-up. Exit 0 when every frame came back and the device still works afterwards.
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <ctime>
 #include <string>
 #include <vector>
 
@@ -50,50 +58,284 @@ uint32_t graphics_compute_family(VkPhysicalDevice device) {
   return ~0u;
 }
 
-// Plays `frames` frames of the capture through a runtime on the app's device.
-int play(const mrgi::AppVulkanDevice& app, const std::string& capture_dir, int frames) {
+// The app's images the composites go into: a ring, each with the semaphore the runtime signals
+// when it wrote one (--output image) and the app's "present" (a submission that waits for that
+// semaphore, as a swapchain's present would), or, on the host path, the app's own copy of the
+// returned composite into it; fenced so an image is reused only after it.
+class ImageRing {
+ public:
+  bool create(VkPhysicalDevice physical, VkDevice device, VkQueue queue, uint32_t family, uint32_t w, uint32_t h) {
+    device_ = device;
+    queue_ = queue;
+    VkPhysicalDeviceMemoryProperties mp{};
+    vkGetPhysicalDeviceMemoryProperties(physical, &mp);
+    for (Slot& s : slots_) {
+      VkImageCreateInfo ici{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+      ici.imageType = VK_IMAGE_TYPE_2D;
+      ici.format = VK_FORMAT_R8G8B8A8_UNORM;
+      ici.extent = {w, h, 1};
+      ici.mipLevels = ici.arrayLayers = 1;
+      ici.samples = VK_SAMPLE_COUNT_1_BIT;
+      ici.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+      if (vkCreateImage(device, &ici, nullptr, &s.image) != VK_SUCCESS) return false;
+      VkMemoryRequirements mr{};
+      vkGetImageMemoryRequirements(device, s.image, &mr);
+      VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+      mai.allocationSize = mr.size;
+      for (uint32_t i = 0; i < mp.memoryTypeCount; ++i)
+        if (mr.memoryTypeBits & (1u << i)) {
+          mai.memoryTypeIndex = i;
+          break;
+        }
+      if (vkAllocateMemory(device, &mai, nullptr, &s.memory) != VK_SUCCESS) return false;
+      vkBindImageMemory(device, s.image, s.memory, 0);
+      VkSemaphoreCreateInfo sci{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+      VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+      fci.flags = VK_FENCE_CREATE_SIGNALED_BIT;
+      if (vkCreateSemaphore(device, &sci, nullptr, &s.written) != VK_SUCCESS ||
+          vkCreateFence(device, &fci, nullptr, &s.presented) != VK_SUCCESS)
+        return false;
+      // For the host path: a host-visible buffer the returned image is copied into, and a
+      // command buffer that copies it into the image.
+      VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+      bci.size = VkDeviceSize(w) * h * 4;
+      bci.usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+      if (vkCreateBuffer(device, &bci, nullptr, &s.staging) != VK_SUCCESS) return false;
+      vkGetBufferMemoryRequirements(device, s.staging, &mr);
+      mai.allocationSize = mr.size;
+      const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+      for (uint32_t i = 0; i < mp.memoryTypeCount; ++i)
+        if ((mr.memoryTypeBits & (1u << i)) && (mp.memoryTypes[i].propertyFlags & host) == host) {
+          mai.memoryTypeIndex = i;
+          break;
+        }
+      if (vkAllocateMemory(device, &mai, nullptr, &s.staging_memory) != VK_SUCCESS) return false;
+      vkBindBufferMemory(device, s.staging, s.staging_memory, 0);
+      vkMapMemory(device, s.staging_memory, 0, VK_WHOLE_SIZE, 0, &s.mapped);
+    }
+    VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    pci.queueFamilyIndex = family;
+    if (vkCreateCommandPool(device, &pci, nullptr, &pool_) != VK_SUCCESS) return false;
+    VkCommandBufferAllocateInfo cai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    cai.commandPool = pool_;
+    cai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    cai.commandBufferCount = 1;
+    for (Slot& s : slots_)
+      if (vkAllocateCommandBuffers(device, &cai, &s.cmd) != VK_SUCCESS) return false;
+    w_ = w;
+    h_ = h;
+    return true;
+  }
+  // The host path's way into the app's image: the returned composite copied into the next
+  // image's staging buffer on the host, then into the image by the app's own submission.
+  void upload(const mrgi::ImageRGBA8& composite) {
+    Slot& s = slots_[next_];
+    vkWaitForFences(device_, 1, &s.presented, VK_TRUE, UINT64_MAX);
+    vkResetFences(device_, 1, &s.presented);
+    std::memcpy(s.mapped, composite.data.data(), std::min<size_t>(composite.data.size(), size_t(w_) * h_ * 4));
+    vkResetCommandBuffer(s.cmd, 0);
+    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    vkBeginCommandBuffer(s.cmd, &bi);
+    VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+    b.srcAccessMask = 0;
+    b.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = s.image;
+    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    vkCmdPipelineBarrier(s.cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
+                         nullptr, 1, &b);
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageExtent = {w_, h_, 1};
+    vkCmdCopyBufferToImage(s.cmd, s.staging, s.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+    b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    vkCmdPipelineBarrier(s.cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, nullptr, 0,
+                         nullptr, 1, &b);
+    vkEndCommandBuffer(s.cmd);
+    VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    si.commandBufferCount = 1;
+    si.pCommandBuffers = &s.cmd;
+    vkQueueSubmit(queue_, 1, &si, s.presented);
+    next_ = (next_ + 1) % kSlots;
+  }
+  // The next image, once the app's last use of it is done.
+  mrgi::AppOutputImage next() {
+    Slot& s = slots_[next_];
+    vkWaitForFences(device_, 1, &s.presented, VK_TRUE, UINT64_MAX);
+    vkResetFences(device_, 1, &s.presented);
+    mrgi::AppOutputImage t;
+    t.image = s.image;
+    t.format = VK_FORMAT_R8G8B8A8_UNORM;
+    t.old_layout = VK_IMAGE_LAYOUT_UNDEFINED;
+    t.final_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    t.signal = s.written;
+    return t;
+  }
+  // The app takes the image the last next() gave (after process() submitted the frame).
+  void present() {
+    Slot& s = slots_[next_];
+    const VkPipelineStageFlags stage = VK_PIPELINE_STAGE_ALL_COMMANDS_BIT;
+    VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    si.waitSemaphoreCount = 1;
+    si.pWaitSemaphores = &s.written;
+    si.pWaitDstStageMask = &stage;
+    vkQueueSubmit(queue_, 1, &si, s.presented);
+    next_ = (next_ + 1) % kSlots;
+  }
+  void destroy() {
+    if (!device_) return;  // never created
+    for (Slot& s : slots_) {
+      if (s.presented) vkWaitForFences(device_, 1, &s.presented, VK_TRUE, UINT64_MAX);
+      vkDestroyFence(device_, s.presented, nullptr);
+      vkDestroyBuffer(device_, s.staging, nullptr);
+      vkFreeMemory(device_, s.staging_memory, nullptr);
+      vkDestroySemaphore(device_, s.written, nullptr);
+      vkDestroyImage(device_, s.image, nullptr);
+      vkFreeMemory(device_, s.memory, nullptr);
+    }
+    vkDestroyCommandPool(device_, pool_, nullptr);
+  }
+
+ private:
+  static constexpr int kSlots = 3;
+  struct Slot {
+    VkImage image = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    VkSemaphore written = VK_NULL_HANDLE;
+    VkFence presented = VK_NULL_HANDLE;
+    VkBuffer staging = VK_NULL_HANDLE;
+    VkDeviceMemory staging_memory = VK_NULL_HANDLE;
+    void* mapped = nullptr;
+    VkCommandBuffer cmd = VK_NULL_HANDLE;
+  } slots_[kSlots];
+  VkCommandPool pool_ = VK_NULL_HANDLE;
+  uint32_t w_ = 0, h_ = 0;
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  int next_ = 0;
+};
+
+struct Options {
+  int frames = 4;         // frames played (the capture's, looped forwards and back)
+  bool to_image = false;  // --output image: composites into the app's images
+  std::string level;      // --level N (default: the scheduler's)
+  std::string technique;  // --technique NAME (default: baseline)
+};
+
+double process_cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
+}
+
+// Plays the capture's frames (preloaded) through a runtime on the app's device, into host memory
+// or the app's images; after 4 warm-up frames, prints the sustained wall and CPU ms a frame.
+int play(const mrgi::AppVulkanDevice& app, const std::string& capture_dir, const Options& o) {
   auto capture = mrgi::CaptureReader::open(capture_dir);
   if (!capture) return fail(capture.error().message);
   const mrgi::CaptureInfo& info = capture->info();
+  std::vector<mrgi::InputFrame> frames;
+  for (size_t i = 0; i < capture->frame_count(); ++i) {
+    auto f = capture->read_frame(i);
+    if (!f) return fail(f.error().message);
+    frames.push_back(std::move(*f));
+  }
+  if (frames.empty()) return fail(capture_dir + ": no frames");
   mrgi::RuntimeSettings settings;
   settings.device.app_device = &app;
   settings.exposure = info.exposure;
+  if (!o.level.empty()) settings.level = std::atoi(o.level.c_str());
+  if (!o.technique.empty()) settings.technique = o.technique;
   auto runtime = mrgi::create_runtime(
       settings, mrgi::CameraSetup{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera},
       *capture->scene());
   if (!runtime) return fail(runtime.error().message);
-  std::printf("runtime on the app's device: %s\n", (*runtime)->device().name.c_str());
+  std::printf("runtime on the app's device: %s, composites into %s\n", (*runtime)->device().name.c_str(),
+              o.to_image ? "the app's images" : "host memory");
+  // The app's images: the composites go into them either way (straight, or copied there from
+  // host memory by the app, as an app that presents them must).
+  ImageRing ring;
+  if (!ring.create(app.physical_device, app.device, app.queue, app.queue_family, uint32_t(info.color.width),
+                   uint32_t(info.color.height)))
+    return fail("the app could not create its images");
   int returned = 0;
-  auto report = [&](const std::vector<mrgi::FrameOutput>& outs) {
-    for (const mrgi::FrameOutput& o : outs) {
-      std::printf("frame %lld: %dx%d, cost %.1f ms\n", static_cast<long long>(o.stats.frame_index), o.image.width,
-                  o.image.height, o.stats.cost_ms);
+  uint64_t copied = 0;
+  auto report = [&](std::vector<mrgi::FrameOutput>& outs) {
+    for (mrgi::FrameOutput& out : outs) {
+      if (o.frames <= 8)
+        std::printf("frame %lld: %s, cost %.1f ms, %llu bytes copied by the host\n",
+                    static_cast<long long>(out.stats.frame_index),
+                    out.image.empty() ? "in the app's image" : "in host memory", out.stats.cost_ms,
+                    static_cast<unsigned long long>(out.stats.host_copy_bytes));
+      copied += out.stats.host_copy_bytes;
+      if (!out.image.empty()) {
+        ring.upload(out.image);  // the host path: the app copies the composite into its image
+        copied += out.image.data.size();
+      }
       ++returned;
+      (*runtime)->recycle(std::move(out));
     }
   };
-  const int n = std::min<int>(frames, int(capture->frame_count()));
-  for (int i = 0; i < n; ++i) {
-    auto frame = capture->read_frame(size_t(i));
-    if (!frame) return fail(frame.error().message);
-    frame->index = i;
-    auto outs = (*runtime)->process(*frame);
+  constexpr int kWarmUp = 4;
+  double wall0 = 0.0, cpu0 = 0.0;
+  const size_t n = frames.size(), period = n > 1 ? 2 * (n - 1) : 1;
+  for (int i = 0; i < o.frames; ++i) {
+    if (i == std::min(kWarmUp, o.frames - 1)) {
+      wall0 = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+      cpu0 = process_cpu_ms();
+    }
+    const size_t k = size_t(i) % period;
+    mrgi::InputFrame& frame = frames[k < n ? k : period - k];
+    frame.index = i;
+    frame.timestamp = frame.depth_timestamp = double(i) / 30.0;
+    auto outs = o.to_image ? (*runtime)->process(frame, ring.next()) : (*runtime)->process(frame);
     if (!outs) return fail(outs.error().message);
+    if (o.to_image) ring.present();
     report(*outs);
   }
   auto rest = (*runtime)->flush();
   if (!rest) return fail(rest.error().message);
   report(*rest);
-  return returned == n ? 0 : fail(std::to_string(returned) + " of " + std::to_string(n) + " frames came back");
+  const double wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count() - wall0;
+  const double cpu = process_cpu_ms() - cpu0;
+  const int timed = o.frames - std::min(kWarmUp, o.frames - 1);
+  std::printf("%d frames after the warm-up: %.2f ms a frame sustained, %.2f CPU ms a frame; %.0f bytes a frame copied by the host\n",
+              timed, wall / timed, cpu / timed, double(copied) / std::max(returned, 1));
+  runtime->reset();
+  ring.destroy();
+  return returned == o.frames ? 0 : fail(std::to_string(returned) + " of " + std::to_string(o.frames) + " frames came back");
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "--help") {
-    std::fprintf(stderr, "usage: %s CAPTURE_DIR [FRAMES]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s CAPTURE_DIR [FRAMES] [--output host|image] [--technique NAME] [--level N]\n", argv[0]);
     return 2;
   }
-  const int frames = argc > 2 ? std::atoi(argv[2]) : 4;
+  Options options;
+  for (int i = 2; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--output" && i + 1 < argc) {
+      const std::string v = argv[++i];
+      if (v != "host" && v != "image") return fail("--output: host or image, not '" + v + "'");
+      options.to_image = v == "image";
+    } else if (a == "--level" && i + 1 < argc) {
+      options.level = argv[++i];
+    } else if (a == "--technique" && i + 1 < argc) {
+      options.technique = argv[++i];
+    } else if (std::atoi(a.c_str()) > 0) {
+      options.frames = std::atoi(a.c_str());
+    } else {
+      return fail("unknown argument '" + a + "' (--help)");
+    }
+  }
 
   // The app's instance and device, created as the app wants them.
   VkApplicationInfo ai{VK_STRUCTURE_TYPE_APPLICATION_INFO};
@@ -139,7 +381,7 @@ int main(int argc, char** argv) {
   app.api_version = ai.apiVersion;
   for (const char* e : needs->device_extensions) app.enabled_extensions.push_back(e);
   app.enabled_features = &needs->features;
-  int status = play(app, argv[1], frames);
+  int status = play(app, argv[1], options);
 
   // The runtime is gone: the device is still the app's, with its work and objects.
   if (status == 0) {

@@ -173,7 +173,9 @@ struct FrameStats {
   double host_ms = 0.0;
   /// Bytes of frame images the host copied between the app and the runtime for this frame: the
   /// input's colour and depth into the upload buffers and, unless the composite went to an app
-  /// image (Runtime::process with an AppOutputImage), the output's image and mask back.
+  /// image (Runtime::process with an AppOutputImage), the output's image and mask back. A frame
+  /// into an app image on a CPU device at the camera's size also counts the camera frame the
+  /// host expands under the composite's tiles (cheaper there than a pass over every pixel).
   uint64_t host_copy_bytes = 0;
   /// CPU time of the light stage this frame (light/light_stage.h: environment sampling or the
   /// probeless system's part and solve) on the calling thread, ms; inside record_ms and host_ms.

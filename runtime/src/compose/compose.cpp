@@ -145,7 +145,11 @@ Status Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
     b.bind("virtual_position", in_.virtual_position);
     b.bind("virtual_coverage", in_.virtual_coverage.valid() ? in_.virtual_coverage : no_coverage_);
   };
-  if (tiled_ && !host_camera) {
+  if (in_.camera_prefilled && in_.camera_only) {
+    graph.mark_output(output_);  // the camera frame the host wrote is the output
+    return ok_status();
+  }
+  if (tiled_ && !host_camera && !in_.camera_prefilled) {
     // The camera frame everywhere, then the composite over the technique's tiles.
     const gpu::Pipeline* pipe = &*camera_pipeline_;
     graph.add_shader_pass(

@@ -61,6 +61,10 @@ struct ComposeInputs {
   // The output stays on the device (an app's image): the camera frame around the tiles is
   // written by the camera pass, not laid on the host.
   bool device_output = false;
+  // With device_output at the camera's size on a CPU device: the host already wrote the camera
+  // frame into this slot's output words (cheaper there than a pass over every pixel): no camera
+  // pass; the tiles are composed over it, and a frame nothing virtual affects adds no pass.
+  bool camera_prefilled = false;
 };
 
 // `image` at w x h, reusing its storage when it already has that size (Runtime::recycle: no

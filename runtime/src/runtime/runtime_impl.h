@@ -66,6 +66,7 @@ struct SlotRecord {
   // The composite went to an app's image (Runtime::process with an AppOutputImage): nothing to
   // read back.
   bool app_output = false;
+  bool camera_prefilled = false;  // compose::ComposeInputs::camera_prefilled
   uint64_t host_copy_bytes = 0;  // the input's upload (FrameStats::host_copy_bytes)
   double light_ms = 0.0;
   std::vector<std::string> skipped;
@@ -167,6 +168,10 @@ class RuntimeImpl final : public Runtime {
   Status record_compose(FrameContext& f);
   // The composite copied into the app's image (AppOutputImage), after compose.
   Status record_app_output(FrameContext& f);
+  // For a frame into an app's image on a CPU device at the camera's size: the camera frame
+  // written into the slot's output words on the host (compose::ComposeInputs::camera_prefilled);
+  // false where it cannot be (a Y'CbCr frame, another size, non-coherent memory).
+  bool prefill_camera(const InputFrame& frame, SlotRecord& rec);
 
   RuntimeSettings settings_;
   CameraSetup cameras_;
