@@ -474,7 +474,9 @@ Expected<size_t> SceneGpu::add_object(const Model& model, const Placement& place
                 (capacity_.indices - used.indices) / 3);
   if (need.draws > capacity_.draws) return full("meshes", meshes.draws.size(), capacity_.draws - used.draws);
   if (need.materials > capacity_.materials)
-    return full("meshes", meshes.materials.size(), capacity_.materials - used.materials);
+    return fail(ErrorKind::BadUsage, where + "the object has " + std::to_string(meshes.materials.size()) +
+                                         " materials, " + std::to_string(capacity_.materials - used.materials) +
+                                         " are free (one a mesh: RuntimeSettings::objects.meshes)");
   if (meshes.textures.size() > free_layers_.size()) return full("textures", meshes.textures.size(), free_layers_.size());
   std::vector<uint32_t> layers(free_layers_.end() - std::ptrdiff_t(meshes.textures.size()), free_layers_.end());
   std::reverse(layers.begin(), layers.end());
