@@ -14,7 +14,6 @@
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
-#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -28,22 +27,10 @@
 
 namespace {
 using namespace mrgi;
-using mrgi::test::SurfaceKind;
 using mrgi::test::SyntheticScene;
 
-// Intersection over union of the output's virtual mask and the pixels the analytic scene sees
-// the virtual boxes at (0.85-0.9 where the boxes are at 64 x 48, far less where they are not).
-double mask_iou(const FrameOutput& out, const SyntheticScene& scene) {
-  int both = 0, either = 0;
-  for (int v = 0; v < scene.intrinsics.height; ++v)
-    for (int u = 0; u < scene.intrinsics.width; ++u) {
-      const bool want = scene.trace(u, v, true).kind == SurfaceKind::Virtual;
-      const bool got = out.virtual_mask.at(u, v)[0] != 0;
-      both += want && got;
-      either += want || got;
-    }
-  return either == 0 ? 1.0 : double(both) / double(either);
-}
+using mrgi::test::mask_iou;
+using mrgi::test::run_frames;
 
 // Room for one cube (24 vertices, 12 triangles, one primitive) and `textures` texture layers.
 ObjectCapacity room_for_one(int textures = 0) {
@@ -57,34 +44,14 @@ ObjectCapacity room_for_one(int textures = 0) {
   return room;
 }
 
-std::unique_ptr<Runtime> cheapest_runtime(const std::string& technique, const SyntheticScene& scene,
+// The cheapest level of `technique` with `room` for added objects, validation on (a message
+// fails the frame).
+std::unique_ptr<Runtime> room_runtime(const std::string& technique, const SyntheticScene& scene,
                                           const ObjectCapacity& room = {}) {
   RuntimeSettings settings;
-  settings.technique = technique;
-  settings.level = int(technique_levels(technique)->size()) - 1;
   settings.objects = room;
-  settings.device.validate = true;  // a validation message fails the frame
-  auto rt = create_runtime(settings, scene.cameras(), scene.scene);
-  EXPECT_TRUE(rt.ok()) << rt.error().message;
-  return rt.ok() ? std::move(*rt) : nullptr;
-}
-
-// `frames` frames of `scene` through `r`, `before(k)` called before frame k is given, flushed.
-std::vector<FrameOutput> run_frames(Runtime& r, const SyntheticScene& scene, int frames,
-                                    const std::function<void(int)>& before) {
-  std::vector<FrameOutput> outs;
-  for (int k = 0; k < frames; ++k) {
-    before(k);
-    auto o = r.process(scene.frame(k));
-    EXPECT_TRUE(o.ok()) << o.error().message;
-    if (!o.ok()) return outs;
-    for (auto& x : *o) outs.push_back(std::move(x));
-  }
-  auto rest = r.flush();
-  EXPECT_TRUE(rest.ok()) << rest.error().message;
-  if (rest.ok())
-    for (auto& x : *rest) outs.push_back(std::move(x));
-  return outs;
+  settings.device.validate = true;
+  return mrgi::test::cheapest_runtime(technique, scene, settings);
 }
 
 // The scene as scene.json would have it without its last object (the one the app adds).
@@ -122,8 +89,8 @@ TEST(AddObject, AnObjectAddedBeforeTheFirstFrameGivesTheDeclaredObjectsFrames) {
   const VirtualObjectDesc& added = scene.scene.virtual_objects.back();
   for (const std::string& technique : technique_names()) {
     SCOPED_TRACE(technique);
-    auto declared = cheapest_runtime(technique, scene);
-    auto app = cheapest_runtime(technique, first, room_for_one());
+    auto declared = room_runtime(technique, scene);
+    auto app = room_runtime(technique, first, room_for_one());
     ASSERT_TRUE(declared && app);
     EXPECT_EQ(app->object_count(), 2u);
     EXPECT_FALSE(app->has_object(1));
@@ -131,7 +98,7 @@ TEST(AddObject, AnObjectAddedBeforeTheFirstFrameGivesTheDeclaredObjectsFrames) {
     ASSERT_TRUE(slot.ok()) << slot.error().message;
     EXPECT_EQ(*slot, 1u);
     EXPECT_TRUE(app->has_object(1));
-    expect_same_frames(run_frames(*declared, scene, 4, [](int) {}), run_frames(*app, first, 4, [](int) {}));
+    expect_same_frames(run_frames(*declared, scene, 4), run_frames(*app, first, 4));
   }
 }
 
@@ -157,15 +124,15 @@ TEST(AddObject, ATexturedObjectAddedGivesTheDeclaredObjectsFrames) {
   scene.scene.virtual_objects.back().gltf = dir.str() + "/textured.gltf";
   const SyntheticScene first = without_last(scene);
   const VirtualObjectDesc& added = scene.scene.virtual_objects.back();
-  auto declared = cheapest_runtime("baseline", scene);
-  auto app = cheapest_runtime("baseline", first, room_for_one(1));
+  auto declared = room_runtime("baseline", scene);
+  auto app = room_runtime("baseline", first, room_for_one(1));
   ASSERT_TRUE(declared && app);
   ASSERT_TRUE(app->add_object(added.gltf, added.placement).ok());
-  const std::vector<FrameOutput> a = run_frames(*declared, scene, 2, [](int) {});
-  const std::vector<FrameOutput> b = run_frames(*app, first, 2, [](int) {});
+  const std::vector<FrameOutput> a = run_frames(*declared, scene, 2);
+  const std::vector<FrameOutput> b = run_frames(*app, first, 2);
   expect_same_frames(a, b);
   // Without room for a texture the same object is refused, naming the room's field.
-  auto no_room = cheapest_runtime("baseline", first, room_for_one(0));
+  auto no_room = room_runtime("baseline", first, room_for_one(0));
   ASSERT_TRUE(no_room);
   auto refused = no_room->add_object(added.gltf, added.placement);
   ASSERT_FALSE(refused.ok());
@@ -182,7 +149,7 @@ TEST(AddObject, AddedAndRemovedObjectsAreDrawnOnlyWhileTheyArePresent) {
   const VirtualObjectDesc& added = scene.scene.virtual_objects.back();
   for (const std::string& technique : technique_names()) {
     SCOPED_TRACE(technique);
-    auto rt = cheapest_runtime(technique, first, room_for_one());
+    auto rt = room_runtime(technique, first, room_for_one());
     ASSERT_TRUE(rt);
     Runtime& r = *rt;
     const double memory = r.memory_mib();
@@ -231,12 +198,12 @@ TEST(AddObject, AFullRoomAndUnpreparedMaterialsAreRefusedCleanly) {
   };
   ObjectCapacity few = room_for_one();
   few.triangles = 11;
-  auto small = cheapest_runtime("baseline", first, few);
+  auto small = room_runtime("baseline", first, few);
   ASSERT_TRUE(small);
   refused(small->add_object(added.gltf, added.placement), ErrorKind::BadUsage, "objects.triangles");
 
-  auto rt = cheapest_runtime("baseline", first, room_for_one());
-  auto untouched = cheapest_runtime("baseline", first, room_for_one());
+  auto rt = room_runtime("baseline", first, room_for_one());
+  auto untouched = room_runtime("baseline", first, room_for_one());
   ASSERT_TRUE(rt && untouched);
   refused(rt->add_object(glossy.scene.virtual_objects[0].gltf, added.placement), ErrorKind::BadUsage, "objects.glossy");
   refused(rt->add_object(mirror.scene.virtual_objects[0].gltf, added.placement), ErrorKind::BadUsage, "mirror or glass");
@@ -247,12 +214,12 @@ TEST(AddObject, AFullRoomAndUnpreparedMaterialsAreRefusedCleanly) {
   ASSERT_TRUE(rt->add_object(added.gltf, added.placement).ok());
   refused(rt->add_object(added.gltf, added.placement), ErrorKind::BadUsage, "slot");
   ASSERT_TRUE(untouched->add_object(added.gltf, added.placement).ok());
-  expect_same_frames(run_frames(*rt, first, 3, [](int) {}), run_frames(*untouched, first, 3, [](int) {}));
+  expect_same_frames(run_frames(*rt, first, 3), run_frames(*untouched, first, 3));
 
   // A room that was prepared for glossy objects takes one.
   ObjectCapacity prepared = room_for_one();
   prepared.glossy = true;
-  auto ready = cheapest_runtime("baseline", first, prepared);
+  auto ready = room_runtime("baseline", first, prepared);
   ASSERT_TRUE(ready);
   EXPECT_TRUE(ready->add_object(glossy.scene.virtual_objects[0].gltf, added.placement).ok());
   // Room settings out of range are refused at creation, naming the field.

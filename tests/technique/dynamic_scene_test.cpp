@@ -16,54 +16,11 @@
 
 namespace {
 using namespace mrgi;
-using mrgi::test::SurfaceKind;
 using mrgi::test::SyntheticScene;
 
-// Intersection over union of the output's virtual mask and the pixels the analytic scene sees
-// the virtual boxes at. At 64 x 48 a box is a few pixels across and the cheap levels draw it at
-// a fraction of that, so its edge pixels disagree: 0.85-0.9 where it is, far less where the
-// moved box would be.
-double mask_iou(const FrameOutput& out, const SyntheticScene& scene) {
-  int both = 0, either = 0;
-  for (int v = 0; v < scene.intrinsics.height; ++v)
-    for (int u = 0; u < scene.intrinsics.width; ++u) {
-      const bool want = scene.trace(u, v, true).kind == SurfaceKind::Virtual;
-      const bool got = out.virtual_mask.at(u, v)[0] != 0;
-      both += want && got;
-      either += want || got;
-    }
-  return either == 0 ? 1.0 : double(both) / double(either);
-}
-
-// A runtime of `technique` at its cheapest level for `scene` (null, with a test failure, when it
-// cannot be made).
-std::unique_ptr<Runtime> cheapest_runtime(const std::string& technique, const SyntheticScene& scene) {
-  RuntimeSettings settings;
-  settings.technique = technique;
-  settings.level = int(technique_levels(technique)->size()) - 1;
-  auto rt = create_runtime(settings, scene.cameras(), scene.scene);
-  EXPECT_TRUE(rt.ok()) << rt.error().message;
-  return rt.ok() ? std::move(*rt) : nullptr;
-}
-
-// `frames` frames of `scene` through `r`, `before(k)` called before frame k is given, flushed:
-// every output in order (fewer where a call failed, reported as a test failure).
-std::vector<FrameOutput> run_frames(Runtime& r, const SyntheticScene& scene, int frames,
-                                    const std::function<void(int)>& before) {
-  std::vector<FrameOutput> outs;
-  for (int k = 0; k < frames; ++k) {
-    before(k);
-    auto o = r.process(scene.frame(k));
-    EXPECT_TRUE(o.ok()) << o.error().message;
-    if (!o.ok()) return outs;
-    for (auto& x : *o) outs.push_back(std::move(x));
-  }
-  auto rest = r.flush();
-  EXPECT_TRUE(rest.ok()) << rest.error().message;
-  if (rest.ok())
-    for (auto& x : *rest) outs.push_back(std::move(x));
-  return outs;
-}
+using mrgi::test::cheapest_runtime;
+using mrgi::test::mask_iou;
+using mrgi::test::run_frames;
 
 SyntheticScene moved(SyntheticScene s, const glm::vec3& by) {
   s.scene.virtual_objects[0].placement.position += by;

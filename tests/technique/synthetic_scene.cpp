@@ -234,19 +234,47 @@ InputFrame SyntheticScene::frame(int64_t index) const {
 std::vector<FrameOutput> run_synthetic_frames(const SyntheticScene& scene, const RuntimeSettings& settings, int frames) {
   auto rt = create_runtime(settings, scene.cameras(), scene.scene);
   EXPECT_TRUE(rt.ok()) << rt.error().message;
+  if (!rt.ok()) return {};
+  return run_frames(**rt, scene, frames);
+}
+
+std::vector<FrameOutput> run_frames(Runtime& r, const SyntheticScene& scene, int frames,
+                                    const std::function<void(int)>& before) {
   std::vector<FrameOutput> outs;
-  if (!rt.ok()) return outs;
   for (int k = 0; k < frames; ++k) {
-    auto o = (*rt)->process(scene.frame(k));
+    if (before) before(k);
+    auto o = r.process(scene.frame(k));
     EXPECT_TRUE(o.ok()) << o.error().message;
     if (!o.ok()) return outs;
     for (auto& x : *o) outs.push_back(std::move(x));
   }
-  auto rest = (*rt)->flush();
+  auto rest = r.flush();
   EXPECT_TRUE(rest.ok()) << rest.error().message;
   if (rest.ok())
     for (auto& x : *rest) outs.push_back(std::move(x));
   return outs;
+}
+
+std::unique_ptr<Runtime> cheapest_runtime(const std::string& technique, const SyntheticScene& scene,
+                                          const RuntimeSettings& base) {
+  RuntimeSettings settings = base;
+  settings.technique = technique;
+  settings.level = int(technique_levels(technique)->size()) - 1;
+  auto rt = create_runtime(settings, scene.cameras(), scene.scene);
+  EXPECT_TRUE(rt.ok()) << rt.error().message;
+  return rt.ok() ? std::move(*rt) : nullptr;
+}
+
+double mask_iou(const FrameOutput& out, const SyntheticScene& scene) {
+  int both = 0, either = 0;
+  for (int v = 0; v < scene.intrinsics.height; ++v)
+    for (int u = 0; u < scene.intrinsics.width; ++u) {
+      const bool want = scene.trace(u, v, true).kind == SurfaceKind::Virtual;
+      const bool got = out.virtual_mask.at(u, v)[0] != 0;
+      both += want && got;
+      either += want || got;
+    }
+  return either == 0 ? 1.0 : double(both) / double(either);
 }
 
 }  // namespace mrgi::test

@@ -5,6 +5,8 @@
 // baseline uses (Lambert, inverse square, spot cone, constant ambient, hard shadows of the real
 // box), so the tests check the implementation rather than the model.
 #pragma once
+#include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -73,5 +75,20 @@ struct SyntheticScene {
 // `frames` frames of `scene` through a runtime made with `settings` and flushed: every output, in
 // order (fewer where a call failed, which is reported as a test failure).
 std::vector<FrameOutput> run_synthetic_frames(const SyntheticScene& scene, const RuntimeSettings& settings, int frames);
+
+// `frames` frames of `scene` through `r`, `before(k)` (if given) called before frame k is given,
+// flushed: every output in order (fewer where a call failed, reported as a test failure).
+std::vector<FrameOutput> run_frames(Runtime& r, const SyntheticScene& scene, int frames,
+                                    const std::function<void(int)>& before = {});
+
+// A runtime of `technique` at its cheapest level for `scene`, the other settings `base`'s (null,
+// with a test failure, when it cannot be made).
+std::unique_ptr<Runtime> cheapest_runtime(const std::string& technique, const SyntheticScene& scene,
+                                          const RuntimeSettings& base = {});
+
+// Intersection over union of the output's virtual mask and the pixels the analytic scene sees
+// the virtual boxes at. At 64 x 48 a box is a few pixels across and the cheap levels draw it at a
+// fraction of that, so its edge pixels disagree: 0.85-0.9 where it is, far less where it is not.
+double mask_iou(const FrameOutput& out, const SyntheticScene& scene);
 
 }  // namespace mrgi::test

@@ -120,9 +120,9 @@ class MRGI_API Runtime {
   /// process() on, within the room stated at creation (RuntimeSettings::objects: slots, meshes,
   /// triangles, vertices, textures); returns the slot. Its data for every technique (vertices,
   /// levels of detail, materials, textures, sphere proxies, the ISMs' triangle list, voxelisation)
-  /// is ready for that frame; nothing the frames use is allocated. Host work on the calling
-  /// thread (loading, simplification: tens of ms for a 10k-triangle model) and one transfer of
-  /// its textures, waited for on its own fence. Errors: NotFound or BadInput naming the file for a
+  /// is ready for that frame; no memory is allocated. Host work on the calling thread (loading,
+  /// simplification: tens of ms for a 10k-triangle model) and a transfer for each of its
+  /// textures, ordered after the frames in flight and waited for on its own fence. Errors: NotFound or BadInput naming the file for a
   /// glTF that is missing or cannot be read; BadUsage naming the capacity that is full (no slot, meshes, triangles,
   /// vertices, texture layers), a material the runtime was not prepared for (glossy, emissive:
   /// ObjectCapacity) or a mirror or glass material; the runtime is unchanged after any error.

@@ -120,10 +120,12 @@ struct SceneDesc {
 /// object's room (scene.json's or an added one's) is free for the next added object. The
 /// default (all 0) is scene.json's objects only.
 struct ObjectCapacity {
-  int objects = 0;          ///< added objects present at once
+  int objects = 0;          ///< slots for added objects (a removed scene.json object's slot takes one too)
   int meshes = 0;           ///< their glTF primitives (draw ranges), in all
-  uint32_t triangles = 0;   ///< their triangles at full detail, in all (levels of detail, at most
-                            ///< as many again, are reserved beside them)
+  /// Their triangles at full detail, in all. Their levels of detail are reserved at as many
+  /// again (what halving simplification gives); a mesh whose simplification keeps more is
+  /// refused, naming "triangles (with their levels of detail)".
+  uint32_t triangles = 0;
   uint32_t vertices = 0;    ///< their vertices, in all
   int textures = 0;         ///< their base-colour and emissive textures (one array layer each)
   /// Texels a side of each texture layer when scene.json's objects have no larger ones (added

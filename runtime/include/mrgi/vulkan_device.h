@@ -89,9 +89,11 @@ struct AppVulkanDevice {
 /// (Runtime::process(frame, target); a runtime on DeviceSettings::app_device only): the app's
 /// image, written by a copy at the end of the frame's own submission on the runtime's queue, so
 /// an app that presents or samples it never copies it. The frame's FrameOutput then carries its
-/// stats and light estimate but no image or mask (FrameStats::host_copy_bytes counts only the
-/// input's upload). The image holds the composite's sRGB-encoded bytes and, in alpha, the
-/// virtual mask (255 on the objects' pixels, 0 elsewhere).
+/// stats and light estimate but no image or mask (FrameStats::host_copy_bytes counts no output
+/// bytes: the input's upload and, on a CPU device, the camera frame the host expands under the
+/// composite). The image holds the composite's sRGB-encoded bytes and, in alpha, the virtual
+/// mask (255 on the objects' pixels, 0 elsewhere). When process() returns an error for the
+/// frame, its semaphores are not used (nothing waits or signals them).
 struct AppOutputImage {
   /// The output's size, one mip level and layer, created with VK_IMAGE_USAGE_TRANSFER_DST_BIT.
   VkImage image = VK_NULL_HANDLE;

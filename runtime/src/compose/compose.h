@@ -49,7 +49,8 @@ struct ComposeInputs {
   // The technique wrote the composite of those tiles into output() itself
   // (Technique::ComposeTiles::composed): compose adds no pass of its own, only the tile-list
   // readback, and lays the tiles over the camera frame on the host. Honoured only for a frame
-  // at the camera's size whose solutions have the output's size (fusable()).
+  // at the camera's size whose solutions have the output's size (fusable()) that comes back to
+  // the host (not device_output, where compose composes those tiles itself).
   bool tiles_composed = false;
   // The virtual objects' coverage at the output resolution (recon::VirtualGBuffer::
   // output_coverage), required where the solutions are smaller than the output: the mask and

@@ -26,22 +26,9 @@ struct ProxyData {
 void append_proxy(const Model& model, ProxyData& out) {
   for (const MeshPrimitive& prim : model.primitives) {
     if (prim.indices.empty() || prim.positions.empty()) continue;
-    DrawRange range;
-    range.first_index = uint32_t(out.indices.size());
-    range.index_count = uint32_t(prim.indices.size());
-    range.vertex_offset = int32_t(out.vertices.size());
-    range.bounds_min = glm::vec3(1e30f);
-    range.bounds_max = glm::vec3(-1e30f);
-    for (size_t i = 0; i < prim.positions.size(); ++i) {
-      GpuVertex v{prim.positions[i], i < prim.normals.size() ? prim.normals[i] : glm::vec3(0.0f, 1.0f, 0.0f),
-                  i < prim.uvs.size() ? prim.uvs[i] : glm::vec2(0.0f)};
-      range.bounds_min = glm::min(range.bounds_min, v.position);
-      range.bounds_max = glm::max(range.bounds_max, v.position);
-      out.vertices.push_back(v);
-    }
+    const DrawRange range = append_primitive(prim, out.vertices, out.indices);
     out.lo = glm::min(out.lo, range.bounds_min);
     out.hi = glm::max(out.hi, range.bounds_max);
-    out.indices.insert(out.indices.end(), prim.indices.begin(), prim.indices.end());
     out.draws.push_back(range);
   }
 }

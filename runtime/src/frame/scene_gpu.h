@@ -84,8 +84,9 @@ struct MeshSet {
   static size_t select_lod(const DrawRange& range, const LodView& view);
 };
 
-// Base-colour textures are resampled to one square size (the largest texture side, at most
-// kMaxTextureSide texels) so they fit one 2D array image; glTF texture i is layer i.
+// Base-colour and emissive textures are resampled to one square size (the largest texture side,
+// at most kMaxTextureSide texels) so they fit one 2D array image, a layer each (scene.json's in
+// order, then the room's, taken from a free list).
 inline constexpr int kMaxTextureSide = 1024;
 
 // The virtual meshes' triangles at full detail as shaders/gi/virtual_points.glsl reads them
@@ -116,6 +117,9 @@ struct ObjectMeshes {
 // The object's meshes from a loaded model (placement not applied): ranges with their levels of
 // detail, sphere proxies, orientation patches and mean albedo.
 ObjectMeshes object_meshes(const Model& model);
+// Appends a primitive's vertices (normals up and uv 0 where it has none) and indices: its range
+// (first index, count, vertex offset, bounds; no material, no levels of detail).
+DrawRange append_primitive(const MeshPrimitive& prim, std::vector<GpuVertex>& vertices, std::vector<uint32_t>& indices);
 
 class SceneGpu {
  public:
@@ -137,6 +141,11 @@ class SceneGpu {
   // objects). A slot holds an object (present) or is empty.
   size_t object_count() const { return objects_.size(); }
   bool present(size_t object) const { return object < objects_.size() && objects_[object].present; }
+  size_t present_count() const {
+    size_t n = 0;
+    for (const ObjectSpan& o : objects_) n += o.present ? 1 : 0;
+    return n;
+  }
   const Placement& placement(size_t object) const { return objects_[object].placement; }
   // Takes effect at the next commit(). BadUsage for an index out of range or an empty slot, a
   // non-finite value or a scale that is not positive.
@@ -154,7 +163,8 @@ class SceneGpu {
   bool any_visible() const { return visible_count_ > 0; }
   // Puts `model` (model space: load_gltf with an identity placement) in the first empty slot
   // at `placement`, shown from the next commit() on; returns the slot. Its textures are copied
-  // into free layers of the array now (one transfer, waited for on its own fence). BadUsage
+  // into free layers of the array now, a transfer each, ordered after the frames in flight and
+  // waited for on its own fence (Context::upload_image_layer). BadUsage
   // naming `what` and the capacity that is full, or a material the scene was not prepared for;
   // nothing changes on an error.
   Expected<size_t> add_object(const Model& model, const Placement& placement, const std::string& what);

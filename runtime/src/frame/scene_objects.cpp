@@ -107,30 +107,35 @@ glm::vec3 mean_albedo(const ObjectMesh& mesh) {
 
 }  // namespace
 
+DrawRange append_primitive(const MeshPrimitive& prim, std::vector<GpuVertex>& vertices, std::vector<uint32_t>& indices) {
+  DrawRange range;
+  range.first_index = uint32_t(indices.size());
+  range.index_count = uint32_t(prim.indices.size());
+  range.vertex_offset = int32_t(vertices.size());
+  range.bounds_min = glm::vec3(1e30f);
+  range.bounds_max = glm::vec3(-1e30f);
+  for (size_t i = 0; i < prim.positions.size(); ++i) {
+    GpuVertex v;
+    v.position = prim.positions[i];
+    v.normal = i < prim.normals.size() ? prim.normals[i] : glm::vec3(0.0f, 1.0f, 0.0f);
+    v.uv = i < prim.uvs.size() ? prim.uvs[i] : glm::vec2(0.0f);
+    range.bounds_min = glm::min(range.bounds_min, v.position);
+    range.bounds_max = glm::max(range.bounds_max, v.position);
+    vertices.push_back(v);
+  }
+  indices.insert(indices.end(), prim.indices.begin(), prim.indices.end());
+  return range;
+}
+
 ObjectMeshes object_meshes(const Model& model) {
   ObjectMeshes out;
   out.materials = model.materials;
   for (const Texture& t : model.textures) out.textures.push_back(&t.image);
   for (const MeshPrimitive& prim : model.primitives) {
     if (prim.indices.empty() || prim.positions.empty()) continue;
-    DrawRange range;
-    range.first_index = uint32_t(out.indices.size());
-    range.index_count = uint32_t(prim.indices.size());
-    range.vertex_offset = int32_t(out.vertices.size());
+    DrawRange range = append_primitive(prim, out.vertices, out.indices);
     range.material = prim.material >= 0 && size_t(prim.material) < model.materials.size() ? prim.material : -1;
     range.double_sided = range.material >= 0 && model.materials[size_t(range.material)].double_sided;
-    range.bounds_min = glm::vec3(1e30f);
-    range.bounds_max = glm::vec3(-1e30f);
-    for (size_t i = 0; i < prim.positions.size(); ++i) {
-      GpuVertex v;
-      v.position = prim.positions[i];
-      v.normal = i < prim.normals.size() ? prim.normals[i] : glm::vec3(0.0f, 1.0f, 0.0f);
-      v.uv = i < prim.uvs.size() ? prim.uvs[i] : glm::vec2(0.0f);
-      range.bounds_min = glm::min(range.bounds_min, v.position);
-      range.bounds_max = glm::max(range.bounds_max, v.position);
-      out.vertices.push_back(v);
-    }
-    out.indices.insert(out.indices.end(), prim.indices.begin(), prim.indices.end());
     out.triangles += uint32_t(prim.indices.size() / 3);
     std::vector<float> errors;
     append_lods(prim, range, out.indices, errors);

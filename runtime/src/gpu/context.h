@@ -162,9 +162,16 @@ class Context {
 
   // Copies mip 0 of one layer from `staging` (tightly packed, its first bytes) while frames may
   // be on the queue: ordered after every earlier submission (a frame still reading the layer's
-  // old contents finishes first), the layer left in SHADER_READ_ONLY_OPTIMAL. Nothing is
-  // allocated; waits on its own fence only. For an object added at run time.
+  // old contents finishes first, so this waits for the frames in flight), the layer left in
+  // SHADER_READ_ONLY_OPTIMAL. No memory is allocated (a command buffer and a fence are made for
+  // it, as submit_and_wait does); waits on its own fence only. For an object added at run time.
   Status upload_image_layer(const GpuImage& dst, uint32_t layer, const GpuBuffer& staging);
+
+  // Into `cmd`: layers [first_layer, first_layer + layers) of `dst` (mip 0; every mip's layout
+  // for a whole-image copy) from UNDEFINED to TRANSFER_DST after the commands of stages `after`,
+  // a copy from `src` (tightly packed), then to `final_layout` for every later command.
+  void record_buffer_to_image(VkCommandBuffer cmd, VkBuffer src, const GpuImage& dst, uint32_t first_layer,
+                              uint32_t layers, VkPipelineStageFlags2 after, VkImageLayout final_layout) const;
 
   // Debug names through VK_EXT_debug_utils when validation is on (no-op otherwise).
   void set_name(VkObjectType type, uint64_t handle, const std::string& name) const;

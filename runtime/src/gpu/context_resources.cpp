@@ -231,7 +231,7 @@ Status Context::submit_and_wait(const std::function<void(VkCommandBuffer)>& reco
     si.pCommandBuffers = &cmd;
     VK_CHECK(queue_submit(si, fence));
     const VkResult w = vkWaitForFences(device_, 1, &fence, VK_TRUE, kUploadTimeoutNs);
-    if (w == VK_TIMEOUT) return fail(ErrorKind::Timeout, "start-up upload did not finish within 30 s");
+    if (w == VK_TIMEOUT) return fail(ErrorKind::Timeout, "an upload to the device did not finish within 30 s");
     VK_CHECK(w);
     return ok_status();
   };
@@ -283,30 +283,7 @@ Status Context::upload_image(const GpuImage& dst, const void* texels, VkDeviceSi
   if (!staging) return staging.error();
   std::memcpy(staging->mapped, texels, size);
   Status s = submit_and_wait([&](VkCommandBuffer cmd) {
-    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-    b.srcStageMask = VK_PIPELINE_STAGE_2_NONE;
-    b.dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-    b.dstAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.image = dst.image;
-    b.subresourceRange = {dst.aspect, 0, dst.mip_levels, 0, dst.layers};
-    VkDependencyInfo di{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-    di.imageMemoryBarrierCount = 1;
-    di.pImageMemoryBarriers = &b;
-    fn_.cmd_pipeline_barrier2(cmd, &di);
-    VkBufferImageCopy region{};
-    region.imageSubresource = {dst.aspect, 0, 0, dst.layers};
-    region.imageExtent = {dst.extent.width, dst.extent.height, dst.depth};
-    vkCmdCopyBufferToImage(cmd, staging->buffer, dst.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-    b.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-    b.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-    b.dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-    b.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT;
-    b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-    b.newLayout = final_layout;
-    fn_.cmd_pipeline_barrier2(cmd, &di);
+    record_buffer_to_image(cmd, staging->buffer, dst, 0, dst.layers, VK_PIPELINE_STAGE_2_NONE, final_layout);
   });
   destroy(*staging);
   return s;
@@ -318,33 +295,39 @@ Status Context::upload_image_layer(const GpuImage& dst, uint32_t layer, const Gp
     return fail(ErrorKind::Internal, "image layer upload: layer " + std::to_string(layer) + " of " +
                                          std::to_string(dst.layers) + ", staging " + std::to_string(staging.size) +
                                          " bytes for " + std::to_string(bytes));
+  // All commands before: a frame submitted earlier may still sample this layer's old object.
   return submit_and_wait([&](VkCommandBuffer cmd) {
-    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-    // All commands before: a frame submitted earlier may still sample this layer's old object.
-    b.srcStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-    b.dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-    b.dstAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.image = dst.image;
-    b.subresourceRange = {dst.aspect, 0, 1, layer, 1};
-    VkDependencyInfo di{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-    di.imageMemoryBarrierCount = 1;
-    di.pImageMemoryBarriers = &b;
-    fn_.cmd_pipeline_barrier2(cmd, &di);
-    VkBufferImageCopy region{};
-    region.imageSubresource = {dst.aspect, 0, layer, 1};
-    region.imageExtent = {dst.extent.width, dst.extent.height, 1};
-    vkCmdCopyBufferToImage(cmd, staging.buffer, dst.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-    b.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-    b.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-    b.dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-    b.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT;
-    b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-    b.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-    fn_.cmd_pipeline_barrier2(cmd, &di);
+    record_buffer_to_image(cmd, staging.buffer, dst, layer, 1, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                           VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
   });
+}
+
+void Context::record_buffer_to_image(VkCommandBuffer cmd, VkBuffer src, const GpuImage& dst, uint32_t first_layer,
+                                     uint32_t layers, VkPipelineStageFlags2 after, VkImageLayout final_layout) const {
+  VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+  b.srcStageMask = after;
+  b.dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+  b.dstAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+  b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+  b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  b.image = dst.image;
+  b.subresourceRange = {dst.aspect, 0, layers == dst.layers ? dst.mip_levels : 1, first_layer, layers};
+  VkDependencyInfo di{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  di.imageMemoryBarrierCount = 1;
+  di.pImageMemoryBarriers = &b;
+  fn_.cmd_pipeline_barrier2(cmd, &di);
+  VkBufferImageCopy region{};
+  region.imageSubresource = {dst.aspect, 0, first_layer, layers};
+  region.imageExtent = {dst.extent.width, dst.extent.height, dst.depth};
+  vkCmdCopyBufferToImage(cmd, src, dst.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+  b.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+  b.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+  b.dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+  b.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT;
+  b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+  b.newLayout = final_layout;
+  fn_.cmd_pipeline_barrier2(cmd, &di);
 }
 
 bool is_depth_format(VkFormat f) {

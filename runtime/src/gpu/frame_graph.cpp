@@ -453,6 +453,9 @@ Expected<std::optional<FrameTimings>> FrameGraph::collect(uint32_t index) {
 
 Expected<std::optional<FrameTimings>> FrameGraph::begin_frame() {
   if (in_frame_) return fail(ErrorKind::BadUsage, "begin_frame: the previous frame was not submitted");
+  // An app's semaphores belong to the frame they were given with: a frame that failed before
+  // its submission leaves them unused, never to a later frame.
+  submit_wait_ = submit_signal_ = VK_NULL_HANDLE;
   const int64_t next = frame_index_ + 1;
   const uint32_t slot = uint32_t(next % int64_t(slots_.size()));
   auto done = collect(slot);

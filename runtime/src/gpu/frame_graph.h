@@ -390,7 +390,8 @@ class FrameGraph {
   // Begins the slot's command buffer, execute()s, ends and submits it with the slot's fence.
   Status submit();
   // Semaphores for this frame's submission (binary; null for none): `wait` before the commands
-  // of `wait_stage` run, `signal` when the frame's commands are done. Cleared by submit().
+  // of `wait_stage` run, `signal` when the frame's commands are done. Cleared by submit() and
+  // by begin_frame() (a frame that failed before its submission does not pass them on).
   void set_submit_semaphores(VkSemaphore wait, VkPipelineStageFlags2 wait_stage, VkSemaphore signal) {
     submit_wait_ = wait;
     submit_wait_stage_ = wait_stage;

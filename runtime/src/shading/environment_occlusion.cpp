@@ -221,7 +221,7 @@ void EnvironmentOcclusion::record(const EnvOcclusionLevel& level, const light::S
   m.spheres_.clear();
   // Each object's first spheres_per_object proxies, as many as fit: with many objects, the first
   // ones of every object before more of any (a round-robin over ranks).
-  const int objects = std::max<int>(1, int(sg.object_count()));
+  const int objects = std::max<int>(1, int(sg.present_count()));  // (not the room's empty slots)
   const int per_object = std::min(level.spheres_per_object, std::max(1, MRGI_MAX_OCCLUDER_SPHERES / objects));
   m.albedo_.clear();
   m.object_.clear();
