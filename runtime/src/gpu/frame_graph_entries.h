@@ -1,11 +1,17 @@
 // The frame graph's per-resource and per-slot records, shared by its .cpp files (private).
 #pragma once
+#include <cstdint>
 #include <string>
 #include <vector>
 
 #include "gpu/frame_graph.h"
 
 namespace mrgi::gpu {
+
+// A frame that has not finished after this long is treated as a hung device. Generous because
+// the CPU rasteriser (lavapipe, 2 threads) runs the best quality levels at seconds per frame.
+inline constexpr uint64_t kFrameTimeoutS = 120;
+inline constexpr uint64_t kFrameTimeoutNs = kFrameTimeoutS * 1000ull * 1000 * 1000;
 
 struct FrameGraph::ImageEntry {
   ImageDesc desc;
