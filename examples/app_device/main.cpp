@@ -3,12 +3,19 @@
 // needs itself), hands the objects to create_runtime, plays a recorded capture through the
 // runtime, and goes on using its device after the runtime is gone.
 //
-//   app_device CAPTURE_DIR [FRAMES] [--output host|image] [--technique NAME] [--level N]
+//   app_device CAPTURE_DIR [FRAMES] [--input host|image] [--output host|image] [--technique NAME]
+//              [--level N] [--profile]
 //
+// --input image: the capture's frames are the app's images (an RGBA8 colour and an R16 depth
+// image each, filled once at start, as a camera's frames would already be on the device), given
+// to the runtime as mrgi::AppInputImages; the host copies none of them. --input host (the
+// default): host-memory frames the runtime uploads.
 // --output image: the composites go straight into the app's images (mrgi::AppOutputImage), with
 // the semaphore the app's "present" waits for; no readback. --output host (the default): they
 // come back in host memory and the app copies each into its image (as an app that presents them
-// must); the bytes the host copied a frame count both. Prints the device, what was enabled
+// must); the bytes the host copied a frame count both (with --input image and --output image:
+// none). --profile: each pass submitted on its own (RuntimeSettings::profile_passes) and the
+// median CPU ms of each over the frames after the warm-up printed. Prints the device, what was enabled
 // for mrgi, each frame's output (up to 8 frames) and the sustained wall and CPU ms a frame after
 // a 4-frame warm-up. Exit 0 when every frame came back and the device still works afterwards.
 #include <algorithm>
@@ -221,9 +228,132 @@ class ImageRing {
   int next_ = 0;
 };
 
+// The capture's frames as the app's images (--input image): colour RGBA8 and depth R16_UINT,
+// filled once through a host-visible buffer by the app's own submission.
+class InputImages {
+ public:
+  bool create(VkPhysicalDevice physical, VkDevice device, VkQueue queue, uint32_t family,
+              const std::vector<mrgi::InputFrame>& frames) {
+    device_ = device;
+    vkGetPhysicalDeviceMemoryProperties(physical, &mp_);
+    VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    pci.queueFamilyIndex = family;
+    if (vkCreateCommandPool(device, &pci, nullptr, &pool_) != VK_SUCCESS) return false;
+    for (const mrgi::InputFrame& f : frames) {
+      std::vector<uint8_t> rgba(f.color.data.size() / 3 * 4, 255);
+      for (size_t i = 0; i < rgba.size() / 4; ++i) std::memcpy(&rgba[4 * i], &f.color.data[3 * i], 3);
+      mrgi::AppInputImages in;
+      in.color_format = VK_FORMAT_R8G8B8A8_UNORM;
+      in.depth_format = VK_FORMAT_R16_UINT;
+      if (!image(in.color_format, f.color.width, f.color.height, rgba.data(), rgba.size(), queue, in.color) ||
+          !image(in.depth_format, f.depth.width, f.depth.height, f.depth.data.data(), f.depth.data.size() * 2, queue,
+                 in.depth))
+        return false;
+      frames_.push_back(in);
+    }
+    return true;
+  }
+  const mrgi::AppInputImages& frame(size_t i) const { return frames_[i]; }
+  void destroy() {
+    for (size_t i = 0; i < images_.size(); ++i) {
+      vkDestroyImage(device_, images_[i], nullptr);
+      vkFreeMemory(device_, memory_[i], nullptr);
+    }
+    if (pool_) vkDestroyCommandPool(device_, pool_, nullptr);
+  }
+
+ private:
+  uint32_t memory_type(uint32_t bits, VkMemoryPropertyFlags want) const {
+    for (uint32_t i = 0; i < mp_.memoryTypeCount; ++i)
+      if ((bits & (1u << i)) && (mp_.memoryTypes[i].propertyFlags & want) == want) return i;
+    return 0;
+  }
+  // One image in SHADER_READ_ONLY_OPTIMAL holding `bytes`.
+  bool image(VkFormat format, int w, int h, const void* bytes, size_t size, VkQueue queue, VkImage& out) {
+    VkImageCreateInfo ici{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+    ici.imageType = VK_IMAGE_TYPE_2D;
+    ici.format = format;
+    ici.extent = {uint32_t(w), uint32_t(h), 1};
+    ici.mipLevels = ici.arrayLayers = 1;
+    ici.samples = VK_SAMPLE_COUNT_1_BIT;
+    ici.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    if (vkCreateImage(device_, &ici, nullptr, &out) != VK_SUCCESS) return false;
+    VkMemoryRequirements mr{};
+    vkGetImageMemoryRequirements(device_, out, &mr);
+    VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    mai.allocationSize = mr.size;
+    mai.memoryTypeIndex = memory_type(mr.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    if (vkAllocateMemory(device_, &mai, nullptr, &memory) != VK_SUCCESS) return false;
+    vkBindImageMemory(device_, out, memory, 0);
+    images_.push_back(out);
+    memory_.push_back(memory);
+    // The fill: a staging buffer, a copy, the image left for reading.
+    VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    bci.size = size;
+    bci.usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+    VkBuffer staging = VK_NULL_HANDLE;
+    if (vkCreateBuffer(device_, &bci, nullptr, &staging) != VK_SUCCESS) return false;
+    vkGetBufferMemoryRequirements(device_, staging, &mr);
+    mai.allocationSize = mr.size;
+    mai.memoryTypeIndex =
+        memory_type(mr.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+    VkDeviceMemory staging_memory = VK_NULL_HANDLE;
+    void* mapped = nullptr;
+    if (vkAllocateMemory(device_, &mai, nullptr, &staging_memory) != VK_SUCCESS) return false;
+    vkBindBufferMemory(device_, staging, staging_memory, 0);
+    vkMapMemory(device_, staging_memory, 0, VK_WHOLE_SIZE, 0, &mapped);
+    std::memcpy(mapped, bytes, size);
+    VkCommandBufferAllocateInfo cai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    cai.commandPool = pool_;
+    cai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    cai.commandBufferCount = 1;
+    VkCommandBuffer cmd = VK_NULL_HANDLE;
+    vkAllocateCommandBuffers(device_, &cai, &cmd);
+    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    vkBeginCommandBuffer(cmd, &bi);
+    VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+    b.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = out;
+    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
+                         nullptr, 1, &b);
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageExtent = ici.extent;
+    vkCmdCopyBufferToImage(cmd, staging, out, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_MEMORY_READ_BIT;
+    b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, nullptr, 0,
+                         nullptr, 1, &b);
+    vkEndCommandBuffer(cmd);
+    VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    si.commandBufferCount = 1;
+    si.pCommandBuffers = &cmd;
+    const bool ok = vkQueueSubmit(queue, 1, &si, VK_NULL_HANDLE) == VK_SUCCESS && vkQueueWaitIdle(queue) == VK_SUCCESS;
+    vkFreeCommandBuffers(device_, pool_, 1, &cmd);
+    vkDestroyBuffer(device_, staging, nullptr);
+    vkFreeMemory(device_, staging_memory, nullptr);
+    return ok;
+  }
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkPhysicalDeviceMemoryProperties mp_{};
+  VkCommandPool pool_ = VK_NULL_HANDLE;
+  std::vector<VkImage> images_;
+  std::vector<VkDeviceMemory> memory_;
+  std::vector<mrgi::AppInputImages> frames_;
+};
+
 struct Options {
   int frames = 4;         // frames played (the capture's, looped forwards and back)
+  bool from_images = false;  // --input image: frames as the app's images
   bool to_image = false;  // --output image: composites into the app's images
+  bool profile = false;   // --profile: the per-pass split
   std::string level;      // --level N (default: the scheduler's)
   std::string technique;  // --technique NAME (default: baseline)
 };
@@ -252,12 +382,22 @@ int play(const mrgi::AppVulkanDevice& app, const std::string& capture_dir, const
   settings.exposure = info.exposure;
   if (!o.level.empty()) settings.level = std::atoi(o.level.c_str());
   if (!o.technique.empty()) settings.technique = o.technique;
+  settings.profile_passes = o.profile;
   auto runtime = mrgi::create_runtime(
       settings, mrgi::CameraSetup{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera},
       *capture->scene());
   if (!runtime) return fail(runtime.error().message);
-  std::printf("runtime on the app's device: %s, composites into %s\n", (*runtime)->device().name.c_str(),
-              o.to_image ? "the app's images" : "host memory");
+  std::printf("runtime on the app's device: %s, frames from %s, composites into %s\n", (*runtime)->device().name.c_str(),
+              o.from_images ? "the app's images" : "host memory", o.to_image ? "the app's images" : "host memory");
+  InputImages inputs;
+  if (o.from_images) {
+    if (!inputs.create(app.physical_device, app.device, app.queue, app.queue_family, frames))
+      return fail("the app could not create its input images");
+    for (mrgi::InputFrame& f : frames) {  // what stays in host memory: index, times, pose, env
+      f.color = mrgi::ImageRGB8();
+      f.depth = mrgi::ImageU16();
+    }
+  }
   // The app's images: the composites go into them either way (straight, or copied there from
   // host memory by the app, as an app that presents them must).
   ImageRing ring;
@@ -266,8 +406,15 @@ int play(const mrgi::AppVulkanDevice& app, const std::string& capture_dir, const
     return fail("the app could not create its images");
   int returned = 0;
   uint64_t copied = 0;
+  std::vector<std::pair<std::string, std::vector<double>>> pass_cpu;  // --profile: per pass, per frame
   auto report = [&](std::vector<mrgi::FrameOutput>& outs) {
     for (mrgi::FrameOutput& out : outs) {
+      if (o.profile && out.stats.frame_index >= 4)
+        for (const mrgi::PassTiming& t : out.stats.passes) {
+          auto it = std::find_if(pass_cpu.begin(), pass_cpu.end(), [&](const auto& p) { return p.first == t.name; });
+          if (it == pass_cpu.end()) it = pass_cpu.insert(pass_cpu.end(), {t.name, {}});
+          it->second.push_back(t.cpu_ms);
+        }
       if (o.frames <= 8)
         std::printf("frame %lld: %s, cost %.1f ms, %llu bytes copied by the host\n",
                     static_cast<long long>(out.stats.frame_index),
@@ -291,10 +438,15 @@ int play(const mrgi::AppVulkanDevice& app, const std::string& capture_dir, const
       cpu0 = process_cpu_ms();
     }
     const size_t k = size_t(i) % period;
-    mrgi::InputFrame& frame = frames[k < n ? k : period - k];
+    const size_t which = k < n ? k : period - k;
+    mrgi::InputFrame& frame = frames[which];
     frame.index = i;
     frame.timestamp = frame.depth_timestamp = double(i) / 30.0;
-    auto outs = o.to_image ? (*runtime)->process(frame, ring.next()) : (*runtime)->process(frame);
+    mrgi::AppOutputImage target;
+    if (o.to_image) target = ring.next();
+    auto outs = o.from_images ? (*runtime)->process(frame, inputs.frame(which), o.to_image ? &target : nullptr)
+                : o.to_image  ? (*runtime)->process(frame, target)
+                              : (*runtime)->process(frame);
     if (!outs) return fail(outs.error().message);
     if (o.to_image) ring.present();
     report(*outs);
@@ -307,8 +459,13 @@ int play(const mrgi::AppVulkanDevice& app, const std::string& capture_dir, const
   const int timed = o.frames - std::min(kWarmUp, o.frames - 1);
   std::printf("%d frames after the warm-up: %.2f ms a frame sustained, %.2f CPU ms a frame; %.0f bytes a frame copied by the host\n",
               timed, wall / timed, cpu / timed, double(copied) / std::max(returned, 1));
+  for (auto& [name, ms] : pass_cpu) {
+    std::sort(ms.begin(), ms.end());
+    std::printf("  pass %-28s %6.2f CPU ms (median of %zu frames)\n", name.c_str(), ms[ms.size() / 2], ms.size());
+  }
   runtime->reset();
   ring.destroy();
+  inputs.destroy();
   return returned == o.frames ? 0 : fail(std::to_string(returned) + " of " + std::to_string(o.frames) + " frames came back");
 }
 
@@ -316,16 +473,22 @@ int play(const mrgi::AppVulkanDevice& app, const std::string& capture_dir, const
 
 int main(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "--help") {
-    std::fprintf(stderr, "usage: %s CAPTURE_DIR [FRAMES] [--output host|image] [--technique NAME] [--level N]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s CAPTURE_DIR [FRAMES] [--input host|image] [--output host|image] [--technique NAME] [--level N] [--profile]\n", argv[0]);
     return 2;
   }
   Options options;
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--output" && i + 1 < argc) {
+    if (a == "--input" && i + 1 < argc) {
+      const std::string v = argv[++i];
+      if (v != "host" && v != "image") return fail("--input: host or image, not '" + v + "'");
+      options.from_images = v == "image";
+    } else if (a == "--output" && i + 1 < argc) {
       const std::string v = argv[++i];
       if (v != "host" && v != "image") return fail("--output: host or image, not '" + v + "'");
       options.to_image = v == "image";
+    } else if (a == "--profile") {
+      options.profile = true;
     } else if (a == "--level" && i + 1 < argc) {
       options.level = argv[++i];
     } else if (a == "--technique" && i + 1 < argc) {

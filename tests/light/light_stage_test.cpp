@@ -530,7 +530,7 @@ TEST(LightStage, EnvCameraFramesLightTheScene) {
   auto f = cap->read_frame(0);
   ASSERT_TRUE(f.ok() && f->env && f->pose);
   std::vector<std::string> notes;
-  ASSERT_TRUE((*stage)->update(*f, f->pose->matrix(), notes).ok());
+  ASSERT_TRUE((*stage)->update(frame::CameraView::of(*f, f->pose->matrix()), notes).ok());
   ASSERT_FALSE(notes.empty());
   // The courtyard's brightest parts (a hazy low sun, lit clouds) are broad, so none is a
   // shadowed light (LightStageSettings::shadowed_max_solid_angle_sr): all of it is ambient,
@@ -645,7 +645,7 @@ TEST(LightStage, BrightNearSurfacesAreNotDistantLights) {
     f.color = ImageRGB8(64, 48, 128);
     f.depth = ImageU16(64, 48, uint16_t(camera_depth_m * 1000.0));
     std::vector<std::string> notes;
-    EXPECT_TRUE((*stage)->update(f, camera_to_world, notes).ok());
+    EXPECT_TRUE((*stage)->update(frame::CameraView::of(f, camera_to_world), notes).ok());
     return (*stage)->lighting().lights.size();
   };
   EXPECT_EQ(lights_with_wall_at(2.0), 0u);   // the wall 1 m from the env camera: near
@@ -681,7 +681,7 @@ TEST(LightStage, SaysWhetherItsAmbientHoldsTheRealBounce) {
     f.color = ImageRGB8(64, 48, 128);
     f.depth = ImageU16(64, 48, uint16_t(2000));
     std::vector<std::string> notes;
-    EXPECT_TRUE((*stage)->update(f, glm::dmat4(1.0), notes).ok());
+    EXPECT_TRUE((*stage)->update(frame::CameraView::of(f, glm::dmat4(1.0)), notes).ok());
     return (*stage)->lighting();
   };
   auto expect_flags = [](const Lighting& l, bool holds, bool below, const char* what) {

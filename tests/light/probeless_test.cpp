@@ -122,7 +122,7 @@ TEST(Probeless, EstimatesTheSunsDirectionAndColourInARoomCorner) {
   EXPECT_EQ((*stage)->planned_source(), LightSourceKind::Probeless);
   std::vector<std::string> notes;
   const auto t0 = std::chrono::steady_clock::now();
-  ASSERT_TRUE((*stage)->update(f.frame, f.pose, notes).ok());
+  ASSERT_TRUE((*stage)->update(frame::CameraView::of(f.frame, f.pose), notes).ok());
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   const Lighting& lit = (*stage)->lighting();
   ASSERT_TRUE(lit.estimate.valid);
@@ -166,6 +166,33 @@ TEST(Probeless, EstimatesTheSunsDirectionAndColourInARoomCorner) {
 // sky not. The lamp's light is taken off each sample, so the estimate's mean radiance (band 0)
 // is the sky's: its band-0 coefficient is sky * Y_0 * 2 pi. Without a sky the residual is near
 // 0 (what is left is the lamp's model error: its shadows outside the depth grid).
+// A lagged view of the camera (frames given as the app's images: frame/camera_view.h) has no
+// images for the first frames: the estimate waits, saying so, and comes from the first view with
+// images, stamped with that frame's index and timestamp (not the frame being lit).
+TEST(Probeless, AnEmptyCameraViewWaitsAndTheEstimateIsStampedWithTheViewsFrame) {
+  const Room room;
+  const RenderedFrame f = render(room, {1.6, 1.3, -0.9}, {0.1, 0.25, 1.0}, 160, 120);
+  SceneDesc nothing;
+  auto stage = LightStage::create({}, nothing, CameraSetup{f.k, f.k, 5000.0, 1.0, std::nullopt});
+  ASSERT_TRUE(stage.ok()) << stage.error().message;
+  std::vector<std::string> notes;
+  frame::CameraView empty;
+  empty.index = 7;
+  ASSERT_TRUE((*stage)->update(empty, notes).ok());
+  EXPECT_FALSE((*stage)->lighting().estimate.valid);
+  ASSERT_GE(notes.size(), 2u);
+  EXPECT_NE(notes[0].find("no camera frame readable on the host yet"), std::string::npos) << notes[0];
+  frame::CameraView view = frame::CameraView::of(f.frame, f.pose);
+  view.index = 5;  // the frame two before the one being lit
+  view.timestamp = 0.25;
+  notes.clear();
+  ASSERT_TRUE((*stage)->update(view, notes).ok());
+  const LightEstimate& e = (*stage)->lighting().estimate;
+  ASSERT_TRUE(e.valid);
+  EXPECT_EQ(e.frame_index, 5);
+  EXPECT_DOUBLE_EQ(e.timestamp, 0.25);
+}
+
 TEST(Probeless, ResidualLightBesideADeclaredLampIsTheUndeclaredSky) {
   for (const bool with_sky : {true, false}) {
     Room room;
@@ -191,7 +218,7 @@ TEST(Probeless, ResidualLightBesideADeclaredLampIsTheUndeclaredSky) {
       ASSERT_TRUE(stage.ok()) << stage.error().message;
       EXPECT_EQ((*stage)->planned_source(), LightSourceKind::Declared);
       std::vector<std::string> notes;
-      ASSERT_TRUE((*stage)->update(f.frame, f.pose, notes).ok());
+      ASSERT_TRUE((*stage)->update(frame::CameraView::of(f.frame, f.pose), notes).ok());
       const Lighting& lit = (*stage)->lighting();
       EXPECT_EQ(lit.lights.size(), 1u);  // the lamp; the residual is ambient, not a light
       EXPECT_EQ(lit.ambient_is_residual, residual);
@@ -250,7 +277,7 @@ TEST(Probeless, NoDriftOverTenThousandFramesOfAStaticScene) {
     f.index = i;
     f.timestamp = i / 30.0;
     notes.clear();
-    ASSERT_TRUE((*stage)->update(f, clean.pose, notes).ok());
+    ASSERT_TRUE((*stage)->update(frame::CameraView::of(f, clean.pose), notes).ok());
     const LightEstimate& e = (*stage)->lighting().estimate;
     const double lum = luminance(glm::dvec3(e.sh_radiance[0][0], e.sh_radiance[0][1], e.sh_radiance[0][2]));
     const glm::dvec3 dir(e.direction_to_light[0], e.direction_to_light[1], e.direction_to_light[2]);
@@ -282,7 +309,7 @@ TEST(Probeless, ColourVoteIgnoresAMinorityRedWall) {
     auto stage = LightStage::create(s, SceneDesc{}, CameraSetup{f.k, f.k, 5000.0, 1.0, std::nullopt});
     EXPECT_TRUE(stage.ok());
     std::vector<std::string> notes;
-    EXPECT_TRUE((*stage)->update(f.frame, f.pose, notes).ok());
+    EXPECT_TRUE((*stage)->update(frame::CameraView::of(f.frame, f.pose), notes).ok());
     const auto& b0 = (*stage)->lighting().estimate.sh_radiance[0];
     const glm::dvec3 c(b0[0], b0[1], b0[2]);
     const glm::dvec3 n = c / luminance(c);
@@ -306,12 +333,12 @@ TEST(Probeless, RefusesFramesOfAnotherSizeAndBadSettings) {
   f.color = ImageRGB8(32, 24);
   f.depth = ImageU16(32, 24);
   LightSystem sys;
-  EXPECT_FALSE(b->add_part(f, glm::dmat4(1.0), 1.0, 0, sys).ok());
+  EXPECT_FALSE(b->add_part(frame::CameraView::of(f, glm::dmat4(1.0)), 1.0, 0, sys).ok());
   f.color = ImageRGB8(64, 48);
   f.depth = ImageU16(64, 48);
-  EXPECT_FALSE(b->add_part(f, glm::dmat4(1.0), 1.0, 9, sys).ok());
+  EXPECT_FALSE(b->add_part(frame::CameraView::of(f, glm::dmat4(1.0)), 1.0, 9, sys).ok());
   // An empty depth image: no sample, nothing added, no NaN.
-  ASSERT_TRUE(b->add_part(f, glm::dmat4(1.0), 1.0, 0, sys).ok());
+  ASSERT_TRUE(b->add_part(frame::CameraView::of(f, glm::dmat4(1.0)), 1.0, 0, sys).ok());
   EXPECT_EQ(sys.samples, 0.0);
 }
 

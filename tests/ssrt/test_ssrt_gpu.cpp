@@ -95,6 +95,7 @@ struct Driver {
   // The raw frame the technique's geometry stage (volume + depth filter chain) starts from: depth
   // and sRGB colour made from the analytic G-buffer, so both describe the same scene.
   InputFrame input;
+  frame::CameraView camera;  // the host's view of `input`, as the runtime gives it (FrameInfo::camera)
 
   // Edits the analytic real G-buffer (positions, albedo as half floats) before the upload.
   using Tweak = std::function<void(std::vector<glm::vec4>&, std::vector<uint16_t>&,
@@ -246,7 +247,8 @@ struct Driver {
     skipped.clear();
     frame::FrameInfo info;
     info.camera_to_world = glm::dmat4(camera_to_world());
-    info.input = &input;
+    camera = frame::CameraView::of(input, info.camera_to_world);
+    info.camera = &camera;
     info.frame_index = index;
     info.level = level;
     info.virtual_objects_present = !scene_gpu->virtual_objects.empty();

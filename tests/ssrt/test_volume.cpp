@@ -107,6 +107,7 @@ struct Rig {
   std::vector<std::string> skipped;
   std::vector<FrameTimings> timings;
   ImageU16 depth;
+  frame::DepthView depth_view;  // of `depth`, what the volume's skip test reads
   uint32_t last_slot = 0;
   ssrt::VolumeFrame last_frame;
 
@@ -197,7 +198,8 @@ struct Rig {
         test::pinhole_frame_constants(glm::mat4(pose), k, int(w), int(h), 5000.0f);
     std::memcpy(graph->mapped(shared.frame_constants, graph->slot()), &fc, sizeof(fc));
     vf.camera_to_world = pose;
-    vf.depth = &depth;
+    depth_view = frame::DepthView{depth.data.data(), depth.width, depth.height};
+    vf.depth = &depth_view;
     last_frame = vf;
     skipped.clear();
     const Status st = volume->record(vf, skipped);
@@ -548,7 +550,8 @@ TEST_F(VulkanTest, VolumeRefusesBadFramesAndSettings) {
   EXPECT_NE(st.error().message.find("resolution 128"), std::string::npos) << st.error().message;
   f = level(64);
   ImageU16 wrong(10, 10);
-  f.depth = &wrong;
+  const frame::DepthView wrong_view{wrong.data.data(), wrong.width, wrong.height};
+  f.depth = &wrong_view;
   st = r.volume->record(f, skipped);
   ASSERT_FALSE(st.ok());
   EXPECT_NE(st.error().message.find("depth is 10x10"), std::string::npos) << st.error().message;

@@ -138,7 +138,8 @@ class ReconFilterTest : public VulkanTest {
     const shader::FrameConstants fc =
         mrgi::test::pinhole_frame_constants(glm::mat4(pose), kk, int(W), int(H), float(kDepthScale));
     std::memcpy(graph_->mapped(constants_, graph_->slot()), &fc, sizeof(fc));
-    recon_->upload(*graph_, input);
+    recon_->take_input(input, nullptr);
+    recon_->copy_host_input(*graph_, input);
     recon_->record(*graph_, constants_);
     for (const auto& image_and_buffer : {std::pair{recon_->normal(), normal_rb_},
                                          std::pair{recon_->filtered_depth(), depth_rb_}}) {

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "app_images.h"
 #include "app_vulkan.h"
 #include "mrgi/platform/capture.h"
 #include "mrgi/runtime.h"
@@ -21,101 +22,6 @@ namespace {
 
 const std::string kSample = std::string(MRGI_SOURCE_DIR) + "/data/sample";
 constexpr int kFrames = 4;
-
-// One image of the app's with a host-visible buffer to read it back into.
-struct AppImage {
-  VkImage image = VK_NULL_HANDLE;
-  VkDeviceMemory memory = VK_NULL_HANDLE;
-  VkBuffer readback = VK_NULL_HANDLE;
-  VkDeviceMemory readback_memory = VK_NULL_HANDLE;
-  void* mapped = nullptr;
-  VkSemaphore written = VK_NULL_HANDLE;  // signalled by the runtime
-};
-
-uint32_t memory_type(VkPhysicalDevice pd, uint32_t bits, VkMemoryPropertyFlags want) {
-  VkPhysicalDeviceMemoryProperties mp{};
-  vkGetPhysicalDeviceMemoryProperties(pd, &mp);
-  for (uint32_t i = 0; i < mp.memoryTypeCount; ++i)
-    if ((bits & (1u << i)) && (mp.memoryTypes[i].propertyFlags & want) == want) return i;
-  return ~0u;
-}
-
-bool make_image(AppVulkan& app, uint32_t w, uint32_t h, AppImage& out) {
-  VkImageCreateInfo ici{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
-  ici.imageType = VK_IMAGE_TYPE_2D;
-  ici.format = VK_FORMAT_R8G8B8A8_UNORM;
-  ici.extent = {w, h, 1};
-  ici.mipLevels = ici.arrayLayers = 1;
-  ici.samples = VK_SAMPLE_COUNT_1_BIT;
-  ici.tiling = VK_IMAGE_TILING_OPTIMAL;
-  ici.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
-  if (vkCreateImage(app.device, &ici, nullptr, &out.image) != VK_SUCCESS) return false;
-  VkMemoryRequirements mr{};
-  vkGetImageMemoryRequirements(app.device, out.image, &mr);
-  VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-  mai.allocationSize = mr.size;
-  mai.memoryTypeIndex = memory_type(app.physical, mr.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-  if (vkAllocateMemory(app.device, &mai, nullptr, &out.memory) != VK_SUCCESS) return false;
-  vkBindImageMemory(app.device, out.image, out.memory, 0);
-  VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-  bci.size = VkDeviceSize(w) * h * 4;
-  bci.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-  if (vkCreateBuffer(app.device, &bci, nullptr, &out.readback) != VK_SUCCESS) return false;
-  vkGetBufferMemoryRequirements(app.device, out.readback, &mr);
-  mai.allocationSize = mr.size;
-  mai.memoryTypeIndex = memory_type(app.physical, mr.memoryTypeBits,
-                                    VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
-  if (vkAllocateMemory(app.device, &mai, nullptr, &out.readback_memory) != VK_SUCCESS) return false;
-  vkBindBufferMemory(app.device, out.readback, out.readback_memory, 0);
-  vkMapMemory(app.device, out.readback_memory, 0, VK_WHOLE_SIZE, 0, &out.mapped);
-  VkSemaphoreCreateInfo sci{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
-  return vkCreateSemaphore(app.device, &sci, nullptr, &out.written) == VK_SUCCESS;
-}
-
-void destroy_image(AppVulkan& app, AppImage& i) {
-  vkDestroySemaphore(app.device, i.written, nullptr);
-  vkDestroyBuffer(app.device, i.readback, nullptr);
-  vkFreeMemory(app.device, i.readback_memory, nullptr);
-  vkDestroyImage(app.device, i.image, nullptr);
-  vkFreeMemory(app.device, i.memory, nullptr);
-}
-
-// The app's own submission: waits for the runtime's semaphore, copies the image (left by the
-// runtime in TRANSFER_SRC_OPTIMAL) into its readback buffer; waited for on a fence.
-bool read_back(AppVulkan& app, const AppImage& img, uint32_t w, uint32_t h) {
-  VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-  pci.queueFamilyIndex = app.family;
-  VkCommandPool pool = VK_NULL_HANDLE;
-  vkCreateCommandPool(app.device, &pci, nullptr, &pool);
-  VkCommandBufferAllocateInfo cai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  cai.commandPool = pool;
-  cai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  cai.commandBufferCount = 1;
-  VkCommandBuffer cmd = VK_NULL_HANDLE;
-  vkAllocateCommandBuffers(app.device, &cai, &cmd);
-  VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  vkBeginCommandBuffer(cmd, &bi);
-  VkBufferImageCopy region{};
-  region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-  region.imageExtent = {w, h, 1};
-  vkCmdCopyImageToBuffer(cmd, img.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, img.readback, 1, &region);
-  vkEndCommandBuffer(cmd);
-  const VkPipelineStageFlags stage = VK_PIPELINE_STAGE_TRANSFER_BIT;
-  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-  si.waitSemaphoreCount = 1;
-  si.pWaitSemaphores = &img.written;
-  si.pWaitDstStageMask = &stage;
-  si.commandBufferCount = 1;
-  si.pCommandBuffers = &cmd;
-  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  VkFence fence = VK_NULL_HANDLE;
-  vkCreateFence(app.device, &fci, nullptr, &fence);
-  bool ok = vkQueueSubmit(app.queue, 1, &si, fence) == VK_SUCCESS &&
-            vkWaitForFences(app.device, 1, &fence, VK_TRUE, 30'000'000'000ull) == VK_SUCCESS;
-  vkDestroyFence(app.device, fence, nullptr);
-  vkDestroyCommandPool(app.device, pool, nullptr);
-  return ok;
-}
 
 struct Played {
   std::vector<FrameOutput> host;           // through process(frame)
@@ -139,7 +45,7 @@ void play(AppVulkan& app, int level, bool half, Played& out) {
   s.output_height = int(h);
   const CameraSetup cameras{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera};
   std::vector<AppImage> images(kFrames);
-  for (AppImage& i : images) ASSERT_TRUE(make_image(app, w, h, i));
+  for (AppImage& i : images) ASSERT_TRUE(make_image(app, w, h, VK_FORMAT_R8G8B8A8_UNORM, i));
   for (int pass = 0; pass < 2; ++pass) {
     auto rt = create_runtime(s, cameras, *capture->scene());
     ASSERT_TRUE(rt.ok()) << rt.error().message;

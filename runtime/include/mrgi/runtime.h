@@ -30,6 +30,7 @@ struct FrameOutput;
 struct ResearchSettings;  // mrgi/research.h
 struct AppVulkanDevice;   // mrgi/vulkan_device.h
 struct AppOutputImage;    // mrgi/vulkan_device.h
+struct AppInputImages;    // mrgi/vulkan_device.h
 
 // ---------------------------------------------------------------------------------------------
 // 1-2. Creating a runtime and running frames
@@ -84,6 +85,18 @@ class MRGI_API Runtime {
   /// (DeviceSettings::app_device), for a null image, a format other than R8G8B8A8 UNORM / SRGB
   /// or a final layout an image cannot be left in.
   virtual Expected<std::vector<FrameOutput>> process(const InputFrame& frame, const AppOutputImage& target) = 0;
+  /// process(), with the frame's colour and depth given as the app's images on the app's device
+  /// (mrgi/vulkan_device.h AppInputImages) instead of host memory: the GPU copies them at the
+  /// start of the frame's submission, the host copies nothing. `frame` carries the rest (index,
+  /// timestamps, pose, environment image) with color, color_yuv and depth empty. With `target`
+  /// the composite goes to the app's image too (zero host copies of frame images,
+  /// FrameStats::host_copy_bytes 0); without it, it is read back as process()'s. The host's
+  /// readers of the camera (the light stage's estimates, the techniques' reuse tests) take the
+  /// frame frames_in_flight frames earlier (RuntimeSettings::lagged_camera_reads). BadUsage on a
+  /// runtime not made on the app's device, for a null image, a format or layout it does not
+  /// take, or a frame that also carries images in host memory.
+  virtual Expected<std::vector<FrameOutput>> process(const InputFrame& frame, const AppInputImages& images,
+                                                     const AppOutputImage* target = nullptr) = 0;
   virtual Expected<std::vector<FrameOutput>> flush() = 0;
   /// Hands a delivered frame back once the caller is done with it: a later process() or flush()
   /// fills its image and mask instead of allocating new ones. Optional, but a live loop should:
@@ -172,10 +185,11 @@ struct FrameStats {
   /// wall clock is about its passes plus this.
   double host_ms = 0.0;
   /// Bytes of frame images the host copied between the app and the runtime for this frame: the
-  /// input's colour and depth into the upload buffers and, unless the composite went to an app
-  /// image (Runtime::process with an AppOutputImage), the output's image and mask back. A frame
-  /// into an app image on a CPU device at the camera's size also counts the camera frame the
-  /// host expands under the composite's tiles (cheaper there than a pass over every pixel).
+  /// input's colour and depth into the upload buffers (none for a frame given as the app's
+  /// images, AppInputImages) and, unless the composite went to an app image (AppOutputImage),
+  /// the output's image and mask back. A host-memory frame into an app image on a CPU device at
+  /// the camera's size also counts the camera frame the host expands under the composite's tiles
+  /// (cheaper there than a pass over every pixel; from app images the GPU's unpacking does it).
   uint64_t host_copy_bytes = 0;
   /// CPU time of the light stage this frame (light/light_stage.h: environment sampling or the
   /// probeless system's part and solve) on the calling thread, ms; inside record_ms and host_ms.
@@ -331,6 +345,16 @@ struct RuntimeSettings {
   /// 0 = CameraSetup::exposure (capture.json). A positive value overrides it.
   double exposure = 0.0;
   int frames_in_flight = 2;            ///< readback latency, frames (1..3)
+  /// The host's readers of the camera frame (the light stage's estimates from colour and depth:
+  /// probeless and residual light, an env camera's unseen prior and near-field test; the reuse
+  /// tests of dir, dlpv, dvct and ssrt) take the frame frames_in_flight frames earlier, from the
+  /// runtime's own upload buffers, at that frame's pose, instead of this frame's. Always so for
+  /// frames given as the app's images (Runtime::process with AppInputImages), which the host never
+  /// sees; set here for frames in host memory too, the two paths give the same frames value for
+  /// value. The first frames_in_flight frames then have no camera on the host (no estimate from
+  /// colour and depth yet, an env camera's unseen part unlit, no reuse). false: this frame's
+  /// images.
+  bool lagged_camera_reads = false;
   /// Skip the virtual G-buffer and the technique on frames where no virtual object or its shadow
   /// can be seen (the output is then the camera frame; FrameStats::skipped says so).
   bool skip_unaffected_frames = true;

@@ -91,7 +91,7 @@ struct AppVulkanDevice {
 /// an app that presents or samples it never copies it. The frame's FrameOutput then carries its
 /// stats and light estimate but no image or mask (FrameStats::host_copy_bytes counts no output
 /// bytes: the input's upload and, on a CPU device, the camera frame the host expands under the
-/// composite). The image holds the composite's sRGB-encoded bytes and, in alpha, the virtual
+/// composite; neither for a frame given as the app's images, AppInputImages). The image holds the composite's sRGB-encoded bytes and, in alpha, the virtual
 /// mask (255 on the objects' pixels, 0 elsewhere). When process() returns an error for the
 /// frame, its semaphores are not used (nothing waits or signals them).
 struct AppOutputImage {
@@ -109,6 +109,32 @@ struct AppOutputImage {
   /// work on the same queue is ordered before the copy without one.
   VkSemaphore wait = VK_NULL_HANDLE;
   VkSemaphore signal = VK_NULL_HANDLE;
+};
+
+/// A camera frame given as the app's images on its device (Runtime::process(frame, images)):
+/// the frame's own submission copies them, on the runtime's queue and after `wait`, into the
+/// runtime's buffers every pass reads (a transfer and a pass that packs the colour's 4 bytes a
+/// pixel into 3), so the host copies no frame image. The images are read only by that
+/// submission; the app may write them again once the frame's output is signalled (its
+/// AppOutputImage::signal) or returned. Each is one mip level and layer, created with
+/// VK_IMAGE_USAGE_TRANSFER_SRC_BIT, in the given layout before the frame and left in it after.
+/// Their sizes must be the CameraSetup's colour and depth intrinsics' (Vulkan has no query for
+/// an image's extent; a wrong size is the app's error, which the validation layer reports).
+struct AppInputImages {
+  /// The camera's sRGB-encoded colour (alpha ignored): VK_FORMAT_R8G8B8A8_UNORM or _SRGB, or
+  /// VK_FORMAT_B8G8R8A8_UNORM or _SRGB (the bytes are taken as they are; SRGB is not decoded).
+  VkImage color = VK_NULL_HANDLE;
+  VkFormat color_format = VK_FORMAT_R8G8B8A8_UNORM;
+  VkImageLayout color_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+  /// Depth registered to the colour in depth units (CameraSetup::depth_scale per metre, 0 =
+  /// invalid): VK_FORMAT_R16_UINT or R16_UNORM (the 16 bits as they are), or D16_UNORM (its
+  /// depth aspect's 16 bits: still depth units, not a projection's normalised depth).
+  VkImage depth = VK_NULL_HANDLE;
+  VkFormat depth_format = VK_FORMAT_R16_UINT;
+  VkImageLayout depth_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+  /// Optional binary semaphore waited for before the copies (the app's or the camera's writes).
+  /// Earlier work on the same queue is ordered before them without one.
+  VkSemaphore wait = VK_NULL_HANDLE;
 };
 
 }  // namespace mrgi

@@ -38,9 +38,11 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
   c.tile_readback_ = *tiles;
   c.slot_host_camera_.assign(graph.frames_in_flight(), 0);
   const VkDeviceSize bytes = VkDeviceSize(width) * height * 4;
-  // Transfer source: copied into an app's image (AppOutputImage) instead of read back.
-  auto out = graph.create_buffer({"output_rgba8", bytes, gpu::MemoryUsage::Readback, true},
-                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  // Transfer source: copied into an app's image (AppOutputImage) instead of read back. Whole
+  // groups of 16 pixels: an app's colour image is unpacked into it as the camera words under the
+  // composite, 16 pixels at a time (shaders/recon/rgba_to_rgb.comp).
+  gpu::BufferDesc od{"output_rgba8", (bytes + 63) / 64 * 64, gpu::MemoryUsage::Readback, true};
+  auto out = graph.create_buffer(od, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
   if (!out) return out.error();
   c.output_ = *out;
   auto spv = gpu::shader_spirv("compose/compose.comp");

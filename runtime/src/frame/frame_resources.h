@@ -9,6 +9,7 @@
 
 #include <glm/glm.hpp>
 
+#include "frame/camera_view.h"
 #include "gpu/frame_graph.h"
 #include "mrgi/frame.h"
 #include "mrgi/runtime.h"
@@ -124,7 +125,9 @@ struct FrameInfo {
   int level = 0;
   bool virtual_objects_present = false;
   glm::dmat4 camera_to_world{1.0};   // this frame's pose (the previous one when none was given)
-  const InputFrame* input = nullptr; // the host copy of this frame's images (valid during record)
+  // The camera as the host sees it (frame/camera_view.h: this frame's images, or for frames
+  // given as the app's images an earlier frame's); valid during record. Null: none.
+  const CameraView* camera = nullptr;
   const CausticPhotons* caustics = nullptr;  // this frame's, written before record(); or none
   // The internal pixels where a virtual pixel can be this frame (recon::VirtualGBuffer::
   // objects_area); outside it every pixel is real, so a pass may run a variant without the

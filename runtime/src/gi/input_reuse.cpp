@@ -36,13 +36,13 @@ void InputReuse::reserve(size_t depth_pixels, double depth_scale) {
   depth_scale_ = depth_scale > 0.0 ? depth_scale : 5000.0;
 }
 
-void InputReuse::set_frame(int level, const glm::dmat4& camera_to_world, const InputFrame* input,
+void InputReuse::set_frame(int level, const glm::dmat4& camera_to_world, const frame::CameraView* camera,
                            uint64_t objects_revision) {
   now_ = Source{};
   now_.level = level;
   now_.pose = camera_to_world;
   now_.objects = objects_revision;
-  input_ = input;
+  depth_ = camera && !camera->depth.empty() ? &camera->depth : nullptr;
 }
 
 void InputReuse::add_lamp(const LightDesc& lamp) {
@@ -50,11 +50,11 @@ void InputReuse::add_lamp(const LightDesc& lamp) {
 }
 
 bool InputReuse::depth_close() const {
-  if (input_ == nullptr || input_->depth.data.size() != source_depth_.size()) return false;
+  if (depth_ == nullptr || depth_->size() != source_depth_.size()) return false;
   const double metres_per_unit = 1.0 / depth_scale_;
   double sum_m = 0.0;
   size_t both = 0, changed_validity = 0;
-  const uint16_t* now = input_->depth.data.data();
+  const uint16_t* now = depth_->data;
   for (size_t i = 0; i < source_depth_.size(); ++i) {
     const bool a = source_depth_[i] != 0, b = now[i] != 0;
     if (a != b) {
@@ -80,8 +80,8 @@ bool InputReuse::close() const {
 
 void InputReuse::remember() {
   source_ = now_;
-  source_.valid = input_ != nullptr && input_->depth.data.size() == source_depth_.size();
-  if (source_.valid) std::copy(input_->depth.data.begin(), input_->depth.data.end(), source_depth_.begin());
+  source_.valid = depth_ != nullptr && depth_->size() == source_depth_.size();
+  if (source_.valid) std::copy(depth_->data, depth_->data + depth_->size(), source_depth_.begin());
 }
 
 }  // namespace mrgi::gi

@@ -10,7 +10,10 @@
 //   - every lamp within 1 mm, 0.5 degrees (direction and cone) and 1 % of its colour x intensity;
 //   - the virtual objects where they were (SceneGpu::revision: any move counts; an object that
 //     moves, moves every frame, and a tolerance would only delay its light by frames).
-// The depth copy is sized at reserve() (no allocation per frame).
+// The depth frame is the host's view of the camera (frame/camera_view.h): for frames given as
+// the app's images, the one frames_in_flight frames earlier, so a change of the depth is seen
+// that many frames late (the pose and the lamps are this frame's). The depth copy is sized at
+// reserve() (no allocation per frame).
 #pragma once
 #include <array>
 #include <cstdint>
@@ -18,6 +21,7 @@
 
 #include <glm/glm.hpp>
 
+#include "frame/camera_view.h"
 #include "light/light_stage.h"
 #include "mrgi/frame.h"
 #include "mrgi/scene.h"
@@ -29,7 +33,7 @@ class InputReuse {
   // `depth_pixels`: the depth camera's width x height; `depth_scale`: its units per metre.
   void reserve(size_t depth_pixels, double depth_scale);
   // This frame's inputs, to compare with the remembered ones (set before close() / remember()).
-  void set_frame(int level, const glm::dmat4& camera_to_world, const InputFrame* input,
+  void set_frame(int level, const glm::dmat4& camera_to_world, const frame::CameraView* camera,
                  uint64_t objects_revision);
   // The lamps the work is made for this frame (strongest first); at most kMaxLamps are compared.
   void add_lamp(const LightDesc& lamp);
@@ -55,7 +59,7 @@ class InputReuse {
   };
   bool depth_close() const;
   Source source_, now_;
-  const InputFrame* input_ = nullptr;
+  const frame::DepthView* depth_ = nullptr;
   std::vector<uint16_t> source_depth_;
   double depth_scale_ = 5000.0;
 };

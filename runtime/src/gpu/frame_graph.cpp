@@ -214,11 +214,13 @@ Expected<BufferHandle> FrameGraph::create_buffer(const BufferDesc& desc, VkBuffe
   if (texel) {
     // Texel sizes of the formats used so far; others are refused by name.
     const VkDeviceSize texel_bytes =
-        desc.texel_format == VK_FORMAT_R32_UINT || desc.texel_format == VK_FORMAT_R32_SFLOAT ? 4 : 0;
+        desc.texel_format == VK_FORMAT_R32_UINT || desc.texel_format == VK_FORMAT_R32_SFLOAT ? 4
+        : desc.texel_format == VK_FORMAT_R32G32B32A32_UINT                                   ? 16
+                                                                                              : 0;
     if (texel_bytes == 0)
       return fail(ErrorKind::NotImplemented, what + ": texel_format " +
                                                  std::to_string(int(desc.texel_format)) +
-                                                 " (only R32_UINT and R32_SFLOAT views are implemented)");
+                                                 " (only R32_UINT, R32_SFLOAT and R32G32B32A32_UINT views are implemented)");
     const VkDeviceSize texels = desc.size / texel_bytes;
     const uint32_t limit = context_.properties().limits.maxTexelBufferElements;
     if (desc.size % texel_bytes != 0 || texels > limit)
@@ -450,7 +452,8 @@ Expected<std::optional<FrameTimings>> FrameGraph::begin_frame() {
   if (in_frame_) return fail(ErrorKind::BadUsage, "begin_frame: the previous frame was not submitted");
   // An app's semaphores belong to the frame they were given with: a frame that failed before
   // its submission leaves them unused, never to a later frame.
-  submit_wait_ = submit_signal_ = VK_NULL_HANDLE;
+  submit_wait_count_ = 0;
+  submit_signal_ = VK_NULL_HANDLE;
   const int64_t next = frame_index_ + 1;
   const uint32_t slot = uint32_t(next % int64_t(slots_.size()));
   auto done = collect(slot);
@@ -515,8 +518,13 @@ void FrameGraph::update_resource_infos() {
     r.host_read = e.desc.memory == MemoryUsage::Readback;
     r.initial = e.states.size() > 1 ? e.states[slot_] : e.states[0];
   }
+  // An upload buffer the GPU writes and the host reads back (a camera frame converted or copied
+  // on the GPU) is made visible to the host as a readback buffer is.
   for (const ResourceRef& o : outputs_)
-    if (o.id < infos_.size()) infos_[o.id].is_output = true;
+    if (o.id < infos_.size()) {
+      infos_[o.id].is_output = true;
+      if (!o.is_image && buffers_[o.id - images_.size()].desc.memory == MemoryUsage::Upload) infos_[o.id].host_read = true;
+    }
 }
 
 Status FrameGraph::compile() {

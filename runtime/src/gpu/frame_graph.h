@@ -15,6 +15,7 @@
 #pragma once
 #include <vulkan/vulkan.h>
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -389,14 +390,13 @@ class FrameGraph {
   Status execute(VkCommandBuffer cmd);
   // Begins the slot's command buffer, execute()s, ends and submits it with the slot's fence.
   Status submit();
-  // Semaphores for this frame's submission (binary; null for none): `wait` before the commands
-  // of `wait_stage` run, `signal` when the frame's commands are done. Cleared by submit() and
-  // by begin_frame() (a frame that failed before its submission does not pass them on).
-  void set_submit_semaphores(VkSemaphore wait, VkPipelineStageFlags2 wait_stage, VkSemaphore signal) {
-    submit_wait_ = wait;
-    submit_wait_stage_ = wait_stage;
-    submit_signal_ = signal;
-  }
+  // Semaphores for this frame's submission (binary; null is ignored): each `wait` before the
+  // commands of `stage` run (at most kMaxSubmitWaits a frame: the app's input images' and its
+  // output image's), `signal` when the frame's commands are done. Cleared by submit() and by
+  // begin_frame() (a frame that failed before its submission does not pass them on).
+  static constexpr uint32_t kMaxSubmitWaits = 2;
+  Status add_submit_wait(VkSemaphore wait, VkPipelineStageFlags2 stage);
+  void set_submit_signal(VkSemaphore signal) { submit_signal_ = signal; }
   // Waits for every frame in flight; returns their timings oldest first.
   Expected<std::vector<FrameTimings>> flush();
   // Waits until every frame submitted and not yet collected has completed (their slots' fences;
@@ -462,10 +462,11 @@ class FrameGraph {
   std::vector<ImageEntry> images_;
   std::vector<BufferEntry> buffers_;
   std::vector<Slot> slots_;
-  VkSemaphore submit_wait_ = VK_NULL_HANDLE, submit_signal_ = VK_NULL_HANDLE;
-  VkPipelineStageFlags2 submit_wait_stage_ = 0;
-  // `si` with this frame's semaphores (set_submit_semaphores), which are then cleared.
-  void add_submit_semaphores(VkSubmitInfo2& si, VkSemaphoreSubmitInfo& wait, VkSemaphoreSubmitInfo& signal);
+  std::array<VkSemaphoreSubmitInfo, kMaxSubmitWaits> submit_waits_{};
+  uint32_t submit_wait_count_ = 0;
+  VkSemaphore submit_signal_ = VK_NULL_HANDLE;
+  // `si` with this frame's semaphores (add_submit_wait, set_submit_signal), which are then cleared.
+  void add_submit_semaphores(VkSubmitInfo2& si, VkSemaphoreSubmitInfo& signal);
   std::vector<PassDecl> decls_;     // first pass_count_ are this frame's; the rest keep capacity
   std::vector<ExecuteFn> executes_;
   uint32_t pass_count_ = 0;

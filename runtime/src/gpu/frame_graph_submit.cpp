@@ -69,12 +69,22 @@ Status FrameGraph::measure_submission_overhead() {
   return ok_status();
 }
 
-void FrameGraph::add_submit_semaphores(VkSubmitInfo2& si, VkSemaphoreSubmitInfo& wait, VkSemaphoreSubmitInfo& signal) {
-  if (submit_wait_) {
-    wait.semaphore = submit_wait_;
-    wait.stageMask = submit_wait_stage_;
-    si.waitSemaphoreInfoCount = 1;
-    si.pWaitSemaphoreInfos = &wait;
+Status FrameGraph::add_submit_wait(VkSemaphore wait, VkPipelineStageFlags2 stage) {
+  if (wait == VK_NULL_HANDLE) return ok_status();
+  if (submit_wait_count_ == kMaxSubmitWaits)
+    return fail(ErrorKind::BadUsage, "add_submit_wait: at most " + std::to_string(kMaxSubmitWaits) +
+                                         " wait semaphores a frame");
+  VkSemaphoreSubmitInfo& w = submit_waits_[submit_wait_count_++];
+  w = VkSemaphoreSubmitInfo{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+  w.semaphore = wait;
+  w.stageMask = stage;
+  return ok_status();
+}
+
+void FrameGraph::add_submit_semaphores(VkSubmitInfo2& si, VkSemaphoreSubmitInfo& signal) {
+  if (submit_wait_count_ > 0) {
+    si.waitSemaphoreInfoCount = submit_wait_count_;
+    si.pWaitSemaphoreInfos = submit_waits_.data();
   }
   if (submit_signal_) {
     signal.semaphore = submit_signal_;
@@ -82,7 +92,8 @@ void FrameGraph::add_submit_semaphores(VkSubmitInfo2& si, VkSemaphoreSubmitInfo&
     si.signalSemaphoreInfoCount = 1;
     si.pSignalSemaphoreInfos = &signal;
   }
-  submit_wait_ = submit_signal_ = VK_NULL_HANDLE;
+  submit_wait_count_ = 0;
+  submit_signal_ = VK_NULL_HANDLE;
 }
 
 Status FrameGraph::submit_profiled() {
@@ -93,15 +104,13 @@ Status FrameGraph::submit_profiled() {
   // The frame that used this slot before has completed (begin_frame waited), but the other
   // slots' frames may still run: wait for them, so the first pass's time is its own.
   MRGI_TRY(wait_submitted());
-  if (submit_wait_) {
-    // The passes are submitted one by one: the frame's wait semaphore is waited for first, by an
-    // empty submission the host waits on, so every pass runs after it.
+  if (submit_wait_count_ > 0) {
+    // The passes are submitted one by one: the frame's wait semaphores are waited for first, by
+    // an empty submission the host waits on, so every pass runs after them.
     VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-    VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-    wait.semaphore = submit_wait_;
-    wait.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-    si.waitSemaphoreInfoCount = 1;
-    si.pWaitSemaphoreInfos = &wait;
+    for (uint32_t i = 0; i < submit_wait_count_; ++i) submit_waits_[i].stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+    si.waitSemaphoreInfoCount = submit_wait_count_;
+    si.pWaitSemaphoreInfos = submit_waits_.data();
     VK_CHECK(context_.queue_submit2(si, profile_fence_));
     const VkResult w = vkWaitForFences(context_.device(), 1, &profile_fence_, VK_TRUE, kFrameTimeoutNs);
     if (w == VK_TIMEOUT)
@@ -109,7 +118,7 @@ Status FrameGraph::submit_profiled() {
                                           std::to_string(kFrameTimeoutS) + " s (profiling mode)");
     VK_CHECK(w);
     VK_CHECK(vkResetFences(context_.device(), 1, &profile_fence_));
-    submit_wait_ = VK_NULL_HANDLE;
+    submit_wait_count_ = 0;
   }
   Slot& slot = slots_[slot_];
   slot.host_ms.assign(n, 0.0);
@@ -137,8 +146,8 @@ Status FrameGraph::submit_profiled() {
   // The slot's fence marks the frame done, as in normal mode (an empty submission signals it,
   // and the frame's semaphores: the passes' submissions before it have all completed).
   VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-  VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO}, signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-  add_submit_semaphores(si, wait, signal);
+  VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+  add_submit_semaphores(si, signal);
   VK_CHECK(context_.queue_submit2(si, slot.fence));
   slot.submitted = true;
   in_frame_ = false;
@@ -160,8 +169,8 @@ Status FrameGraph::submit() {
   VkSubmitInfo2 si{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
   si.commandBufferInfoCount = 1;
   si.pCommandBufferInfos = &cbi;
-  VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO}, signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-  add_submit_semaphores(si, wait, signal);
+  VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+  add_submit_semaphores(si, signal);
   VK_CHECK(context_.queue_submit2(si, slot.fence));
   slot.submitted = true;
   in_frame_ = false;

@@ -1,5 +1,6 @@
 // The camera's colour at a pixel on the host, from whichever form the frame came in: RGB8
-// (InputFrame::color) or Y'CbCr (InputFrame::color_yuv, decoded here with the formula and the
+// (InputFrame::color, or the runtime's upload buffer: frame/camera_view.h) or Y'CbCr
+// (InputFrame::color_yuv, decoded here with the formula and the
 // chroma siting the GPU conversion uses: shared/mrgi_shared.h yuv_to_rgb8_packed,
 // shaders/recon/yuv_to_rgb.comp). For the light stage's host readers, which sample the frame
 // sparsely (every 8th pixel, the probeless grid's blocks): no full-frame conversion on the host.
@@ -7,6 +8,7 @@
 #include <array>
 #include <cstdint>
 
+#include "frame/camera_view.h"
 #include "mrgi/frame.h"
 #include "shared/mrgi_shared.h"
 
@@ -14,14 +16,16 @@ namespace mrgi::light {
 
 class CameraColor {
  public:
-  explicit CameraColor(const InputFrame& frame) : rgb_(frame.color), yuv_(frame.color_yuv ? &*frame.color_yuv : nullptr) {}
-  int width() const { return yuv_ ? yuv_->width : rgb_.width; }
-  int height() const { return yuv_ ? yuv_->height : rgb_.height; }
-  bool empty() const { return width() <= 0 || height() <= 0; }
+  explicit CameraColor(const frame::CameraView& view)
+      : rgb_(view.rgb), yuv_(view.yuv), width_(view.has_color() ? view.color_width : 0),
+        height_(view.has_color() ? view.color_height : 0) {}
+  int width() const { return width_; }
+  int height() const { return height_; }
+  bool empty() const { return width_ <= 0 || height_ <= 0; }
   // sRGB 8-bit codes of pixel (x, y), inside the image.
   std::array<uint8_t, 3> at(int x, int y) const {
     if (!yuv_) {
-      const uint8_t* p = rgb_.at(x, y);
+      const uint8_t* p = rgb_ + (size_t(y) * size_t(width_) + size_t(x)) * 3;
       return {p[0], p[1], p[2]};
     }
     const size_t w = size_t(yuv_->width), h = size_t(yuv_->height);
@@ -45,8 +49,9 @@ class CameraColor {
   }
 
  private:
-  const ImageRGB8& rgb_;
+  const uint8_t* rgb_;
   const YuvImage* yuv_;
+  int width_, height_;
 };
 
 }  // namespace mrgi::light

@@ -223,8 +223,8 @@ const std::vector<EnvLight>& LightStage::environment_regions() const {
   return lighting_.environment && env_ && env_->valid() ? env_->lights() : none;
 }
 
-glm::dvec3 LightStage::mean_camera_radiance(const InputFrame& frame) const {
-  const CameraColor c(frame);
+glm::dvec3 LightStage::mean_camera_radiance(const frame::CameraView& camera) const {
+  const CameraColor c(camera);
   if (c.empty() || !(cameras_.exposure > 0.0)) return glm::dvec3(0.0);
   glm::dvec3 sum(0.0);
   size_t n = 0;
@@ -237,9 +237,8 @@ glm::dvec3 LightStage::mean_camera_radiance(const InputFrame& frame) const {
   return n ? sum / (double(n) * cameras_.exposure) : glm::dvec3(0.0);
 }
 
-bool LightStage::crosses_surface(const glm::dvec3& from, const glm::dvec3& direction, const InputFrame& frame,
+bool LightStage::crosses_surface(const glm::dvec3& from, const glm::dvec3& direction, const frame::DepthView& depth,
                                  const glm::dmat4& world_to_camera) const {
-  const ImageU16& depth = frame.depth;
   const Intrinsics& k = cameras_.depth;
   const double scale = cameras_.depth_scale;
   bool in_front = false;
@@ -249,7 +248,7 @@ bool LightStage::crosses_surface(const glm::dvec3& from, const glm::dvec3& direc
     if (!(p.z > 0.05)) continue;
     const int u = int(std::lround(k.fx * p.x / p.z + k.cx)), v = int(std::lround(k.fy * p.y / p.z + k.cy));
     if (u < 0 || v < 0 || u >= depth.width || v >= depth.height) continue;
-    const uint16_t raw = depth.at(u, v)[0];
+    const uint16_t raw = depth.at(u, v);
     if (raw == 0) continue;
     const double measured = double(raw) / scale;
     if (p.z < measured - settings_.near_field_tolerance_m) {
@@ -261,16 +260,16 @@ bool LightStage::crosses_surface(const glm::dvec3& from, const glm::dvec3& direc
   return false;
 }
 
-void LightStage::mark_near_regions(const InputFrame& frame, const glm::dmat4& camera_to_world) {
+void LightStage::mark_near_regions(const frame::CameraView& camera) {
   near_.assign(env_->lights().size(), 0);
   const std::optional<EnvCamera>& cam = cameras_.env_camera;
-  if (!cam || !cam->position || frame.depth.empty() || !(settings_.near_field_distance_m > 0.0)) return;
-  const glm::dmat4 world_to_camera = glm::inverse(camera_to_world);
+  if (!cam || !cam->position || camera.depth.empty() || !(settings_.near_field_distance_m > 0.0)) return;
+  const glm::dmat4 world_to_camera = glm::inverse(camera.camera_to_world);
   // Only the candidates (compact and bright) need the march.
   for (size_t k = 0; k < env_->lights().size(); ++k) {
     const EnvLight& r = env_->lights()[k];
     if (!shadowable_region(r, env_->mean_lit_luminance())) continue;
-    near_[k] = crosses_surface(*cam->position, r.direction, frame, world_to_camera) ? 1 : 0;
+    near_[k] = crosses_surface(*cam->position, r.direction, camera.depth, world_to_camera) ? 1 : 0;
   }
 }
 
@@ -417,48 +416,54 @@ Status LightStage::submit_system(const LightSystem& system, int64_t frame_index,
   return ok_status();
 }
 
-Status LightStage::add_probeless_parts(const InputFrame& frame, const glm::dmat4& camera_to_world,
-                                       std::vector<std::string>& notes, bool& solved) {
+Status LightStage::add_probeless_parts(const frame::CameraView& camera, std::vector<std::string>& notes,
+                                       bool& solved) {
+  solved = false;
+  if (camera.empty()) {
+    // The first frames_in_flight frames of a lagged view (frame/camera_view.h).
+    notes.push_back("light: no camera frame readable on the host yet (frames on the device are read "
+                    "frames_in_flight frames later): the estimate waits");
+    return ok_status();
+  }
   // Rows interleaved over `parts` frames; until the first estimate exists the whole system is
   // built at once, so no frame is lit by the prior.
   const int parts = probeless_->settings().parts;
   const bool first = !estimator_->estimate().valid;
   for (int p = first ? 0 : next_part_; p < (first ? parts : next_part_ + 1); ++p)
-    MRGI_TRY(probeless_->add_part(frame, camera_to_world, cameras_.exposure, p, pending_));
+    MRGI_TRY(probeless_->add_part(camera, cameras_.exposure, p, pending_));
   next_part_ = first ? 0 : (next_part_ + 1) % parts;
   solved = next_part_ == 0;
   if (solved) {
-    auto r = estimator_->update(pending_, frame.index, frame.timestamp);
+    auto r = estimator_->update(pending_, camera.index, camera.timestamp);
     if (!r) notes.push_back("light: " + r.error().message);
     pending_.clear();
   }
   return ok_status();
 }
 
-Status LightStage::update(const InputFrame& frame, const glm::dmat4& camera_to_world,
-                          std::vector<std::string>& notes) {
+Status LightStage::update(const frame::CameraView& camera, std::vector<std::string>& notes) {
   char text[200];
   const EnvironmentDesc& env = scene_.environment;
   if (planned_ == LightSourceKind::Environment && env.from_env_camera) {
-    if (frame.env && cameras_.env_camera) {
+    if (camera.env && cameras_.env_camera) {
       // Declared lamps the env camera sees are taken out of its image first (lamp_removal.h).
-      const ImageRGBF* image = &*frame.env;
+      const ImageRGBF* image = camera.env;
       lamps_removed_ = 0;
       if (settings_.remove_declared_lamps && !real_lamps_.empty()) {
-        env_scratch_ = *frame.env;
+        env_scratch_ = *camera.env;
         lamps_removed_ = lamp_removal_.apply(env_scratch_, *cameras_.env_camera, real_lamps_);
         if (lamps_removed_ > 0) image = &env_scratch_;
       }
       MRGI_TRY(env_->update(*image, *cameras_.env_camera, glm::dquat(env.rotation), env.intensity,
-                            settings_.unseen_from_camera ? mean_camera_radiance(frame) : glm::dvec3(0.0)));
-    } else if (frame.env) {
+                            settings_.unseen_from_camera ? mean_camera_radiance(camera) : glm::dvec3(0.0)));
+    } else if (camera.env) {
       notes.push_back("light: this frame's env image came without an env camera model (capture.json "
                       "env_camera): not used");
     } else if (env_->valid()) {
       notes.push_back("light: no env image in this frame, the last one's light kept");
     }
     if (env_->valid()) {
-      mark_near_regions(frame, camera_to_world);
+      mark_near_regions(camera);
       set_environment_lighting(env.real);
       lighting_.source = LightSourceKind::Environment;
       lighting_.ambient_holds_real_bounce = settings_.unseen_from_camera && cameras_.env_camera.has_value();
@@ -476,19 +481,19 @@ Status LightStage::update(const InputFrame& frame, const glm::dmat4& camera_to_w
   }
   if (planned_ == LightSourceKind::Probeless && !external_system_) {
     bool solved = false;
-    MRGI_TRY(add_probeless_parts(frame, camera_to_world, notes, solved));
+    MRGI_TRY(add_probeless_parts(camera, notes, solved));
     if (solved) set_probeless_lighting();
   }
   if (residual_) {
     bool solved = false;
-    MRGI_TRY(add_probeless_parts(frame, camera_to_world, notes, solved));
+    MRGI_TRY(add_probeless_parts(camera, notes, solved));
     if (solved) {
       set_residual_lighting();
       finish_declared();
     }
   }
-  lighting_.estimate.frame_index = planned_ == LightSourceKind::Probeless ? lighting_.estimate.frame_index : frame.index;
-  lighting_.estimate.timestamp = planned_ == LightSourceKind::Probeless ? lighting_.estimate.timestamp : frame.timestamp;
+  lighting_.estimate.frame_index = planned_ == LightSourceKind::Probeless ? lighting_.estimate.frame_index : camera.index;
+  lighting_.estimate.timestamp = planned_ == LightSourceKind::Probeless ? lighting_.estimate.timestamp : camera.timestamp;
 
   switch (lighting_.source) {
     case LightSourceKind::Probeless: {

@@ -28,6 +28,7 @@
 
 #include <glm/glm.hpp>
 
+#include "frame/camera_view.h"
 #include "light/env_sampler.h"
 #include "light/lamp_removal.h"
 #include "light/probeless.h"
@@ -244,8 +245,11 @@ class LightStage {
   void use_external_system();
   bool external_system() const { return external_system_; }
 
-  // This frame's light. `notes` gets one line naming the source (and any problem).
-  Status update(const InputFrame& frame, const glm::dmat4& camera_to_world, std::vector<std::string>& notes);
+  // This frame's light from the camera as the host sees it (frame/camera_view.h: this frame's
+  // images, or an earlier frame's at its own pose; an empty view adds nothing from the camera)
+  // and this frame's environment image. `notes` gets one line naming the source (and any
+  // problem).
+  Status update(const frame::CameraView& camera, std::vector<std::string>& notes);
   // A technique's GPU-summed system (use_external_system), solved into the probeless estimate.
   Status submit_system(const LightSystem& system, int64_t frame_index, double timestamp_s,
                        int solve_bands, std::vector<std::string>& notes);
@@ -287,8 +291,7 @@ class LightStage {
   void set_residual_lighting();
   // Feeds this frame's part(s) of the stage's own probeless system; `solved` when a whole
   // system was solved this frame.
-  Status add_probeless_parts(const InputFrame& frame, const glm::dmat4& camera_to_world,
-                             std::vector<std::string>& notes, bool& solved);
+  Status add_probeless_parts(const frame::CameraView& camera, std::vector<std::string>& notes, bool& solved);
   // `near`: per region of the sampler's cut, whether it is a surface near the env camera
   // (near_regions); empty = none known to be.
   void set_environment_lighting(bool real);
@@ -296,14 +299,14 @@ class LightStage {
   void set_ambient_regions();
   // Marks near_ for this frame's regions: the ray from the env camera towards each region's
   // direction crosses a surface of the frame's depth image within near_field_distance_m.
-  void mark_near_regions(const InputFrame& frame, const glm::dmat4& camera_to_world);
-  bool crosses_surface(const glm::dvec3& from, const glm::dvec3& direction, const InputFrame& frame,
+  void mark_near_regions(const frame::CameraView& camera);
+  bool crosses_surface(const glm::dvec3& from, const glm::dvec3& direction, const frame::DepthView& depth,
                        const glm::dmat4& world_to_camera) const;
   std::vector<uint8_t> near_;  // per region; reserved at start-up
   // Whether an environment region may be a shadowed light (LightStageSettings::shadowed_min_contrast).
   bool shadowable_region(const EnvLight& r, double mean_luminance) const;
   // The mean radiance of the colour frame (linear, over the exposure): the unseen prior.
-  glm::dvec3 mean_camera_radiance(const InputFrame& frame) const;
+  glm::dvec3 mean_camera_radiance(const frame::CameraView& camera) const;
   std::vector<size_t> shadowed_regions_;  // this frame's, indices into the sampler's lights
   std::vector<std::pair<double, size_t>> region_order_;  // set_ambient_regions' (contrast, index)
   std::vector<EnvSource> sources_;        // set_ambient_regions' (occlusion_regions_from_sources)

@@ -88,7 +88,7 @@ Expected<ProbelessBuilder> ProbelessBuilder::create(const ProbelessSettings& s, 
   return b;
 }
 
-void ProbelessBuilder::build_positions(const InputFrame& frame) {
+void ProbelessBuilder::build_positions(const frame::DepthView& depth) {
   const int s = stride_;
   const glm::vec4 k(float(depth_.fx), float(depth_.fy), float(depth_.cx), float(depth_.cy));
   const float to_m = float(1.0 / depth_scale_);
@@ -100,7 +100,7 @@ void ProbelessBuilder::build_positions(const InputFrame& frame) {
       // The block's centre depth picks the surface; the block's depths on that surface are
       // averaged (Kinect noise grows with distance squared; 16 samples take most of it out).
       const int x0 = gx * s, y0 = gy * s;
-      const uint16_t centre = frame.depth.data[size_t(y0 + s / 2) * size_t(frame.depth.width) + size_t(x0 + s / 2)];
+      const uint16_t centre = depth.at(x0 + s / 2, y0 + s / 2);
       glm::vec3& out = position_[size_t(gy) * grid_w_ + gx];
       out = glm::vec3(0.0f);
       if (centre == 0) continue;
@@ -108,7 +108,7 @@ void ProbelessBuilder::build_positions(const InputFrame& frame) {
       double sum_z = 0.0, sum_u = 0.0, sum_v = 0.0;
       int count = 0;
       for (int y = y0; y < y0 + s; y += step) {
-        const uint16_t* row = frame.depth.data.data() + size_t(y) * size_t(frame.depth.width);
+        const uint16_t* row = depth.row(y);
         for (int x = x0; x < x0 + s; x += step) {
           const float z = float(row[x]) * to_m;
           if (row[x] == 0 || std::abs(z - zc) > kSameSurface * zc) continue;
@@ -179,18 +179,18 @@ void ProbelessBuilder::build_normals(const glm::mat3& rot) {
   }
 }
 
-Status ProbelessBuilder::add_part(const InputFrame& frame, const glm::dmat4& camera_to_world,
-                                  double exposure, int part, LightSystem& system) {
-  const CameraColor camera(frame);
-  if (frame.depth.width != depth_.width || frame.depth.height != depth_.height ||
+Status ProbelessBuilder::add_part(const frame::CameraView& view, double exposure, int part, LightSystem& system) {
+  const CameraColor camera(view);
+  const glm::dmat4& camera_to_world = view.camera_to_world;
+  if (view.depth.empty() || view.depth.width != depth_.width || view.depth.height != depth_.height ||
       camera.width() != color_.width || camera.height() != color_.height)
-    return fail(ErrorKind::BadInput, "probeless light estimation: frame " + std::to_string(frame.index) +
+    return fail(ErrorKind::BadInput, "probeless light estimation: frame " + std::to_string(view.index) +
                                          " does not have the cameras' sizes");
   if (part < 0 || part >= settings_.parts)
     return fail(ErrorKind::BadUsage, "probeless light estimation: part " + std::to_string(part) +
                                          " outside 0.." + std::to_string(settings_.parts - 1));
   if (!(exposure > 0.0)) exposure = 1.0;
-  build_positions(frame);
+  build_positions(view.depth);
   const glm::mat3 rot = glm::mat3(camera_to_world);
   build_normals(rot);
   const glm::mat3 rot_t = glm::transpose(rot);

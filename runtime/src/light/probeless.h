@@ -25,6 +25,7 @@
 
 #include "light/sh_estimator.h"
 #include "mrgi/expected.h"
+#include "frame/camera_view.h"
 #include "mrgi/frame.h"
 #include "mrgi/scene.h"
 
@@ -71,11 +72,11 @@ class ProbelessBuilder {
   static Expected<ProbelessBuilder> create(const ProbelessSettings& settings, const Intrinsics& color,
                                            const Intrinsics& depth, double depth_scale);
 
-  // Adds the sample rows of part `part` (0..parts-1) of `frame` to `system`: I_c is the linear
-  // camera value divided by `exposure` (radiance units, the estimator divides by the albedo).
-  // Frames whose images do not have the intrinsics' sizes are refused (BadInput).
-  Status add_part(const InputFrame& frame, const glm::dmat4& camera_to_world, double exposure,
-                  int part, LightSystem& system);
+  // Adds the sample rows of part `part` (0..parts-1) of the camera frame `camera` (at its pose)
+  // to `system`: I_c is the linear camera value divided by `exposure` (radiance units, the
+  // estimator divides by the albedo). Frames whose images do not have the intrinsics' sizes are
+  // refused (BadInput).
+  Status add_part(const frame::CameraView& camera, double exposure, int part, LightSystem& system);
   // Light the rows should not explain (the residual estimate, light_stage.h): every later row's
   // intensity has albedo / pi * E_lamps(x) taken off, E_lamps the lamps' irradiance at the
   // sample (lamp_irradiance, cosine, and the sample's visibility towards the lamp searched in
@@ -90,7 +91,7 @@ class ProbelessBuilder {
  private:
   ProbelessBuilder() = default;
   // Camera-space positions of every grid cell from its block's depth (z 0 = none).
-  void build_positions(const InputFrame& frame);
+  void build_positions(const frame::DepthView& depth);
   // Normals (camera space, 0 = none) of every cell, their orientation bins and row weights.
   void build_normals(const glm::mat3& camera_to_world_rotation);
   static constexpr int kNormalBins = 32;

@@ -59,25 +59,48 @@ Status check_camera_upload(const gpu::FrameGraph& graph, gpu::BufferHandle uploa
 
 Expected<Reconstruction> Reconstruction::create(gpu::Context& context, gpu::FrameGraph& graph,
                                                 const Intrinsics& color, const Intrinsics& depth,
-                                                const ReconstructionSettings& settings) {
+                                                const ReconstructionSettings& settings, bool app_images) {
   MRGI_TRY(check_settings(settings));
   Reconstruction r;
   r.settings_ = settings;
+  r.context_ = &context;
   r.color_bytes_ = size_t(color.width) * color.height * 3;
   r.depth_bytes_ = size_t(depth.width) * depth.height * 2;
-  // Whole groups of 4 pixels (12 bytes): what the Y'CbCr conversion writes at a time.
-  const gpu::BufferDesc cb = camera_upload_desc("color_upload", (r.color_bytes_ + 11) / 12 * 12);
-  auto c = graph.create_buffer(cb, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  r.color_w_ = color.width;
+  r.color_h_ = color.height;
+  r.depth_w_ = depth.width;
+  r.depth_h_ = depth.height;
+  // Transfer destination: an app image's copy (AppInputImages) lands in them.
+  constexpr VkBufferUsageFlags kUploadUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  // Whole groups of 16 pixels (48 bytes): what the app colour's unpacking writes at a time (the
+  // Y'CbCr conversion: 4 pixels, 12 bytes).
+  const gpu::BufferDesc cb = camera_upload_desc("color_upload", (r.color_bytes_ + 47) / 48 * 48);
+  auto c = graph.create_buffer(cb, kUploadUsage);
   if (!c) return c.error();
   r.color_upload_ = *c;
   const gpu::BufferDesc db = camera_upload_desc("depth_upload", r.depth_bytes_);
-  auto d = graph.create_buffer(db, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  auto d = graph.create_buffer(db, kUploadUsage);
   if (!d) return d.error();
   r.depth_upload_ = *d;
   const gpu::BufferDesc yb = camera_upload_desc("color_yuv_upload", size_t(color.width) * size_t(color.height) * 2);
   auto y = graph.create_buffer(yb, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (!y) return y.error();
   r.yuv_upload_ = *y;
+  if (app_images) {
+    // 4 pixels a texel, as the unpacking reads it (and compose's output words), whole groups of
+    // 16 pixels (shaders/recon/rgba_to_rgb.comp).
+    gpu::BufferDesc sd{"camera_rgba_staging", (VkDeviceSize(color.width) * VkDeviceSize(color.height) * 4 + 63) / 64 * 64};
+    sd.texel_format = VK_FORMAT_R32G32B32A32_UINT;
+    auto s = graph.create_buffer(sd, kUploadUsage);
+    if (!s) return s.error();
+    r.rgba_staging_ = *s;
+    auto none = graph.create_buffer({"camera_words_none", 64}, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    if (!none) return none.error();
+    r.no_camera_words_ = *none;
+    auto rp = gpu::load_compute_pipeline(context, "recon/rgba_to_rgb.comp", {});
+    if (!rp) return rp.error();
+    r.rgba_pipeline_ = std::move(*rp);
+  }
 
   // Transfer source: tests and debug tools read the reconstruction back.
   const VkImageUsageFlags usage =
@@ -115,31 +138,48 @@ Expected<Reconstruction> Reconstruction::create(gpu::Context& context, gpu::Fram
   return r;
 }
 
-size_t Reconstruction::upload(const gpu::FrameGraph& graph, const InputFrame& frame) {
+void Reconstruction::take_input(const InputFrame& frame, const AppInputImages* images) {
   yuv_push_.frame.x = 0;
-  size_t bytes = depth_bytes_;
-  if (const std::optional<YuvImage>& yuv = frame.color_yuv) {
-    std::memcpy(graph.mapped(yuv_upload_, graph.slot()), yuv->data.data(), yuv->expected_bytes());
-    bytes += yuv->expected_bytes();
+  app_images_.reset();
+  if (images) {
+    app_images_ = *images;
+  } else if (const std::optional<YuvImage>& yuv = frame.color_yuv) {
     constexpr int kGroupsPerRow = 256;  // the dispatch's row of 4-pixel groups
     yuv_push_.frame = glm::ivec4(yuv->width, yuv->height,
                                  yuv->layout == YuvImage::Layout::Yuyv ? MRGI_YUV_YUYV : MRGI_YUV_NV12, kGroupsPerRow);
     yuv_push_.format = glm::ivec4(yuv->matrix == YuvImage::Matrix::Bt709 ? MRGI_YUV_BT709 : MRGI_YUV_BT601,
                                   yuv->range == YuvImage::Range::Full ? 1 : 0, 0, 0);
+  }
+  // Same rule as the runtime's frame constants: no pose = the last known one (not moved).
+  if (frame.pose) pose_ = frame.pose->matrix();
+}
+
+size_t Reconstruction::copy_host_input(const gpu::FrameGraph& graph, const InputFrame& frame) {
+  if (app_images_) return 0;
+  size_t bytes = depth_bytes_;
+  if (const std::optional<YuvImage>& yuv = frame.color_yuv) {
+    std::memcpy(graph.mapped(yuv_upload_, graph.slot()), yuv->data.data(), yuv->expected_bytes());
+    bytes += yuv->expected_bytes();
   } else {
     std::memcpy(graph.mapped(color_upload_, graph.slot()), frame.color.data.data(), color_bytes_);
     bytes += color_bytes_;
   }
   std::memcpy(graph.mapped(depth_upload_, graph.slot()), frame.depth.data.data(), depth_bytes_);
-  // Same rule as the runtime's frame constants: no pose = the last known one (not moved).
-  if (frame.pose) {
-    pose_ = frame.pose->matrix();
-  }
   return bytes;
 }
 
-void Reconstruction::record_camera_input(gpu::FrameGraph& graph) {
-  if (yuv_push_.frame.x == 0) return;
+frame::CameraView Reconstruction::slot_view(const gpu::FrameGraph& graph) const {
+  frame::CameraView v;
+  v.rgb = static_cast<const uint8_t*>(graph.mapped(color_upload_, graph.slot()));
+  v.color_width = color_w_;
+  v.color_height = color_h_;
+  v.depth = frame::DepthView{static_cast<const uint16_t*>(graph.mapped(depth_upload_, graph.slot())), depth_w_, depth_h_};
+  return v;
+}
+
+Status Reconstruction::record_camera_input(gpu::FrameGraph& graph, gpu::BufferHandle camera_words) {
+  if (app_images_) return record_app_images(graph, camera_words);
+  if (yuv_push_.frame.x == 0) return ok_status();
   graph.add_shader_pass(
       "camera_yuv_to_rgb", gpu::PassKind::Compute, *yuv_pipeline_,
       [this](gpu::ShaderPassBuilder& b) {
@@ -152,6 +192,7 @@ void Reconstruction::record_camera_input(gpu::FrameGraph& graph) {
         gpu::dispatch_2d(cmd, *yuv_pipeline_, &yuv_push_, sizeof(yuv_push_), row, (groups + row - 1) / row);
       });
   graph.mark_output(color_upload_);  // the host reads the camera frame from it where nothing virtual shows
+  return ok_status();
 }
 
 void Reconstruction::record(gpu::FrameGraph& graph, gpu::BufferHandle frame_constants) {

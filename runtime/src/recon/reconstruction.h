@@ -1,7 +1,9 @@
 // Reconstruction (docs/DESIGN.md "One frame, as data"): the real G-buffer from the RGB-D stream, with
 // the DIR paper's temporal depth filter (section 4.2, eq. 11-14).
-//   upload          colour (sRGB8) and depth (u16) copied into this frame slot's upload buffers;
-//                   the pose change since the previous frame is computed here (CPU, double)
+//   upload          colour (sRGB8) and depth (u16) copied into this frame slot's upload buffers
+//                   by the host, or for a frame given as the app's images by the GPU
+//                   (camera_from_app_images, camera_rgba_to_rgb); the pose change since the
+//                   previous frame is computed here (CPU, double)
 //   recon_warp      the previous frame's filtered depth + weight (history image) forward-
 //                   projected into this view as its grid mesh (each pixel a triangle covers gets
 //                   the interpolated depth; atomicMin between surfaces); skipped on the first frame,
@@ -18,9 +20,13 @@
 // real_albedo (RGBA16F: linear rgb, w 1 valid). Invalid stays invalid in every later step.
 // A frame without a pose is treated as not moved (the runtime keeps the previous pose for it).
 #pragma once
+#include "frame/camera_view.h"
 #include "gpu/frame_graph.h"
 #include "gpu/pipelines.h"
 #include "mrgi/frame.h"
+#include "mrgi/vulkan_device.h"
+
+#include <optional>
 
 #include <glm/glm.hpp>
 
@@ -48,20 +54,32 @@ Status check_camera_upload(const gpu::FrameGraph& graph, gpu::BufferHandle uploa
 class Reconstruction {
  public:
   // Buffers sized for the colour and depth images; images allocated at the output size.
+  // `app_images`: frames may come as the app's images (a staging buffer for their colour).
   static Expected<Reconstruction> create(gpu::Context& context, gpu::FrameGraph& graph,
                                          const Intrinsics& color, const Intrinsics& depth,
-                                         const ReconstructionSettings& settings = {});
-  // Copies the frame's images into the current slot's upload buffers (sizes checked by the
-  // caller) and takes the frame's pose: the RGB8 colour as it is, a Y'CbCr colour
-  // (InputFrame::color_yuv) as the camera delivered it, for record_camera_input to convert. Call
-  // between FrameGraph::begin_frame and submit.
-  // Returns the bytes copied (FrameStats::host_copy_bytes).
-  size_t upload(const gpu::FrameGraph& graph, const InputFrame& frame);
-  // Adds camera_yuv_to_rgb where this frame's colour came as Y'CbCr: the RGB8 words of
-  // color_upload() from it on the GPU (shaders/recon/yuv_to_rgb.comp), before any pass reads
-  // them, kept for the host's reads too (the camera frame where nothing virtual shows). Nothing
-  // for an RGB8 frame. Every frame, whether or not the reconstruction runs.
-  void record_camera_input(gpu::FrameGraph& graph);
+                                         const ReconstructionSettings& settings = {}, bool app_images = false);
+  // The frame's input, in two steps around its recording (between FrameGraph::begin_frame and
+  // submit; sizes and formats checked by the caller). take_input() before any stage: the pose,
+  // and the form the colour comes in (RGB8, Y'CbCr for record_camera_input to convert, or the
+  // app's images for it to copy: `images`, null for host memory). copy_host_input() after the
+  // stages: the host's copies into the current slot's upload buffers (none for app images),
+  // after any host reader of the slot's earlier frame (slot_view) is done. Returns the bytes
+  // copied (FrameStats::host_copy_bytes).
+  void take_input(const InputFrame& frame, const AppInputImages* images);
+  size_t copy_host_input(const gpu::FrameGraph& graph, const InputFrame& frame);
+  // The images the current slot's upload buffers hold, RGB8 colour and u16 depth (the frame
+  // recorded in this slot before, once it completed: frame/camera_view.h); index, timestamp and
+  // pose are the caller's to fill.
+  frame::CameraView slot_view(const gpu::FrameGraph& graph) const;
+  // Adds the passes that bring this frame's colour into color_upload()'s RGB8 words on the GPU,
+  // before any pass reads them, kept for the host's reads too (the camera frame where nothing
+  // virtual shows, slot_view): camera_yuv_to_rgb for a Y'CbCr colour
+  // (shaders/recon/yuv_to_rgb.comp); for the app's images camera_from_app_images (their copy
+  // into depth_upload() and 4-byte words) and camera_rgba_to_rgb (shaders/recon/rgba_to_rgb.comp).
+  // `camera_words`, where valid (the composite's RGBA8 output words, at the colour's size), takes
+  // the app's colour as the composite's camera words (alpha 0) on the way. Nothing for an RGB8
+  // frame in host memory. Every frame, whether or not the reconstruction runs.
+  Status record_camera_input(gpu::FrameGraph& graph, gpu::BufferHandle camera_words = {});
   // Adds recon_warp (when there is a history), recon_positions and recon_normals.
   void record(gpu::FrameGraph& graph, gpu::BufferHandle frame_constants);
   // A frame on which the reconstruction is not recorded (nothing virtual in view): the temporal
@@ -82,6 +100,15 @@ class Reconstruction {
   gpu::ImageHandle position_, normal_, albedo_, filtered_depth_, warped_;
   gpu::PipelineHandle warp_pipeline_, positions_pipeline_, normals_pipeline_;
   size_t color_bytes_ = 0, depth_bytes_ = 0;
+  int color_w_ = 0, color_h_ = 0, depth_w_ = 0, depth_h_ = 0;
+  // The app's images for this frame (take_input), their colour's staging words (4 bytes a pixel;
+  // made only for a runtime that takes app images) and the pack pass.
+  std::optional<AppInputImages> app_images_;
+  gpu::BufferHandle rgba_staging_, no_camera_words_;
+  gpu::PipelineHandle rgba_pipeline_;
+  glm::ivec4 pack_push_{0};
+  Status record_app_images(gpu::FrameGraph& graph, gpu::BufferHandle camera_words);
+  const gpu::Context* context_ = nullptr;  // for the app images' barriers (synchronization2 entry points)
   // Y'CbCr colour: its upload (sized for YUYV, the larger layout), the conversion, and this
   // frame's layout and format (yuv_to_rgb.comp ConvertConstants; frame.x 0: an RGB8 frame).
   gpu::BufferHandle yuv_upload_;

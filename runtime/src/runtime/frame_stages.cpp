@@ -4,8 +4,12 @@
 //
 // The stages, and why each full-resolution pass is there (profiled ms at 640x480 on lavapipe x2,
 // baseline on desk_spot; floor pass about 1.2 ms):
-//   (upload)          host memcpy of colour and depth into this slot's buffers (in host_ms, <1)
-//   reconstruction    camera_yuv_to_rgb, only for a Y'CbCr colour frame (InputFrame::color_yuv)
+//   (upload)          host memcpy of colour and depth into this slot's buffers (in host_ms, <1),
+//                     after the stages are recorded (a lagged camera view reads the slot's
+//                     earlier frame: frame/camera_view.h); none for the app's images
+//   reconstruction    camera_from_app_images and camera_rgba_to_rgb, only for a frame given as
+//                     the app's images (AppInputImages): their copy into the upload buffers;
+//                     camera_yuv_to_rgb, only for a Y'CbCr colour frame (InputFrame::color_yuv)
 //                     and on every such frame: its RGB8 words, which every later reader of the
 //                     camera takes; recon_warp: the temporal history warped into this frame's camera, internal
 //                     resolution (0.7 at lowest's 320x240, 2.5 at high's 640x480), the merge
@@ -52,19 +56,43 @@ const RuntimeImpl::FrameStageEntry RuntimeImpl::kFrameStages[] = {
     {"app output", &RuntimeImpl::record_app_output},
 };
 
+frame::CameraView RuntimeImpl::camera_view(const InputFrame& frame, const SlotRecord& rec, bool lagged) const {
+  if (!lagged) return frame::CameraView::of(frame, last_pose_);
+  frame::CameraView v;
+  if (rec.uploaded.valid) {
+    v = recon_->slot_view(*graph_);
+    v.index = rec.uploaded.index;
+    v.timestamp = rec.uploaded.timestamp;
+    v.camera_to_world = rec.uploaded.camera_to_world;
+  } else {  // the slot's first frame: no images yet
+    v.index = frame.index;
+    v.timestamp = frame.timestamp;
+    v.camera_to_world = last_pose_;
+  }
+  v.env = frame.env ? &*frame.env : nullptr;
+  return v;
+}
+
+// The host's copies of the frame's images into the slot's upload buffers come after the stages:
+// a lagged camera view reads the images the slot held before (frame/camera_view.h).
 Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, bool affected,
-                                      const AppOutputImage* target) {
+                                      const AppOutputImage* target, const AppInputImages* images) {
   const technique::QualityLevel& level = technique_->levels()[size_t(level_)];
   rec.scale_factor = auto_level_ ? scheduler_->choice().scale : 1.0f;
   rec.internal_scale = level.internal_scale * rec.scale_factor;
   MRGI_TRY(graph_->set_render_scale(rec.internal_scale));
   rec.technique_ran = affected;
   write_constants(last_pose_);
-  rec.host_copy_bytes = recon_->upload(*graph_, frame);
+  recon_->take_input(frame, images);
+  const frame::CameraView camera = camera_view(frame, rec, images != nullptr || settings_.lagged_camera_reads);
+  rec.host_copy_bytes = 0;
   rec.app_output = target != nullptr;
-  rec.camera_prefilled = target && prefill_camera(frame, rec);
+  // The app's colour image is expanded into the output's camera words by the pass that unpacks
+  // it (recon/camera_from_app_images.cpp), on any device; a host frame's by the host on a CPU device.
+  const bool camera_size = output_w_ == cameras_.color.width && output_h_ == cameras_.color.height;
+  rec.camera_prefilled = target && (images ? camera_size : prefill_camera(frame, rec));
 
-  FrameContext f{frame, rec, affected, false, false, level, {}, target};
+  FrameContext f{frame, camera, images, rec, affected, false, false, level, {}, target};
   f.has_objects = !scene_gpu_->virtual_objects.empty() && scene_gpu_->any_visible();
   // The specular stage's impostors and back-projection read the reconstruction's G-buffer, so it
   // runs for a technique without one (ssrt) when a mirror or glass object is in the scene.
@@ -73,8 +101,10 @@ Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, 
   f.info.level = level_;
   f.info.virtual_objects_present = f.has_objects;
   f.info.camera_to_world = last_pose_;
-  f.info.input = &frame;
+  f.info.camera = &camera;
   for (const FrameStageEntry& stage : kFrameStages) MRGI_TRY((this->*stage.record)(f));
+  rec.host_copy_bytes += recon_->copy_host_input(*graph_, frame);
+  rec.uploaded = {true, frame.index, frame.timestamp, last_pose_};
   MRGI_TRY(graph_->compile());
   MRGI_TRY(graph_->submit());
   return check_validation();
@@ -84,7 +114,8 @@ Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, 
 // is not needed for it; its temporal history restarts on the next affected frame (one frame of
 // unfiltered depth).
 Status RuntimeImpl::record_reconstruction(FrameContext& f) {
-  recon_->record_camera_input(*graph_);
+  MRGI_TRY(recon_->record_camera_input(*graph_, f.images && f.rec.camera_prefilled ? compose_->output()
+                                                                                   : gpu::BufferHandle{}));
   if (f.affected && f.recon_used) {
     recon_->record(*graph_, frame_constants_);
     return ok_status();
@@ -102,7 +133,7 @@ Status RuntimeImpl::record_reconstruction(FrameContext& f) {
 Status RuntimeImpl::update_light(FrameContext& f) {
   if (!f.affected) return ok_status();
   const double light_start = thread_cpu_ms();
-  MRGI_TRY(light_stage_->update(f.input, last_pose_, f.rec.notes));
+  MRGI_TRY(light_stage_->update(f.camera, f.rec.notes));
   f.rec.light_ms = thread_cpu_ms() - light_start;
   return ok_status();
 }
@@ -239,7 +270,8 @@ Status RuntimeImpl::record_app_output(FrameContext& f) {
         b.newLayout = target.final_layout;
         ctx->fn().cmd_pipeline_barrier2(cmd, &di);
       });
-  graph_->set_submit_semaphores(target.wait, VK_PIPELINE_STAGE_2_COPY_BIT, target.signal);
+  MRGI_TRY(graph_->add_submit_wait(target.wait, VK_PIPELINE_STAGE_2_COPY_BIT));
+  graph_->set_submit_signal(target.signal);
   return ok_status();
 }
 

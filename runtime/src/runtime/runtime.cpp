@@ -39,10 +39,11 @@ Status RuntimeImpl::check_validation() const {
                                      " message(s):" + all);
 }
 
-Status RuntimeImpl::check_frame(const InputFrame& frame) const {
+Status RuntimeImpl::check_frame(const InputFrame& frame, const AppInputImages* images) const {
   const Intrinsics& c = cameras_.color;
   const Intrinsics& d = cameras_.depth;
   const std::string where = "frame " + std::to_string(frame.index) + ": ";
+  if (images) return check_app_images(frame, *images);
   if (const std::optional<YuvImage>& yuv = frame.color_yuv) {
     const std::string field = where + "InputFrame::color_yuv: ";
     if (yuv->width != c.width || yuv->height != c.height)
@@ -146,7 +147,45 @@ Expected<SlotRecord*> RuntimeImpl::begin_slot(const InputFrame& frame,
   return &rec;
 }
 
+// The app's images are the frame's colour and depth: the frame carries none in host memory.
+Status RuntimeImpl::check_app_images(const InputFrame& frame, const AppInputImages& images) const {
+  const std::string where = "frame " + std::to_string(frame.index) + ": ";
+  if (!context_->app_device())
+    return fail(ErrorKind::BadUsage, where + "AppInputImages: the runtime was not made on the app's device "
+                                             "(DeviceSettings::app_device); its images are not the runtime's to read");
+  if (!frame.color.data.empty() || frame.color_yuv || !frame.depth.data.empty())
+    return fail(ErrorKind::BadUsage, where + "InputFrame::color, color_yuv and depth must be empty when the frame "
+                                             "is given as AppInputImages (one source for each image)");
+  if (images.color == VK_NULL_HANDLE) return fail(ErrorKind::BadUsage, where + "AppInputImages::color is null");
+  if (images.depth == VK_NULL_HANDLE) return fail(ErrorKind::BadUsage, where + "AppInputImages::depth is null");
+  const VkFormat cf = images.color_format, df = images.depth_format;
+  if (cf != VK_FORMAT_R8G8B8A8_UNORM && cf != VK_FORMAT_R8G8B8A8_SRGB && cf != VK_FORMAT_B8G8R8A8_UNORM &&
+      cf != VK_FORMAT_B8G8R8A8_SRGB)
+    return fail(ErrorKind::BadUsage, where + "AppInputImages::color_format must be R8G8B8A8 or B8G8R8A8, UNORM or "
+                                             "SRGB (the camera's sRGB bytes), not " + std::to_string(int(cf)));
+  if (df != VK_FORMAT_R16_UINT && df != VK_FORMAT_R16_UNORM && df != VK_FORMAT_D16_UNORM)
+    return fail(ErrorKind::BadUsage, where + "AppInputImages::depth_format must be R16_UINT, R16_UNORM or D16_UNORM "
+                                             "(16-bit depth units), not " + std::to_string(int(df)));
+  for (const auto& [layout, name] : {std::pair{images.color_layout, "color_layout"}, std::pair{images.depth_layout, "depth_layout"}})
+    if (layout == VK_IMAGE_LAYOUT_UNDEFINED || layout == VK_IMAGE_LAYOUT_PREINITIALIZED)
+      return fail(ErrorKind::BadUsage, where + "AppInputImages::" + name +
+                                               " must be the layout the image's contents are in (not UNDEFINED or "
+                                               "PREINITIALIZED)");
+  return ok_status();
+}
+
+Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame, const AppInputImages& images,
+                                                        const AppOutputImage* target) {
+  if (target) MRGI_TRY(check_app_output(frame, *target));
+  return process_frame(frame, target, &images);
+}
+
 Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame, const AppOutputImage& target) {
+  MRGI_TRY(check_app_output(frame, target));
+  return process_frame(frame, &target, nullptr);
+}
+
+Status RuntimeImpl::check_app_output(const InputFrame& frame, const AppOutputImage& target) const {
   const std::string where = "frame " + std::to_string(frame.index) + ": AppOutputImage::";
   if (!context_->app_device())
     return fail(ErrorKind::BadUsage, where + "image: the runtime was not made on the app's device "
@@ -159,12 +198,13 @@ Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame,
   if (target.final_layout == VK_IMAGE_LAYOUT_UNDEFINED || target.final_layout == VK_IMAGE_LAYOUT_PREINITIALIZED)
     return fail(ErrorKind::BadUsage, where + "final_layout must be a layout an image can be left in "
                                              "(not UNDEFINED or PREINITIALIZED)");
-  return process_frame(frame, &target);
+  return ok_status();
 }
 
-Expected<std::vector<FrameOutput>> RuntimeImpl::process_frame(const InputFrame& frame, const AppOutputImage* target) {
+Expected<std::vector<FrameOutput>> RuntimeImpl::process_frame(const InputFrame& frame, const AppOutputImage* target,
+                                                              const AppInputImages* images) {
   const auto t0 = std::chrono::steady_clock::now();
-  MRGI_TRY(check_frame(frame));
+  MRGI_TRY(check_frame(frame, images));
   const double check_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   std::vector<FrameOutput> outputs;
   // begin_slot waits for the slot's earlier frame and collects it: that frame's time.
@@ -200,6 +240,7 @@ Expected<std::vector<FrameOutput>> RuntimeImpl::process_frame(const InputFrame& 
   // virtual G-buffer's draw 145 ms on the sample's first frame, 6-8 ms after), which the first
   // frame would otherwise pay beyond any budget. The repeat sees the same inputs, so the
   // temporal filters and reuse caches are where one run of the frame would leave them, nearly.
+  AppInputImages again;  // the app's images once a priming run below has waited for their semaphore
   const bool warm_up = auto_level_ && !warmed_up_;
   const bool for_estimate = affected && technique_->needs().estimate_from_frames && technique_->estimate_pending();
   if (affected && (for_estimate || warm_up)) {
@@ -211,7 +252,12 @@ Expected<std::vector<FrameOutput>> RuntimeImpl::process_frame(const InputFrame& 
     double prime_ms = 0.0;
     for (int r = 0; r < runs; ++r) {
       double ms = 0.0;
-      MRGI_TRY(prime(frame, *rec, outputs, ms));
+      MRGI_TRY(prime(frame, images, *rec, outputs, ms));
+      if (images) {  // a binary semaphore is waited for once: the first run's submission did
+        again = *images;
+        again.wait = VK_NULL_HANDLE;
+        images = &again;
+      }
       prime_ms += ms;
       slot = begin_slot(frame, outputs);
       if (!slot) return slot.error();
@@ -231,17 +277,17 @@ Expected<std::vector<FrameOutput>> RuntimeImpl::process_frame(const InputFrame& 
     choice_reason_.clear();
   }
   rec->notes.insert(rec->notes.end(), notes.begin(), notes.end());
-  MRGI_TRY(record_and_submit(frame, *rec, affected, target));
+  MRGI_TRY(record_and_submit(frame, *rec, affected, target, images));
   const auto t1 = std::chrono::steady_clock::now();
   rec->record_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
   rec->host_work_ms = std::max(0.0, check_ms) + std::chrono::duration<double, std::milli>(t1 - t_work).count();
   return outputs;
 }
 
-Status RuntimeImpl::prime(const InputFrame& frame, SlotRecord& rec, std::vector<FrameOutput>& outputs,
-                          double& prime_ms) {
+Status RuntimeImpl::prime(const InputFrame& frame, const AppInputImages* images, SlotRecord& rec,
+                          std::vector<FrameOutput>& outputs, double& prime_ms) {
   rec.priming = true;
-  MRGI_TRY(record_and_submit(frame, rec, true));
+  MRGI_TRY(record_and_submit(frame, rec, true, nullptr, images));
   auto all = graph_->flush();
   if (!all) return all.error();
   for (const gpu::FrameTimings& t : *all) {

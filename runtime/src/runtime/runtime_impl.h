@@ -68,6 +68,14 @@ struct SlotRecord {
   bool app_output = false;
   bool camera_prefilled = false;  // compose::ComposeInputs::camera_prefilled
   uint64_t host_copy_bytes = 0;  // the input's upload (FrameStats::host_copy_bytes)
+  // The frame whose images this slot's upload buffers hold (the last one recorded in it): what a
+  // lagged camera view reads (frame/camera_view.h) when the slot comes round again.
+  struct UploadedFrame {
+    bool valid = false;
+    int64_t index = 0;
+    double timestamp = 0.0;
+    glm::dmat4 camera_to_world{1.0};
+  } uploaded;
   double light_ms = 0.0;
   std::vector<std::string> skipped;
   std::vector<std::string> notes;
@@ -80,9 +88,11 @@ class RuntimeImpl final : public Runtime {
   Status init(const RuntimeSettings& settings, const CameraSetup& cameras, const SceneDesc& scene);
 
   Expected<std::vector<FrameOutput>> process(const InputFrame& frame) override {
-    return process_frame(frame, nullptr);
+    return process_frame(frame, nullptr, nullptr);
   }
   Expected<std::vector<FrameOutput>> process(const InputFrame& frame, const AppOutputImage& target) override;
+  Expected<std::vector<FrameOutput>> process(const InputFrame& frame, const AppInputImages& images,
+                                             const AppOutputImage* target) override;
   Expected<std::vector<FrameOutput>> flush() override;
   void recycle(FrameOutput&& done) override;
   const DeviceInfo& device() const override { return context_->info(); }
@@ -115,21 +125,29 @@ class RuntimeImpl final : public Runtime {
 
  private:
   Status check_validation() const;
-  Status check_frame(const InputFrame& frame) const;
+  Status check_frame(const InputFrame& frame, const AppInputImages* images) const;
+  Status check_app_images(const InputFrame& frame, const AppInputImages& images) const;
+  Status check_app_output(const InputFrame& frame, const AppOutputImage& target) const;
   void write_constants(const glm::dmat4& camera_to_world);
   Expected<FrameOutput> collect(const gpu::FrameTimings& timings);
   // Waits for the frame that last used the next slot (its output joins `outputs`) and starts
   // that slot's record for `frame`.
   Expected<SlotRecord*> begin_slot(const InputFrame& frame, std::vector<FrameOutput>& outputs);
   // Records the frame's passes into the current slot and submits them.
-  // `target`: the app's image the composite goes to (null: read back into host memory).
+  // `target`: the app's image the composite goes to (null: read back into host memory);
+  // `images`: the app's images the frame's colour and depth come from (null: `frame`'s).
   Status record_and_submit(const InputFrame& frame, SlotRecord& rec, bool affected,
-                           const AppOutputImage* target = nullptr);
-  Expected<std::vector<FrameOutput>> process_frame(const InputFrame& frame, const AppOutputImage* target);
+                           const AppOutputImage* target = nullptr, const AppInputImages* images = nullptr);
+  Expected<std::vector<FrameOutput>> process_frame(const InputFrame& frame, const AppOutputImage* target,
+                                                   const AppInputImages* images);
+  // The host's view of the camera for this frame (frame/camera_view.h): this frame's images, or
+  // where lagged (app images, RuntimeSettings::lagged_camera_reads) the ones the slot holds.
+  frame::CameraView camera_view(const InputFrame& frame, const SlotRecord& rec, bool lagged) const;
   // The technique's priming run (Technique::Needs::estimate_from_frames): this frame run once,
   // waited for, its output dropped; the frames still in flight before it are collected into
   // `outputs`.
-  Status prime(const InputFrame& frame, SlotRecord& rec, std::vector<FrameOutput>& outputs, double& prime_ms);
+  Status prime(const InputFrame& frame, const AppInputImages* images, SlotRecord& rec,
+               std::vector<FrameOutput>& outputs, double& prime_ms);
 
   // Start-up (runtime_init.cpp), in order.
   Expected<std::vector<technique::QualityLevel>> choose_technique_and_ladder(const RuntimeSettings& settings);
@@ -144,6 +162,8 @@ class RuntimeImpl final : public Runtime {
   // The frame's stages (frame_stages.cpp), recorded in the order kFrameStages lists them.
   struct FrameContext {
     const InputFrame& input;
+    const frame::CameraView& camera;  // the host's view of the camera (camera_view)
+    const AppInputImages* images;     // the app's images the frame comes from, or null
     SlotRecord& rec;
     bool affected;          // something virtual can be seen: the technique runs
     bool has_objects;       // a virtual object is in the scene and visible

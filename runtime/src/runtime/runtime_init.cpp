@@ -152,7 +152,8 @@ Status RuntimeImpl::create_shared_stages(const RuntimeSettings& settings) {
   if (!stage) return stage.error();
   light_stage_ = std::move(*stage);
   const Intrinsics& c = cameras_.color;
-  auto rc = recon::Reconstruction::create(*context_, *graph_, c, cameras_.depth);
+  // On the app's device frames may come as its images (AppInputImages): their staging is made.
+  auto rc = recon::Reconstruction::create(*context_, *graph_, c, cameras_.depth, {}, context_->app_device());
   if (!rc) return rc.error();
   recon_.emplace(std::move(*rc));
   auto vg = recon::VirtualGBuffer::create(*context_, *graph_, *scene_gpu_);

@@ -346,7 +346,7 @@ Status Dir::record(const frame::FrameInfo& info, std::vector<std::string>& skipp
   }
   // The VPLs and ISMs in the buffers stand for this frame's while its inputs stay within
   // tolerance of the frame that made them (gi/input_reuse.h): no map, VPL or ISM pass.
-  reuse_.set_frame(info.level, info.camera_to_world, info.input, shared_.scene_gpu->revision());
+  reuse_.set_frame(info.level, info.camera_to_world, info.camera, shared_.scene_gpu->revision());
   for (const auto& [i, view] : planned_) reuse_.add_lamp(lighting.lights[i]);
   const VplSlots slots = plan_vpl_slots(level, direct.shadowed_estimated_lights);
   if (slots.bounce == 0)

@@ -264,7 +264,7 @@ Status Dlpv::record_volumes(const frame::FrameInfo& info, const DlpvLevel& level
     const VkExtent2D g = graph.extent(shared_.real_position);
     const uint32_t stride = std::max(1u, uint32_t(std::ceil(double(std::max(g.width, g.height)) / (level.rsm_size / 2.0))));
     // The real lamps the maps are drawn for this level (strongest first), as the reuse compares them.
-    reuse_.set_frame(info.level, info.camera_to_world, info.input, shared_.scene_gpu->revision());
+    reuse_.set_frame(info.level, info.camera_to_world, info.camera, shared_.scene_gpu->revision());
     for (size_t i = 0, n = 0; i < lighting.lights.size() && n < level.rsm_lamps; ++i)
       if (lighting.lights[i].real) {
         reuse_.add_lamp(lighting.lights[i]);

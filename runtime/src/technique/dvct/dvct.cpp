@@ -285,7 +285,7 @@ Status Dvct::record_volumes(const DvctLevel& level, const frame::FrameInfo& info
   object_light_->set_region(region);
 
   const light::Lighting& lighting = shared_.light_stage->lighting();
-  reuse_.set_frame(info.level, info.camera_to_world, info.input, sg.revision());
+  reuse_.set_frame(info.level, info.camera_to_world, info.camera, sg.revision());
   for (size_t i = 0, n = 0; i < lighting.lights.size() && n < level.rsm_lamps; ++i)
     if (lighting.lights[i].real) {
       reuse_.add_lamp(lighting.lights[i]);

@@ -48,7 +48,7 @@ Status Ssrt::record_real_geometry(const frame::FrameInfo& info, const SsrtLevel&
   vf.aux_resolution = level.aux_resolution;
   vf.center = *volume_center_;
   vf.camera_to_world = info.camera_to_world;
-  vf.depth = info.input ? &info.input->depth : nullptr;
+  vf.depth = info.camera && !info.camera->depth.empty() ? &info.camera->depth : nullptr;
   const LightEstimate& e = estimator().estimate();
   vf.direction_to_light = glm::vec3(e.direction_to_light[0], e.direction_to_light[1], e.direction_to_light[2]);
   MRGI_TRY(volume_->record(vf, skipped));

@@ -154,7 +154,7 @@ Status Volume::validate(const VolumeFrame& f) const {
   if (!std::isfinite(l) || !(l > 1e-6f))
     return fail(ErrorKind::BadUsage, where + "direction_to_light must be a finite non-zero vector");
   if (f.depth && (f.depth->width != last_depth_.width || f.depth->height != last_depth_.height ||
-                  f.depth->data.size() != last_depth_.data.size()))
+                  f.depth->size() != last_depth_.data.size()))
     return fail(ErrorKind::BadUsage,
                 where + "depth is " + std::to_string(f.depth->width) + "x" +
                     std::to_string(f.depth->height) + ", the depth intrinsics say " +
@@ -169,7 +169,7 @@ bool Volume::unchanged_since_last_fuse(const VolumeFrame& f) const {
   if (rotation_deg(last_fused_pose_, f.camera_to_world) >= settings_.pose_tolerance_deg)
     return false;
   const uint16_t* a = last_depth_.data.data();
-  const uint16_t* b = f.depth->data.data();
+  const uint16_t* b = f.depth->data;
   const size_t n = last_depth_.data.size();
   size_t valid_a = 0, valid_b = 0, both = 0;
   uint64_t sum_abs = 0;  // depth units
@@ -287,8 +287,7 @@ Status Volume::record(const VolumeFrame& frame, std::vector<std::string>& skippe
     has_fused_ = true;
     last_fused_pose_ = frame.camera_to_world;
     last_depth_valid_ = frame.depth != nullptr;
-    if (frame.depth) std::copy(frame.depth->data.begin(), frame.depth->data.end(),
-                               last_depth_.data.begin());
+    if (frame.depth) std::copy(frame.depth->data, frame.depth->data + frame.depth->size(), last_depth_.data.begin());
   }
   resolution_ = frame.resolution;
   center_ = frame.center;

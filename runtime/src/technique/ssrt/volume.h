@@ -32,6 +32,7 @@
 
 #include <glm/glm.hpp>
 
+#include "frame/camera_view.h"
 #include "gpu/frame_graph.h"
 #include "gpu/pipelines.h"
 #include "mrgi/expected.h"
@@ -58,7 +59,9 @@ struct VolumeFrame {
   uint32_t aux_resolution = 256;   // this level's aux texels per side (<= max)
   glm::vec3 center{0.0f};          // world centre of the cube; a change resets V
   glm::dmat4 camera_to_world{1.0}; // this frame's pose (the frame constants' pose)
-  const ImageU16* depth = nullptr; // host copy of this frame's depth (for the skip test)
+  // The host's view of the depth (frame/camera_view.h; for frames given as the app's images an
+  // earlier frame's), for the skip test; null: always fused.
+  const frame::DepthView* depth = nullptr;
   glm::vec3 direction_to_light{0, 1, 0}; // unit, towards the dominant light (light aux buffer)
 };
 
