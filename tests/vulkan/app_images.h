@@ -69,9 +69,10 @@ inline void destroy_image(AppVulkan& app, AppImage& i) {
   vkFreeMemory(app.device, i.memory, nullptr);
 }
 
-// The app's own submission: waits for the runtime's semaphore, copies the image (left by the
-// runtime in TRANSFER_SRC_OPTIMAL) into its readback buffer; waited for on a fence.
-inline bool read_back(AppVulkan& app, const AppImage& img, uint32_t w, uint32_t h) {
+// One submission of the app's, recorded by `record`, waiting for `wait` (at the transfer stage)
+// and signalling `signal` (each may be null); waited for on a fence.
+template <typename Record>
+bool submit_once(AppVulkan& app, Record record, VkSemaphore wait, VkSemaphore signal) {
   VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   pci.queueFamilyIndex = app.family;
   VkCommandPool pool = VK_NULL_HANDLE;
@@ -84,18 +85,17 @@ inline bool read_back(AppVulkan& app, const AppImage& img, uint32_t w, uint32_t 
   vkAllocateCommandBuffers(app.device, &cai, &cmd);
   VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   vkBeginCommandBuffer(cmd, &bi);
-  VkBufferImageCopy region{};
-  region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-  region.imageExtent = {w, h, 1};
-  vkCmdCopyImageToBuffer(cmd, img.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, img.readback, 1, &region);
+  record(cmd);
   vkEndCommandBuffer(cmd);
   const VkPipelineStageFlags stage = VK_PIPELINE_STAGE_TRANSFER_BIT;
   VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-  si.waitSemaphoreCount = 1;
-  si.pWaitSemaphores = &img.written;
+  si.waitSemaphoreCount = wait ? 1 : 0;
+  si.pWaitSemaphores = &wait;
   si.pWaitDstStageMask = &stage;
   si.commandBufferCount = 1;
   si.pCommandBuffers = &cmd;
+  si.signalSemaphoreCount = signal ? 1 : 0;
+  si.pSignalSemaphores = &signal;
   VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
   VkFence fence = VK_NULL_HANDLE;
   vkCreateFence(app.device, &fci, nullptr, &fence);
@@ -106,58 +106,47 @@ inline bool read_back(AppVulkan& app, const AppImage& img, uint32_t w, uint32_t 
   return ok;
 }
 
+// The app's own submission: waits for the runtime's semaphore, copies the image (left by the
+// runtime in TRANSFER_SRC_OPTIMAL) into its readback buffer.
+inline bool read_back(AppVulkan& app, const AppImage& img, uint32_t w, uint32_t h) {
+  auto record = [&](VkCommandBuffer cmd) {
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageExtent = {w, h, 1};
+    vkCmdCopyImageToBuffer(cmd, img.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, img.readback, 1, &region);
+  };
+  return submit_once(app, record, img.written, VK_NULL_HANDLE);
+}
+
 // The app's submission that fills the image from `bytes` (through its buffer) and leaves it in
-// `layout`, signalling `img.written` where `signal` (what the runtime waits for: AppInputImages::wait); waited
-// for on a fence here, so the buffer may be written again at once.
+// `layout`, signalling `img.written` where `signal` (what the runtime waits for:
+// AppInputImages::wait); done when this returns, so the buffer may be written again at once.
 inline bool fill(AppVulkan& app, const AppImage& img, uint32_t w, uint32_t h, const void* bytes, size_t size,
                  VkImageAspectFlags aspect, VkImageLayout layout, bool signal) {
   std::memcpy(img.mapped, bytes, size);
-  VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-  pci.queueFamilyIndex = app.family;
-  VkCommandPool pool = VK_NULL_HANDLE;
-  vkCreateCommandPool(app.device, &pci, nullptr, &pool);
-  VkCommandBufferAllocateInfo cai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  cai.commandPool = pool;
-  cai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  cai.commandBufferCount = 1;
-  VkCommandBuffer cmd = VK_NULL_HANDLE;
-  vkAllocateCommandBuffers(app.device, &cai, &cmd);
-  VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  vkBeginCommandBuffer(cmd, &bi);
-  VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-  b.srcAccessMask = 0;
-  b.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-  b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-  b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-  b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  b.image = img.image;
-  b.subresourceRange = {aspect, 0, 1, 0, 1};
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
-                       nullptr, 1, &b);
-  VkBufferImageCopy region{};
-  region.imageSubresource = {aspect, 0, 0, 1};
-  region.imageExtent = {w, h, 1};
-  vkCmdCopyBufferToImage(cmd, img.readback, img.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-  b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-  b.dstAccessMask = VK_ACCESS_MEMORY_READ_BIT;
-  b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-  b.newLayout = layout;
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, nullptr, 0,
-                       nullptr, 1, &b);
-  vkEndCommandBuffer(cmd);
-  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-  si.commandBufferCount = 1;
-  si.pCommandBuffers = &cmd;
-  si.signalSemaphoreCount = signal ? 1 : 0;
-  si.pSignalSemaphores = &img.written;
-  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  VkFence fence = VK_NULL_HANDLE;
-  vkCreateFence(app.device, &fci, nullptr, &fence);
-  bool ok = vkQueueSubmit(app.queue, 1, &si, fence) == VK_SUCCESS &&
-            vkWaitForFences(app.device, 1, &fence, VK_TRUE, 30'000'000'000ull) == VK_SUCCESS;
-  vkDestroyFence(app.device, fence, nullptr);
-  vkDestroyCommandPool(app.device, pool, nullptr);
-  return ok;
+  auto record = [&](VkCommandBuffer cmd) {
+    VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+    b.srcAccessMask = 0;
+    b.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = img.image;
+    b.subresourceRange = {aspect, 0, 1, 0, 1};
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
+                         nullptr, 1, &b);
+    VkBufferImageCopy region{};
+    region.imageSubresource = {aspect, 0, 0, 1};
+    region.imageExtent = {w, h, 1};
+    vkCmdCopyBufferToImage(cmd, img.readback, img.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_MEMORY_READ_BIT;
+    b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.newLayout = layout;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, nullptr, 0,
+                         nullptr, 1, &b);
+  };
+  return submit_once(app, record, VK_NULL_HANDLE, signal ? img.written : VK_NULL_HANDLE);
 }
 
 }  // namespace mrgi::test
