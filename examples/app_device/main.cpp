@@ -364,6 +364,16 @@ double process_cpu_ms() {
   return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
 }
 
+using PassSamples = std::vector<std::pair<std::string, std::vector<double>>>;  // per pass, per frame
+
+// --profile: each pass's median CPU ms over the frames it ran in.
+void print_pass_medians(PassSamples& passes) {
+  for (auto& [name, ms] : passes) {
+    std::sort(ms.begin(), ms.end());
+    std::printf("  pass %-28s %6.2f CPU ms (median of %zu frames)\n", name.c_str(), ms[ms.size() / 2], ms.size());
+  }
+}
+
 // Plays the capture's frames (preloaded) through a runtime on the app's device, into host memory
 // or the app's images; after 4 warm-up frames, prints the sustained wall and CPU ms a frame.
 int play(const mrgi::AppVulkanDevice& app, const std::string& capture_dir, const Options& o) {
@@ -406,7 +416,7 @@ int play(const mrgi::AppVulkanDevice& app, const std::string& capture_dir, const
     return fail("the app could not create its images");
   int returned = 0;
   uint64_t copied = 0;
-  std::vector<std::pair<std::string, std::vector<double>>> pass_cpu;  // --profile: per pass, per frame
+  PassSamples pass_cpu;  // --profile
   auto report = [&](std::vector<mrgi::FrameOutput>& outs) {
     for (mrgi::FrameOutput& out : outs) {
       if (o.profile && out.stats.frame_index >= 4)
@@ -459,10 +469,7 @@ int play(const mrgi::AppVulkanDevice& app, const std::string& capture_dir, const
   const int timed = o.frames - std::min(kWarmUp, o.frames - 1);
   std::printf("%d frames after the warm-up: %.2f ms a frame sustained, %.2f CPU ms a frame; %.0f bytes a frame copied by the host\n",
               timed, wall / timed, cpu / timed, double(copied) / std::max(returned, 1));
-  for (auto& [name, ms] : pass_cpu) {
-    std::sort(ms.begin(), ms.end());
-    std::printf("  pass %-28s %6.2f CPU ms (median of %zu frames)\n", name.c_str(), ms[ms.size() / 2], ms.size());
-  }
+  print_pass_medians(pass_cpu);
   runtime->reset();
   ring.destroy();
   inputs.destroy();

@@ -248,6 +248,15 @@ TEST(AppInput, ImagesAreRefusedByNameWhereTheyCannotBeRead) {
   auto r = (*rt)->process(meta, in, &target);
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.error().message.find("AppOutputImage::image is null"), std::string::npos) << r.error().message;
+  // One binary semaphore as both waits (never used: refused before).
+  AppInputImages waits = in;
+  waits.wait = reinterpret_cast<VkSemaphore>(uintptr_t(0x9abc));
+  target.image = reinterpret_cast<VkImage>(uintptr_t(0xdef0));
+  target.wait = waits.wait;
+  r = (*rt)->process(meta, waits, &target);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().message.find("AppInputImages::wait and AppOutputImage::wait are the same semaphore"),
+            std::string::npos) << r.error().message;
   for (const std::string& m : app.messages()) ADD_FAILURE() << "validation: " << m;
 }
 

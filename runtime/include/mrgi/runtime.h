@@ -91,10 +91,10 @@ class MRGI_API Runtime {
   /// timestamps, pose, environment image) with color, color_yuv and depth empty. With `target`
   /// the composite goes to the app's image too (zero host copies of frame images,
   /// FrameStats::host_copy_bytes 0); without it, it is read back as process()'s. The host's
-  /// readers of the camera (the light stage's estimates, the techniques' reuse tests) take the
-  /// frame frames_in_flight frames earlier (RuntimeSettings::lagged_camera_reads). BadUsage on a
-  /// runtime not made on the app's device, for a null image, a format or layout it does not
-  /// take, or a frame that also carries images in host memory.
+  /// readers of the camera (the light stage's estimates, the techniques' reuse tests) take an
+  /// earlier frame (RuntimeSettings::lagged_camera_reads). BadUsage on a runtime not made on the
+  /// app's device, for a null image, a format or layout it does not take, one semaphore as both
+  /// the input's and the output's wait, or a frame that also carries images in host memory.
   virtual Expected<std::vector<FrameOutput>> process(const InputFrame& frame, const AppInputImages& images,
                                                      const AppOutputImage* target = nullptr) = 0;
   virtual Expected<std::vector<FrameOutput>> flush() = 0;
@@ -347,11 +347,13 @@ struct RuntimeSettings {
   int frames_in_flight = 2;            ///< readback latency, frames (1..3)
   /// The host's readers of the camera frame (the light stage's estimates from colour and depth:
   /// probeless and residual light, an env camera's unseen prior and near-field test; the reuse
-  /// tests of dir, dlpv, dvct and ssrt) take the frame frames_in_flight frames earlier, from the
-  /// runtime's own upload buffers, at that frame's pose, instead of this frame's. Always so for
+  /// tests of dir, dlpv, dvct and ssrt) take an earlier frame from the runtime's own upload
+  /// buffers, at that frame's pose, instead of this frame's: the one last recorded in the frame
+  /// slot this frame reuses (frames_in_flight frames earlier in a steady stream; fewer just after
+  /// a priming run, which fills a slot with the frame it primes). Always so for
   /// frames given as the app's images (Runtime::process with AppInputImages), which the host never
   /// sees; set here for frames in host memory too, the two paths give the same frames value for
-  /// value. The first frames_in_flight frames then have no camera on the host (no estimate from
+  /// value. A frame whose slot was not used before has no camera on the host (no estimate from
   /// colour and depth yet, an env camera's unseen part unlit, no reuse). false: this frame's
   /// images.
   bool lagged_camera_reads = false;

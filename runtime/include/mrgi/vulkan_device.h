@@ -91,9 +91,10 @@ struct AppVulkanDevice {
 /// an app that presents or samples it never copies it. The frame's FrameOutput then carries its
 /// stats and light estimate but no image or mask (FrameStats::host_copy_bytes counts no output
 /// bytes: the input's upload and, on a CPU device, the camera frame the host expands under the
-/// composite; neither for a frame given as the app's images, AppInputImages). The image holds the composite's sRGB-encoded bytes and, in alpha, the virtual
-/// mask (255 on the objects' pixels, 0 elsewhere). When process() returns an error for the
-/// frame, its semaphores are not used (nothing waits or signals them).
+/// composite; neither for a frame given as the app's images, AppInputImages). The image holds
+/// the composite's sRGB-encoded bytes and, in alpha, the virtual mask (255 on the objects'
+/// pixels, 0 elsewhere). When process() returns an error for the frame, its semaphores are not
+/// used (nothing waits or signals them).
 struct AppOutputImage {
   /// The output's size, one mip level and layer, created with VK_IMAGE_USAGE_TRANSFER_DST_BIT.
   VkImage image = VK_NULL_HANDLE;
@@ -133,7 +134,9 @@ struct AppInputImages {
   VkFormat depth_format = VK_FORMAT_R16_UINT;
   VkImageLayout depth_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
   /// Optional binary semaphore waited for before the copies (the app's or the camera's writes).
-  /// Earlier work on the same queue is ordered before them without one.
+  /// Earlier work on the same queue is ordered before them without one. Not the output's
+  /// AppOutputImage::wait. Where process() returns an error it may have been waited for already
+  /// (a priming run's submission waits for it first).
   VkSemaphore wait = VK_NULL_HANDLE;
 };
 

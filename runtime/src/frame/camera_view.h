@@ -6,11 +6,13 @@
 // Where the images come from:
 //   - this frame's InputFrame (CameraView::of), for a frame given in host memory;
 //   - the runtime's own upload buffers of the frame slot about to be reused, which hold the frame
-//     recorded frames_in_flight frames earlier (written by the host's upload or, for a frame
-//     given as the app's images, by the GPU's copy), with that frame's index, timestamp and pose.
-//     The host never sees a frame given as the app's images, so its readers take this view, a
-//     fixed lag of frames_in_flight frames (RuntimeSettings::lagged_camera_reads selects it for
-//     host-memory frames too); the first frames_in_flight frames have no images (empty()).
+//     last recorded in that slot (written by the host's upload or, for a frame given as the app's
+//     images, by the GPU's copy), with that frame's index, timestamp and pose: in a steady stream
+//     the frame frames_in_flight frames earlier; a priming run (Runtime::process) fills a slot
+//     with the frame it primes, so just after one the lag is shorter. The host never sees a frame
+//     given as the app's images, so its readers take this view (RuntimeSettings::
+//     lagged_camera_reads selects it for host-memory frames too); a slot not yet used has no
+//     images (empty()).
 // The view points into memory it does not own, valid while the frame is recorded.
 #pragma once
 #include <array>
@@ -36,6 +38,10 @@ struct DepthView {
 struct CameraView {
   int64_t index = 0;        // the frame these images are (InputFrame::index)
   double timestamp = 0.0;   // its colour timestamp, seconds
+  // The frame being recorded (its index and timestamp; the same as above unless lagged): what
+  // light from this frame's own inputs (its environment image, the lamps) is stamped with.
+  int64_t frame_index = 0;
+  double frame_timestamp = 0.0;
   glm::dmat4 camera_to_world{1.0};  // its pose (the runtime's rule: the last known one when none)
   // Colour: sRGB8 rows (3 bytes a pixel, tightly packed), or the Y'CbCr frame as delivered
   // (light/camera_color.h decodes the pixels it reads); at most one is set.
@@ -53,8 +59,8 @@ struct CameraView {
   // The view of a frame given in host memory, at `camera_to_world`.
   static CameraView of(const InputFrame& frame, const glm::dmat4& camera_to_world) {
     CameraView v;
-    v.index = frame.index;
-    v.timestamp = frame.timestamp;
+    v.index = v.frame_index = frame.index;
+    v.timestamp = v.frame_timestamp = frame.timestamp;
     v.camera_to_world = camera_to_world;
     if (frame.color_yuv) {
       v.yuv = &*frame.color_yuv;

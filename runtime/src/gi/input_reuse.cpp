@@ -42,7 +42,7 @@ void InputReuse::set_frame(int level, const glm::dmat4& camera_to_world, const f
   now_.level = level;
   now_.pose = camera_to_world;
   now_.objects = objects_revision;
-  depth_ = camera && !camera->depth.empty() ? &camera->depth : nullptr;
+  depth_ = camera ? camera->depth : frame::DepthView{};
 }
 
 void InputReuse::add_lamp(const LightDesc& lamp) {
@@ -50,11 +50,11 @@ void InputReuse::add_lamp(const LightDesc& lamp) {
 }
 
 bool InputReuse::depth_close() const {
-  if (depth_ == nullptr || depth_->size() != source_depth_.size()) return false;
+  if (depth_.empty() || depth_.size() != source_depth_.size()) return false;
   const double metres_per_unit = 1.0 / depth_scale_;
   double sum_m = 0.0;
   size_t both = 0, changed_validity = 0;
-  const uint16_t* now = depth_->data;
+  const uint16_t* now = depth_.data;
   for (size_t i = 0; i < source_depth_.size(); ++i) {
     const bool a = source_depth_[i] != 0, b = now[i] != 0;
     if (a != b) {
@@ -80,8 +80,9 @@ bool InputReuse::close() const {
 
 void InputReuse::remember() {
   source_ = now_;
-  source_.valid = depth_ != nullptr && depth_->size() == source_depth_.size();
-  if (source_.valid) std::copy(depth_->data, depth_->data + depth_->size(), source_depth_.begin());
+  source_.valid = !depth_.empty() && depth_.size() == source_depth_.size();
+  if (source_.valid) std::copy(depth_.data, depth_.data + depth_.size(), source_depth_.begin());
+  depth_ = frame::DepthView{};  // the view's memory is the frame's: not kept past it
 }
 
 }  // namespace mrgi::gi

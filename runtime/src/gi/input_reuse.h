@@ -11,8 +11,8 @@
 //   - the virtual objects where they were (SceneGpu::revision: any move counts; an object that
 //     moves, moves every frame, and a tolerance would only delay its light by frames).
 // The depth frame is the host's view of the camera (frame/camera_view.h): for frames given as
-// the app's images, the one frames_in_flight frames earlier, so a change of the depth is seen
-// that many frames late (the pose and the lamps are this frame's). The depth copy is sized at
+// the app's images an earlier one (frames_in_flight frames earlier in a steady stream), so a
+// change of the depth is seen that many frames late (the pose and the lamps are this frame's). The depth copy is sized at
 // reserve() (no allocation per frame).
 #pragma once
 #include <array>
@@ -59,7 +59,7 @@ class InputReuse {
   };
   bool depth_close() const;
   Source source_, now_;
-  const frame::DepthView* depth_ = nullptr;
+  frame::DepthView depth_;  // this frame's (a copy of the view: set_frame's may not outlive it)
   std::vector<uint16_t> source_depth_;
   double depth_scale_ = 5000.0;
 };

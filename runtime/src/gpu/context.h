@@ -24,6 +24,11 @@ enum class MemoryUsage {
   DeviceLocal,  // GPU only
   Upload,       // host-visible + coherent, persistently mapped: host writes, GPU reads
   Readback,     // host-visible (cached if available), persistently mapped: GPU writes, host reads
+  // host-visible + coherent, cached if available, persistently mapped: the host writes and the
+  // GPU reads it, or the GPU writes it, and the host reads it back too (the camera uploads, which
+  // the host's readers of the camera take frames later: frame/camera_view.h); uncached
+  // write-combined memory would make those reads slow on a discrete GPU.
+  UploadHostRead,
 };
 
 // A buffer with its own VkDeviceMemory. `mapped` is non-null for Upload/Readback.

@@ -19,6 +19,10 @@ Expected<VkDeviceMemory> Context::allocate(const VkMemoryRequirements& req, Memo
     case MemoryUsage::Upload:
       need = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
       break;
+    case MemoryUsage::UploadHostRead:
+      need = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+      prefer = VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
+      break;
     case MemoryUsage::Readback:
       need = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT;
       prefer = VK_MEMORY_PROPERTY_HOST_CACHED_BIT;

@@ -518,12 +518,13 @@ void FrameGraph::update_resource_infos() {
     r.host_read = e.desc.memory == MemoryUsage::Readback;
     r.initial = e.states.size() > 1 ? e.states[slot_] : e.states[0];
   }
-  // An upload buffer the GPU writes and the host reads back (a camera frame converted or copied
-  // on the GPU) is made visible to the host as a readback buffer is.
+  // A host-written buffer the GPU also writes and the host reads back (a camera frame converted
+  // or copied on the GPU) is made visible to the host as a readback buffer is.
   for (const ResourceRef& o : outputs_)
     if (o.id < infos_.size()) {
       infos_[o.id].is_output = true;
-      if (!o.is_image && buffers_[o.id - images_.size()].desc.memory == MemoryUsage::Upload) infos_[o.id].host_read = true;
+      const MemoryUsage m = o.is_image ? MemoryUsage::DeviceLocal : buffers_[o.id - images_.size()].desc.memory;
+      if (m == MemoryUsage::Upload || m == MemoryUsage::UploadHostRead) infos_[o.id].host_read = true;
     }
 }
 

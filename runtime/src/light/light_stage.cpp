@@ -492,8 +492,8 @@ Status LightStage::update(const frame::CameraView& camera, std::vector<std::stri
       finish_declared();
     }
   }
-  lighting_.estimate.frame_index = planned_ == LightSourceKind::Probeless ? lighting_.estimate.frame_index : camera.index;
-  lighting_.estimate.timestamp = planned_ == LightSourceKind::Probeless ? lighting_.estimate.timestamp : camera.timestamp;
+  lighting_.estimate.frame_index = planned_ == LightSourceKind::Probeless ? lighting_.estimate.frame_index : camera.frame_index;
+  lighting_.estimate.timestamp = planned_ == LightSourceKind::Probeless ? lighting_.estimate.timestamp : camera.frame_timestamp;
 
   switch (lighting_.source) {
     case LightSourceKind::Probeless: {

@@ -42,7 +42,8 @@ Status check_settings(const ReconstructionSettings& s) {
 }  // namespace
 
 gpu::BufferDesc camera_upload_desc(const std::string& name, size_t bytes) {
-  gpu::BufferDesc d{name, words_bytes(std::max<size_t>(bytes, 4)), gpu::MemoryUsage::Upload, true};
+  // Host-read too: the host's readers of the camera take a slot's frame frames later.
+  gpu::BufferDesc d{name, words_bytes(std::max<size_t>(bytes, 4)), gpu::MemoryUsage::UploadHostRead, true};
   d.texel_format = VK_FORMAT_R32_UINT;
   return d;
 }

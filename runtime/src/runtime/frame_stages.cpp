@@ -69,6 +69,8 @@ frame::CameraView RuntimeImpl::camera_view(const InputFrame& frame, const SlotRe
     v.timestamp = frame.timestamp;
     v.camera_to_world = last_pose_;
   }
+  v.frame_index = frame.index;
+  v.frame_timestamp = frame.timestamp;
   v.env = frame.env ? &*frame.env : nullptr;
   return v;
 }
@@ -104,9 +106,9 @@ Status RuntimeImpl::record_and_submit(const InputFrame& frame, SlotRecord& rec, 
   f.info.camera = &camera;
   for (const FrameStageEntry& stage : kFrameStages) MRGI_TRY((this->*stage.record)(f));
   rec.host_copy_bytes += recon_->copy_host_input(*graph_, frame);
-  rec.uploaded = {true, frame.index, frame.timestamp, last_pose_};
   MRGI_TRY(graph_->compile());
   MRGI_TRY(graph_->submit());
+  rec.uploaded = {true, frame.index, frame.timestamp, last_pose_};
   return check_validation();
 }
 

@@ -177,6 +177,10 @@ Status RuntimeImpl::check_app_images(const InputFrame& frame, const AppInputImag
 Expected<std::vector<FrameOutput>> RuntimeImpl::process(const InputFrame& frame, const AppInputImages& images,
                                                         const AppOutputImage* target) {
   if (target) MRGI_TRY(check_app_output(frame, *target));
+  if (target && images.wait != VK_NULL_HANDLE && images.wait == target->wait)
+    return fail(ErrorKind::BadUsage, "frame " + std::to_string(frame.index) +
+                                         ": AppInputImages::wait and AppOutputImage::wait are the same semaphore "
+                                         "(a binary semaphore is waited for once: give one of them)");
   return process_frame(frame, target, &images);
 }
 
