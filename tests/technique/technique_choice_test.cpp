@@ -45,6 +45,10 @@ TEST(TechniqueChoice, LeavesOutWhatTheSceneCannotUseAndTakesTheMostAccurateFit) 
   c = choose_technique(glossy_no_lamp, 33.3, kTable);
   EXPECT_EQ(c->technique, "baseline") << c->reason;
   EXPECT_NE(c->reason.find("ssrt left out: a glossy virtual material"), std::string::npos) << c->reason;
+  // No glossy material in scene.json, but room for glossy objects added at run time: ssrt is out.
+  c = choose_technique(no_lamp, 33.3, kTable, SchedulerSettings{}.headroom, true);
+  EXPECT_EQ(c->technique, "baseline") << c->reason;
+  EXPECT_NE(c->reason.find("ssrt left out: room for glossy objects added at run time"), std::string::npos) << c->reason;
   // A glTF that cannot be read is refused by name.
   SceneDesc broken = diffuse.scene;
   broken.virtual_objects[0].gltf = dir.str() + "/missing.glb";

@@ -424,10 +424,13 @@ struct TechniqueChoice {
 /// that fits the budget (less the scheduler's headroom) has the lowest RDE; where none fits, the
 /// one with the fastest level. `table`: a bench's figures for this device; empty: the built-in
 /// table (lavapipe x2, 640x480, scheduler/technique_choice.cpp). BadInput where the scene's glTF
-/// cannot be read (its materials say whether it is glossy).
+/// cannot be read (its materials say whether it is glossy). `glossy_objects_added`: objects added
+/// at run time may be glossy (RuntimeSettings::objects.glossy), which leaves ssrt out as a
+/// glossy material in scene.json does.
 MRGI_API Expected<TechniqueChoice> choose_technique(const SceneDesc& scene, double budget_ms,
                                            const std::vector<TechniqueFigure>& table = {},
-                                           double headroom = SchedulerSettings{}.headroom);
+                                           double headroom = SchedulerSettings{}.headroom,
+                                           bool glossy_objects_added = false);
 
 /// Names of the registered techniques and their level names (best first).
 MRGI_API std::vector<std::string> technique_names();

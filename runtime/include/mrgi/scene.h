@@ -135,7 +135,8 @@ struct ObjectCapacity {
   /// light: the passes for them are prepared at start-up (dir's glossy VPLs cost every pixel
   /// whether or not a glossy object is shown). An object needing what was not prepared is
   /// refused, naming its material. Mirrors and glass (specular materials) cannot be added: declare
-  /// them in scene.json and show or hide them (Runtime::set_object_visible).
+  /// them in scene.json and show or hide them (Runtime::set_object_visible). With glossy set,
+  /// technique "auto" leaves ssrt out (its transfer is diffuse), as for a glossy scene.json object.
   bool glossy = false;
   bool emissive = false;
 };

@@ -52,7 +52,8 @@ Expected<std::vector<technique::QualityLevel>> RuntimeImpl::choose_technique_and
       if (!std::isfinite(f.ms) || f.ms <= 0.0 || !std::isfinite(f.rde) || f.rde < 0.0)
         return fail(ErrorKind::BadUsage, "RuntimeSettings.technique_table: " + f.technique + " level " +
                                              std::to_string(f.level) + ": ms must be > 0 and rde >= 0");
-    auto choice = choose_technique(scene_, settings.frame_budget_ms, settings.technique_table, settings.scheduler.headroom);
+    auto choice = choose_technique(scene_, settings.frame_budget_ms, settings.technique_table, settings.scheduler.headroom,
+                                   settings.objects.glossy);
     if (!choice) return choice.error();
     technique_name_ = choice->technique;
     choice_reason_ = choice->reason;

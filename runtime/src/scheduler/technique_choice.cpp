@@ -34,7 +34,8 @@ std::string fmt(double v, int decimals) {
 }  // namespace
 
 Expected<TechniqueChoice> choose_technique(const SceneDesc& scene, double budget_ms,
-                                           const std::vector<TechniqueFigure>& table_in, double headroom) {
+                                           const std::vector<TechniqueFigure>& table_in, double headroom,
+                                           bool glossy_objects_added) {
   if (!(budget_ms > 0.0)) return fail(ErrorKind::BadUsage, "choose_technique: the budget must be > 0 ms");
   const std::vector<TechniqueFigure>& table = table_in.empty() ? builtin_table() : table_in;
   bool glossy = false;
@@ -53,8 +54,9 @@ Expected<TechniqueChoice> choose_technique(const SceneDesc& scene, double budget
       reason += t + " left out: no lamp (its bounce starts at the lamps' reflective shadow maps); ";
       continue;
     }
-    if (glossy && t == "ssrt") {
-      reason += t + " left out: a glossy virtual material (its transfer is diffuse); ";
+    if ((glossy || glossy_objects_added) && t == "ssrt") {
+      reason += t + (glossy ? " left out: a glossy virtual material (its transfer is diffuse); "
+                            : " left out: room for glossy objects added at run time (its transfer is diffuse); ");
       continue;
     }
     candidates.push_back(t);
