@@ -1,5 +1,5 @@
-// Reading the frame's raw camera uploads (RGB8 colour and u16 depth packed into uint words, as
-// the runtime copies them) and the nearest-sample gather from the internal image into either
+// Reading the frame's raw camera uploads (colour as one word a pixel, R | G << 8 | B << 16 with
+// the top byte ignored, and u16 depth packed two to a word, as the runtime copies them) and the nearest-sample gather from the internal image into either
 // camera. Shared by recon/depth_to_positions.comp and the ssrt passes, which start from the raw
 // frame. The including shader declares, before including this file:
 //   layout(..., r32ui) readonly uniform uimageBuffer color_words;  (and depth_words)
@@ -13,17 +13,11 @@
 #ifndef MRGI_UPLOAD_GATHER_GLSL
 #define MRGI_UPLOAD_GATHER_GLSL
 
-// The three bytes of colour pixel `pixel` (row-major) from the two words they lie in: two reads
-// instead of three (every buffer read is a per-lane gather on lavapipe). The second word is
-// clamped to the buffer (the last pixel's bytes can end in the last word).
+// The sRGB bytes of colour pixel `pixel` (row-major): one word a pixel, so one read (every
+// buffer read is a per-lane gather on lavapipe; three bytes a pixel took two), and a frame given
+// as the app's RGBA image is its texels as they are (recon/camera_from_app_images.cpp).
 uvec3 color_rgb8(uint pixel) {
-  uint base = pixel * 3u;
-  uint w = base >> 2;
-  uint shift = (base & 3u) * 8u;
-  uint lo = imageLoad(color_words, int(w)).x;
-  uint hi = imageLoad(color_words, int(min(w + 1u, uint(imageSize(color_words)) - 1u))).x;
-  // Bytes base .. base + 2 as the low 24 bits (for shift 0 the high word is not needed).
-  uint v = shift == 0u ? lo : (lo >> shift) | (hi << (32u - shift));
+  uint v = imageLoad(color_words, int(pixel)).x;
   return uvec3(v & 0xffu, (v >> 8u) & 0xffu, (v >> 16u) & 0xffu);
 }
 #ifdef MRGI_FRAME_CONSTANTS_GLSL

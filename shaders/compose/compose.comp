@@ -34,7 +34,7 @@ layout(constant_id = 2) const bool kSameInternal = false; // solutions' used siz
 layout(constant_id = 3) const bool kTiled = false;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
 FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
-layout(set = 0, binding = 1, r32ui) readonly uniform uimageBuffer color_words;  // RGB8 words
+layout(set = 0, binding = 1, r32ui) readonly uniform uimageBuffer color_words;  // the camera's colour words, one a pixel
 // Storage images read with imageLoad: on lavapipe a sampled texelFetch costs 2-3x as much.
 layout(set = 0, binding = 2, rgba16f) readonly uniform image2D lit_rv;
 layout(set = 0, binding = 3, rgba16f) readonly uniform image2D lit_r;

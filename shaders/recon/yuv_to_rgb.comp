@@ -1,9 +1,8 @@
 #version 460
 // A Y'CbCr colour frame (mrgi/frame.h YuvImage: NV12 or YUYV, 8-bit, as the camera delivered it)
-// into the RGB8 words every pass reads the camera through (common/upload_gather.glsl
-// color_words), with shared/mrgi_shared.h yuv_to_rgb8_packed. One invocation per 4 pixels in
-// row-major order, which are exactly 3 words (12 bytes): no two invocations share a word, so the
-// words are written whole, without atomics. The chroma is the nearest sample (the pair's for
+// into the colour words every pass reads the camera through (common/upload_gather.glsl
+// color_words: one a pixel), with shared/mrgi_shared.h yuv_to_rgb8_packed. One invocation per 4
+// pixels in row-major order (a YUYV word holds two of them). The chroma is the nearest sample (the pair's for
 // YUYV, the 2 x 2 block's for NV12), as the camera's own conversion does it on the host
 // (platform/src/common/pixel_convert.cpp).
 #extension GL_GOOGLE_include_directive : require
@@ -11,7 +10,7 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0, r32ui) readonly uniform uimageBuffer yuv_words;   // the frame's bytes
-layout(set = 0, binding = 1, r32ui) writeonly uniform uimageBuffer rgb_words;  // RGB8, 3 bytes a pixel
+layout(set = 0, binding = 1, r32ui) writeonly uniform uimageBuffer rgb_words;  // one word a pixel, R | G << 8 | B << 16
 struct ConvertConstants {
   ivec4 frame;   // x width, y height (even), z layout (MRGI_YUV_NV12 / _YUYV), w groups a dispatch row
   ivec4 format;  // x matrix (MRGI_YUV_BT601 / _BT709), y 1 = full range
@@ -46,8 +45,8 @@ void main() {
   if (gl_GlobalInvocationID.x >= uint(convert.frame.w) || group * 4u >= w * h) return;
   uint p0 = rgb_of(group * 4u, w, h), p1 = rgb_of(group * 4u + 1u, w, h);
   uint p2 = rgb_of(group * 4u + 2u, w, h), p3 = rgb_of(group * 4u + 3u, w, h);
-  // Bytes r0 g0 b0 r1 | g1 b1 r2 g2 | b2 r3 g3 b3.
-  imageStore(rgb_words, int(group * 3u), uvec4(p0 | (p1 << 24u)));
-  imageStore(rgb_words, int(group * 3u + 1u), uvec4((p1 >> 8u) | (p2 << 16u)));
-  imageStore(rgb_words, int(group * 3u + 2u), uvec4((p2 >> 16u) | (p3 << 8u)));
+  imageStore(rgb_words, int(group * 4u), uvec4(p0));
+  imageStore(rgb_words, int(group * 4u + 1u), uvec4(p1));
+  imageStore(rgb_words, int(group * 4u + 2u), uvec4(p2));
+  imageStore(rgb_words, int(group * 4u + 3u), uvec4(p3));
 }

@@ -32,7 +32,7 @@ layout(set = 0, binding = 3, rgba16f) readonly uniform image2D real_normal;
 layout(set = 0, binding = 4, rgba32f) readonly uniform image2D virtual_position;
 layout(set = 0, binding = 5, rgba16f) readonly uniform image2D virtual_normal;
 layout(set = 0, binding = 6, rgba16f) writeonly uniform image2D env_occlusion;
-layout(set = 0, binding = 7, r32ui) readonly uniform uimageBuffer color_words;  // the camera's RGB8 words
+layout(set = 0, binding = 7, r32ui) readonly uniform uimageBuffer color_words;  // the camera's colour words
 #define MRGI_UPLOAD_COLOR_ONLY
 #include "common/upload_gather.glsl"
 

@@ -21,7 +21,7 @@ layout(set = 0, binding = 0, rgba32f) readonly uniform image2DArray coarse;
 // The camera frame as uploaded (upload_gather.glsl camera_at: linear colour).
 layout(std140, set = 0, binding = 3) uniform FrameUbo { FrameConstants frame_ubo; };
 FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
-layout(set = 0, binding = 1, r32ui) readonly uniform uimageBuffer color_words;  // RGB8 words
+layout(set = 0, binding = 1, r32ui) readonly uniform uimageBuffer color_words;  // the camera's colour words, one a pixel
 layout(set = 0, binding = 4, r32ui) readonly uniform uimageBuffer depth_words;  // u16 pairs
 #include "common/upload_gather.glsl"
 layout(std430, set = 0, binding = 2) writeonly buffer Partials { float partials[]; };

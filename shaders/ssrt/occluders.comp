@@ -24,7 +24,7 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
 FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)  // internal
-layout(set = 0, binding = 1, r32ui) readonly uniform uimageBuffer color_words;  // RGB8 words
+layout(set = 0, binding = 1, r32ui) readonly uniform uimageBuffer color_words;  // the camera's colour words, one a pixel
 layout(set = 0, binding = 2, r32ui) readonly uniform uimageBuffer depth_words;  // u16 pairs
 #include "common/upload_gather.glsl"
 layout(set = 0, binding = 3, rgba32f) readonly uniform image2D virtual_position;

@@ -41,7 +41,7 @@ layout(set = 0, binding = 0, rgba32f) readonly uniform image2DArray coarse;
 layout(set = 0, binding = 1, rgba32f) readonly uniform image2D real_position;
 // The camera frame as uploaded: A = upload_gather.glsl camera_at (what recon's real_albedo
 // holds, read only at the pixels shaded).
-layout(set = 0, binding = 2, r32ui) readonly uniform uimageBuffer color_words;  // RGB8 words
+layout(set = 0, binding = 2, r32ui) readonly uniform uimageBuffer color_words;  // the camera's colour words, one a pixel
 layout(set = 0, binding = 9, r32ui) readonly uniform uimageBuffer depth_words;  // u16 pairs
 layout(std140, set = 0, binding = 10) uniform FrameUbo { FrameConstants frame_ubo; };
 FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)

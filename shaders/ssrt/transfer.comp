@@ -52,7 +52,7 @@ layout(set = 0, binding = 4, rgba16f) readonly uniform image2D real_normal;
 // full-resolution buffers 6-7 and 5, 13 (the camera's colour and depth as uploaded,
 // upload_gather.glsl); what a sample lands on from the packed occluder G-buffer
 // (occluders.comp: 8 and 12).
-layout(set = 0, binding = 5, r32ui) readonly uniform uimageBuffer color_words;  // RGB8 words
+layout(set = 0, binding = 5, r32ui) readonly uniform uimageBuffer color_words;  // the camera's colour words, one a pixel
 layout(set = 0, binding = 13, r32ui) readonly uniform uimageBuffer depth_words;  // u16 pairs
 #include "common/upload_gather.glsl"
 layout(set = 0, binding = 6, rgba32f) readonly uniform image2D virtual_position;

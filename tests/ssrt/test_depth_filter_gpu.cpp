@@ -117,7 +117,7 @@ struct Rig {
       EXPECT_TRUE(b.ok()) << b.error().message;
       return *b;
     };
-    s.color_upload = upload("color_upload", in.rgb.size());
+    s.color_upload = upload("color_upload", recon::color_upload_bytes(in.rgb.size() / 3));
     s.depth_upload = upload("depth_upload", in.raw.size() * 2);
     s.depth_scale = kDepthScale;
     s.context = &ctx;
@@ -166,7 +166,7 @@ struct Rig {
     fc.flags = glm::ivec4(in.depth_k == in.k && in.depth_w == in.w ? 1 : 0, 0, 0, 0);
     const uint32_t slot = graph->slot();
     std::memcpy(graph->mapped(shared.frame_constants, slot), &fc, sizeof(fc));
-    std::memcpy(graph->mapped(shared.color_upload, slot), in.rgb.data(), in.rgb.size());
+    recon::rgb8_to_color_words(in.rgb.data(), in.rgb.size() / 3, static_cast<uint32_t*>(graph->mapped(shared.color_upload, slot)));
     std::memcpy(graph->mapped(shared.depth_upload, slot), in.raw.data(), in.raw.size() * 2);
     skipped.clear();
     const Status st = filter->record(with_volume ? volume : ImageHandle{}, final_pass, skipped);

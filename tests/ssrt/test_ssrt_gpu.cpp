@@ -147,7 +147,7 @@ struct Driver {
                                      VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
     EXPECT_TRUE(fc.ok());
     s.frame_constants = *fc;
-    auto cu = d.graph->create_buffer(recon::camera_upload_desc("color_upload", W * H * 3),
+    auto cu = d.graph->create_buffer(recon::camera_upload_desc("color_upload", recon::color_upload_bytes(W * H)),
                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     auto du = d.graph->create_buffer(recon::camera_upload_desc("depth_upload", W * H * 2),
                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
@@ -242,7 +242,8 @@ struct Driver {
     EXPECT_TRUE(begun.ok()) << begun.error().message;
     if (begun.ok() && begun->has_value()) timings.push_back(**begun);
     write_constants();
-    std::memcpy(graph->mapped(shared.color_upload, graph->slot()), input.color.data.data(), input.color.data.size());
+    recon::rgb8_to_color_words(input.color.data.data(), input.color.data.size() / 3,
+                               static_cast<uint32_t*>(graph->mapped(shared.color_upload, graph->slot())));
     std::memcpy(graph->mapped(shared.depth_upload, graph->slot()), input.depth.data.data(), input.depth.data.size() * 2);
     skipped.clear();
     frame::FrameInfo info;

@@ -121,7 +121,7 @@ TEST(AppOutput, TheAppsImagesHoldTheHostPathsFramesWithNoHostCopyOfTheOutput) {
       // Nothing of the output is copied; on a CPU device (lavapipe) the host expands the camera
       // frame under the composite's tiles (4 bytes a pixel) instead of a pass doing it.
       const uint64_t camera = uint64_t(h.image.width) * h.image.height * (half ? 4 : 1);  // the camera's pixels
-      const uint64_t input = camera * 5;  // RGB8 + u16 depth
+      const uint64_t input = camera * 6;  // colour words (4 bytes a pixel) + u16 depth
       EXPECT_EQ(p.app_stats[i].host_copy_bytes, input + (half ? 0 : pixels * 4)) << "frame " << i << ": the output is not copied";
       EXPECT_EQ(h.stats.host_copy_bytes, input + h.image.data.size() + h.virtual_mask.data.size()) << "frame " << i;
     }

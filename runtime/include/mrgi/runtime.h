@@ -184,12 +184,13 @@ struct FrameStats {
   /// On a CPU device this competes with the passes for the same cores, so a frame's sustained
   /// wall clock is about its passes plus this.
   double host_ms = 0.0;
-  /// Bytes of frame images the host copied between the app and the runtime for this frame: the
-  /// input's colour and depth into the upload buffers (none for a frame given as the app's
-  /// images, AppInputImages) and, unless the composite went to an app image (AppOutputImage),
-  /// the output's image and mask back. A host-memory frame into an app image on a CPU device at
-  /// the camera's size also counts the camera frame the host expands under the composite's tiles
-  /// (cheaper there than a pass over every pixel; from app images the GPU's unpacking does it).
+  /// Bytes of frame images the host wrote between the app and the runtime for this frame: the
+  /// input's colour (4 bytes a pixel in the upload) and depth into the upload buffers (none for
+  /// a frame given as the app's images, AppInputImages) and, unless the composite went to an app
+  /// image (AppOutputImage), the output's image and mask back. A host-memory frame into an app
+  /// image on a CPU device at the camera's size also counts the camera frame the host expands
+  /// under the composite's tiles (cheaper there than a pass over every pixel; from app images a
+  /// GPU pass writes it).
   uint64_t host_copy_bytes = 0;
   /// CPU time of the light stage this frame (light/light_stage.h: environment sampling or the
   /// probeless system's part and solve) on the calling thread, ms; inside record_ms and host_ms.

@@ -39,8 +39,8 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
   c.slot_host_camera_.assign(graph.frames_in_flight(), 0);
   const VkDeviceSize bytes = VkDeviceSize(width) * height * 4;
   // Transfer source: copied into an app's image (AppOutputImage) instead of read back. Whole
-  // groups of 16 pixels: an app's colour image is unpacked into it as the camera words under the
-  // composite, 16 pixels at a time (shaders/recon/rgba_to_rgb.comp).
+  // groups of 16 pixels: an app's colour image is written into it as the camera words under the
+  // composite, 16 pixels at a time (shaders/recon/app_color_words.comp).
   gpu::BufferDesc od{"output_rgba8", (bytes + 63) / 64 * 64, gpu::MemoryUsage::Readback, true};
   auto out = graph.create_buffer(od, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
   if (!out) return out.error();
@@ -234,6 +234,14 @@ void Compose::dispatch(VkCommandBuffer cmd, gpu::PassContext& pass, const gpu::P
   }
 }
 
+void camera_words_to_rgba8(const uint32_t* words, size_t count, uint8_t* rgba) {
+  static_assert(std::endian::native == std::endian::little, "RGBA8 words are R | G << 8 | B << 16");
+  for (size_t i = 0; i < count; ++i) {
+    const uint32_t v = words[i] | 0xff000000u;
+    std::memcpy(rgba + 4 * i, &v, 4);
+  }
+}
+
 namespace {
 // `count` words of the readback buffer (mrgi_shared.h pack_output_word: packUnorm4x8, r in the
 // low byte, so on a little-endian host the bytes are RGBA; the mask in alpha, 0 or 255) into
@@ -261,30 +269,11 @@ Status Compose::read(const gpu::FrameGraph& graph, uint32_t slot, ImageRGBA8& im
     unpack_output_words(out, image.data.data(), mask.data.data(), mask.data.size());
     return ok_status();
   }
-  // The camera frame (this slot's upload: RGB8 at the output size), then the composed tiles.
+  // The camera frame (this slot's upload: colour words at the output size), then the composed tiles.
   const gpu::GpuBuffer& tb = graph.gpu_buffer(tile_readback_, slot);
   MRGI_TRY(graph.context().invalidate(tb));
-  const auto* rgb = static_cast<const uint8_t*>(graph.mapped(in_.color_upload, slot));
   uint8_t* px = image.data.data();
-  const size_t n = size_t(width_) * height_;
-  // One 4-byte load per pixel (its RGB and the next pixel's R, replaced by alpha 255): the
-  // byte-wise loop was about a third of the host's time per frame at 640x480. The last pixel
-  // is copied byte-wise so nothing is read past the frame.
-  static_assert(std::endian::native == std::endian::little, "RGBA8 words are R | G << 8 | B << 16");
-  const uint32_t alpha = 0xffu << 24;
-  for (size_t i = 0; i + 1 < n; ++i) {
-    uint32_t v;
-    std::memcpy(&v, rgb + 3 * i, 4);
-    v = (v & 0x00ffffffu) | alpha;
-    std::memcpy(px + 4 * i, &v, 4);
-  }
-  if (n > 0) {
-    const size_t i = n - 1;
-    px[4 * i + 0] = rgb[3 * i + 0];
-    px[4 * i + 1] = rgb[3 * i + 1];
-    px[4 * i + 2] = rgb[3 * i + 2];
-    px[4 * i + 3] = 255;
-  }
+  camera_words_to_rgba8(static_cast<const uint32_t*>(graph.mapped(in_.color_upload, slot)), size_t(width_) * height_, px);
   const auto* words = static_cast<const uint32_t*>(graph.mapped(tile_readback_, slot));
   const uint32_t count = std::min(words[0], max_tiles_);  // (the list copy bounds it too)
   const uint32_t tiles_x = (width_ + 7) / 8;

@@ -68,6 +68,10 @@ struct ComposeInputs {
   bool camera_prefilled = false;
 };
 
+// `count` camera colour words (recon/reconstruction.h kColorWordBytes: R | G << 8 | B << 16, top
+// byte ignored) as RGBA8 pixels with alpha 255.
+void camera_words_to_rgba8(const uint32_t* words, size_t count, uint8_t* rgba);
+
 // `image` at w x h, reusing its storage when it already has that size (Runtime::recycle: no
 // fresh pages for the OS to zero each frame); every value zero, or, with `zeroed` false, left as
 // it was where reused (the caller writes every value).

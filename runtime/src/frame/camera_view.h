@@ -43,9 +43,11 @@ struct CameraView {
   int64_t frame_index = 0;
   double frame_timestamp = 0.0;
   glm::dmat4 camera_to_world{1.0};  // its pose (the runtime's rule: the last known one when none)
-  // Colour: sRGB8 rows (3 bytes a pixel, tightly packed), or the Y'CbCr frame as delivered
-  // (light/camera_color.h decodes the pixels it reads); at most one is set.
+  // Colour: sRGB8 rows (R, G, B bytes first in each pixel's rgb_stride bytes, tightly packed:
+  // 3 for an InputFrame's image, 4 for the runtime's upload words), or the Y'CbCr frame as
+  // delivered (light/camera_color.h decodes the pixels it reads); at most one is set.
   const uint8_t* rgb = nullptr;
+  int rgb_stride = 3;
   const YuvImage* yuv = nullptr;
   int color_width = 0, color_height = 0;
   DepthView depth;

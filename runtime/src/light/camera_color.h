@@ -1,5 +1,5 @@
 // The camera's colour at a pixel on the host, from whichever form the frame came in: RGB8
-// (InputFrame::color, or the runtime's upload buffer: frame/camera_view.h) or Y'CbCr
+// (InputFrame::color, or the runtime's upload words, 4 bytes a pixel: frame/camera_view.h) or Y'CbCr
 // (InputFrame::color_yuv, decoded here with the formula and the
 // chroma siting the GPU conversion uses: shared/mrgi_shared.h yuv_to_rgb8_packed,
 // shaders/recon/yuv_to_rgb.comp). For the light stage's host readers, which sample the frame
@@ -17,7 +17,7 @@ namespace mrgi::light {
 class CameraColor {
  public:
   explicit CameraColor(const frame::CameraView& view)
-      : rgb_(view.rgb), yuv_(view.yuv), width_(view.has_color() ? view.color_width : 0),
+      : rgb_(view.rgb), yuv_(view.yuv), stride_(size_t(view.rgb_stride)), width_(view.has_color() ? view.color_width : 0),
         height_(view.has_color() ? view.color_height : 0) {}
   int width() const { return width_; }
   int height() const { return height_; }
@@ -25,7 +25,7 @@ class CameraColor {
   // sRGB 8-bit codes of pixel (x, y), inside the image.
   std::array<uint8_t, 3> at(int x, int y) const {
     if (!yuv_) {
-      const uint8_t* p = rgb_ + (size_t(y) * size_t(width_) + size_t(x)) * 3;
+      const uint8_t* p = rgb_ + (size_t(y) * size_t(width_) + size_t(x)) * stride_;
       return {p[0], p[1], p[2]};
     }
     const size_t w = size_t(yuv_->width), h = size_t(yuv_->height);
@@ -51,6 +51,7 @@ class CameraColor {
  private:
   const uint8_t* rgb_;
   const YuvImage* yuv_;
+  size_t stride_;  // bytes a pixel of rgb_
   int width_, height_;
 };
 

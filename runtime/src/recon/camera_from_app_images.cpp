@@ -1,9 +1,11 @@
 // A camera frame given as the app's images (mrgi/vulkan_device.h AppInputImages) into the
 // upload buffers every camera reader takes, on the GPU, at the start of the frame's submission:
-// the depth image's texels are the u16 words depth_upload() holds (a copy), the colour image's
-// 4-byte texels are copied into words and packed into color_upload()'s RGB8 words
-// (shaders/recon/rgba_to_rgb.comp). Both are marked as outputs, so the host may read them once
-// the frame completes (frame/camera_view.h: the host's view of the frame frames_in_flight later).
+// the depth image's texels are the u16 words depth_upload() holds, the colour image's 4-byte
+// texels the words color_upload() holds (an RGBA image's as they are: the readers ignore the top
+// byte), both by a copy; a BGRA image's words are swapped, and the composite's camera words
+// written, by shaders/recon/app_color_words.comp. Both are marked as outputs, so the host may
+// read them once the frame completes (frame/camera_view.h: the host's view of the frame
+// frames_in_flight later).
 #include <array>
 
 #include "gpu/context.h"
@@ -50,12 +52,12 @@ VkImageMemoryBarrier2 copy_barrier(VkImage image, VkImageAspectFlags aspect, VkI
 
 Status Reconstruction::record_app_images(gpu::FrameGraph& graph, gpu::BufferHandle camera_words) {
   const AppInputImages in = *app_images_;
-  const gpu::BufferHandle rgba = rgba_staging_;
-  if (!rgba.valid())
-    return fail(ErrorKind::Internal, "reconstruction: a frame of app images on a runtime made without their staging");
+  if (!no_camera_words_.valid())
+    return fail(ErrorKind::Internal, "reconstruction: a frame of app images on a runtime made without their colour pass");
   // Without camera words to write the shader's binding still needs a buffer: a 64-byte stand-in.
   const gpu::BufferHandle camera = camera_words.valid() ? camera_words : no_camera_words_;
-  pack_push_ = glm::ivec4(color_w_ * color_h_, 0, is_bgra(in.color_format) ? 1 : 0, camera_words.valid() ? 1 : 0);
+  words_push_ = glm::ivec4(color_w_ * color_h_, 0, is_bgra(in.color_format) ? 1 : 0, camera_words.valid() ? 1 : 0);
+  const gpu::BufferHandle rgba = color_upload_;
   const uint32_t cw = uint32_t(color_w_), ch = uint32_t(color_h_), dw = uint32_t(depth_w_), dh = uint32_t(depth_h_);
   const gpu::Context* ctx = context_;
   graph.add_pass(
@@ -83,18 +85,19 @@ Status Reconstruction::record_app_images(gpu::FrameGraph& graph, gpu::BufferHand
              copy_barrier(in.depth, da, in.depth_layout, false)};
         ctx->fn().cmd_pipeline_barrier2(cmd, &di);
       });
-  graph.add_shader_pass(
-      "camera_rgba_to_rgb", gpu::PassKind::Compute, *rgba_pipeline_,
-      [this, rgba, camera](gpu::ShaderPassBuilder& b) {
-        b.bind("rgba_words", rgba);
-        b.bind("RgbWords", color_upload_);
-        b.bind("CameraWords", camera);
-      },
-      [this](VkCommandBuffer cmd, gpu::PassContext&) {
-        // rgba_to_rgb.comp: 1024 pixels a workgroup.
-        gpu::push_and_dispatch(cmd, *rgba_pipeline_, &pack_push_, sizeof(pack_push_),
-                               {(uint32_t(pack_push_.x) + 1023) / 1024, 1, 1});
-      });
+  if (words_push_.z != 0 || words_push_.w != 0) {
+    graph.add_shader_pass(
+        "app_color_words", gpu::PassKind::Compute, *words_pipeline_,
+        [this, camera](gpu::ShaderPassBuilder& b) {
+          b.bind("ColorWords", color_upload_);
+          b.bind("CameraWords", camera);
+        },
+        [this](VkCommandBuffer cmd, gpu::PassContext&) {
+          // app_color_words.comp: 1024 pixels a workgroup.
+          gpu::push_and_dispatch(cmd, *words_pipeline_, &words_push_, sizeof(words_push_),
+                                 {(uint32_t(words_push_.x) + 1023) / 1024, 1, 1});
+        });
+  }
   // The host reads both back (the camera frame where nothing virtual shows; the lagged view).
   graph.mark_output(color_upload_);
   graph.mark_output(depth_upload_);

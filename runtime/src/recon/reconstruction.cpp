@@ -1,6 +1,7 @@
 #include "recon/reconstruction.h"
 
 #include <algorithm>
+#include <bit>
 #include <cstring>
 
 #include "gpu/shaders.h"
@@ -48,6 +49,21 @@ gpu::BufferDesc camera_upload_desc(const std::string& name, size_t bytes) {
   return d;
 }
 
+void rgb8_to_color_words(const uint8_t* rgb, size_t pixels, uint32_t* words) {
+  static_assert(std::endian::native == std::endian::little, "colour words are R | G << 8 | B << 16");
+  // One 4-byte load a pixel (its RGB and the next pixel's R, masked off); the last pixel
+  // byte-wise, so nothing is read past the frame.
+  for (size_t i = 0; i + 1 < pixels; ++i) {
+    uint32_t v;
+    std::memcpy(&v, rgb + 3 * i, 4);
+    words[i] = v & 0x00ffffffu;
+  }
+  if (pixels > 0) {
+    const size_t i = pixels - 1;
+    words[i] = uint32_t(rgb[3 * i]) | uint32_t(rgb[3 * i + 1]) << 8 | uint32_t(rgb[3 * i + 2]) << 16;
+  }
+}
+
 Status check_camera_upload(const gpu::FrameGraph& graph, gpu::BufferHandle upload,
                            const std::string& who) {
   if (!upload.valid() || graph.texel_format(upload) != VK_FORMAT_R32_UINT)
@@ -65,7 +81,7 @@ Expected<Reconstruction> Reconstruction::create(gpu::Context& context, gpu::Fram
   Reconstruction r;
   r.settings_ = settings;
   r.context_ = &context;
-  r.color_bytes_ = size_t(color.width) * color.height * 3;
+  r.color_pixels_ = size_t(color.width) * size_t(color.height);
   r.depth_bytes_ = size_t(depth.width) * depth.height * 2;
   r.color_w_ = color.width;
   r.color_h_ = color.height;
@@ -73,9 +89,7 @@ Expected<Reconstruction> Reconstruction::create(gpu::Context& context, gpu::Fram
   r.depth_h_ = depth.height;
   // Transfer destination: an app image's copy (AppInputImages) lands in them.
   constexpr VkBufferUsageFlags kUploadUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-  // Whole groups of 16 pixels (48 bytes): what the app colour's unpacking writes at a time (the
-  // Y'CbCr conversion: 4 pixels, 12 bytes).
-  const gpu::BufferDesc cb = camera_upload_desc("color_upload", (r.color_bytes_ + 47) / 48 * 48);
+  const gpu::BufferDesc cb = camera_upload_desc("color_upload", color_upload_bytes(r.color_pixels_));
   auto c = graph.create_buffer(cb, kUploadUsage);
   if (!c) return c.error();
   r.color_upload_ = *c;
@@ -88,19 +102,12 @@ Expected<Reconstruction> Reconstruction::create(gpu::Context& context, gpu::Fram
   if (!y) return y.error();
   r.yuv_upload_ = *y;
   if (app_images) {
-    // 4 pixels a texel, as the unpacking reads it (and compose's output words), whole groups of
-    // 16 pixels (shaders/recon/rgba_to_rgb.comp).
-    gpu::BufferDesc sd{"camera_rgba_staging", (VkDeviceSize(color.width) * VkDeviceSize(color.height) * 4 + 63) / 64 * 64};
-    sd.texel_format = VK_FORMAT_R32G32B32A32_UINT;
-    auto s = graph.create_buffer(sd, kUploadUsage);
-    if (!s) return s.error();
-    r.rgba_staging_ = *s;
     auto none = graph.create_buffer({"camera_words_none", 64}, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     if (!none) return none.error();
     r.no_camera_words_ = *none;
-    auto rp = gpu::load_compute_pipeline(context, "recon/rgba_to_rgb.comp", {});
-    if (!rp) return rp.error();
-    r.rgba_pipeline_ = std::move(*rp);
+    auto wp = gpu::load_compute_pipeline(context, "recon/app_color_words.comp", {});
+    if (!wp) return wp.error();
+    r.words_pipeline_ = std::move(*wp);
   }
 
   // Transfer source: tests and debug tools read the reconstruction back.
@@ -162,8 +169,8 @@ size_t Reconstruction::copy_host_input(const gpu::FrameGraph& graph, const Input
     std::memcpy(graph.mapped(yuv_upload_, graph.slot()), yuv->data.data(), yuv->expected_bytes());
     bytes += yuv->expected_bytes();
   } else {
-    std::memcpy(graph.mapped(color_upload_, graph.slot()), frame.color.data.data(), color_bytes_);
-    bytes += color_bytes_;
+    rgb8_to_color_words(frame.color.data.data(), color_pixels_, static_cast<uint32_t*>(graph.mapped(color_upload_, graph.slot())));
+    bytes += color_pixels_ * kColorWordBytes;
   }
   std::memcpy(graph.mapped(depth_upload_, graph.slot()), frame.depth.data.data(), depth_bytes_);
   return bytes;
@@ -172,6 +179,7 @@ size_t Reconstruction::copy_host_input(const gpu::FrameGraph& graph, const Input
 frame::CameraView Reconstruction::slot_view(const gpu::FrameGraph& graph) const {
   frame::CameraView v;
   v.rgb = static_cast<const uint8_t*>(graph.mapped(color_upload_, graph.slot()));
+  v.rgb_stride = int(kColorWordBytes);
   v.color_width = color_w_;
   v.color_height = color_h_;
   v.depth = frame::DepthView{static_cast<const uint16_t*>(graph.mapped(depth_upload_, graph.slot())), depth_w_, depth_h_};

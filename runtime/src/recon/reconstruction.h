@@ -1,8 +1,8 @@
 // Reconstruction (docs/DESIGN.md "One frame, as data"): the real G-buffer from the RGB-D stream, with
 // the DIR paper's temporal depth filter (section 4.2, eq. 11-14).
-//   upload          colour (sRGB8) and depth (u16) copied into this frame slot's upload buffers
-//                   by the host, or for a frame given as the app's images by the GPU
-//                   (camera_from_app_images, camera_rgba_to_rgb); the pose change since the
+//   upload          colour (sRGB8, one word a pixel) and depth (u16) copied into this frame
+//                   slot's upload buffers by the host, or for a frame given as the app's images
+//                   by the GPU (camera_from_app_images, app_color_words); the pose change since the
 //                   previous frame is computed here (CPU, double)
 //   recon_warp      the previous frame's filtered depth + weight (history image) forward-
 //                   projected into this view as its grid mesh (each pixel a triangle covers gets
@@ -26,6 +26,8 @@
 #include "mrgi/frame.h"
 #include "mrgi/vulkan_device.h"
 
+#include <cstddef>
+#include <cstdint>
 #include <optional>
 
 #include <glm/glm.hpp>
@@ -43,10 +45,20 @@ struct ReconstructionSettings {
   int normal_radius = 2;            // pixels: central-difference half-width for normals, [1, 8]
 };
 
-// How a camera upload buffer (RGB8 colour or u16 depth packed into uint words, host-written each
+// How a camera upload buffer (colour words or u16 depth packed into uint words, host-written each
 // frame) is created, as every pass that reads one expects it: one copy per frame slot, rounded
 // to whole words, with the R32_UINT texel view shaders/common/upload_gather.glsl reads.
 gpu::BufferDesc camera_upload_desc(const std::string& name, size_t bytes);
+// The colour upload's layout (common/upload_gather.glsl color_words): one 32-bit word a pixel,
+// R | G << 8 | B << 16, the top byte ignored by every reader. A word a pixel because every
+// buffer read is a per-lane gather on lavapipe (three bytes a pixel took two reads) and because
+// an app's RGBA image then copies into it as it is (recon/camera_from_app_images.cpp).
+inline constexpr size_t kColorWordBytes = 4;
+// The upload's size for `pixels` pixels: whole groups of 16 pixels (the app colour pass's step,
+// shaders/recon/app_color_words.comp).
+inline size_t color_upload_bytes(size_t pixels) { return (pixels + 15) / 16 * 16 * kColorWordBytes; }
+// `pixels` sRGB8 pixels (3 bytes each, tightly packed) as colour words (top byte 0).
+void rgb8_to_color_words(const uint8_t* rgb, size_t pixels, uint32_t* words);
 // BadUsage naming `who` unless `upload` was created that way (has the texel view).
 Status check_camera_upload(const gpu::FrameGraph& graph, gpu::BufferHandle upload,
                            const std::string& who);
@@ -54,7 +66,7 @@ Status check_camera_upload(const gpu::FrameGraph& graph, gpu::BufferHandle uploa
 class Reconstruction {
  public:
   // Buffers sized for the colour and depth images; images allocated at the output size.
-  // `app_images`: frames may come as the app's images (a staging buffer for their colour).
+  // `app_images`: frames may come as the app's images (the pass that finishes their colour).
   static Expected<Reconstruction> create(gpu::Context& context, gpu::FrameGraph& graph,
                                          const Intrinsics& color, const Intrinsics& depth,
                                          const ReconstructionSettings& settings = {}, bool app_images = false);
@@ -67,18 +79,18 @@ class Reconstruction {
   // copied (FrameStats::host_copy_bytes).
   void take_input(const InputFrame& frame, const AppInputImages* images);
   size_t copy_host_input(const gpu::FrameGraph& graph, const InputFrame& frame);
-  // The images the current slot's upload buffers hold, RGB8 colour and u16 depth (the frame
+  // The images the current slot's upload buffers hold, colour words and u16 depth (the frame
   // recorded in this slot before, once it completed: frame/camera_view.h); index, timestamp and
   // pose are the caller's to fill.
   frame::CameraView slot_view(const gpu::FrameGraph& graph) const;
-  // Adds the passes that bring this frame's colour into color_upload()'s RGB8 words on the GPU,
+  // Adds the passes that bring this frame's colour into color_upload()'s words on the GPU,
   // before any pass reads them, kept for the host's reads too (the camera frame where nothing
   // virtual shows, slot_view): camera_yuv_to_rgb for a Y'CbCr colour
   // (shaders/recon/yuv_to_rgb.comp); for the app's images camera_from_app_images (their copy
-  // into depth_upload() and 4-byte words) and camera_rgba_to_rgb (shaders/recon/rgba_to_rgb.comp).
-  // `camera_words`, where valid (the composite's RGBA8 output words, at the colour's size), takes
-  // the app's colour as the composite's camera words (alpha 0) on the way. Nothing for an RGB8
-  // frame in host memory. Every frame, whether or not the reconstruction runs.
+  // into depth_upload() and color_upload()) and, for a BGRA image or where `camera_words` is
+  // valid, app_color_words (shaders/recon/app_color_words.comp). `camera_words`, where valid (the
+  // composite's RGBA8 output words, at the colour's size), takes the app's colour as the
+  // composite's camera words (alpha 0) on the way. Nothing for an RGB8 frame in host memory. Every frame, whether or not the reconstruction runs.
   Status record_camera_input(gpu::FrameGraph& graph, gpu::BufferHandle camera_words = {});
   // Adds recon_warp (when there is a history), recon_positions and recon_normals.
   void record(gpu::FrameGraph& graph, gpu::BufferHandle frame_constants);
@@ -99,14 +111,14 @@ class Reconstruction {
   gpu::BufferHandle color_upload_, depth_upload_, frame_constants_;
   gpu::ImageHandle position_, normal_, albedo_, filtered_depth_, warped_;
   gpu::PipelineHandle warp_pipeline_, positions_pipeline_, normals_pipeline_;
-  size_t color_bytes_ = 0, depth_bytes_ = 0;
+  size_t color_pixels_ = 0, depth_bytes_ = 0;
   int color_w_ = 0, color_h_ = 0, depth_w_ = 0, depth_h_ = 0;
-  // The app's images for this frame (take_input), their colour's staging words (4 bytes a pixel;
-  // made only for a runtime that takes app images) and the pack pass.
+  // The app's images for this frame (take_input), the colour words pass (made only for a
+  // runtime that takes app images) and its stand-in for no camera words.
   std::optional<AppInputImages> app_images_;
-  gpu::BufferHandle rgba_staging_, no_camera_words_;
-  gpu::PipelineHandle rgba_pipeline_;
-  glm::ivec4 pack_push_{0};
+  gpu::BufferHandle no_camera_words_;
+  gpu::PipelineHandle words_pipeline_;
+  glm::ivec4 words_push_{0};
   Status record_app_images(gpu::FrameGraph& graph, gpu::BufferHandle camera_words);
   const gpu::Context* context_ = nullptr;  // for the app images' barriers (synchronization2 entry points)
   // Y'CbCr colour: its upload (sized for YUYV, the larger layout), the conversion, and this

@@ -7,10 +7,10 @@
 //   (upload)          host memcpy of colour and depth into this slot's buffers (in host_ms, <1),
 //                     after the stages are recorded (a lagged camera view reads the slot's
 //                     earlier frame: frame/camera_view.h); none for the app's images
-//   reconstruction    camera_from_app_images and camera_rgba_to_rgb, only for a frame given as
+//   reconstruction    camera_from_app_images and app_color_words, only for a frame given as
 //                     the app's images (AppInputImages): their copy into the upload buffers;
 //                     camera_yuv_to_rgb, only for a Y'CbCr colour frame (InputFrame::color_yuv)
-//                     and on every such frame: its RGB8 words, which every later reader of the
+//                     and on every such frame: its colour words, which every later reader of the
 //                     camera takes; recon_warp: the temporal history warped into this frame's camera, internal
 //                     resolution (0.7 at lowest's 320x240, 2.5 at high's 640x480), the merge
 //                     needs it; recon_positions: depth decode, 3x3 same-surface median, temporal
@@ -218,13 +218,10 @@ bool RuntimeImpl::prefill_camera(const InputFrame& frame, SlotRecord& rec) {
     return false;
   const gpu::GpuBuffer& out = graph_->gpu_buffer(compose_->output(), graph_->slot());
   if (!out.coherent || !out.mapped) return false;
-  const uint8_t* rgb = frame.color.data.data();
-  auto* words = static_cast<uint32_t*>(out.mapped);
   const size_t n = size_t(output_w_) * size_t(output_h_);
-  // RGB bytes into R | G << 8 | B << 16 words (alpha 0: no virtual pixel), as compose.comp's
-  // camera path writes them.
-  for (size_t i = 0; i < n; ++i)
-    words[i] = uint32_t(rgb[3 * i]) | uint32_t(rgb[3 * i + 1]) << 8 | uint32_t(rgb[3 * i + 2]) << 16;
+  // R | G << 8 | B << 16 words (alpha 0: no virtual pixel), as compose.comp's camera path writes
+  // them: the upload's own colour words.
+  recon::rgb8_to_color_words(frame.color.data.data(), n, static_cast<uint32_t*>(out.mapped));
   rec.host_copy_bytes += n * 4;
   return true;
 }

@@ -331,17 +331,10 @@ Expected<FrameOutput> RuntimeImpl::collect(const gpu::FrameTimings& timings) {
     out.image = ImageRGBA8();
     out.virtual_mask = Image<uint8_t, 1>();
   } else if (rec.camera_copy) {
-    const auto* rgb = static_cast<const uint8_t*>(graph_->mapped(recon_->color_upload(), timings.slot));
     compose::reuse_or_allocate(out.image, output_w_, output_h_, false);  // all written
     compose::reuse_or_allocate(out.virtual_mask, output_w_, output_h_);  // zero: no virtual pixel
-    uint8_t* px = out.image.data.data();
-    const size_t n = size_t(output_w_) * size_t(output_h_);
-    for (size_t i = 0; i < n; ++i) {
-      px[4 * i + 0] = rgb[3 * i + 0];
-      px[4 * i + 1] = rgb[3 * i + 1];
-      px[4 * i + 2] = rgb[3 * i + 2];
-      px[4 * i + 3] = 255;
-    }
+    compose::camera_words_to_rgba8(static_cast<const uint32_t*>(graph_->mapped(recon_->color_upload(), timings.slot)),
+                                   size_t(output_w_) * size_t(output_h_), out.image.data.data());
   } else {
     MRGI_TRY(compose_->read(*graph_, timings.slot, out.image, out.virtual_mask));
   }
