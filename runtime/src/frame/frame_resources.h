@@ -44,9 +44,10 @@ struct FrameResources {
   gpu::ImageHandle virtual_position, virtual_normal, virtual_albedo, virtual_emission;
   // The solutions the technique writes (RGBA16F, internal resolution, linear radiance).
   gpu::ImageHandle lit_rv, lit_r;
-  // This frame's raw inputs as uploaded by recon/ (per-slot buffers): colour sRGB8 packed as
-  // 3 bytes per pixel (colour intrinsics' size), depth u16 (depth intrinsics' size, depth_scale
-  // units per metre, 0 = no measurement), and the cameras they come from.
+  // This frame's raw inputs as uploaded by recon/ (per-slot buffers): colour sRGB8 as one word
+  // a pixel (recon/reconstruction.h kColorWordBytes; colour intrinsics' size), depth u16 (depth
+  // intrinsics' size, depth_scale units per metre, 0 = no measurement), and the cameras they
+  // come from.
   gpu::BufferHandle color_upload, depth_upload;
   Intrinsics color_intrinsics, depth_intrinsics;
   double depth_scale = 5000.0;
