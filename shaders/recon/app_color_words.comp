@@ -19,13 +19,16 @@ layout(std430, set = 0, binding = 1) writeonly buffer CameraWords { uvec4 camera
 struct WordsConstants {
   ivec4 frame;  // x pixels, y unused, z 1 = BGRA order (swap in place), w 1 = write the camera words
 };
-layout(push_constant) uniform Words { WordsConstants words; };
+layout(push_constant) uniform Words { WordsConstants words_block; };
+WordsConstants words;  // private copy (MRGI_UNIFORM_COPIES, common/frame_constants.glsl): read
+                       // after a branch, a push constant is gathered lane by lane on lavapipe
 
 uvec4 rgb_of(uvec4 t) {
   return words.frame.z != 0 ? ((t >> 16u) & 0xffu) | (t & 0xff00u) | ((t & 0xffu) << 16u) : t & 0xffffffu;
 }
 
 void main() {
+  words = words_block;
   const uint n = uint(words.frame.x);
   const uint q = gl_WorkGroupID.x * 64u + gl_LocalInvocationID.x;  // 16 pixels: elements 4q..4q+3
   if (q * 16u >= n) return;
