@@ -24,6 +24,11 @@
 #include "common/frame_constants.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
+// Every sphere belongs to object 0 or to none of the lit objects (the usual single object): its
+// per-object values are computed once before the sphere loop and the loop's per-object block is
+// compiled out. On lavapipe every lane runs that block on every sphere, taken or not, and its 27
+// uniform reads at a dynamic object index are gathered lane by lane.
+layout(constant_id = 0) const bool kOneObject = false;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
 FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(std140, set = 0, binding = 1) uniform OcclusionUbo { EnvOcclusionSet occluders; };
@@ -133,6 +138,10 @@ void main() {
   int seen_object = -1;
   float object_scale = 1.0f;
   vec3 lit_shown = vec3(0.0f);
+  if (kOneObject) {
+    object_scale = object_far_field_scale(0, p);
+    lit_shown = lit ? object_lit_radiance(0, p) : vec3(0.0f);
+  }
   for (int i = 0; i < count; ++i) {
     vec4 s = occluders.spheres[i];
     vec3 d = s.xyz - p;
@@ -144,7 +153,7 @@ void main() {
     vec3 w = d * inv_l;
     float s2 = r2 / l2;
     const int object = int(occluders.albedo[i].w);
-    if (object >= 0 && object != seen_object) {
+    if (!kOneObject && object >= 0 && object != seen_object) {
       seen_object = object;
       object_scale = object_far_field_scale(object, p);
       lit_shown = lit ? object_lit_radiance(object, p) : vec3(0.0f);

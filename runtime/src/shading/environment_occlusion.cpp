@@ -105,7 +105,9 @@ glm::vec3 real_bounce_flux(const frame::OrientedPatch* patches, int count, const
 
 struct EnvironmentOcclusion::Impl {
   frame::FrameResources frame_;
-  gpu::PipelineHandle pipeline_;
+  // The general shader, and the one for spheres of object 0 alone (kOneObject: the per-object
+  // values once a texel, not once a sphere).
+  gpu::PipelineHandle pipeline_, one_object_pipeline_;
   gpu::BufferHandle set_;          // shader::EnvOcclusionSet, one per frame slot
   gpu::ImageHandle image_, none_;  // the result (allocated at the internal size), the stand-in
   int divisor_ = 0;                // this frame's; 0: left out
@@ -122,9 +124,15 @@ Expected<std::unique_ptr<EnvironmentOcclusion>> EnvironmentOcclusion::create(con
   auto m = std::make_unique<Impl>();
   m->frame_ = frame;
   gpu::FrameGraph& graph = *frame.graph;
-  auto pipe = gpu::load_compute_pipeline(*frame.context, "shading/environment_occlusion.comp", {});
-  if (!pipe) return pipe.error();
-  m->pipeline_ = std::move(*pipe);
+  auto spv = gpu::shader_spirv("shading/environment_occlusion.comp");
+  if (!spv) return spv.error();
+  for (uint32_t one : {0u, 1u}) {
+    // Bindings and push constants from the shader (the pass binds by name).
+    gpu::ComputePipelineDesc d{one ? "env_occlusion_one_object" : "env_occlusion", *spv, {}, 0, {one}};
+    auto pipe = gpu::create_compute_pipeline(*frame.context, d);
+    if (!pipe) return pipe.error();
+    (one ? m->one_object_pipeline_ : m->pipeline_) = gpu::PipelineHandle(*frame.context, std::move(*pipe));
+  }
   auto set = graph.create_buffer({"env_occlusion_set", sizeof(shader::EnvOcclusionSet), gpu::MemoryUsage::Upload, true},
                                  VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   if (!set) return set.error();
@@ -259,8 +267,12 @@ void EnvironmentOcclusion::record(const EnvOcclusionLevel& level, const light::S
   m.write_objects(*set, lights, ambient, bounce, loss, level.real_bounce_loss_lights);
   const frame::FrameResources& r = m.frame_;
   const int divisor = m.divisor_;
+  // Every sphere of object 0 or of none of the lit objects (albedo[i].w -1).
+  const bool one_object = std::all_of(m.object_.begin(), m.object_.end(),
+                                      [](int k) { return k == 0 || k >= MRGI_MAX_OCCLUSION_OBJECTS; });
+  const gpu::Pipeline* pipe = one_object ? &*m.one_object_pipeline_ : &*m.pipeline_;
   r.graph->add_shader_pass(
-      "env_occlusion", gpu::PassKind::Compute, *m.pipeline_,
+      "env_occlusion", gpu::PassKind::Compute, *pipe,
       [&r, &m](gpu::ShaderPassBuilder& b) {
         b.bind("FrameUbo", r.frame_constants);
         b.bind("OcclusionUbo", m.set_);
@@ -271,9 +283,9 @@ void EnvironmentOcclusion::record(const EnvOcclusionLevel& level, const light::S
         b.bind("color_words", r.color_upload);
         b.bind("env_occlusion", m.image_);
       },
-      [&m, divisor](VkCommandBuffer cmd, gpu::PassContext& pass) {
+      [&m, divisor, pipe](VkCommandBuffer cmd, gpu::PassContext& pass) {
         const VkExtent2D e = pass.extent(m.frame_.lit_rv);
-        gpu::dispatch_2d(cmd, *m.pipeline_, nullptr, 0, (e.width + uint32_t(divisor) - 1) / uint32_t(divisor),
+        gpu::dispatch_2d(cmd, *pipe, nullptr, 0, (e.width + uint32_t(divisor) - 1) / uint32_t(divisor),
                          (e.height + uint32_t(divisor) - 1) / uint32_t(divisor));
       });
 }
