@@ -20,24 +20,21 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct FamilyRun {
-  RdeReport pooled;
-  bool any = false;
-  std::optional<LightEstimate> light;  // the last frame's
-  std::string light_note;
-};
+}  // namespace
 
-// Replays every frame of `capture` with `scene` (its lights as given) and pools the error.
-Expected<FamilyRun> replay_family_capture(const CaptureReader& capture, const SceneDesc& scene, const LightFamilySettings& s) {
+Expected<LightReplay> replay_light_capture(const CaptureReader& capture, const SceneDesc& scene,
+                                           const LightFamilySettings& s) {
   const CaptureInfo& info = capture.info();
   RuntimeSettings rs;
   rs.technique = s.technique;
   rs.level = s.level;
   rs.device.validate = s.validate;
+  rs.light_accumulate_views = s.accumulate_views;
   auto rt = create_runtime(rs, CameraSetup{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera},
                            scene);
   if (!rt) return rt.error();
-  FamilyRun run;
+  LightReplay run;
+  run.frames.resize(capture.frame_count());
   std::vector<ImageRGB8> cameras(capture.frame_count());
   auto consume = [&](std::vector<FrameOutput>& outs) -> Status {
     for (FrameOutput& o : outs) {
@@ -55,8 +52,12 @@ Expected<FamilyRun> replay_family_capture(const CaptureReader& capture, const Sc
         run.pooled = pool(run.pooled, *r);
       }
       run.light = o.light;
-      for (const std::string& n : o.stats.notes)
+      run.frames[i].rde = r->all.rde;
+      run.frames[i].light = o.light;
+      for (const std::string& n : o.stats.notes) {
         if (n.rfind("light:", 0) == 0) run.light_note = n;
+        if (n.find("the light changed") != std::string::npos) ++run.changes;
+      }
     }
     return ok_status();
   };
@@ -73,6 +74,15 @@ Expected<FamilyRun> replay_family_capture(const CaptureReader& capture, const Sc
   if (!rest) return rest.error();
   MRGI_TRY(consume(*rest));
   return run;
+}
+
+Expected<LightEstimate> load_light_truth(const std::string& capture_dir, bool direct) {
+  const std::string path = (fs::path(capture_dir) / "light_probe" / (direct ? "probe_direct.exr" : "probe.exr")).string();
+  auto probe = load_hdr_image(path);
+  if (!probe) return fail(probe.error().kind, "the light probe: " + probe.error().message);
+  auto light = light_from_environment(*probe, EnvCamera{});
+  if (!light) return fail(light.error().kind, path + ": " + light.error().message);
+  return *light;
 }
 
 double family_irradiance_error(const LightEstimate& est, const LightEstimate& truth) {
@@ -101,8 +111,6 @@ double family_colour_error(const LightEstimate& est, const LightEstimate& truth)
   for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(e[c] - t[c]) / std::max(t[c], 1e-9));
   return worst;
 }
-
-}  // namespace
 
 Expected<std::vector<LightFamilyScene>> load_light_family(const std::string& path) {
   std::ifstream in(path);
@@ -149,25 +157,20 @@ Expected<std::vector<LightFamilyResult>> run_light_family(const LightFamilySetti
     SceneDesc undeclared = truth_scene;
     undeclared.lights.clear();
     undeclared.environment = EnvironmentDesc{};
-    auto truth = replay_family_capture(*capture, truth_scene, s);
+    auto truth = replay_light_capture(*capture, truth_scene, s);
     if (!truth) return fail(truth.error().kind, sc.name + " (true light): " + truth.error().message);
-    auto est = replay_family_capture(*capture, undeclared, s);
+    auto est = replay_light_capture(*capture, undeclared, s);
     if (!est) return fail(est.error().kind, sc.name + " (estimate): " + est.error().message);
     if (!est->light) return fail(ErrorKind::Internal, sc.name + ": the estimate-lit run gave no light estimate");
     // The truth: the light sources as the virtual objects' centre sees them (mrgi synth's
-    // light_probe/probe_direct.exr: environment and lamps where no real surface is in the way).
-    const std::string probe_path = (fs::path(s.root) / sc.capture / "light_probe" / "probe_direct.exr").string();
-    auto probe = load_hdr_image(probe_path);
-    if (!probe) return fail(probe.error().kind, sc.name + ": the light probe: " + probe.error().message);
-    auto probe_light = light_from_environment(*probe, EnvCamera{});
-    if (!probe_light) return fail(probe_light.error().kind, probe_path + ": " + probe_light.error().message);
-    // The irradiance's truth is everything that reaches the object, bounce light included
+    // light_probe/probe_direct.exr: environment and lamps where no real surface is in the way);
+    // the irradiance's truth is everything that reaches the object, bounce light included
     // (probe.exr, path-traced): that is what lights it.
-    const std::string full_path = (fs::path(s.root) / sc.capture / "light_probe" / "probe.exr").string();
-    auto full = load_hdr_image(full_path);
-    if (!full) return fail(full.error().kind, sc.name + ": the light probe: " + full.error().message);
-    auto full_light = light_from_environment(*full, EnvCamera{});
-    if (!full_light) return fail(full_light.error().kind, full_path + ": " + full_light.error().message);
+    const std::string dir = (fs::path(s.root) / sc.capture).string();
+    auto probe_light = load_light_truth(dir, true);
+    if (!probe_light) return fail(probe_light.error().kind, sc.name + ": " + probe_light.error().message);
+    auto full_light = load_light_truth(dir, false);
+    if (!full_light) return fail(full_light.error().kind, sc.name + ": " + full_light.error().message);
     LightFamilyResult r;
     r.scene = sc;
     r.estimate_source = est->light_note;

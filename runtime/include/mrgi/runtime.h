@@ -392,6 +392,12 @@ struct RuntimeSettings {
   /// differential composite divides by the model of the real light, which without it holds the
   /// lamps' direct light only. false: the lamps alone (as before; an ablation).
   bool residual_light = true;
+  /// With nothing declared (the probeless estimate from colour and depth): keep what every view
+  /// showed (surface patches in world space, their transfer and colour; light/radiance_samples.h)
+  /// and solve the light over all of them, so the estimate grows with the directions the camera
+  /// has swept; a light change (surfaces seen again differ in brightness) drops what is out of
+  /// view. false: each solve from the current view only.
+  bool light_accumulate_views = true;
 };
 
 // ---------------------------------------------------------------------------------------------

@@ -132,6 +132,11 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
     if (!b) return b.error();
     s.probeless_.emplace(std::move(*b));
     if (s.residual_) s.probeless_->set_known_lamps(s.real_lamps_, settings.estimator.gray_albedo);
+    if (!s.residual_ && settings.samples.enabled) {
+      auto store = RadianceSamples::create(settings.samples);
+      if (!store) return store.error();
+      s.samples_.emplace(std::move(*store));
+    }
   }
   s.max_lights_ = s.declared_ + s.env_lights_ + (s.planned_ == LightSourceKind::Probeless ? 1 : 0);
   s.lighting_.lights.reserve(kMaxStageLights);
@@ -429,11 +434,28 @@ Status LightStage::add_probeless_parts(const frame::CameraView& camera, std::vec
   // built at once, so no frame is lit by the prior.
   const int parts = probeless_->settings().parts;
   const bool first = !estimator_->estimate().valid;
+  RadianceSamples* store = samples_ ? &*samples_ : nullptr;
   for (int p = first ? 0 : next_part_; p < (first ? parts : next_part_ + 1); ++p)
-    MRGI_TRY(probeless_->add_part(camera, cameras_.exposure, p, pending_));
-  next_part_ = first ? 0 : (next_part_ + 1) % parts;
+    MRGI_TRY(probeless_->add_part(camera, cameras_.exposure, p, pending_, store));
+  bool changed = false;
+  if (store && store->end_frame(camera.index)) {
+    // The light changed (a lamp switched on or off): the samples out of view are gone, so the
+    // rest of this view goes in now and the estimate jumps to this frame's solve instead of
+    // being filtered towards it from the old light.
+    changed = true;
+    for (int p = 0; p < parts && !first; ++p)
+      if (p != next_part_) MRGI_TRY(probeless_->add_part(camera, cameras_.exposure, p, pending_, store));
+    estimator_->restart_filter();
+    notes.push_back("light: the light changed (surfaces seen again differ in brightness): the probeless "
+                    "estimate restarts from this view");
+  }
+  next_part_ = first || changed ? 0 : (next_part_ + 1) % parts;
   solved = next_part_ == 0;
   if (solved) {
+    if (store) {
+      pending_.clear();
+      store->add_to(pending_, &estimator_->filtered(), estimator_->settings().gray_albedo);
+    }
     auto r = estimator_->update(pending_, camera.index, camera.timestamp);
     if (!r) notes.push_back("light: " + r.error().message);
     pending_.clear();

@@ -101,6 +101,10 @@ struct LightStageSettings {
   double near_field_tolerance_m = 0.03;
   LampRemovalSettings lamp_removal;
   ProbelessSettings probeless;
+  // The probeless source's memory of the views seen (radiance_samples.h): the system is solved
+  // over every surface the camera has swept, not only the current view. The residual estimate
+  // (declared lamps) stays per view: its low-order ambient is constrained by one view.
+  RadianceSampleSettings samples;
   // The estimator of the probeless source fed by the stage's own builder. RGB (white_light
   // false): the paper's white-light assumption gives a grey estimate under a blue sky. Chosen on
   // the light family's tuning half only (perf/suite/light/family.json; perf/results/
@@ -281,6 +285,8 @@ class LightStage {
   }
   int environment_grid_width() const { return settings_.environment.grid_width; }
   const LightEstimator& estimator() const { return *estimator_; }
+  // The probeless source's store of the views seen; null when it does not accumulate.
+  const RadianceSamples* radiance_samples() const { return samples_ ? &*samples_ : nullptr; }
   // The largest number of shadowed lights any frame can have (for shadow map allocation).
   int max_lights() const { return max_lights_; }
   LightSourceKind planned_source() const { return planned_; }
@@ -328,6 +334,7 @@ class LightStage {
   bool env_from_file_ = false;
   std::optional<ProbelessBuilder> probeless_;
   std::optional<LightEstimator> estimator_;
+  std::optional<RadianceSamples> samples_;  // the probeless source's, when accumulating
   LightSystem pending_;             // the parts of the probeless system summed so far
   int next_part_ = 0;
   Lighting lighting_;

@@ -179,7 +179,8 @@ void ProbelessBuilder::build_normals(const glm::mat3& rot) {
   }
 }
 
-Status ProbelessBuilder::add_part(const frame::CameraView& view, double exposure, int part, LightSystem& system) {
+Status ProbelessBuilder::add_part(const frame::CameraView& view, double exposure, int part, LightSystem& system,
+                                  RadianceSamples* samples) {
   const CameraColor camera(view);
   const glm::dmat4& camera_to_world = view.camera_to_world;
   if (view.depth.empty() || view.depth.width != depth_.width || view.depth.height != depth_.height ||
@@ -236,19 +237,19 @@ Status ProbelessBuilder::add_part(const frame::CameraView& view, double exposure
       glm::dvec3 colour(0.0);
       int count = 0;
       bool saturated = false;
-      for (int y = cy0; y < cy1 && !saturated; ++y) {
+      for (int y = cy0; y < cy1 && !(saturated && !samples); ++y) {
         for (int x = cx0; x < cx1; ++x) {
           const std::array<uint8_t, 3> px = camera.at(x, y);
           if (px[0] >= kSaturated || px[1] >= kSaturated || px[2] >= kSaturated) {
             saturated = true;
-            break;
+            if (!samples) break;
           }
           colour += glm::dvec3(lut[px[0]], lut[px[1]], lut[px[2]]);
           ++count;
         }
       }
-      if (saturated || count == 0) continue;
-      samples_.push_back({gy * grid_w_ + gx, colour / (double(count) * exposure)});
+      if ((saturated && !samples) || count == 0) continue;
+      samples_.push_back({gy * grid_w_ + gx, colour / (double(count) * exposure), saturated});
     }
   }
   if (settings_.grey_vote) vote_light_colour();
@@ -284,6 +285,11 @@ Status ProbelessBuilder::add_part(const frame::CameraView& view, double exposure
           known += e * (cos_n * double(k));
         }
         known *= known_albedo_ / kPi;
+      }
+      if (samples) {
+        const glm::dvec3 world = glm::dvec3(camera_to_world * glm::dvec4(glm::dvec3(p), 1.0));
+        samples->observe(world, bin_[size_t(sample.cell)], t, colour - known, weight_row, view.index, sample.clipped);
+        continue;
       }
       // Rows weighted so that every orientation of surface counts alike (balance_normals).
       const float sw = std::sqrt(weight_row);

@@ -16,13 +16,17 @@
 //
 // Deviation from the paper: visibility is searched in the current depth image only (no TSDF
 // auxiliary views): an occluder outside the view does not shadow. Saturated colour (any channel
-// at 250 or more of 255) is left out: it is not a linear measurement of the light.
+// at 250 or more of 255) is not a linear measurement of the light: a single view leaves it out;
+// the store of the views seen keeps it as a lower bound (RadianceSamples: a row only while the
+// estimate predicts less than the block showed), so a sunlit surface the camera clips still
+// says the light is at least that bright.
 #pragma once
 #include <cstdint>
 #include <vector>
 
 #include <glm/glm.hpp>
 
+#include "light/radiance_samples.h"
 #include "light/sh_estimator.h"
 #include "mrgi/expected.h"
 #include "frame/camera_view.h"
@@ -76,7 +80,10 @@ class ProbelessBuilder {
   // to `system`: I_c is the linear camera value divided by `exposure` (radiance units, the
   // estimator divides by the albedo). Frames whose images do not have the intrinsics' sizes are
   // refused (BadInput).
-  Status add_part(const frame::CameraView& camera, double exposure, int part, LightSystem& system);
+  // With `samples`, the rows go into that store of the views seen (radiance_samples.h) instead
+  // of `system`.
+  Status add_part(const frame::CameraView& camera, double exposure, int part, LightSystem& system,
+                  RadianceSamples* samples = nullptr);
   // Light the rows should not explain (the residual estimate, light_stage.h): every later row's
   // intensity has albedo / pi * E_lamps(x) taken off, E_lamps the lamps' irradiance at the
   // sample (lamp_irradiance, cosine, and the sample's visibility towards the lamp searched in
@@ -101,6 +108,7 @@ class ProbelessBuilder {
   struct Sample {
     int cell;
     glm::dvec3 colour;  // linear, exposure divided out
+    bool clipped;       // a pixel of the block at kSaturated: the colour is a lower bound
   };
   std::vector<Sample> samples_;         // this part's, reserved at start-up
   std::vector<LightDesc> known_lamps_;  // set_known_lamps

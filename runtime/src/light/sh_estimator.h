@@ -117,6 +117,9 @@ class LightEstimator {
   // frame had none (no data or bands < 2).
   const glm::dvec3& dominant_normal() const { return dominant_normal_; }
   void reset();
+  // The next update replaces the filtered estimate with its solution (as the first one does),
+  // keeping the estimate valid meanwhile: after a detected change of the light.
+  void restart_filter() { have_previous_ = false; }
 
  private:
   explicit LightEstimator(const LightEstimatorSettings& settings) : settings_(settings) {}

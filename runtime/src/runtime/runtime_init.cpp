@@ -147,6 +147,7 @@ Status RuntimeImpl::create_shared_stages(const RuntimeSettings& settings) {
   ls.estimator.lag_frames = settings.light_lag_frames;
   ls.environment.filter_frames = settings.light_lag_frames;
   ls.residual_light = settings.residual_light;
+  ls.samples.enabled = settings.light_accumulate_views;
   if (!scene_gpu_->virtual_objects.empty())
     ls.focus = 0.5f * (scene_gpu_->virtual_objects.bounds_min + scene_gpu_->virtual_objects.bounds_max);
   auto stage = light::LightStage::create(ls, scene_, cameras_);

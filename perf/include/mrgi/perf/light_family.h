@@ -18,7 +18,13 @@
 #include <string>
 #include <vector>
 
+#include <optional>
+
 #include "mrgi/expected.h"
+#include "mrgi/light_estimate.h"
+#include "mrgi/metrics.h"
+#include "mrgi/platform/capture.h"
+#include "mrgi/scene.h"
 
 namespace mrgi::perf {
 
@@ -52,7 +58,30 @@ struct LightFamilySettings {
   bool validate = false;
   // Which scenes run: "all", "tuning" (the half a parameter may be chosen on) or "held-out".
   std::string half = "all";
+  bool accumulate_views = true;  // RuntimeSettings::light_accumulate_views
 };
+
+// One capture replayed through the runtime: the error of every frame and the light it came
+// back with (with frames in flight, the newest estimate when that frame was collected).
+struct LightReplayFrame {
+  double rde = 0.0;                   // all pixels
+  std::optional<LightEstimate> light;
+};
+struct LightReplay {
+  RdeReport pooled;
+  bool any = false;
+  std::optional<LightEstimate> light;  // the last frame's
+  std::string light_note;
+  std::vector<LightReplayFrame> frames;
+  int changes = 0;  // frames whose notes say the light stage detected a change of the light
+};
+Expected<LightReplay> replay_light_capture(const CaptureReader& capture, const SceneDesc& scene,
+                                           const LightFamilySettings& settings);
+// A capture's light probe as an estimate: `direct` the light sources only (probe_direct.exr),
+// else everything reaching the virtual objects' centre (probe.exr).
+Expected<LightEstimate> load_light_truth(const std::string& capture_dir, bool direct);
+double family_irradiance_error(const LightEstimate& estimate, const LightEstimate& truth);
+double family_colour_error(const LightEstimate& estimate, const LightEstimate& truth);
 
 // Runs every scene (progress through `progress(name, done, total)` when given).
 Expected<std::vector<LightFamilyResult>> run_light_family(

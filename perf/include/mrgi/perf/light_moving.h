@@ -1,0 +1,70 @@
+// The moving-camera light family (perf/suite/light/moving/family.json): each capture is a
+// 90-degree sweep around a virtual object on a table, replayed lit by its true light and by the
+// runtime's probeless estimate, with the estimate's figures at every frame (as the sweep grows):
+// direction error (degrees, against the light sources as the object's centre sees them),
+// colour error (largest per-channel error of the mean light's chromaticity), confidence, and
+// the per-frame RDE ratio (estimate-lit over true-lit, all pixels). After the sweep: the last
+// frame's direction and colour, the RDE ratio pooled over the last 8 frames.
+//
+// Switches: a still camera whose room gets one more lamp at a stated frame (splice_switch.py);
+// "followed" is the first frame from which the estimate stays within 10 % in intensity (band 0
+// luminance) and 5 degrees in direction of where it ends, counted from the switch.
+//
+// Drift: one capture played back and forth for N frames; the largest change of the estimate's
+// direction (degrees) and intensity (relative) from the end of the first round trip on.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "mrgi/expected.h"
+#include "mrgi/perf/light_family.h"
+
+namespace mrgi::perf {
+
+struct MovingFrame {
+  double direction_error_deg = 0.0, colour_error = 0.0, confidence = 0.0;
+  double rde_true = 0.0, rde_estimate = 0.0;
+  bool valid = false;  // an estimate existed
+};
+
+struct MovingResult {
+  LightFamilyScene scene;
+  std::vector<MovingFrame> frames;
+  double final_direction_deg = 0.0, final_colour = 0.0, final_confidence = 0.0;
+  double final_rde_ratio = 0.0;  // pooled over the last 8 frames
+};
+
+struct SwitchResult {
+  std::string name;
+  bool held_out = false;
+  int switch_frame = 0;
+  int followed_after = -1;  // frames after the switch; -1 = never settled
+  int changes_noted = 0;    // frames whose notes say a light change was detected
+  double final_direction_deg = 0.0;  // against the lamp-on truth
+};
+
+struct DriftResult {
+  std::string name;
+  int frames = 0;
+  double direction_deg = 0.0, intensity = 0.0;  // largest change after the first round trip
+};
+
+struct MovingFamilyReport {
+  std::vector<MovingResult> scenes;
+  std::vector<SwitchResult> switches;
+  std::vector<DriftResult> drift;
+};
+
+struct MovingFamilySettings {
+  LightFamilySettings family;     // manifest, technique, level, root, half, accumulate_views
+  int drift_frames = 0;           // 0: no drift run
+  std::string drift_scene;        // the scene looped (default: the half's first)
+  bool switches = true;
+};
+
+Expected<MovingFamilyReport> run_moving_family(const MovingFamilySettings& settings,
+                                               void (*progress)(const std::string&, size_t, size_t) = nullptr);
+std::string moving_family_markdown(const MovingFamilyReport& report, const MovingFamilySettings& settings);
+std::string moving_family_json(const MovingFamilyReport& report);
+
+}  // namespace mrgi::perf

@@ -1,0 +1,170 @@
+#include "light/radiance_samples.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace mrgi::light {
+namespace {
+
+Status check_sample_setting(bool ok, const char* field, const std::string& rule) {
+  if (ok) return ok_status();
+  return fail(ErrorKind::BadUsage, std::string("RadianceSampleSettings.") + field + ": " + rule);
+}
+
+uint64_t mix64(uint64_t x) {  // splitmix64's finaliser: cells next to each other spread over the table
+  x ^= x >> 30;
+  x *= 0xbf58476d1ce4e5b9ull;
+  x ^= x >> 27;
+  x *= 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+}  // namespace
+
+Expected<RadianceSamples> RadianceSamples::create(const RadianceSampleSettings& s) {
+  MRGI_TRY(check_sample_setting(s.cell_m >= 0.005 && s.cell_m <= 1.0, "cell_m", "must be 0.005..1 metres"));
+  MRGI_TRY(check_sample_setting(s.capacity >= 64 && s.capacity <= 65536, "capacity", "must be 64..65536 samples"));
+  MRGI_TRY(check_sample_setting(s.colour_frames >= 1 && s.colour_frames <= 1024, "colour_frames", "must be 1..1024"));
+  MRGI_TRY(check_sample_setting(s.change_ratio > 1.0 && std::isfinite(s.change_ratio), "change_ratio", "must be > 1"));
+  MRGI_TRY(check_sample_setting(s.change_fraction > 0.0 && s.change_fraction <= 1.0, "change_fraction",
+                                "must be in (0, 1]"));
+  MRGI_TRY(check_sample_setting(s.change_min_samples >= 1, "change_min_samples", "must be >= 1"));
+  RadianceSamples r;
+  r.settings_ = s;
+  r.samples_.reserve(size_t(s.capacity));
+  r.scratch_.reserve(size_t(s.capacity));
+  size_t slots = 1;
+  while (slots < size_t(s.capacity) * 2) slots <<= 1;
+  r.table_.assign(slots, -1);
+  r.table_mask_ = slots - 1;
+  return r;
+}
+
+uint64_t RadianceSamples::key_of(const glm::dvec3& p, int bin) const {
+  // 20 bits a coordinate (cells of 6 cm: +-31 km) and 6 for the orientation.
+  constexpr int64_t kHalf = int64_t(1) << 19;
+  auto q = [&](double v) {
+    const int64_t c = std::clamp(int64_t(std::floor(v / settings_.cell_m)), -kHalf, kHalf - 1) + kHalf;
+    return uint64_t(c);
+  };
+  return (q(p.x) << 46) | (q(p.y) << 26) | (q(p.z) << 6) | uint64_t(bin & 63);
+}
+
+int64_t RadianceSamples::find_slot(uint64_t key) const {
+  uint64_t i = mix64(key) & table_mask_;
+  for (;;) {  // the table is at most half full: an empty slot is always reached
+    const int32_t at = table_[i];
+    if (at < 0 || samples_[size_t(at)].key == key) return int64_t(i);
+    i = (i + 1) & table_mask_;
+  }
+}
+
+void RadianceSamples::rebuild_table() {
+  std::fill(table_.begin(), table_.end(), -1);
+  for (size_t k = 0; k < samples_.size(); ++k) table_[size_t(find_slot(samples_[k].key))] = int32_t(k);
+}
+
+void RadianceSamples::evict_oldest() {
+  // Drop the quarter least recently seen (at least one sample).
+  scratch_.clear();
+  for (const Sample& s : samples_) scratch_.push_back(s.last_frame);
+  const size_t cut = std::max<size_t>(1, samples_.size() / 4);
+  std::nth_element(scratch_.begin(), scratch_.begin() + ptrdiff_t(cut - 1), scratch_.end());
+  const int64_t oldest_kept = scratch_[cut - 1];
+  size_t dropped = 0;
+  samples_.erase(std::remove_if(samples_.begin(), samples_.end(),
+                                [&](const Sample& s) {
+                                  if (dropped < cut && s.last_frame <= oldest_kept) {
+                                    ++dropped;
+                                    return true;
+                                  }
+                                  return false;
+                                }),
+                 samples_.end());
+  rebuild_table();
+}
+
+void RadianceSamples::observe(const glm::dvec3& position, int bin, const ShVector& transfer,
+                              const glm::dvec3& colour, float row_weight, int64_t frame, bool clipped) {
+  if (frame != frame_) {
+    frame_ = frame;
+    reobserved_ = changed_ = 0;
+  }
+  const uint64_t key = key_of(position, bin);
+  int64_t slot = find_slot(key);
+  if (table_[size_t(slot)] < 0) {
+    if (samples_.size() >= size_t(settings_.capacity)) {
+      evict_oldest();
+      slot = find_slot(key);
+    }
+    table_[size_t(slot)] = int32_t(samples_.size());
+    samples_.push_back({key, transfer, colour, colour, row_weight, clipped, 1, frame});
+    return;
+  }
+  Sample& s = samples_[size_t(table_[size_t(slot)])];
+  if (clipped != s.clipped) {
+    if (clipped) {  // a bound beside measurements: the measurements stand
+      s.last_frame = frame;
+      return;
+    }
+    s = Sample{key, transfer, colour, colour, row_weight, false, 1, frame};  // a measurement replaces a bound
+    return;
+  }
+  if (s.last_frame < frame && !clipped) {
+    // Seen in an earlier frame: does it show the light it showed then?
+    const double before = luminance(s.colour), now = luminance(colour);
+    ++reobserved_;
+    const double r = settings_.change_ratio;
+    if (before > 0.0 && now > 0.0 ? (now > before * r || now * r < before) : (before > 0.0) != (now > 0.0))
+      ++changed_;
+  }
+  s.observations = std::min(s.observations + 1, settings_.colour_frames);
+  const double a = 1.0 / double(s.observations);
+  s.colour += a * (colour - s.colour);
+  for (size_t i = 0; i < s.transfer.size(); ++i) s.transfer[i] += float(a) * (transfer[i] - s.transfer[i]);
+  s.last_colour = colour;
+  s.row_weight = row_weight;
+  s.last_frame = frame;
+}
+
+bool RadianceSamples::end_frame(int64_t frame) {
+  if (frame != frame_) return false;  // nothing observed in it
+  const bool change = reobserved_ >= settings_.change_min_samples &&
+                      double(changed_) >= settings_.change_fraction * double(reobserved_);
+  reobserved_ = changed_ = 0;
+  if (!change) return false;
+  ++changes_;
+  samples_.erase(std::remove_if(samples_.begin(), samples_.end(), [&](const Sample& s) { return s.last_frame < frame; }),
+                 samples_.end());
+  for (Sample& s : samples_) {
+    s.colour = s.last_colour;
+    s.observations = 1;
+  }
+  rebuild_table();
+  return true;
+}
+
+void RadianceSamples::add_to(LightSystem& system, const ShRgb* estimate, double albedo) const {
+  for (const Sample& s : samples_) {
+    if (s.clipped) {
+      if (!estimate) continue;
+      glm::dvec3 predicted(0.0);
+      for (int i = 0; i < kMaxShCoeffs; ++i) predicted += double(s.transfer[size_t(i)]) * (*estimate)[size_t(i)];
+      if (albedo * luminance(predicted) >= luminance(s.colour)) continue;
+    }
+    const float w = std::sqrt(s.row_weight);
+    ShVector t = s.transfer;
+    for (float& v : t) v *= w;
+    system.add(t, s.colour * double(w));
+  }
+}
+
+void RadianceSamples::clear() {
+  samples_.clear();
+  std::fill(table_.begin(), table_.end(), -1);
+  reobserved_ = changed_ = 0;
+  frame_ = -1;
+}
+
+}  // namespace mrgi::light

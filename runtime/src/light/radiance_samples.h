@@ -1,0 +1,101 @@
+// The probeless estimate's memory of the views a user sweeps: radiance samples (a surface
+// patch's world position and normal, its diffuse transfer vector T, the colour it showed) kept in
+// world space across frames, so the least-squares system for the environment SH holds every
+// orientation of surface the camera has seen, not only the current view's (one view of a floor
+// and a box constrains 1-3 of the 16 SH directions; a 90-degree sweep adds walls, table sides and
+// the other faces of objects).
+//
+// A sample stands for a cell of `cell_m` metres and one of 32 orientations (a table's top and
+// its side in the same cell are two samples). Each observation of the cell moves the sample's
+// colour and transfer towards the new one with a running mean over `colour_frames` observations,
+// so noise averages out and a slow change is followed. Every sample is one row of the system
+// (each patch of surface counts alike, however often or closely it was seen).
+//
+// Stale samples: when the light changes (a lamp switched on) the samples not in view keep the
+// old light's colours. A change is detected without the estimate (which may itself be wrong where
+// the view is new): surfaces seen again show a different brightness than they had. When at least
+// `change_fraction` of the re-observed samples of a frame (and `change_min_samples` of them)
+// differ in luminance by more than a factor `change_ratio`, the frame is a light change: every
+// sample not observed in that frame is dropped, the observed ones restart from their new colour.
+// A camera move or a new view cannot trigger it (new cells are not re-observations); a moving
+// shadow can only where it covers half of what is seen again.
+//
+// Everything is allocated at start-up for `capacity` samples; when full, the quarter least
+// recently seen is dropped.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "light/sh_estimator.h"
+#include "mrgi/expected.h"
+
+namespace mrgi::light {
+
+struct RadianceSampleSettings {
+  // Accumulate over views; false: every solve from the current view's samples only.
+  bool enabled = true;
+  double cell_m = 0.06;        // side of the world cell a sample stands for, metres (0.005..1)
+  int capacity = 8192;         // samples kept (64..65536)
+  int colour_frames = 16;      // observations a sample's running mean spans (1..1024)
+  double change_ratio = 1.25;  // luminance factor that counts a re-observed sample as changed (> 1)
+  double change_fraction = 0.5;  // of a frame's re-observed samples, for a light change (0..1]
+  int change_min_samples = 12;   // re-observed samples a frame needs before it can be a change
+};
+
+class RadianceSamples {
+ public:
+  // BadUsage naming the field for a setting out of range.
+  static Expected<RadianceSamples> create(const RadianceSampleSettings& settings);
+
+  // One observation of frame `frame`: world position (metres), unit world normal, its
+  // orientation bin (0..63), the transfer vector and the colour (the row's right-hand side) and
+  // the row's weight (ProbelessSettings::balance_normals; 1 otherwise).
+  // `clipped`: the colour is a lower bound (a saturated pixel in the block). A sample keeps its
+  // unclipped observations over clipped ones, and clipped ones never count as a light change.
+  void observe(const glm::dvec3& position, int orientation_bin, const ShVector& transfer,
+               const glm::dvec3& colour, float row_weight, int64_t frame, bool clipped = false);
+  // Closes frame `frame`'s observations: true when they showed a light change (the samples
+  // not observed in it are then gone, see above).
+  bool end_frame(int64_t frame);
+  // Adds every sample as a row (weight sqrt(row_weight) on both sides, as a direct row). A
+  // clipped sample is a row only while `estimate` (radiance SH; the surfaces' grey `albedo`)
+  // predicts less luminance than its bound (censored data: a bound the estimate meets says
+  // nothing more); without an estimate clipped samples are left out.
+  void add_to(LightSystem& system, const ShRgb* estimate = nullptr, double albedo = 0.5) const;
+
+  size_t size() const { return samples_.size(); }
+  int64_t changes() const { return changes_; }
+  const RadianceSampleSettings& settings() const { return settings_; }
+  void clear();
+
+ private:
+  RadianceSamples() = default;
+  struct Sample {
+    uint64_t key;
+    ShVector transfer;
+    glm::dvec3 colour;
+    glm::dvec3 last_colour;  // the newest observation (a restart after a change begins there)
+    float row_weight;
+    bool clipped;
+    int observations;
+    int64_t last_frame;
+  };
+  uint64_t key_of(const glm::dvec3& position, int orientation_bin) const;
+  int64_t find_slot(uint64_t key) const;  // the table slot holding `key` or the empty one it goes in
+  void rebuild_table();
+  void evict_oldest();
+  static double luminance(const glm::dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
+
+  RadianceSampleSettings settings_;
+  std::vector<Sample> samples_;    // reserved to capacity
+  std::vector<int32_t> table_;     // open addressing, -1 empty; 2x capacity rounded to a power of 2
+  std::vector<int64_t> scratch_;   // last frames, for eviction
+  uint64_t table_mask_ = 0;
+  int64_t frame_ = -1;             // the frame being observed
+  int reobserved_ = 0, changed_ = 0;
+  int64_t changes_ = 0;
+};
+
+}  // namespace mrgi::light

@@ -1,0 +1,165 @@
+// The probeless estimate's memory of the views seen (light/radiance_samples.h): the store's
+// merging, its light-change detector and eviction, and the light stage with it on a camera
+// sweeping a ray-traced room corner (room_scene.h): more of the SH constrained as the sweep
+// grows, no change detected while only the camera moves, a lamp switched on followed.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "light/light_stage.h"
+#include "light/radiance_samples.h"
+#include "room_scene.h"
+
+namespace {
+using namespace mrgi;
+using namespace mrgi::light;
+using namespace mrgi::test_room;
+
+ShVector unit_transfer(int i) {
+  ShVector t{};
+  t[size_t(i % kMaxShCoeffs)] = 1.0f;
+  return t;
+}
+
+TEST(RadianceSamples, OneSamplePerCellAndOrientationWithTheMeanColour) {
+  RadianceSampleSettings s;
+  s.cell_m = 0.1;
+  auto store = RadianceSamples::create(s);
+  ASSERT_TRUE(store.ok()) << store.error().message;
+  store->observe({0.01, 0.0, 0.02}, 3, unit_transfer(0), {1.0, 1.0, 1.0}, 1.0f, 0);
+  store->observe({0.05, 0.0, 0.08}, 3, unit_transfer(0), {1.1, 1.1, 1.1}, 1.0f, 1);  // same cell, same bin
+  store->observe({0.05, 0.0, 0.08}, 4, unit_transfer(1), {0.5, 0.5, 0.5}, 1.0f, 1);  // same cell, other bin
+  store->observe({0.25, 0.0, 0.08}, 3, unit_transfer(2), {0.7, 0.7, 0.7}, 1.0f, 1);  // next cell
+  EXPECT_FALSE(store->end_frame(1));
+  EXPECT_EQ(store->size(), 3u);
+  LightSystem sys;
+  store->add_to(sys);
+  EXPECT_DOUBLE_EQ(sys.samples, 3.0);
+  // Coefficient 0's row is the first sample: its colour the mean of its two observations.
+  EXPECT_NEAR(sys.atb[0], 1.05, 1e-12);
+  EXPECT_NEAR(sys.ata[0], 1.0, 1e-12);
+}
+
+TEST(RadianceSamples, ALightChangeDropsWhatIsOutOfViewAndACameraMoveDoesNot) {
+  RadianceSampleSettings s;
+  s.cell_m = 0.1;
+  s.change_min_samples = 4;
+  auto store = RadianceSamples::create(s);
+  ASSERT_TRUE(store.ok());
+  // Frame 0 sees cells 0..9; frame 1 moves on to 5..14 under the same light: no change.
+  for (int c = 0; c < 10; ++c) store->observe({0.1 * c + 0.05, 0, 0}, 0, unit_transfer(c), glm::dvec3(0.4), 1.0f, 0);
+  EXPECT_FALSE(store->end_frame(0));
+  for (int c = 5; c < 15; ++c) store->observe({0.1 * c + 0.05, 0, 0}, 0, unit_transfer(c), glm::dvec3(0.41), 1.0f, 1);
+  EXPECT_FALSE(store->end_frame(1));
+  EXPECT_EQ(store->size(), 15u);
+  // Frame 2: a lamp on, cells 10..14 seen again 60 % brighter: a change; cells 0..9 are gone.
+  for (int c = 10; c < 15; ++c) store->observe({0.1 * c + 0.05, 0, 0}, 0, unit_transfer(c), glm::dvec3(0.66), 1.0f, 2);
+  EXPECT_TRUE(store->end_frame(2));
+  EXPECT_EQ(store->changes(), 1);
+  EXPECT_EQ(store->size(), 5u);
+  LightSystem sys;
+  store->add_to(sys);
+  for (int c = 10; c < 15; ++c) EXPECT_NEAR(sys.atb[size_t(c) * 3], 0.66, 1e-12) << "restarts from the new colour";
+  // Below the fraction (2 of 5 changed): not a change.
+  for (int c = 10; c < 15; ++c)
+    store->observe({0.1 * c + 0.05, 0, 0}, 0, unit_transfer(c), glm::dvec3(c < 12 ? 1.0 : 0.66), 1.0f, 3);
+  EXPECT_FALSE(store->end_frame(3));
+}
+
+TEST(RadianceSamples, AFullStoreDropsTheLeastRecentlySeenAndRefusesBadSettings) {
+  RadianceSampleSettings s;
+  s.capacity = 64;
+  s.cell_m = 0.1;
+  auto store = RadianceSamples::create(s);
+  ASSERT_TRUE(store.ok());
+  for (int c = 0; c < 200; ++c) store->observe({0.1 * c + 0.05, 0, 0}, 0, unit_transfer(c), glm::dvec3(0.3), 1.0f, c);
+  EXPECT_LE(store->size(), 64u);
+  EXPECT_GE(store->size(), 48u);
+  for (auto [field, bad] : std::vector<std::pair<std::string, RadianceSampleSettings>>{
+           {"cell_m", [] { RadianceSampleSettings b; b.cell_m = 0.0; return b; }()},
+           {"capacity", [] { RadianceSampleSettings b; b.capacity = 10; return b; }()},
+           {"colour_frames", [] { RadianceSampleSettings b; b.colour_frames = 0; return b; }()},
+           {"change_ratio", [] { RadianceSampleSettings b; b.change_ratio = 1.0; return b; }()},
+           {"change_fraction", [] { RadianceSampleSettings b; b.change_fraction = 0.0; return b; }()}}) {
+    auto r = RadianceSamples::create(bad);
+    ASSERT_FALSE(r.ok()) << field;
+    EXPECT_NE(r.error().message.find("RadianceSampleSettings." + field), std::string::npos) << r.error().message;
+  }
+}
+
+// The camera on a circle around the room's box, from `start` over `sweep` degrees.
+glm::dvec3 eye_at(double deg) {
+  const double a = deg * kPi / 180.0;
+  return {0.3 + 1.8 * std::sin(a), 1.3, 0.8 - 1.8 * std::cos(a)};
+}
+
+struct SweepResult {
+  double confidence = 0.0;
+  size_t samples = 0;
+  int changes = 0;
+};
+
+SweepResult sweep(const Room& room, bool accumulate, int frames) {
+  LightStageSettings settings;
+  settings.samples.enabled = accumulate;
+  settings.probeless.parts = 1;  // a whole system a frame: the test's frames are few
+  const RenderedFrame first = render(room, eye_at(-20), {0.3, 0.2, 0.8}, 80, 60);
+  auto stage = LightStage::create(settings, SceneDesc{}, CameraSetup{first.k, first.k, 5000.0, 1.0, std::nullopt});
+  EXPECT_TRUE(stage.ok());
+  SweepResult r;
+  for (int i = 0; i < frames; ++i) {
+    const RenderedFrame f = render(room, eye_at(-20 + 90.0 * i / (frames - 1)), {0.3, 0.2, 0.8}, 80, 60);
+    frame::CameraView view = frame::CameraView::of(f.frame, f.pose);
+    view.index = i;
+    std::vector<std::string> notes;
+    EXPECT_TRUE((*stage)->update(view, notes).ok());
+    for (const std::string& n : notes) r.changes += n.find("the light changed") != std::string::npos ? 1 : 0;
+  }
+  r.confidence = (*stage)->lighting().estimate.confidence;
+  r.samples = (*stage)->radiance_samples() ? (*stage)->radiance_samples()->size() : 0;
+  return r;
+}
+
+TEST(RadianceSamples, ASweepConstrainsMoreOfTheLightThanItsLastViewAndIsNotAChange) {
+  const Room room;
+  const SweepResult kept = sweep(room, true, 8), single = sweep(room, false, 8);
+  std::printf("sweep of 90 degrees: confidence %.3f accumulated (%zu samples), %.3f the last view alone\n",
+              kept.confidence, kept.samples, single.confidence);
+  EXPECT_GT(kept.samples, 100u);
+  EXPECT_EQ(single.samples, 0u);
+  EXPECT_GE(kept.confidence, single.confidence);
+  EXPECT_EQ(kept.changes, 0) << "a camera move is not a light change";
+}
+
+TEST(RadianceSamples, ALampSwitchedOnIsFollowedWithinAFewFrames) {
+  Room dark;
+  dark.sun_e = glm::dvec3(0.0);
+  Room lit = dark;
+  lit.lamp_intensity = glm::dvec3(1.5);
+  LightStageSettings settings;
+  const RenderedFrame off = render(dark, eye_at(0), {0.3, 0.2, 0.8}, 80, 60);
+  const RenderedFrame on = render(lit, eye_at(0), {0.3, 0.2, 0.8}, 80, 60);
+  auto stage = LightStage::create(settings, SceneDesc{}, CameraSetup{off.k, off.k, 5000.0, 1.0, std::nullopt});
+  ASSERT_TRUE(stage.ok());
+  auto fresh = LightStage::create(settings, SceneDesc{}, CameraSetup{on.k, on.k, 5000.0, 1.0, std::nullopt});
+  ASSERT_TRUE(fresh.ok());
+  std::vector<std::string> notes;
+  for (int i = 0; i < 40; ++i) {
+    frame::CameraView view = frame::CameraView::of(i < 20 ? off.frame : on.frame, i < 20 ? off.pose : on.pose);
+    view.index = i;
+    ASSERT_TRUE((*stage)->update(view, notes).ok());
+  }
+  frame::CameraView view = frame::CameraView::of(on.frame, on.pose);
+  ASSERT_TRUE((*fresh)->update(view, notes).ok());
+  int changes = 0;
+  for (const std::string& n : notes) changes += n.find("the light changed") != std::string::npos ? 1 : 0;
+  EXPECT_EQ(changes, 1);
+  // 20 frames after the switch the estimate is the lit room's, as a stage that never saw the
+  // dark one estimates it (band 0 within 5 %).
+  const auto& a = (*stage)->lighting().estimate.sh_radiance[0];
+  const auto& b = (*fresh)->lighting().estimate.sh_radiance[0];
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 0.05 * b[c]) << "channel " << c;
+}
+
+}  // namespace
