@@ -46,6 +46,10 @@ void setup(CLI::App& app) {
   cmd->add_option("--half", o->settings.half,
                   "all (default), tuning (the scenes a parameter may be chosen on) or held-out")
       ->check(CLI::IsMember({"all", "tuning", "held-out"}));
+  cmd->add_flag("--single-view", [o](int64_t n) { o->settings.accumulate_views = n == 0; },
+                "solve each view on its own (RuntimeSettings::light_accumulate_views false; the comparison)");
+  cmd->add_flag("--no-near-lamps", [o](int64_t n) { o->settings.near_lamps = n == 0; },
+                "distant light only: no near lamp looked for among the views (RuntimeSettings::light_near_lamps false)");
   cmd->add_flag("--validate", o->settings.validate, "Vulkan validation layers on (a message fails the run)");
   cmd->add_option("-o,--out", o->out, "write light-family.md and light-family.json into this folder");
   cmd->callback([o] { run(*o); });

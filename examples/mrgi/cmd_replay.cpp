@@ -27,6 +27,7 @@ struct ReplayOptions {
   OutputImagesOption output_images;
   int frames = 0, width = 0, height = 0, preload_frames = 0;
   bool validate = false, quiet = false, vulkan_1_2 = false, no_residual_light = false, profile = false;
+  bool single_view_light = false;
   ViewOptions view;
 };
 
@@ -38,6 +39,7 @@ void apply_options(const ReplayOptions& o, const CaptureInfo& info, RuntimeSetti
   settings.profile_passes = o.profile;
   settings.device.vulkan_1_2 = o.vulkan_1_2;
   settings.residual_light = !o.no_residual_light;
+  settings.light_accumulate_views = !o.single_view_light;
   settings.output_width = o.width;
   settings.output_height = o.height;
   settings.exposure = info.exposure;
@@ -442,6 +444,9 @@ void setup(CLI::App& app) {
   cmd->add_flag("--no-residual-light", opts->no_residual_light,
                 "with declared lamps: light by the lamps alone, without the estimate of the real light they do not "
                 "explain (RuntimeSettings::residual_light; an ablation)");
+  cmd->add_flag("--single-view-light", opts->single_view_light,
+                "the probeless estimate from each view on its own, not from every view seen "
+                "(RuntimeSettings::light_accumulate_views false; the comparison)");
   cmd->add_option("--io", opts->io,
                   "preloaded (default): decode a chunk of frames, run them back to back, then write them, so the "
                   "frames have the cores to themselves as on a live device, the scheduler holds their own cost to "

@@ -30,6 +30,7 @@ Expected<LightReplay> replay_light_capture(const CaptureReader& capture, const S
   rs.level = s.level;
   rs.device.validate = s.validate;
   rs.light_accumulate_views = s.accumulate_views;
+  rs.light_near_lamps = s.near_lamps;
   auto rt = create_runtime(rs, CameraSetup{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera},
                            scene);
   if (!rt) return rt.error();

@@ -147,6 +147,9 @@ Expected<SwitchResult> run_switch(const Manifest::Switch& w, const LightFamilySe
   if (!end) return fail(ErrorKind::Internal, w.name + ": no estimate at the last frame");
   r.final_direction_deg = direction_error_deg(*end, *probe);
   const double lum_end = band0_luminance(*end);
+  r.intensity_after = lum_end;
+  if (r.switch_frame > 0 && size_t(r.switch_frame) <= est->frames.size())
+    if (const auto& b = est->frames[size_t(r.switch_frame - 1)].light) r.intensity_before = band0_luminance(*b);
   int settled = -1;
   for (int i = int(est->frames.size()) - 1; i >= r.switch_frame; --i) {
     const auto& l = est->frames[size_t(i)].light;
@@ -177,6 +180,7 @@ Expected<DriftResult> run_drift(const LightFamilyScene& sc, const MovingFamilySe
   rs.technique = s.technique;
   rs.level = s.level;
   rs.light_accumulate_views = s.accumulate_views;
+  rs.light_near_lamps = s.near_lamps;
   auto rt = create_runtime(rs, CameraSetup{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera},
                            undeclared(*capture->scene()));
   if (!rt) return rt.error();
@@ -185,16 +189,17 @@ Expected<DriftResult> run_drift(const LightFamilyScene& sc, const MovingFamilySe
   DriftResult r;
   r.name = sc.name;
   r.frames = ms.drift_frames;
+  r.settled_from = int(std::max<int64_t>(cycle, ms.drift_frames / 10));
   auto consume = [&](const std::vector<FrameOutput>& outs) {
     for (const FrameOutput& o : outs) {
-      if (!o.light || !o.light->valid || o.stats.frame_index < cycle) continue;
-      if (!ref) {
-        ref = *o.light;
-        continue;
-      }
-      r.direction_deg = std::max(r.direction_deg, angle_deg(o.light->direction_to_light, ref->direction_to_light));
+      if (!o.light || !o.light->valid || o.stats.frame_index < r.settled_from) continue;
+      if (!ref) ref = *o.light;
+      const double dir = angle_deg(o.light->direction_to_light, ref->direction_to_light);
       const double l0 = band0_luminance(*ref);
-      if (l0 > 0.0) r.intensity = std::max(r.intensity, std::abs(band0_luminance(*o.light) / l0 - 1.0));
+      const double rel = l0 > 0.0 ? band0_luminance(*o.light) / l0 - 1.0 : 0.0;
+      r.direction_deg = std::max(r.direction_deg, dir);
+      r.intensity = std::max(r.intensity, std::abs(rel));
+      if (o.stats.frame_index % 10 == 0) r.series.push_back({double(o.stats.frame_index), dir, rel});
     }
   };
   for (int64_t k = 0; k < ms.drift_frames; ++k) {
@@ -225,7 +230,9 @@ Expected<MovingFamilyReport> run_moving_family(const MovingFamilySettings& ms,
   std::vector<const LightFamilyScene*> scenes;
   for (const LightFamilyScene& sc : m->scenes)
     if (in_half(sc.held_out, s.half)) scenes.push_back(&sc);
-  const size_t total = scenes.size() + (ms.switches ? m->switches.size() : 0) + (ms.drift_frames > 0 ? 1 : 0);
+  size_t switches = 0;
+  for (const Manifest::Switch& w : m->switches) switches += ms.switches && in_half(w.held_out, s.half) ? 1 : 0;
+  const size_t total = scenes.size() + switches + (ms.drift_frames > 0 ? 1 : 0);
   size_t done = 0;
   for (const LightFamilyScene* sc : scenes) {
     if (progress) progress(sc->name, done++, total);
@@ -264,7 +271,9 @@ std::string moving_family_markdown(const MovingFamilyReport& rep, const MovingFa
                 "dominant light; colour: largest per-channel error of the mean light's chromaticity; RDE "
                 "ratio: estimate-lit over true-lit (all pixels).\n\n",
                 ms.family.technique.c_str(), ms.family.level,
-                ms.family.accumulate_views ? "the estimate accumulated over the views" : "each view on its own");
+                !ms.family.accumulate_views ? "each view on its own"
+                : ms.family.near_lamps      ? "the estimate accumulated over the views, near lamps found"
+                                            : "the estimate accumulated over the views, distant light only");
   md += line;
   md += "Direction error (degrees) as the sweep grows:\n\n| scene | half | 0 deg | 22 deg | 45 deg | 67 deg | 90 deg |"
         " colour after | confidence after | RDE ratio, last 8 frames |\n|---|---|---|---|---|---|---|---|---|---|\n";
@@ -294,21 +303,23 @@ std::string moving_family_markdown(const MovingFamilyReport& rep, const MovingFa
     md += line;
   }
   if (!rep.switches.empty()) {
-    md += "\nA lamp switched on (target: followed within 30 frames):\n\n| switch | half | at frame | followed after "
-          "(frames) | changes detected | direction error after |\n|---|---|---|---|---|---|\n";
+    md += "\nA lamp switched on (target: followed within 30 frames; an output frame carries the newest estimate "
+          "when it is collected, up to 2 frames later with 2 in flight):\n\n| switch | half | at frame | followed after "
+          "(frames) | changes detected | intensity before -> after (band 0) | direction error after |\n"
+          "|---|---|---|---|---|---|---|\n";
     for (const SwitchResult& w : rep.switches) {
-      std::snprintf(line, sizeof line, "| %s | %s | %d | %s | %d | %.1f |\n", w.name.c_str(),
+      std::snprintf(line, sizeof line, "| %s | %s | %d | %s | %d | %.3f -> %.3f | %.1f |\n", w.name.c_str(),
                     w.held_out ? "held out" : "tuning", w.switch_frame,
                     w.followed_after < 0 ? "never" : std::to_string(w.followed_after).c_str(), w.changes_noted,
-                    w.final_direction_deg);
+                    w.intensity_before, w.intensity_after, w.final_direction_deg);
       md += line;
     }
   }
   for (const DriftResult& d : rep.drift) {
     std::snprintf(line, sizeof line,
-                  "\nDrift: %s played back and forth for %d frames: the estimate's direction moved at most %.3f "
-                  "degrees and its intensity %.3f %% after the first round trip (target 1 degree, 1 %%).\n",
-                  d.name.c_str(), d.frames, d.direction_deg, 100.0 * d.intensity);
+                  "\nDrift: %s played back and forth for %d frames: from frame %d on the estimate's direction "
+                  "moved at most %.3f degrees and its intensity %.3f %% (target 1 degree, 1 %%).\n",
+                  d.name.c_str(), d.frames, d.settled_from, d.direction_deg, 100.0 * d.intensity);
     md += line;
   }
   return md;
@@ -332,11 +343,12 @@ std::string moving_family_json(const MovingFamilyReport& rep) {
   for (const SwitchResult& w : rep.switches)
     j["switches"].push_back({{"name", w.name}, {"held_out", w.held_out}, {"at", w.switch_frame},
                              {"followed_after", w.followed_after}, {"changes_detected", w.changes_noted},
+                             {"intensity_before", w.intensity_before}, {"intensity_after", w.intensity_after},
                              {"final_direction_error_deg", w.final_direction_deg}});
   j["drift"] = nlohmann::json::array();
   for (const DriftResult& d : rep.drift)
-    j["drift"].push_back({{"scene", d.name}, {"frames", d.frames}, {"direction_deg", d.direction_deg},
-                          {"intensity", d.intensity}});
+    j["drift"].push_back({{"scene", d.name}, {"frames", d.frames}, {"settled_from", d.settled_from},
+                          {"direction_deg", d.direction_deg}, {"intensity", d.intensity}, {"series", d.series}});
   return j.dump(1) + "\n";
 }
 

@@ -25,8 +25,10 @@ struct ReplayResult {
 // `undeclared_light`: scene.json's lamps and environment are dropped, so the runtime lights the
 // scene from what it estimates (the light stage's probeless source), as an app that declares
 // nothing; the environment frames still serve as the truth for the direction error.
+// `accumulate_views`: RuntimeSettings::light_accumulate_views (the probeless estimate kept over
+// the views, or each view's own).
 inline ReplayResult replay_capture(const std::string& path, const std::string& technique, int level,
-                                   bool undeclared_light = false) {
+                                   bool undeclared_light = false, bool accumulate_views = true) {
   ReplayResult g;
   auto capture = CaptureReader::open(path);
   EXPECT_TRUE(capture.ok()) << (capture.ok() ? "" : capture.error().message);
@@ -43,6 +45,7 @@ inline ReplayResult replay_capture(const std::string& path, const std::string& t
   s.technique = technique;
   s.level = level;
   s.exposure = info.exposure;
+  s.light_accumulate_views = accumulate_views;
   auto rt = create_runtime(s, CameraSetup{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera},
                            scene);
   EXPECT_TRUE(rt.ok()) << (rt.ok() ? "" : rt.error().message);

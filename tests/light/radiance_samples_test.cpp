@@ -8,6 +8,7 @@
 #include <cstdio>
 
 #include "light/light_stage.h"
+#include "light/point_lamp_fit.h"
 #include "light/radiance_samples.h"
 #include "room_scene.h"
 
@@ -27,10 +28,10 @@ TEST(RadianceSamples, OneSamplePerCellAndOrientationWithTheMeanColour) {
   s.cell_m = 0.1;
   auto store = RadianceSamples::create(s);
   ASSERT_TRUE(store.ok()) << store.error().message;
-  store->observe({0.01, 0.0, 0.02}, 3, unit_transfer(0), {1.0, 1.0, 1.0}, 1.0f, 0);
-  store->observe({0.05, 0.0, 0.08}, 3, unit_transfer(0), {1.1, 1.1, 1.1}, 1.0f, 1);  // same cell, same bin
-  store->observe({0.05, 0.0, 0.08}, 4, unit_transfer(1), {0.5, 0.5, 0.5}, 1.0f, 1);  // same cell, other bin
-  store->observe({0.25, 0.0, 0.08}, 3, unit_transfer(2), {0.7, 0.7, 0.7}, 1.0f, 1);  // next cell
+  store->observe({0.01, 0.0, 0.02}, {0, 1, 0}, 3, unit_transfer(0), {1.0, 1.0, 1.0}, 1.0f, 0);
+  store->observe({0.05, 0.0, 0.08}, {0, 1, 0}, 3, unit_transfer(0), {1.1, 1.1, 1.1}, 1.0f, 1);  // same cell, same bin
+  store->observe({0.05, 0.0, 0.08}, {0, 1, 0}, 4, unit_transfer(1), {0.5, 0.5, 0.5}, 1.0f, 1);  // same cell, other bin
+  store->observe({0.25, 0.0, 0.08}, {0, 1, 0}, 3, unit_transfer(2), {0.7, 0.7, 0.7}, 1.0f, 1);  // next cell
   EXPECT_FALSE(store->end_frame(1));
   EXPECT_EQ(store->size(), 3u);
   LightSystem sys;
@@ -41,6 +42,26 @@ TEST(RadianceSamples, OneSamplePerCellAndOrientationWithTheMeanColour) {
   EXPECT_NEAR(sys.ata[0], 1.0, 1e-12);
 }
 
+TEST(RadianceSamples, ASettledSampleKeepsItsTransferAndTakesColourOnly) {
+  RadianceSampleSettings s;
+  s.cell_m = 0.1;
+  s.settle_observations = 3;
+  auto store = RadianceSamples::create(s);
+  ASSERT_TRUE(store.ok());
+  const glm::dvec3 at(0.05, 0.0, 0.05);
+  EXPECT_FALSE(store->observe_if_settled(at, {0, 1, 0}, 0, glm::dvec3(0.5), 1.0f, 0, false)) << "not there yet";
+  EXPECT_EQ(store->size(), 0u);
+  for (int f = 0; f < 3; ++f) {
+    EXPECT_FALSE(store->observe_if_settled(at, {0, 1, 0}, 0, glm::dvec3(0.5), 1.0f, f, false)) << "observation " << f;
+    store->observe(at, {0, 1, 0}, 0, unit_transfer(0), glm::dvec3(0.5), 1.0f, f);
+  }
+  ASSERT_TRUE(store->observe_if_settled(at, {0, 1, 0}, 0, glm::dvec3(0.9), 1.0f, 3, false));
+  ASSERT_EQ(store->size(), 1u);
+  EXPECT_FLOAT_EQ(store->samples()[0].transfer[0], 1.0f);
+  EXPECT_NEAR(store->samples()[0].colour.x, 0.6, 1e-12) << "the running mean of 0.5, 0.5, 0.5, 0.9";
+  EXPECT_FALSE(store->observe_if_settled(at, {0, 1, 0}, 0, glm::dvec3(0.9), 1.0f, 4, true)) << "a clipped block";
+}
+
 TEST(RadianceSamples, ALightChangeDropsWhatIsOutOfViewAndACameraMoveDoesNot) {
   RadianceSampleSettings s;
   s.cell_m = 0.1;
@@ -48,13 +69,13 @@ TEST(RadianceSamples, ALightChangeDropsWhatIsOutOfViewAndACameraMoveDoesNot) {
   auto store = RadianceSamples::create(s);
   ASSERT_TRUE(store.ok());
   // Frame 0 sees cells 0..9; frame 1 moves on to 5..14 under the same light: no change.
-  for (int c = 0; c < 10; ++c) store->observe({0.1 * c + 0.05, 0, 0}, 0, unit_transfer(c), glm::dvec3(0.4), 1.0f, 0);
+  for (int c = 0; c < 10; ++c) store->observe({0.1 * c + 0.05, 0, 0}, {0, 1, 0}, 0, unit_transfer(c), glm::dvec3(0.4), 1.0f, 0);
   EXPECT_FALSE(store->end_frame(0));
-  for (int c = 5; c < 15; ++c) store->observe({0.1 * c + 0.05, 0, 0}, 0, unit_transfer(c), glm::dvec3(0.41), 1.0f, 1);
+  for (int c = 5; c < 15; ++c) store->observe({0.1 * c + 0.05, 0, 0}, {0, 1, 0}, 0, unit_transfer(c), glm::dvec3(0.41), 1.0f, 1);
   EXPECT_FALSE(store->end_frame(1));
   EXPECT_EQ(store->size(), 15u);
   // Frame 2: a lamp on, cells 10..14 seen again 60 % brighter: a change; cells 0..9 are gone.
-  for (int c = 10; c < 15; ++c) store->observe({0.1 * c + 0.05, 0, 0}, 0, unit_transfer(c), glm::dvec3(0.66), 1.0f, 2);
+  for (int c = 10; c < 15; ++c) store->observe({0.1 * c + 0.05, 0, 0}, {0, 1, 0}, 0, unit_transfer(c), glm::dvec3(0.66), 1.0f, 2);
   EXPECT_TRUE(store->end_frame(2));
   EXPECT_EQ(store->changes(), 1);
   EXPECT_EQ(store->size(), 5u);
@@ -63,7 +84,7 @@ TEST(RadianceSamples, ALightChangeDropsWhatIsOutOfViewAndACameraMoveDoesNot) {
   for (int c = 10; c < 15; ++c) EXPECT_NEAR(sys.atb[size_t(c) * 3], 0.66, 1e-12) << "restarts from the new colour";
   // Below the fraction (2 of 5 changed): not a change.
   for (int c = 10; c < 15; ++c)
-    store->observe({0.1 * c + 0.05, 0, 0}, 0, unit_transfer(c), glm::dvec3(c < 12 ? 1.0 : 0.66), 1.0f, 3);
+    store->observe({0.1 * c + 0.05, 0, 0}, {0, 1, 0}, 0, unit_transfer(c), glm::dvec3(c < 12 ? 1.0 : 0.66), 1.0f, 3);
   EXPECT_FALSE(store->end_frame(3));
 }
 
@@ -73,7 +94,7 @@ TEST(RadianceSamples, AFullStoreDropsTheLeastRecentlySeenAndRefusesBadSettings) 
   s.cell_m = 0.1;
   auto store = RadianceSamples::create(s);
   ASSERT_TRUE(store.ok());
-  for (int c = 0; c < 200; ++c) store->observe({0.1 * c + 0.05, 0, 0}, 0, unit_transfer(c), glm::dvec3(0.3), 1.0f, c);
+  for (int c = 0; c < 200; ++c) store->observe({0.1 * c + 0.05, 0, 0}, {0, 1, 0}, 0, unit_transfer(c), glm::dvec3(0.3), 1.0f, c);
   EXPECT_LE(store->size(), 64u);
   EXPECT_GE(store->size(), 48u);
   for (auto [field, bad] : std::vector<std::pair<std::string, RadianceSampleSettings>>{
@@ -145,10 +166,12 @@ TEST(RadianceSamples, ALampSwitchedOnIsFollowedWithinAFewFrames) {
   auto fresh = LightStage::create(settings, SceneDesc{}, CameraSetup{on.k, on.k, 5000.0, 1.0, std::nullopt});
   ASSERT_TRUE(fresh.ok());
   std::vector<std::string> notes;
+  Rgb before{};
   for (int i = 0; i < 40; ++i) {
     frame::CameraView view = frame::CameraView::of(i < 20 ? off.frame : on.frame, i < 20 ? off.pose : on.pose);
     view.index = i;
     ASSERT_TRUE((*stage)->update(view, notes).ok());
+    if (i == 19) before = (*stage)->lighting().estimate.sh_radiance[0];
   }
   frame::CameraView view = frame::CameraView::of(on.frame, on.pose);
   ASSERT_TRUE((*fresh)->update(view, notes).ok());
@@ -156,10 +179,59 @@ TEST(RadianceSamples, ALampSwitchedOnIsFollowedWithinAFewFrames) {
   for (const std::string& n : notes) changes += n.find("the light changed") != std::string::npos ? 1 : 0;
   EXPECT_EQ(changes, 1);
   // 20 frames after the switch the estimate is the lit room's, as a stage that never saw the
-  // dark one estimates it (band 0 within 5 %).
+  // dark one estimates it (band 0 within 10 %, the `mrgi light-moving` rule for "followed"),
+  // which the estimate before the switch is not.
   const auto& a = (*stage)->lighting().estimate.sh_radiance[0];
   const auto& b = (*fresh)->lighting().estimate.sh_radiance[0];
-  for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 0.05 * b[c]) << "channel " << c;
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(a[c], b[c], 0.1 * b[c]) << "channel " << c;
+    EXPECT_GT(std::abs(before[c] - b[c]), 0.1 * b[c]) << "channel " << c << ": the switch must change the light";
+  }
+}
+
+}  // namespace
+
+namespace {
+
+// Samples of a floor and two walls (a corner), lit by `lamp` at `lamp_at` (W/sr, unshadowed) or
+// by a distant light from `sun` (W/m^2), plus a uniform ambient irradiance, grey albedo 0.5.
+RadianceSamples lit_corner(const glm::dvec3* lamp_at, double lamp, const glm::dvec3* sun, double sun_e) {
+  RadianceSampleSettings s;
+  s.cell_m = 0.05;
+  auto store = RadianceSamples::create(s);
+  EXPECT_TRUE(store.ok());
+  auto add = [&](const glm::dvec3& p, const glm::dvec3& n) {
+    double e = 0.3;
+    if (lamp_at) {
+      const glm::dvec3 v = *lamp_at - p;
+      const double d = glm::length(v);
+      e += lamp * std::max(0.0, glm::dot(n, v / d)) / (d * d);
+    }
+    if (sun) e += sun_e * std::max(0.0, glm::dot(n, *sun));
+    store->observe(p, glm::vec3(n), 0, unit_transfer(0), glm::dvec3(0.5 / kPi * e), 1.0f, 0);
+  };
+  for (int i = 0; i < 30; ++i)
+    for (int j = 0; j < 30; ++j) {
+      const double u = -1.0 + 2.0 * i / 29.0, v = -0.5 + 2.0 * j / 29.0;
+      add({u, 0.0, v}, {0, 1, 0});                             // floor
+      add({u, 0.05 + 1.8 * j / 29.0, 1.5}, {0, 0, -1});        // back wall
+      if (i < 15) add({-1.0, 0.05 + 1.8 * i / 14.0, v}, {1, 0, 0});  // left wall
+    }
+  return std::move(*store);
+}
+
+TEST(PointLampFit, FindsANearLampInACornerAndNotTheSun) {
+  const glm::dvec3 lamp(0.3, 1.4, 0.4);
+  PointLampFitter fitter{PointLampFitSettings{}};
+  const RadianceSamples near = lit_corner(&lamp, 2.0, nullptr, 0.0);
+  const PointLampFit f = fitter.fit(near, 0.5);
+  ASSERT_TRUE(f.found) << "residuals point " << f.residual_point << " distant " << f.residual_distant;
+  EXPECT_LT(glm::distance(f.position, lamp), 0.15) << f.position.x << " " << f.position.y << " " << f.position.z;
+  EXPECT_NEAR(f.intensity.x, 2.0, 0.3);
+  const glm::dvec3 sun = glm::normalize(glm::dvec3(0.4, 0.8, 0.3));
+  const PointLampFit g = fitter.fit(lit_corner(nullptr, 0.0, &sun, 2.0), 0.5);
+  EXPECT_FALSE(g.found) << "a distant light is not a lamp: " << g.position.x << " " << g.position.y << " "
+                        << g.position.z;
 }
 
 }  // namespace

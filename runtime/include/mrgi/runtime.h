@@ -398,6 +398,10 @@ struct RuntimeSettings {
   /// has swept; a light change (surfaces seen again differ in brightness) drops what is out of
   /// view. false: each solve from the current view only.
   bool light_accumulate_views = true;
+  /// With the views accumulated: look for a near lamp among them (light/point_lamp_fit.h) and
+  /// light with it where it was found, as a shadowed lamp at its position, instead of a distant
+  /// light. false: the distant light only.
+  bool light_near_lamps = true;
 };
 
 // ---------------------------------------------------------------------------------------------

@@ -27,6 +27,12 @@ Lighting::AmbientRegion ambient_region(const glm::dvec3& direction, const glm::d
   return a;
 }
 
+// The cone of the near lamp's stand-in spot (set_probeless_lighting): full light within 50 degrees
+// of the virtual objects' direction, none beyond 60 (a 120-degree shadow frustum).
+constexpr double kNearLampInnerDeg = 50.0, kNearLampOuterDeg = 60.0;
+// Successive near-lamp fits closer than this are the same lamp, and move it this fraction.
+constexpr double kSameLampM = 0.5, kLampSmoothing = 0.3;
+
 // The lights' colour and intensity in scene.json's convention: colour times intensity per
 // channel, the colour's largest channel 1.
 void set_rgb(LightDesc& l, const glm::dvec3& rgb) {
@@ -136,6 +142,7 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
       auto store = RadianceSamples::create(settings.samples);
       if (!store) return store.error();
       s.samples_.emplace(std::move(*store));
+      if (settings.point_lamp.enabled) s.lamp_fitter_.emplace(settings.point_lamp);
     }
   }
   s.max_lights_ = s.declared_ + s.env_lights_ + (s.planned_ == LightSourceKind::Probeless ? 1 : 0);
@@ -360,6 +367,36 @@ void LightStage::set_probeless_lighting() {
   lighting_.foldable.clear();
   ShRgb ambient = l;
   glm::dvec3 dir;
+  if (est.valid && lamp_.found) {
+    // A near lamp: a shadowed light where it was found, a wide spot aimed at the virtual objects'
+    // centre (the focus), so it takes one shadow map layer as the distant light it stands in
+    // for does (a point lamp's six would overrun what was allocated for the probeless source);
+    // the estimate is exported with the lamp as the focus sees it added to the SH of the rest.
+    const glm::dvec3 v = lamp_.position - glm::dvec3(settings_.focus);
+    const double d2 = std::max(glm::dot(v, v), 1e-4);
+    const glm::dvec3 to_lamp = v / std::sqrt(d2);
+    LightDesc p;
+    p.type = LightType::Spot;
+    p.real = true;
+    p.position = glm::vec3(lamp_.position);
+    p.direction = glm::vec3(-to_lamp);
+    p.inner_angle_deg = float(kNearLampInnerDeg);
+    p.outer_angle_deg = float(kNearLampOuterDeg);
+    set_rgb(p, lamp_.intensity);
+    const ShRgb sh = sh_directional_light(to_lamp, lamp_.intensity / d2);
+    lighting_.lights.push_back(p);
+    lighting_.light_sh.push_back(sh);
+    lighting_.foldable.push_back(0);
+    ShRgb all = l;
+    for (int i = 0; i < kMaxShCoeffs; ++i) all[size_t(i)] += sh[size_t(i)];
+    lighting_.ambient_real = ambient;
+    lighting_.ambient_virtual = ShRgb{};
+    lighting_.ambient_regions.clear();
+    lighting_.estimate = est;
+    fill_light_estimate(all, est.bands, lighting_.estimate);
+    ++lighting_.revision;
+    return;
+  }
   if (est.valid && sh_dominant_direction(l, dir)) {
     const glm::dvec3 e = sh_dominant_intensity(l, dir);
     if (luminance(e) > 0.0) {
@@ -406,6 +443,9 @@ void LightStage::use_external_system() {
   lighting_.environment = false;
   max_lights_ = 1;
   probeless_.reset();
+  samples_.reset();
+  lamp_fitter_.reset();
+  lamp_ = PointLampFit{};
   residual_ = false;
   set_probeless_lighting();
 }
@@ -437,24 +477,36 @@ Status LightStage::add_probeless_parts(const frame::CameraView& camera, std::vec
   RadianceSamples* store = samples_ ? &*samples_ : nullptr;
   for (int p = first ? 0 : next_part_; p < (first ? parts : next_part_ + 1); ++p)
     MRGI_TRY(probeless_->add_part(camera, cameras_.exposure, p, pending_, store));
-  bool changed = false;
   if (store && store->end_frame(camera.index)) {
-    // The light changed (a lamp switched on or off): the samples out of view are gone, so the
-    // rest of this view goes in now and the estimate jumps to this frame's solve instead of
-    // being filtered towards it from the old light.
-    changed = true;
-    for (int p = 0; p < parts && !first; ++p)
-      if (p != next_part_) MRGI_TRY(probeless_->add_part(camera, cameras_.exposure, p, pending_, store));
-    estimator_->restart_filter();
+    // The light changed (a lamp switched on or off): the samples out of view are gone and the
+    // next two solves (by then this view's parts are all in, at most 2 x `parts` frames on; no
+    // frame pays for a whole grid) replace the estimate instead of being filtered towards from
+    // the old light.
+    estimator_->restart_filter(2);
     notes.push_back("light: the light changed (surfaces seen again differ in brightness): the probeless "
-                    "estimate restarts from this view");
+                    "estimate restarts from the views after it");
   }
-  next_part_ = first || changed ? 0 : (next_part_ + 1) % parts;
+  const double albedo = estimator_->settings().gray_albedo;
+  // The near lamp is looked for half way through the parts, not with the solve, so no frame
+  // pays for both (each about 2 ms of one core at 640x480).
+  if (store && lamp_fitter_ && (first || next_part_ == parts / 2)) {
+    // Fits of the same lamp are averaged (a fit reads a few hundred samples, so its position
+    // scatters by a decimetre or two from one to the next); another lamp, or none, replaces it.
+    const PointLampFit fit = lamp_fitter_->fit(*store, albedo);
+    if (fit.found && lamp_.found && glm::distance(fit.position, lamp_.position) < kSameLampM) {
+      lamp_.position += kLampSmoothing * (fit.position - lamp_.position);
+      lamp_.intensity += kLampSmoothing * (fit.intensity - lamp_.intensity);
+    } else {
+      lamp_ = fit;
+    }
+  }
+  next_part_ = first ? 0 : (next_part_ + 1) % parts;
   solved = next_part_ == 0;
   if (solved) {
     if (store) {
       pending_.clear();
-      store->add_to(pending_, &estimator_->filtered(), estimator_->settings().gray_albedo);
+      store->add_to(pending_, &estimator_->filtered(), albedo, lamp_.found ? &lamp_.position : nullptr,
+                    lamp_.found ? &lamp_.intensity : nullptr);
     }
     auto r = estimator_->update(pending_, camera.index, camera.timestamp);
     if (!r) notes.push_back("light: " + r.error().message);

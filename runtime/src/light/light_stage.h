@@ -31,6 +31,7 @@
 #include "frame/camera_view.h"
 #include "light/env_sampler.h"
 #include "light/lamp_removal.h"
+#include "light/point_lamp_fit.h"
 #include "light/probeless.h"
 #include "light/sh_estimator.h"
 #include "light/sh_tools.h"
@@ -105,6 +106,9 @@ struct LightStageSettings {
   // over every surface the camera has swept, not only the current view. The residual estimate
   // (declared lamps) stays per view: its low-order ambient is constrained by one view.
   RadianceSampleSettings samples;
+  // A near lamp found from those views (point_lamp_fit.h): lit as a shadowed point light at its
+  // position, the SH estimate then holding the rest.
+  PointLampFitSettings point_lamp;
   // The estimator of the probeless source fed by the stage's own builder. RGB (white_light
   // false): the paper's white-light assumption gives a grey estimate under a blue sky. Chosen on
   // the light family's tuning half only (perf/suite/light/family.json; perf/results/
@@ -335,6 +339,8 @@ class LightStage {
   std::optional<ProbelessBuilder> probeless_;
   std::optional<LightEstimator> estimator_;
   std::optional<RadianceSamples> samples_;  // the probeless source's, when accumulating
+  std::optional<PointLampFitter> lamp_fitter_;
+  PointLampFit lamp_;                       // the last solve's
   LightSystem pending_;             // the parts of the probeless system summed so far
   int next_part_ = 0;
   Lighting lighting_;

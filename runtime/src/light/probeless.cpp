@@ -261,6 +261,14 @@ Status ProbelessBuilder::add_part(const frame::CameraView& view, double exposure
     const glm::dvec3 colour = sample.colour;
     {
       const glm::vec3 n = rot * n_cam;
+      if (samples && known_lamps_.empty()) {
+        // A surface the store has seen often enough keeps its transfer: only its colour is new
+        // (the visibility search is most of this loop's cost).
+        const glm::dvec3 world = glm::dvec3(camera_to_world * glm::dvec4(glm::dvec3(p), 1.0));
+        if (samples->observe_if_settled(world, n, bin_[size_t(sample.cell)], colour, weight_row, view.index,
+                                        sample.clipped))
+          continue;
+      }
       ShVector t{};
       for (size_t j = 0; j < directions_.size(); ++j) {
         const glm::vec3& w = directions_[j];
@@ -288,7 +296,7 @@ Status ProbelessBuilder::add_part(const frame::CameraView& view, double exposure
       }
       if (samples) {
         const glm::dvec3 world = glm::dvec3(camera_to_world * glm::dvec4(glm::dvec3(p), 1.0));
-        samples->observe(world, bin_[size_t(sample.cell)], t, colour - known, weight_row, view.index, sample.clipped);
+        samples->observe(world, n, bin_[size_t(sample.cell)], t, colour - known, weight_row, view.index, sample.clipped);
         continue;
       }
       // Rows weighted so that every orientation of surface counts alike (balance_normals).

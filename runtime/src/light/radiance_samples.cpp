@@ -30,6 +30,8 @@ Expected<RadianceSamples> RadianceSamples::create(const RadianceSampleSettings& 
   MRGI_TRY(check_sample_setting(s.change_fraction > 0.0 && s.change_fraction <= 1.0, "change_fraction",
                                 "must be in (0, 1]"));
   MRGI_TRY(check_sample_setting(s.change_min_samples >= 1, "change_min_samples", "must be >= 1"));
+  MRGI_TRY(check_sample_setting(s.settle_observations >= 1 && s.settle_observations <= 1024, "settle_observations",
+                                "must be 1..1024"));
   RadianceSamples r;
   r.settings_ = s;
   r.samples_.reserve(size_t(s.capacity));
@@ -85,12 +87,15 @@ void RadianceSamples::evict_oldest() {
   rebuild_table();
 }
 
-void RadianceSamples::observe(const glm::dvec3& position, int bin, const ShVector& transfer,
+void RadianceSamples::begin(int64_t frame) {
+  if (frame == frame_) return;
+  frame_ = frame;
+  reobserved_ = changed_ = 0;
+}
+
+void RadianceSamples::observe(const glm::dvec3& position, const glm::vec3& normal, int bin, const ShVector& transfer,
                               const glm::dvec3& colour, float row_weight, int64_t frame, bool clipped) {
-  if (frame != frame_) {
-    frame_ = frame;
-    reobserved_ = changed_ = 0;
-  }
+  begin(frame);
   const uint64_t key = key_of(position, bin);
   int64_t slot = find_slot(key);
   if (table_[size_t(slot)] < 0) {
@@ -99,16 +104,32 @@ void RadianceSamples::observe(const glm::dvec3& position, int bin, const ShVecto
       slot = find_slot(key);
     }
     table_[size_t(slot)] = int32_t(samples_.size());
-    samples_.push_back({key, transfer, colour, colour, row_weight, clipped, 1, frame});
+    samples_.push_back({key, transfer, colour, colour, glm::vec3(position), normal, row_weight, clipped, 1, frame});
     return;
   }
+  update(samples_[size_t(table_[size_t(slot)])], position, normal, &transfer, colour, row_weight, frame, clipped);
+}
+
+bool RadianceSamples::observe_if_settled(const glm::dvec3& position, const glm::vec3& normal, int bin,
+                                         const glm::dvec3& colour, float row_weight, int64_t frame, bool clipped) {
+  begin(frame);
+  const int64_t slot = find_slot(key_of(position, bin));
+  if (table_[size_t(slot)] < 0) return false;
   Sample& s = samples_[size_t(table_[size_t(slot)])];
+  if (s.observations < settings_.settle_observations || s.clipped != clipped) return false;
+  update(s, position, normal, nullptr, colour, row_weight, frame, clipped);
+  return true;
+}
+
+void RadianceSamples::update(Sample& s, const glm::dvec3& position, const glm::vec3& normal, const ShVector* transfer,
+                             const glm::dvec3& colour, float row_weight, int64_t frame, bool clipped) {
   if (clipped != s.clipped) {
     if (clipped) {  // a bound beside measurements: the measurements stand
       s.last_frame = frame;
       return;
     }
-    s = Sample{key, transfer, colour, colour, row_weight, false, 1, frame};  // a measurement replaces a bound
+    // A measurement replaces a bound.
+    s = Sample{s.key, transfer ? *transfer : s.transfer, colour, colour, glm::vec3(position), normal, row_weight, false, 1, frame};
     return;
   }
   if (s.last_frame < frame && !clipped) {
@@ -122,7 +143,10 @@ void RadianceSamples::observe(const glm::dvec3& position, int bin, const ShVecto
   s.observations = std::min(s.observations + 1, settings_.colour_frames);
   const double a = 1.0 / double(s.observations);
   s.colour += a * (colour - s.colour);
-  for (size_t i = 0; i < s.transfer.size(); ++i) s.transfer[i] += float(a) * (transfer[i] - s.transfer[i]);
+  if (transfer)
+    for (size_t i = 0; i < s.transfer.size(); ++i) s.transfer[i] += float(a) * ((*transfer)[i] - s.transfer[i]);
+  s.position += float(a) * (glm::vec3(position) - s.position);
+  s.normal += float(a) * (normal - s.normal);
   s.last_colour = colour;
   s.row_weight = row_weight;
   s.last_frame = frame;
@@ -145,18 +169,27 @@ bool RadianceSamples::end_frame(int64_t frame) {
   return true;
 }
 
-void RadianceSamples::add_to(LightSystem& system, const ShRgb* estimate, double albedo) const {
+void RadianceSamples::add_to(LightSystem& system, const ShRgb* estimate, double albedo,
+                             const glm::dvec3* lamp_position, const glm::dvec3* lamp_intensity) const {
   for (const Sample& s : samples_) {
+    glm::dvec3 colour = s.colour;
+    if (lamp_position && lamp_intensity) {
+      const glm::dvec3 v = *lamp_position - glm::dvec3(s.position);
+      const double d = std::max(glm::length(v), 0.15);
+      const double len = glm::length(glm::dvec3(s.normal));
+      const double g = len > 0.0 ? std::max(0.0, glm::dot(glm::dvec3(s.normal) / len, v)) / (d * d * d) : 0.0;
+      colour = glm::max(colour - (albedo / 3.14159265358979323846 * g) * *lamp_intensity, glm::dvec3(0.0));
+    }
     if (s.clipped) {
       if (!estimate) continue;
       glm::dvec3 predicted(0.0);
       for (int i = 0; i < kMaxShCoeffs; ++i) predicted += double(s.transfer[size_t(i)]) * (*estimate)[size_t(i)];
-      if (albedo * luminance(predicted) >= luminance(s.colour)) continue;
+      if (albedo * luminance(predicted) >= luminance(colour)) continue;
     }
     const float w = std::sqrt(s.row_weight);
     ShVector t = s.transfer;
     for (float& v : t) v *= w;
-    system.add(t, s.colour * double(w));
+    system.add(t, colour * double(w));
   }
 }
 

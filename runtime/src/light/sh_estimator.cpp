@@ -177,6 +177,7 @@ void LightEstimator::reset() {
   estimate_.bands = settings_.bands;
   fill_light_estimate(filtered_, settings_.bands, estimate_);
   have_previous_ = false;
+  replace_updates_ = 0;
   last_frame_ = 0;
 }
 
@@ -240,7 +241,9 @@ Expected<LightEstimate> LightEstimator::update(const LightSystem& system, int64_
 
   // Temporal filter. The first real frame replaces the prior outright.
   double alpha = 1.0;
-  if (have_previous_ && settings_.lag_frames > 0.0) {
+  const bool replace = replace_updates_ > 0;
+  if (replace) --replace_updates_;
+  if (have_previous_ && !replace && settings_.lag_frames > 0.0) {
     // At least one frame (a frame solved twice, indices going back after a reset of the
     // source), at most ten time constants (a long gap: the old estimate is worthless).
     const double step = std::clamp(double(frame_index - last_frame_), 1.0, 10.0 * settings_.lag_frames);

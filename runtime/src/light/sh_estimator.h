@@ -13,6 +13,7 @@
 // (Tikhonov towards p = the previous estimate, or the prior before the first one), so
 // unconstrained directions keep what was known and constrained ones follow the data.
 #pragma once
+#include <algorithm>
 #include <array>
 #include <cstdint>
 
@@ -117,9 +118,13 @@ class LightEstimator {
   // frame had none (no data or bands < 2).
   const glm::dvec3& dominant_normal() const { return dominant_normal_; }
   void reset();
-  // The next update replaces the filtered estimate with its solution (as the first one does),
-  // keeping the estimate valid meanwhile: after a detected change of the light.
-  void restart_filter() { have_previous_ = false; }
+  // The next `updates` updates replace the filtered estimate with their solutions (as the first
+  // one does), keeping the estimate valid meanwhile: after a detected change of the light, while
+  // the new light's view is still being gathered (its first solve may hold part of a view).
+  void restart_filter(int updates = 1) {
+    have_previous_ = false;
+    replace_updates_ = std::max(updates, 1);
+  }
 
  private:
   explicit LightEstimator(const LightEstimatorSettings& settings) : settings_(settings) {}
@@ -130,6 +135,7 @@ class LightEstimator {
   LightEstimate estimate_;
   glm::dvec3 dominant_normal_{0.0};
   bool have_previous_ = false;
+  int replace_updates_ = 0;  // restart_filter's updates still to replace outright
   int64_t last_frame_ = 0;
 };
 

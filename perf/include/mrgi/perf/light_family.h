@@ -59,6 +59,7 @@ struct LightFamilySettings {
   // Which scenes run: "all", "tuning" (the half a parameter may be chosen on) or "held-out".
   std::string half = "all";
   bool accumulate_views = true;  // RuntimeSettings::light_accumulate_views
+  bool near_lamps = true;        // RuntimeSettings::light_near_lamps
 };
 
 // One capture replayed through the runtime: the error of every frame and the light it came

@@ -11,8 +11,10 @@
 // luminance) and 5 degrees in direction of where it ends, counted from the switch.
 //
 // Drift: one capture played back and forth for N frames; the largest change of the estimate's
-// direction (degrees) and intensity (relative) from the end of the first round trip on.
+// direction (degrees) and intensity (relative) from a tenth of the run on (at least one round
+// trip: the store has seen every view and the filter has settled).
 #pragma once
+#include <array>
 #include <string>
 #include <vector>
 
@@ -41,12 +43,16 @@ struct SwitchResult {
   int followed_after = -1;  // frames after the switch; -1 = never settled
   int changes_noted = 0;    // frames whose notes say a light change was detected
   double final_direction_deg = 0.0;  // against the lamp-on truth
+  double intensity_before = 0.0, intensity_after = 0.0;  // band-0 luminance before the switch, at the end
 };
 
 struct DriftResult {
   std::string name;
   int frames = 0;
-  double direction_deg = 0.0, intensity = 0.0;  // largest change after the first round trip
+  int settled_from = 0;  // the frame the changes are measured from (a tenth of the run, at least a round trip)
+  double direction_deg = 0.0, intensity = 0.0;  // largest change from settled_from on
+  // Every 10th frame's estimate: direction (degrees from settled_from's) and intensity (relative).
+  std::vector<std::array<double, 3>> series;  // frame, direction_deg, intensity
 };
 
 struct MovingFamilyReport {
