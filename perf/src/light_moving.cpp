@@ -17,7 +17,7 @@ namespace {
 namespace fs = std::filesystem;
 
 double band0_luminance(const LightEstimate& e) {
-  const Rgb& c = e.sh_radiance[0];
+  const mrgi::Rgb& c = e.sh_radiance[0];
   return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
 }
 

@@ -32,8 +32,11 @@ TEST(RadianceSamples, OneSamplePerCellAndOrientationWithTheMeanColour) {
   store->observe({0.05, 0.0, 0.08}, {0, 1, 0}, 3, unit_transfer(0), {1.1, 1.1, 1.1}, 1.0f, 1);  // same cell, same bin
   store->observe({0.05, 0.0, 0.08}, {0, 1, 0}, 4, unit_transfer(1), {0.5, 0.5, 0.5}, 1.0f, 1);  // same cell, other bin
   store->observe({0.25, 0.0, 0.08}, {0, 1, 0}, 3, unit_transfer(2), {0.7, 0.7, 0.7}, 1.0f, 1);  // next cell
+  const double nan = std::nan("");
+  store->observe({nan, 0.0, 0.0}, {0, 1, 0}, 3, unit_transfer(0), {1.0, 1.0, 1.0}, 1.0f, 1);  // a broken pose
+  store->observe({0.01, 0.0, 0.02}, {0, 1, 0}, 3, unit_transfer(0), {nan, 1.0, 1.0}, 1.0f, 1);
   EXPECT_FALSE(store->end_frame(1));
-  EXPECT_EQ(store->size(), 3u);
+  EXPECT_EQ(store->size(), 3u) << "what is not finite is ignored";
   LightSystem sys;
   store->add_to(sys);
   EXPECT_DOUBLE_EQ(sys.samples, 3.0);

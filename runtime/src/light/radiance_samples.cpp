@@ -96,6 +96,7 @@ void RadianceSamples::begin(int64_t frame) {
 void RadianceSamples::observe(const glm::dvec3& position, const glm::vec3& normal, int bin, const ShVector& transfer,
                               const glm::dvec3& colour, float row_weight, int64_t frame, bool clipped) {
   begin(frame);
+  if (!std::isfinite(position.x + position.y + position.z) || !std::isfinite(colour.x + colour.y + colour.z)) return;
   const uint64_t key = key_of(position, bin);
   int64_t slot = find_slot(key);
   if (table_[size_t(slot)] < 0) {
@@ -113,6 +114,8 @@ void RadianceSamples::observe(const glm::dvec3& position, const glm::vec3& norma
 bool RadianceSamples::observe_if_settled(const glm::dvec3& position, const glm::vec3& normal, int bin,
                                          const glm::dvec3& colour, float row_weight, int64_t frame, bool clipped) {
   begin(frame);
+  if (!std::isfinite(position.x + position.y + position.z) || !std::isfinite(colour.x + colour.y + colour.z))
+    return true;  // nothing to learn from it, and no transfer to compute for it
   const int64_t slot = find_slot(key_of(position, bin));
   if (table_[size_t(slot)] < 0) return false;
   Sample& s = samples_[size_t(table_[size_t(slot)])];

@@ -63,6 +63,7 @@ class RadianceSamples {
   // the row's weight (ProbelessSettings::balance_normals; 1 otherwise).
   // `clipped`: the colour is a lower bound (a saturated pixel in the block). A sample keeps its
   // unclipped observations over clipped ones, and clipped ones never count as a light change.
+  // A position or colour that is not finite (a broken pose) is ignored.
   void observe(const glm::dvec3& position, const glm::vec3& normal, int orientation_bin, const ShVector& transfer,
                const glm::dvec3& colour, float row_weight, int64_t frame, bool clipped = false);
   // The same observation without a transfer vector, taken only where the sample exists and
