@@ -23,22 +23,29 @@ ShVector unit_transfer(int i) {
   return t;
 }
 
-TEST(RadianceSamples, OneSamplePerCellAndOrientationWithTheMeanColour) {
+// A store of 10 cm cells, with `change` applied to its settings first.
+RadianceSamples store_of(void (*change)(RadianceSampleSettings&) = nullptr) {
   RadianceSampleSettings s;
   s.cell_m = 0.1;
+  if (change) change(s);
   auto store = RadianceSamples::create(s);
-  ASSERT_TRUE(store.ok()) << store.error().message;
-  store->observe({0.01, 0.0, 0.02}, {0, 1, 0}, 3, unit_transfer(0), {1.0, 1.0, 1.0}, 1.0f, 0);
-  store->observe({0.05, 0.0, 0.08}, {0, 1, 0}, 3, unit_transfer(0), {1.1, 1.1, 1.1}, 1.0f, 1);  // same cell, same bin
-  store->observe({0.05, 0.0, 0.08}, {0, 1, 0}, 4, unit_transfer(1), {0.5, 0.5, 0.5}, 1.0f, 1);  // same cell, other bin
-  store->observe({0.25, 0.0, 0.08}, {0, 1, 0}, 3, unit_transfer(2), {0.7, 0.7, 0.7}, 1.0f, 1);  // next cell
+  EXPECT_TRUE(store.ok()) << (store.ok() ? "" : store.error().message);
+  return std::move(*store);
+}
+
+TEST(RadianceSamples, OneSamplePerCellAndOrientationWithTheMeanColour) {
+  RadianceSamples store = store_of();
+  store.observe({0.01, 0.0, 0.02}, {0, 1, 0}, 3, unit_transfer(0), {1.0, 1.0, 1.0}, 1.0f, 0);
+  store.observe({0.05, 0.0, 0.08}, {0, 1, 0}, 3, unit_transfer(0), {1.1, 1.1, 1.1}, 1.0f, 1);  // same cell, same bin
+  store.observe({0.05, 0.0, 0.08}, {0, 1, 0}, 4, unit_transfer(1), {0.5, 0.5, 0.5}, 1.0f, 1);  // same cell, other bin
+  store.observe({0.25, 0.0, 0.08}, {0, 1, 0}, 3, unit_transfer(2), {0.7, 0.7, 0.7}, 1.0f, 1);  // next cell
   const double nan = std::nan("");
-  store->observe({nan, 0.0, 0.0}, {0, 1, 0}, 3, unit_transfer(0), {1.0, 1.0, 1.0}, 1.0f, 1);  // a broken pose
-  store->observe({0.01, 0.0, 0.02}, {0, 1, 0}, 3, unit_transfer(0), {nan, 1.0, 1.0}, 1.0f, 1);
-  EXPECT_FALSE(store->end_frame(1));
-  EXPECT_EQ(store->size(), 3u) << "what is not finite is ignored";
+  store.observe({nan, 0.0, 0.0}, {0, 1, 0}, 3, unit_transfer(0), {1.0, 1.0, 1.0}, 1.0f, 1);  // a broken pose
+  store.observe({0.01, 0.0, 0.02}, {0, 1, 0}, 3, unit_transfer(0), {nan, 1.0, 1.0}, 1.0f, 1);
+  EXPECT_FALSE(store.end_frame(1));
+  EXPECT_EQ(store.size(), 3u) << "what is not finite is ignored";
   LightSystem sys;
-  store->add_to(sys);
+  store.add_to(sys);
   EXPECT_DOUBLE_EQ(sys.samples, 3.0);
   // Coefficient 0's row is the first sample: its colour the mean of its two observations.
   EXPECT_NEAR(sys.atb[0], 1.05, 1e-12);
@@ -46,60 +53,48 @@ TEST(RadianceSamples, OneSamplePerCellAndOrientationWithTheMeanColour) {
 }
 
 TEST(RadianceSamples, ASettledSampleKeepsItsTransferAndTakesColourOnly) {
-  RadianceSampleSettings s;
-  s.cell_m = 0.1;
-  s.settle_observations = 3;
-  auto store = RadianceSamples::create(s);
-  ASSERT_TRUE(store.ok());
+  RadianceSamples store = store_of([](RadianceSampleSettings& s) { s.settle_observations = 3; });
   const glm::dvec3 at(0.05, 0.0, 0.05);
-  EXPECT_FALSE(store->observe_if_settled(at, {0, 1, 0}, 0, glm::dvec3(0.5), 1.0f, 0, false)) << "not there yet";
-  EXPECT_EQ(store->size(), 0u);
+  EXPECT_FALSE(store.observe_if_settled(at, {0, 1, 0}, 0, glm::dvec3(0.5), 1.0f, 0, false)) << "not there yet";
+  EXPECT_EQ(store.size(), 0u);
   for (int f = 0; f < 3; ++f) {
-    EXPECT_FALSE(store->observe_if_settled(at, {0, 1, 0}, 0, glm::dvec3(0.5), 1.0f, f, false)) << "observation " << f;
-    store->observe(at, {0, 1, 0}, 0, unit_transfer(0), glm::dvec3(0.5), 1.0f, f);
+    EXPECT_FALSE(store.observe_if_settled(at, {0, 1, 0}, 0, glm::dvec3(0.5), 1.0f, f, false)) << "observation " << f;
+    store.observe(at, {0, 1, 0}, 0, unit_transfer(0), glm::dvec3(0.5), 1.0f, f);
   }
-  ASSERT_TRUE(store->observe_if_settled(at, {0, 1, 0}, 0, glm::dvec3(0.9), 1.0f, 3, false));
-  ASSERT_EQ(store->size(), 1u);
-  EXPECT_FLOAT_EQ(store->samples()[0].transfer[0], 1.0f);
-  EXPECT_NEAR(store->samples()[0].colour.x, 0.6, 1e-12) << "the running mean of 0.5, 0.5, 0.5, 0.9";
-  EXPECT_FALSE(store->observe_if_settled(at, {0, 1, 0}, 0, glm::dvec3(0.9), 1.0f, 4, true)) << "a clipped block";
+  ASSERT_TRUE(store.observe_if_settled(at, {0, 1, 0}, 0, glm::dvec3(0.9), 1.0f, 3, false));
+  ASSERT_EQ(store.size(), 1u);
+  EXPECT_FLOAT_EQ(store.samples()[0].transfer[0], 1.0f);
+  EXPECT_NEAR(store.samples()[0].colour.x, 0.6, 1e-12) << "the running mean of 0.5, 0.5, 0.5, 0.9";
+  EXPECT_FALSE(store.observe_if_settled(at, {0, 1, 0}, 0, glm::dvec3(0.9), 1.0f, 4, true)) << "a clipped block";
 }
 
 TEST(RadianceSamples, ALightChangeDropsWhatIsOutOfViewAndACameraMoveDoesNot) {
-  RadianceSampleSettings s;
-  s.cell_m = 0.1;
-  s.change_min_samples = 4;
-  auto store = RadianceSamples::create(s);
-  ASSERT_TRUE(store.ok());
+  RadianceSamples store = store_of([](RadianceSampleSettings& s) { s.change_min_samples = 4; });
   // Frame 0 sees cells 0..9; frame 1 moves on to 5..14 under the same light: no change.
-  for (int c = 0; c < 10; ++c) store->observe({0.1 * c + 0.05, 0, 0}, {0, 1, 0}, 0, unit_transfer(c), glm::dvec3(0.4), 1.0f, 0);
-  EXPECT_FALSE(store->end_frame(0));
-  for (int c = 5; c < 15; ++c) store->observe({0.1 * c + 0.05, 0, 0}, {0, 1, 0}, 0, unit_transfer(c), glm::dvec3(0.41), 1.0f, 1);
-  EXPECT_FALSE(store->end_frame(1));
-  EXPECT_EQ(store->size(), 15u);
+  for (int c = 0; c < 10; ++c) store.observe({0.1 * c + 0.05, 0, 0}, {0, 1, 0}, 0, unit_transfer(c), glm::dvec3(0.4), 1.0f, 0);
+  EXPECT_FALSE(store.end_frame(0));
+  for (int c = 5; c < 15; ++c) store.observe({0.1 * c + 0.05, 0, 0}, {0, 1, 0}, 0, unit_transfer(c), glm::dvec3(0.41), 1.0f, 1);
+  EXPECT_FALSE(store.end_frame(1));
+  EXPECT_EQ(store.size(), 15u);
   // Frame 2: a lamp on, cells 10..14 seen again 60 % brighter: a change; cells 0..9 are gone.
-  for (int c = 10; c < 15; ++c) store->observe({0.1 * c + 0.05, 0, 0}, {0, 1, 0}, 0, unit_transfer(c), glm::dvec3(0.66), 1.0f, 2);
-  EXPECT_TRUE(store->end_frame(2));
-  EXPECT_EQ(store->changes(), 1);
-  EXPECT_EQ(store->size(), 5u);
+  for (int c = 10; c < 15; ++c) store.observe({0.1 * c + 0.05, 0, 0}, {0, 1, 0}, 0, unit_transfer(c), glm::dvec3(0.66), 1.0f, 2);
+  EXPECT_TRUE(store.end_frame(2));
+  EXPECT_EQ(store.changes(), 1);
+  EXPECT_EQ(store.size(), 5u);
   LightSystem sys;
-  store->add_to(sys);
+  store.add_to(sys);
   for (int c = 10; c < 15; ++c) EXPECT_NEAR(sys.atb[size_t(c) * 3], 0.66, 1e-12) << "restarts from the new colour";
   // Below the fraction (2 of 5 changed): not a change.
   for (int c = 10; c < 15; ++c)
-    store->observe({0.1 * c + 0.05, 0, 0}, {0, 1, 0}, 0, unit_transfer(c), glm::dvec3(c < 12 ? 1.0 : 0.66), 1.0f, 3);
-  EXPECT_FALSE(store->end_frame(3));
+    store.observe({0.1 * c + 0.05, 0, 0}, {0, 1, 0}, 0, unit_transfer(c), glm::dvec3(c < 12 ? 1.0 : 0.66), 1.0f, 3);
+  EXPECT_FALSE(store.end_frame(3));
 }
 
 TEST(RadianceSamples, AFullStoreDropsTheLeastRecentlySeenAndRefusesBadSettings) {
-  RadianceSampleSettings s;
-  s.capacity = 64;
-  s.cell_m = 0.1;
-  auto store = RadianceSamples::create(s);
-  ASSERT_TRUE(store.ok());
-  for (int c = 0; c < 200; ++c) store->observe({0.1 * c + 0.05, 0, 0}, {0, 1, 0}, 0, unit_transfer(c), glm::dvec3(0.3), 1.0f, c);
-  EXPECT_LE(store->size(), 64u);
-  EXPECT_GE(store->size(), 48u);
+  RadianceSamples store = store_of([](RadianceSampleSettings& s) { s.capacity = 64; });
+  for (int c = 0; c < 200; ++c) store.observe({0.1 * c + 0.05, 0, 0}, {0, 1, 0}, 0, unit_transfer(c), glm::dvec3(0.3), 1.0f, c);
+  EXPECT_LE(store.size(), 64u);
+  EXPECT_GE(store.size(), 48u);
   for (auto [field, bad] : std::vector<std::pair<std::string, RadianceSampleSettings>>{
            {"cell_m", [] { RadianceSampleSettings b; b.cell_m = 0.0; return b; }()},
            {"capacity", [] { RadianceSampleSettings b; b.capacity = 10; return b; }()},
