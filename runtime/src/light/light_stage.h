@@ -11,7 +11,10 @@
 //     what it cannot see (below an upward fisheye) takes the colour camera's mean radiance;
 //   - neither: the probeless estimate from colour and depth (light::LightEstimator, fed by the
 //     stage's own ProbelessBuilder or by a technique's GPU sums, ssrt's), as one shadowed
-//     dominant directional light plus the rest of the estimate as SH ambient;
+//     dominant directional light plus the rest of the estimate as SH ambient. The stage's own
+//     estimate keeps what every view showed (radiance_samples.h), so it grows with the views a
+//     user sweeps, and where those views show a near lamp (point_lamp_fit.h) the shadowed light
+//     is that lamp at its position instead of a distant one;
 //   - lamps without an environment also get the residual: the light the camera sees that the
 //     lamps' direct light does not explain (the room's own interreflection, daylight through a
 //     window), estimated probelessly from the same rows with the lamps' light taken off each
