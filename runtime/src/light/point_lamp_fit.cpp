@@ -27,7 +27,11 @@ double lamp_term(bool point, const glm::dvec3& at, const glm::dvec3& p, const gl
 }  // namespace
 
 PointLampFitter::PointLampFitter(const PointLampFitSettings& s) : settings_(s) {
-  rows_.reserve(size_t(std::max(64, s.max_samples)));
+  const size_t most = size_t(std::max(64, s.max_samples));
+  rows_.reserve(most);
+  residual_point_.reserve(most);
+  residual_distant_.reserve(most);
+  scratch_.reserve(most);
   constexpr int kDirections = 128;
   for (int k = 0; k < kDirections; ++k) {
     const glm::dvec3 d = fibonacci_direction(k, kDirections);
@@ -93,10 +97,9 @@ double PointLampFitter::best_point(glm::dvec3& x, double& k, bool search) {
 double PointLampFitter::best_distant(glm::dvec3& d, double& k, bool search) {
   double best = search ? kInf : solve(false, d, nullptr), c[5];
   for (size_t i = 0; i < directions_.size() && search; ++i)
-    if (const glm::dvec3& w = directions_[i]; true)
-    if (const double e = solve(false, w, c); e < best) {
+    if (const double e = solve(false, directions_[i], c); e < best) {
       best = e;
-      d = w;
+      d = directions_[i];
       k = c[0];
     }
   if (!std::isfinite(best)) return best;
@@ -146,9 +149,10 @@ PointLampFit PointLampFitter::fit(const RadianceSamples& store, double albedo) {
   double ep = best_point(x, kp, true), ed = best_distant(d, kd, true);
   if (!std::isfinite(ep) || !std::isfinite(ed)) return out;
   // Shadowed samples out of both fits (see the header), then both again.
-  std::vector<double> rp, rd;
-  rp.reserve(rows_.size());
-  rd.reserve(rows_.size());
+  std::vector<double>& rp = residual_point_;
+  std::vector<double>& rd = residual_distant_;
+  rp.clear();
+  rd.clear();
   double cp[5], cd[5];
   solve(true, x, cp);
   solve(false, d, cd);
@@ -157,7 +161,8 @@ PointLampFit PointLampFitter::fit(const RadianceSamples& store, double albedo) {
     rp.push_back(r.y - predict(cp, lamp_term(true, x, r.p, r.n), r.n));
     rd.push_back(r.y - predict(cd, lamp_term(false, d, r.p, r.n), r.n));
   }
-  auto mad = [](std::vector<double> v) {
+  auto mad = [&v = scratch_](const std::vector<double>& from) {  // 1.4826 x the median absolute deviation
+    v.assign(from.begin(), from.end());
     std::nth_element(v.begin(), v.begin() + ptrdiff_t(v.size() / 2), v.end());
     const double med = v[v.size() / 2];
     for (double& e : v) e = std::abs(e - med);

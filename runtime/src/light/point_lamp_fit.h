@@ -63,7 +63,8 @@ class PointLampFitter {
   double best_distant(glm::dvec3& d, double& k, bool search);
   double solve(bool point, const glm::dvec3& at, double* coeffs) const;  // SSE; coeffs[5] or null
   PointLampFitSettings settings_;
-  std::vector<Row> rows_;               // reserved to max_samples
+  std::vector<Row> rows_;               // reserved to max_samples, as the three below
+  std::vector<double> residual_point_, residual_distant_, scratch_;  // the shadow test's
   std::vector<glm::dvec3> directions_;  // distant candidates (upper hemisphere and below)
   glm::dvec3 lo_{0.0}, hi_{0.0};        // the candidate box
 };
