@@ -50,6 +50,8 @@ void setup(CLI::App& app) {
                 "solve each view on its own (RuntimeSettings::light_accumulate_views false; the comparison)");
   cmd->add_flag("--no-near-lamps", [o](int64_t n) { o->settings.near_lamps = n == 0; },
                 "distant light only: no near lamp looked for among the views (RuntimeSettings::light_near_lamps false)");
+  cmd->add_flag("--no-albedo-fit", [o](int64_t n) { o->settings.albedo_fit = n == 0; },
+                "the grey-world albedo (0.5): the surfaces' albedo not measured from their interreflection (RuntimeSettings::light_albedo_fit false)");
   cmd->add_flag("--validate", o->settings.validate, "Vulkan validation layers on (a message fails the run)");
   cmd->add_option("-o,--out", o->out, "write light-family.md and light-family.json into this folder");
   cmd->callback([o] { run(*o); });

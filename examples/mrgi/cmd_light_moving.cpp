@@ -60,6 +60,8 @@ void setup(CLI::App& app) {
   cmd->add_option("--drift-scene", o->settings.drift_scene, "the scene the drift run loops (default the half's first)");
   cmd->add_flag("--no-near-lamps", [o](int64_t n) { o->settings.family.near_lamps = n == 0; },
                 "distant light only: no near lamp looked for among the views (RuntimeSettings::light_near_lamps false)");
+  cmd->add_flag("--no-albedo-fit", [o](int64_t n) { o->settings.family.albedo_fit = n == 0; },
+                "the grey-world albedo (0.5): the surfaces' albedo not measured from their interreflection (RuntimeSettings::light_albedo_fit false)");
   cmd->add_flag("--validate", o->settings.family.validate, "Vulkan validation layers on (a message fails the run)");
   cmd->add_option("-o,--out", o->out, "write light-moving.md and light-moving.json into this folder");
   cmd->callback([o] { run(*o); });

@@ -28,6 +28,7 @@ struct ReplayOptions {
   int frames = 0, width = 0, height = 0, preload_frames = 0;
   bool validate = false, quiet = false, vulkan_1_2 = false, no_residual_light = false, profile = false;
   bool single_view_light = false;
+  bool no_albedo_fit = false;
   ViewOptions view;
 };
 
@@ -40,6 +41,7 @@ void apply_options(const ReplayOptions& o, const CaptureInfo& info, RuntimeSetti
   settings.device.vulkan_1_2 = o.vulkan_1_2;
   settings.residual_light = !o.no_residual_light;
   settings.light_accumulate_views = !o.single_view_light;
+  settings.light_albedo_fit = !o.no_albedo_fit;
   settings.output_width = o.width;
   settings.output_height = o.height;
   settings.exposure = info.exposure;
@@ -444,6 +446,9 @@ void setup(CLI::App& app) {
   cmd->add_flag("--no-residual-light", opts->no_residual_light,
                 "with declared lamps: light by the lamps alone, without the estimate of the real light they do not "
                 "explain (RuntimeSettings::residual_light; an ablation)");
+  cmd->add_flag("--no-albedo-fit", opts->no_albedo_fit,
+                "the probeless estimate with the grey-world albedo (0.5), not the surfaces' albedo measured from their "
+                "interreflection (RuntimeSettings::light_albedo_fit false; the comparison)");
   cmd->add_flag("--single-view-light", opts->single_view_light,
                 "the probeless estimate from each view on its own, not from every view seen "
                 "(RuntimeSettings::light_accumulate_views false; the comparison)");

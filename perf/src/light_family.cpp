@@ -31,6 +31,7 @@ Expected<LightReplay> replay_light_capture(const CaptureReader& capture, const S
   rs.device.validate = s.validate;
   rs.light_accumulate_views = s.accumulate_views;
   rs.light_near_lamps = s.near_lamps;
+  rs.light_albedo_fit = s.albedo_fit;
   auto rt = create_runtime(rs, CameraSetup{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera},
                            scene);
   if (!rt) return rt.error();

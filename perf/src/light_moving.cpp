@@ -181,6 +181,7 @@ Expected<DriftResult> run_drift(const LightFamilyScene& sc, const MovingFamilySe
   rs.level = s.level;
   rs.light_accumulate_views = s.accumulate_views;
   rs.light_near_lamps = s.near_lamps;
+  rs.light_albedo_fit = s.albedo_fit;
   auto rt = create_runtime(rs, CameraSetup{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera},
                            undeclared(*capture->scene()));
   if (!rt) return rt.error();
@@ -267,13 +268,14 @@ std::string moving_family_markdown(const MovingFamilyReport& rep, const MovingFa
   std::string md;
   char line[512];
   std::snprintf(line, sizeof line,
-                "Technique `%s` level %d, %s. Direction: degrees between the estimate's and the truth's "
+                "Technique `%s` level %d, %s%s. Direction: degrees between the estimate's and the truth's "
                 "dominant light; colour: largest per-channel error of the mean light's chromaticity; RDE "
                 "ratio: estimate-lit over true-lit (all pixels).\n\n",
                 ms.family.technique.c_str(), ms.family.level,
                 !ms.family.accumulate_views ? "each view on its own"
                 : ms.family.near_lamps      ? "the estimate accumulated over the views, near lamps found"
-                                            : "the estimate accumulated over the views, distant light only");
+                                            : "the estimate accumulated over the views, distant light only",
+                ms.family.accumulate_views && ms.family.albedo_fit ? ", albedo from interreflection" : "");
   md += line;
   md += "Direction error (degrees) as the sweep grows:\n\n| scene | half | 0 deg | 22 deg | 45 deg | 67 deg | 90 deg |"
         " colour after | confidence after | RDE ratio, last 8 frames |\n|---|---|---|---|---|---|---|---|---|---|\n";

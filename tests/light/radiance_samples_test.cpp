@@ -157,6 +157,8 @@ TEST(RadianceSamples, ALampSwitchedOnIsFollowedWithinAFewFrames) {
   Room lit = dark;
   lit.lamp_intensity = glm::dvec3(1.5);
   LightStageSettings settings;
+  // The room is ray traced with direct light only: no interreflection to measure its albedo by.
+  settings.albedo_fit.enabled = false;
   const RenderedFrame off = render(dark, eye_at(0), {0.3, 0.2, 0.8}, 80, 60);
   const RenderedFrame on = render(lit, eye_at(0), {0.3, 0.2, 0.8}, 80, 60);
   auto stage = LightStage::create(settings, SceneDesc{}, CameraSetup{off.k, off.k, 5000.0, 1.0, std::nullopt});
@@ -222,12 +224,12 @@ TEST(PointLampFit, FindsANearLampInACornerAndNotTheSun) {
   const glm::dvec3 lamp(0.3, 1.4, 0.4);
   PointLampFitter fitter{PointLampFitSettings{}};
   const RadianceSamples near = lit_corner(&lamp, 2.0, nullptr, 0.0);
-  const PointLampFit f = fitter.fit(near, 0.5);
+  const PointLampFit f = fitter.fit(near, glm::dvec3(0.5));
   ASSERT_TRUE(f.found) << "residuals point " << f.residual_point << " distant " << f.residual_distant;
   EXPECT_LT(glm::distance(f.position, lamp), 0.15) << f.position.x << " " << f.position.y << " " << f.position.z;
   EXPECT_NEAR(f.intensity.x, 2.0, 0.3);
   const glm::dvec3 sun = glm::normalize(glm::dvec3(0.4, 0.8, 0.3));
-  const PointLampFit g = fitter.fit(lit_corner(nullptr, 0.0, &sun, 2.0), 0.5);
+  const PointLampFit g = fitter.fit(lit_corner(nullptr, 0.0, &sun, 2.0), glm::dvec3(0.5));
   EXPECT_FALSE(g.found) << "a distant light is not a lamp: " << g.position.x << " " << g.position.y << " "
                         << g.position.z;
 }

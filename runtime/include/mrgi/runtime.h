@@ -402,6 +402,11 @@ struct RuntimeSettings {
   /// light with it where it was found, as a shadowed lamp at its position, instead of a distant
   /// light. false: the distant light only.
   bool light_near_lamps = true;
+  /// With the views accumulated: measure the real surfaces' albedo from the light they bounce
+  /// onto each other (light/albedo_fit.h: a grey-world prior of 0.5 combined with what the
+  /// interreflection shows), instead of assuming 0.5. The estimate's brightness and colour scale
+  /// with 1 / albedo. false: the grey world.
+  bool light_albedo_fit = true;
 };
 
 // ---------------------------------------------------------------------------------------------

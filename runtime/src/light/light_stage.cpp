@@ -31,7 +31,9 @@ Lighting::AmbientRegion ambient_region(const glm::dvec3& direction, const glm::d
 // of the virtual objects' direction, none beyond 60 (a 120-degree shadow frustum).
 constexpr double kNearLampInnerDeg = 50.0, kNearLampOuterDeg = 60.0;
 // Successive near-lamp fits closer than this are the same lamp, and move it this fraction.
-constexpr double kSameLampM = 0.5, kLampSmoothing = 0.3;
+constexpr double kSameLampM = 0.5, kLampSmoothing = 0.3, kKeepLampResidual = 0.75;
+constexpr int kAlbedoFits = 16, kAlbedoSettleFits = 4;
+constexpr double kAlbedoGrowth = 1.1;
 
 // The lights' colour and intensity in scene.json's convention: colour times intensity per
 // channel, the colour's largest channel 1.
@@ -143,6 +145,10 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
       if (!store) return store.error();
       s.samples_.emplace(std::move(*store));
       if (settings.point_lamp.enabled) s.lamp_fitter_.emplace(settings.point_lamp);
+      if (settings.albedo_fit.enabled) {
+        s.albedo_fitter_.emplace(settings.albedo_fit);
+        s.direct_samples_.reserve(size_t(std::max(16, settings.albedo_fit.receivers)));
+      }
     }
   }
   s.max_lights_ = s.declared_ + s.env_lights_ + (s.planned_ == LightSourceKind::Probeless ? 1 : 0);
@@ -445,6 +451,11 @@ void LightStage::use_external_system() {
   probeless_.reset();
   samples_.reset();
   lamp_fitter_.reset();
+  albedo_fitter_.reset();
+  albedo_fits_ = 0;
+  albedo_store_size_ = 0;
+  albedo_urgent_in_ = -1;
+  lamp_search_due_ = false;
   lamp_ = PointLampFit{};
   residual_ = false;
   set_probeless_lighting();
@@ -459,6 +470,65 @@ Status LightStage::submit_system(const LightSystem& system, int64_t frame_index,
   }
   if (planned_ == LightSourceKind::Probeless) set_probeless_lighting();
   return ok_status();
+}
+
+void LightStage::update_albedo(const RadianceSamples& store, bool first) {
+  // A fit is spread over frames, a step each. After a light change the receivers are wanted
+  // soon (the lamp search waits for them): once the view's parts are all in the store again
+  // (`parts` frames on), a fit in bigger steps (three frames, not eight), and the lamp is
+  // searched as soon as it is in.
+  const bool urgent = albedo_urgent_in_ == 0;
+  if (albedo_urgent_in_ > 0 && --albedo_urgent_in_ == 0) albedo_fitter_->restart();
+  if (!first && albedo_urgent_in_ <= 0) {
+    if (!albedo_fitter_->busy()) albedo_fitter_->begin(store);
+    const int count = urgent ? (albedo_fitter_->settings().receivers + 1) / 2 : 0;
+    if (albedo_fitter_->busy() && albedo_fitter_->step(count)) {
+      lamp_search_due_ = urgent;
+      albedo_urgent_in_ = -1;
+      const AlbedoFit fit = albedo_fitter_->solve(lamp_.found ? &lamp_ : nullptr);
+      // A running mean over the fits (at most the last kAlbedoFits). The albedo is the
+      // surfaces', not the light's: after the first kAlbedoSettleFits it moves only when the
+      // store has grown by kAlbedoGrowth since it last moved (new surfaces seen), so a still
+      // camera's estimate settles, and a light switched on is not also read as new albedo (the
+      // bounce's share changes with the light: measured, followed after 23-71 frames instead of
+      // 7-31 while every fit moved it).
+      const size_t seen = store.size();
+      if (fit.found && (albedo_fits_ < kAlbedoSettleFits || double(seen) >= kAlbedoGrowth * double(albedo_store_size_))) {
+        albedo_fits_ = std::min(albedo_fits_ + 1, kAlbedoFits);
+        albedo_store_size_ = std::max(albedo_store_size_, seen);
+        estimator_->set_albedo(estimator_->albedo() + (fit.albedo - estimator_->albedo()) / double(albedo_fits_));
+      }
+    }
+  }
+}
+
+void LightStage::search_lamp(const RadianceSamples& store, const glm::dvec3& albedo) {
+  lamp_search_due_ = false;
+  // With the albedo fit's receivers the lamp is fitted to the light it gives directly: their
+  // colour with the light bounced onto them taken off. Right after a light change they are
+  // being fitted again (their colours were the old light's): the search waits for them, rather
+  // than reading the store's samples with the bounce in once and then jumping to where the
+  // direct light puts the lamp.
+  const bool direct = albedo_fitter_ && !albedo_fitter_->fitted().empty();
+  if (albedo_fitter_ && !direct && albedo_fits_ > 0) return;
+  if (direct) {
+    direct_samples_.clear();
+    for (const AlbedoFitter::Receiver& r : albedo_fitter_->fitted())
+      direct_samples_.push_back({r.p, r.n, glm::max(r.c - albedo * r.bounce, glm::dvec3(0.0))});
+  }
+  const PointLampFit fit = direct ? lamp_fitter_->fit(direct_samples_, albedo) : lamp_fitter_->fit(store, albedo);
+  // Fits of the same lamp are averaged (a fit reads a few hundred samples, so its position
+  // scatters by a decimetre or two from one to the next); another lamp, or none, replaces it.
+  if (fit.found && lamp_.found && glm::distance(fit.position, lamp_.position) < kSameLampM) {
+    lamp_.position += kLampSmoothing * (fit.position - lamp_.position);
+    lamp_.intensity += kLampSmoothing * (fit.intensity - lamp_.intensity);
+    return;
+  }
+  // Hysteresis: a lamp found stays while a point still explains the samples clearly better
+  // than a distant light, if no longer by the margin it took to find it (a still view's fit
+  // hovers at that margin: the lamp came and went every few fits).
+  if (!fit.found && lamp_.found && fit.residual_point <= kKeepLampResidual * fit.residual_distant) return;
+  lamp_ = fit;
 }
 
 Status LightStage::add_probeless_parts(const frame::CameraView& camera, std::vector<std::string>& notes,
@@ -483,23 +553,18 @@ Status LightStage::add_probeless_parts(const frame::CameraView& camera, std::vec
     // frame pays for a whole grid) replace the estimate instead of being filtered towards from
     // the old light.
     estimator_->restart_filter(2);
+    if (albedo_fitter_) {
+      albedo_fitter_->restart();
+      albedo_urgent_in_ = parts;
+    }
     notes.push_back("light: the light changed (surfaces seen again differ in brightness): the probeless "
                     "estimate restarts from the views after it");
   }
-  const double albedo = estimator_->settings().gray_albedo;
+  if (store && albedo_fitter_) update_albedo(*store, first);
+  const glm::dvec3 albedo = estimator_->albedo();
   // The near lamp is looked for half way through the parts, not with the solve, so no frame
   // pays for both (each about 2 ms of one core at 640x480).
-  if (store && lamp_fitter_ && (first || next_part_ == parts / 2)) {
-    // Fits of the same lamp are averaged (a fit reads a few hundred samples, so its position
-    // scatters by a decimetre or two from one to the next); another lamp, or none, replaces it.
-    const PointLampFit fit = lamp_fitter_->fit(*store, albedo);
-    if (fit.found && lamp_.found && glm::distance(fit.position, lamp_.position) < kSameLampM) {
-      lamp_.position += kLampSmoothing * (fit.position - lamp_.position);
-      lamp_.intensity += kLampSmoothing * (fit.intensity - lamp_.intensity);
-    } else {
-      lamp_ = fit;
-    }
-  }
+  if (store && lamp_fitter_ && (first || next_part_ == parts / 2 || lamp_search_due_)) search_lamp(*store, albedo);
   next_part_ = first ? 0 : (next_part_ + 1) % parts;
   solved = next_part_ == 0;
   if (solved) {

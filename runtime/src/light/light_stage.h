@@ -13,8 +13,10 @@
 //     stage's own ProbelessBuilder or by a technique's GPU sums, ssrt's), as one shadowed
 //     dominant directional light plus the rest of the estimate as SH ambient. The stage's own
 //     estimate keeps what every view showed (radiance_samples.h), so it grows with the views a
-//     user sweeps, and where those views show a near lamp (point_lamp_fit.h) the shadowed light
-//     is that lamp at its position instead of a distant one;
+//     user sweeps; the surfaces' albedo, which scales the whole estimate, is measured from the
+//     light they bounce onto each other (albedo_fit.h) instead of assumed grey (0.5); and where
+//     those views show a near lamp (point_lamp_fit.h, fitted to the light with that bounce
+//     taken off) the shadowed light is that lamp at its position instead of a distant one;
 //   - lamps without an environment also get the residual: the light the camera sees that the
 //     lamps' direct light does not explain (the room's own interreflection, daylight through a
 //     window), estimated probelessly from the same rows with the lamps' light taken off each
@@ -32,6 +34,7 @@
 #include <glm/glm.hpp>
 
 #include "frame/camera_view.h"
+#include "light/albedo_fit.h"
 #include "light/env_sampler.h"
 #include "light/lamp_removal.h"
 #include "light/point_lamp_fit.h"
@@ -112,6 +115,9 @@ struct LightStageSettings {
   // A near lamp found from those views (point_lamp_fit.h): lit as a shadowed point light at its
   // position, the SH estimate then holding the rest.
   PointLampFitSettings point_lamp;
+  // The real surfaces' albedo from their interreflection among those views (albedo_fit.h),
+  // instead of the estimator's grey world.
+  AlbedoFitSettings albedo_fit;
   // The estimator of the probeless source fed by the stage's own builder. RGB (white_light
   // false): the paper's white-light assumption gives a grey estimate under a blue sky. Chosen on
   // the light family's tuning half only (perf/suite/light/family.json; perf/results/
@@ -304,6 +310,12 @@ class LightStage {
   void set_residual_lighting();
   // Feeds this frame's part(s) of the stage's own probeless system; `solved` when a whole
   // system was solved this frame.
+  // One step of the albedo fit over the store (albedo_fit.h); a finished fit moves the
+  // estimator's albedo.
+  void update_albedo(const RadianceSamples& store, bool first);
+  // The near-lamp search (point_lamp_fit.h) over the albedo fit's receivers with their bounce
+  // taken off (the store's samples before the first fit); lamp_ follows it.
+  void search_lamp(const RadianceSamples& store, const glm::dvec3& albedo);
   Status add_probeless_parts(const frame::CameraView& camera, std::vector<std::string>& notes, bool& solved);
   // `near`: per region of the sampler's cut, whether it is a surface near the env camera
   // (near_regions); empty = none known to be.
@@ -343,6 +355,13 @@ class LightStage {
   std::optional<LightEstimator> estimator_;
   std::optional<RadianceSamples> samples_;  // the probeless source's, when accumulating
   std::optional<PointLampFitter> lamp_fitter_;
+  std::optional<AlbedoFitter> albedo_fitter_;
+  std::vector<LampFitSample> direct_samples_;  // the lamp fit's input with the bounce off; reserved
+  int albedo_fits_ = 0;                        // fits averaged into the estimator's albedo
+  size_t albedo_store_size_ = 0;               // the store's size when the albedo last moved
+  // A light changed: frames until the next albedo fit starts, in two steps (0: under way; -1 none).
+  int albedo_urgent_in_ = -1;
+  bool lamp_search_due_ = false;               // ... and the lamp searched as soon as it is in
   PointLampFit lamp_;                       // the last solve's
   LightSystem pending_;             // the parts of the probeless system summed so far
   int next_part_ = 0;

@@ -121,13 +121,12 @@ double PointLampFitter::best_distant(glm::dvec3& d, double& k, bool search) {
   return best;
 }
 
-PointLampFit PointLampFitter::fit(const RadianceSamples& store, double albedo) {
-  PointLampFit out;
+PointLampFit PointLampFitter::fit(const RadianceSamples& store, const glm::dvec3& albedo) {
   rows_.clear();
   const auto& all = store.samples();
   size_t unclipped = 0;
   for (const auto& s : all) unclipped += s.clipped ? 0 : 1;
-  if (!settings_.enabled || int(unclipped) < settings_.min_samples || !(albedo > 0.0)) return out;
+  if (!settings_.enabled || int(unclipped) < settings_.min_samples) return PointLampFit{};
   const size_t stride = std::max<size_t>(1, (unclipped + size_t(settings_.max_samples) - 1) / size_t(settings_.max_samples));
   size_t k = 0;
   glm::dvec3 lo(kInf), hi(-kInf);
@@ -140,6 +139,26 @@ PointLampFit PointLampFitter::fit(const RadianceSamples& store, double albedo) {
     lo = glm::min(lo, p);
     hi = glm::max(hi, p);
   }
+  return fit_rows(albedo, lo, hi);
+}
+
+PointLampFit PointLampFitter::fit(const std::vector<LampFitSample>& samples, const glm::dvec3& albedo) {
+  rows_.clear();
+  if (!settings_.enabled || int(samples.size()) < settings_.min_samples) return PointLampFit{};
+  const size_t stride = std::max<size_t>(1, (samples.size() + size_t(settings_.max_samples) - 1) / size_t(settings_.max_samples));
+  glm::dvec3 lo(kInf), hi(-kInf);
+  for (size_t i = 0; i < samples.size(); i += stride) {
+    const LampFitSample& s = samples[i];
+    rows_.push_back({s.position, s.normal, s.colour, luminance_of(s.colour), true});
+    lo = glm::min(lo, s.position);
+    hi = glm::max(hi, s.position);
+  }
+  return fit_rows(albedo, lo, hi);
+}
+
+PointLampFit PointLampFitter::fit_rows(const glm::dvec3& albedo, const glm::dvec3& lo, const glm::dvec3& hi) {
+  PointLampFit out;
+  if (!(glm::min(albedo.x, glm::min(albedo.y, albedo.z)) > 0.0)) return out;
   if (int(rows_.size()) < settings_.min_samples) return out;
   lo_ = glm::dvec3(lo.x - settings_.margin_m, lo.y + 0.3, lo.z - settings_.margin_m);
   hi_ = glm::dvec3(hi.x + settings_.margin_m, hi.y + settings_.height_m, hi.z + settings_.margin_m);
@@ -189,7 +208,7 @@ PointLampFit PointLampFitter::fit(const RadianceSamples& store, double albedo) {
   for (int ch = 0; ch < 3; ++ch) {
     for (Row& r : rows_) r.y = r.c[ch];
     double c[5] = {0, 0, 0, 0, 0};
-    if (std::isfinite(solve(true, x, c))) out.intensity[ch] = kPi * c[0] / albedo;
+    if (std::isfinite(solve(true, x, c))) out.intensity[ch] = kPi * c[0] / albedo[ch];
   }
   out.found = luminance_of(out.intensity) > 0.0;
   out.position = x;

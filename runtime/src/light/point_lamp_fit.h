@@ -35,6 +35,11 @@ struct PointLampFitSettings {
   int min_samples = 64;        // fewer unclipped samples: no fit
 };
 
+// A surface sample as the fit reads it: world position (metres), unit normal, linear colour.
+struct LampFitSample {
+  glm::dvec3 position, normal, colour;
+};
+
 struct PointLampFit {
   bool found = false;
   glm::dvec3 position{0.0};    // world, metres
@@ -46,8 +51,13 @@ struct PointLampFit {
 class PointLampFitter {
  public:
   explicit PointLampFitter(const PointLampFitSettings& settings);
-  // `albedo`: the surfaces' grey albedo the estimate assumes (y = albedo / pi * E).
-  PointLampFit fit(const RadianceSamples& store, double albedo);
+  // `albedo`: the surfaces' albedo per channel the estimate assumes (y = albedo / pi * E).
+  // Over the store's unclipped samples (strided to max_samples):
+  PointLampFit fit(const RadianceSamples& store, const glm::dvec3& albedo);
+  // Over given samples (strided to max_samples): the stage's with the light the surfaces
+  // bounce onto each other taken off (albedo_fit.h), so the lamp is fitted to the light it gives
+  // directly (with that bounce in, a white corner's lamp came out higher and paler).
+  PointLampFit fit(const std::vector<LampFitSample>& samples, const glm::dvec3& albedo);
   const PointLampFitSettings& settings() const { return settings_; }
 
  private:
@@ -62,6 +72,7 @@ class PointLampFitter {
   double best_point(glm::dvec3& x, double& k, bool search);
   double best_distant(glm::dvec3& d, double& k, bool search);
   double solve(bool point, const glm::dvec3& at, double* coeffs) const;  // SSE; coeffs[5] or null
+  PointLampFit fit_rows(const glm::dvec3& albedo, const glm::dvec3& lo, const glm::dvec3& hi);  // over rows_
   PointLampFitSettings settings_;
   std::vector<Row> rows_;               // reserved to max_samples, as the three below
   std::vector<double> residual_point_, residual_distant_, scratch_;  // the shadow test's

@@ -172,7 +172,7 @@ bool RadianceSamples::end_frame(int64_t frame) {
   return true;
 }
 
-void RadianceSamples::add_to(LightSystem& system, const ShRgb* estimate, double albedo,
+void RadianceSamples::add_to(LightSystem& system, const ShRgb* estimate, const glm::dvec3& albedo,
                              const glm::dvec3* lamp_position, const glm::dvec3* lamp_intensity) const {
   for (const Sample& s : samples_) {
     glm::dvec3 colour = s.colour;
@@ -181,13 +181,13 @@ void RadianceSamples::add_to(LightSystem& system, const ShRgb* estimate, double 
       const double d = std::max(glm::length(v), 0.15);
       const double len = glm::length(glm::dvec3(s.normal));
       const double g = len > 0.0 ? std::max(0.0, glm::dot(glm::dvec3(s.normal) / len, v)) / (d * d * d) : 0.0;
-      colour = glm::max(colour - (albedo / 3.14159265358979323846 * g) * *lamp_intensity, glm::dvec3(0.0));
+      colour = glm::max(colour - (g / 3.14159265358979323846) * albedo * *lamp_intensity, glm::dvec3(0.0));
     }
     if (s.clipped) {
       if (!estimate) continue;
       glm::dvec3 predicted(0.0);
       for (int i = 0; i < kMaxShCoeffs; ++i) predicted += double(s.transfer[size_t(i)]) * (*estimate)[size_t(i)];
-      if (albedo * luminance(predicted) >= luminance(colour)) continue;
+      if (luminance(albedo * predicted) >= luminance(colour)) continue;
     }
     const float w = std::sqrt(s.row_weight);
     ShVector t = s.transfer;

@@ -74,13 +74,13 @@ class RadianceSamples {
   // not observed in it are then gone, see above).
   bool end_frame(int64_t frame);
   // Adds every sample as a row (weight sqrt(row_weight) on both sides, as a direct row). A
-  // clipped sample is a row only while `estimate` (radiance SH; the surfaces' grey `albedo`)
+  // clipped sample is a row only while `estimate` (radiance SH; the surfaces' `albedo` per channel)
   // predicts less luminance than its bound (censored data: a bound the estimate meets says
   // nothing more); without an estimate clipped samples are left out.
   // With `lamp_position` / `lamp_intensity` (a near lamp found by PointLampFitter: radiant
   // intensity W/sr, RGB), each row's colour has that lamp's unshadowed light taken off
   // (albedo / pi * I cos / d^2, clamped at 0), so the system holds what the lamp does not explain.
-  void add_to(LightSystem& system, const ShRgb* estimate = nullptr, double albedo = 0.5,
+  void add_to(LightSystem& system, const ShRgb* estimate = nullptr, const glm::dvec3& albedo = glm::dvec3(0.5),
               const glm::dvec3* lamp_position = nullptr, const glm::dvec3* lamp_intensity = nullptr) const;
 
   struct Sample {

@@ -66,11 +66,10 @@ Status check_system_finite(const LightSystem& system, int64_t frame_index) {
 
 // The system's first n coefficients: T^T T into `ata` (symmetrised) and T^T I_c / albedo into
 // `atb` (each row's luminance in all three channels for white light).
-void load_system(const LightSystem& system, int n, double gray_albedo, bool white_light, Mat& ata, Rhs& atb) {
+void load_system(const LightSystem& system, int n, const glm::dvec3& albedo, bool white_light, Mat& ata, Rhs& atb) {
   for (int i = 0; i < n; ++i) {
     for (int j = 0; j < n; ++j) ata(i, j) = system.ata[i * kMaxShCoeffs + j];
-    const double inv_a = 1.0 / gray_albedo;  // T l = I_c / a
-    for (int c = 0; c < 3; ++c) atb(i, c) = system.atb[i * 3 + c] * inv_a;
+    for (int c = 0; c < 3; ++c) atb(i, c) = system.atb[i * 3 + c] / albedo[c];  // T l = I_c / a
   }
   if (white_light) {
     for (int i = 0; i < n; ++i) {
@@ -168,6 +167,11 @@ Expected<LightEstimator> LightEstimator::create(const LightEstimatorSettings& s)
   return e;
 }
 
+void LightEstimator::set_albedo(const glm::dvec3& albedo) {
+  for (int c = 0; c < 3; ++c)
+    if (albedo[c] > 0.0 && albedo[c] <= 1.0) albedo_[c] = albedo[c];
+}
+
 void LightEstimator::reset() {
   filtered_ = ShRgb{};
   // Band 0 of a uniform radiance L is L * sqrt(4 pi) (Y00 = 1 / sqrt(4 pi)).
@@ -192,7 +196,7 @@ Expected<LightEstimate> LightEstimator::update(const LightSystem& system, int64_
   const int n = bands * bands;
   Mat ata(n, n);
   Rhs atb(n, 3);
-  load_system(system, n, settings_.gray_albedo, settings_.white_light, ata, atb);
+  load_system(system, n, albedo_, settings_.white_light, ata, atb);
 
   // Confidence: how many directions of the SH space the data pins down on its own.
   const int constrained = constrained_directions(ata, n, settings_.confidence_eigen_fraction);

@@ -114,6 +114,10 @@ class LightEstimator {
   const ShRgb& filtered() const { return filtered_; }
   const LightEstimate& estimate() const { return estimate_; }
   const LightEstimatorSettings& settings() const { return settings_; }
+  // The real surfaces' albedo per channel the rows are divided by (T l = I_c / a): the setting's
+  // gray_albedo until a caller that has measured it (albedo_fit.h) sets it; each in (0, 1].
+  void set_albedo(const glm::dvec3& albedo);
+  const glm::dvec3& albedo() const { return albedo_; }
   // The last frame's dominant surface normal (world), used by below_surface_penalty; 0 when the
   // frame had none (no data or bands < 2).
   const glm::dvec3& dominant_normal() const { return dominant_normal_; }
@@ -127,9 +131,11 @@ class LightEstimator {
   }
 
  private:
-  explicit LightEstimator(const LightEstimatorSettings& settings) : settings_(settings) {}
+  explicit LightEstimator(const LightEstimatorSettings& settings)
+      : settings_(settings), albedo_(settings.gray_albedo) {}
 
   LightEstimatorSettings settings_;
+  glm::dvec3 albedo_;
   ShRgb frame_solution_{};
   ShRgb filtered_{};
   LightEstimate estimate_;
