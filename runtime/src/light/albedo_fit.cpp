@@ -12,7 +12,6 @@ namespace mrgi::light {
 namespace {
 
 constexpr int kMaxColumns = kMaxShCoeffs + 2;  // SH, bounce, near lamp
-constexpr double kMinLampDistance = 0.15;       // metres, as the lamp fit's
 const glm::dvec3 kLuminance(0.2126, 0.7152, 0.0722);
 constexpr double kMinInformation = 1e-3;  // the bounce column's share not explained by the others, below: no fit
 constexpr double kLayer = 1.5;  // a bin's nearest layer: within this factor of its nearest sample (+ 2 cells)

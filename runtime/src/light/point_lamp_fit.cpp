@@ -11,7 +11,6 @@
 namespace mrgi::light {
 namespace {
 
-constexpr double kMinLampDistance = 0.15;  // metres: a candidate nearer a sample does not spike on it
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 double luminance_of(const glm::dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }

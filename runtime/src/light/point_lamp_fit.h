@@ -35,6 +35,10 @@ struct PointLampFitSettings {
   int min_samples = 64;        // fewer unclipped samples: no fit
 };
 
+// Nearer than this (metres) a lamp's fall-off is held: a candidate next to a sample does not
+// spike on it.
+constexpr double kMinLampDistance = 0.15;
+
 // A surface sample as the fit reads it: world position (metres), unit normal, linear colour.
 struct LampFitSample {
   glm::dvec3 position, normal, colour;
