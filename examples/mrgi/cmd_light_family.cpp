@@ -52,6 +52,8 @@ void setup(CLI::App& app) {
                 "distant light only: no near lamp looked for among the views (RuntimeSettings::light_near_lamps false)");
   cmd->add_flag("--no-albedo-fit", [o](int64_t n) { o->settings.albedo_fit = n == 0; },
                 "the grey-world albedo (0.5): the surfaces' albedo not measured from their interreflection (RuntimeSettings::light_albedo_fit false)");
+  cmd->add_flag("--no-near-field", [o](int64_t n) { o->settings.near_field = n == 0; },
+                "the bounce of the seen surfaces read as part of the distant light, not computed from them and added at the objects (RuntimeSettings::light_near_field false)");
   cmd->add_flag("--validate", o->settings.validate, "Vulkan validation layers on (a message fails the run)");
   cmd->add_option("-o,--out", o->out, "write light-family.md and light-family.json into this folder");
   cmd->callback([o] { run(*o); });

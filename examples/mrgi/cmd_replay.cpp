@@ -29,6 +29,7 @@ struct ReplayOptions {
   bool validate = false, quiet = false, vulkan_1_2 = false, no_residual_light = false, profile = false;
   bool single_view_light = false;
   bool no_albedo_fit = false;
+  bool no_near_field = false;
   ViewOptions view;
 };
 
@@ -42,6 +43,7 @@ void apply_options(const ReplayOptions& o, const CaptureInfo& info, RuntimeSetti
   settings.residual_light = !o.no_residual_light;
   settings.light_accumulate_views = !o.single_view_light;
   settings.light_albedo_fit = !o.no_albedo_fit;
+  settings.light_near_field = !o.no_near_field;
   settings.output_width = o.width;
   settings.output_height = o.height;
   settings.exposure = info.exposure;
@@ -449,6 +451,9 @@ void setup(CLI::App& app) {
   cmd->add_flag("--no-albedo-fit", opts->no_albedo_fit,
                 "the probeless estimate with the grey-world albedo (0.5), not the surfaces' albedo measured from their "
                 "interreflection (RuntimeSettings::light_albedo_fit false; the comparison)");
+  cmd->add_flag("--no-near-field", opts->no_near_field,
+                "the probeless estimate with the seen surfaces' bounce read as part of the distant light, not computed "
+                "from them and added at the objects (RuntimeSettings::light_near_field false; the comparison)");
   cmd->add_flag("--single-view-light", opts->single_view_light,
                 "the probeless estimate from each view on its own, not from every view seen "
                 "(RuntimeSettings::light_accumulate_views false; the comparison)");

@@ -32,6 +32,7 @@ Expected<LightReplay> replay_light_capture(const CaptureReader& capture, const S
   rs.light_accumulate_views = s.accumulate_views;
   rs.light_near_lamps = s.near_lamps;
   rs.light_albedo_fit = s.albedo_fit;
+  rs.light_near_field = s.near_field;
   auto rt = create_runtime(rs, CameraSetup{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera},
                            scene);
   if (!rt) return rt.error();

@@ -182,6 +182,7 @@ Expected<DriftResult> run_drift(const LightFamilyScene& sc, const MovingFamilySe
   rs.light_accumulate_views = s.accumulate_views;
   rs.light_near_lamps = s.near_lamps;
   rs.light_albedo_fit = s.albedo_fit;
+  rs.light_near_field = s.near_field;
   auto rt = create_runtime(rs, CameraSetup{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera},
                            undeclared(*capture->scene()));
   if (!rt) return rt.error();
@@ -275,7 +276,8 @@ std::string moving_family_markdown(const MovingFamilyReport& rep, const MovingFa
                 !ms.family.accumulate_views ? "each view on its own"
                 : ms.family.near_lamps      ? "the estimate accumulated over the views, near lamps found"
                                             : "the estimate accumulated over the views, distant light only",
-                ms.family.accumulate_views && ms.family.albedo_fit ? ", albedo from interreflection" : "");
+                !(ms.family.accumulate_views && ms.family.albedo_fit) ? ""
+                : ms.family.near_field ? ", albedo from interreflection, near field" : ", albedo from interreflection");
   md += line;
   md += "Direction error (degrees) as the sweep grows:\n\n| scene | half | 0 deg | 22 deg | 45 deg | 67 deg | 90 deg |"
         " colour after | confidence after | RDE ratio, last 8 frames |\n|---|---|---|---|---|---|---|---|---|---|\n";

@@ -134,6 +134,33 @@ TEST(AlbedoFit, TooFewSamplesMakeNoFitAndAFitSpreadOverStepsIsTheSame) {
   EXPECT_FALSE(fitter.busy());
 }
 
+TEST(AlbedoFit, TheNearFieldIsTheLightTheKeptSurfacesSendToAPoint) {
+  // Half a metre above the middle of a 2 x 2 m floor of radiance 0.3 (the walls dark): the
+  // light from below is the floor's (0.3 straight down, less towards the floor's edges), none
+  // arrives from above.
+  constexpr double kCell = 0.06;
+  std::vector<Patch> patches = corner(true, kCell);
+  for (Patch& p : patches) p.colour = glm::dvec3(p.n.y > 0.5 ? 0.3 : 0.0);
+  const RadianceSamples store = store_of(patches, kCell);
+  AlbedoFitter fitter{AlbedoFitSettings{}};
+  ShRgb near{};
+  EXPECT_FALSE(fitter.near_field_at({0.0, 0.5, 0.5}, near)) << "no fit begun: no emitters";
+  ASSERT_TRUE(fitter.begin(store));
+  ASSERT_TRUE(fitter.near_field_at({0.0, 0.5, 0.5}, near));
+  auto radiance = [&](const glm::vec3& w) {
+    const ShVector y = sh_basis(w);
+    double l = 0.0;
+    for (int i = 0; i < kMaxShCoeffs; ++i) l += double(y[size_t(i)]) * near[size_t(i)].y;
+    return l;
+  };
+  EXPECT_NEAR(radiance({0, -1, 0}), 0.3, 0.06);
+  EXPECT_NEAR(radiance({0, 1, 0}), 0.0, 0.06);
+  // Band 0: the floor, a square of half-side 1 m 0.5 m below, spans 4 asin(1 / 1.25) = 3.709 sr,
+  // so the radiance averaged over the sphere is 0.3 x 3.709 / 4 pi.
+  const double mean = near[0].y / std::sqrt(4.0 * kPi);
+  EXPECT_NEAR(mean, 0.3 * 3.709 / (4.0 * kPi), 0.1 * 0.3 * 3.709 / (4.0 * kPi));
+}
+
 TEST(AlbedoFit, TheLampSearchOnGivenSamplesFindsWhatItFindsOnTheStore) {
   constexpr double kCell = 0.05;
   const glm::dvec3 lamp(0.3, 1.4, 0.4);

@@ -407,6 +407,10 @@ struct RuntimeSettings {
   /// interreflection shows), instead of assuming 0.5. The estimate's brightness and colour scale
   /// with 1 / albedo. false: the grey world.
   bool light_albedo_fit = true;
+  /// With the albedo fit: the light the seen surfaces bounce onto the virtual objects is computed
+  /// from them (their positions and colours) and added as ambient, and the distant light is solved
+  /// without it (light/light_stage.h). false: the bounce is read as part of the distant light.
+  bool light_near_field = true;
 };
 
 // ---------------------------------------------------------------------------------------------

@@ -114,6 +114,47 @@ void AlbedoFitter::receiver_terms(Receiver& r) {
   }
 }
 
+bool AlbedoFitter::near_field_at(const glm::dvec3& focus, ShRgb& out) {
+  out = ShRgb{};
+  if (emitters_.empty()) return false;
+  std::fill(coverage_.begin(), coverage_.end(), 0.0);
+  std::fill(radiance_.begin(), radiance_.end(), glm::dvec3(0.0));
+  std::fill(nearest_.begin(), nearest_.end(), std::numeric_limits<double>::infinity());
+  const glm::vec3 p(focus);
+  for (size_t i = 0; i < emitters_.size(); ++i) {
+    const glm::vec3 v = emitters_[i].p - p;
+    const float d2 = glm::dot(v, v);
+    bin_of_[i] = -1;
+    if (d2 < float(min_d2_)) continue;
+    const float d = std::sqrt(d2);
+    const int b = cube_bin(glm::dvec3(v / d));
+    bin_of_[i] = b;
+    distance_[i] = d;
+    nearest_[size_t(b)] = std::min(nearest_[size_t(b)], double(d));
+  }
+  for (size_t i = 0; i < emitters_.size(); ++i) {
+    const int b = bin_of_[i];
+    if (b < 0) continue;
+    const Emitter& e = emitters_[i];
+    const float d = distance_[i], d2 = d * d;
+    if (double(d) > kLayer * nearest_[size_t(b)] + layer_m_) continue;
+    const glm::vec3 v = e.p - p;
+    const float cos_e_d = -glm::dot(e.n, v);
+    const double omega = double(e.area * std::abs(cos_e_d) / (d2 * d));
+    coverage_[size_t(b)] += omega;
+    if (cos_e_d > 0.0f) radiance_[size_t(b)] += omega * glm::dvec3(e.c);
+  }
+  for (int b = 0; b < kBins; ++b) {
+    const double covered = coverage_[size_t(b)];
+    if (!(covered > 0.0)) continue;
+    const Bin& bin = bins_[size_t(b)];
+    const double f = std::min(1.0, covered / bin.solid_angle);
+    const glm::dvec3 l = radiance_[size_t(b)] / covered;  // the covering samples' mean radiance
+    for (int i = 0; i < kMaxShCoeffs; ++i) out[size_t(i)] += (f * bin.solid_angle * double(bin.sh[size_t(i)])) * l;
+  }
+  return true;
+}
+
 bool AlbedoFitter::begin(const RadianceSamples& store) {
   receivers_.clear();
   emitters_.clear();

@@ -38,7 +38,8 @@
 //
 // The same receivers, with a B / pi taken off their colour, are what the near-lamp search
 // reads (point_lamp_fit.h): the light a lamp gives directly, so the walls' bounce does not
-// flatten its fall-off.
+// flatten its fall-off. near_field_at() bins the whole sphere around a point the same way: the
+// light the kept surfaces send to the virtual objects.
 #pragma once
 #include <vector>
 
@@ -105,6 +106,10 @@ class AlbedoFitter {
   AlbedoFit solve(const PointLampFit* lamp);
   // begin, every step and solve at once.
   AlbedoFit fit(const RadianceSamples& store, const PointLampFit* lamp);
+  // The radiance SH of the light the kept samples (the emitters of the fit begun last) send to
+  // `focus` from every direction: the near field a virtual object there receives. False before
+  // any fit was begun.
+  bool near_field_at(const glm::dvec3& focus, ShRgb& out);
   // The receivers of the last solved fit with their bounce (empty before the first).
   const std::vector<Receiver>& fitted() const { return fitted_; }
   const AlbedoFitSettings& settings() const { return settings_; }

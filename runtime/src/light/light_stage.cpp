@@ -1,5 +1,7 @@
 #include "light/light_stage.h"
 
+#include <functional>
+
 #include "light/camera_color.h"
 
 #include <algorithm>
@@ -147,6 +149,7 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
       if (settings.point_lamp.enabled) s.lamp_fitter_.emplace(settings.point_lamp);
       if (settings.albedo_fit.enabled) {
         s.albedo_fitter_.emplace(settings.albedo_fit);
+        s.near_field_on_ = settings.near_field;
         s.direct_samples_.reserve(size_t(std::max(16, settings.albedo_fit.receivers)));
       }
     }
@@ -368,10 +371,16 @@ void LightStage::set_probeless_lighting() {
   lighting_.ambient_holds_real_bounce = true;
   const LightEstimate& est = estimator_->estimate();
   const ShRgb& l = estimator_->filtered();
+  // The near field (the light the kept surfaces send to the focus, albedo_fit.h) is unshadowed
+  // ambient: the dominant light and its shadow come from the distant light alone.
+  const bool near = near_field_on_ && near_field_valid_;
+  const ShRgb none{};
+  const ShRgb& nf = near ? near_field_ : none;
   lighting_.lights.clear();
   lighting_.light_sh.clear();
   lighting_.foldable.clear();
   ShRgb ambient = l;
+  for (int i = 0; i < kMaxShCoeffs; ++i) ambient[size_t(i)] += nf[size_t(i)];
   glm::dvec3 dir;
   if (est.valid && lamp_.found) {
     // A near lamp: a shadowed light where it was found, a wide spot aimed at the virtual objects'
@@ -400,6 +409,7 @@ void LightStage::set_probeless_lighting() {
     lighting_.ambient_regions.clear();
     lighting_.estimate = est;
     fill_light_estimate(all, est.bands, lighting_.estimate);
+    if (near) add_near_field(lighting_.estimate);
     ++lighting_.revision;
     return;
   }
@@ -422,7 +432,23 @@ void LightStage::set_probeless_lighting() {
   lighting_.ambient_virtual = ShRgb{};
   lighting_.ambient_regions.clear();
   lighting_.estimate = est;
+  if (near) add_near_field(lighting_.estimate);
   ++lighting_.revision;
+}
+
+void LightStage::add_near_field(LightEstimate& estimate) const {
+  // The exported SH is all the light reaching the focus; its dominant light stays the distant
+  // light's (the near field is many dim sources, none of them the main light).
+  const auto direction = estimate.direction_to_light;
+  const auto intensity = estimate.dominant_intensity;
+  ShRgb all{};
+  for (int i = 0; i < kMaxShCoeffs; ++i) {
+    const auto& c = estimate.sh_radiance[size_t(i)];
+    all[size_t(i)] = glm::dvec3(c[0], c[1], c[2]) + near_field_[size_t(i)];
+  }
+  fill_light_estimate(all, estimate.bands, estimate);
+  estimate.direction_to_light = direction;
+  estimate.dominant_intensity = intensity;
 }
 
 void LightStage::set_residual_lighting() {
@@ -498,6 +524,7 @@ void LightStage::update_albedo(const RadianceSamples& store, bool first) {
         albedo_store_size_ = std::max(albedo_store_size_, seen);
         estimator_->set_albedo(estimator_->albedo() + (fit.albedo - estimator_->albedo()) / double(albedo_fits_));
       }
+      if (near_field_on_) near_field_valid_ = albedo_fitter_->near_field_at(glm::dvec3(settings_.focus), near_field_);
     }
   }
 }
@@ -570,8 +597,25 @@ Status LightStage::add_probeless_parts(const frame::CameraView& camera, std::vec
   if (solved) {
     if (store) {
       pending_.clear();
+      // With the near field on, the distant light is solved from each sample's colour less the
+      // bounce its nearest fitted receiver (same side, within 0.5 m) receives.
+      const std::vector<AlbedoFitter::Receiver>* fitted = albedo_fitter_ ? &albedo_fitter_->fitted() : nullptr;
+      const std::function<glm::dvec3(const glm::vec3&, const glm::vec3&)> bounce = [&](const glm::vec3& p, const glm::vec3& n) {
+        double best = 0.25;
+        glm::dvec3 out(0.0);
+        for (const AlbedoFitter::Receiver& r : *fitted) {
+          const glm::dvec3 v = r.p - glm::dvec3(p);
+          const double d2 = glm::dot(v, v);
+          if (d2 < best && glm::dot(r.n, glm::dvec3(n)) > 0.7 * glm::length(glm::dvec3(n))) {
+            best = d2;
+            out = albedo * r.bounce;
+          }
+        }
+        return out;
+      };
+      const bool direct_rows = near_field_on_ && near_field_valid_ && fitted && !fitted->empty();
       store->add_to(pending_, &estimator_->filtered(), albedo, lamp_.found ? &lamp_.position : nullptr,
-                    lamp_.found ? &lamp_.intensity : nullptr);
+                    lamp_.found ? &lamp_.intensity : nullptr, direct_rows ? &bounce : nullptr);
     }
     auto r = estimator_->update(pending_, camera.index, camera.timestamp);
     if (!r) notes.push_back("light: " + r.error().message);

@@ -173,9 +173,11 @@ bool RadianceSamples::end_frame(int64_t frame) {
 }
 
 void RadianceSamples::add_to(LightSystem& system, const ShRgb* estimate, const glm::dvec3& albedo,
-                             const glm::dvec3* lamp_position, const glm::dvec3* lamp_intensity) const {
+                             const glm::dvec3* lamp_position, const glm::dvec3* lamp_intensity,
+                             const std::function<glm::dvec3(const glm::vec3&, const glm::vec3&)>* taken_off) const {
   for (const Sample& s : samples_) {
     glm::dvec3 colour = s.colour;
+    if (taken_off) colour = glm::max(colour - (*taken_off)(s.position, s.normal), glm::dvec3(0.0));
     if (lamp_position && lamp_intensity) {
       const glm::dvec3 v = *lamp_position - glm::dvec3(s.position);
       const double d = std::max(glm::length(v), 0.15);

@@ -24,6 +24,7 @@
 // recently seen is dropped.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -80,8 +81,11 @@ class RadianceSamples {
   // With `lamp_position` / `lamp_intensity` (a near lamp found by PointLampFitter: radiant
   // intensity W/sr, RGB), each row's colour has that lamp's unshadowed light taken off
   // (albedo / pi * I cos / d^2, clamped at 0), so the system holds what the lamp does not explain.
+  // With `taken_off`, each row's colour has what it returns for the sample taken off first
+  // (clamped at 0): the light the surfaces around bounce onto it (albedo_fit.h).
   void add_to(LightSystem& system, const ShRgb* estimate = nullptr, const glm::dvec3& albedo = glm::dvec3(0.5),
-              const glm::dvec3* lamp_position = nullptr, const glm::dvec3* lamp_intensity = nullptr) const;
+              const glm::dvec3* lamp_position = nullptr, const glm::dvec3* lamp_intensity = nullptr,
+              const std::function<glm::dvec3(const glm::vec3&, const glm::vec3&)>* taken_off = nullptr) const;
 
   struct Sample {
     uint64_t key;

@@ -61,6 +61,7 @@ struct LightFamilySettings {
   bool accumulate_views = true;  // RuntimeSettings::light_accumulate_views
   bool near_lamps = true;        // RuntimeSettings::light_near_lamps
   bool albedo_fit = true;        // RuntimeSettings::light_albedo_fit
+  bool near_field = true;        // RuntimeSettings::light_near_field
 };
 
 // One capture replayed through the runtime: the error of every frame and the light it came
