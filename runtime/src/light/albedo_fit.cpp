@@ -67,8 +67,8 @@ AlbedoFitter::AlbedoFitter(const AlbedoFitSettings& s) : settings_(s) {
       }
 }
 
-void AlbedoFitter::receiver_terms(Receiver& r) {
-  // What each direction bin above the receiver sees: the nearest layer of emitters in it (those
+void AlbedoFitter::cover_bins(const glm::vec3& p, const glm::vec3* hemisphere) {
+  // What each direction bin around the point sees: the nearest layer of emitters in it (those
   // within kLayer of the nearest: a table top hides the wall behind it), by the solid angle they
   // cover (at most the bin's) and their mean radiance; an emitter seen from behind (a table top
   // from the floor under it) covers its share dark, its lit side facing away. The rest of the
@@ -76,12 +76,11 @@ void AlbedoFitter::receiver_terms(Receiver& r) {
   std::fill(coverage_.begin(), coverage_.end(), 0.0);
   std::fill(radiance_.begin(), radiance_.end(), glm::dvec3(0.0));
   std::fill(nearest_.begin(), nearest_.end(), std::numeric_limits<double>::infinity());
-  const glm::vec3 p(r.p), n(r.n);
   for (size_t i = 0; i < emitters_.size(); ++i) {
     const glm::vec3 v = emitters_[i].p - p;
     const float d2 = glm::dot(v, v);
     bin_of_[i] = -1;
-    if (d2 < float(min_d2_) || glm::dot(n, v) <= 0.0f) continue;
+    if (d2 < float(min_d2_) || (hemisphere && glm::dot(*hemisphere, v) <= 0.0f)) continue;
     const float d = std::sqrt(d2);
     const int b = cube_bin(glm::dvec3(v / d));
     bin_of_[i] = b;
@@ -100,6 +99,11 @@ void AlbedoFitter::receiver_terms(Receiver& r) {
     coverage_[size_t(b)] += omega;
     if (cos_e_d > 0.0f) radiance_[size_t(b)] += omega * glm::dvec3(e.c);
   }
+}
+
+void AlbedoFitter::receiver_terms(Receiver& r) {
+  const glm::vec3 n(r.n);
+  cover_bins(glm::vec3(r.p), &n);
   r.t.fill(0.0f);
   r.bounce = glm::dvec3(0.0);
   for (int b = 0; b < kBins; ++b) {
@@ -117,33 +121,7 @@ void AlbedoFitter::receiver_terms(Receiver& r) {
 bool AlbedoFitter::near_field_at(const glm::dvec3& focus, ShRgb& out) {
   out = ShRgb{};
   if (emitters_.empty()) return false;
-  std::fill(coverage_.begin(), coverage_.end(), 0.0);
-  std::fill(radiance_.begin(), radiance_.end(), glm::dvec3(0.0));
-  std::fill(nearest_.begin(), nearest_.end(), std::numeric_limits<double>::infinity());
-  const glm::vec3 p(focus);
-  for (size_t i = 0; i < emitters_.size(); ++i) {
-    const glm::vec3 v = emitters_[i].p - p;
-    const float d2 = glm::dot(v, v);
-    bin_of_[i] = -1;
-    if (d2 < float(min_d2_)) continue;
-    const float d = std::sqrt(d2);
-    const int b = cube_bin(glm::dvec3(v / d));
-    bin_of_[i] = b;
-    distance_[i] = d;
-    nearest_[size_t(b)] = std::min(nearest_[size_t(b)], double(d));
-  }
-  for (size_t i = 0; i < emitters_.size(); ++i) {
-    const int b = bin_of_[i];
-    if (b < 0) continue;
-    const Emitter& e = emitters_[i];
-    const float d = distance_[i], d2 = d * d;
-    if (double(d) > kLayer * nearest_[size_t(b)] + layer_m_) continue;
-    const glm::vec3 v = e.p - p;
-    const float cos_e_d = -glm::dot(e.n, v);
-    const double omega = double(e.area * std::abs(cos_e_d) / (d2 * d));
-    coverage_[size_t(b)] += omega;
-    if (cos_e_d > 0.0f) radiance_[size_t(b)] += omega * glm::dvec3(e.c);
-  }
+  cover_bins(glm::vec3(focus), nullptr);
   for (int b = 0; b < kBins; ++b) {
     const double covered = coverage_[size_t(b)];
     if (!(covered > 0.0)) continue;

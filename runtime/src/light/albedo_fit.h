@@ -127,6 +127,9 @@ class AlbedoFitter {
   // The fit of `pick` . colour (a channel, or luminance): the bounce column's coefficient and
   // its standard error. False when the system is singular.
   bool solve_pick(const glm::dvec3& pick, const PointLampFit* lamp, double& albedo, double& sigma) const;
+  // Fills coverage_ and radiance_ per bin for a point: the nearest layer of emitters (within
+  // `hemisphere`'s side where given, else the whole sphere).
+  void cover_bins(const glm::vec3& p, const glm::vec3* hemisphere);
   void receiver_terms(Receiver& r);
   AlbedoFitSettings settings_;
   std::vector<Receiver> receivers_, fitted_;  // reserved to settings.receivers
