@@ -482,6 +482,7 @@ void LightStage::use_external_system() {
   albedo_store_size_ = 0;
   albedo_urgent_in_ = -1;
   lamp_search_due_ = false;
+  near_field_on_ = near_field_valid_ = false;
   lamp_ = PointLampFit{};
   residual_ = false;
   set_probeless_lighting();
@@ -583,6 +584,7 @@ Status LightStage::add_probeless_parts(const frame::CameraView& camera, std::vec
     if (albedo_fitter_) {
       albedo_fitter_->restart();
       albedo_urgent_in_ = parts;
+      near_field_valid_ = false;  // the old light's bounce, until the next fit
     }
     notes.push_back("light: the light changed (surfaces seen again differ in brightness): the probeless "
                     "estimate restarts from the views after it");
