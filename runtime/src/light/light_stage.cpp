@@ -512,6 +512,11 @@ void LightStage::update_albedo(const RadianceSamples& store, bool first) {
     if (albedo_fitter_->busy() && albedo_fitter_->step(count)) {
       lamp_search_due_ = urgent;
       albedo_urgent_in_ = -1;
+      // The first fit under a new light (and the lamp search right after it) changes what the
+      // rows hold: the next solve replaces the estimate too, rather than being filtered towards
+      // from one solved while the receivers still held the old light (measured: a lamp switched on
+      // in a white corner overshot by a third and took 39 frames to settle).
+      if (urgent) estimator_->restart_filter(1);
       const AlbedoFit fit = albedo_fitter_->solve(lamp_.found ? &lamp_ : nullptr);
       // A running mean over the fits (at most the last kAlbedoFits). The albedo is the
       // surfaces', not the light's: after the first kAlbedoSettleFits it moves only when the
