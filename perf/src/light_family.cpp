@@ -185,6 +185,7 @@ Expected<std::vector<LightFamilyResult>> run_light_family(const LightFamilySetti
     r.truth_direction = probe_light->direction_to_light;
     r.estimate_mean = est->light->sh_radiance[0];
     r.truth_mean = probe_light->sh_radiance[0];
+    r.truth_all_mean = full_light->sh_radiance[0];
     r.rde_true = truth->pooled.all.rde;
     r.rde_estimate = est->pooled.all.rde;
     r.sky = sc.name.rfind("sky", 0) == 0;
@@ -240,7 +241,8 @@ std::string light_family_json(const std::vector<LightFamilyResult>& results) {
                  {"colour_error", r.colour_error}, {"confidence", r.confidence}, {"rde_true", r.rde_true},
                  {"rde_estimate", r.rde_estimate}, {"rde_ratio", r.rde_ratio()},
                  {"estimate_direction", r.estimate_direction}, {"truth_direction", r.truth_direction},
-                 {"estimate_band0", r.estimate_mean}, {"truth_band0", r.truth_mean}});
+                 {"estimate_band0", r.estimate_mean}, {"truth_band0", r.truth_mean},
+                 {"truth_all_band0", r.truth_all_mean}});
   return j.dump(1) + "\n";
 }
 

@@ -92,6 +92,8 @@ Expected<MovingResult> run_scene(const LightFamilyScene& sc, const LightFamilySe
   if (!est) return fail(est.error().kind, sc.name + " (estimate): " + est.error().message);
   auto probe = load_light_truth(dir, true);
   if (!probe) return fail(probe.error().kind, sc.name + ": " + probe.error().message);
+  auto all_light = load_light_truth(dir, false);
+  if (!all_light) return fail(all_light.error().kind, sc.name + ": " + all_light.error().message);
   MovingResult r;
   r.scene = sc;
   for (size_t i = 0; i < est->frames.size(); ++i) {
@@ -102,6 +104,7 @@ Expected<MovingResult> run_scene(const LightFamilyScene& sc, const LightFamilySe
       f.valid = true;
       f.direction_error_deg = direction_error_deg(*l, *probe);
       f.colour_error = family_colour_error(*l, *probe);
+      f.colour_error_all = family_colour_error(*l, *all_light);
       f.confidence = l->confidence;
     }
     r.frames.push_back(f);
@@ -110,6 +113,7 @@ Expected<MovingResult> run_scene(const LightFamilyScene& sc, const LightFamilySe
   const MovingFrame& last = r.frames.back();
   r.final_direction_deg = last.direction_error_deg;
   r.final_colour = last.colour_error;
+  r.final_colour_all = last.colour_error_all;
   r.final_confidence = last.confidence;
   double t = 0.0, e = 0.0;
   for (size_t i = r.frames.size() - std::min<size_t>(8, r.frames.size()); i < r.frames.size(); ++i) {
@@ -150,6 +154,8 @@ Expected<SwitchResult> run_switch(const Manifest::Switch& w, const LightFamilySe
   r.intensity_after = lum_end;
   if (r.switch_frame > 0 && size_t(r.switch_frame) <= est->frames.size())
     if (const auto& b = est->frames[size_t(r.switch_frame - 1)].light) r.intensity_before = band0_luminance(*b);
+  for (size_t i = size_t(std::max(r.switch_frame, 0)); i < est->frames.size(); ++i)
+    if (const auto& l = est->frames[i].light) r.series.push_back({band0_luminance(*l), direction_error_deg(*l, *probe)});
   int settled = -1;
   for (int i = int(est->frames.size()) - 1; i >= r.switch_frame; --i) {
     const auto& l = est->frames[size_t(i)].light;
@@ -270,8 +276,9 @@ std::string moving_family_markdown(const MovingFamilyReport& rep, const MovingFa
   char line[512];
   std::snprintf(line, sizeof line,
                 "Technique `%s` level %d, %s%s. Direction: degrees between the estimate's and the truth's "
-                "dominant light; colour: largest per-channel error of the mean light's chromaticity; RDE "
-                "ratio: estimate-lit over true-lit (all pixels).\n\n",
+                "dominant light; colour: largest per-channel error of the mean light's chromaticity, against "
+                "the light sources' (probe_direct.exr) and against all the light at the objects' centre "
+                "(probe.exr, bounce included); RDE ratio: estimate-lit over true-lit (all pixels).\n\n",
                 ms.family.technique.c_str(), ms.family.level,
                 !ms.family.accumulate_views ? "each view on its own"
                 : ms.family.near_lamps      ? "the estimate accumulated over the views, near lamps found"
@@ -280,30 +287,34 @@ std::string moving_family_markdown(const MovingFamilyReport& rep, const MovingFa
                 : ms.family.near_field ? ", albedo from interreflection, near field" : ", albedo from interreflection");
   md += line;
   md += "Direction error (degrees) as the sweep grows:\n\n| scene | half | 0 deg | 22 deg | 45 deg | 67 deg | 90 deg |"
-        " colour after | confidence after | RDE ratio, last 8 frames |\n|---|---|---|---|---|---|---|---|---|---|\n";
+        " colour after (sources / all light) | confidence after | RDE ratio, last 8 frames |\n"
+        "|---|---|---|---|---|---|---|---|---|---|\n";
   for (const MovingResult& r : rep.scenes) {
     const size_t n = r.frames.size();
     auto at = [&](double q) { return r.frames[std::min(n - 1, size_t(std::lround(q * double(n - 1))))].direction_error_deg; };
-    std::snprintf(line, sizeof line, "| %s | %s | %.1f | %.1f | %.1f | %.1f | %.1f | %.2f | %.2f | %.2f |\n",
+    std::snprintf(line, sizeof line, "| %s | %s | %.1f | %.1f | %.1f | %.1f | %.1f | %.2f / %.2f | %.2f | %.2f |\n",
                   r.scene.name.c_str(), r.scene.held_out ? "held out" : "tuning", at(0.0), at(0.25), at(0.5),
-                  at(0.75), at(1.0), r.final_colour, r.final_confidence, r.final_rde_ratio);
+                  at(0.75), at(1.0), r.final_colour, r.final_colour_all, r.final_confidence, r.final_rde_ratio);
     md += line;
   }
   md += "\n| half | scenes | direction after the sweep, median / worst (target 15 / 30) | RDE ratio median / worst "
-        "(target 1.2 / 1.5) | colour median / worst (target 0.10 / 0.15) |\n|---|---|---|---|---|\n";
+        "(target 1.2 / 1.5) | colour median / worst (target 0.10 / 0.15) | colour against all the light, median / "
+        "worst |\n|---|---|---|---|---|---|\n";
   for (const bool held : {false, true}) {
-    std::vector<double> dir, ratio, colour;
+    std::vector<double> dir, ratio, colour, colour_all;
     for (const MovingResult& r : rep.scenes) {
       if (r.scene.held_out != held) continue;
       dir.push_back(r.final_direction_deg);
       ratio.push_back(r.final_rde_ratio);
       colour.push_back(r.final_colour);
+      colour_all.push_back(r.final_colour_all);
     }
     if (dir.empty()) continue;
-    std::snprintf(line, sizeof line, "| %s | %zu | %.1f / %.1f | %.2f / %.2f | %.2f / %.2f |\n", held ? "held out" : "tuning",
-                  dir.size(), median(dir), *std::max_element(dir.begin(), dir.end()), median(ratio),
-                  *std::max_element(ratio.begin(), ratio.end()), median(colour),
-                  *std::max_element(colour.begin(), colour.end()));
+    std::snprintf(line, sizeof line, "| %s | %zu | %.1f / %.1f | %.2f / %.2f | %.2f / %.2f | %.2f / %.2f |\n",
+                  held ? "held out" : "tuning", dir.size(), median(dir), *std::max_element(dir.begin(), dir.end()),
+                  median(ratio), *std::max_element(ratio.begin(), ratio.end()), median(colour),
+                  *std::max_element(colour.begin(), colour.end()), median(colour_all),
+                  *std::max_element(colour_all.begin(), colour_all.end()));
     md += line;
   }
   if (!rep.switches.empty()) {
@@ -336,10 +347,12 @@ std::string moving_family_json(const MovingFamilyReport& rep) {
     nlohmann::json frames = nlohmann::json::array();
     for (const MovingFrame& f : r.frames)
       frames.push_back({{"valid", f.valid}, {"direction_error_deg", f.direction_error_deg},
-                        {"colour_error", f.colour_error}, {"confidence", f.confidence},
+                        {"colour_error", f.colour_error}, {"colour_error_all_light", f.colour_error_all},
+                        {"confidence", f.confidence},
                         {"rde_true", f.rde_true}, {"rde_estimate", f.rde_estimate}});
     j["scenes"].push_back({{"scene", r.scene.name}, {"held_out", r.scene.held_out},
                            {"final_direction_error_deg", r.final_direction_deg}, {"final_colour_error", r.final_colour},
+                           {"final_colour_error_all_light", r.final_colour_all},
                            {"final_confidence", r.final_confidence}, {"final_rde_ratio", r.final_rde_ratio},
                            {"frames", frames}});
   }
@@ -348,7 +361,7 @@ std::string moving_family_json(const MovingFamilyReport& rep) {
     j["switches"].push_back({{"name", w.name}, {"held_out", w.held_out}, {"at", w.switch_frame},
                              {"followed_after", w.followed_after}, {"changes_detected", w.changes_noted},
                              {"intensity_before", w.intensity_before}, {"intensity_after", w.intensity_after},
-                             {"final_direction_error_deg", w.final_direction_deg}});
+                             {"final_direction_error_deg", w.final_direction_deg}, {"series", w.series}});
   j["drift"] = nlohmann::json::array();
   for (const DriftResult& d : rep.drift)
     j["drift"].push_back({{"scene", d.name}, {"frames", d.frames}, {"settled_from", d.settled_from},

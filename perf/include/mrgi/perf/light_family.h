@@ -45,6 +45,7 @@ struct LightFamilyResult {
   double confidence = 0.0;
   std::array<float, 3> estimate_direction{}, truth_direction{};  // towards the dominant light
   std::array<float, 3> estimate_mean{}, truth_mean{};            // band-0 radiance, linear RGB
+  std::array<float, 3> truth_all_mean{};  // band 0 of everything reaching the objects (probe.exr, bounce included)
   double rde_true = 0.0, rde_estimate = 0.0;  // pooled over the frames, all pixels
   double rde_ratio() const { return rde_true > 0.0 ? rde_estimate / rde_true : 0.0; }
   bool sky = false;              // lit by a procedural sun and sky (colour target applies)

@@ -2,7 +2,9 @@
 // 90-degree sweep around a virtual object on a table, replayed lit by its true light and by the
 // runtime's probeless estimate, with the estimate's figures at every frame (as the sweep grows):
 // direction error (degrees, against the light sources as the object's centre sees them),
-// colour error (largest per-channel error of the mean light's chromaticity), confidence, and
+// colour error (largest per-channel error of the mean light's chromaticity against the light
+// sources', light_probe/probe_direct.exr, and against all the light reaching the object's centre,
+// probe.exr, bounce included: with the near field the exported SH holds both), confidence, and
 // the per-frame RDE ratio (estimate-lit over true-lit, all pixels). After the sweep: the last
 // frame's direction and colour, the RDE ratio pooled over the last 8 frames.
 //
@@ -24,7 +26,7 @@
 namespace mrgi::perf {
 
 struct MovingFrame {
-  double direction_error_deg = 0.0, colour_error = 0.0, confidence = 0.0;
+  double direction_error_deg = 0.0, colour_error = 0.0, colour_error_all = 0.0, confidence = 0.0;
   double rde_true = 0.0, rde_estimate = 0.0;
   bool valid = false;  // an estimate existed
 };
@@ -32,7 +34,7 @@ struct MovingFrame {
 struct MovingResult {
   LightFamilyScene scene;
   std::vector<MovingFrame> frames;
-  double final_direction_deg = 0.0, final_colour = 0.0, final_confidence = 0.0;
+  double final_direction_deg = 0.0, final_colour = 0.0, final_colour_all = 0.0, final_confidence = 0.0;
   double final_rde_ratio = 0.0;  // pooled over the last 8 frames
 };
 
@@ -44,6 +46,8 @@ struct SwitchResult {
   int changes_noted = 0;    // frames whose notes say a light change was detected
   double final_direction_deg = 0.0;  // against the lamp-on truth
   double intensity_before = 0.0, intensity_after = 0.0;  // band-0 luminance before the switch, at the end
+  // Every frame from the switch on: band-0 luminance, direction error against the lamp-on truth (degrees).
+  std::vector<std::array<double, 2>> series;
 };
 
 struct DriftResult {
