@@ -15,6 +15,16 @@ constexpr int kMaxColumns = kMaxShCoeffs + 2;  // SH, bounce, near lamp
 const glm::dvec3 kLuminance(0.2126, 0.7152, 0.0722);
 constexpr double kMinInformation = 1e-3;  // the bounce column's share not explained by the others, below: no fit
 constexpr double kLayer = 1.5;  // a bin's nearest layer: within this factor of its nearest sample (+ 2 cells)
+constexpr int kMaxSplit = 6;    // an emitter near a point is split into at most this squared pieces
+constexpr size_t kSplitPieces = 16384;  // the pieces' scratch beyond one per emitter, reserved at start-up
+
+// Two unit tangents of a unit normal (Duff et al. 2017, "Building an orthonormal basis, revisited").
+void tangents(const glm::vec3& n, glm::vec3& t1, glm::vec3& t2) {
+  const float sign = std::copysign(1.0f, n.z);
+  const float a = -1.0f / (sign + n.z), b = n.x * n.y * a;
+  t1 = glm::vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
+  t2 = glm::vec3(b, sign + n.y * n.y * a, -n.y);
+}
 
 glm::dvec3 unit_normal(const glm::vec3& n) {
   const double len = glm::length(glm::dvec3(n));
@@ -41,8 +51,8 @@ AlbedoFitter::AlbedoFitter(const AlbedoFitSettings& s) : settings_(s) {
   receivers_.reserve(size_t(std::max(16, s.receivers)));
   fitted_.reserve(receivers_.capacity());
   emitters_.reserve(size_t(std::max(64, s.emitters)));
-  bin_of_.resize(emitters_.capacity());
-  distance_.resize(emitters_.capacity());
+  near_emitters_.reserve(size_t(std::clamp(s.near_field_emitters, 64, 65536)));
+  pieces_.reserve(std::max(emitters_.capacity(), near_emitters_.capacity()) + kSplitPieces);
   bins_.resize(size_t(kBins));
   coverage_.resize(size_t(kBins));
   nearest_.resize(size_t(kBins));
@@ -64,46 +74,63 @@ AlbedoFitter::AlbedoFitter(const AlbedoFitSettings& s) : settings_(s) {
         glm::dvec3 w = face < 2 ? glm::dvec3(sign, u, v) : face < 4 ? glm::dvec3(u, sign, v) : glm::dvec3(u, v, sign);
         b.direction = glm::normalize(w);
         b.sh = sh_basis(glm::vec3(b.direction));
+        min_bin_solid_angle_ = std::min(min_bin_solid_angle_, b.solid_angle);
       }
 }
 
-void AlbedoFitter::cover_bins(const glm::vec3& p, const glm::vec3* hemisphere) {
+void AlbedoFitter::cover_bins(const glm::vec3& p, const glm::vec3* hemisphere, const std::vector<Emitter>& emitters,
+                              bool split) {
   // What each direction bin around the point sees: the nearest layer of emitters in it (those
   // within kLayer of the nearest: a table top hides the wall behind it), by the solid angle they
   // cover (at most the bin's) and their mean radiance; an emitter seen from behind (a table top
   // from the floor under it) covers its share dark, its lit side facing away. The rest of the
-  // bin is the distant light.
+  // bin is the distant light. With `split`, an emitter whose square would span more than half
+  // the smallest bin is split into pieces first (a 6 cm cell 10 cm below the objects spans ten
+  // bins: whole, it covered one). The receivers' strided emitters are not split: each stands for
+  // samples elsewhere, and split squares that overlap covered the corner's bins twice (its
+  // albedo read 0.21 for 0.3).
   std::fill(coverage_.begin(), coverage_.end(), 0.0);
   std::fill(radiance_.begin(), radiance_.end(), glm::dvec3(0.0));
   std::fill(nearest_.begin(), nearest_.end(), std::numeric_limits<double>::infinity());
-  for (size_t i = 0; i < emitters_.size(); ++i) {
-    const glm::vec3 v = emitters_[i].p - p;
+  pieces_.clear();
+  const double piece_omega = 0.5 * min_bin_solid_angle_;
+  auto add_piece = [&](const glm::vec3& v, float area, int emitter) {
     const float d2 = glm::dot(v, v);
-    bin_of_[i] = -1;
-    if (d2 < float(min_d2_) || (hemisphere && glm::dot(*hemisphere, v) <= 0.0f)) continue;
+    if (d2 < float(min_d2_) || (hemisphere && glm::dot(*hemisphere, v) <= 0.0f)) return;
     const float d = std::sqrt(d2);
     const int b = cube_bin(glm::dvec3(v / d));
-    bin_of_[i] = b;
-    distance_[i] = d;
     nearest_[size_t(b)] = std::min(nearest_[size_t(b)], double(d));
-  }
-  for (size_t i = 0; i < emitters_.size(); ++i) {
-    const int b = bin_of_[i];
-    if (b < 0) continue;
-    const Emitter& e = emitters_[i];
-    const float d = distance_[i], d2 = d * d;
-    if (double(d) > kLayer * nearest_[size_t(b)] + layer_m_) continue;
+    pieces_.push_back({v, d, area, b, emitter});
+  };
+  for (size_t i = 0; i < emitters.size(); ++i) {
+    const Emitter& e = emitters[i];
     const glm::vec3 v = e.p - p;
-    const float cos_e_d = -glm::dot(e.n, v);  // cos_e d; < 0 seen from behind
-    const double omega = double(e.area * std::abs(cos_e_d) / (d2 * d));
-    coverage_[size_t(b)] += omega;
-    if (cos_e_d > 0.0f) radiance_[size_t(b)] += omega * glm::dvec3(e.c);
+    const double d2 = std::max(double(glm::dot(v, v)), min_d2_);
+    const int m = split ? std::clamp(int(std::ceil(std::sqrt(double(e.area) / d2 / piece_omega))), 1, kMaxSplit) : 1;
+    if (m == 1 || pieces_.size() + size_t(m * m) > pieces_.capacity()) {
+      add_piece(v, e.area, int(i));
+      continue;
+    }
+    const float side = std::sqrt(e.area), a = e.area / float(m * m);
+    for (int y = 0; y < m; ++y)
+      for (int x = 0; x < m; ++x) {
+        const float u = ((float(x) + 0.5f) / float(m) - 0.5f) * side, w = ((float(y) + 0.5f) / float(m) - 0.5f) * side;
+        add_piece(v + u * e.t1 + w * e.t2, a, int(i));
+      }
+  }
+  for (const Piece& q : pieces_) {
+    if (double(q.d) > kLayer * nearest_[size_t(q.bin)] + layer_m_) continue;
+    const Emitter& e = emitters[size_t(q.emitter)];
+    const float cos_e_d = -glm::dot(e.n, q.v);  // cos_e d; < 0 seen from behind
+    const double omega = double(q.area * std::abs(cos_e_d) / (q.d * q.d * q.d));
+    coverage_[size_t(q.bin)] += omega;
+    if (cos_e_d > 0.0f) radiance_[size_t(q.bin)] += omega * glm::dvec3(e.c);
   }
 }
 
 void AlbedoFitter::receiver_terms(Receiver& r) {
   const glm::vec3 n(r.n);
-  cover_bins(glm::vec3(r.p), &n);
+  cover_bins(glm::vec3(r.p), &n, emitters_, false);
   r.t.fill(0.0f);
   r.bounce = glm::dvec3(0.0);
   for (int b = 0; b < kBins; ++b) {
@@ -118,10 +145,22 @@ void AlbedoFitter::receiver_terms(Receiver& r) {
   }
 }
 
-bool AlbedoFitter::near_field_at(const glm::dvec3& focus, ShRgb& out) {
+bool AlbedoFitter::near_field_at(const glm::dvec3& focus, const RadianceSamples& store, ShRgb& out) {
   out = ShRgb{};
-  if (emitters_.empty()) return false;
-  cover_bins(glm::vec3(focus), nullptr);
+  const auto& all = store.samples();
+  if (emitters_.empty() || all.empty()) return false;
+  const size_t cap = near_emitters_.capacity(), stride = std::max<size_t>(1, (all.size() + cap - 1) / cap);
+  const double cell = store.settings().cell_m;
+  const float area = float(cell * cell * double(stride));
+  near_emitters_.clear();
+  for (size_t i = 0; i < all.size(); i += stride) {
+    const glm::dvec3 n = unit_normal(all[i].normal);
+    if (n == glm::dvec3(0.0)) continue;
+    Emitter e{all[i].position, glm::vec3(n), glm::vec3(all[i].colour), area, {}, {}};
+    tangents(e.n, e.t1, e.t2);
+    near_emitters_.push_back(e);
+  }
+  cover_bins(glm::vec3(focus), nullptr, near_emitters_, true);
   for (int b = 0; b < kBins; ++b) {
     const double covered = coverage_[size_t(b)];
     if (!(covered > 0.0)) continue;
@@ -158,7 +197,10 @@ bool AlbedoFitter::begin(const RadianceSamples& store) {
   const float area = float(cell * cell * double(emitter_stride));
   for (size_t i = 0; i < all.size(); i += emitter_stride) {
     const glm::dvec3 n = unit_normal(all[i].normal);
-    if (n != glm::dvec3(0.0)) emitters_.push_back({all[i].position, glm::vec3(n), glm::vec3(all[i].colour), area});
+    if (n == glm::dvec3(0.0)) continue;
+    Emitter e{all[i].position, glm::vec3(n), glm::vec3(all[i].colour), area, {}, {}};
+    tangents(e.n, e.t1, e.t2);
+    emitters_.push_back(e);
   }
   if (receivers_.size() < 16) {
     receivers_.clear();

@@ -55,6 +55,7 @@ struct AlbedoFitSettings {
   bool enabled = true;
   int receivers = 192;         // samples the fit is over (strided over the unclipped ones), 16..4096
   int emitters = 1024;         // samples standing for the surfaces around them (strided), 64..65536
+  int near_field_emitters = 8192;  // samples the near field reads (strided beyond), 64..65536
   int receivers_per_step = 24; // receivers a step computes the terms of (one step a frame), >= 1
   int min_samples = 96;        // fewer unclipped samples: no fit (the prior stands)
   int bands = 3;               // SH bands of the distant light in the fit (1..4)
@@ -106,10 +107,12 @@ class AlbedoFitter {
   AlbedoFit solve(const PointLampFit* lamp);
   // begin, every step and solve at once.
   AlbedoFit fit(const RadianceSamples& store, const PointLampFit* lamp);
-  // The radiance SH of the light the kept samples (the emitters of the fit begun last) send to
-  // `focus` from every direction: the near field a virtual object there receives. False before
-  // any fit was begun.
-  bool near_field_at(const glm::dvec3& focus, ShRgb& out);
+  // The radiance SH of the light `store`'s samples send to `focus` from every direction: the
+  // near field a virtual object there receives. Every sample (up to near_field_emitters) is an
+  // emitter of its cell's area, and one near the focus is split to the bins it spans (the table
+  // under the objects is most of their lower hemisphere). False before any fit was begun (the
+  // fitter then has not read the store's settings) or for an empty store.
+  bool near_field_at(const glm::dvec3& focus, const RadianceSamples& store, ShRgb& out);
   // The receivers of the last solved fit with their bounce (empty before the first).
   const std::vector<Receiver>& fitted() const { return fitted_; }
   const AlbedoFitSettings& settings() const { return settings_; }
@@ -123,22 +126,35 @@ class AlbedoFitter {
   struct Emitter {
     glm::vec3 p, n, c;  // position, unit normal, colour
     float area;         // m^2: the cell's, times the samples it stands for
+    glm::vec3 t1, t2;   // unit tangents: the square of side sqrt(area) it stands for spans them
+  };
+  // A part of an emitter as a point sees it: an emitter near the point (a table top under the
+  // objects, the wall beside a receiver) covers more than one direction bin, so it is split into
+  // m x m squares, each small enough for a bin (kMaxSplit^2 at most).
+  struct Piece {
+    glm::vec3 v;  // from the point to the piece
+    float d;      // its distance
+    float area;
+    int bin;
+    int emitter;
   };
   // The fit of `pick` . colour (a channel, or luminance): the bounce column's coefficient and
   // its standard error. False when the system is singular.
   bool solve_pick(const glm::dvec3& pick, const PointLampFit* lamp, double& albedo, double& sigma) const;
-  // Fills coverage_ and radiance_ per bin for a point: the nearest layer of emitters (within
-  // `hemisphere`'s side where given, else the whole sphere).
-  void cover_bins(const glm::vec3& p, const glm::vec3* hemisphere);
+  // Fills coverage_ and radiance_ per bin for a point: the nearest layer of `emitters` (within
+  // `hemisphere`'s side where given, else the whole sphere); with `split`, an emitter spanning
+  // more than half a bin is split into pieces first.
+  void cover_bins(const glm::vec3& p, const glm::vec3* hemisphere, const std::vector<Emitter>& emitters, bool split);
   void receiver_terms(Receiver& r);
   AlbedoFitSettings settings_;
   std::vector<Receiver> receivers_, fitted_;  // reserved to settings.receivers
   std::vector<Emitter> emitters_;             // reserved to settings.emitters
-  std::vector<int> bin_of_;                   // per emitter, the receiver's scratch: its bin (-1 none)
-  std::vector<float> distance_;               // ... and its distance
+  std::vector<Emitter> near_emitters_;        // reserved to settings.near_field_emitters
+  std::vector<Piece> pieces_;                 // the point's scratch; reserved, splitting stops when full
   size_t next_ = 0;                           // the next receiver a step computes
   double min_d2_ = 0.0;                       // a cell's area: nearer samples are the receiver's own
   double layer_m_ = 0.0;                      // a bin's nearest layer reaches this beyond kLayer x nearest
+  double min_bin_solid_angle_ = 1e9;          // sr, the smallest bin's (a cube map's corner texel)
   std::vector<Bin> bins_;
   std::vector<double> coverage_, nearest_;    // per bin, the receiver's scratch
   std::vector<glm::dvec3> radiance_;

@@ -530,7 +530,7 @@ void LightStage::update_albedo(const RadianceSamples& store, bool first) {
         albedo_store_size_ = std::max(albedo_store_size_, seen);
         estimator_->set_albedo(estimator_->albedo() + (fit.albedo - estimator_->albedo()) / double(albedo_fits_));
       }
-      if (near_field_on_) near_field_valid_ = albedo_fitter_->near_field_at(glm::dvec3(settings_.focus), near_field_);
+      if (near_field_on_) near_field_valid_ = albedo_fitter_->near_field_at(glm::dvec3(settings_.focus), store, near_field_);
     }
   }
 }
