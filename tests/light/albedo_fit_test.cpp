@@ -169,6 +169,30 @@ TEST(AlbedoFit, TheNearFieldIsTheLightTheKeptSurfacesSendToAPoint) {
   EXPECT_NEAR(radiance({0, -1, 0}), 0.268, 0.04);
 }
 
+TEST(AlbedoFit, TheSurfacesAroundAPointHideTheDistantLightBehindThem) {
+  // A floor alone, half a metre below: of a uniform distant light (band 0) it hides the floor's
+  // share of the sphere, 3.709 sr of 4 pi; from straight above the light arrives whole.
+  constexpr double kCell = 0.06;
+  std::vector<Patch> patches = corner(false, kCell);
+  for (Patch& p : patches) p.colour = glm::dvec3(0.2);
+  const RadianceSamples store = store_of(patches, kCell);
+  AlbedoFitter fitter{AlbedoFitSettings{}};
+  ASSERT_TRUE(fitter.begin(store));
+  ShRgb near{};
+  ShMatrix hidden{};
+  ASSERT_TRUE(fitter.near_field_at({0.0, 0.5, 0.5}, store, near, &hidden));
+  EXPECT_NEAR(hidden[0], 3.709 / (4.0 * kPi), 0.1 * 3.709 / (4.0 * kPi));
+  // A light from above only (a cosine lobe's first two bands, pointing up): the floor hides
+  // little of it, far less than of the uniform light.
+  const ShVector up = sh_basis(glm::vec3(0, 1, 0));
+  double hidden_up = 0.0, whole_up = 0.0;
+  for (int i = 0; i < 4; ++i) {
+    whole_up += double(up[size_t(i)]) * up[size_t(i)];
+    for (int j = 0; j < 4; ++j) hidden_up += double(up[size_t(i)]) * hidden[size_t(i * kMaxShCoeffs + j)] * up[size_t(j)];
+  }
+  EXPECT_LT(hidden_up / whole_up, 0.5 * hidden[0]);
+}
+
 TEST(AlbedoFit, TheLampSearchOnGivenSamplesFindsWhatItFindsOnTheStore) {
   constexpr double kCell = 0.05;
   const glm::dvec3 lamp(0.3, 1.4, 0.4);

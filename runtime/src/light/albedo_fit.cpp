@@ -145,8 +145,9 @@ void AlbedoFitter::receiver_terms(Receiver& r) {
   }
 }
 
-bool AlbedoFitter::near_field_at(const glm::dvec3& focus, const RadianceSamples& store, ShRgb& out) {
+bool AlbedoFitter::near_field_at(const glm::dvec3& focus, const RadianceSamples& store, ShRgb& out, ShMatrix* hidden) {
   out = ShRgb{};
+  if (hidden) hidden->fill(0.0);
   const auto& all = store.samples();
   if (emitters_.empty() || all.empty()) return false;
   const size_t cap = near_emitters_.capacity(), stride = std::max<size_t>(1, (all.size() + cap - 1) / cap);
@@ -168,6 +169,10 @@ bool AlbedoFitter::near_field_at(const glm::dvec3& focus, const RadianceSamples&
     const double f = std::min(1.0, covered / bin.solid_angle);
     const glm::dvec3 l = radiance_[size_t(b)] / covered;  // the covering samples' mean radiance
     for (int i = 0; i < kMaxShCoeffs; ++i) out[size_t(i)] += (f * bin.solid_angle * double(bin.sh[size_t(i)])) * l;
+    if (hidden)
+      for (int i = 0; i < kMaxShCoeffs; ++i)
+        for (int j = 0; j < kMaxShCoeffs; ++j)
+          (*hidden)[size_t(i * kMaxShCoeffs + j)] += f * bin.solid_angle * double(bin.sh[size_t(i)]) * double(bin.sh[size_t(j)]);
   }
   return true;
 }

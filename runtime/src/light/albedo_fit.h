@@ -112,7 +112,10 @@ class AlbedoFitter {
   // emitter of its cell's area, and one near the focus is split to the bins it spans (the table
   // under the objects is most of their lower hemisphere). False before any fit was begun (the
   // fitter then has not read the store's settings) or for an empty store.
-  bool near_field_at(const glm::dvec3& focus, const RadianceSamples& store, ShRgb& out);
+  // `hidden` (optional) receives the part of the sphere the seen surfaces cover, as the SH
+  // matrix H (H_ij = sum over bins of covered solid angle x Y_i Y_j): distant light l reaches the
+  // focus as l - H l, the surfaces in front of it send the near field instead.
+  bool near_field_at(const glm::dvec3& focus, const RadianceSamples& store, ShRgb& out, ShMatrix* hidden = nullptr);
   // The receivers of the last solved fit with their bounce (empty before the first).
   const std::vector<Receiver>& fitted() const { return fitted_; }
   const AlbedoFitSettings& settings() const { return settings_; }

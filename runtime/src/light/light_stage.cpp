@@ -372,15 +372,22 @@ void LightStage::set_probeless_lighting() {
   const LightEstimate& est = estimator_->estimate();
   const ShRgb& l = estimator_->filtered();
   // The near field (the light the kept surfaces send to the focus, albedo_fit.h) is unshadowed
-  // ambient: the dominant light and its shadow come from the distant light alone.
+  // ambient: the dominant light and its shadow come from the distant light alone. The distant
+  // ambient stays whole here, though the surfaces in front of the focus hide part of it (the
+  // exported estimate takes that part off, add_near_field): rendered with it taken off, the
+  // moving family's tuning half read worse in every scene (RDE ratio median / worst 1.22 / 1.44
+  // -> 1.38 / 1.61).
   const bool near = near_field_on_ && near_field_valid_;
-  const ShRgb none{};
-  const ShRgb& nf = near ? near_field_ : none;
+  auto with_near_field = [&](const ShRgb& distant) {
+    if (!near) return distant;
+    ShRgb out = distant;
+    for (int i = 0; i < kMaxShCoeffs; ++i) out[size_t(i)] += near_field_[size_t(i)];
+    return out;
+  };
   lighting_.lights.clear();
   lighting_.light_sh.clear();
   lighting_.foldable.clear();
   ShRgb ambient = l;
-  for (int i = 0; i < kMaxShCoeffs; ++i) ambient[size_t(i)] += nf[size_t(i)];
   glm::dvec3 dir;
   if (est.valid && lamp_.found) {
     // A near lamp: a shadowed light where it was found, a wide spot aimed at the virtual objects'
@@ -404,7 +411,7 @@ void LightStage::set_probeless_lighting() {
     lighting_.foldable.push_back(0);
     ShRgb all = l;
     for (int i = 0; i < kMaxShCoeffs; ++i) all[size_t(i)] += sh[size_t(i)];
-    lighting_.ambient_real = ambient;
+    lighting_.ambient_real = with_near_field(ambient);
     lighting_.ambient_virtual = ShRgb{};
     lighting_.ambient_regions.clear();
     lighting_.estimate = est;
@@ -428,7 +435,7 @@ void LightStage::set_probeless_lighting() {
       for (int i = 0; i < kMaxShCoeffs; ++i) ambient[size_t(i)] -= sh[size_t(i)];
     }
   }
-  lighting_.ambient_real = ambient;
+  lighting_.ambient_real = with_near_field(ambient);
   lighting_.ambient_virtual = ShRgb{};
   lighting_.ambient_regions.clear();
   lighting_.estimate = est;
@@ -441,10 +448,16 @@ void LightStage::add_near_field(LightEstimate& estimate) const {
   // light's (the near field is many dim sources, none of them the main light).
   const auto direction = estimate.direction_to_light;
   const auto intensity = estimate.dominant_intensity;
+  // The distant light from the directions the seen surfaces cover is hidden by them: they send
+  // the near field instead.
   ShRgb all{};
   for (int i = 0; i < kMaxShCoeffs; ++i) {
     const auto& c = estimate.sh_radiance[size_t(i)];
     all[size_t(i)] = glm::dvec3(c[0], c[1], c[2]) + near_field_[size_t(i)];
+    for (int j = 0; j < kMaxShCoeffs; ++j) {
+      const auto& d = estimate.sh_radiance[size_t(j)];
+      all[size_t(i)] -= near_hidden_[size_t(i * kMaxShCoeffs + j)] * glm::dvec3(d[0], d[1], d[2]);
+    }
   }
   fill_light_estimate(all, estimate.bands, estimate);
   estimate.direction_to_light = direction;
@@ -530,7 +543,7 @@ void LightStage::update_albedo(const RadianceSamples& store, bool first) {
         albedo_store_size_ = std::max(albedo_store_size_, seen);
         estimator_->set_albedo(estimator_->albedo() + (fit.albedo - estimator_->albedo()) / double(albedo_fits_));
       }
-      if (near_field_on_) near_field_valid_ = albedo_fitter_->near_field_at(glm::dvec3(settings_.focus), store, near_field_);
+      if (near_field_on_) near_field_valid_ = albedo_fitter_->near_field_at(glm::dvec3(settings_.focus), store, near_field_, &near_hidden_);
     }
   }
 }

@@ -125,6 +125,9 @@ struct LightStageSettings {
   // near field, AlbedoFitter::near_field_at) is added to the ambient. Why: a white corner's
   // interreflection, strongest at its walls and crease, read as distant light was 1.4x what
   // reaches the box (RDE ratio on the moving family's tuning half 1.42 / 1.94 -> 1.33 / 1.54).
+  // The exported estimate is then the light reaching the virtual objects' centre: the near field
+  // plus the distant light from the directions no seen surface covers (as an app lights its
+  // object with it, and as ARCore's environment estimate holds the room around the anchor).
   bool near_field = true;
   // The estimator of the probeless source fed by the stage's own builder. RGB (white_light
   // false): the paper's white-light assumption gives a grey estimate under a blue sky. Chosen on
@@ -321,7 +324,8 @@ class LightStage {
   // One step of the albedo fit over the store (albedo_fit.h); a finished fit moves the
   // estimator's albedo.
   void update_albedo(const RadianceSamples& store, bool first);
-  // Adds the near field to an exported estimate's SH, its dominant light kept.
+  // Adds the near field to an exported estimate's SH and takes off the distant light the seen
+  // surfaces hide from the focus; its dominant light is kept.
   void add_near_field(LightEstimate& estimate) const;
   // The near-lamp search (point_lamp_fit.h) over the albedo fit's receivers with their bounce
   // taken off (the store's samples before the first fit); lamp_ follows it.
@@ -370,6 +374,7 @@ class LightStage {
   int albedo_fits_ = 0;                        // fits averaged into the estimator's albedo
   bool near_field_on_ = false, near_field_valid_ = false;
   ShRgb near_field_{};
+  ShMatrix near_hidden_{};  // the distant light the seen surfaces hide from the focus (albedo_fit.h)
   size_t albedo_store_size_ = 0;               // the store's size when the albedo last moved
   // A light changed: frames until the next albedo fit starts, in two steps (0: under way; -1 none).
   int albedo_urgent_in_ = -1;

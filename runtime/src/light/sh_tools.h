@@ -22,6 +22,7 @@ constexpr int kMaxShCoeffs = kMaxShBands * kMaxShBands;  // 16
 
 using ShVector = std::array<float, kMaxShCoeffs>;           // one channel
 using ShRgb = std::array<glm::dvec3, kMaxShCoeffs>;         // linear RGB per coefficient
+using ShMatrix = std::array<double, kMaxShCoeffs * kMaxShCoeffs>;  // row-major, a linear map of SH
 
 // Y_i(d) for i < 16 (d is normalised here; a zero vector gives all zeros).
 ShVector sh_basis(const glm::vec3& direction);
