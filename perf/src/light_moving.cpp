@@ -155,7 +155,7 @@ Expected<SwitchResult> run_switch(const Manifest::Switch& w, const LightFamilySe
   if (r.switch_frame > 0 && size_t(r.switch_frame) <= est->frames.size())
     if (const auto& b = est->frames[size_t(r.switch_frame - 1)].light) r.intensity_before = band0_luminance(*b);
   for (size_t i = size_t(std::max(r.switch_frame, 0)); i < est->frames.size(); ++i)
-    if (const auto& l = est->frames[i].light) r.series.push_back({band0_luminance(*l), direction_error_deg(*l, *probe)});
+    if (const auto& l = est->frames[i].light) r.series.push_back({double(i), band0_luminance(*l), direction_error_deg(*l, *probe)});
   int settled = -1;
   for (int i = int(est->frames.size()) - 1; i >= r.switch_frame; --i) {
     const auto& l = est->frames[size_t(i)].light;

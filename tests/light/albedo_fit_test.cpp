@@ -182,7 +182,7 @@ TEST(AlbedoFit, TheSurfacesAroundAPointHideTheDistantLightBehindThem) {
   ShMatrix hidden{};
   ASSERT_TRUE(fitter.near_field_at({0.0, 0.5, 0.5}, store, near, &hidden));
   EXPECT_NEAR(hidden[0], 3.709 / (4.0 * kPi), 0.1 * 3.709 / (4.0 * kPi));
-  // A light from above only (a cosine lobe's first two bands, pointing up): the floor hides
+  // A light from straight up projected on the first two bands (1 + 3 cos): the floor hides
   // little of it, far less than of the uniform light.
   const ShVector up = sh_basis(glm::vec3(0, 1, 0));
   double hidden_up = 0.0, whole_up = 0.0;
@@ -191,6 +191,18 @@ TEST(AlbedoFit, TheSurfacesAroundAPointHideTheDistantLightBehindThem) {
     for (int j = 0; j < 4; ++j) hidden_up += double(up[size_t(i)]) * hidden[size_t(i * kMaxShCoeffs + j)] * up[size_t(j)];
   }
   EXPECT_LT(hidden_up / whole_up, 0.5 * hidden[0]);
+  // The light at the point: a uniform distant light loses the floor's share and the floor's
+  // near field comes instead; a lamp among the sources (not in the distant light) stays whole.
+  ShRgb distant{}, lamp{};
+  distant[0] = glm::dvec3(1.0);
+  lamp[0] = glm::dvec3(0.25);
+  lamp[2] = glm::dvec3(0.4);  // band 1, towards +y
+  ShRgb sources = distant;
+  for (int i = 0; i < kMaxShCoeffs; ++i) sources[size_t(i)] += lamp[size_t(i)];
+  const ShRgb at = light_at_point(sources, distant, near, hidden);
+  EXPECT_NEAR(at[0].y, 1.0 * (1.0 - hidden[0]) + near[0].y + 0.25, 1e-9);
+  EXPECT_NEAR(at[0].y, 1.0 - 3.709 / (4.0 * kPi) + 0.2 * 3.709 / std::sqrt(4.0 * kPi) + 0.25, 0.05);
+  EXPECT_NEAR(at[2].y, 0.4 + near[2].y - hidden[2 * kMaxShCoeffs] * 1.0, 1e-9);
 }
 
 TEST(AlbedoFit, TheLampSearchOnGivenSamplesFindsWhatItFindsOnTheStore) {

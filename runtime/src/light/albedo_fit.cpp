@@ -47,11 +47,20 @@ int cube_bin(const glm::dvec3& w) {
 
 }  // namespace
 
+ShRgb light_at_point(const ShRgb& sources, const ShRgb& distant, const ShRgb& near, const ShMatrix& hidden) {
+  ShRgb out{};
+  for (int i = 0; i < kMaxShCoeffs; ++i) {
+    out[size_t(i)] = sources[size_t(i)] + near[size_t(i)];
+    for (int j = 0; j < kMaxShCoeffs; ++j) out[size_t(i)] -= hidden[size_t(i * kMaxShCoeffs + j)] * distant[size_t(j)];
+  }
+  return out;
+}
+
 AlbedoFitter::AlbedoFitter(const AlbedoFitSettings& s) : settings_(s) {
   receivers_.reserve(size_t(std::max(16, s.receivers)));
   fitted_.reserve(receivers_.capacity());
   emitters_.reserve(size_t(std::max(64, s.emitters)));
-  near_emitters_.reserve(size_t(std::clamp(s.near_field_emitters, 64, 65536)));
+  near_emitters_.reserve(size_t(std::clamp(s.near_field_emitters, 64, 65536)));  // read to its capacity
   pieces_.reserve(std::max(emitters_.capacity(), near_emitters_.capacity()) + kSplitPieces);
   bins_.resize(size_t(kBins));
   coverage_.resize(size_t(kBins));
@@ -107,15 +116,18 @@ void AlbedoFitter::cover_bins(const glm::vec3& p, const glm::vec3* hemisphere, c
     const glm::vec3 v = e.p - p;
     const double d2 = std::max(double(glm::dot(v, v)), min_d2_);
     const int m = split ? std::clamp(int(std::ceil(std::sqrt(double(e.area) / d2 / piece_omega))), 1, kMaxSplit) : 1;
-    if (m == 1 || pieces_.size() + size_t(m * m) > pieces_.capacity()) {
+    // Room is kept for one piece of every emitter still to come, so the scratch never grows.
+    if (m == 1 || pieces_.size() + size_t(m * m) + (emitters.size() - i - 1) > pieces_.capacity()) {
       add_piece(v, e.area, int(i));
       continue;
     }
+    glm::vec3 t1, t2;
+    tangents(e.n, t1, t2);
     const float side = std::sqrt(e.area), a = e.area / float(m * m);
     for (int y = 0; y < m; ++y)
       for (int x = 0; x < m; ++x) {
         const float u = ((float(x) + 0.5f) / float(m) - 0.5f) * side, w = ((float(y) + 0.5f) / float(m) - 0.5f) * side;
-        add_piece(v + u * e.t1 + w * e.t2, a, int(i));
+        add_piece(v + u * t1 + w * t2, a, int(i));
       }
   }
   for (const Piece& q : pieces_) {
@@ -150,18 +162,10 @@ bool AlbedoFitter::near_field_at(const glm::dvec3& focus, const RadianceSamples&
   if (hidden) hidden->fill(0.0);
   const auto& all = store.samples();
   if (emitters_.empty() || all.empty()) return false;
-  const size_t cap = near_emitters_.capacity(), stride = std::max<size_t>(1, (all.size() + cap - 1) / cap);
-  const double cell = store.settings().cell_m;
-  const float area = float(cell * cell * double(stride));
-  near_emitters_.clear();
-  for (size_t i = 0; i < all.size(); i += stride) {
-    const glm::dvec3 n = unit_normal(all[i].normal);
-    if (n == glm::dvec3(0.0)) continue;
-    Emitter e{all[i].position, glm::vec3(n), glm::vec3(all[i].colour), area, {}, {}};
-    tangents(e.n, e.t1, e.t2);
-    near_emitters_.push_back(e);
-  }
-  cover_bins(glm::vec3(focus), nullptr, near_emitters_, true);
+  // Split only where each emitter is its own cell (the stage reserves room for the whole store):
+  // a strided one stands for samples elsewhere too.
+  const size_t stride = read_emitters(store, near_emitters_.capacity(), near_emitters_);
+  cover_bins(glm::vec3(focus), nullptr, near_emitters_, stride == 1);
   for (int b = 0; b < kBins; ++b) {
     const double covered = coverage_[size_t(b)];
     if (!(covered > 0.0)) continue;
@@ -177,6 +181,22 @@ bool AlbedoFitter::near_field_at(const glm::dvec3& focus, const RadianceSamples&
   return true;
 }
 
+size_t AlbedoFitter::read_emitters(const RadianceSamples& store, size_t cap, std::vector<Emitter>& out) const {
+  // Every sample, strided to at most `cap` (what `out` was reserved for), each standing for the
+  // area of the samples it stands for.
+  const auto& all = store.samples();
+  const size_t stride = std::max<size_t>(1, (all.size() + cap - 1) / cap);
+  const double cell = store.settings().cell_m;
+  const float area = float(cell * cell * double(stride));
+  out.clear();
+  for (size_t i = 0; i < all.size(); i += stride) {
+    const glm::dvec3 n = unit_normal(all[i].normal);
+    if (n == glm::dvec3(0.0)) continue;
+    out.push_back({all[i].position, glm::vec3(n), glm::vec3(all[i].colour), area});
+  }
+  return stride;
+}
+
 bool AlbedoFitter::begin(const RadianceSamples& store) {
   receivers_.clear();
   emitters_.clear();
@@ -188,8 +208,7 @@ bool AlbedoFitter::begin(const RadianceSamples& store) {
   const double cell = store.settings().cell_m;
   min_d2_ = cell * cell;
   layer_m_ = 2.0 * cell;
-  // Receivers: unclipped samples, strided. Emitters: every sample, strided, each standing for
-  // the area of the samples it stands for.
+  // Receivers: unclipped samples, strided. Emitters: every sample, strided (read_emitters).
   const size_t cap = size_t(std::max(16, settings_.receivers));
   const size_t stride = std::max<size_t>(1, (unclipped + cap - 1) / cap);
   size_t k = 0;
@@ -198,15 +217,7 @@ bool AlbedoFitter::begin(const RadianceSamples& store) {
     const glm::dvec3 n = unit_normal(s.normal);
     if (n != glm::dvec3(0.0)) receivers_.push_back({glm::dvec3(s.position), n, s.colour, glm::dvec3(0.0), double(s.row_weight), ShVector{}});
   }
-  const size_t emitter_stride = std::max<size_t>(1, (all.size() + size_t(std::max(64, settings_.emitters)) - 1) / size_t(std::max(64, settings_.emitters)));
-  const float area = float(cell * cell * double(emitter_stride));
-  for (size_t i = 0; i < all.size(); i += emitter_stride) {
-    const glm::dvec3 n = unit_normal(all[i].normal);
-    if (n == glm::dvec3(0.0)) continue;
-    Emitter e{all[i].position, glm::vec3(n), glm::vec3(all[i].colour), area, {}, {}};
-    tangents(e.n, e.t1, e.t2);
-    emitters_.push_back(e);
-  }
+  read_emitters(store, size_t(std::max(64, settings_.emitters)), emitters_);
   if (receivers_.size() < 16) {
     receivers_.clear();
     return false;

@@ -55,7 +55,9 @@ struct AlbedoFitSettings {
   bool enabled = true;
   int receivers = 192;         // samples the fit is over (strided over the unclipped ones), 16..4096
   int emitters = 1024;         // samples standing for the surfaces around them (strided), 64..65536
-  int near_field_emitters = 8192;  // samples the near field reads (strided beyond), 64..65536
+  // Samples the near field reads, 64..65536; beyond, strided and not split (the light stage sets
+  // it to the store's capacity).
+  int near_field_emitters = 8192;
   int receivers_per_step = 24; // receivers a step computes the terms of (one step a frame), >= 1
   int min_samples = 96;        // fewer unclipped samples: no fit (the prior stands)
   int bands = 3;               // SH bands of the distant light in the fit (1..4)
@@ -75,6 +77,12 @@ struct AlbedoFit {
   double bounce_share = 0.0;     // mean a B / pi over mean I (luminance): how much the bounce explains
   int receivers = 0;
 };
+
+// The light reaching a point from `sources` (SH of everything estimated: the distant light, a
+// near lamp) with the seen surfaces around it: their `near` field added and, of the `distant`
+// light, the part `hidden` behind them (near_field_at) taken off; a lamp in `sources` but not in
+// `distant` is left whole (it is in the room, in front of the surfaces it lights).
+ShRgb light_at_point(const ShRgb& sources, const ShRgb& distant, const ShRgb& near, const ShMatrix& hidden);
 
 class AlbedoFitter {
  public:
@@ -129,11 +137,10 @@ class AlbedoFitter {
   struct Emitter {
     glm::vec3 p, n, c;  // position, unit normal, colour
     float area;         // m^2: the cell's, times the samples it stands for
-    glm::vec3 t1, t2;   // unit tangents: the square of side sqrt(area) it stands for spans them
   };
   // A part of an emitter as a point sees it: an emitter near the point (a table top under the
-  // objects, the wall beside a receiver) covers more than one direction bin, so it is split into
-  // m x m squares, each small enough for a bin (kMaxSplit^2 at most).
+  // objects) covers more than one direction bin, so it is split into m x m squares in its
+  // tangent plane, each small enough for a bin (kMaxSplit^2 at most).
   struct Piece {
     glm::vec3 v;  // from the point to the piece
     float d;      // its distance
@@ -149,11 +156,13 @@ class AlbedoFitter {
   // more than half a bin is split into pieces first.
   void cover_bins(const glm::vec3& p, const glm::vec3* hemisphere, const std::vector<Emitter>& emitters, bool split);
   void receiver_terms(Receiver& r);
+  // Fills `out` (cleared) with at most `cap` of the store's samples as emitters, strided; the stride.
+  size_t read_emitters(const RadianceSamples& store, size_t cap, std::vector<Emitter>& out) const;
   AlbedoFitSettings settings_;
   std::vector<Receiver> receivers_, fitted_;  // reserved to settings.receivers
   std::vector<Emitter> emitters_;             // reserved to settings.emitters
   std::vector<Emitter> near_emitters_;        // reserved to settings.near_field_emitters
-  std::vector<Piece> pieces_;                 // the point's scratch; reserved, splitting stops when full
+  std::vector<Piece> pieces_;                 // the point's scratch; reserved, splitting stops short of full
   size_t next_ = 0;                           // the next receiver a step computes
   double min_d2_ = 0.0;                       // a cell's area: nearer samples are the receiver's own
   double layer_m_ = 0.0;                      // a bin's nearest layer reaches this beyond kLayer x nearest

@@ -148,7 +148,9 @@ Expected<std::unique_ptr<LightStage>> LightStage::create(const LightStageSetting
       s.samples_.emplace(std::move(*store));
       if (settings.point_lamp.enabled) s.lamp_fitter_.emplace(settings.point_lamp);
       if (settings.albedo_fit.enabled) {
-        s.albedo_fitter_.emplace(settings.albedo_fit);
+        AlbedoFitSettings fit = settings.albedo_fit;
+        fit.near_field_emitters = settings.samples.capacity;  // the near field reads every sample
+        s.albedo_fitter_.emplace(fit);
         s.near_field_on_ = settings.near_field;
         s.direct_samples_.reserve(size_t(std::max(16, settings.albedo_fit.receivers)));
       }
@@ -416,7 +418,7 @@ void LightStage::set_probeless_lighting() {
     lighting_.ambient_regions.clear();
     lighting_.estimate = est;
     fill_light_estimate(all, est.bands, lighting_.estimate);
-    if (near) add_near_field(lighting_.estimate);
+    if (near) add_near_field(lighting_.estimate, l);
     ++lighting_.revision;
     return;
   }
@@ -439,27 +441,21 @@ void LightStage::set_probeless_lighting() {
   lighting_.ambient_virtual = ShRgb{};
   lighting_.ambient_regions.clear();
   lighting_.estimate = est;
-  if (near) add_near_field(lighting_.estimate);
+  if (near) add_near_field(lighting_.estimate, l);
   ++lighting_.revision;
 }
 
-void LightStage::add_near_field(LightEstimate& estimate) const {
-  // The exported SH is all the light reaching the focus; its dominant light stays the distant
-  // light's (the near field is many dim sources, none of them the main light).
+void LightStage::add_near_field(LightEstimate& estimate, const ShRgb& distant) const {
+  // The exported SH is all the light reaching the focus (light_at_point); its dominant light
+  // stays the distant light's (the near field is many dim sources, none of them the main light).
   const auto direction = estimate.direction_to_light;
   const auto intensity = estimate.dominant_intensity;
-  // The distant light from the directions the seen surfaces cover is hidden by them: they send
-  // the near field instead.
-  ShRgb all{};
+  ShRgb sources{};
   for (int i = 0; i < kMaxShCoeffs; ++i) {
     const auto& c = estimate.sh_radiance[size_t(i)];
-    all[size_t(i)] = glm::dvec3(c[0], c[1], c[2]) + near_field_[size_t(i)];
-    for (int j = 0; j < kMaxShCoeffs; ++j) {
-      const auto& d = estimate.sh_radiance[size_t(j)];
-      all[size_t(i)] -= near_hidden_[size_t(i * kMaxShCoeffs + j)] * glm::dvec3(d[0], d[1], d[2]);
-    }
+    sources[size_t(i)] = glm::dvec3(c[0], c[1], c[2]);
   }
-  fill_light_estimate(all, estimate.bands, estimate);
+  fill_light_estimate(light_at_point(sources, distant, near_field_, near_hidden_), estimate.bands, estimate);
   estimate.direction_to_light = direction;
   estimate.dominant_intensity = intensity;
 }

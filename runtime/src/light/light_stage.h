@@ -326,7 +326,7 @@ class LightStage {
   void update_albedo(const RadianceSamples& store, bool first);
   // Adds the near field to an exported estimate's SH and takes off the distant light the seen
   // surfaces hide from the focus; its dominant light is kept.
-  void add_near_field(LightEstimate& estimate) const;
+  void add_near_field(LightEstimate& estimate, const ShRgb& distant) const;
   // The near-lamp search (point_lamp_fit.h) over the albedo fit's receivers with their bounce
   // taken off (the store's samples before the first fit); lamp_ follows it.
   void search_lamp(const RadianceSamples& store, const glm::dvec3& albedo);

@@ -46,8 +46,9 @@ struct SwitchResult {
   int changes_noted = 0;    // frames whose notes say a light change was detected
   double final_direction_deg = 0.0;  // against the lamp-on truth
   double intensity_before = 0.0, intensity_after = 0.0;  // band-0 luminance before the switch, at the end
-  // Every frame from the switch on: band-0 luminance, direction error against the lamp-on truth (degrees).
-  std::vector<std::array<double, 2>> series;
+  // Every frame from the switch on that had an estimate: frame, band-0 luminance, direction error
+  // against the lamp-on truth (degrees).
+  std::vector<std::array<double, 3>> series;
 };
 
 struct DriftResult {
