@@ -319,8 +319,6 @@ class LightStage {
   LightStage() = default;
   void set_probeless_lighting();
   void set_residual_lighting();
-  // Feeds this frame's part(s) of the stage's own probeless system; `solved` when a whole
-  // system was solved this frame.
   // One step of the albedo fit over the store (albedo_fit.h); a finished fit moves the
   // estimator's albedo.
   void update_albedo(const RadianceSamples& store, bool first);
@@ -330,6 +328,8 @@ class LightStage {
   // The near-lamp search (point_lamp_fit.h) over the albedo fit's receivers with their bounce
   // taken off (the store's samples before the first fit); lamp_ follows it.
   void search_lamp(const RadianceSamples& store, const glm::dvec3& albedo);
+  // Feeds this frame's part(s) of the stage's own probeless system; `solved` when a whole
+  // system was solved this frame.
   Status add_probeless_parts(const frame::CameraView& camera, std::vector<std::string>& notes, bool& solved);
   // `near`: per region of the sampler's cut, whether it is a surface near the env camera
   // (near_regions); empty = none known to be.
