@@ -16,9 +16,7 @@ struct Options {
 
 void run(const Options& o) {
   perf::ensure_lp_num_threads();  // before any Vulkan instance: lavapipe reads it then
-  const perf::LpvCosts c = take(perf::measure_lpv_costs(o.settings, [](const std::string& what, size_t done, size_t total) {
-    progress(what, done, total, 0.0);
-  }));
+  const perf::LpvCosts c = take(perf::measure_lpv_costs(o.settings, progress_since_now()));
   const std::string md = perf::lpv_costs_markdown(c);
   std::cout << md;
   if (!o.out.empty()) write_text_file(o.out, md);

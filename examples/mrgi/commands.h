@@ -2,6 +2,7 @@
 // command touches no other file. Contract for scripts and CI: exit 0 on success, 2 on bad usage,
 // 1 on bad input or failure, with a message on stderr.
 #pragma once
+#include <functional>
 #include <stdexcept>
 #include <string>
 
@@ -85,5 +86,7 @@ CLI::Validator frame_budget_ms_check();
 
 // Progress on stderr for long work (one line, rewritten in place when stderr is a terminal).
 void progress(const std::string& what, size_t done, size_t total, double elapsed_s);
+// A progress callback (what, done, total) whose elapsed time counts from its own creation.
+std::function<void(const std::string&, size_t, size_t)> progress_since_now();
 
 }  // namespace mrgi::tool

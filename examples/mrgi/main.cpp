@@ -2,6 +2,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
@@ -141,6 +142,13 @@ void progress(const std::string& what, size_t done, size_t total, double elapsed
                what.c_str(), done, total, total ? 100.0 * double(done) / double(total) : 100.0,
                elapsed_s, eta, tty ? (done == total ? "\n" : "") : "\n");
   std::fflush(stderr);
+}
+
+std::function<void(const std::string&, size_t, size_t)> progress_since_now() {
+  const auto t0 = std::chrono::steady_clock::now();
+  return [t0](const std::string& what, size_t done, size_t total) {
+    progress(what, done, total, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  };
 }
 
 }  // namespace mrgi::tool

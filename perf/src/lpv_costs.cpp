@@ -77,7 +77,7 @@ Expected<Maps> make_maps(gpu::FrameGraph& graph, uint32_t size, float volume_sid
 }  // namespace
 
 Expected<LpvCosts> measure_lpv_costs(const LpvCostSettings& s,
-                                     void (*progress)(const std::string&, size_t, size_t)) {
+                                     const std::function<void(const std::string&, size_t, size_t)>& progress) {
   if (s.volume_sizes.empty() || s.steps.empty() || s.repeats < 1)
     return fail(ErrorKind::BadUsage, "lpv-costs: volume sizes, steps and repeats >= 1 needed");
   const uint32_t top = *std::max_element(s.volume_sizes.begin(), s.volume_sizes.end());

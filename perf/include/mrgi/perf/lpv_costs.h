@@ -6,6 +6,7 @@
 // device 100x slower than the paper's GTX 470 still shows whether the cost grows the same way.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -39,7 +40,7 @@ struct LpvCosts {
 };
 
 Expected<LpvCosts> measure_lpv_costs(const LpvCostSettings& settings,
-                                     void (*progress)(const std::string&, size_t, size_t) = nullptr);
+                                     const std::function<void(const std::string&, size_t, size_t)>& progress = {});
 std::string lpv_costs_markdown(const LpvCosts& costs);
 
 }  // namespace mrgi::perf
