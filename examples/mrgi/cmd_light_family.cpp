@@ -22,9 +22,7 @@ struct Options {
 void run(Options o) {
   perf::ensure_lp_num_threads();
   o.settings.level = resolve_level(o.settings.technique, o.level);
-  const auto results = take(perf::run_light_family(o.settings, [](const std::string& what, size_t done, size_t total) {
-    progress(what, done, total, 0.0);
-  }));
+  const auto results = take(perf::run_light_family(o.settings, progress_since_now()));
   const std::string md = perf::light_family_markdown(results, o.settings);
   std::cout << md;
   if (!o.out.empty()) {
@@ -54,6 +52,8 @@ void setup(CLI::App& app) {
                 "the grey-world albedo (0.5): the surfaces' albedo not measured from their interreflection (RuntimeSettings::light_albedo_fit false)");
   cmd->add_flag("--no-near-field", [o](int64_t n) { o->settings.near_field = n == 0; },
                 "the bounce of the seen surfaces read as part of the distant light, not computed from them and added at the objects (RuntimeSettings::light_near_field false)");
+  cmd->add_flag("--no-distant-views", [o](int64_t n) { o->settings.distant_views = n == 0; },
+                "surfaces only: regions without depth (sky, windows, beyond the sensor's range) not read as the distant light (RuntimeSettings::light_distant_views false)");
   cmd->add_flag("--validate", o->settings.validate, "Vulkan validation layers on (a message fails the run)");
   cmd->add_option("-o,--out", o->out, "write light-family.md and light-family.json into this folder");
   cmd->callback([o] { run(*o); });

@@ -25,9 +25,7 @@ void run(Options o) {
   o.settings.family.level = resolve_level(o.settings.family.technique, o.level);
   o.settings.family.accumulate_views = !o.single_view;
   o.settings.switches = !o.no_switches;
-  const auto report = take(perf::run_moving_family(o.settings, [](const std::string& what, size_t done, size_t total) {
-    progress(what, done, total, 0.0);
-  }));
+  const auto report = take(perf::run_moving_family(o.settings, progress_since_now()));
   const std::string md = perf::moving_family_markdown(report, o.settings);
   std::cout << md;
   if (!o.out.empty()) {
@@ -64,6 +62,8 @@ void setup(CLI::App& app) {
                 "the grey-world albedo (0.5): the surfaces' albedo not measured from their interreflection (RuntimeSettings::light_albedo_fit false)");
   cmd->add_flag("--no-near-field", [o](int64_t n) { o->settings.family.near_field = n == 0; },
                 "the bounce of the seen surfaces read as part of the distant light, not computed from them and added at the objects (RuntimeSettings::light_near_field false)");
+  cmd->add_flag("--no-distant-views", [o](int64_t n) { o->settings.family.distant_views = n == 0; },
+                "surfaces only: regions without depth (sky, windows, beyond the sensor's range) not read as the distant light (RuntimeSettings::light_distant_views false)");
   cmd->add_flag("--validate", o->settings.family.validate, "Vulkan validation layers on (a message fails the run)");
   cmd->add_option("-o,--out", o->out, "write light-moving.md and light-moving.json into this folder");
   cmd->callback([o] { run(*o); });

@@ -33,6 +33,7 @@ Expected<LightReplay> replay_light_capture(const CaptureReader& capture, const S
   rs.light_near_lamps = s.near_lamps;
   rs.light_albedo_fit = s.albedo_fit;
   rs.light_near_field = s.near_field;
+  rs.light_distant_views = s.distant_views;
   auto rt = create_runtime(rs, CameraSetup{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera},
                            scene);
   if (!rt) return rt.error();
@@ -140,7 +141,7 @@ Expected<std::vector<LightFamilyScene>> load_light_family(const std::string& pat
 }
 
 Expected<std::vector<LightFamilyResult>> run_light_family(const LightFamilySettings& s,
-                                                          void (*progress)(const std::string&, size_t, size_t)) {
+                                                          const std::function<void(const std::string&, size_t, size_t)>& progress) {
   auto all = load_light_family(s.manifest);
   if (!all) return all.error();
   if (s.half != "all" && s.half != "tuning" && s.half != "held-out")

@@ -115,6 +115,12 @@ Expected<MovingResult> run_scene(const LightFamilyScene& sc, const LightFamilySe
   r.final_colour = last.colour_error;
   r.final_colour_all = last.colour_error_all;
   r.final_confidence = last.confidence;
+  for (int c = 0; c < 3; ++c) {
+    r.truth_band0[size_t(c)] = probe->sh_radiance[0][size_t(c)];
+    r.truth_all_band0[size_t(c)] = all_light->sh_radiance[0][size_t(c)];
+    const auto& l = est->frames.back().light;
+    if (l && l->valid) r.final_band0[size_t(c)] = l->sh_radiance[0][size_t(c)];
+  }
   double t = 0.0, e = 0.0;
   for (size_t i = r.frames.size() - std::min<size_t>(8, r.frames.size()); i < r.frames.size(); ++i) {
     t += r.frames[i].rde_true;
@@ -189,6 +195,7 @@ Expected<DriftResult> run_drift(const LightFamilyScene& sc, const MovingFamilySe
   rs.light_near_lamps = s.near_lamps;
   rs.light_albedo_fit = s.albedo_fit;
   rs.light_near_field = s.near_field;
+  rs.light_distant_views = s.distant_views;
   auto rt = create_runtime(rs, CameraSetup{info.color, info.depth, info.depth_scale, info.exposure, info.env_camera},
                            undeclared(*capture->scene()));
   if (!rt) return rt.error();
@@ -228,7 +235,7 @@ Expected<DriftResult> run_drift(const LightFamilyScene& sc, const MovingFamilySe
 }  // namespace
 
 Expected<MovingFamilyReport> run_moving_family(const MovingFamilySettings& ms,
-                                               void (*progress)(const std::string&, size_t, size_t)) {
+                                               const std::function<void(const std::string&, size_t, size_t)>& progress) {
   const LightFamilySettings& s = ms.family;
   if (s.half != "all" && s.half != "tuning" && s.half != "held-out")
     return fail(ErrorKind::BadUsage, "light moving: half '" + s.half + "': all, tuning or held-out");
@@ -286,6 +293,8 @@ std::string moving_family_markdown(const MovingFamilyReport& rep, const MovingFa
                 !(ms.family.accumulate_views && ms.family.albedo_fit) ? ""
                 : ms.family.near_field ? ", albedo from interreflection, near field" : ", albedo from interreflection");
   md += line;
+  if (ms.family.accumulate_views && !ms.family.distant_views)
+    md += "Regions without depth not read as distant light (--no-distant-views).\n\n";
   md += "Direction error (degrees) as the sweep grows:\n\n| scene | half | 0 deg | 22 deg | 45 deg | 67 deg | 90 deg |"
         " colour after (sources / all light) | confidence after | RDE ratio, last 8 frames |\n"
         "|---|---|---|---|---|---|---|---|---|---|\n";
@@ -354,7 +363,8 @@ std::string moving_family_json(const MovingFamilyReport& rep) {
                            {"final_direction_error_deg", r.final_direction_deg}, {"final_colour_error", r.final_colour},
                            {"final_colour_error_all_light", r.final_colour_all},
                            {"final_confidence", r.final_confidence}, {"final_rde_ratio", r.final_rde_ratio},
-                           {"frames", frames}});
+                           {"final_band0", r.final_band0}, {"truth_band0", r.truth_band0},
+                           {"truth_all_band0", r.truth_all_band0}, {"frames", frames}});
   }
   j["switches"] = nlohmann::json::array();
   for (const SwitchResult& w : rep.switches)

@@ -230,12 +230,49 @@ TEST(Probeless, ColourVoteIgnoresAMinorityRedWall) {
   EXPECT_LT(voted, 0.1);
 }
 
+TEST(Probeless, ASkyBeyondTheDepthSensorsRangeIsDistantLightAndANarrowDepthHoleIsNot) {
+  const Room room;
+  // Over the corner's walls (1.5 m high) from the open side: the sky fills the frame's top.
+  const RenderedFrame f = render(room, {2.6, 1.0, -1.5}, {0.5, 1.4, 0.8}, 160, 120, true);
+  ProbelessSettings ps;
+  ps.parts = 1;
+  auto b = ProbelessBuilder::create(ps, f.k, f.k, 5000);
+  ASSERT_TRUE(b.ok()) << b.error().message;
+  auto distant_bins = [&](const InputFrame& frame, const glm::dmat4& pose) {
+    auto store = RadianceSamples::create({});
+    EXPECT_TRUE(store.ok());
+    LightSystem sys;
+    EXPECT_TRUE(b->add_part(frame::CameraView::of(frame, pose), 1.0, 0, sys, &*store).ok());
+    std::vector<RadianceSamples::DistantBin> seen;
+    for (const auto& bin : store->distant_bins())
+      if (bin.observations > 0) seen.push_back(bin);
+    return seen;
+  };
+  const auto sky = distant_bins(f.frame, f.pose);
+  std::printf("%zu distant bins seen\n", sky.size());
+  EXPECT_GE(sky.size(), 6u);
+  for (const auto& bin : sky) {
+    EXPECT_GT(bin.direction.y, 0.0f) << "only the sky is beyond the room";
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(bin.colour[c], room.sky[c], 0.08 * room.sky[c]) << "channel " << c;
+  }
+  // A view of the floor alone with a 2-pixel line and a 3 x 3 spot of lost depth (what a sensor
+  // drops along edges and on dark spots): no view of the distant light.
+  RenderedFrame floor = render(room, {1.0, 1.2, -1.0}, {1.0, 0.0, 0.2}, 160, 120, true);
+  for (int v = 0; v < 120; ++v) floor.frame.depth.at(70, v)[0] = floor.frame.depth.at(71, v)[0] = 0;
+  for (int v = 50; v < 53; ++v)
+    for (int u = 100; u < 103; ++u) floor.frame.depth.at(u, v)[0] = 0;
+  EXPECT_TRUE(distant_bins(floor.frame, floor.pose).empty());
+}
+
 TEST(Probeless, RefusesFramesOfAnotherSizeAndBadSettings) {
   Intrinsics k{64, 48, 50, 50, 32, 24};
   EXPECT_FALSE(ProbelessBuilder::create({8, 64, 6, 0.6, 4}, k, k, 5000).ok());
   EXPECT_FALSE(ProbelessBuilder::create({80, 8, 6, 0.6, 4}, k, k, 5000).ok());
   EXPECT_FALSE(ProbelessBuilder::create({80, 64, 6, 0.0, 4}, k, k, 5000).ok());
   EXPECT_FALSE(ProbelessBuilder::create({80, 64, 6, 0.6, 0}, k, k, 5000).ok());
+  ProbelessSettings margin;
+  margin.distant_margin = 9;
+  EXPECT_FALSE(ProbelessBuilder::create(margin, k, k, 5000).ok());
   auto b = ProbelessBuilder::create({}, k, k, 5000);
   ASSERT_TRUE(b.ok()) << b.error().message;
   InputFrame f;

@@ -4,6 +4,7 @@
 // grows, no change detected while only the camera moves, a lamp switched on followed.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 
@@ -100,11 +101,104 @@ TEST(RadianceSamples, AFullStoreDropsTheLeastRecentlySeenAndRefusesBadSettings) 
            {"capacity", [] { RadianceSampleSettings b; b.capacity = 10; return b; }()},
            {"colour_frames", [] { RadianceSampleSettings b; b.colour_frames = 0; return b; }()},
            {"change_ratio", [] { RadianceSampleSettings b; b.change_ratio = 1.0; return b; }()},
-           {"change_fraction", [] { RadianceSampleSettings b; b.change_fraction = 0.0; return b; }()}}) {
+           {"change_fraction", [] { RadianceSampleSettings b; b.change_fraction = 0.0; return b; }()},
+           {"distant_rows", [] { RadianceSampleSettings b; b.distant_rows = 65; return b; }()},
+           {"distant_weight", [] { RadianceSampleSettings b; b.distant_weight = 0.0; return b; }()}}) {
     auto r = RadianceSamples::create(bad);
     ASSERT_FALSE(r.ok()) << field;
     EXPECT_NE(r.error().message.find("RadianceSampleSettings." + field), std::string::npos) << r.error().message;
   }
+}
+
+// Solves the normal equations of `sys` (16 x 16, Gaussian elimination with partial pivoting) for
+// channel c, dividing the right-hand side by `albedo` as LightEstimator does.
+std::array<double, kMaxShCoeffs> solve_channel(const LightSystem& sys, int c, double albedo) {
+  constexpr int n = kMaxShCoeffs;
+  std::array<std::array<double, n + 1>, n> m{};
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) m[size_t(i)][size_t(j)] = sys.ata[size_t(i * n + j)];
+    m[size_t(i)][n] = sys.atb[size_t(i * 3 + c)] / albedo;
+  }
+  for (int k = 0; k < n; ++k) {
+    int p = k;
+    for (int i = k + 1; i < n; ++i)
+      if (std::abs(m[size_t(i)][size_t(k)]) > std::abs(m[size_t(p)][size_t(k)])) p = i;
+    std::swap(m[size_t(k)], m[size_t(p)]);
+    for (int i = k + 1; i < n; ++i) {
+      const double f = m[size_t(i)][size_t(k)] / m[size_t(k)][size_t(k)];
+      for (int j = k; j <= n; ++j) m[size_t(i)][size_t(j)] -= f * m[size_t(k)][size_t(j)];
+    }
+  }
+  std::array<double, n> x{};
+  for (int i = n - 1; i >= 0; --i) {
+    double v = m[size_t(i)][n];
+    for (int j = i + 1; j < n; ++j) v -= m[size_t(i)][size_t(j)] * x[size_t(j)];
+    x[size_t(i)] = v / m[size_t(i)][size_t(i)];
+  }
+  return x;
+}
+
+TEST(RadianceSamples, DistantViewsAreRowsOfTheLightItself) {
+  // A warm sky brighter above, seen in every direction: the rows Y(w) . l = albedo * L(w) give
+  // back the light, whatever the albedo the system is divided by.
+  ShRgb light{};
+  light[0] = {0.9, 0.8, 0.6};
+  light[2] = {0.3, 0.25, 0.2};  // Y_1^0: brighter towards +y
+  RadianceSamples store = store_of();
+  for (int k = 0; k < 4096; ++k) {
+    const glm::vec3 d(fibonacci_direction(k, 4096));
+    store.observe_distant(d, sh_evaluate(light, d), 0, 0);
+  }
+  const glm::dvec3 albedo(0.4, 0.5, 0.6);
+  LightSystem sys;
+  store.add_to(sys, nullptr, albedo);
+  EXPECT_EQ(sys.samples, 512.0) << "every bin of the 16 x 32 grid seen once";
+  for (int c = 0; c < 3; ++c) {
+    const auto l = solve_channel(sys, c, albedo[c]);
+    EXPECT_NEAR(l[0], light[0][c], 0.02 * light[0][c]) << "channel " << c;
+    EXPECT_NEAR(l[2], light[2][c], 0.03 * light[2][c]) << "channel " << c;
+    EXPECT_NEAR(l[1], 0.0, 0.01) << "channel " << c;
+  }
+  // Turned off, nothing is kept.
+  RadianceSamples off = store_of([](RadianceSampleSettings& s) { s.distant_rows = 0; });
+  off.observe_distant({0, 1, 0}, glm::dvec3(1.0), 0, 0);
+  LightSystem none;
+  off.add_to(none);
+  EXPECT_EQ(none.samples, 0.0);
+}
+
+TEST(RadianceSamples, AClippedChannelIsABoundAndTheOthersStayMeasurements) {
+  // One surface sample (transfer Y_0 only) and one view of the distant light straight up, red
+  // clipped in both (a sunlit surface clips in red first).
+  const glm::dvec3 albedo(0.5);
+  const glm::dvec3 seen(0.5, 0.4, 0.3);
+  const uint8_t red = 1;
+  const double y0 = 0.28209479177387814;
+  auto rows = [&](const ShRgb* estimate) {
+    RadianceSamples store = store_of();
+    store.observe({0.05, 0, 0.05}, {0, 1, 0}, 0, unit_transfer(0), seen, 1.0f, 0, red);
+    store.observe_distant({0, 1, 0}, seen, 0, red);
+    LightSystem sys;
+    store.add_to(sys, estimate, albedo);
+    return sys;
+  };
+  EXPECT_EQ(rows(nullptr).samples, 0.0) << "without an estimate a bound says nothing";
+  // The estimate predicts more red than the bound: the row takes the prediction there.
+  ShRgb bright{};
+  bright[0] = glm::dvec3(1.6, 0.2, 0.2) / y0;  // L(w) = 1.6 red in every direction; T . l = 1.6 / Y_0
+  LightSystem sys = rows(&bright);
+  ASSERT_EQ(sys.samples, 2.0);
+  // atb[c] (coefficient 0, channel c) = the surface row's rhs (transfer 1 there) + Y_0 x the
+  // distant row's rhs.
+  const double surface_red = albedo.x * 1.6 / y0, distant_red = albedo.x * 1.6;
+  EXPECT_NEAR(sys.atb[0], surface_red + y0 * distant_red, 1e-6);
+  EXPECT_NEAR(sys.atb[1], seen.y + y0 * albedo.y * seen.y, 1e-6) << "green measured, not predicted";
+  EXPECT_NEAR(sys.atb[2], seen.z + y0 * albedo.z * seen.z, 1e-6);
+  // It predicts less: the bound stands.
+  ShRgb dim{};
+  dim[0] = glm::dvec3(0.1) / y0;
+  sys = rows(&dim);
+  EXPECT_NEAR(sys.atb[0], seen.x + y0 * albedo.x * seen.x, 1e-6);
 }
 
 // The camera on a circle around the room's box, from `start` over `sweep` degrees.

@@ -85,7 +85,10 @@ struct RenderedFrame {
   Intrinsics k;
 };
 
-inline RenderedFrame render(const Room& room, const glm::dvec3& eye, const glm::dvec3& target, int w, int h) {
+// `sky_background`: rays that leave the room upwards show the sky's radiance (no depth, as beyond
+// a depth sensor's range); otherwise every miss is black.
+inline RenderedFrame render(const Room& room, const glm::dvec3& eye, const glm::dvec3& target, int w, int h,
+                            bool sky_background = false) {
   RenderedFrame r;
   r.k = Intrinsics{w, h, 0.82 * w, 0.82 * w, 0.5 * (w - 1), 0.5 * (h - 1)};
   r.pose = test::opencv_look_at(eye, target, {0, 1, 0});
@@ -97,7 +100,11 @@ inline RenderedFrame render(const Room& room, const glm::dvec3& eye, const glm::
       const glm::dvec3 dc((u - r.k.cx) / r.k.fx, (v - r.k.cy) / r.k.fy, 1.0);
       const glm::dvec3 d = glm::normalize(rot * dc);
       const Hit hit = room.trace(eye, d);
-      if (hit.t > 1e20) continue;
+      if (hit.t > 1e20) {
+        if (sky_background && d.y > 0.0)
+          for (int c = 0; c < 3; ++c) r.frame.color.at(u, v)[c] = linear_to_srgb8(float(room.sky[c]));
+        continue;
+      }
       const glm::dvec3 p = eye + hit.t * d;
       const double z = glm::dot(p - eye, glm::dvec3(r.pose[2]));
       r.frame.depth.at(u, v)[0] = uint16_t(std::lround(z * 5000.0));

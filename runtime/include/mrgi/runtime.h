@@ -411,6 +411,10 @@ struct RuntimeSettings {
   /// from them (their positions and colours) and added as ambient, and the distant light is solved
   /// without it (light/light_stage.h). false: the bounce is read as part of the distant light.
   bool light_near_field = true;
+  /// With the views accumulated: where the depth frame shows no surface over a region (the sky,
+  /// a window, a far wall beyond the sensor's range) its colour is the distant light from those
+  /// directions and joins the solve as such (light/radiance_samples.h). false: only surfaces.
+  bool light_distant_views = true;
 };
 
 // ---------------------------------------------------------------------------------------------

@@ -53,6 +53,7 @@ Expected<ProbelessBuilder> ProbelessBuilder::create(const ProbelessSettings& s, 
   MRGI_TRY(check_probeless_setting(s.march_steps >= 1 && s.march_steps <= 64, "march_steps", "must be 1..64"));
   MRGI_TRY(check_probeless_setting(s.radius_m > 0.0 && std::isfinite(s.radius_m), "radius_m", "must be > 0 metres"));
   MRGI_TRY(check_probeless_setting(s.parts >= 1 && s.parts <= 16, "parts", "must be 1..16 frames"));
+  MRGI_TRY(check_probeless_setting(s.distant_margin >= 0 && s.distant_margin <= 8, "distant_margin", "must be 0..8 blocks"));
   const int stride = std::max(2, depth.width / s.grid_width);
   if (color.width < 1 || color.height < 1 || depth.width < stride || depth.height < stride ||
       !(color.fx > 0) || !(color.fy > 0) || !(depth.fx > 0) || !(depth.fy > 0) || !(depth_scale > 0))
@@ -179,6 +180,28 @@ void ProbelessBuilder::build_normals(const glm::mat3& rot) {
   }
 }
 
+void ProbelessBuilder::add_distant_views(int part, const glm::mat3& rot, const BlockColour& block_colour, int64_t frame,
+                                         RadianceSamples& samples) const {
+  const int m = settings_.distant_margin, s = stride_;
+  const glm::vec4 kd(float(depth_.fx), float(depth_.fy), float(depth_.cx), float(depth_.cy));
+  const glm::vec4 kc(float(color_.fx), float(color_.fy), float(color_.cx), float(color_.cy));
+  auto has_depth = [&](int gx, int gy) { return position_[size_t(gy) * grid_w_ + gx].z > 0.0f; };
+  for (int gy = part; gy < grid_h_; gy += settings_.parts) {
+    for (int gx = 0; gx < grid_w_; ++gx) {
+      bool near = false;
+      for (int y = std::max(0, gy - m); y <= std::min(grid_h_ - 1, gy + m) && !near; ++y)
+        for (int x = std::max(0, gx - m); x <= std::min(grid_w_ - 1, gx + m) && !near; ++x) near = has_depth(x, y);
+      if (near) continue;
+      // The depth camera's ray through the block's centre pixel (the cameras share a centre).
+      const glm::vec3 ray = shader::unproject_pinhole(glm::vec2(float(gx * s + s / 2), float(gy * s + s / 2)), 1.0f, kd);
+      glm::dvec3 colour;
+      uint8_t saturated = 0;
+      if (!block_colour(shader::project_pinhole(ray, kc), false, colour, saturated)) continue;
+      samples.observe_distant(rot * ray, colour, frame, saturated);
+    }
+  }
+}
+
 Status ProbelessBuilder::add_part(const frame::CameraView& view, double exposure, int part, LightSystem& system,
                                   RadianceSamples* samples) {
   const CameraColor camera(view);
@@ -221,6 +244,30 @@ Status ProbelessBuilder::add_part(const frame::CameraView& view, double exposure
     }
     return k;
   };
+  // The linear mean colour (exposure divided out) of the colour frame's block of one sample
+  // around colour pixel c; `saturated` bit ch: channel ch reached kSaturated in a pixel of it.
+  // False for an empty block, or (`stop_at_saturated`) one with a saturated pixel.
+  const int half = std::max(1, int(std::lround(0.5 * s * color_.fx / depth_.fx)));
+  auto block_colour = [&](const glm::vec2& c, bool stop_at_saturated, glm::dvec3& colour, uint8_t& saturated) {
+    const int cx0 = std::max(0, int(c.x) - half), cx1 = std::min(color_.width, int(c.x) + half);
+    const int cy0 = std::max(0, int(c.y) - half), cy1 = std::min(color_.height, int(c.y) + half);
+    colour = glm::dvec3(0.0);
+    saturated = 0;
+    int count = 0;
+    for (int y = cy0; y < cy1; ++y) {
+      for (int x = cx0; x < cx1; ++x) {
+        const std::array<uint8_t, 3> px = camera.at(x, y);
+        for (int ch = 0; ch < 3; ++ch)
+          if (px[size_t(ch)] >= kSaturated) saturated |= uint8_t(1u << ch);
+        if (saturated && stop_at_saturated) return false;
+        colour += glm::dvec3(lut[px[0]], lut[px[1]], lut[px[2]]);
+        ++count;
+      }
+    }
+    if (count == 0) return false;
+    colour /= double(count) * exposure;
+    return true;
+  };
   // First the part's samples and their colours, so the light's colour can be voted on before
   // any row is added.
   samples_.clear();
@@ -230,26 +277,10 @@ Status ProbelessBuilder::add_part(const frame::CameraView& view, double exposure
       if (!(p.z > 0.0f) || normal_[size_t(gy) * grid_w_ + gx] == glm::vec3(0.0f)) continue;
       // Colour: the linear mean of the block's pixels where the depth camera's sample lands in
       // the colour camera (same centre; intrinsics may differ).
-      const glm::vec2 c = shader::project_pinhole(p, kc);
-      const int half = std::max(1, int(std::lround(0.5 * s * color_.fx / depth_.fx)));
-      const int cx0 = std::max(0, int(c.x) - half), cx1 = std::min(color_.width, int(c.x) + half);
-      const int cy0 = std::max(0, int(c.y) - half), cy1 = std::min(color_.height, int(c.y) + half);
-      glm::dvec3 colour(0.0);
-      int count = 0;
-      bool saturated = false;
-      for (int y = cy0; y < cy1 && !(saturated && !samples); ++y) {
-        for (int x = cx0; x < cx1; ++x) {
-          const std::array<uint8_t, 3> px = camera.at(x, y);
-          if (px[0] >= kSaturated || px[1] >= kSaturated || px[2] >= kSaturated) {
-            saturated = true;
-            if (!samples) break;
-          }
-          colour += glm::dvec3(lut[px[0]], lut[px[1]], lut[px[2]]);
-          ++count;
-        }
-      }
-      if ((saturated && !samples) || count == 0) continue;
-      samples_.push_back({gy * grid_w_ + gx, colour / (double(count) * exposure), saturated});
+      glm::dvec3 colour;
+      uint8_t saturated = 0;
+      if (!block_colour(shader::project_pinhole(p, kc), !samples, colour, saturated)) continue;
+      samples_.push_back({gy * grid_w_ + gx, colour, saturated});
     }
   }
   if (settings_.grey_vote) vote_light_colour();
@@ -305,6 +336,7 @@ Status ProbelessBuilder::add_part(const frame::CameraView& view, double exposure
       system.add(t, (colour - known) * double(sw));
     }
   }
+  if (samples && samples->distant_enabled() && known_lamps_.empty()) add_distant_views(part, rot, block_colour, view.index, *samples);
   return ok_status();
 }
 

@@ -15,13 +15,18 @@
 // computes T at every pixel anyway, hands its own sums to the same estimator instead).
 //
 // Deviation from the paper: visibility is searched in the current depth image only (no TSDF
-// auxiliary views): an occluder outside the view does not shadow. Saturated colour (any channel
-// at 250 or more of 255) is not a linear measurement of the light: a single view leaves it out;
-// the store of the views seen keeps it as a lower bound (RadianceSamples: a row only while the
-// estimate predicts less than the block showed), so a sunlit surface the camera clips still
-// says the light is at least that bright.
+// auxiliary views): an occluder outside the view does not shadow. Saturated colour (a channel
+// at 250 or more of 255) is not a linear measurement of the light: a single view leaves such a
+// block out; the store of the views seen keeps its saturated channels as lower bounds and the
+// others as measurements (RadianceSamples::add_to), so a sunlit surface the camera clips still
+// says the light is at least that bright, and what colour it is.
+//
+// With the store, blocks without depth around them are views of the distant light itself
+// (ProbelessSettings::distant_margin, RadianceSamples::observe_distant): the sky or a window
+// beyond the depth sensor's range shows the light arriving from there.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -62,6 +67,13 @@ struct ProbelessSettings {
   // mean when the coloured surface is the majority; it needs a prior on which colours light can
   // have (near the daylight locus) before it can be on.
   bool grey_vote = false;
+  // A block is a view of the distant light (RadianceSamples::observe_distant: the sky, a window,
+  // anything beyond the depth sensor's range) when neither it nor any block within this many
+  // blocks has depth (0..8). Why a margin: a depth sensor also drops the few pixels along a
+  // near surface's edges and on dark or shiny spots; those holes are narrow, the far background
+  // is not. Only with the store of views, and not while known lamps are taken off (a declared
+  // lamp in view would be counted twice).
+  int distant_margin = 2;
 };
 
 // Irradiance a lamp sends to world point `p` (per channel, at normal incidence: W/m^2 for the
@@ -105,10 +117,16 @@ class ProbelessBuilder {
   // The light's colour as the mode of the samples' chromaticities; samples far from it take it
   // (their luminance kept). See probeless.cpp.
   void vote_light_colour();
+  using BlockColour = std::function<bool(const glm::vec2& colour_pixel, bool stop_at_saturated, glm::dvec3& colour,
+                                         uint8_t& saturated)>;
+  // Part `part`'s blocks without depth around them (distant_margin) into `samples` as views of
+  // the distant light along their world directions.
+  void add_distant_views(int part, const glm::mat3& camera_to_world_rotation, const BlockColour& block_colour,
+                         int64_t frame, RadianceSamples& samples) const;
   struct Sample {
     int cell;
     glm::dvec3 colour;  // linear, exposure divided out
-    bool clipped;       // a pixel of the block at kSaturated: the colour is a lower bound
+    uint8_t clipped;    // bit c: a pixel of the block at kSaturated in channel c, a lower bound there
   };
   std::vector<Sample> samples_;         // this part's, reserved at start-up
   std::vector<LightDesc> known_lamps_;  // set_known_lamps

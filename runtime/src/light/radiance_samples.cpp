@@ -32,6 +32,9 @@ Expected<RadianceSamples> RadianceSamples::create(const RadianceSampleSettings& 
   MRGI_TRY(check_sample_setting(s.change_min_samples >= 1, "change_min_samples", "must be >= 1"));
   MRGI_TRY(check_sample_setting(s.settle_observations >= 1 && s.settle_observations <= 1024, "settle_observations",
                                 "must be 1..1024"));
+  MRGI_TRY(check_sample_setting(s.distant_rows >= 0 && s.distant_rows <= 64, "distant_rows", "must be 0..64"));
+  MRGI_TRY(check_sample_setting(s.distant_weight > 0.0 && std::isfinite(s.distant_weight), "distant_weight",
+                                "must be > 0"));
   RadianceSamples r;
   r.settings_ = s;
   r.samples_.reserve(size_t(s.capacity));
@@ -40,6 +43,7 @@ Expected<RadianceSamples> RadianceSamples::create(const RadianceSampleSettings& 
   while (slots < size_t(s.capacity) * 2) slots <<= 1;
   r.table_.assign(slots, -1);
   r.table_mask_ = slots - 1;
+  r.distant_.assign(size_t(2 * s.distant_rows * s.distant_rows), DistantBin{});
   return r;
 }
 
@@ -94,7 +98,7 @@ void RadianceSamples::begin(int64_t frame) {
 }
 
 void RadianceSamples::observe(const glm::dvec3& position, const glm::vec3& normal, int bin, const ShVector& transfer,
-                              const glm::dvec3& colour, float row_weight, int64_t frame, bool clipped) {
+                              const glm::dvec3& colour, float row_weight, int64_t frame, uint8_t clipped) {
   begin(frame);
   if (!std::isfinite(position.x + position.y + position.z) || !std::isfinite(colour.x + colour.y + colour.z)) return;
   const uint64_t key = key_of(position, bin);
@@ -112,29 +116,30 @@ void RadianceSamples::observe(const glm::dvec3& position, const glm::vec3& norma
 }
 
 bool RadianceSamples::observe_if_settled(const glm::dvec3& position, const glm::vec3& normal, int bin,
-                                         const glm::dvec3& colour, float row_weight, int64_t frame, bool clipped) {
+                                         const glm::dvec3& colour, float row_weight, int64_t frame, uint8_t clipped) {
   begin(frame);
   if (!std::isfinite(position.x + position.y + position.z) || !std::isfinite(colour.x + colour.y + colour.z))
     return true;  // nothing to learn from it, and no transfer to compute for it
   const int64_t slot = find_slot(key_of(position, bin));
   if (table_[size_t(slot)] < 0) return false;
   Sample& s = samples_[size_t(table_[size_t(slot)])];
-  if (s.observations < settings_.settle_observations || s.clipped != clipped) return false;
+  if (s.observations < settings_.settle_observations || (s.clipped != 0) != (clipped != 0)) return false;
   update(s, position, normal, nullptr, colour, row_weight, frame, clipped);
   return true;
 }
 
 void RadianceSamples::update(Sample& s, const glm::dvec3& position, const glm::vec3& normal, const ShVector* transfer,
-                             const glm::dvec3& colour, float row_weight, int64_t frame, bool clipped) {
-  if (clipped != s.clipped) {
+                             const glm::dvec3& colour, float row_weight, int64_t frame, uint8_t clipped) {
+  if ((clipped != 0) != (s.clipped != 0)) {
     if (clipped) {  // a bound beside measurements: the measurements stand
       s.last_frame = frame;
       return;
     }
     // A measurement replaces a bound.
-    s = Sample{s.key, transfer ? *transfer : s.transfer, colour, colour, glm::vec3(position), normal, row_weight, false, 1, frame};
+    s = Sample{s.key, transfer ? *transfer : s.transfer, colour, colour, glm::vec3(position), normal, row_weight, 0, 1, frame};
     return;
   }
+  s.clipped |= clipped;  // bounds in other channels: a channel any of them clipped stays a bound
   if (s.last_frame < frame && !clipped) {
     // Seen in an earlier frame: does it show the light it showed then?
     const double before = luminance(s.colour), now = luminance(colour);
@@ -168,6 +173,11 @@ bool RadianceSamples::end_frame(int64_t frame) {
     s.colour = s.last_colour;
     s.observations = 1;
   }
+  for (DistantBin& b : distant_) {
+    if (b.observations == 0) continue;
+    b.observations = b.last_frame < frame ? 0 : 1;
+    b.colour = b.last_colour;
+  }
   rebuild_table();
   return true;
 }
@@ -189,18 +199,66 @@ void RadianceSamples::add_to(LightSystem& system, const ShRgb* estimate, const g
       if (!estimate) continue;
       glm::dvec3 predicted(0.0);
       for (int i = 0; i < kMaxShCoeffs; ++i) predicted += double(s.transfer[size_t(i)]) * (*estimate)[size_t(i)];
-      if (luminance(albedo * predicted) >= luminance(colour)) continue;
+      for (int c = 0; c < 3; ++c)
+        if (s.clipped & (1u << c)) colour[c] = std::max(colour[c], albedo[c] * predicted[c]);
     }
     const float w = std::sqrt(s.row_weight);
     ShVector t = s.transfer;
     for (float& v : t) v *= w;
     system.add(t, colour * double(w));
   }
+  const double w = std::sqrt(settings_.distant_weight);
+  for (const DistantBin& b : distant_) {
+    if (b.observations == 0) continue;
+    glm::dvec3 colour = b.colour;
+    if (b.clipped) {
+      if (!estimate) continue;
+      const glm::dvec3 predicted = sh_evaluate(*estimate, b.direction);
+      for (int c = 0; c < 3; ++c)
+        if (b.clipped & (1u << c)) colour[c] = std::max(colour[c], predicted[c]);
+    }
+    ShVector y = sh_basis(b.direction);
+    for (float& v : y) v *= float(w);
+    system.add(y, albedo * colour * w);
+  }
+}
+
+void RadianceSamples::observe_distant(const glm::vec3& direction, const glm::dvec3& colour, int64_t frame,
+                                      uint8_t clipped) {
+  begin(frame);
+  const float len = glm::length(direction);
+  if (distant_.empty() || !(len > 0.0f) || !std::isfinite(len) || !std::isfinite(colour.x + colour.y + colour.z)) return;
+  const glm::vec3 d = direction / len;
+  // Equal-area bins: bands of equal height in d.y (Archimedes), equal azimuth steps in each.
+  const int rows = settings_.distant_rows, cols = 2 * rows;
+  const int row = std::clamp(int((d.y + 1.0f) * 0.5f * float(rows)), 0, rows - 1);
+  const float azimuth = std::atan2(d.z, d.x);  // -pi..pi
+  const int col = std::clamp(int((azimuth + float(kPi)) / float(2.0 * kPi) * float(cols)), 0, cols - 1);
+  DistantBin& b = distant_[size_t(row * cols + col)];
+  if (b.observations > 0 && (clipped != 0) != (b.clipped != 0)) {
+    if (clipped) {  // a bound beside measurements: the measurements stand
+      b.last_frame = frame;
+      return;
+    }
+    b.observations = 0;  // a measurement replaces a bound
+  }
+  if (b.observations == 0) {
+    b = DistantBin{d, colour, colour, clipped, 1, frame};
+    return;
+  }
+  b.clipped |= clipped;
+  b.observations = std::min(b.observations + 1, settings_.colour_frames);
+  const double a = 1.0 / double(b.observations);
+  b.colour += a * (colour - b.colour);
+  b.direction += float(a) * (d - b.direction);
+  b.last_colour = colour;
+  b.last_frame = frame;
 }
 
 void RadianceSamples::clear() {
   samples_.clear();
   std::fill(table_.begin(), table_.end(), -1);
+  std::fill(distant_.begin(), distant_.end(), DistantBin{});
   reobserved_ = changed_ = 0;
   frame_ = -1;
 }

@@ -15,6 +15,7 @@
 // Figures are taken from the last frame's estimate (the filter has seen every frame).
 #pragma once
 #include <array>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -63,6 +64,7 @@ struct LightFamilySettings {
   bool near_lamps = true;        // RuntimeSettings::light_near_lamps
   bool albedo_fit = true;        // RuntimeSettings::light_albedo_fit
   bool near_field = true;        // RuntimeSettings::light_near_field
+  bool distant_views = true;     // RuntimeSettings::light_distant_views
 };
 
 // One capture replayed through the runtime: the error of every frame and the light it came
@@ -90,7 +92,7 @@ double family_colour_error(const LightEstimate& estimate, const LightEstimate& t
 // Runs every scene (progress through `progress(name, done, total)` when given).
 Expected<std::vector<LightFamilyResult>> run_light_family(
     const LightFamilySettings& settings,
-    void (*progress)(const std::string&, size_t, size_t) = nullptr);
+    const std::function<void(const std::string&, size_t, size_t)>& progress = {});
 
 // Markdown: one row per scene, then the summary of each half (median and worst direction
 // error, median irradiance error, worst colour error on the sky scenes, median and worst RDE

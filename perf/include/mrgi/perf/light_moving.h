@@ -17,6 +17,7 @@
 // trip: the store has seen every view and the filter has settled).
 #pragma once
 #include <array>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,9 @@ struct MovingResult {
   std::vector<MovingFrame> frames;
   double final_direction_deg = 0.0, final_colour = 0.0, final_colour_all = 0.0, final_confidence = 0.0;
   double final_rde_ratio = 0.0;  // pooled over the last 8 frames
+  // Band 0 (mean radiance, linear RGB) of the last estimate, of the light sources and of all the
+  // light at the objects' centre, so a colour error reads as which channel is off.
+  std::array<double, 3> final_band0{}, truth_band0{}, truth_all_band0{};
 };
 
 struct SwitchResult {
@@ -74,7 +78,7 @@ struct MovingFamilySettings {
 };
 
 Expected<MovingFamilyReport> run_moving_family(const MovingFamilySettings& settings,
-                                               void (*progress)(const std::string&, size_t, size_t) = nullptr);
+                                               const std::function<void(const std::string&, size_t, size_t)>& progress = {});
 std::string moving_family_markdown(const MovingFamilyReport& report, const MovingFamilySettings& settings);
 std::string moving_family_json(const MovingFamilyReport& report);
 
