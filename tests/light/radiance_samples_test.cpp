@@ -28,6 +28,7 @@ ShVector unit_transfer(int i) {
 RadianceSamples store_of(void (*change)(RadianceSampleSettings&) = nullptr) {
   RadianceSampleSettings s;
   s.cell_m = 0.1;
+  s.distant_views = true;
   if (change) change(s);
   auto store = RadianceSamples::create(s);
   EXPECT_TRUE(store.ok()) << (store.ok() ? "" : store.error().message);
@@ -102,7 +103,7 @@ TEST(RadianceSamples, AFullStoreDropsTheLeastRecentlySeenAndRefusesBadSettings) 
            {"colour_frames", [] { RadianceSampleSettings b; b.colour_frames = 0; return b; }()},
            {"change_ratio", [] { RadianceSampleSettings b; b.change_ratio = 1.0; return b; }()},
            {"change_fraction", [] { RadianceSampleSettings b; b.change_fraction = 0.0; return b; }()},
-           {"distant_rows", [] { RadianceSampleSettings b; b.distant_rows = 65; return b; }()},
+           {"distant_rows", [] { RadianceSampleSettings b; b.distant_rows = 0; return b; }()},
            {"distant_weight", [] { RadianceSampleSettings b; b.distant_weight = 0.0; return b; }()}}) {
     auto r = RadianceSamples::create(bad);
     ASSERT_FALSE(r.ok()) << field;
@@ -160,7 +161,7 @@ TEST(RadianceSamples, DistantViewsAreRowsOfTheLightItself) {
     EXPECT_NEAR(l[1], 0.0, 0.01) << "channel " << c;
   }
   // Turned off, nothing is kept.
-  RadianceSamples off = store_of([](RadianceSampleSettings& s) { s.distant_rows = 0; });
+  RadianceSamples off = store_of([](RadianceSampleSettings& s) { s.distant_views = false; });
   off.observe_distant({0, 1, 0}, glm::dvec3(1.0), 0, 0);
   LightSystem none;
   off.add_to(none);

@@ -21,7 +21,7 @@
 // others as measurements (RadianceSamples::add_to), so a sunlit surface the camera clips still
 // says the light is at least that bright, and what colour it is.
 //
-// With the store, blocks without depth around them are views of the distant light itself
+// With the store and RadianceSampleSettings::distant_views, blocks without depth around them are views of the distant light itself
 // (ProbelessSettings::distant_margin, RadianceSamples::observe_distant): the sky or a window
 // beyond the depth sensor's range shows the light arriving from there.
 #pragma once

@@ -32,7 +32,7 @@ Expected<RadianceSamples> RadianceSamples::create(const RadianceSampleSettings& 
   MRGI_TRY(check_sample_setting(s.change_min_samples >= 1, "change_min_samples", "must be >= 1"));
   MRGI_TRY(check_sample_setting(s.settle_observations >= 1 && s.settle_observations <= 1024, "settle_observations",
                                 "must be 1..1024"));
-  MRGI_TRY(check_sample_setting(s.distant_rows >= 0 && s.distant_rows <= 64, "distant_rows", "must be 0..64"));
+  MRGI_TRY(check_sample_setting(s.distant_rows >= 1 && s.distant_rows <= 64, "distant_rows", "must be 1..64"));
   MRGI_TRY(check_sample_setting(s.distant_weight > 0.0 && std::isfinite(s.distant_weight), "distant_weight",
                                 "must be > 0"));
   RadianceSamples r;
@@ -43,7 +43,7 @@ Expected<RadianceSamples> RadianceSamples::create(const RadianceSampleSettings& 
   while (slots < size_t(s.capacity) * 2) slots <<= 1;
   r.table_.assign(slots, -1);
   r.table_mask_ = slots - 1;
-  r.distant_.assign(size_t(2 * s.distant_rows * s.distant_rows), DistantBin{});
+  if (s.distant_views) r.distant_.assign(size_t(2 * s.distant_rows * s.distant_rows), DistantBin{});
   return r;
 }
 

@@ -20,7 +20,7 @@
 // A camera move or a new view cannot trigger it (new cells are not re-observations); a moving
 // shadow can only where it covers half of what is seen again.
 //
-// Distant light seen directly: where the depth frame has no surface over a block and around it
+// Distant light seen directly (`distant_views`, off by default): where the depth frame has no surface over a block and around it
 // (ProbelessSettings::distant_margin), the colour frame shows the radiance arriving from beyond
 // the sensor's range in that direction (sky, a window, a far wall): a sample of the distant light
 // L(w) itself, not of a surface it lit. Such views are kept per direction bin (an equal-area grid
@@ -62,8 +62,13 @@ struct RadianceSampleSettings {
   // surface seen from 8 views has a settled transfer (0.3 of the stage's CPU ms at 640x480 after
   // a sweep, against 2.4 with every sample's transfer computed each view).
   int settle_observations = 8;
-  // Distant-light bins' elevation bands (0..64; 0: blocks without depth are not used), 2x as many
-  // azimuth bins each: 16 gives 512 bins of 0.025 sr (about 9 degrees).
+  // Read blocks without depth as views of the distant light (see above). Off: on the moving
+  // family's tuning half it took the RDE ratio from 1.22 to 1.16 (median), but lit by the estimate
+  // the suite's env_fisheye went 0.590 -> 0.602 and the independent courtyard_bunny 0.795 ->
+  // 0.800 (perf/results/light-moving/README.md).
+  bool distant_views = false;
+  // Distant-light bins' elevation bands (1..64), 2x as many azimuth bins each: 16 gives 512 bins
+  // of 0.025 sr (about 9 degrees).
   int distant_rows = 16;
   // Weight of a distant bin's row against a surface sample's (each 1 before normal balancing),
   // > 0. 1: a direction seen counts as much as a patch of surface.
@@ -90,9 +95,9 @@ class RadianceSamples {
                           const glm::dvec3& colour, float row_weight, int64_t frame, uint8_t clipped);
   // A view of the distant light (see above): the world direction it arrives from (towards the
   // light, need not be unit), its colour (radiance, exposure divided out) and which channels are
-  // lower bounds (`clipped`, as observe's). Nothing when distant_rows is 0 or it is not finite.
+  // lower bounds (`clipped`, as observe's). Nothing when distant_views is off or it is not finite.
   void observe_distant(const glm::vec3& direction, const glm::dvec3& colour, int64_t frame, uint8_t clipped);
-  bool distant_enabled() const { return settings_.distant_rows > 0; }
+  bool distant_enabled() const { return settings_.distant_views; }
   // Closes frame `frame`'s observations: true when they showed a light change (the samples
   // and distant bins not observed in it are then gone, see above).
   bool end_frame(int64_t frame);

@@ -151,7 +151,7 @@ Status RuntimeImpl::create_shared_stages(const RuntimeSettings& settings) {
   ls.point_lamp.enabled = settings.light_near_lamps;
   ls.albedo_fit.enabled = settings.light_albedo_fit;
   ls.near_field = settings.light_near_field;
-  if (!settings.light_distant_views) ls.samples.distant_rows = 0;
+  ls.samples.distant_views = settings.light_distant_views;
   if (!scene_gpu_->virtual_objects.empty())
     ls.focus = 0.5f * (scene_gpu_->virtual_objects.bounds_min + scene_gpu_->virtual_objects.bounds_max);
   auto stage = light::LightStage::create(ls, scene_, cameras_);
