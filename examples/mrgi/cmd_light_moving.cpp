@@ -62,8 +62,8 @@ void setup(CLI::App& app) {
                 "the grey-world albedo (0.5): the surfaces' albedo not measured from their interreflection (RuntimeSettings::light_albedo_fit false)");
   cmd->add_flag("--no-near-field", [o](int64_t n) { o->settings.family.near_field = n == 0; },
                 "the bounce of the seen surfaces read as part of the distant light, not computed from them and added at the objects (RuntimeSettings::light_near_field false)");
-  cmd->add_flag("--distant-views", [o](int64_t n) { o->settings.family.distant_views = n > 0; },
-                "regions without depth (sky, windows, beyond the sensor's range) read as views of the distant light (RuntimeSettings::light_distant_views true)");
+  cmd->add_flag("--no-distant-views", [o](int64_t n) { o->settings.family.distant_views = n == 0; },
+                "surfaces only: regions without depth (sky, windows, beyond the sensor's range) not read as the distant light (RuntimeSettings::light_distant_views false)");
   cmd->add_flag("--validate", o->settings.family.validate, "Vulkan validation layers on (a message fails the run)");
   cmd->add_option("-o,--out", o->out, "write light-moving.md and light-moving.json into this folder");
   cmd->callback([o] { run(*o); });

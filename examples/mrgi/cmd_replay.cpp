@@ -30,7 +30,7 @@ struct ReplayOptions {
   bool single_view_light = false;
   bool no_albedo_fit = false;
   bool no_near_field = false;
-  bool distant_views = false;
+  bool no_distant_views = false;
   ViewOptions view;
 };
 
@@ -45,7 +45,7 @@ void apply_options(const ReplayOptions& o, const CaptureInfo& info, RuntimeSetti
   settings.light_accumulate_views = !o.single_view_light;
   settings.light_albedo_fit = !o.no_albedo_fit;
   settings.light_near_field = !o.no_near_field;
-  settings.light_distant_views = o.distant_views;
+  settings.light_distant_views = !o.no_distant_views;
   settings.output_width = o.width;
   settings.output_height = o.height;
   settings.exposure = info.exposure;
@@ -456,9 +456,9 @@ void setup(CLI::App& app) {
   cmd->add_flag("--no-near-field", opts->no_near_field,
                 "the probeless estimate with the seen surfaces' bounce read as part of the distant light, not computed "
                 "from them and added at the objects (RuntimeSettings::light_near_field false; the comparison)");
-  cmd->add_flag("--distant-views", opts->distant_views,
-                "the probeless estimate with regions without depth (sky, windows, beyond the sensor's range) read as "
-                "views of the distant light (RuntimeSettings::light_distant_views true; off by default)");
+  cmd->add_flag("--no-distant-views", opts->no_distant_views,
+                "the probeless estimate from surfaces only: regions without depth (sky, windows, beyond the sensor's "
+                "range) not read as the distant light (RuntimeSettings::light_distant_views false; the comparison)");
   cmd->add_flag("--single-view-light", opts->single_view_light,
                 "the probeless estimate from each view on its own, not from every view seen "
                 "(RuntimeSettings::light_accumulate_views false; the comparison)");

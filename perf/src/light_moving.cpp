@@ -293,8 +293,8 @@ std::string moving_family_markdown(const MovingFamilyReport& rep, const MovingFa
                 !(ms.family.accumulate_views && ms.family.albedo_fit) ? ""
                 : ms.family.near_field ? ", albedo from interreflection, near field" : ", albedo from interreflection");
   md += line;
-  if (ms.family.accumulate_views && ms.family.distant_views)
-    md += "Regions without depth read as views of the distant light (--distant-views).\n\n";
+  if (ms.family.accumulate_views && !ms.family.distant_views)
+    md += "Regions without depth not read as distant light (--no-distant-views).\n\n";
   md += "Direction error (degrees) as the sweep grows:\n\n| scene | half | 0 deg | 22 deg | 45 deg | 67 deg | 90 deg |"
         " colour after (sources / all light) | confidence after | RDE ratio, last 8 frames |\n"
         "|---|---|---|---|---|---|---|---|---|---|\n";

@@ -239,9 +239,7 @@ TEST(Probeless, ASkyBeyondTheDepthSensorsRangeIsDistantLightAndANarrowDepthHoleI
   auto b = ProbelessBuilder::create(ps, f.k, f.k, 5000);
   ASSERT_TRUE(b.ok()) << b.error().message;
   auto distant_bins = [&](const InputFrame& frame, const glm::dmat4& pose) {
-    RadianceSampleSettings with_distant;
-    with_distant.distant_views = true;
-    auto store = RadianceSamples::create(with_distant);
+    auto store = RadianceSamples::create({});
     EXPECT_TRUE(store.ok());
     LightSystem sys;
     EXPECT_TRUE(b->add_part(frame::CameraView::of(frame, pose), 1.0, 0, sys, &*store).ok());

@@ -413,10 +413,9 @@ struct RuntimeSettings {
   bool light_near_field = true;
   /// With the views accumulated: where the depth frame shows no surface over a region (the sky,
   /// a window, a far wall beyond the sensor's range) its colour is the distant light from those
-  /// directions and joins the solve as such (light/radiance_samples.h). Off by default: better on
-  /// the moving-camera family, slightly worse on the suite's and the independent set's scenes
-  /// lit by the estimate (perf/results/light-moving/README.md). false: only surfaces.
-  bool light_distant_views = false;
+  /// directions and joins the solve as such, where it is above the dominant real surface (a floor's
+  /// horizon; light/radiance_samples.h). false: only surfaces.
+  bool light_distant_views = true;
 };
 
 // ---------------------------------------------------------------------------------------------

@@ -630,8 +630,10 @@ Status LightStage::add_probeless_parts(const frame::CameraView& camera, std::vec
         return out;
       };
       const bool direct_rows = near_field_on_ && near_field_valid_ && fitted && !fitted->empty();
+      const glm::dvec3 floor = estimator_->dominant_normal();
       store->add_to(pending_, &estimator_->filtered(), albedo, lamp_.found ? &lamp_.position : nullptr,
-                    lamp_.found ? &lamp_.intensity : nullptr, direct_rows ? &bounce : nullptr);
+                    lamp_.found ? &lamp_.intensity : nullptr, direct_rows ? &bounce : nullptr,
+                    glm::length(floor) > 0.5 ? &floor : nullptr);
     }
     auto r = estimator_->update(pending_, camera.index, camera.timestamp);
     if (!r) notes.push_back("light: " + r.error().message);

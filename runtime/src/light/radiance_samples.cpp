@@ -184,7 +184,8 @@ bool RadianceSamples::end_frame(int64_t frame) {
 
 void RadianceSamples::add_to(LightSystem& system, const ShRgb* estimate, const glm::dvec3& albedo,
                              const glm::dvec3* lamp_position, const glm::dvec3* lamp_intensity,
-                             const std::function<glm::dvec3(const glm::vec3&, const glm::vec3&)>* taken_off) const {
+                             const std::function<glm::dvec3(const glm::vec3&, const glm::vec3&)>* taken_off,
+                             const glm::dvec3* in_front_of) const {
   for (const Sample& s : samples_) {
     glm::dvec3 colour = s.colour;
     if (taken_off) colour = glm::max(colour - (*taken_off)(s.position, s.normal), glm::dvec3(0.0));
@@ -217,9 +218,10 @@ void RadianceSamples::add_to(LightSystem& system, const ShRgb* estimate, const g
       for (int c = 0; c < 3; ++c)
         if (b.clipped & (1u << c)) colour[c] = std::max(colour[c], predicted[c]);
     }
+    if (!in_front_of || glm::dot(glm::dvec3(b.direction), *in_front_of) <= 0.0) continue;
     ShVector y = sh_basis(b.direction);
     for (float& v : y) v *= float(w);
-    system.add(y, albedo * colour * w);
+    system.add_view(y, albedo * colour * w);
   }
 }
 

@@ -20,7 +20,7 @@
 // A camera move or a new view cannot trigger it (new cells are not re-observations); a moving
 // shadow can only where it covers half of what is seen again.
 //
-// Distant light seen directly (`distant_views`, off by default): where the depth frame has no surface over a block and around it
+// Distant light seen directly (`distant_views`): where the depth frame has no surface over a block and around it
 // (ProbelessSettings::distant_margin), the colour frame shows the radiance arriving from beyond
 // the sensor's range in that direction (sky, a window, a far wall): a sample of the distant light
 // L(w) itself, not of a surface it lit. Such views are kept per direction bin (an equal-area grid
@@ -62,11 +62,11 @@ struct RadianceSampleSettings {
   // surface seen from 8 views has a settled transfer (0.3 of the stage's CPU ms at 640x480 after
   // a sweep, against 2.4 with every sample's transfer computed each view).
   int settle_observations = 8;
-  // Read blocks without depth as views of the distant light (see above). Off: on the moving
-  // family's tuning half it took the RDE ratio from 1.22 to 1.16 (median), but lit by the estimate
-  // the suite's env_fisheye went 0.590 -> 0.602 and the independent courtyard_bunny 0.795 ->
-  // 0.800 (perf/results/light-moving/README.md).
-  bool distant_views = false;
+  // Read blocks without depth as views of the distant light (see above; only above the dominant
+  // real surface, add_to). Without that rule the far floor a camera sees beyond the sensor's range
+  // was read as light from below: env_fisheye lit by the estimate 0.590 -> 0.602, the independent
+  // courtyard_bunny 0.795 -> 0.800 (perf/results/light-moving/README.md).
+  bool distant_views = true;
   // Distant-light bins' elevation bands (1..64), 2x as many azimuth bins each: 16 gives 512 bins
   // of 0.025 sr (about 9 degrees).
   int distant_rows = 16;
@@ -114,10 +114,15 @@ class RadianceSamples {
   // With `taken_off`, each row's colour has what it returns for the sample taken off first
   // (clamped at 0): the light the surfaces around bounce onto it (albedo_fit.h).
   // Then each distant bin seen: the row Y(w) . l = albedo * colour (the system's rows are
-  // divided by the albedo, LightEstimator), clipped channels censored as above.
+  // divided by the albedo, LightEstimator; LightSystem::add_view), clipped channels censored as
+  // above; only the bins on the side `in_front_of` (a unit normal) faces, none without it. Why: the estimator holds
+  // that no light arrives from behind the dominant real surface (the floor:
+  // LightEstimatorSettings::below_surface_penalty; its bounce is the near field's), and what a
+  // camera sees without depth below the horizon is that surface far away, not distant light.
   void add_to(LightSystem& system, const ShRgb* estimate = nullptr, const glm::dvec3& albedo = glm::dvec3(0.5),
               const glm::dvec3* lamp_position = nullptr, const glm::dvec3* lamp_intensity = nullptr,
-              const std::function<glm::dvec3(const glm::vec3&, const glm::vec3&)>* taken_off = nullptr) const;
+              const std::function<glm::dvec3(const glm::vec3&, const glm::vec3&)>* taken_off = nullptr,
+              const glm::dvec3* in_front_of = nullptr) const;
 
   struct Sample {
     uint64_t key;

@@ -22,12 +22,17 @@ Status check_estimator_setting(bool ok, const char* field, const std::string& ru
 // The dominant normal of the frame's pixels: the principal axis of the band-1 block of T^T T
 // (T's band 1 is the visibility-weighted cosine lobe around the normal, so the block is a sum of
 // n n^T), signed so that the pixels are lit from its side (T^T I_c). Zero when undefined.
-glm::dvec3 dominant_surface_normal(const Mat& ata, const Rhs& atb) {
+// The rows that are views of the light (LightSystem::add_view) are taken out first.
+glm::dvec3 dominant_surface_normal(const Mat& ata, const Rhs& atb, const LightSystem& system, double albedo) {
   Eigen::Matrix3d b = ata.block(1, 1, 3, 3);
+  Eigen::Vector3d side = atb.block(1, 0, 3, 1);
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) b(i, j) -= system.view_ata1[size_t(i * 3 + j)];
+    side(i) -= system.view_atb1[size_t(i * 3)] / albedo;
+  }
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(b);
   if (eig.info() != Eigen::Success || !(eig.eigenvalues()(2) > 0.0)) return glm::dvec3(0.0);
   Eigen::Vector3d e = eig.eigenvectors().col(2);
-  const Eigen::Vector3d side = atb.block(1, 0, 3, 1);
   if (e.dot(side) < 0.0) e = -e;
   // Band 1 in Sloan order is c * (-y, z, -x).
   const glm::dvec3 n(-e(2), -e(0), e(1));
@@ -140,6 +145,14 @@ void LightSystem::add(const ShVector& transfer, const glm::dvec3& intensity) {
   samples += 1.0;
 }
 
+void LightSystem::add_view(const ShVector& basis, const glm::dvec3& intensity) {
+  add(basis, intensity);
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) view_ata1[size_t(i * 3 + j)] += double(basis[size_t(1 + i)]) * double(basis[size_t(1 + j)]);
+    for (int c = 0; c < 3; ++c) view_atb1[size_t(i * 3 + c)] += double(basis[size_t(1 + i)]) * intensity[c];
+  }
+}
+
 Expected<LightEstimator> LightEstimator::create(const LightEstimatorSettings& s) {
   MRGI_TRY(check_estimator_setting(s.bands >= 1 && s.bands <= kMaxShBands, "bands", "must be 1..4"));
   MRGI_TRY(check_estimator_setting(s.gray_albedo > 0.0 && s.gray_albedo <= 1.0, "gray_albedo",
@@ -216,7 +229,7 @@ Expected<LightEstimate> LightEstimator::update(const LightSystem& system, int64_
                         settings_.min_regularisation;
   Mat lhs = ata;
   Rhs rhs = atb;
-  dominant_normal_ = n >= 4 ? dominant_surface_normal(ata, atb) : glm::dvec3(0.0);
+  dominant_normal_ = n >= 4 ? dominant_surface_normal(ata, atb, system, albedo_[0]) : glm::dvec3(0.0);
   const double mu = settings_.below_surface_penalty;
   if (mu > 0.0 && glm::length(dominant_normal_) > 0.5)
     lhs += (mu * std::max(mean_diag, 0.0)) * below_surface_gram(dominant_normal_, n);

@@ -32,9 +32,17 @@ struct LightSystem {
   std::array<double, kMaxShCoeffs * 3> atb{};
   double samples = 0.0;
 
+  // The band-1 block (coefficients 1..3) of the rows added by add_view, T^T T (3 x 3, row-major)
+  // and T^T I_c (coefficient, then R G B): taken out again where the dominant real surface is
+  // read from the system (a view of the light is no surface normal).
+  std::array<double, 9> view_ata1{};
+  std::array<double, 9> view_atb1{};
+
   void clear() { *this = LightSystem{}; }
   // Adds one pixel: transfer vector (the first `bands`^2 entries are used) and linear RGB.
   void add(const ShVector& transfer, const glm::dvec3& intensity);
+  // Adds a row that is a view of the light itself (Y(w) . l = I_c), not a surface lit by it.
+  void add_view(const ShVector& basis, const glm::dvec3& intensity);
 };
 
 struct LightEstimatorSettings {

@@ -64,7 +64,7 @@ struct LightFamilySettings {
   bool near_lamps = true;        // RuntimeSettings::light_near_lamps
   bool albedo_fit = true;        // RuntimeSettings::light_albedo_fit
   bool near_field = true;        // RuntimeSettings::light_near_field
-  bool distant_views = false;    // RuntimeSettings::light_distant_views
+  bool distant_views = true;     // RuntimeSettings::light_distant_views
 };
 
 // One capture replayed through the runtime: the error of every frame and the light it came
