@@ -1,6 +1,7 @@
 #include "mrgi/perf/light_moving.h"
 
 #include <algorithm>
+#include <map>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -278,6 +279,39 @@ Expected<MovingFamilyReport> run_moving_family(const MovingFamilySettings& ms,
   return rep;
 }
 
+// Every frame of each half's sweeps by the estimate's confidence: whether it says how far the
+// estimate is to be trusted, and which frames the ARCore-shaped output calls valid.
+std::string confidence_markdown(const MovingFamilyReport& rep) {
+  std::string md =
+      "\nThe estimate by its confidence (every frame of the sweeps; the ARCore-shaped output, "
+      "to_environmental_hdr, is valid from a confidence of " +
+      std::to_string(int(std::lround(kEnvironmentalHdrMinConfidence * 16.0f))) +
+      " / 16):\n\n| half | confidence | frames | RDE ratio median / worst | direction median / worst | ARCore "
+      "output |\n|---|---|---|---|---|---|\n";
+  char line[256];
+  for (const bool held : {false, true}) {
+    std::map<int, std::pair<std::vector<double>, std::vector<double>>> by;  // sixteenths -> ratios, directions
+    for (const MovingResult& r : rep.scenes) {
+      if (r.scene.held_out != held) continue;
+      for (const MovingFrame& f : r.frames) {
+        if (!f.valid || !(f.rde_true > 0.0)) continue;
+        auto& b = by[int(std::lround(f.confidence * 16.0))];
+        b.first.push_back(f.rde_estimate / f.rde_true);
+        b.second.push_back(f.direction_error_deg);
+      }
+    }
+    for (auto& [k, b] : by) {
+      std::snprintf(line, sizeof line, "| %s | %d / 16 | %zu | %.2f / %.2f | %.1f / %.1f | %s |\n",
+                    held ? "held out" : "tuning", k, b.first.size(), median(b.first),
+                    *std::max_element(b.first.begin(), b.first.end()), median(b.second),
+                    *std::max_element(b.second.begin(), b.second.end()),
+                    float(k) / 16.0f >= kEnvironmentalHdrMinConfidence - 1e-6f ? "valid" : "not valid");
+      md += line;
+    }
+  }
+  return md;
+}
+
 std::string moving_family_markdown(const MovingFamilyReport& rep, const MovingFamilySettings& ms) {
   std::string md;
   char line[512];
@@ -326,6 +360,7 @@ std::string moving_family_markdown(const MovingFamilyReport& rep, const MovingFa
                   *std::max_element(colour_all.begin(), colour_all.end()));
     md += line;
   }
+  md += confidence_markdown(rep);
   if (!rep.switches.empty()) {
     md += "\nA lamp switched on (target: followed within 30 frames; an output frame carries the newest estimate "
           "when it is collected, up to 2 frames later with 2 in flight):\n\n| switch | half | at frame | followed after "

@@ -22,6 +22,7 @@ struct Analytic {
     LightEstimate e;
     fill_light_estimate(l, kMaxShBands, e);
     e.valid = true;
+    e.confidence = 1.0f;
     return e;
   }
   // Irradiance of the 3-band projection (what 9 coefficients can hold) at normal n.
@@ -69,9 +70,25 @@ TEST(EnvironmentalHdr, MainLightAndAmbientOfAKnownLight) {
   }
   EXPECT_GT(glm::dot(best_dir, a.d), std::cos(10.0 * kPi / 180.0));  // within a texel or two
   EXPECT_FALSE(to_environmental_hdr(a.estimate(), 300).ok());
+  EXPECT_FALSE(to_environmental_hdr(a.estimate(), 16, 1.5f).ok());
+  EXPECT_FALSE(to_environmental_hdr(a.estimate(), 16, std::nanf("")).ok());
   auto no_cube = to_environmental_hdr(a.estimate(), 0);
   ASSERT_TRUE(no_cube.ok());
   EXPECT_TRUE(no_cube->cubemap[0].empty());
+}
+
+TEST(EnvironmentalHdr, ValidOnceTheConfidenceSaysSo) {
+  const Analytic a;
+  LightEstimate e = a.estimate();
+  e.confidence = 2.0f / 16.0f;  // one flat surface in view
+  auto low = to_environmental_hdr(e, 0);
+  ASSERT_TRUE(low.ok());
+  EXPECT_FALSE(low->valid);
+  EXPECT_TRUE(to_environmental_hdr(e, 0, 0.0f)->valid) << "an app may take every estimate";
+  e.confidence = kEnvironmentalHdrMinConfidence;
+  EXPECT_TRUE(to_environmental_hdr(e, 0)->valid);
+  e.valid = false;
+  EXPECT_FALSE(to_environmental_hdr(e, 0, 0.0f)->valid) << "no estimate is never valid";
 }
 
 TEST(FilamentIrradiance, ShaderPolynomialGivesIrradianceOverPi) {

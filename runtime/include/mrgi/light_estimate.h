@@ -76,8 +76,19 @@ struct EnvironmentalHdr {
   bool valid = false;
 };
 
-/// BadUsage for face_size outside 0..256 (0 = no cubemap).
-MRGI_API Expected<EnvironmentalHdr> to_environmental_hdr(const LightEstimate& estimate, int face_size = 16);
+/// The confidence (LightEstimate::confidence) from which to_environmental_hdr calls an estimate
+/// valid: 3 of the 16 SH directions constrained by the data. Why: on the moving-camera light
+/// family's tuning half (every frame of 4 sweeps, baseline high) the estimate-lit RDE over the
+/// true-lit was 2.35 (median) at 1 / 16, 1.55 at 2 / 16 (worst 2.62), 1.26 at 3 / 16 and 1.17 at
+/// 4 / 16 (perf/results/light-moving/README.md). A still camera on one flat surface stays below it;
+/// an environment image's light has confidence 1.
+inline constexpr float kEnvironmentalHdrMinConfidence = 3.0f / 16.0f;
+
+/// `valid` = the estimate's and its confidence at least `min_confidence` (0..1; 0 passes every
+/// valid estimate). BadUsage for face_size outside 0..256 (0 = no cubemap) or min_confidence
+/// outside 0..1.
+MRGI_API Expected<EnvironmentalHdr> to_environmental_hdr(const LightEstimate& estimate, int face_size = 16,
+                                                         float min_confidence = kEnvironmentalHdrMinConfidence);
 
 /// Filament's irradiance SH (IndirectLight::Builder::irradiance(3, sh)): 9 RGB coefficients
 /// pre-scaled by the cosine lobe A_l / pi and the basis constants, so that Filament's shader

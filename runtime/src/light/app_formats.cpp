@@ -31,12 +31,15 @@ std::array<float, 3> cube_direction(int face, int u, int v, int size) {
 
 }  // namespace
 
-Expected<EnvironmentalHdr> to_environmental_hdr(const LightEstimate& e, int face_size) {
+Expected<EnvironmentalHdr> to_environmental_hdr(const LightEstimate& e, int face_size, float min_confidence) {
   if (face_size < 0 || face_size > 256)
     return fail(ErrorKind::BadUsage, "to_environmental_hdr: face_size " + std::to_string(face_size) +
                                          " outside 0..256 (0 = no cubemap)");
+  if (!(min_confidence >= 0.0f && min_confidence <= 1.0f))
+    return fail(ErrorKind::BadUsage, "to_environmental_hdr: min_confidence " + std::to_string(min_confidence) +
+                                         " outside 0..1");
   EnvironmentalHdr out;
-  out.valid = e.valid;
+  out.valid = e.valid && e.confidence >= min_confidence;
   out.main_light_direction = e.direction_to_light;
   out.main_light_intensity = e.dominant_intensity;
   for (int i = 0; i < 9; ++i)
