@@ -180,8 +180,32 @@ void ProbelessBuilder::build_normals(const glm::mat3& rot) {
   }
 }
 
-void ProbelessBuilder::add_distant_views(int part, const glm::mat3& rot, const BlockColour& block_colour, int64_t frame,
-                                         RadianceSamples& samples) const {
+bool ProbelessBuilder::block_colour(const CameraColor& camera, double exposure, const glm::vec2& c,
+                                    bool stop_at_saturated, glm::dvec3& colour, uint8_t& saturated) const {
+  const auto& lut = srgb8_to_linear_table();
+  const int half = std::max(1, int(std::lround(0.5 * stride_ * color_.fx / depth_.fx)));
+  const int cx0 = std::max(0, int(c.x) - half), cx1 = std::min(color_.width, int(c.x) + half);
+  const int cy0 = std::max(0, int(c.y) - half), cy1 = std::min(color_.height, int(c.y) + half);
+  colour = glm::dvec3(0.0);
+  saturated = 0;
+  int count = 0;
+  for (int y = cy0; y < cy1; ++y) {
+    for (int x = cx0; x < cx1; ++x) {
+      const std::array<uint8_t, 3> px = camera.at(x, y);
+      for (int ch = 0; ch < 3; ++ch)
+        if (px[size_t(ch)] >= kSaturated) saturated |= uint8_t(1u << ch);
+      if (saturated && stop_at_saturated) return false;
+      colour += glm::dvec3(lut[px[0]], lut[px[1]], lut[px[2]]);
+      ++count;
+    }
+  }
+  if (count == 0) return false;
+  colour /= double(count) * exposure;
+  return true;
+}
+
+void ProbelessBuilder::add_distant_views(int part, const glm::mat3& rot, const CameraColor& camera, double exposure,
+                                         int64_t frame, RadianceSamples& samples) const {
   const int m = settings_.distant_margin, s = stride_;
   const glm::vec4 kd(float(depth_.fx), float(depth_.fy), float(depth_.cx), float(depth_.cy));
   const glm::vec4 kc(float(color_.fx), float(color_.fy), float(color_.cx), float(color_.cy));
@@ -196,7 +220,7 @@ void ProbelessBuilder::add_distant_views(int part, const glm::mat3& rot, const B
       const glm::vec3 ray = shader::unproject_pinhole(glm::vec2(float(gx * s + s / 2), float(gy * s + s / 2)), 1.0f, kd);
       glm::dvec3 colour;
       uint8_t saturated = 0;
-      if (!block_colour(shader::project_pinhole(ray, kc), false, colour, saturated)) continue;
+      if (!block_colour(camera, exposure, shader::project_pinhole(ray, kc), false, colour, saturated)) continue;
       samples.observe_distant(rot * ray, colour, frame, saturated);
     }
   }
@@ -220,7 +244,6 @@ Status ProbelessBuilder::add_part(const frame::CameraView& view, double exposure
   const glm::mat3 rot_t = glm::transpose(rot);
   const glm::vec4 kd(float(depth_.fx), float(depth_.fy), float(depth_.cx), float(depth_.cy));
   const glm::vec4 kc(float(color_.fx), float(color_.fy), float(color_.cx), float(color_.cy));
-  const auto& lut = srgb8_to_linear_table();
   const int s = stride_;
   const float radius = float(settings_.radius_m);
   const float solid_angle = float(4.0 * kPi / settings_.directions);
@@ -244,30 +267,6 @@ Status ProbelessBuilder::add_part(const frame::CameraView& view, double exposure
     }
     return k;
   };
-  // The linear mean colour (exposure divided out) of the colour frame's block of one sample
-  // around colour pixel c; `saturated` bit ch: channel ch reached kSaturated in a pixel of it.
-  // False for an empty block, or (`stop_at_saturated`) one with a saturated pixel.
-  const int half = std::max(1, int(std::lround(0.5 * s * color_.fx / depth_.fx)));
-  auto block_colour = [&](const glm::vec2& c, bool stop_at_saturated, glm::dvec3& colour, uint8_t& saturated) {
-    const int cx0 = std::max(0, int(c.x) - half), cx1 = std::min(color_.width, int(c.x) + half);
-    const int cy0 = std::max(0, int(c.y) - half), cy1 = std::min(color_.height, int(c.y) + half);
-    colour = glm::dvec3(0.0);
-    saturated = 0;
-    int count = 0;
-    for (int y = cy0; y < cy1; ++y) {
-      for (int x = cx0; x < cx1; ++x) {
-        const std::array<uint8_t, 3> px = camera.at(x, y);
-        for (int ch = 0; ch < 3; ++ch)
-          if (px[size_t(ch)] >= kSaturated) saturated |= uint8_t(1u << ch);
-        if (saturated && stop_at_saturated) return false;
-        colour += glm::dvec3(lut[px[0]], lut[px[1]], lut[px[2]]);
-        ++count;
-      }
-    }
-    if (count == 0) return false;
-    colour /= double(count) * exposure;
-    return true;
-  };
   // First the part's samples and their colours, so the light's colour can be voted on before
   // any row is added.
   samples_.clear();
@@ -279,7 +278,7 @@ Status ProbelessBuilder::add_part(const frame::CameraView& view, double exposure
       // the colour camera (same centre; intrinsics may differ).
       glm::dvec3 colour;
       uint8_t saturated = 0;
-      if (!block_colour(shader::project_pinhole(p, kc), !samples, colour, saturated)) continue;
+      if (!block_colour(camera, exposure, shader::project_pinhole(p, kc), !samples, colour, saturated)) continue;
       samples_.push_back({gy * grid_w_ + gx, colour, saturated});
     }
   }
@@ -336,7 +335,7 @@ Status ProbelessBuilder::add_part(const frame::CameraView& view, double exposure
       system.add(t, (colour - known) * double(sw));
     }
   }
-  if (samples && samples->distant_enabled() && known_lamps_.empty()) add_distant_views(part, rot, block_colour, view.index, *samples);
+  if (samples && samples->distant_enabled() && known_lamps_.empty()) add_distant_views(part, rot, camera, exposure, view.index, *samples);
   return ok_status();
 }
 

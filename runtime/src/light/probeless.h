@@ -26,7 +26,6 @@
 // beyond the depth sensor's range shows the light arriving from there.
 #pragma once
 #include <cstdint>
-#include <functional>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -39,6 +38,8 @@
 #include "mrgi/scene.h"
 
 namespace mrgi::light {
+
+class CameraColor;  // light/camera_color.h
 
 struct ProbelessSettings {
   // Samples across the depth image's width (16..512); each stands for a square block of
@@ -117,12 +118,15 @@ class ProbelessBuilder {
   // The light's colour as the mode of the samples' chromaticities; samples far from it take it
   // (their luminance kept). See probeless.cpp.
   void vote_light_colour();
-  using BlockColour = std::function<bool(const glm::vec2& colour_pixel, bool stop_at_saturated, glm::dvec3& colour,
-                                         uint8_t& saturated)>;
+  // The linear mean colour (exposure divided out) of the colour frame's block of one sample
+  // around colour pixel c; `saturated` bit ch: channel ch reached kSaturated in a pixel of it.
+  // False for an empty block, or (`stop_at_saturated`) one with a saturated pixel.
+  bool block_colour(const CameraColor& camera, double exposure, const glm::vec2& c, bool stop_at_saturated,
+                    glm::dvec3& colour, uint8_t& saturated) const;
   // Part `part`'s blocks without depth around them (distant_margin) into `samples` as views of
   // the distant light along their world directions.
-  void add_distant_views(int part, const glm::mat3& camera_to_world_rotation, const BlockColour& block_colour,
-                         int64_t frame, RadianceSamples& samples) const;
+  void add_distant_views(int part, const glm::mat3& camera_to_world_rotation, const CameraColor& camera,
+                         double exposure, int64_t frame, RadianceSamples& samples) const;
   struct Sample {
     int cell;
     glm::dvec3 colour;  // linear, exposure divided out
