@@ -210,7 +210,7 @@ void RadianceSamples::add_to(LightSystem& system, const ShRgb* estimate, const g
   }
   const double w = std::sqrt(settings_.distant_weight);
   for (const DistantBin& b : distant_) {
-    if (b.observations == 0) continue;
+    if (b.observations == 0 || !in_front_of || glm::dot(glm::dvec3(b.direction), *in_front_of) <= 0.0) continue;
     glm::dvec3 colour = b.colour;
     if (b.clipped) {
       if (!estimate) continue;
@@ -218,7 +218,6 @@ void RadianceSamples::add_to(LightSystem& system, const ShRgb* estimate, const g
       for (int c = 0; c < 3; ++c)
         if (b.clipped & (1u << c)) colour[c] = std::max(colour[c], predicted[c]);
     }
-    if (!in_front_of || glm::dot(glm::dvec3(b.direction), *in_front_of) <= 0.0) continue;
     ShVector y = sh_basis(b.direction);
     for (float& v : y) v *= float(w);
     system.add_view(y, albedo * colour * w);
