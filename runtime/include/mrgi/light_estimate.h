@@ -81,7 +81,8 @@ struct EnvironmentalHdr {
 /// family's tuning half (every frame of 4 sweeps, baseline high) the estimate-lit RDE over the
 /// true-lit was 2.35 (median) at 1 / 16, 1.55 at 2 / 16 (worst 2.62), 1.26 at 3 / 16 and 1.17 at
 /// 4 / 16 (perf/results/light-moving/README.md). A still camera on one flat surface stays below it;
-/// an environment image's light has confidence 1.
+/// an environment image's light has confidence 1. Across scenes it does not rank the error (the
+/// still-camera family's two valid scenes had ratios of 2.0): it keeps a sweep's first frames out.
 inline constexpr float kEnvironmentalHdrMinConfidence = 3.0f / 16.0f;
 
 /// `valid` = the estimate's and its confidence at least `min_confidence` (0..1; 0 passes every
