@@ -4,7 +4,8 @@
 // grows, no change detected while only the camera moves, a lamp switched on followed.
 #include <gtest/gtest.h>
 
-#include <array>
+#include <Eigen/Dense>
+
 #include <cmath>
 #include <cstdio>
 
@@ -110,33 +111,16 @@ TEST(RadianceSamples, AFullStoreDropsTheLeastRecentlySeenAndRefusesBadSettings) 
   }
 }
 
-// Solves the normal equations of `sys` restricted to its first 4 coefficients (bands 0-1;
-// Gaussian elimination with partial pivoting) for channel c, dividing the right-hand side by
-// `albedo` as LightEstimator does.
-std::array<double, 4> solve_channel(const LightSystem& sys, int c, double albedo) {
-  constexpr int n = 4;
-  std::array<std::array<double, n + 1>, n> m{};
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) m[size_t(i)][size_t(j)] = sys.ata[size_t(i * kMaxShCoeffs + j)];
-    m[size_t(i)][n] = sys.atb[size_t(i * 3 + c)] / albedo;
+// Solves the normal equations of `sys` restricted to its first 4 coefficients (bands 0-1) for
+// channel c, dividing the right-hand side by `albedo` as LightEstimator does.
+Eigen::Vector4d solve_channel(const LightSystem& sys, int c, double albedo) {
+  Eigen::Matrix4d a;
+  Eigen::Vector4d b;
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j) a(i, j) = sys.ata[size_t(i * kMaxShCoeffs + j)];
+    b(i) = sys.atb[size_t(i * 3 + c)] / albedo;
   }
-  for (int k = 0; k < n; ++k) {
-    int p = k;
-    for (int i = k + 1; i < n; ++i)
-      if (std::abs(m[size_t(i)][size_t(k)]) > std::abs(m[size_t(p)][size_t(k)])) p = i;
-    std::swap(m[size_t(k)], m[size_t(p)]);
-    for (int i = k + 1; i < n; ++i) {
-      const double f = m[size_t(i)][size_t(k)] / m[size_t(k)][size_t(k)];
-      for (int j = k; j <= n; ++j) m[size_t(i)][size_t(j)] -= f * m[size_t(k)][size_t(j)];
-    }
-  }
-  std::array<double, n> x{};
-  for (int i = n - 1; i >= 0; --i) {
-    double v = m[size_t(i)][n];
-    for (int j = i + 1; j < n; ++j) v -= m[size_t(i)][size_t(j)] * x[size_t(j)];
-    x[size_t(i)] = v / m[size_t(i)][size_t(i)];
-  }
-  return x;
+  return a.ldlt().solve(b);
 }
 
 TEST(RadianceSamples, DistantViewsAreRowsOfTheLightItselfInFrontOfTheFloor) {

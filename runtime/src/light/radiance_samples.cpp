@@ -20,6 +20,15 @@ uint64_t mix64(uint64_t x) {  // splitmix64's finaliser: cells next to each othe
   return x ^ (x >> 31);
 }
 
+// How an observation with clip mask `now` joins a kept one with mask `had` (bit c: channel c a
+// lower bound): a measurement replaces bounds, a bound beside measurements is ignored (the
+// measurements stand), otherwise it folds in and a channel either clipped stays a bound.
+enum class Join { Fold, Replace, Ignore };
+Join join(uint8_t had, uint8_t now) {
+  if ((had != 0) == (now != 0)) return Join::Fold;
+  return now ? Join::Ignore : Join::Replace;
+}
+
 }  // namespace
 
 Expected<RadianceSamples> RadianceSamples::create(const RadianceSampleSettings& s) {
@@ -123,23 +132,24 @@ bool RadianceSamples::observe_if_settled(const glm::dvec3& position, const glm::
   const int64_t slot = find_slot(key_of(position, bin));
   if (table_[size_t(slot)] < 0) return false;
   Sample& s = samples_[size_t(table_[size_t(slot)])];
-  if (s.observations < settings_.settle_observations || (s.clipped != 0) != (clipped != 0)) return false;
+  if (s.observations < settings_.settle_observations || join(s.clipped, clipped) != Join::Fold) return false;
   update(s, position, normal, nullptr, colour, row_weight, frame, clipped);
   return true;
 }
 
 void RadianceSamples::update(Sample& s, const glm::dvec3& position, const glm::vec3& normal, const ShVector* transfer,
                              const glm::dvec3& colour, float row_weight, int64_t frame, uint8_t clipped) {
-  if ((clipped != 0) != (s.clipped != 0)) {
-    if (clipped) {  // a bound beside measurements: the measurements stand
+  switch (join(s.clipped, clipped)) {
+    case Join::Ignore:
       s.last_frame = frame;
       return;
-    }
-    // A measurement replaces a bound.
-    s = Sample{s.key, transfer ? *transfer : s.transfer, colour, colour, glm::vec3(position), normal, row_weight, 0, 1, frame};
-    return;
+    case Join::Replace:
+      s = Sample{s.key, transfer ? *transfer : s.transfer, colour, colour, glm::vec3(position), normal, row_weight, 0, 1, frame};
+      return;
+    case Join::Fold:
+      s.clipped |= clipped;
+      break;
   }
-  s.clipped |= clipped;  // bounds in other channels: a channel any of them clipped stays a bound
   if (s.last_frame < frame && !clipped) {
     // Seen in an earlier frame: does it show the light it showed then?
     const double before = luminance(s.colour), now = luminance(colour);
@@ -236,14 +246,12 @@ void RadianceSamples::observe_distant(const glm::vec3& direction, const glm::dve
   const float azimuth = std::atan2(d.z, d.x);  // -pi..pi
   const int col = std::clamp(int((azimuth + float(kPi)) / float(2.0 * kPi) * float(cols)), 0, cols - 1);
   DistantBin& b = distant_[size_t(row * cols + col)];
-  if (b.observations > 0 && (clipped != 0) != (b.clipped != 0)) {
-    if (clipped) {  // a bound beside measurements: the measurements stand
-      b.last_frame = frame;
-      return;
-    }
-    b.observations = 0;  // a measurement replaces a bound
+  const Join j = b.observations == 0 ? Join::Replace : join(b.clipped, clipped);
+  if (j == Join::Ignore) {
+    b.last_frame = frame;
+    return;
   }
-  if (b.observations == 0) {
+  if (j == Join::Replace) {
     b = DistantBin{d, colour, colour, clipped, 1, frame};
     return;
   }

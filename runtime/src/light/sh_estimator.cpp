@@ -22,13 +22,18 @@ Status check_estimator_setting(bool ok, const char* field, const std::string& ru
 // The dominant normal of the frame's pixels: the principal axis of the band-1 block of T^T T
 // (T's band 1 is the visibility-weighted cosine lobe around the normal, so the block is a sum of
 // n n^T), signed so that the pixels are lit from its side (T^T I_c). Zero when undefined.
-// The rows that are views of the light (LightSystem::add_view) are taken out first.
-glm::dvec3 dominant_surface_normal(const Mat& ata, const Rhs& atb, const LightSystem& system, double albedo) {
+// The rows that are views of the light (LightSystem::add_view) are taken out first, their
+// right-hand side in the units load_system gives `atb` (divided by the albedo; luminance for
+// white light).
+glm::dvec3 dominant_surface_normal(const Mat& ata, const Rhs& atb, const LightSystem& system, const glm::dvec3& albedo,
+                                   bool white_light) {
   Eigen::Matrix3d b = ata.block(1, 1, 3, 3);
   Eigen::Vector3d side = atb.block(1, 0, 3, 1);
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) b(i, j) -= system.view_ata1[size_t(i * 3 + j)];
-    side(i) -= system.view_atb1[size_t(i * 3)] / albedo;
+    const glm::dvec3 v = glm::dvec3(system.view_atb1[size_t(i * 3)], system.view_atb1[size_t(i * 3 + 1)],
+                                    system.view_atb1[size_t(i * 3 + 2)]) / albedo;
+    side(i) -= white_light ? luminance(v) : v.x;
   }
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(b);
   if (eig.info() != Eigen::Success || !(eig.eigenvalues()(2) > 0.0)) return glm::dvec3(0.0);
@@ -229,7 +234,7 @@ Expected<LightEstimate> LightEstimator::update(const LightSystem& system, int64_
                         settings_.min_regularisation;
   Mat lhs = ata;
   Rhs rhs = atb;
-  dominant_normal_ = n >= 4 ? dominant_surface_normal(ata, atb, system, albedo_[0]) : glm::dvec3(0.0);
+  dominant_normal_ = n >= 4 ? dominant_surface_normal(ata, atb, system, albedo_, settings_.white_light) : glm::dvec3(0.0);
   const double mu = settings_.below_surface_penalty;
   if (mu > 0.0 && glm::length(dominant_normal_) > 0.5)
     lhs += (mu * std::max(mean_diag, 0.0)) * below_surface_gram(dominant_normal_, n);
