@@ -10,7 +10,7 @@ PKGS=(
   libcli11-dev libembree-dev libgtest-dev libgmock-dev libbenchmark-dev
   libapriltag-dev libv4l-dev libcamera-dev libopenni2-dev libusb-1.0-0-dev
   libpng-dev zlib1g-dev libjpeg62-turbo-dev
-  libglfw3-dev xvfb xdotool
+  libglfw3-dev libx11-dev libxrandr-dev xvfb xdotool
   clang libclang-rt-14-dev
 )
 missing=()
