@@ -32,6 +32,10 @@ layout(constant_id = 2) const bool kSameInternal = false; // solutions' used siz
 // kTiled (with kSameInternal): only the 8 x 8 tiles the technique listed (Technique::
 // compose_tiles), workgroup i = tiles.list[i]; the camera-only pipeline wrote every pixel first.
 layout(constant_id = 3) const bool kTiled = false;
+// kRealTiles (with kTiled): tiles no virtual texel or covered output pixel reaches (compose's own
+// classification, compose/tile_split.comp): every pixel is real and every tap on its side, so
+// neither the mask nor the coverage is read (the same arithmetic as the general path there).
+layout(constant_id = 4) const bool kRealTiles = false;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
 FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.glsl)
 layout(set = 0, binding = 1, r32ui) readonly uniform uimageBuffer color_words;  // the camera's colour words, one a pixel
@@ -52,6 +56,7 @@ struct ParamsConstants {
   // ComposeInputs::coverage_area): outside it the coverage is 0 whatever the image holds (its
   // earlier contents are not kept by every driver).
   ivec4 coverage_area;
+  ivec4 tiles;  // x: the tile list's first entry for this dispatch (compose/tile_lists.glsl)
 };
 layout(push_constant) uniform Params { ParamsConstants params_block; };
 ParamsConstants params;
@@ -89,7 +94,8 @@ struct Taps {
   bool no_side;  // no tap on the pixel's side: plain bilinear weights
 };
 
-Taps joint_taps(vec2 rel, ivec2 used, float is_virtual) {
+// real_tile: no tap is virtual (kRealTiles), so the mask is not read.
+Taps joint_taps(vec2 rel, ivec2 used, float is_virtual, bool real_tile) {
   vec2 ipos = rel * vec2(used) - 0.5f;
   ivec2 i0 = ivec2(floor(ipos));
   vec2 f = ipos - vec2(i0);
@@ -97,7 +103,7 @@ Taps joint_taps(vec2 rel, ivec2 used, float is_virtual) {
   t.a = clamp(i0, ivec2(0), used - 1);
   t.b = clamp(i0 + 1, ivec2(0), used - 1);
   vec4 bilinear = vec4((1.0f - f.x) * (1.0f - f.y), f.x * (1.0f - f.y), (1.0f - f.x) * f.y, f.x * f.y);
-  vec4 side = vec4(imageLoad(virtual_position, ivec2(t.a.x, t.a.y)).w > 0.5f ? 1.0f : 0.0f,
+  vec4 side = real_tile ? vec4(0.0f) : vec4(imageLoad(virtual_position, ivec2(t.a.x, t.a.y)).w > 0.5f ? 1.0f : 0.0f,
                    imageLoad(virtual_position, ivec2(t.b.x, t.a.y)).w > 0.5f ? 1.0f : 0.0f,
                    imageLoad(virtual_position, ivec2(t.a.x, t.b.y)).w > 0.5f ? 1.0f : 0.0f,
                    imageLoad(virtual_position, ivec2(t.b.x, t.b.y)).w > 0.5f ? 1.0f : 0.0f);
@@ -125,7 +131,7 @@ void main() {
   ivec2 pixel = spread_invocation_id();
   ivec2 out_size = frame.internal_output_size.zw;
   if (kTiled) {
-    int t = int(tiles.list[spread_workgroup_index_1d()]);
+    int t = int(tiles.list[params.tiles.x + spread_workgroup_index_1d()]);
     int tiles_x = (out_size.x + 7) / 8;
     int ty = div_nonneg1(t, tiles_x);  // (a vector integer division is 8 scalar ones on lavapipe)
     pixel = ivec2(t - ty * tiles_x, ty) * 8 + ivec2(gl_LocalInvocationID.xy);
@@ -145,12 +151,15 @@ void main() {
   ivec2 used = frame.internal_output_size.xy;
   float is_virtual;
   Taps taps;
-  if (kSameInternal) {
+  if (kRealTiles) {
+    is_virtual = 0.0f;
+    if (!kSameInternal) taps = joint_taps(rel, used, is_virtual, true);
+  } else if (kSameInternal) {
     is_virtual = imageLoad(virtual_position, pixel).w > 0.5f ? 1.0f : 0.0f;
   } else {
     bool drawn = all(greaterThanEqual(pixel, params.coverage_area.xy)) && all(lessThan(pixel, params.coverage_area.zw));
     is_virtual = drawn && imageLoad(virtual_coverage, pixel).r > 0.5f ? 1.0f : 0.0f;
-    taps = joint_taps(rel, used, is_virtual);
+    taps = joint_taps(rel, used, is_virtual, false);
   }
   vec3 rv = solution_rv(taps, pixel);
   vec3 r = solution_r(taps, pixel);

@@ -5,17 +5,19 @@
 // of an output pixel the output-resolution coverage marks virtual), or whose two
 // solutions differ by more than compose_tile_invisible allows, marks every output tile whose
 // pixels read it (compose.comp: the bilinear taps floor(ipos), floor(ipos) + 1 with
-// ipos = (p + 0.5) * used / out - 0.5), and the first
-// to mark a tile appends it to the list. Outside the listed tiles compose writes the camera
-// frame (on the host when the output has the camera's size), so a technique whose solutions are
+// ipos = (p + 0.5) * used / out - 0.5) by its flag; tile_split.comp then lists the flagged
+// tiles. Outside the listed tiles compose writes the camera frame (on the host when the output has the camera's size), so a technique whose solutions are
 // equal away from the virtual objects' influence (baseline, dlpv) pays for the composite only
 // where it shows. On lavapipe a shader runs all of its code for every invocation: pixels that
 // need no composite can only be saved by not dispatching them.
-// Output: args = VkDispatchIndirectCommand (x counted here; compose_tiles_reset set it to
-// (0, 1, 1) and every flag to 0 first), list = the tile indices (ty * tiles_x + tx), in no order.
+// Each tile's flag says whether it is listed (bit 0) and whether a virtual texel, or an output
+// pixel the coverage marks, is within its pixels' reach (bit 1): compose runs the tiles without
+// it through a variant that reads neither the mask nor the coverage (compose.comp kRealTiles).
+// compose_tiles_reset zeroed every flag first; tile_split.comp turns the flags into the lists.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/mrgi_shared.h"
 #include "common/frame_constants.glsl"
+#include "compose/tile_lists.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, set = 0, binding = 0) uniform FrameUbo { FrameConstants frame_ubo; };
@@ -23,9 +25,9 @@ FrameConstants frame;  // private copy (MRGI_UNIFORM_COPIES, frame_constants.gls
 layout(set = 0, binding = 1, rgba16f) readonly uniform image2D lit_rv;
 layout(set = 0, binding = 2, rgba16f) readonly uniform image2D lit_r;
 layout(set = 0, binding = 3, rgba32f) readonly uniform image2D virtual_position;  // w: coverage
-// words 0..3: VkDispatchIndirectCommand (x, y, z) and a pad; then one flag per output tile.
+// words 0..7: the two lists' VkDispatchIndirectCommands (tile_split.comp); then one flag per
+// output tile (MRGI_TILE_LISTED, MRGI_TILE_VIRTUAL_REACH).
 layout(std430, set = 0, binding = 4) coherent buffer TileState { uint words[]; };
-layout(std430, set = 0, binding = 5) writeonly buffer TileList { uint list[]; };
 // The coverage at the output resolution where the solutions are smaller (compose.comp's mask
 // there): an object thinner than a texel covers output pixels no texel centre of it falls in.
 layout(set = 0, binding = 6, r32f) readonly uniform image2D virtual_coverage;
@@ -39,9 +41,9 @@ struct ClassifyConstants {
 layout(push_constant) uniform Classify { ClassifyConstants classify_block; };
 ClassifyConstants classify;
 
-void mark(int tile) {
-  if (words[4 + tile] != 0u) return;  // (a plain read first: most marks find the tile listed)
-  if (atomicExchange(words[4 + tile], 1u) == 0u) list[atomicAdd(words[0], 1u)] = uint(tile);
+void mark(int tile, uint bits) {
+  if ((words[MRGI_TILE_FLAGS + tile] & bits) == bits) return;  // (a plain read first: most marks find it set)
+  atomicOr(words[MRGI_TILE_FLAGS + tile], bits);
 }
 
 void main() {
@@ -61,6 +63,7 @@ void main() {
     for (int y = q0.y; y < q1.y && !shows; ++y)
       for (int x = q0.x; x < q1.x; ++x) shows = shows || imageLoad(virtual_coverage, ivec2(x, y)).r > 0.5f;
   }
+  const uint bits = shows ? MRGI_TILE_LISTED | MRGI_TILE_VIRTUAL_REACH : MRGI_TILE_LISTED;
   if (!shows) {
     float exposure = frame.camera.y;
     vec3 rv = clamp(finite3(imageLoad(lit_rv, texel).rgb) * exposure, vec3(0.0f), vec3(1.0f));
@@ -78,5 +81,5 @@ void main() {
   }
   int tiles_x = (out_size.x + 7) / 8;
   for (int ty = p0.y / 8; ty <= p1.y / 8; ++ty)
-    for (int tx = p0.x / 8; tx <= p1.x / 8; ++tx) mark(ty * tiles_x + tx);
+    for (int tx = p0.x / 8; tx <= p1.x / 8; ++tx) mark(ty * tiles_x + tx, bits);
 }

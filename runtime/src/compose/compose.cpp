@@ -14,7 +14,22 @@ namespace {
 struct ComposePush {
   glm::vec4 compose;
   glm::ivec4 coverage_area;  // x0, y0, x1, y1 (compose.comp ParamsConstants)
+  glm::ivec4 tiles{0};       // x: the list's first entry for this dispatch
 };
+
+// compose/tile_lists.glsl: the state's words (two dispatch commands, then a flag per tile).
+constexpr VkDeviceSize kArgsVirtualBytes = 0, kArgsRealBytes = 16, kStateHeaderBytes = 32;
+
+// Both lists' dispatch commands to (0, 1, 1) and every tile flag to 0; fills over disjoint
+// ranges only (overlapping ones in one pass are a write-after-write hazard).
+void reset_tile_state(VkCommandBuffer cmd, VkBuffer state) {
+  for (VkDeviceSize args : {kArgsVirtualBytes, kArgsRealBytes}) {
+    vkCmdFillBuffer(cmd, state, args, 4, 0u);      // x groups
+    vkCmdFillBuffer(cmd, state, args + 4, 8, 1u);  // y, z
+    vkCmdFillBuffer(cmd, state, args + 12, 4, 0u); // pad
+  }
+  vkCmdFillBuffer(cmd, state, kStateHeaderBytes, VK_WHOLE_SIZE, 0u);
+}
 
 glm::ivec4 area_corners(const VkRect2D& r) {
   return {r.offset.x, r.offset.y, r.offset.x + int(r.extent.width), r.offset.y + int(r.extent.height)};
@@ -31,12 +46,14 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
   c.height_ = height;
   c.same_size_as_camera_ = same_size_as_camera;
   c.max_tiles_ = ((width + 7) / 8) * ((height + 7) / 8);
-  auto tiles = graph.create_buffer({"compose_tile_readback", 16 + VkDeviceSize(c.max_tiles_) * 4,
+  // Both dispatch commands, then both lists (compose/tile_lists.glsl).
+  auto tiles = graph.create_buffer({"compose_tile_readback", kStateHeaderBytes + 2 * VkDeviceSize(c.max_tiles_) * 4,
                                     gpu::MemoryUsage::Readback, true},
                                    VK_BUFFER_USAGE_TRANSFER_DST_BIT);
   if (!tiles) return tiles.error();
   c.tile_readback_ = *tiles;
   c.slot_host_camera_.assign(graph.frames_in_flight(), 0);
+  c.slot_split_.assign(graph.frames_in_flight(), 0);
   const VkDeviceSize bytes = VkDeviceSize(width) * height * 4;
   // Transfer source: copied into an app's image (AppOutputImage) instead of read back. Whole
   // groups of 16 pixels: an app's colour image is written into it as the camera words under the
@@ -47,16 +64,19 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
   c.output_ = *out;
   auto spv = gpu::shader_spirv("compose/compose.comp");
   if (!spv) return spv.error();
-  // compose.comp: kSameSize, kCameraOnly, kSameInternal; each path compiled out of the others'.
+  // compose.comp: kSameSize, kCameraOnly, kSameInternal, kTiled, kRealTiles; each path compiled
+  // out of the others'.
   const struct {
     const char* name;
-    uint32_t camera_only, same_internal, tiled;
+    uint32_t camera_only, same_internal, tiled, real_tiles;
     gpu::PipelineHandle* handle;
-  } variants[] = {{"compose", 0, 0, 0, &c.pipeline_},
-                  {"compose_same_internal", 0, 1, 0, &c.same_internal_pipeline_},
-                  {"compose_tiled", 0, 1, 1, &c.tiled_pipeline_},
-                  {"compose_tiled_scaled", 0, 0, 1, &c.tiled_scaled_pipeline_},
-                  {"compose_camera_only", 1, 0, 0, &c.camera_pipeline_}};
+  } variants[] = {{"compose", 0, 0, 0, 0, &c.pipeline_},
+                  {"compose_same_internal", 0, 1, 0, 0, &c.same_internal_pipeline_},
+                  {"compose_tiled", 0, 1, 1, 0, &c.tiled_pipeline_},
+                  {"compose_tiled_scaled", 0, 0, 1, 0, &c.tiled_scaled_pipeline_},
+                  {"compose_tiled_real", 0, 1, 1, 1, &c.tiled_real_pipeline_},
+                  {"compose_tiled_scaled_real", 0, 0, 1, 1, &c.tiled_scaled_real_pipeline_},
+                  {"compose_camera_only", 1, 0, 0, 0, &c.camera_pipeline_}};
   auto no_tiles = graph.create_buffer({"compose_no_tiles", 16}, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (!no_tiles) return no_tiles.error();
   c.no_tiles_ = *no_tiles;
@@ -72,7 +92,7 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
     // Bindings and push constants from the shader (the passes bind by name).
     gpu::ComputePipelineDesc d{v.name, *spv, {}, 0,
                                {same_size_as_camera ? 1u : 0u, v.camera_only, v.same_internal,
-                                v.tiled}};
+                                v.tiled, v.real_tiles}};
     auto p = gpu::create_compute_pipeline(context, d);
     if (!p) return p.error();
     *v.handle = gpu::PipelineHandle(context, std::move(*p));
@@ -81,12 +101,15 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
     auto classify = gpu::load_compute_pipeline(context, "compose/tile_classify.comp", {});
     if (!classify) return classify.error();
     c.classify_pipeline_ = std::move(*classify);
-    auto state = graph.create_buffer({"compose_tile_state", 16 + VkDeviceSize(c.max_tiles_) * 4},
+    auto split = gpu::load_compute_pipeline(context, "compose/tile_split.comp", {});
+    if (!split) return split.error();
+    c.split_pipeline_ = std::move(*split);
+    auto state = graph.create_buffer({"compose_tile_state", kStateHeaderBytes + VkDeviceSize(c.max_tiles_) * 4},
                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
                                          VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
     if (!state) return state.error();
     c.classify_state_ = *state;
-    auto list = graph.create_buffer({"compose_tile_list", VkDeviceSize(c.max_tiles_) * 4},
+    auto list = graph.create_buffer({"compose_tile_list", 2 * VkDeviceSize(c.max_tiles_) * 4},
                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
     if (!list) return list.error();
     c.classify_list_ = *list;
@@ -94,14 +117,14 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
   return c;
 }
 
-// The tiles of a frame whose technique listed none: reset, then tile_classify.comp over the
-// solutions' used extent.
+// The tiles of a frame whose technique listed none: reset, tile_classify.comp over the
+// solutions' used extent, then tile_split.comp over the output's tiles.
 void Compose::record_classify(gpu::FrameGraph& graph) {
   graph.add_pass(
       "compose_tiles_reset", gpu::PassKind::Transfer,
       [this](gpu::PassBuilder& b) { b.write(classify_state_, gpu::Access::TransferDst); },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
-        gpu::reset_dispatch_args(cmd, pass.buffer(classify_state_), true);  // and the tile flags
+        reset_tile_state(cmd, pass.buffer(classify_state_));
       });
   const gpu::Pipeline* pipe = &*classify_pipeline_;
   graph.add_shader_pass(
@@ -113,7 +136,6 @@ void Compose::record_classify(gpu::FrameGraph& graph) {
         b.bind("virtual_position", in_.virtual_position);
         b.bind("virtual_coverage", in_.virtual_coverage.valid() ? in_.virtual_coverage : no_coverage_);
         b.bind("TileState", classify_state_);
-        b.bind("TileList", classify_list_);
       },
       [this, pipe](VkCommandBuffer cmd, gpu::PassContext& pass) {
         const VkExtent2D used = pass.extent(in_.lit_r);
@@ -124,6 +146,17 @@ void Compose::record_classify(gpu::FrameGraph& graph) {
                area_corners(in_.coverage_area)};
         gpu::push_and_dispatch(cmd, *pipe, &push, sizeof push, {(used.width + 7) / 8, (used.height + 7) / 8, 1});
       });
+  const gpu::Pipeline* split = &*split_pipeline_;
+  graph.add_shader_pass(
+      "compose_tiles_split", gpu::PassKind::Compute, *split_pipeline_,
+      [this](gpu::ShaderPassBuilder& b) {
+        b.bind("FrameUbo", in_.frame_constants);
+        b.bind("TileState", classify_state_);
+        b.bind("TileList", classify_list_);
+      },
+      [this, split](VkCommandBuffer cmd, gpu::PassContext&) {
+        gpu::push_and_dispatch(cmd, *split, nullptr, 0, {(max_tiles_ + 63) / 64, 1, 1});
+      });
   in_.tile_args = classify_state_;
   in_.tile_list = classify_list_;
   in_.tiles_composed = false;
@@ -132,7 +165,11 @@ void Compose::record_classify(gpu::FrameGraph& graph) {
 Status Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
   in_ = inputs;
   const bool listed = in_.tile_args.valid() && in_.tile_list.valid();
-  if (!in_.camera_only && !listed && classify_state_.valid()) record_classify(graph);
+  // Compose's own classification lists real-only tiles apart (compose/tile_lists.glsl); a
+  // technique's list is one list.
+  split_ = !in_.camera_only && !listed && classify_state_.valid();
+  if (split_) record_classify(graph);
+  slot_split_[graph.slot()] = split_ ? 1 : 0;
   tiled_ = !in_.camera_only && in_.tile_args.valid() && in_.tile_list.valid();
   const bool host_camera = tiled_ && same_size_as_camera_ && !in_.device_output;
   slot_host_camera_[graph.slot()] = host_camera ? 1 : 0;
@@ -197,12 +234,27 @@ Status Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
           }
         },
         [this, pipe](VkCommandBuffer cmd, gpu::PassContext& pass) { dispatch(cmd, pass, *pipe, tiled_); });
+    if (split_) {
+      // The real-only tiles, over the pass above (disjoint tiles of the same output).
+      const gpu::Pipeline* real = same_internal ? &*tiled_real_pipeline_ : &*tiled_scaled_real_pipeline_;
+      graph.add_shader_pass(
+          "compose_real_tiles", gpu::PassKind::Compute, *real,
+          [this, bind_inputs](gpu::ShaderPassBuilder& b) {
+            bind_inputs(b);
+            b.bind("Tiles", in_.tile_list);
+            b.uses().read(in_.tile_args, gpu::Access::IndirectRead);
+            b.bind_over("Output", output_);
+          },
+          [this, real](VkCommandBuffer cmd, gpu::PassContext& pass) {
+            dispatch(cmd, pass, *real, true, kArgsRealBytes, int(max_tiles_));
+          });
+    }
   }
   graph.mark_output(output_);
   if (!host_camera) return ok_status();
   // A technique's list may be smaller than this output's tile count (it lists only its used
   // extent's tiles); the count in args never exceeds what it holds.
-  list_bytes_ = std::min<VkDeviceSize>(VkDeviceSize(max_tiles_) * 4,
+  list_bytes_ = std::min<VkDeviceSize>(VkDeviceSize(max_tiles_) * (split_ ? 8 : 4),
                                        graph.gpu_buffer(in_.tile_list, graph.slot()).size);
   graph.add_pass(
       "compose_tile_readback", gpu::PassKind::Transfer,
@@ -212,23 +264,26 @@ Status Compose::record(gpu::FrameGraph& graph, const ComposeInputs& inputs) {
         b.write(tile_readback_, gpu::Access::TransferDst);
       },
       [this](VkCommandBuffer cmd, gpu::PassContext& pass) {
-        const VkBufferCopy args{0, 0, 16};
+        const VkBufferCopy args{0, 0, split_ ? kStateHeaderBytes : 16};
         vkCmdCopyBuffer(cmd, pass.buffer(in_.tile_args), pass.buffer(tile_readback_), 1, &args);
-        const VkBufferCopy list{0, 16, list_bytes_};
+        const VkBufferCopy list{0, kStateHeaderBytes, list_bytes_};
         vkCmdCopyBuffer(cmd, pass.buffer(in_.tile_list), pass.buffer(tile_readback_), 1, &list);
       });
   graph.mark_output(tile_readback_);
   return ok_status();
 }
 
-// tiled_pass: the composite over the listed tiles (their count in tile_args); otherwise every
-// pixel (the camera copy of a tiled frame, or the whole compose of an untiled one).
-void Compose::dispatch(VkCommandBuffer cmd, gpu::PassContext& pass, const gpu::Pipeline& pipeline, bool tiled_pass) {
+// tiled_pass: the composite over the listed tiles (their count in tile_args at args_offset, the
+// first at list entry first_entry); otherwise every pixel (the camera copy of a tiled frame, or
+// the whole compose of an untiled one).
+void Compose::dispatch(VkCommandBuffer cmd, gpu::PassContext& pass, const gpu::Pipeline& pipeline, bool tiled_pass,
+                       VkDeviceSize args_offset, int first_entry) {
   ComposePush pc;
   pc.compose = glm::vec4(settings_.eps, settings_.alpha_max, 0.0f, 0.0f);
   pc.coverage_area = area_corners(in_.coverage_area);
+  pc.tiles.x = first_entry;
   if (tiled_pass) {
-    gpu::dispatch_indirect(cmd, pipeline, &pc, sizeof(pc), pass.buffer(in_.tile_args));
+    gpu::dispatch_indirect(cmd, pipeline, &pc, sizeof(pc), pass.buffer(in_.tile_args), args_offset);
   } else {
     gpu::dispatch_2d(cmd, pipeline, &pc, sizeof(pc), width_, height_);
   }
@@ -275,10 +330,13 @@ Status Compose::read(const gpu::FrameGraph& graph, uint32_t slot, ImageRGBA8& im
   uint8_t* px = image.data.data();
   camera_words_to_rgba8(static_cast<const uint32_t*>(graph.mapped(in_.color_upload, slot)), size_t(width_) * height_, px);
   const auto* words = static_cast<const uint32_t*>(graph.mapped(tile_readback_, slot));
+  const uint32_t* list = words + kStateHeaderBytes / 4;
   const uint32_t count = std::min(words[0], max_tiles_);  // (the list copy bounds it too)
+  // The real-only tiles of compose's own classification, from entry max_tiles_.
+  const uint32_t real_count = slot_split_[slot] ? std::min(words[kArgsRealBytes / 4], max_tiles_) : 0;
   const uint32_t tiles_x = (width_ + 7) / 8;
-  for (uint32_t k = 0; k < count; ++k) {
-    const uint32_t t = words[4 + k];
+  for (uint32_t k = 0; k < count + real_count; ++k) {
+    const uint32_t t = k < count ? list[k] : list[max_tiles_ + (k - count)];
     const uint32_t x0 = (t % tiles_x) * 8, y0 = (t / tiles_x) * 8;
     if (x0 >= width_ || y0 >= height_) continue;  // never written by the GPU either
     const uint32_t w = std::min(8u, width_ - x0);

@@ -92,7 +92,9 @@ class Compose {
                                   uint32_t height, bool same_size_as_camera,
                                   const ComposeSettings& settings = {});
   // Adds the pass "compose" (tiled at the camera's size: and "compose_tile_readback"; tiled at
-  // another size: and "compose_camera" before it) and marks the readback buffers as outputs.
+  // another size: and "compose_camera" before it; with its own classification: "compose_tiles_reset",
+  // "compose_tiles" and "compose_tiles_split" before, "compose_real_tiles" after) and marks the
+  // readback buffers as outputs.
   Status record(gpu::FrameGraph& graph, const ComposeInputs& inputs);
   // Copies slot `slot`'s results (after its frame completed) into `image` and `mask`
   // (resized to the output size; non-zero mask = virtual pixel).
@@ -107,7 +109,8 @@ class Compose {
   bool fusable() const { return same_size_as_camera_; }
 
  private:
-  void dispatch(VkCommandBuffer cmd, gpu::PassContext& pass, const gpu::Pipeline& pipeline, bool tiled_pass);
+  void dispatch(VkCommandBuffer cmd, gpu::PassContext& pass, const gpu::Pipeline& pipeline, bool tiled_pass,
+                VkDeviceSize args_offset = 0, int first_entry = 0);
 
   ComposeSettings settings_;
   uint32_t width_ = 0, height_ = 0;
@@ -116,22 +119,27 @@ class Compose {
   void record_classify(gpu::FrameGraph& graph);
 
   // Composite (solutions resampled), composite at the solutions' own size, camera frame only,
-  // and the composite over listed tiles from solutions at the output's size or resampled.
+  // and the composite over listed tiles from solutions at the output's size or resampled (each
+  // also for tiles no virtual surface reaches: no mask or coverage read).
   gpu::PipelineHandle pipeline_, same_internal_pipeline_, camera_pipeline_, tiled_pipeline_,
-      tiled_scaled_pipeline_;
-  // The tile classifier (ComposeSettings::classify_tiles): its pipeline, its state (dispatch
-  // arguments, then one flag per output tile) and its list.
-  gpu::PipelineHandle classify_pipeline_;
+      tiled_scaled_pipeline_, tiled_real_pipeline_, tiled_scaled_real_pipeline_;
+  // The tile classifier (ComposeSettings::classify_tiles): its pipelines (flags, then the two
+  // lists), its state (both lists' dispatch arguments, then one flag per output tile) and its
+  // lists (shaders/compose/tile_lists.glsl).
+  gpu::PipelineHandle classify_pipeline_, split_pipeline_;
   gpu::BufferHandle classify_state_, classify_list_;
   gpu::BufferHandle no_tiles_;  // bound as the tile list when there is none (never read)
   gpu::ImageHandle no_coverage_;  // 1x1, bound as virtual_coverage at the output's size (never read)
   bool tiled_ = false;          // this frame: camera copy + composite over the listed tiles
+  bool split_ = false;          // this frame: compose's own two lists (else a technique's one)
   bool same_size_as_camera_ = false;
   uint32_t max_tiles_ = 0;
   VkDeviceSize list_bytes_ = 0;  // this frame's tile-list copy (at most the list's size)
-  // Per slot: args (16 bytes) then the tile indices of that slot's tiled frame.
+  // Per slot: both lists' args (32 bytes; the second only when split) then the tile indices of
+  // that slot's tiled frame (compose/tile_lists.glsl).
   gpu::BufferHandle tile_readback_;
   std::vector<uint8_t> slot_host_camera_;  // per slot: the camera frame is laid on the host
+  std::vector<uint8_t> slot_split_;        // per slot: the readback holds two lists
 };
 
 }  // namespace mrgi::compose
