@@ -142,7 +142,7 @@ void Compose::record_classify(gpu::FrameGraph& graph) {
         struct {
           glm::vec4 compose;
           glm::ivec4 coverage_area;
-        } push{{settings_.eps, settings_.alpha_max, settings_.tile_tolerance, 0.0f},
+        } push{{settings_.eps, settings_.alpha_max, in_.tile_tolerance, 0.0f},
                area_corners(in_.coverage_area)};
         gpu::push_and_dispatch(cmd, *pipe, &push, sizeof push, {(used.width + 7) / 8, (used.height + 7) / 8, 1});
       });

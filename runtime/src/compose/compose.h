@@ -25,12 +25,11 @@ struct ComposeSettings {
   float eps = 1e-3f;       // below this modelled real light, alpha blends to 1 (absolute delta)
   float alpha_max = 10.0f; // alpha = CI / TM(L_r) clamped to [0, alpha_max]
   // For a technique that lists no tiles of its own (Technique::compose_tiles): compose lists the
-  // 8 x 8 output tiles whose composite can move a pixel by more than `tile_tolerance` 8-bit
-  // levels from the camera's (shaders/compose/tile_classify.comp, mrgi_shared.h
-  // compose_tile_invisible), and composites only those; the camera frame elsewhere. Off: every
-  // pixel composited (the A/B reference; outputs then differ by at most one level per channel).
+  // 8 x 8 output tiles whose composite can move a pixel by more than ComposeInputs::
+  // tile_tolerance 8-bit levels from the camera's (shaders/compose/tile_classify.comp,
+  // mrgi_shared.h compose_tile_invisible), and composites only those; the camera frame
+  // elsewhere. Off: every pixel composited (the A/B reference).
   bool classify_tiles = true;
-  float tile_tolerance = 0.5f;  // 8-bit levels; a rounding step can add one more
 };
 
 struct ComposeInputs {
@@ -46,6 +45,11 @@ struct ComposeInputs {
   // over the tiles only, from solutions at the output size or resampled, and takes the camera
   // frame elsewhere (on the host at the camera's size, else a camera copy pass first).
   gpu::BufferHandle tile_args, tile_list;
+  // Compose's own classification (ComposeSettings::classify_tiles): the 8-bit levels a tile's
+  // composite may move a pixel by and the tile still keep the camera frame, for any camera value
+  // (the level's QualityLevel::compose_tolerance); outputs then differ from composing every pixel
+  // by at most that, rounded to the nearest level (0.5: one level).
+  float tile_tolerance = 0.5f;
   // The technique wrote the composite of those tiles into output() itself
   // (Technique::ComposeTiles::composed): compose adds no pass of its own, only the tile-list
   // readback, and lays the tiles over the camera frame on the host. Honoured only for a frame

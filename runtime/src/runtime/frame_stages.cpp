@@ -192,6 +192,7 @@ Status RuntimeImpl::record_compose(FrameContext& f) {
                             !f.affected};
   ci.device_output = f.target != nullptr;
   ci.camera_prefilled = f.rec.camera_prefilled;
+  ci.tile_tolerance = f.level.compose_tolerance;
   if (f.affected) {
     const technique::Technique::ComposeTiles tiles = technique_->compose_tiles();
     // Caustics land where the technique's tiles may not reach: then every pixel is composed.

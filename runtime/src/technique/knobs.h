@@ -124,6 +124,7 @@ std::vector<QualityLevel> ladder_of(const std::vector<L>& levels, const Levels& 
     q.name = l.name;
     q.internal_scale = l.internal_scale;
     if constexpr (requires { l.mesh_error_px; }) q.mesh_error_px = l.mesh_error_px;
+    if constexpr (requires { l.compose_tolerance; }) q.compose_tolerance = l.compose_tolerance;
     q.knobs = knob_list(l, defaults, fields);
     out.push_back(std::move(q));
   }

@@ -47,6 +47,13 @@ struct QualityLevel {
   // the coarser triangles interpolate the normals over larger areas (baseline's 160x120 golden
   // capture: virtual RDE 0.240 -> 0.249 at 0.1 px, 0.314 at 0.5 px); only fast levels use it.
   float mesh_error_px = 0.0f;
+  // Compose's tile classifier (shaders/compose/tile_classify.comp) keeps the camera frame in the
+  // 8 x 8 tiles where the composite can move no pixel by more than this many 8-bit levels, for
+  // any camera value; applied by the runtime. 0.5: a pixel within one level of composing every
+  // pixel. The fast levels take 1.5 (within two levels): under environment light the objects'
+  // faint occlusion of the sky far from them lists most of the frame at 0.5, and compose is then
+  // a fifth of such a frame (perf/results/compose/tile-tolerance-fast-levels-2026-12-08.md).
+  float compose_tolerance = 0.5f;
 };
 
 class Technique {

@@ -36,6 +36,9 @@ const KnobField<BaselineLevel> kBaselineKnobs[] = {
     {"env_occlusion_real_bounce",
      "the real surfaces round the objects, darkened by them, light the rest of the scene less (0 = off, 1 = on)",
      &BaselineLevel::env_occlusion_real_bounce},
+    {"compose_tolerance",
+     "8-bit levels a tile's composite may move a pixel by and the tile still keep the camera frame (rounding adds up to half a level)",
+     &BaselineLevel::compose_tolerance},
 };
 
 shading::DirectLightLevel direct_level(const BaselineLevel& l) {
@@ -73,12 +76,14 @@ const std::array<BaselineLevel, 4>& baseline_levels() {
     // spread over larger triangles); 0.3 costs glossy_table +0.026, 0.5 +0.059.
     // Perf/results/direct-light-block/mesh-lod-lowest-2026-12-06.md.
     const float mesh_error_px[4] = {0.0f, 0.0f, 0.0f, 0.2f};
+    // QualityLevel::compose_tolerance says why the lowest level keeps more tiles as the camera's.
+    const float compose_tolerance[4] = {0.5f, 0.5f, 0.5f, 1.5f};
     std::array<BaselineLevel, 4> out{};
     for (size_t i = 0; i < 4; ++i)
       out[i] = {names[i], d[i].shadow_map_size, scales[i], d[i].pcf_radius, d[i].caster_cell_shadow_texels,
                 d[i].shadowed_estimated_lights, d[i].env_occlusion.divisor, d[i].env_occlusion.spheres_per_object,
                 d[i].env_occlusion.regions, d[i].env_occlusion.near_field_steps, d[i].env_occlusion.lights_bounce,
-                d[i].env_occlusion.real_bounce_loss, mesh_error_px[i]};
+                d[i].env_occlusion.real_bounce_loss, mesh_error_px[i], compose_tolerance[i]};
     return out;
   }();
   return levels;

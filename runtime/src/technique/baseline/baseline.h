@@ -41,6 +41,7 @@ struct BaselineLevel {
   bool env_occlusion_lights_bounce; // the objects send the shadowed lights' bounce on
   bool env_occlusion_real_bounce;   // the surroundings they darken light the scene less
   float mesh_error_px;              // QualityLevel::mesh_error_px: the virtual G-buffer's level of detail
+  float compose_tolerance;          // QualityLevel::compose_tolerance: 8-bit levels a kept tile may miss
 };
 const std::array<BaselineLevel, 4>& baseline_levels();  // the defaults
 // The defaults with RuntimeSettings::knobs applied (technique/knobs.h; BadUsage for a refused one).

@@ -22,11 +22,11 @@ namespace mrgi::technique {
 
 const std::array<DirLevel, 5>& dir_levels() {
   static const std::array<DirLevel, 5> levels = {{
-      {"paper", 256, 64, 16, 4, 128, 1024, 512, 4, 4, 1, 1.0f, 0.0f, -1, 0, true},
-      {"high", 256, 64, 0, 1, 64, 512, 256, 4, 4, 1, 1.0f, 0.0f, -1, 0, false},
-      {"medium", 64, 16, 0, 1, 64, 512, 256, 2, 4, 1, 1.0f, 0.0f, -1, 1, false},
-      {"fast", 32, 0, 0, 1, 32, 256, 64, 1, 4, 2, 0.5f, 0.5f, 0, 3, false},
-      {"fastest", 16, 0, 0, 1, 32, 128, 64, 1, 4, 2, 0.5f, 0.5f, 0, 3, false},
+      {"paper", 256, 64, 16, 4, 128, 1024, 512, 4, 4, 1, 1.0f, 0.0f, -1, 0, true, 0.5f},
+      {"high", 256, 64, 0, 1, 64, 512, 256, 4, 4, 1, 1.0f, 0.0f, -1, 0, false, 0.5f},
+      {"medium", 64, 16, 0, 1, 64, 512, 256, 2, 4, 1, 1.0f, 0.0f, -1, 1, false, 0.5f},
+      {"fast", 32, 0, 0, 1, 32, 256, 64, 1, 4, 2, 0.5f, 0.5f, 0, 3, false, 1.5f},
+      {"fastest", 16, 0, 0, 1, 32, 128, 64, 1, 4, 2, 0.5f, 0.5f, 0, 3, false, 1.5f},
   }};
   return levels;
 }
@@ -47,6 +47,9 @@ const KnobField<DirLevel> kDirKnobs[] = {
     {"internal_scale", "fraction of the output width and height", &DirLevel::internal_scale},
     {"mesh_error_px", "largest projected error of the virtual meshes' level of detail (internal pixels)",
      &DirLevel::mesh_error_px},
+    {"compose_tolerance",
+     "8-bit levels a tile's composite may move a pixel by and the tile still keep the camera frame (rounding adds up to half a level)",
+     &DirLevel::compose_tolerance},
     {"shadowed_env", "environment regions the direct-light block shadows with maps (-1: its level's)", &DirLevel::shadowed_env},
     {"baseline_level", "the direct-light block's level for the direct light", &DirLevel::baseline_level},
     {"real_bounce_beside_camera_ambient",

@@ -141,6 +141,7 @@ struct DirLevel {
   // the VPLs' local bounce is kept (without it desk_spot 0.124 -> 0.168: a 1-3 band fit over the
   // frame does not hold it).
   bool real_bounce_beside_camera_ambient;
+  float compose_tolerance;  // QualityLevel::compose_tolerance: 8-bit levels a kept tile may miss
 };
 const std::array<DirLevel, 5>& dir_levels();  // the defaults
 

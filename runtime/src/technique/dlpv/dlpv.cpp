@@ -20,11 +20,11 @@ namespace mrgi::technique {
 
 const std::array<DlpvLevel, 5>& dlpv_levels() {
   static const std::array<DlpvLevel, 5> levels = {{
-      {"paper", 32, 32, 512, 4, true, 1.0f, true, 0, true, 0.0f},
-      {"high", 32, 32, 512, 4, true, 1.0f, false, 0, false, 0.0f},
-      {"medium", 16, 16, 256, 2, true, 1.0f, false, 1, false, 0.0f},
-      {"fast", 8, 8, 128, 1, false, 0.5f, false, 3, false, 0.2f},
-      {"fastest", 8, 4, 64, 1, false, 0.5f, false, 3, false, 0.2f},
+      {"paper", 32, 32, 512, 4, true, 1.0f, true, 0, true, 0.0f, 0.5f},
+      {"high", 32, 32, 512, 4, true, 1.0f, false, 0, false, 0.0f, 0.5f},
+      {"medium", 16, 16, 256, 2, true, 1.0f, false, 1, false, 0.0f, 0.5f},
+      {"fast", 8, 8, 128, 1, false, 0.5f, false, 3, false, 0.2f, 1.5f},
+      {"fastest", 8, 4, 64, 1, false, 0.5f, false, 3, false, 0.2f, 1.5f},
   }};
   return levels;
 }
@@ -46,6 +46,9 @@ const KnobField<DlpvLevel> kDlpvKnobs[] = {
      &DlpvLevel::rho_beside_bounce_ambient},
     {"mesh_error_px", "largest projected error of the virtual meshes' level of detail (internal pixels; 0 = full detail)",
      &DlpvLevel::mesh_error_px},
+    {"compose_tolerance",
+     "8-bit levels a tile's composite may move a pixel by and the tile still keep the camera frame (rounding adds up to half a level)",
+     &DlpvLevel::compose_tolerance},
 };
 }  // namespace
 

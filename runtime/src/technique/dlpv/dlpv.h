@@ -98,6 +98,7 @@ struct DlpvLevel {
   // RDE 0.68 with V^rho, 0.17 with the ambient; corner 0.43 / 0.29; desk_spot 0.35 / 0.19).
   bool rho_beside_bounce_ambient;
   float mesh_error_px;     // QualityLevel::mesh_error_px: the virtual G-buffer's level of detail (baseline lowest's at fast)
+  float compose_tolerance; // QualityLevel::compose_tolerance: 8-bit levels a kept tile may miss
 };
 const std::array<DlpvLevel, 5>& dlpv_levels();  // the defaults
 // The defaults with RuntimeSettings::knobs applied (technique/knobs.h; BadUsage for a refused one).

@@ -24,11 +24,11 @@ namespace mrgi::technique {
 
 const std::array<DvctLevel, 5>& dvct_levels() {
   static const std::array<DvctLevel, 5> levels = {{
-      {"paper", 128, 9, true, 512, 4, 1, 1.0f, true, 0, 0.03f, 0.5f, true, 0.0f},
-      {"high", 64, 9, true, 512, 4, 2, 1.0f, false, 0, 0.1f, 0.5f, true, 0.0f},
-      {"medium", 64, 5, true, 256, 2, 4, 1.0f, false, 1, 0.1f, 0.5f, true, 0.0f},
-      {"fast", 16, 3, false, 64, 1, 4, 0.5f, false, 3, 0.1f, 0.5f, false, 0.2f},
-      {"fastest", 16, 1, false, 64, 1, 4, 0.5f, false, 3, 0.1f, 0.5f, false, 0.2f},
+      {"paper", 128, 9, true, 512, 4, 1, 1.0f, true, 0, 0.03f, 0.5f, true, 0.0f, 0.5f},
+      {"high", 64, 9, true, 512, 4, 2, 1.0f, false, 0, 0.1f, 0.5f, true, 0.0f, 0.5f},
+      {"medium", 64, 5, true, 256, 2, 4, 1.0f, false, 1, 0.1f, 0.5f, true, 0.0f, 0.5f},
+      {"fast", 16, 3, false, 64, 1, 4, 0.5f, false, 3, 0.1f, 0.5f, false, 0.2f, 1.5f},
+      {"fastest", 16, 1, false, 64, 1, 4, 0.5f, false, 3, 0.1f, 0.5f, false, 0.2f, 1.5f},
   }};
   return levels;
 }
@@ -51,6 +51,9 @@ const KnobField<DvctLevel> kDvctKnobs[] = {
      &DvctLevel::object_light},
     {"mesh_error_px", "largest projected error of the virtual meshes' level of detail (internal pixels; 0 = full detail)",
      &DvctLevel::mesh_error_px},
+    {"compose_tolerance",
+     "8-bit levels a tile's composite may move a pixel by and the tile still keep the camera frame (rounding adds up to half a level)",
+     &DvctLevel::compose_tolerance},
 };
 
 // The region's side is never under this (metres): a flat or tiny object still gets room for its

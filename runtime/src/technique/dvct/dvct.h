@@ -108,6 +108,7 @@ struct DvctLevel {
   // under environment light as lit, not black (the light volume holds the lamps' maps only).
   bool object_light;
   float mesh_error_px;     // QualityLevel::mesh_error_px: the virtual G-buffer's level of detail (baseline lowest's at fast)
+  float compose_tolerance; // QualityLevel::compose_tolerance: 8-bit levels a kept tile may miss
 };
 const std::array<DvctLevel, 5>& dvct_levels();  // the defaults
 Expected<std::vector<DvctLevel>> dvct_levels(const std::vector<KnobSetting>& knobs);
