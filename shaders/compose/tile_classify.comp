@@ -37,17 +37,9 @@ struct ClassifyConstants {
   // VirtualGBuffer::output_coverage_area): outside it no pixel is covered, so texels there skip
   // the footprint test. Empty at the output's own size.
   ivec4 coverage_area;
-  // This dispatch's texels, [x0, x1) x [y0, y1): compose.cpp covers the used extent with one
-  // rectangle or several (frame/area_dispatch.h).
-  ivec4 rect;
 };
 layout(push_constant) uniform Classify { ClassifyConstants classify_block; };
 ClassifyConstants classify;
-// kOutside: dispatched over texels outside the objects' bounds and away from the coverage's
-// area (frame/area_dispatch.h, ComposeInputs::virtual_area): none is virtual and none holds a
-// covered output pixel, so neither is read (on lavapipe a shader pays for its code taken or not).
-layout(constant_id = 0) const bool kOutside = false;
-
 
 void mark(int tile, uint bits) {
   if ((words[MRGI_TILE_FLAGS + tile] & bits) == bits) return;  // (a plain read first: most marks find it set)
@@ -57,13 +49,13 @@ void mark(int tile, uint bits) {
 void main() {
   frame = frame_ubo;  // MRGI_UNIFORM_COPIES
   classify = classify_block;
-  ivec2 texel = ivec2(gl_GlobalInvocationID.xy) + classify.rect.xy;
+  ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
   ivec2 used = frame.internal_output_size.xy;
   ivec2 out_size = frame.internal_output_size.zw;
-  if (any(greaterThanEqual(texel, min(used, classify.rect.zw)))) return;
-  bool shows = !kOutside && imageLoad(virtual_position, texel).w > 0.5f;
+  if (any(greaterThanEqual(texel, used))) return;
+  bool shows = imageLoad(virtual_position, texel).w > 0.5f;
   vec2 s = vec2(out_size) / vec2(used);
-  if (!kOutside && !shows && used != out_size) {
+  if (!shows && used != out_size) {
     // The output pixels whose centre falls in this texel: (p + 0.5) / s in [texel, texel + 1),
     // within the area the coverage raster drew.
     ivec2 q0 = max(ivec2(ceil(vec2(texel) * s - 0.5f)), classify.coverage_area.xy);

@@ -2,12 +2,10 @@
 
 #include <algorithm>
 #include <bit>
-#include <cmath>
 #include <cstring>
 
 #include <glm/glm.hpp>
 
-#include "frame/area_dispatch.h"
 #include "gpu/shaders.h"
 
 namespace mrgi::compose {
@@ -35,32 +33,6 @@ void reset_tile_state(VkCommandBuffer cmd, VkBuffer state) {
 
 glm::ivec4 area_corners(const VkRect2D& r) {
   return {r.offset.x, r.offset.y, r.offset.x + int(r.extent.width), r.offset.y + int(r.extent.height)};
-}
-
-// The solution texels the classifier must test for virtual surfaces: the objects' bounds
-// (internal texels) and the texels holding the centres of the output pixels the coverage raster
-// drew (a texel a pixel more each way, for rounding), as one rectangle; nullopt where the
-// objects' bounds are not known. Empty when neither has a pixel.
-std::optional<VkRect2D> classify_area(const std::optional<VkRect2D>& objects, const VkRect2D& coverage, VkExtent2D used,
-                                      uint32_t out_w, uint32_t out_h) {
-  if (!objects) return std::nullopt;
-  glm::ivec4 box(0);
-  bool any = false;
-  auto add = [&](glm::ivec4 r) {
-    if (r.z <= r.x || r.w <= r.y) return;
-    box = any ? glm::ivec4(glm::min(box.x, r.x), glm::min(box.y, r.y), glm::max(box.z, r.z), glm::max(box.w, r.w)) : r;
-    any = true;
-  };
-  add(area_corners(*objects));
-  if (coverage.extent.width > 0 && coverage.extent.height > 0) {
-    const double sx = double(used.width) / out_w, sy = double(used.height) / out_h;
-    const glm::ivec4 c = area_corners(coverage);
-    add({int(std::floor((c.x + 0.5) * sx)) - 1, int(std::floor((c.y + 0.5) * sy)) - 1,
-         int(std::floor((c.z - 0.5) * sx)) + 2, int(std::floor((c.w - 0.5) * sy)) + 2});
-  }
-  if (!any) return VkRect2D{{0, 0}, {0, 0}};
-  box = glm::clamp(box, glm::ivec4(0), glm::ivec4(int(used.width), int(used.height), int(used.width), int(used.height)));
-  return VkRect2D{{box.x, box.y}, {uint32_t(std::max(0, box.z - box.x)), uint32_t(std::max(0, box.w - box.y))}};
 }
 
 }  // namespace
@@ -126,15 +98,9 @@ Expected<Compose> Compose::create(gpu::Context& context, gpu::FrameGraph& graph,
     *v.handle = gpu::PipelineHandle(context, std::move(*p));
   }
   if (settings.classify_tiles) {
-    auto classify_spv = gpu::shader_spirv("compose/tile_classify.comp");
-    if (!classify_spv) return classify_spv.error();
-    // tile_classify.comp kOutside: the general variant, and the one for texels away from the objects.
-    for (const uint32_t outside : {0u, 1u}) {
-      auto p = gpu::create_compute_pipeline(
-          context, {outside ? "compose_tiles_outside" : "compose_tiles", *classify_spv, {}, 0, {outside}});
-      if (!p) return p.error();
-      (outside ? c.classify_outside_pipeline_ : c.classify_pipeline_) = gpu::PipelineHandle(context, std::move(*p));
-    }
+    auto classify = gpu::load_compute_pipeline(context, "compose/tile_classify.comp", {});
+    if (!classify) return classify.error();
+    c.classify_pipeline_ = std::move(*classify);
     auto split = gpu::load_compute_pipeline(context, "compose/tile_split.comp", {});
     if (!split) return split.error();
     c.split_pipeline_ = std::move(*split);
@@ -161,7 +127,6 @@ void Compose::record_classify(gpu::FrameGraph& graph) {
         reset_tile_state(cmd, pass.buffer(classify_state_));
       });
   const gpu::Pipeline* pipe = &*classify_pipeline_;
-  const gpu::Pipeline* outside = &*classify_outside_pipeline_;
   graph.add_shader_pass(
       "compose_tiles", gpu::PassKind::Compute, *classify_pipeline_,
       [this](gpu::ShaderPassBuilder& b) {
@@ -172,20 +137,14 @@ void Compose::record_classify(gpu::FrameGraph& graph) {
         b.bind("virtual_coverage", in_.virtual_coverage.valid() ? in_.virtual_coverage : no_coverage_);
         b.bind("TileState", classify_state_);
       },
-      [this, pipe, outside](VkCommandBuffer cmd, gpu::PassContext& pass) {
+      [this, pipe](VkCommandBuffer cmd, gpu::PassContext& pass) {
         const VkExtent2D used = pass.extent(in_.lit_r);
         struct {
           glm::vec4 compose;
           glm::ivec4 coverage_area;
-          glm::ivec4 rect;
         } push{{settings_.eps, settings_.alpha_max, in_.tile_tolerance, 0.0f},
-               area_corners(in_.coverage_area), glm::ivec4(0)};
-        const auto area = classify_area(in_.virtual_area, in_.coverage_area, used, width_, height_);
-        for (const frame::AreaDispatch& d : frame::area_dispatches(used, area)) {
-          push.rect = d.rect;
-          gpu::push_and_dispatch(cmd, d.real_only ? *outside : *pipe, &push, sizeof push,
-                                 {uint32_t(d.rect.z - d.rect.x + 7) / 8, uint32_t(d.rect.w - d.rect.y + 7) / 8, 1});
-        }
+               area_corners(in_.coverage_area)};
+        gpu::push_and_dispatch(cmd, *pipe, &push, sizeof push, {(used.width + 7) / 8, (used.height + 7) / 8, 1});
       });
   const gpu::Pipeline* split = &*split_pipeline_;
   graph.add_shader_pass(

@@ -11,7 +11,6 @@
 // compose_encoded); compose then adds no pass, only the tile-list readback.
 #pragma once
 #include <algorithm>
-#include <optional>
 #include <vector>
 
 #include "gpu/frame_graph.h"
@@ -51,9 +50,6 @@ struct ComposeInputs {
   // (the level's QualityLevel::compose_tolerance); outputs then differ from composing every pixel
   // by at most that, rounded to the nearest level (0.5: one level).
   float tile_tolerance = 0.5f;
-  // The internal texels where a virtual pixel can be this frame (frame::FrameInfo::virtual_area):
-  // compose's classifier tests the others for the solutions' difference only. nullopt: not known.
-  std::optional<VkRect2D> virtual_area;
   // The technique wrote the composite of those tiles into output() itself
   // (Technique::ComposeTiles::composed): compose adds no pass of its own, only the tile-list
   // readback, and lays the tiles over the camera frame on the host. Honoured only for a frame
@@ -134,7 +130,7 @@ class Compose {
   // The tile classifier (ComposeSettings::classify_tiles): its pipelines (flags, then the two
   // lists), its state (both lists' dispatch arguments, then one flag per output tile) and its
   // lists (shaders/compose/tile_lists.glsl).
-  gpu::PipelineHandle classify_pipeline_, classify_outside_pipeline_, split_pipeline_;
+  gpu::PipelineHandle classify_pipeline_, split_pipeline_;
   gpu::BufferHandle classify_state_, classify_list_;
   gpu::BufferHandle no_tiles_;  // bound as the tile list when there is none (never read)
   gpu::ImageHandle no_coverage_;  // 1x1, bound as virtual_coverage at the output's size (never read)

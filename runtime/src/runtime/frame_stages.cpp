@@ -207,7 +207,6 @@ Status RuntimeImpl::record_compose(FrameContext& f) {
   if (f.affected) {
     ci.virtual_coverage = virtual_gbuffer_->output_coverage();
     ci.coverage_area = virtual_gbuffer_->output_coverage_area();
-    ci.virtual_area = f.info.virtual_area;
   }
   return compose_->record(*graph_, ci);
 }

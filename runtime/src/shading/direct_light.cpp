@@ -12,7 +12,7 @@
 #include "gpu/shaders.h"
 #include "gpu/vk_check.h"
 #include "light/light_stage.h"
-#include "frame/area_dispatch.h"
+#include "shading/shade_dispatch.h"
 #include "shading/shadow_plan.h"
 #include "shared/occlusion_math.h"
 #include "specular/caustic_receiver.glsl"
@@ -450,7 +450,7 @@ void DirectLightBlock::Impl::add_shade_pass(const gpu::Pipeline& pipeline, const
         if (const auto* screen = std::get_if<ScreenIndirect>(&indirect_)) pc.indirect.y = screen->divisor;
         pc.indirect.z = occlusion_ ? occlusion_->divisor() : 0;
         const VkExtent2D e = pass.extent(frame_.lit_rv);
-        for (const frame::AreaDispatch& d : frame::area_dispatches(e, virtual_area)) {
+        for (const ShadeDispatch& d : shade_dispatches(e, virtual_area)) {
           pc.rect = d.rect;
           gpu::dispatch_2d(cmd, d.real_only ? real_only : pipeline, &pc, sizeof(pc), uint32_t(d.rect.z - d.rect.x),
                            uint32_t(d.rect.w - d.rect.y));

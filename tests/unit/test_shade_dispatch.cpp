@@ -1,18 +1,18 @@
-// The split of an image between a pass's general and real-only variants (frame/area_dispatch.h): every pixel in exactly one
+// shade_direct's split of the image (shading/shade_dispatch.h): every pixel in exactly one
 // dispatch, every pixel of the objects' bounds in the general one, for bounds anywhere (inside,
 // at each edge, the whole image, outside), none (real-only everywhere) and unknown (general).
 #include <gtest/gtest.h>
 
 #include <vector>
 
-#include "frame/area_dispatch.h"
+#include "shading/shade_dispatch.h"
 
-namespace mrgi::frame {
+namespace mrgi::shading {
 namespace {
 
 void expect_partition(VkExtent2D e, const std::optional<VkRect2D>& area) {
   std::vector<int> hits(size_t(e.width) * e.height, 0), general(size_t(e.width) * e.height, 0);
-  for (const AreaDispatch& d : area_dispatches(e, area)) {
+  for (const ShadeDispatch& d : shade_dispatches(e, area)) {
     ASSERT_LE(d.rect.z, int(e.width));
     ASSERT_LE(d.rect.w, int(e.height));
     for (int y = d.rect.y; y < d.rect.w; ++y)
@@ -32,7 +32,7 @@ void expect_partition(VkExtent2D e, const std::optional<VkRect2D>& area) {
     }
 }
 
-TEST(AreaDispatch, EveryPixelOnceAndTheObjectsBoundsInTheGeneralVariant) {
+TEST(ShadeDispatch, EveryPixelOnceAndTheObjectsBoundsInTheGeneralVariant) {
   const VkExtent2D e{83, 61};
   expect_partition(e, std::nullopt);
   expect_partition(e, VkRect2D{{0, 0}, {0, 0}});
@@ -44,15 +44,15 @@ TEST(AreaDispatch, EveryPixelOnceAndTheObjectsBoundsInTheGeneralVariant) {
   expect_partition(e, VkRect2D{{1, 1}, {1, 1}});
 }
 
-TEST(AreaDispatch, NoObjectIsRealOnlyAndUnknownBoundsAreGeneral) {
-  const auto none = area_dispatches({64, 48}, VkRect2D{{0, 0}, {0, 0}});
+TEST(ShadeDispatch, NoObjectIsRealOnlyAndUnknownBoundsAreGeneral) {
+  const auto none = shade_dispatches({64, 48}, VkRect2D{{0, 0}, {0, 0}});
   ASSERT_EQ(none.size(), 1u);
   EXPECT_TRUE(none[0].real_only);
-  const auto unknown = area_dispatches({64, 48}, std::nullopt);
+  const auto unknown = shade_dispatches({64, 48}, std::nullopt);
   ASSERT_EQ(unknown.size(), 1u);
   EXPECT_FALSE(unknown[0].real_only);
   // The general rectangle starts and ends on workgroup edges (8 x 8) inside the image.
-  const auto some = area_dispatches({640, 480}, VkRect2D{{101, 53}, {90, 77}});
+  const auto some = shade_dispatches({640, 480}, VkRect2D{{101, 53}, {90, 77}});
   EXPECT_EQ(some[0].rect.x % 8, 0);
   EXPECT_EQ(some[0].rect.y % 8, 0);
   EXPECT_EQ(some[0].rect.z % 8, 0);
@@ -61,4 +61,4 @@ TEST(AreaDispatch, NoObjectIsRealOnlyAndUnknownBoundsAreGeneral) {
 }
 
 }  // namespace
-}  // namespace mrgi::frame
+}  // namespace mrgi::shading

@@ -1,7 +1,6 @@
-// How a pass whose shader has a real-only variant splits an image between it and its general
-// variant: the pixels where a virtual object can be, and the rest (shade_direct:
-// shaders/shading/direct_light.comp kRealOnly; compose's tile classifier: shaders/compose/
-// tile_classify.comp kOutside). Pure: the unit tests check that the dispatches cover the image
+// How shade_direct (shading/direct_light.cpp) splits the image between its general variant and
+// its real-only one (shaders/shading/direct_light.comp kRealOnly): the pixels where a virtual
+// object can be, and the rest. Pure: the unit tests check that the dispatches cover the image
 // exactly once.
 #pragma once
 #include <algorithm>
@@ -11,10 +10,10 @@
 #include <vulkan/vulkan.h>
 #include <glm/glm.hpp>
 
-namespace mrgi::frame {
+namespace mrgi::shading {
 
-// One dispatch: its pixels [x0, x1) x [y0, y1) and whether none can be virtual.
-struct AreaDispatch {
+// One dispatch of shade_direct: its pixels [x0, x1) x [y0, y1) and whether none can be virtual.
+struct ShadeDispatch {
   glm::ivec4 rect;
   bool real_only = false;
 };
@@ -24,19 +23,19 @@ struct AreaDispatch {
 // and below across the image, left and right beside the bounds. The whole image general when
 // the bounds are not known; all of it real-only when there is no object. A fixed array, not a
 // vector: this runs in every frame's recording, which allocates nothing.
-struct AreaDispatches {
-  std::array<AreaDispatch, 5> items{};
+struct ShadeDispatches {
+  std::array<ShadeDispatch, 5> items{};
   size_t count = 0;
-  const AreaDispatch* begin() const { return items.data(); }
-  const AreaDispatch* end() const { return items.data() + count; }
+  const ShadeDispatch* begin() const { return items.data(); }
+  const ShadeDispatch* end() const { return items.data() + count; }
   size_t size() const { return count; }
-  const AreaDispatch& operator[](size_t i) const { return items[i]; }
-  void push_back(const AreaDispatch& d) { items[count++] = d; }
+  const ShadeDispatch& operator[](size_t i) const { return items[i]; }
+  void push_back(const ShadeDispatch& d) { items[count++] = d; }
 };
 
-inline AreaDispatches area_dispatches(VkExtent2D e, const std::optional<VkRect2D>& area) {
+inline ShadeDispatches shade_dispatches(VkExtent2D e, const std::optional<VkRect2D>& area) {
   const int w = int(e.width), h = int(e.height);
-  AreaDispatches out;
+  ShadeDispatches out;
   if (!area || area->extent.width == 0 || area->extent.height == 0) {
     out.push_back({glm::ivec4(0, 0, w, h), area.has_value()});  // unknown: general; no object: real-only
     return out;
@@ -51,4 +50,4 @@ inline AreaDispatches area_dispatches(VkExtent2D e, const std::optional<VkRect2D
   return out;
 }
 
-}  // namespace mrgi::frame
+}  // namespace mrgi::shading
