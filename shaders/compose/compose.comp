@@ -11,12 +11,13 @@
 // [0, alpha_max] (a barely lit model point would otherwise multiply a virtual lamp's light by
 // an unbounded factor). NaN or Inf never reach the output: inputs are sanitised first.
 //
-// Three pipelines from this file, chosen per frame by the runtime, specialised on whether the
+// Pipelines from this file, chosen per frame by the runtime, specialised on whether the
 // camera and output sizes match (kSameSize): kCameraOnly (nothing virtual in view) writes the
 // camera frame, a byte copy when the sizes match; the others run the composite (joint_taps up-
 // samples the solutions where they are smaller than the output: four taps of each solution and
 // of virtual_position, and the coverage), kSameInternal when the solutions are at the output size
-// (one texel each and the mask from virtual_position: 3 fetches beside the camera's). Not one shader
+// (one texel each and the mask from virtual_position: 3 fetches beside the camera's), each also
+// over listed tiles (kTiled) and over tiles no virtual surface reaches (kRealTiles). Not one shader
 // with branches: on lavapipe a shader costs about as much as all of its code, taken or not
 // (measured at 640x480, x2 threads: the copy alone 0.85 ms as its own pipeline, 8 ms with the
 // composite behind a never-entered uniform `if`), so each path is compiled out of the other.
@@ -103,10 +104,11 @@ Taps joint_taps(vec2 rel, ivec2 used, float is_virtual, bool real_tile) {
   t.a = clamp(i0, ivec2(0), used - 1);
   t.b = clamp(i0 + 1, ivec2(0), used - 1);
   vec4 bilinear = vec4((1.0f - f.x) * (1.0f - f.y), f.x * (1.0f - f.y), (1.0f - f.x) * f.y, f.x * f.y);
-  vec4 side = real_tile ? vec4(0.0f) : vec4(imageLoad(virtual_position, ivec2(t.a.x, t.a.y)).w > 0.5f ? 1.0f : 0.0f,
-                   imageLoad(virtual_position, ivec2(t.b.x, t.a.y)).w > 0.5f ? 1.0f : 0.0f,
-                   imageLoad(virtual_position, ivec2(t.a.x, t.b.y)).w > 0.5f ? 1.0f : 0.0f,
-                   imageLoad(virtual_position, ivec2(t.b.x, t.b.y)).w > 0.5f ? 1.0f : 0.0f);
+  vec4 side = real_tile ? vec4(0.0f)
+                        : vec4(imageLoad(virtual_position, ivec2(t.a.x, t.a.y)).w > 0.5f ? 1.0f : 0.0f,
+                               imageLoad(virtual_position, ivec2(t.b.x, t.a.y)).w > 0.5f ? 1.0f : 0.0f,
+                               imageLoad(virtual_position, ivec2(t.a.x, t.b.y)).w > 0.5f ? 1.0f : 0.0f,
+                               imageLoad(virtual_position, ivec2(t.b.x, t.b.y)).w > 0.5f ? 1.0f : 0.0f);
   vec4 w = bilinear * (vec4(1.0f) - abs(side - vec4(is_virtual)));
   float sum = w.x + w.y + w.z + w.w;
   t.no_side = !(sum > 0.0f);

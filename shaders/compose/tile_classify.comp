@@ -6,9 +6,9 @@
 // solutions differ by more than compose_tile_invisible allows, marks every output tile whose
 // pixels read it (compose.comp: the bilinear taps floor(ipos), floor(ipos) + 1 with
 // ipos = (p + 0.5) * used / out - 0.5) by its flag; tile_split.comp then lists the flagged
-// tiles. Outside the listed tiles compose writes the camera frame (on the host when the output has the camera's size), so a technique whose solutions are
-// equal away from the virtual objects' influence (baseline, dlpv) pays for the composite only
-// where it shows. On lavapipe a shader runs all of its code for every invocation: pixels that
+// tiles. Outside the listed tiles compose writes the camera frame (on the host when the output
+// has the camera's size), so a technique whose solutions are equal away from the virtual
+// objects' influence (baseline, dlpv) pays for the composite only where it shows. On lavapipe a shader runs all of its code for every invocation: pixels that
 // need no composite can only be saved by not dispatching them.
 // Each tile's flag says whether it is listed (bit 0) and whether a virtual texel, or an output
 // pixel the coverage marks, is within its pixels' reach (bit 1): compose runs the tiles without

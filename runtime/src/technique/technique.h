@@ -52,7 +52,7 @@ struct QualityLevel {
   // any camera value; applied by the runtime. 0.5: a pixel within one level of composing every
   // pixel. The fast levels take 1.5 (within two levels): under environment light the objects'
   // faint occlusion of the sky far from them lists most of the frame at 0.5, and compose is then
-  // a fifth of such a frame (perf/results/compose/tile-tolerance-fast-levels-2026-12-08.md).
+  // about a third of such a frame's CPU (perf/results/compose/tile-tolerance-fast-levels-2026-12-08.md).
   float compose_tolerance = 0.5f;
 };
 
